@@ -1,0 +1,158 @@
+"""Residual blocks: the observation equations the engine adjusts.
+
+A residual block computes, for its ``m`` residual components, the model minus the observation
+``r = f(x) - l`` and, on request, the Jacobian ``∂r/∂x`` for each parameter block it depends on.
+It carries the a-priori standard deviation of each component (``sigma``) and how many components
+form one observation (``group_size``: 1 for a line scanner's ζ, 2 for image x, y), which is the unit
+of outlier rejection.
+
+Jacobians come in one of three forms, keyed by parameter-block name:
+
+* :class:`Indexed` ``(index, d)``: row ``j`` touches the items ``index[j]`` of the block viewed as an
+  ``(n_items, k)`` array, with derivatives ``d[j]`` — per-image exterior orientations, per-point
+  coordinates, spline nodes (``index`` of shape ``(m, q)`` when a row touches ``q`` items). The
+  engine needs this form for the points block.
+* a dense ``(m, block.size)`` array, for small global blocks (focal length, distortion).
+* a ``scipy.sparse`` matrix ``(m, block.size)``.
+
+Subclass :class:`ResidualBlock` and implement :meth:`~ResidualBlock.evaluate`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from hsgeo.errors import InputError
+
+__all__ = ["Indexed", "ResidualBlock", "to_coo"]
+
+
+@dataclass(frozen=True)
+class Indexed:
+    """A Jacobian whose row ``j`` touches items ``index[j]`` of an ``(n_items, k)`` block.
+
+    Parameters
+    ----------
+    index : (m,) or (m, q) int ndarray
+        Item (row of the block viewed as ``(n_items, k)``) touched by each residual row; ``-1``
+        for a row that touches none.
+    d : (m, k) or (m, q, k) float ndarray
+        The derivatives of each residual row with respect to the ``k`` entries of its item(s).
+    """
+
+    index: np.ndarray
+    d: np.ndarray
+
+    def __post_init__(self):
+        idx = np.asarray(self.index)
+        d = np.asarray(self.d, dtype=np.float64)
+        if idx.ndim == 1:
+            idx = idx[:, None]
+            d = d[:, None, :] if d.ndim == 2 else d
+        if d.ndim != 3 or d.shape[:2] != idx.shape:
+            raise InputError(
+                f"Indexed Jacobian: index shape {np.shape(self.index)} and derivative shape "
+                f"{np.shape(self.d)} do not match ((m,) with (m, k), or (m, q) with (m, q, k))"
+            )
+        object.__setattr__(self, "index", idx.astype(np.int64, copy=False))
+        object.__setattr__(self, "d", d)
+
+    @property
+    def k(self) -> int:
+        return self.d.shape[2]
+
+
+def to_coo(jac, m: int, size: int, name: str):
+    """Rows, block-local columns and values of a Jacobian in any accepted form.
+
+    Returns
+    -------
+    rows, cols, vals : 1-D ndarrays
+    """
+    if isinstance(jac, Indexed):
+        m_j, q, k = jac.d.shape
+        if m_j != m:
+            raise InputError(f"Jacobian w.r.t. {name!r} has {m_j} rows, residuals have {m}")
+        if size % k:
+            raise InputError(f"Jacobian w.r.t. {name!r}: item width {k} does not divide {size}")
+        valid = jac.index >= 0
+        if np.any(jac.index[valid] >= size // k):
+            raise InputError(f"Jacobian w.r.t. {name!r} indexes past the block's items")
+        rows = np.broadcast_to(np.arange(m)[:, None, None], (m, q, k))
+        cols = jac.index[:, :, None] * k + np.arange(k)
+        keep = np.broadcast_to(valid[:, :, None], (m, q, k))
+        return rows[keep], cols[keep], jac.d[keep]
+    if sp.issparse(jac):
+        c = jac.tocoo()
+        if c.shape != (m, size):
+            raise InputError(f"Jacobian w.r.t. {name!r} has shape {c.shape}, expected {(m, size)}")
+        return c.row.astype(np.int64), c.col.astype(np.int64), c.data
+    arr = np.asarray(jac, dtype=np.float64)
+    if arr.shape != (m, size):
+        raise InputError(f"Jacobian w.r.t. {name!r} has shape {arr.shape}, expected {(m, size)}")
+    rows, cols = np.nonzero(np.ones_like(arr, dtype=bool))
+    return rows, cols, arr.ravel()
+
+
+class ResidualBlock:
+    """Base class of observation equations.
+
+    Attributes
+    ----------
+    name : str
+        Name used in reports (``"image points"``, ``"GCP"``).
+    sigma : (m,) ndarray
+        A-priori standard deviation of each residual component, in the residual's units.
+    group_size : int
+        Components per observation (consecutive rows), the unit of outlier rejection.
+    """
+
+    name: str = "residuals"
+    group_size: int = 1
+
+    def __init__(self, sigma, name: str | None = None, group_size: int | None = None):
+        if name is not None:
+            self.name = name
+        if group_size is not None:
+            self.group_size = int(group_size)
+        s = np.asarray(sigma, dtype=np.float64).ravel()
+        if s.size == 0:
+            raise InputError(f"residual block {self.name!r} has no observations")
+        if not np.all(np.isfinite(s)) or np.any(s <= 0):
+            raise InputError(
+                f"residual block {self.name!r}: a-priori σ must be finite and positive "
+                "(check the observation file's sigma column)"
+            )
+        if s.size % self.group_size:
+            raise InputError(
+                f"residual block {self.name!r}: {s.size} components are not a multiple of the "
+                f"group size {self.group_size}"
+            )
+        self.sigma = s
+
+    @property
+    def m(self) -> int:
+        """Number of residual components."""
+        return self.sigma.size
+
+    def evaluate(self, values: dict[str, np.ndarray], jacobian: bool):
+        """Model minus observation, and optionally the Jacobian.
+
+        Parameters
+        ----------
+        values : dict of str to ndarray
+            Current parameter values by block name (do not modify).
+        jacobian : bool
+            Whether to compute the Jacobian.
+
+        Returns
+        -------
+        r : (m,) ndarray
+            Residuals ``f(x) - l`` in the units of ``sigma``.
+        jac : dict of str to Jacobian, or None
+            ``∂r/∂(block)`` for each block the residuals depend on (see the module docstring).
+        """
+        raise NotImplementedError

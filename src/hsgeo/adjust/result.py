@@ -1,0 +1,269 @@
+"""The result of an adjustment: estimates, σ0, covariance, residuals, a readable report."""
+
+from __future__ import annotations
+
+import html
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg as sla
+from scipy import stats as sst
+
+from hsgeo.adjust.engine import _evaluate, _Layout, _Normal, _reduced, _System
+from hsgeo.adjust.parameters import Parameters
+from hsgeo.errors import DatumError
+
+__all__ = ["AdjustmentResult"]
+
+
+@dataclass
+class AdjustmentResult:
+    """Estimates and their quality (after lmfit's ``MinimizerResult``).
+
+    Attributes
+    ----------
+    params : Parameters
+        The estimated parameters (a copy; the input is untouched).
+    converged : bool
+    message : str
+    iterations : int
+        Accepted steps, over all rejection rounds.
+    cost_history : list of float
+        ½ Σ r_w² after each accepted step.
+    sigma0 : float
+        A-posteriori standard deviation of unit weight, sqrt(vᵀPv / dof).
+    dof : int
+        Redundancy: residual components (priors included, rejected excluded) − unknowns.
+    n_observations : int
+        Observation components used (rejected excluded, priors excluded).
+    n_unknowns : int
+    covariance : (n, n) ndarray
+        σ0²·S⁻¹ of the free non-point parameters, in the order of ``labels``.
+    labels : list of str
+        Names of the free non-point parameters.
+    seconds : float
+        Wall time of the adjustment.
+    """
+
+    params: Parameters
+    converged: bool
+    message: str
+    iterations: int
+    cost_history: list
+    sigma0: float
+    dof: int
+    n_observations: int
+    n_unknowns: int
+    covariance: np.ndarray
+    labels: list
+    seconds: float
+    reject_rounds: int
+    _layout: _Layout = field(repr=False)
+    _blocks: list = field(repr=False)
+    _masks: list = field(repr=False)
+    _normal: _Normal = field(repr=False)
+    _S_inv: np.ndarray = field(repr=False)
+    _residuals: dict = field(repr=False)
+    _point_cov: np.ndarray | None = field(default=None, repr=False)
+
+    # -- construction -----------------------------------------------------------------------
+    @classmethod
+    def _build(cls, *, layout, blocks, masks, system: _System, normal: _Normal, converged,
+               message, iterations, history, seconds, reject_rounds):
+        n_unk = layout.n_unknowns
+        dof = int(system.r.size - n_unk)
+        vtpv = float(system.r @ system.r)
+        sigma0 = float(np.sqrt(vtpv / dof)) if dof > 0 else float("nan")
+        S, _, _, _ = _reduced(layout, normal, 0.0)
+        if layout.n_c:
+            try:
+                cf = sla.cho_factor(S, check_finite=False)
+                S_inv = sla.cho_solve(cf, np.eye(layout.n_c), check_finite=False)
+            except (np.linalg.LinAlgError, sla.LinAlgError) as exc:
+                raise DatumError(
+                    "the normal matrix at the solution is singular: the covariance cannot be "
+                    "computed (a datum defect that appeared during the iteration?)",
+                    layout.labels_c,
+                ) from exc
+        else:
+            S_inv = np.zeros((0, 0))
+        s2 = sigma0**2 if np.isfinite(sigma0) else 1.0
+        full = _evaluate(layout, blocks, [np.ones(b.m, dtype=bool) for b in blocks], False)
+        residuals, off = {}, 0
+        for b in blocks:
+            residuals[b.name] = full.r[off : off + b.m] * b.sigma  # back to the block's units
+            off += b.m
+        return cls(
+            params=layout.params,
+            converged=converged,
+            message=message,
+            iterations=iterations,
+            cost_history=list(history),
+            sigma0=sigma0,
+            dof=dof,
+            n_observations=int(system.n_obs_rows),
+            n_unknowns=n_unk,
+            covariance=s2 * S_inv,
+            labels=list(layout.labels_c),
+            seconds=seconds,
+            reject_rounds=reject_rounds,
+            _layout=layout,
+            _blocks=blocks,
+            _masks=[m.copy() for m in masks],
+            _normal=normal,
+            _S_inv=S_inv,
+            _residuals=residuals,
+        )
+
+    # -- estimates and their σ ----------------------------------------------------------------
+    def value(self, name: str) -> np.ndarray:
+        """Estimated value of a block."""
+        return self.params.value(name)
+
+    def sigma(self, name: str) -> np.ndarray:
+        """A-posteriori σ of a block's entries (same shape; NaN where fixed)."""
+        b = self.params[name]
+        if b.points:
+            cov = self.point_covariance()
+            out = np.sqrt(np.diagonal(cov, axis1=1, axis2=2)).copy()
+            out[~b.free] = np.nan
+            return out
+        cm = self._layout.colmap[name]
+        out = np.full(b.size, np.nan)
+        sel = cm >= 0
+        out[sel] = np.sqrt(np.diag(self.covariance)[cm[sel]])
+        return out.reshape(b.shape)
+
+    def covariance_of(self, *names: str) -> tuple[np.ndarray, list[str]]:
+        """Covariance sub-matrix of the free entries of the named (non-point) blocks."""
+        idx, labs = [], []
+        for n in names:
+            cm = self._layout.colmap[n]
+            lab = self.params[n].labels()
+            for i in np.flatnonzero(cm >= 0):
+                idx.append(cm[i])
+                labs.append(lab[i])
+        idx = np.asarray(idx, dtype=int)
+        return self.covariance[np.ix_(idx, idx)], labs
+
+    def correlation(self) -> np.ndarray:
+        """Correlation matrix of the free non-point parameters."""
+        d = np.sqrt(np.diag(self.covariance))
+        return self.covariance / np.outer(d, d)
+
+    def point_covariance(self, chunk: int = 20000) -> np.ndarray:
+        """σ0²·(V⁻¹ + V⁻¹ Wᵀ S⁻¹ W V⁻¹) for every point: ``(n_points, p, p)``.
+
+        Computed on first request, in chunks of points to bound the memory.
+        """
+        if self._point_cov is not None:
+            return self._point_cov
+        lay, ne = self._layout, self._normal
+        if lay.pblock is None:
+            raise ValueError("this problem has no points block")
+        p = lay.p
+        s2 = self.sigma0**2 if np.isfinite(self.sigma0) else 1.0
+        Vinv = np.linalg.inv(ne.V)
+        out = Vinv.copy()
+        if lay.n_c:
+            Wd = ne.W.tocsc()
+            for a in range(0, lay.n_pts, chunk):
+                b = min(lay.n_pts, a + chunk)
+                Wi = Wd[:, a * p : b * p].toarray().T.reshape(b - a, p, lay.n_c)  # (k, p, n_c)
+                A = np.einsum("kij,kjc->kic", Vinv[a:b], Wi)  # V⁻¹ Wᵀ
+                out[a:b] += np.einsum("kic,cd,kjd->kij", A, self._S_inv, A)
+        out *= s2
+        fixed = ~lay.pfree
+        for j in range(p):
+            out[fixed[:, j], j, :] = np.nan
+            out[fixed[:, j], :, j] = np.nan
+        self._point_cov = out
+        return out
+
+    # -- residuals ----------------------------------------------------------------------------
+    def residuals(self, block: str | int = 0) -> np.ndarray:
+        """Residuals model − observation of a residual block, in its units (all rows)."""
+        return self._residuals[self._block_name(block)]
+
+    def normalized_residuals(self, block: str | int = 0) -> np.ndarray:
+        """Residuals divided by their a-priori σ and by σ0."""
+        b = self._blocks[self._block_index(block)]
+        return self.residuals(block) / b.sigma / self.sigma0
+
+    def outliers(self, block: str | int = 0) -> np.ndarray:
+        """Bool mask of the rejected observations (one entry per group)."""
+        i = self._block_index(block)
+        g = self._blocks[i].group_size
+        return ~self._masks[i].reshape(-1, g)[:, 0]
+
+    def _block_index(self, block) -> int:
+        if isinstance(block, int):
+            return block
+        for i, b in enumerate(self._blocks):
+            if b.name == block:
+                return i
+        raise KeyError(f"no residual block {block!r}; known: {[b.name for b in self._blocks]}")
+
+    def _block_name(self, block) -> str:
+        return self._blocks[self._block_index(block)].name
+
+    # -- quality --------------------------------------------------------------------------------
+    def chi2_interval(self, alpha: float = 0.01) -> tuple[float, float]:
+        """Two-sided (1−α) interval of σ0 under the model (χ² with ``dof`` degrees of freedom)."""
+        lo, hi = sst.chi2.ppf([alpha / 2, 1 - alpha / 2], self.dof)
+        return float(np.sqrt(lo / self.dof)), float(np.sqrt(hi / self.dof))
+
+    # -- reporting ----------------------------------------------------------------------------
+    def to_frame(self, max_block_size: int | None = None):
+        """A pandas DataFrame of the non-point parameters: value, σ, free, prior σ."""
+        import pandas as pd
+
+        rows = []
+        for b in self.params.blocks():
+            if b.points or (max_block_size is not None and b.size > max_block_size):
+                continue
+            sig = self.sigma(b.name).ravel()
+            for lab, v, s, f, ps in zip(b.labels(), b.value.ravel(), sig, b.free.ravel(),
+                                        b.prior_sigma.ravel(), strict=True):
+                rows.append({"parameter": lab, "value": v, "sigma": s, "free": bool(f),
+                             "prior_sigma": ps if np.isfinite(ps) else np.nan})
+        return pd.DataFrame(rows).set_index("parameter")
+
+    def _summary_lines(self) -> list[str]:
+        n_rej = sum(int((~m).sum()) for m in self._masks)
+        lo, hi = self.chi2_interval() if self.dof > 0 else (np.nan, np.nan)
+        return [
+            f"converged: {self.converged} ({self.message}) after {self.iterations} iterations, "
+            f"{self.seconds:.2f} s",
+            f"observations: {self.n_observations} components ({n_rej} rejected in "
+            f"{self.reject_rounds} rounds); unknowns: {self.n_unknowns}; redundancy: {self.dof}",
+            f"sigma0 (a posteriori, unit weight): {self.sigma0:.4f}   "
+            f"[99% chi2 interval under the model: {lo:.3f} … {hi:.3f}]",
+        ]
+
+    def report(self, max_block_size: int = 60) -> str:
+        """A plain-text report: summary, then value ± σ of every non-point parameter."""
+        lines = ["Adjustment report", "================="] + self._summary_lines() + [""]
+        lines.append(f"{'parameter':<36s} {'value':>16s} {'sigma':>12s}")
+        skipped = []
+        for b in self.params.blocks():
+            if b.points or b.size > max_block_size:
+                skipped.append(f"{b.name} {b.shape}")
+                continue
+            sig = self.sigma(b.name).ravel()
+            for lab, v, s, f in zip(b.labels(), b.value.ravel(), sig, b.free.ravel(),
+                                    strict=True):
+                s_txt = f"{s:12.4g}" if f else "       fixed"
+                lines.append(f"{lab:<36s} {v:16.8g} {s_txt}")
+        if skipped:
+            lines.append("(not listed: " + ", ".join(skipped) + ")")
+        return "\n".join(lines)
+
+    def __str__(self) -> str:
+        return self.report()
+
+    def _repr_html_(self) -> str:
+        head = "<br>".join(html.escape(s) for s in self._summary_lines())
+        return (f"<div><b>Adjustment result</b><br>{head}"
+                f"{self.to_frame(max_block_size=60).to_html(float_format=lambda x: f'{x:.6g}')}"
+                "</div>")

@@ -1,0 +1,201 @@
+import numpy as np
+import pytest
+from scipy.optimize import least_squares
+
+from hsgeo import ConvergenceError, DatumError, InputError, ObservationError
+from hsgeo.adjust import Parameters, adjust, identifiability
+from hsgeo.adjust.checks import check_jacobian
+from toy_models import Bearings, Exponential, Line, bearing_scene
+
+
+def line_data(seed, n=50, sigma=0.1):
+    rng = np.random.default_rng(seed)
+    t = np.linspace(0, 10, n)
+    return t, 1.5 + 0.3 * t + sigma * rng.standard_normal(n)
+
+
+def test_linear_matches_lstsq():
+    t, y = line_data(1)
+    p = Parameters()
+    p.add("ab", [0.0, 0.0], columns=("a", "b"))
+    res = adjust(p, Line(t, y, 0.1))
+    A = np.column_stack([np.ones_like(t), t])
+    x, rss, *_ = np.linalg.lstsq(A, y, rcond=None)
+    np.testing.assert_allclose(res.value("ab"), x, rtol=0, atol=1e-10)
+    s0sq = rss[0] / (t.size - 2)
+    np.testing.assert_allclose(res.covariance, s0sq * np.linalg.inv(A.T @ A), rtol=1e-8)
+    np.testing.assert_allclose(res.sigma0, np.sqrt(s0sq) / 0.1, rtol=1e-10)
+    assert res.converged and res.dof == t.size - 2
+    assert p.value("ab").tolist() == [0.0, 0.0]  # input untouched
+
+
+def test_nonlinear_matches_scipy():
+    rng = np.random.default_rng(3)
+    t = np.linspace(0, 4, 60)
+    y = 5.0 * np.exp(-0.7 * t) + 0.02 * rng.standard_normal(t.size)
+    p = Parameters()
+    p.add("Ak", [1.0, 0.1])
+    res = adjust(p, Exponential(t, y, 0.02))
+    ref = least_squares(lambda x: x[0] * np.exp(-x[1] * t) - y, [1.0, 0.1], xtol=1e-15,
+                        ftol=1e-15, gtol=1e-15)
+    np.testing.assert_allclose(res.value("Ak"), ref.x, rtol=1e-8)
+
+
+def _bearing_params(S, P, st, pt, th, points=True, n_control=2, sigma_ctrl=1e-3, seed=0):
+    rng = np.random.default_rng(seed)
+    p = Parameters()
+    p.add("stations", S + rng.normal(0, [2, 2, 0.02], S.shape), columns=("x_m", "y_m", "heading_rad"))
+    p.add("points", P + rng.normal(0, 1.0, P.shape), points=points, columns=("x_m", "y_m"))
+    for j in range(n_control):
+        p.set_prior("points", sigma_ctrl, index=j, mean=P[j])
+    return p, Bearings(st, pt, th, 1e-3)
+
+
+def test_bearing_jacobians():
+    S, P, st, pt, th = bearing_scene(0)
+    blk = Bearings(st, pt, th, 1e-3)
+    vals = {"stations": S, "points": P}
+    assert check_jacobian(blk, vals, "stations") < 1e-7
+    assert check_jacobian(blk, vals, "points") < 1e-7
+
+
+def test_schur_equals_plain_solution():
+    S, P, st, pt, th = bearing_scene(5)
+    p1, blk = _bearing_params(S, P, st, pt, th, points=True)
+    p2, _ = _bearing_params(S, P, st, pt, th, points=False)
+    r1, r2 = adjust(p1, blk), adjust(p2, blk)
+    np.testing.assert_allclose(r1.value("points"), r2.value("points"), atol=1e-9)
+    np.testing.assert_allclose(r1.value("stations"), r2.value("stations"), atol=1e-9)
+    np.testing.assert_allclose(r1.sigma("stations"), r2.sigma("stations"), rtol=1e-6)
+    # point covariance from the Schur back-substitution equals the plain inverse
+    np.testing.assert_allclose(r1.sigma("points"), r2.sigma("points"), rtol=1e-6)
+    assert r1.sigma0 == pytest.approx(r2.sigma0, rel=1e-9)
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_truth_within_3_sigma_and_sigma0_chi2(seed):
+    S, P, st, pt, th = bearing_scene(seed)
+    p, blk = _bearing_params(S, P, st, pt, th, seed=seed)
+    res = adjust(p, blk)
+    z_st = (res.value("stations") - S) / res.sigma("stations")
+    z_pt = (res.value("points") - P) / res.sigma("points")
+    # max over ~100 normal deviates: 4 sigma keeps the family-wise false alarm rate < 1 %
+    assert np.max(np.abs(z_st)) < 4 and np.max(np.abs(z_pt)) < 4.5
+    lo, hi = res.chi2_interval(alpha=0.001)
+    assert lo < res.sigma0 < hi
+
+
+def test_noise_free_recovers_truth():
+    S, P, st, pt, th = bearing_scene(2, sigma_rad=0.0)
+    p, blk = _bearing_params(S, P, st, pt, th)
+    res = adjust(p, blk)
+    np.testing.assert_allclose(res.value("points"), P, atol=1e-8)
+    np.testing.assert_allclose(res.value("stations"), S, atol=1e-8)
+
+
+def test_missing_datum_names_parameters():
+    S, P, st, pt, th = bearing_scene(1)
+    p, blk = _bearing_params(S, P, st, pt, th, n_control=0)
+    with pytest.raises(DatumError) as ei:
+        adjust(p, blk)
+    assert "rank deficient" in str(ei.value) and ei.value.parameters
+    assert any(n.startswith("stations[") for n in ei.value.parameters)
+    ident = identifiability(p, blk)
+    assert ident.n_unknowns - ident.rank == 4  # 2 translations, rotation, scale
+
+
+def test_unobserved_parameter_is_named():
+    t, y = line_data(0)
+    p = Parameters()
+    p.add("ab", [0.0, 0.0])
+    p.add("unused", 1.0)
+    with pytest.raises(DatumError, match="unused"):
+        adjust(p, Line(t, y, 0.1))
+
+
+def test_undetermined_point():
+    S, P, st, pt, th = bearing_scene(4)
+    keep = ~((pt == 7) & (st != st[pt == 7][0]))  # point 7 seen from one station only
+    p, _ = _bearing_params(S, P, st, pt, th)
+    with pytest.raises(DatumError, match="point"):
+        adjust(p, Bearings(st[keep], pt[keep], th[keep], 1e-3))
+
+
+def test_fixed_entries_and_priors():
+    S, P, st, pt, th = bearing_scene(6)
+    p, blk = _bearing_params(S, P, st, pt, th, n_control=0)
+    p.fix("points", index=[0, 1], value=P[:2])  # two fixed points give the datum
+    res = adjust(p, blk)
+    np.testing.assert_array_equal(res.value("points")[:2], P[:2])
+    assert np.all(np.isnan(res.sigma("points")[:2]))
+    assert np.all(np.abs(res.value("points")[2:] - P[2:]) < 5 * res.sigma("points")[2:])
+    t, y = line_data(2)
+    q = Parameters()
+    q.add("ab", [0.0, 0.0])
+    q.set_prior("ab", 1e-9, index=1, mean=0.25)
+    assert adjust(q, Line(t, y, 0.1)).value("ab")[1] == pytest.approx(0.25, abs=1e-8)
+
+
+def test_outliers_are_rejected():
+    t, y = line_data(7, n=200)
+    bad = np.array([5, 50, 120, 180])
+    y[bad] += np.array([2.0, -1.5, 3.0, 1.2])
+    p = Parameters()
+    p.add("ab", [0.0, 0.0])
+    res = adjust(p, Line(t, y, 0.1), reject_k=4.0)
+    assert set(np.flatnonzero(res.outliers("line"))) == set(bad)
+    assert res.value("ab") == pytest.approx([1.5, 0.3], abs=0.05)
+
+
+def test_bad_input_errors():
+    t, y = line_data(0, n=5)
+    p = Parameters()
+    p.add("ab", [0.0, 0.0])
+    y_nan = y.copy()
+    y_nan[2] = np.nan
+    with pytest.raises(InputError, match="non-finite"):
+        adjust(p, Line(t, y_nan, 0.1))
+    with pytest.raises(ObservationError, match="fewer observations"):
+        adjust(p, Line(t[:1], y[:1], 0.1))
+    p.fix("ab")
+    with pytest.raises(ObservationError, match="fixed"):
+        adjust(p, Line(t, y, 0.1))
+    with pytest.raises(InputError, match="non-finite"):
+        Parameters().add("x", [np.nan])
+    with pytest.raises(InputError, match="σ"):
+        Line(t, y, -1.0)
+    with pytest.raises(InputError, match="no parameter named"):
+        p["nope"]
+
+
+def test_nonconvergence_is_reported():
+    rng = np.random.default_rng(3)
+    t = np.linspace(0, 4, 60)
+    y = 5.0 * np.exp(-0.7 * t) + 0.02 * rng.standard_normal(t.size)
+    p = Parameters()
+    p.add("Ak", [1.0, 3.0])
+    with pytest.raises(ConvergenceError) as ei:
+        adjust(p, Exponential(t, y, 0.02), max_iter=2)
+    assert ei.value.result is not None and not ei.value.result.converged
+    res = adjust(p, Exponential(t, y, 0.02), max_iter=2, raise_on_failure=False)
+    assert not res.converged
+
+
+def test_report_and_html():
+    t, y = line_data(0)
+    p = Parameters()
+    p.add("ab", [0.0, 0.0], columns=("a", "b"))
+    res = adjust(p, Line(t, y, 0.1))
+    txt = res.report()
+    assert "ab[a]" in txt and "sigma0" in txt
+    assert "<table" in res._repr_html_()
+    assert list(res.to_frame().columns) == ["value", "sigma", "free", "prior_sigma"]
+
+
+def test_progress_callback():
+    t, y = line_data(0)
+    p = Parameters()
+    p.add("ab", [0.0, 0.0])
+    seen = []
+    adjust(p, Line(t, y, 0.1), progress=seen.append)
+    assert seen and {"iteration", "cost", "lambda", "seconds"} <= set(seen[0])

@@ -1,0 +1,88 @@
+"""Small residual blocks used to test the engine (independent of any sensor model)."""
+
+import numpy as np
+
+from hsgeo.adjust import Indexed, ResidualBlock
+
+
+class Line(ResidualBlock):
+    """y = a + b t: a linear model, solvable in closed form with numpy.linalg.lstsq."""
+
+    name = "line"
+
+    def __init__(self, t, y, sigma):
+        super().__init__(np.broadcast_to(sigma, np.shape(y)))
+        self.t, self.y = np.asarray(t, float), np.asarray(y, float)
+
+    def evaluate(self, values, jacobian):
+        a, b = values["ab"]
+        r = a + b * self.t - self.y
+        if not jacobian:
+            return r, None
+        return r, {"ab": np.column_stack([np.ones_like(self.t), self.t])}
+
+
+class Exponential(ResidualBlock):
+    """y = A exp(-k t): non-linear, for comparison with scipy.optimize.least_squares."""
+
+    name = "exponential"
+
+    def __init__(self, t, y, sigma):
+        super().__init__(np.broadcast_to(sigma, np.shape(y)))
+        self.t, self.y = np.asarray(t, float), np.asarray(y, float)
+
+    def evaluate(self, values, jacobian):
+        A, k = values["Ak"]
+        e = np.exp(-k * self.t)
+        r = A * e - self.y
+        if not jacobian:
+            return r, None
+        return r, {"Ak": np.column_stack([e, -A * self.t * e])}
+
+
+class Bearings(ResidualBlock):
+    """Planar bearings from stations (x, y, heading) to points (x, y): a tiny bundle block.
+
+    θ = atan2(Py − Sy, Px − Sx) − heading. Stations are an ordinary Indexed block, points the
+    Schur-eliminated points block (or an ordinary block, to compare the two solutions).
+    """
+
+    name = "bearings"
+
+    def __init__(self, station, point, theta_rad, sigma_rad):
+        super().__init__(np.full(len(theta_rad), sigma_rad))
+        self.station, self.point = np.asarray(station), np.asarray(point)
+        self.theta = np.asarray(theta_rad, float)
+
+    @staticmethod
+    def model(S, P, station, point):
+        d = P[point] - S[station, :2]
+        return np.arctan2(d[:, 1], d[:, 0]) - S[station, 2], d
+
+    def evaluate(self, values, jacobian):
+        S, P = values["stations"], values["points"]
+        th, d = self.model(S, P, self.station, self.point)
+        r = np.angle(np.exp(1j * (th - self.theta)))
+        if not jacobian:
+            return r, None
+        q = (d**2).sum(axis=1)
+        dth_dP = np.column_stack([-d[:, 1] / q, d[:, 0] / q])
+        dth_dS = np.column_stack([-dth_dP, -np.ones(len(q))])
+        return r, {"stations": Indexed(self.station, dth_dS), "points": Indexed(self.point, dth_dP)}
+
+
+def bearing_scene(rng, n_stations=6, n_points=40, sigma_rad=1e-3, coverage=4):
+    """Stations on a circle looking inward, points inside; returns truth and observations."""
+    rng = np.random.default_rng(rng)
+    ang = np.linspace(0, 2 * np.pi, n_stations, endpoint=False)
+    S = np.column_stack([100 * np.cos(ang), 100 * np.sin(ang), ang + np.pi + 0.1 * rng.standard_normal(n_stations)])
+    P = rng.uniform(-40, 40, (n_points, 2))
+    st, pt = [], []
+    for j in range(n_points):
+        for s in rng.choice(n_stations, size=coverage, replace=False):
+            st.append(s)
+            pt.append(j)
+    st, pt = np.array(st), np.array(pt)
+    th, _ = Bearings.model(S, P, st, pt)
+    th = th + sigma_rad * rng.standard_normal(th.size)
+    return S, P, st, pt, th
