@@ -1,0 +1,283 @@
+"""Frame-camera self-calibration with the hsgeo engine, in OpenCV's and the photogrammetric form.
+
+Initial values come from OpenCV (``cv2.initCameraMatrix2D`` for the focal length and
+``cv2.solvePnP`` for each view's pose, both without distortion); from there the estimation is
+hsgeo's own adjustment (:func:`hsgeo.adjust.adjust`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from hsgeo.adjust import AdjustmentResult, Parameters, adjust
+from hsgeo.errors import InputError, ObservationError
+from hsgeo.rotations import R_from_rotvec, opk_from_R
+from hsgeo.sensors.frame import (
+    OPENCV_DISTORTION,
+    OPENCV_INTRINSICS,
+    PHOTOGRAMMETRIC_DISTORTION,
+    PHOTOGRAMMETRIC_INTERIOR,
+    POSE_COLUMNS,
+    FrameOpenCV,
+    FramePhotogrammetric,
+    pixel_to_mm,
+)
+
+__all__ = ["View", "FrameCalibration", "calibrate_opencv", "calibrate_photogrammetric",
+           "initial_poses"]
+
+_FLIP = np.diag([1.0, -1.0, -1.0])  # OpenCV camera frame (y down, z forward) <-> photogrammetric
+
+
+@dataclass(frozen=True)
+class View:
+    """The observations of one image: object points and their measured pixel coordinates.
+
+    Attributes
+    ----------
+    X : (n, 3) ndarray
+        Object (board) coordinates, any length unit.
+    uv_px : (n, 2) ndarray
+        Measured pixel coordinates (OpenCV convention).
+    ids : (n,) ndarray, optional
+        Point ids (board corner numbers), for reports.
+    """
+
+    X: np.ndarray
+    uv_px: np.ndarray
+    ids: np.ndarray | None = None
+
+
+def _check_views(views: Sequence[View], image_size) -> list[View]:
+    views = list(views)
+    if len(views) < 2:
+        raise ObservationError(
+            f"self-calibration needs at least 2 views of the board (3 or more for all "
+            f"intrinsics), got {len(views)}"
+        )
+    out = []
+    for i, v in enumerate(views):
+        X = np.asarray(v.X, dtype=np.float64)
+        uv = np.asarray(v.uv_px, dtype=np.float64)
+        if X.ndim != 2 or X.shape[1] != 3 or uv.shape != (X.shape[0], 2):
+            raise InputError(f"view {i}: X must be (n, 3) and uv_px (n, 2); got {X.shape}, "
+                             f"{uv.shape}")
+        if not (np.all(np.isfinite(X)) and np.all(np.isfinite(uv))):
+            raise InputError(f"view {i}: NaN or inf in the object or image points")
+        if X.shape[0] < 4:
+            raise ObservationError(f"view {i} has {X.shape[0]} points; a pose needs at least 4")
+        out.append(View(X, uv, v.ids))
+    w, h = image_size
+    if w <= 0 or h <= 0:
+        raise InputError(f"image_size must be positive (width, height), got {image_size}")
+    return out
+
+
+def initial_poses(views: Sequence[View], K: np.ndarray) -> np.ndarray:
+    """Per-view OpenCV pose (``R_cam_from_world`` as a rotation vector, t) from ``cv2.solvePnP``.
+
+    Returns
+    -------
+    (n_views, 6) ndarray of ``(ω, φ, κ, X0, Y0, Z0)`` for the OpenCV camera frame.
+    """
+    import cv2
+
+    out = []
+    for i, v in enumerate(views):
+        ok, rvec, tvec = cv2.solvePnP(v.X.astype(np.float64), v.uv_px.astype(np.float64), K,
+                                      np.zeros(5), flags=cv2.SOLVEPNP_ITERATIVE)
+        if not ok:
+            raise ObservationError(f"view {i}: no initial pose found (degenerate points?)")
+        R_cam_from_world = R_from_rotvec(rvec.ravel())
+        X0 = -R_cam_from_world.T @ tvec.ravel()
+        out.append(np.concatenate([opk_from_R(R_cam_from_world.T), X0]))
+    return np.array(out)
+
+
+def _initial_K(views, image_size) -> np.ndarray:
+    import cv2
+
+    obj = [v.X.astype(np.float32) for v in views]
+    img = [v.uv_px.astype(np.float32) for v in views]
+    if not all(np.allclose(v.X[:, 2], 0) for v in views):
+        raise InputError("initialisation needs planar boards with Z = 0 in board coordinates")
+    K = cv2.initCameraMatrix2D(obj, img, tuple(int(s) for s in image_size), 1.0)
+    return np.asarray(K, dtype=np.float64)
+
+
+@dataclass
+class FrameCalibration:
+    """A calibrated frame camera and its adjustment.
+
+    Attributes
+    ----------
+    form : {"opencv", "photogrammetric"}
+    result : AdjustmentResult
+    image_size : (int, int)
+    views : list of View
+    pixel_pitch_mm : float or None
+    """
+
+    form: str
+    result: AdjustmentResult
+    image_size: tuple[int, int]
+    views: list[View]
+    pixel_pitch_mm: float | None = None
+    _blocks: tuple[str, str] = field(default=("intrinsics", "distortion"), repr=False)
+
+    @property
+    def residuals_px(self) -> np.ndarray:
+        """(n, 2) reprojection residuals (model − observed) in px (mm forms converted)."""
+        r = self.result.residuals(0).reshape(-1, 2)
+        if self.form == "photogrammetric":
+            r = r / self.pixel_pitch_mm * np.array([1.0, -1.0])
+        return r
+
+    @property
+    def rms_px(self) -> float:
+        """sqrt(mean ‖e‖²) over all points: OpenCV's "RMS re-projection error"."""
+        r = self.residuals_px
+        return float(np.sqrt(np.mean(np.sum(r**2, axis=1))))
+
+    def per_view_rms_px(self) -> np.ndarray:
+        """RMS reprojection error of each view (px)."""
+        r = self.residuals_px
+        counts = np.array([v.X.shape[0] for v in self.views])
+        edges = np.concatenate([[0], np.cumsum(counts)])
+        return np.array([np.sqrt(np.mean(np.sum(r[a:b] ** 2, axis=1)))
+                         for a, b in zip(edges[:-1], edges[1:], strict=True)])
+
+    def values(self) -> dict[str, float]:
+        """Interior orientation and distortion by name."""
+        out = {}
+        for blk in self._blocks:
+            b = self.result.params[blk]
+            out.update(dict(zip(b.columns, b.value.ravel().tolist(), strict=True)))
+        return out
+
+    def sigmas(self) -> dict[str, float]:
+        """A-posteriori σ by name (NaN where fixed)."""
+        out = {}
+        for blk in self._blocks:
+            b = self.result.params[blk]
+            out.update(dict(zip(b.columns, self.result.sigma(blk).ravel().tolist(), strict=True)))
+        return out
+
+
+def _stack(views):
+    view = np.concatenate([np.full(v.X.shape[0], i) for i, v in enumerate(views)])
+    X = np.concatenate([v.X for v in views])
+    uv = np.concatenate([v.uv_px for v in views])
+    return view, X, uv
+
+
+def calibrate_opencv(
+    views: Sequence[View],
+    image_size: tuple[int, int],
+    *,
+    fix_principal_point: bool = False,
+    square_pixels: bool = False,
+    zero_tangent: bool = False,
+    fix_k3: bool = False,
+    sigma_px: float = 1.0,
+    reject_k: float | None = None,
+    progress=None,
+) -> FrameCalibration:
+    """Self-calibrate a frame camera in OpenCV's form with hsgeo's engine.
+
+    The flags mirror ``cv2.calibrateCamera``'s ``CALIB_FIX_PRINCIPAL_POINT`` (at the image
+    centre), ``CALIB_FIX_ASPECT_RATIO`` (with aspect 1), ``CALIB_ZERO_TANGENT_DIST`` and
+    ``CALIB_FIX_K3``.
+
+    Parameters
+    ----------
+    views : sequence of View
+    image_size : (width_px, height_px)
+    sigma_px : float
+        A-priori σ of an image coordinate; σ0 then says how well it was guessed.
+
+    Returns
+    -------
+    FrameCalibration
+    """
+    views = _check_views(views, image_size)
+    K = _initial_K(views, image_size)
+    w, h = image_size
+    cx, cy = ((w - 1) / 2, (h - 1) / 2) if fix_principal_point else (K[0, 2], K[1, 2])
+    f0 = float(np.sqrt(K[0, 0] * K[1, 1]))
+    K = np.array([[f0, 0, cx], [0, f0, cy], [0, 0, 1.0]])
+    p = Parameters()
+    p.add("intrinsics", [f0, f0, cx, cy], columns=OPENCV_INTRINSICS)
+    p.add("distortion", np.zeros(5), columns=OPENCV_DISTORTION)
+    p.add("poses", initial_poses(views, K), columns=POSE_COLUMNS)
+    if fix_principal_point:
+        p.fix("intrinsics", index=[2, 3])
+    if square_pixels:
+        p.fix("intrinsics", index=1)
+    if zero_tangent:
+        p.fix("distortion", index=[2, 3])
+    if fix_k3:
+        p.fix("distortion", index=4)
+    view, X, uv = _stack(views)
+    blk = FrameOpenCV(view, uv, sigma_px, X=X, square_pixels=square_pixels)
+    res = adjust(p, blk, reject_k=reject_k, progress=progress)
+    if square_pixels:  # fy is tied to fx: report it so
+        res.params["intrinsics"].value[1] = res.params["intrinsics"].value[0]
+    return FrameCalibration("opencv", res, (int(w), int(h)), views)
+
+
+def calibrate_photogrammetric(
+    views: Sequence[View],
+    image_size: tuple[int, int],
+    pixel_pitch_mm: float,
+    *,
+    fix_principal_point: bool = False,
+    zero_decentering: bool = False,
+    fix_K3: bool = False,
+    sigma_px: float = 1.0,
+    reject_k: float | None = None,
+    progress=None,
+) -> FrameCalibration:
+    """Self-calibrate a frame camera in the photogrammetric form (mm, corrections at the measured
+    coordinates; see :class:`hsgeo.sensors.frame.FramePhotogrammetric`).
+
+    Parameters
+    ----------
+    pixel_pitch_mm : float
+        Pixel size; square pixels are assumed (the mm image frame is isotropic).
+    fix_principal_point : bool
+        Hold (x0, y0) at the image centre.
+    zero_decentering : bool
+        Hold P1 = P2 = 0.
+    """
+    views = _check_views(views, image_size)
+    if not pixel_pitch_mm > 0:
+        raise InputError(f"pixel_pitch_mm must be positive, got {pixel_pitch_mm}")
+    K = _initial_K(views, image_size)
+    w, h = image_size
+    f0 = float(np.sqrt(K[0, 0] * K[1, 1]))
+    K = np.array([[f0, 0, (w - 1) / 2], [0, f0, (h - 1) / 2], [0, 0, 1.0]])
+    poses = initial_poses(views, K)
+    from hsgeo.rotations import R_from_opk
+
+    R = R_from_opk(poses[:, 0], poses[:, 1], poses[:, 2]) @ _FLIP
+    poses[:, :3] = opk_from_R(R)
+    p = Parameters()
+    p.add("interior", [f0 * pixel_pitch_mm, 0.0, 0.0], columns=PHOTOGRAMMETRIC_INTERIOR)
+    p.add("distortion_mm", np.zeros(5), columns=PHOTOGRAMMETRIC_DISTORTION)
+    p.add("poses", poses, columns=POSE_COLUMNS)
+    if fix_principal_point:
+        p.fix("interior", index=[1, 2])
+    if zero_decentering:
+        p.fix("distortion_mm", index=[3, 4])
+    if fix_K3:
+        p.fix("distortion_mm", index=2)
+    view, X, uv = _stack(views)
+    blk = FramePhotogrammetric(view, pixel_to_mm(uv, image_size, pixel_pitch_mm),
+                               sigma_px * pixel_pitch_mm, X=X)
+    res = adjust(p, blk, reject_k=reject_k, progress=progress)
+    return FrameCalibration("photogrammetric", res, (int(w), int(h)), views, pixel_pitch_mm,
+                            _blocks=("interior", "distortion_mm"))

@@ -1,0 +1,564 @@
+"""Brown lens-distortion models, each with matching forward, inverse and Jacobian.
+
+Three forms are provided; all take arbitrary leading batch dimensions ``...``.
+
+1. **Odd radial series in one dimension** for line scanners (000 eq. (2)):
+   ``δ(d) = K1 d³ + K2 d⁵ + K3 d⁷ + …`` — :func:`odd_radial_1d`,
+   :func:`odd_radial_1d_jacobian`.
+2. **OpenCV form**: distortion *applied* to normalised ideal coordinates
+   (``x = X/Z``, ``y = Y/Z``), coefficients ``(k1, k2, p1, p2, k3)`` in OpenCV order —
+   :func:`distort_opencv`, :func:`undistort_opencv`, :func:`distort_opencv_jacobian`.
+3. **Photogrammetric form** (Brown 1971, Fraser 1997; 003 Table 3): a *correction* computed
+   from measured, principal-point-reduced image coordinates in mm, added to obtain the ideal
+   coordinates — :func:`brown_correction`, :func:`brown_correction_jacobian`,
+   :func:`ideal_from_measured_mm`, :func:`measured_from_ideal_mm`.
+
+The two 2D forms are not the same parameterisation:
+
+* direction: OpenCV maps ideal → distorted, the photogrammetric form maps measured
+  (distorted) → ideal, so the coefficients have opposite signs to first order;
+* units: OpenCV coefficients are dimensionless (normalised coordinates), Brown's K_i are in
+  mm^(−2i) and P_i in mm⁻¹ (to first order ``K1 ≈ −k1 / c_mm²``, ``P1 ≈ −p2 / c_mm``);
+* roles: Brown's ``P1`` multiplies ``(r² + 2x̄²)`` in δx, which is OpenCV's ``p2`` term;
+  Brown's ``P2`` is OpenCV's ``p1``.
+
+References
+----------
+.. [1] Brown, D. C. (1971). Close-range camera calibration. Photogrammetric Engineering 37(8).
+.. [2] Fraser, C. S. (1997). Digital camera self-calibration. ISPRS J. Photogramm. Remote
+   Sens. 52(4), 149-159.
+.. [3] Miljković, Gajski, Vela (2017). Spatial calibration of the hyperspectral line scanner
+   by the bundle block adjusting method. Geodetski list 2017/2, eq. (2) (paper 000).
+.. [4] Tommaselli et al. A study on the variations of inner orientation parameters of a
+   hyperspectral frame camera. ISPRS Archives, Table 3 (paper 003).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from hsgeo.errors import ConvergenceError, InputError
+
+__all__ = [
+    "odd_radial_1d",
+    "odd_radial_1d_jacobian",
+    "distort_opencv",
+    "undistort_opencv",
+    "distort_opencv_jacobian",
+    "brown_correction",
+    "brown_correction_jacobian",
+    "ideal_from_measured_mm",
+    "measured_from_ideal_mm",
+]
+
+
+# --------------------------------------------------------------------------- validation
+
+
+def _as_float(a: ArrayLike, name: str) -> NDArray[np.float64]:
+    """Convert to a finite float64 array or raise InputError."""
+    try:
+        arr = np.asarray(a, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise InputError(
+            f"{name} could not be converted to a float array ({exc}); pass numbers."
+        ) from exc
+    if not np.all(np.isfinite(arr)):
+        n_bad = int(np.size(arr) - np.count_nonzero(np.isfinite(arr)))
+        raise InputError(
+            f"{name} contains {n_bad} non-finite value(s) (NaN or inf); "
+            "remove or replace them before calling."
+        )
+    return arr
+
+
+def _as_last(a: ArrayLike, name: str, n: int, what: str) -> NDArray[np.float64]:
+    """Finite float array of shape (..., n)."""
+    arr = _as_float(a, name)
+    if arr.ndim < 1 or arr.shape[-1] != n:
+        raise InputError(f"{name} must have shape (..., {n}) ({what}), got {arr.shape}.")
+    return arr
+
+
+def _broadcast(*arrays: tuple[NDArray[np.float64], int, str]) -> list[NDArray[np.float64]]:
+    """Broadcast the batch dimensions of (array, n_trailing, name) triples."""
+    try:
+        batch = np.broadcast_shapes(
+            *(a.shape[: a.ndim - k] for a, k, _ in arrays)
+        )
+    except ValueError as exc:
+        shapes = ", ".join(f"{nm}{a.shape}" for a, _, nm in arrays)
+        raise InputError(
+            f"batch dimensions do not broadcast: {shapes}; give them compatible leading shapes."
+        ) from exc
+    return [np.broadcast_to(a, batch + a.shape[a.ndim - k:]) for a, k, _ in arrays]
+
+
+def _stack22(a, b, c, d) -> NDArray[np.float64]:
+    """(..., 2, 2) array [[a, b], [c, d]]."""
+    return np.stack([np.stack([a, b], axis=-1), np.stack([c, d], axis=-1)], axis=-2)
+
+
+def _newton_invert(
+    forward: Callable[[NDArray], tuple[NDArray, NDArray]],
+    target: NDArray[np.float64],
+    tol: float,
+    max_iter: int,
+    what: str,
+) -> NDArray[np.float64]:
+    """Solve ``forward(u)[0] = target`` for u (..., 2) by Newton iteration.
+
+    ``forward`` returns the value (..., 2) and its Jacobian (..., 2, 2). Starts at
+    ``u = target``. Raises ConvergenceError when a point does not reach ``|F|∞ ≤ tol``
+    within ``max_iter`` iterations, or lands where J is not positive definite (the folded,
+    non-monotonic part of the model, where the inverse is not the physical one).
+    """
+    if not (np.isfinite(tol) and tol > 0):
+        raise InputError(f"tol must be a positive finite number, got {tol!r}.")
+    if int(max_iter) < 1:
+        raise InputError(f"max_iter must be >= 1, got {max_iter!r}.")
+    u = np.array(target, dtype=np.float64, copy=True)
+    # Divergent iterates may overflow; they are detected below as non-finite.
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        for _ in range(int(max_iter)):
+            f, J = forward(u)
+            F = f - target
+            done = np.all(np.abs(F) <= tol, axis=-1)
+            if np.all(done):
+                break
+            det = J[..., 0, 0] * J[..., 1, 1] - J[..., 0, 1] * J[..., 1, 0]
+            bad = ~np.isfinite(det) | (det == 0.0)
+            det = np.where(bad, 1.0, det)
+            # Δu = J⁻¹ F for a 2×2 matrix
+            du0 = (J[..., 1, 1] * F[..., 0] - J[..., 0, 1] * F[..., 1]) / det
+            du1 = (-J[..., 1, 0] * F[..., 0] + J[..., 0, 0] * F[..., 1]) / det
+            du = np.stack([du0, du1], axis=-1)
+            du = np.where((bad | done)[..., None], 0.0, du)
+            u = np.where(bad[..., None], np.nan, u - du)
+        f, J = forward(u)
+        det = J[..., 0, 0] * J[..., 1, 1] - J[..., 0, 1] * J[..., 1, 0]
+        trace = J[..., 0, 0] + J[..., 1, 1]
+        # J is symmetric for both models; det > 0 and trace > 0 <=> positive definite,
+        # i.e. the solution lies on the monotonic (physical) branch.
+        ok = np.all(np.abs(f - target) <= tol, axis=-1) & (det > 0.0) & (trace > 0.0)
+    if not np.all(ok):
+        n_bad = int(np.size(ok) - np.count_nonzero(ok))
+        raise ConvergenceError(
+            f"{what}: Newton iteration did not converge to |residual| <= {tol:g} for "
+            f"{n_bad} of {np.size(ok)} point(s) in {int(max_iter)} iterations. The points are "
+            "probably outside the region where the distortion model is monotonic (check the "
+            "coefficients and the image extent), or raise max_iter / tol.",
+            result=u,
+        )
+    return u
+
+
+# --------------------------------------------------------------------------- 1D odd radial
+
+
+def _check_K_1d(d: ArrayLike, K: ArrayLike) -> tuple[NDArray, NDArray, NDArray]:
+    d = _as_float(d, "d")
+    K = _as_float(K, "K")
+    if K.ndim < 1 or K.shape[-1] < 1:
+        raise InputError(
+            f"K must have shape (..., n) with n >= 1 coefficients (K1, K2, ...), got {K.shape}."
+        )
+    d, K = _broadcast((d, 0, "d"), (K, 1, "K"))
+    exponents = 2 * np.arange(1, K.shape[-1] + 1) + 1  # 3, 5, 7, ...
+    return d, K, exponents
+
+
+def odd_radial_1d(d: ArrayLike, K: ArrayLike) -> NDArray:
+    """Odd radial distortion series along a line sensor.
+
+    ``δ = Σ_i K_i d^(2i+1) = K1 d³ + K2 d⁵ + K3 d⁷ + …``  (000 eq. (2), where
+    ``d = ζ_T − ζ_0``).
+
+    Parameters
+    ----------
+    d : (...) array_like
+        Distance from the principal point along the line. Its unit and normalisation (pixels,
+        mm, or scaled by some reference length) are the caller's choice; ``K`` must be
+        expressed in the matching units (``K_i`` in unit^(−2i)).
+    K : (n,) or (..., n) array_like
+        Coefficients ``K1, K2, …`` (any n >= 1); batch dimensions broadcast with ``d``.
+
+    Returns
+    -------
+    delta : (...) ndarray
+        Distortion, in the unit of ``d``.
+
+    Raises
+    ------
+    InputError
+        On NaN/inf, empty ``K`` or non-broadcasting shapes.
+
+    Examples
+    --------
+    >>> round(float(odd_radial_1d(2.0, [1e-3, 1e-5])), 12)
+    0.00832
+    """
+    d, K, exponents = _check_K_1d(d, K)
+    powers = d[..., None] ** exponents  # (..., n): d³, d⁵, d⁷, ...
+    return np.sum(K * powers, axis=-1)
+
+
+def odd_radial_1d_jacobian(d: ArrayLike, K: ArrayLike) -> tuple[NDArray, NDArray]:
+    """Jacobian of :func:`odd_radial_1d` with respect to d and K.
+
+    Parameters
+    ----------
+    d : (...) array_like
+        Distance from the principal point (caller's units and normalisation).
+    K : (n,) or (..., n) array_like
+        Coefficients ``K1, K2, …``.
+
+    Returns
+    -------
+    d_delta_d_d : (...) ndarray
+        ``∂δ/∂d = Σ_i (2i+1) K_i d^(2i)`` (dimensionless).
+    d_delta_dK : (..., n) ndarray
+        ``∂δ/∂K_i = d^(2i+1)``.
+
+    Raises
+    ------
+    InputError
+        On NaN/inf, empty ``K`` or non-broadcasting shapes.
+    """
+    d, K, exponents = _check_K_1d(d, K)
+    d_delta_dK = d[..., None] ** exponents
+    d_delta_d_d = np.sum(exponents * K * d[..., None] ** (exponents - 1), axis=-1)
+    return d_delta_d_d, d_delta_dK
+
+
+# --------------------------------------------------------------------------- OpenCV form
+
+
+def _check_opencv(xy: ArrayLike, dist: ArrayLike, xy_name: str) -> tuple[NDArray, NDArray]:
+    xy = _as_last(xy, xy_name, 2, "x, y")
+    dist = _as_float(dist, "dist")
+    if dist.ndim < 1 or dist.shape[-1] != 5:
+        raise InputError(
+            f"dist must have shape (..., 5) = (k1, k2, p1, p2, k3) in OpenCV order, got "
+            f"{dist.shape}; pad missing coefficients with zeros (e.g. k3 = 0)."
+        )
+    return tuple(_broadcast((xy, 1, xy_name), (dist, 1, "dist")))
+
+
+def _opencv_terms(xy: NDArray, dist: NDArray):
+    """Distorted coordinates and the 2×2 Jacobian; also the pieces the dist-Jacobian needs."""
+    x, y = xy[..., 0], xy[..., 1]
+    k1, k2, p1, p2, k3 = (dist[..., i] for i in range(5))
+    r2 = x * x + y * y
+    radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3))  # 1 + k1 r² + k2 r⁴ + k3 r⁶
+    g = k1 + r2 * (2.0 * k2 + 3.0 * k3 * r2)  # ∂radial/∂(r²)
+    xd = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x)
+    yd = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y
+    J = _stack22(
+        radial + 2.0 * x * x * g + 2.0 * p1 * y + 6.0 * p2 * x,
+        2.0 * x * y * g + 2.0 * p1 * x + 2.0 * p2 * y,
+        2.0 * x * y * g + 2.0 * p1 * x + 2.0 * p2 * y,
+        radial + 2.0 * y * y * g + 6.0 * p1 * y + 2.0 * p2 * x,
+    )
+    return np.stack([xd, yd], axis=-1), J, (x, y, r2)
+
+
+def distort_opencv(xy_n: ArrayLike, dist: ArrayLike) -> NDArray:
+    """Apply OpenCV's Brown-Conrady distortion to normalised ideal coordinates.
+
+    ``x_d = x (1 + k1 r² + k2 r⁴ + k3 r⁶) + 2 p1 x y + p2 (r² + 2x²)``,
+    ``y_d = y (1 + k1 r² + k2 r⁴ + k3 r⁶) + p1 (r² + 2y²) + 2 p2 x y``, ``r² = x² + y²``
+    (the model of ``cv2.projectPoints`` with five coefficients).
+
+    Parameters
+    ----------
+    xy_n : (..., 2) array_like
+        Normalised ideal coordinates ``(X/Z, Y/Z)`` (dimensionless).
+    dist : (5,) or (..., 5) array_like
+        ``(k1, k2, p1, p2, k3)`` in OpenCV order (dimensionless).
+
+    Returns
+    -------
+    xy_d : (..., 2) ndarray
+        Distorted normalised coordinates. Pixels are ``K_cam @ [x_d, y_d, 1]``.
+
+    Raises
+    ------
+    InputError
+        On NaN/inf, wrong shapes or a coefficient count other than 5.
+
+    See Also
+    --------
+    brown_correction : photogrammetric form (note P1 ↔ p2, P2 ↔ p1, opposite direction).
+    """
+    xy, dist = _check_opencv(xy_n, dist, "xy_n")
+    return _opencv_terms(xy, dist)[0]
+
+
+def distort_opencv_jacobian(xy_n: ArrayLike, dist: ArrayLike) -> tuple[NDArray, NDArray]:
+    """Jacobian of :func:`distort_opencv`.
+
+    Parameters
+    ----------
+    xy_n : (..., 2) array_like
+        Normalised ideal coordinates.
+    dist : (5,) or (..., 5) array_like
+        ``(k1, k2, p1, p2, k3)`` in OpenCV order.
+
+    Returns
+    -------
+    J_xy : (..., 2, 2) ndarray
+        ``∂(x_d, y_d)/∂(x, y)``.
+    J_dist : (..., 2, 5) ndarray
+        ``∂(x_d, y_d)/∂(k1, k2, p1, p2, k3)``.
+
+    Raises
+    ------
+    InputError
+        On NaN/inf, wrong shapes or a coefficient count other than 5.
+    """
+    xy, dist = _check_opencv(xy_n, dist, "xy_n")
+    _, J_xy, (x, y, r2) = _opencv_terms(xy, dist)
+    r4 = r2 * r2
+    r6 = r4 * r2
+    J_dist = np.stack(
+        [
+            np.stack([x * r2, x * r4, 2.0 * x * y, r2 + 2.0 * x * x, x * r6], axis=-1),
+            np.stack([y * r2, y * r4, r2 + 2.0 * y * y, 2.0 * x * y, y * r6], axis=-1),
+        ],
+        axis=-2,
+    )
+    return J_xy, J_dist
+
+
+def undistort_opencv(
+    xy_d: ArrayLike, dist: ArrayLike, tol: float = 1e-14, max_iter: int = 50
+) -> NDArray:
+    """Invert :func:`distort_opencv` by Newton iteration with the analytic 2×2 Jacobian.
+
+    Parameters
+    ----------
+    xy_d : (..., 2) array_like
+        Distorted normalised coordinates.
+    dist : (5,) or (..., 5) array_like
+        ``(k1, k2, p1, p2, k3)`` in OpenCV order.
+    tol : float, optional
+        Convergence threshold on ``max |distort(xy_n) − xy_d|`` per point (normalised
+        units).
+    max_iter : int, optional
+        Maximum number of Newton iterations.
+
+    Returns
+    -------
+    xy_n : (..., 2) ndarray
+        Normalised ideal coordinates with ``distort_opencv(xy_n, dist) ≈ xy_d``.
+
+    Raises
+    ------
+    InputError
+        On NaN/inf, wrong shapes or a coefficient count other than 5.
+    ConvergenceError
+        If a point does not converge, or converges where J is not positive definite (outside
+        the monotonic region of the model); ``.result`` holds the last iterate.
+    """
+    xy, dist = _check_opencv(xy_d, dist, "xy_d")
+
+    def forward(u):
+        f, J, _ = _opencv_terms(u, dist)
+        return f, J
+
+    return _newton_invert(forward, np.array(xy), tol, max_iter, "undistort_opencv")
+
+
+# --------------------------------------------------------------------------- photogrammetric
+
+
+def _check_brown(xy: ArrayLike, K: ArrayLike, P: ArrayLike, xy_name: str):
+    xy = _as_last(xy, xy_name, 2, "x, y in mm")
+    K = _as_float(K, "K")
+    P = _as_float(P, "P")
+    if K.ndim < 1 or K.shape[-1] != 3:
+        raise InputError(
+            f"K must have shape (..., 3) = (K1, K2, K3) in mm^-2, mm^-4, mm^-6, got {K.shape}; "
+            "pad missing coefficients with zeros."
+        )
+    if P.ndim < 1 or P.shape[-1] != 2:
+        raise InputError(f"P must have shape (..., 2) = (P1, P2) in mm^-1, got {P.shape}.")
+    return _broadcast((xy, 1, xy_name), (K, 1, "K"), (P, 1, "P"))
+
+
+def _brown_terms(xy: NDArray, K: NDArray, P: NDArray):
+    """Correction δ (..., 2), its Jacobian (..., 2, 2) and (x, y, r²)."""
+    x, y = xy[..., 0], xy[..., 1]
+    K1, K2, K3 = K[..., 0], K[..., 1], K[..., 2]
+    P1, P2 = P[..., 0], P[..., 1]
+    r2 = x * x + y * y
+    s = r2 * (K1 + r2 * (K2 + r2 * K3))  # K1 r² + K2 r⁴ + K3 r⁶
+    g = K1 + r2 * (2.0 * K2 + 3.0 * K3 * r2)  # ∂s/∂(r²)
+    # Brown (1971), Fraser (1997) eq. (2); 003 Table 3
+    dx = x * s + P1 * (r2 + 2.0 * x * x) + 2.0 * P2 * x * y
+    dy = y * s + 2.0 * P1 * x * y + P2 * (r2 + 2.0 * y * y)
+    J = _stack22(
+        s + 2.0 * x * x * g + 6.0 * P1 * x + 2.0 * P2 * y,
+        2.0 * x * y * g + 2.0 * P1 * y + 2.0 * P2 * x,
+        2.0 * x * y * g + 2.0 * P1 * y + 2.0 * P2 * x,
+        s + 2.0 * y * y * g + 2.0 * P1 * x + 6.0 * P2 * y,
+    )
+    return np.stack([dx, dy], axis=-1), J, (x, y, r2)
+
+
+def brown_correction(xy_bar_mm: ArrayLike, K: ArrayLike, P: ArrayLike) -> NDArray:
+    """Brown radial + decentering correction of measured image coordinates.
+
+    ``δx = x̄ (K1 r² + K2 r⁴ + K3 r⁶) + P1 (r² + 2x̄²) + 2 P2 x̄ ȳ``,
+    ``δy = ȳ (K1 r² + K2 r⁴ + K3 r⁶) + 2 P1 x̄ ȳ + P2 (r² + 2ȳ²)``, ``r² = x̄² + ȳ²``
+    (Brown 1971; Fraser 1997; the parameterisation of 003 Table 3). The ideal (corrected)
+    coordinate is ``x̄ + δx``.
+
+    Parameters
+    ----------
+    xy_bar_mm : (..., 2) array_like, mm
+        Measured image coordinates reduced to the principal point, ``x̄ = x − x0``.
+    K : (3,) or (..., 3) array_like
+        ``(K1, K2, K3)`` in mm⁻², mm⁻⁴, mm⁻⁶.
+    P : (2,) or (..., 2) array_like
+        ``(P1, P2)`` in mm⁻¹.
+
+    Returns
+    -------
+    delta_mm : (..., 2) ndarray, mm
+        Correction ``(δx, δy)``.
+
+    Raises
+    ------
+    InputError
+        On NaN/inf, wrong shapes or wrong coefficient counts.
+
+    Notes
+    -----
+    Relative to OpenCV (:func:`distort_opencv`) Brown's ``P1`` plays the role of OpenCV's
+    ``p2`` and ``P2`` that of ``p1``. The direction is opposite (a correction of measured
+    coordinates instead of a distortion of ideal ones), so the signs flip to first order, and
+    the units differ (mm powers here, normalised coordinates there): to first order
+    ``K1 ≈ −k1 / c_mm²``, ``P1 ≈ −p2 / c_mm``, ``P2 ≈ −p1 / c_mm``.
+    """
+    xy, K, P = _check_brown(xy_bar_mm, K, P, "xy_bar_mm")
+    return _brown_terms(xy, K, P)[0]
+
+
+def brown_correction_jacobian(
+    xy_bar_mm: ArrayLike, K: ArrayLike, P: ArrayLike
+) -> tuple[NDArray, NDArray, NDArray]:
+    """Jacobian of :func:`brown_correction`.
+
+    Parameters
+    ----------
+    xy_bar_mm : (..., 2) array_like, mm
+        Principal-point-reduced measured image coordinates.
+    K : (3,) or (..., 3) array_like
+        ``(K1, K2, K3)`` in mm⁻², mm⁻⁴, mm⁻⁶.
+    P : (2,) or (..., 2) array_like
+        ``(P1, P2)`` in mm⁻¹.
+
+    Returns
+    -------
+    J_xy : (..., 2, 2) ndarray
+        ``∂δ/∂(x̄, ȳ)`` (dimensionless). The Jacobian of the ideal coordinates
+        ``x̄ + δ`` is ``I + J_xy``.
+    J_K : (..., 2, 3) ndarray
+        ``∂δ/∂(K1, K2, K3)`` in mm³, mm⁵, mm⁷.
+    J_P : (..., 2, 2) ndarray
+        ``∂δ/∂(P1, P2)`` in mm².
+
+    Raises
+    ------
+    InputError
+        On NaN/inf, wrong shapes or wrong coefficient counts.
+    """
+    xy, K, P = _check_brown(xy_bar_mm, K, P, "xy_bar_mm")
+    _, J_xy, (x, y, r2) = _brown_terms(xy, K, P)
+    r4 = r2 * r2
+    r6 = r4 * r2
+    J_K = np.stack(
+        [np.stack([x * r2, x * r4, x * r6], axis=-1), np.stack([y * r2, y * r4, y * r6], axis=-1)],
+        axis=-2,
+    )
+    J_P = _stack22(r2 + 2.0 * x * x, 2.0 * x * y, 2.0 * x * y, r2 + 2.0 * y * y)
+    return J_xy, J_K, J_P
+
+
+def ideal_from_measured_mm(xy_bar_mm: ArrayLike, K: ArrayLike, P: ArrayLike) -> NDArray:
+    """Ideal (distortion-free) image coordinates from measured ones: ``x̄ + δ(x̄)``.
+
+    Parameters
+    ----------
+    xy_bar_mm : (..., 2) array_like, mm
+        Principal-point-reduced measured image coordinates.
+    K : (3,) or (..., 3) array_like
+        ``(K1, K2, K3)`` in mm⁻², mm⁻⁴, mm⁻⁶.
+    P : (2,) or (..., 2) array_like
+        ``(P1, P2)`` in mm⁻¹.
+
+    Returns
+    -------
+    xy_ideal_mm : (..., 2) ndarray, mm
+        Corrected coordinates, principal-point-reduced.
+
+    Raises
+    ------
+    InputError
+        On NaN/inf, wrong shapes or wrong coefficient counts.
+    """
+    xy, K, P = _check_brown(xy_bar_mm, K, P, "xy_bar_mm")
+    return xy + _brown_terms(xy, K, P)[0]
+
+
+def measured_from_ideal_mm(
+    xy_ideal_mm: ArrayLike,
+    K: ArrayLike,
+    P: ArrayLike,
+    tol: float = 1e-12,
+    max_iter: int = 50,
+) -> NDArray:
+    """Measured image coordinates from ideal ones (inverse of :func:`ideal_from_measured_mm`).
+
+    Solves ``x̄ + δ(x̄) = xy_ideal`` by Newton iteration with Jacobian ``I + J_xy``.
+
+    Parameters
+    ----------
+    xy_ideal_mm : (..., 2) array_like, mm
+        Ideal (distortion-free) principal-point-reduced image coordinates, e.g. from
+        collinearity.
+    K : (3,) or (..., 3) array_like
+        ``(K1, K2, K3)`` in mm⁻², mm⁻⁴, mm⁻⁶.
+    P : (2,) or (..., 2) array_like
+        ``(P1, P2)`` in mm⁻¹.
+    tol : float, optional
+        Convergence threshold in mm on ``max |x̄ + δ(x̄) − xy_ideal|`` per point.
+    max_iter : int, optional
+        Maximum number of Newton iterations.
+
+    Returns
+    -------
+    xy_bar_mm : (..., 2) ndarray, mm
+        Measured (distorted) principal-point-reduced image coordinates.
+
+    Raises
+    ------
+    InputError
+        On NaN/inf, wrong shapes or wrong coefficient counts.
+    ConvergenceError
+        If a point does not converge, or converges where ``I + J_xy`` is not positive
+        definite (outside the monotonic region of the model); ``.result`` holds the last
+        iterate.
+    """
+    xy, K, P = _check_brown(xy_ideal_mm, K, P, "xy_ideal_mm")
+
+    def forward(u):
+        delta, J, _ = _brown_terms(u, K, P)
+        return u + delta, np.eye(2) + J
+
+    return _newton_invert(forward, np.array(xy), tol, max_iter, "measured_from_ideal_mm")

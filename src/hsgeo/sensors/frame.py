@@ -1,0 +1,303 @@
+"""Frame cameras: collinearity with Brown distortion, in two forms.
+
+**OpenCV form** (:class:`FrameOpenCV`): the camera frame has x right, y down, z forward; the
+distortion is applied to the *normalised ideal* coordinates ``(X_c/Z_c, Y_c/Z_c)`` and the
+intrinsics are in pixels::
+
+    (x_d, y_d) = distort_opencv(X_c/Z_c, Y_c/Z_c; k1, k2, p1, p2, k3)
+    u = fx·x_d + cx,   v = fy·y_d + cy
+
+**Photogrammetric form** (:class:`FramePhotogrammetric`, 003 Table 3; Fraser 1997): the camera
+frame has x right, y up, z backward (the camera looks along −z); image coordinates are in mm
+from the image centre, and the corrections are a function of the *measured* coordinates reduced
+to the principal point, x̄ = x − x0::
+
+    x̄ + δx(x̄, ȳ) = −f·X_c/Z_c,    ȳ + δy(x̄, ȳ) = −f·Y_c/Z_c          (collinearity)
+
+with Brown's δ (``hsgeo.distortion.brown_correction``). The residual is the left side minus the
+right side, evaluated at the observation, in mm. The two forms are different models, not just
+different units: one distorts the ideal ray, the other corrects the measured point.
+
+Both share the exterior orientation of view ``i``, a row ``(ω, φ, κ, X0, Y0, Z0)`` of the
+``poses`` block: ``R_world_from_cam = R_from_opk(ω, φ, κ)`` and the projection centre ``X0`` in
+world units, so that ``X_c = R_world_from_camᵀ (X − X0)``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hsgeo.adjust import Indexed, ResidualBlock
+from hsgeo.distortion import (
+    brown_correction,
+    brown_correction_jacobian,
+    distort_opencv,
+    distort_opencv_jacobian,
+)
+from hsgeo.errors import InputError
+from hsgeo.rotations import R_from_opk, dR_dopk
+
+__all__ = [
+    "POSE_COLUMNS",
+    "camera_coordinates",
+    "project_opencv",
+    "FrameOpenCV",
+    "FramePhotogrammetric",
+    "pixel_to_mm",
+    "mm_to_pixel",
+]
+
+POSE_COLUMNS = ("omega_rad", "phi_rad", "kappa_rad", "X0", "Y0", "Z0")
+OPENCV_INTRINSICS = ("fx_px", "fy_px", "cx_px", "cy_px")
+OPENCV_DISTORTION = ("k1", "k2", "p1", "p2", "k3")
+PHOTOGRAMMETRIC_INTERIOR = ("f_mm", "x0_mm", "y0_mm")
+PHOTOGRAMMETRIC_DISTORTION = ("K1_per_mm2", "K2_per_mm4", "K3_per_mm6", "P1_per_mm", "P2_per_mm")
+
+
+def camera_coordinates(poses: np.ndarray, view: np.ndarray, X: np.ndarray, jacobian: bool):
+    """World points in the camera frame of their views.
+
+    Parameters
+    ----------
+    poses : (n_views, 6) ndarray
+        ``(ω, φ, κ)`` in rad of ``R_world_from_cam`` and the projection centre.
+    view : (n,) int ndarray
+        The view of each point.
+    X : (n, 3) ndarray
+        World coordinates.
+    jacobian : bool
+
+    Returns
+    -------
+    Xc : (n, 3) ndarray
+        ``R_world_from_camᵀ (X − X0)``.
+    dXc_dpose : (n, 3, 6) ndarray or None
+    dXc_dX : (n, 3, 3) ndarray or None
+        ``R_world_from_camᵀ`` per point.
+    """
+    R = R_from_opk(poses[:, 0], poses[:, 1], poses[:, 2])  # (n_views, 3, 3)
+    Rt = np.swapaxes(R, 1, 2)[view]
+    dX = X - poses[view, 3:6]
+    Xc = np.einsum("nij,nj->ni", Rt, dX)
+    if not jacobian:
+        return Xc, None, None
+    dR = dR_dopk(poses[:, 0], poses[:, 1], poses[:, 2])[view]  # (n, 3 angles, 3, 3)
+    d_ang = np.einsum("nkji,nj->nik", dR, dX)  # (dR_k)ᵀ dX  -> (n, 3, 3 angles)
+    d_pose = np.concatenate([d_ang, -Rt], axis=2)
+    return Xc, d_pose, Rt
+
+
+def _check_views(name, view, xy, X, n_views_hint=None):
+    view = np.asarray(view)
+    xy = np.asarray(xy, dtype=np.float64)
+    if xy.ndim != 2 or xy.shape[1] != 2:
+        raise InputError(f"{name}: image coordinates must be (n, 2), got {xy.shape}")
+    if view.shape != (xy.shape[0],) or not np.issubdtype(view.dtype, np.integer):
+        raise InputError(f"{name}: view must be (n,) integers matching {xy.shape[0]} points")
+    if X is not None:
+        X = np.asarray(X, dtype=np.float64)
+        if X.shape != (xy.shape[0], 3):
+            raise InputError(f"{name}: object points must be (n, 3), got {X.shape}")
+        if not np.all(np.isfinite(X)):
+            raise InputError(f"{name}: object points contain NaN or inf")
+    if not np.all(np.isfinite(xy)):
+        bad = np.flatnonzero(~np.isfinite(xy).all(axis=1))[:5].tolist()
+        raise InputError(f"{name}: image coordinates contain NaN or inf (rows {bad})")
+    return view.astype(np.int64), xy, X
+
+
+class _FrameBase(ResidualBlock):
+    """Shared bookkeeping: which view and which object point each observation belongs to."""
+
+    group_size = 2
+
+    def __init__(self, view, xy, sigma, X=None, point=None, points_block="points",
+                 poses_block="poses", name=None):
+        view, xy, X = _check_views(type(self).__name__, view, xy, X)
+        if (X is None) == (point is None):
+            raise InputError("give either known object points X (n, 3) or point indices into "
+                             "a points block, not both")
+        super().__init__(np.broadcast_to(np.asarray(sigma, float), xy.shape).ravel(), name=name)
+        self.view, self.xy, self.X = view, xy, X
+        self.point = None if point is None else np.asarray(point, dtype=np.int64)
+        self.points_block, self.poses_block = points_block, poses_block
+
+    def _world(self, values):
+        return self.X if self.point is None else values[self.points_block][self.point]
+
+    def _pack(self, r2, d_pose, d_X, extra):
+        """Interleave (n, 2) residuals and Jacobians into rows x0, y0, x1, y1, …"""
+        n = r2.shape[0]
+        jac = dict(extra)
+        jac[self.poses_block] = Indexed(np.repeat(self.view, 2), d_pose.reshape(2 * n, 6))
+        if self.point is not None:
+            jac[self.points_block] = Indexed(np.repeat(self.point, 2), d_X.reshape(2 * n, 3))
+        return r2.ravel(), jac
+
+
+def _dproj(Xc):
+    """∂(X/Z, Y/Z)/∂Xc, (n, 2, 3)."""
+    x, y, z = Xc[:, 0], Xc[:, 1], Xc[:, 2]
+    iz = 1.0 / z
+    zero = np.zeros_like(z)
+    return np.stack(
+        [np.stack([iz, zero, -x * iz * iz], axis=1), np.stack([zero, iz, -y * iz * iz], axis=1)],
+        axis=1,
+    )
+
+
+def project_opencv(poses, view, X, intrinsics, dist):
+    """Pixel coordinates of world points in the OpenCV form (see the module docstring).
+
+    Returns
+    -------
+    uv_px : (n, 2) ndarray
+    """
+    Xc, _, _ = camera_coordinates(np.asarray(poses, float), np.asarray(view), np.asarray(X, float),
+                                  False)
+    xd = distort_opencv(Xc[:, :2] / Xc[:, 2:3], dist)
+    fx, fy, cx, cy = intrinsics
+    return np.column_stack([fx * xd[:, 0] + cx, fy * xd[:, 1] + cy])
+
+
+class FrameOpenCV(_FrameBase):
+    """Reprojection residuals of a frame camera in OpenCV's form (pixels).
+
+    Parameter blocks: ``intrinsics`` ``(fx, fy, cx, cy)`` in px, ``distortion``
+    ``(k1, k2, p1, p2, k3)``, ``poses`` ``(n_views, 6)``, and optionally a points block.
+
+    Parameters
+    ----------
+    view : (n,) int ndarray
+    uv_px : (n, 2) ndarray
+        Measured pixel coordinates (OpenCV convention: origin at the centre of the top-left
+        pixel, x right, y down).
+    sigma_px : float or (n, 2) ndarray
+    X : (n, 3) ndarray, optional
+        Known object points; or ``point`` indices into the points block.
+    square_pixels : bool
+        Use fx for both axes (OpenCV's FIX_ASPECT_RATIO with aspect 1); ``fy`` is then unused
+        and should be fixed.
+    """
+
+    name = "image points (OpenCV form)"
+
+    def __init__(self, view, uv_px, sigma_px=1.0, X=None, point=None, *, square_pixels=False,
+                 intrinsics_block="intrinsics", distortion_block="distortion", **kw):
+        super().__init__(view, uv_px, sigma_px, X, point, **kw)
+        self.square_pixels = square_pixels
+        self.intrinsics_block, self.distortion_block = intrinsics_block, distortion_block
+
+    def evaluate(self, values, jacobian):
+        poses = values[self.poses_block]
+        fx, fy, cx, cy = values[self.intrinsics_block]
+        if self.square_pixels:
+            fy = fx
+        dist = values[self.distortion_block]
+        Xc, d_pose, d_X = camera_coordinates(poses, self.view, self._world(values), jacobian)
+        if np.any(Xc[:, 2] <= 0):
+            raise InputError(
+                f"{int(np.sum(Xc[:, 2] <= 0))} object points lie behind or in the plane of the "
+                "camera: check the initial poses"
+            )
+        xn = Xc[:, :2] / Xc[:, 2:3]
+        J_xy, J_dist = distort_opencv_jacobian(xn, dist)
+        xd = distort_opencv(xn, dist)
+        uv = np.column_stack([fx * xd[:, 0] + cx, fy * xd[:, 1] + cy])
+        r2 = uv - self.xy
+        if not jacobian:
+            return r2.ravel(), None
+        n = r2.shape[0]
+        F = np.array([fx, fy])
+        d_intr = np.zeros((n, 2, 4))
+        d_intr[:, 0, 0] = xd[:, 0]
+        if self.square_pixels:
+            d_intr[:, 1, 0] = xd[:, 1]
+        else:
+            d_intr[:, 1, 1] = xd[:, 1]
+        d_intr[:, 0, 2] = 1.0
+        d_intr[:, 1, 3] = 1.0
+        d_dist = F[None, :, None] * J_dist
+        d_Xc = F[None, :, None] * np.einsum("nab,nbc->nac", J_xy, _dproj(Xc))
+        dp = np.einsum("nac,nck->nak", d_Xc, d_pose)
+        dX = np.einsum("nac,nck->nak", d_Xc, d_X)
+        extra = {self.intrinsics_block: d_intr.reshape(2 * n, 4),
+                 self.distortion_block: d_dist.reshape(2 * n, 5)}
+        return self._pack(r2, dp, dX, extra)
+
+
+def pixel_to_mm(uv_px, image_size, pixel_pitch_mm):
+    """Pixel (OpenCV: x right, y down, origin at the top-left pixel's centre) to mm from the
+    image centre with y up (the photogrammetric image frame).
+
+    Parameters
+    ----------
+    uv_px : (..., 2) ndarray
+    image_size : (width_px, height_px)
+    pixel_pitch_mm : float
+    """
+    uv = np.asarray(uv_px, dtype=np.float64)
+    w, h = image_size
+    return np.stack([(uv[..., 0] - (w - 1) / 2) * pixel_pitch_mm,
+                     -(uv[..., 1] - (h - 1) / 2) * pixel_pitch_mm], axis=-1)
+
+
+def mm_to_pixel(xy_mm, image_size, pixel_pitch_mm):
+    """Inverse of :func:`pixel_to_mm`."""
+    xy = np.asarray(xy_mm, dtype=np.float64)
+    w, h = image_size
+    return np.stack([xy[..., 0] / pixel_pitch_mm + (w - 1) / 2,
+                     -xy[..., 1] / pixel_pitch_mm + (h - 1) / 2], axis=-1)
+
+
+class FramePhotogrammetric(_FrameBase):
+    """Collinearity residuals in the photogrammetric form (mm), 003 Table 3 style.
+
+    Parameter blocks: ``interior`` ``(f, x0, y0)`` in mm, ``distortion_mm``
+    ``(K1, K2, K3, P1, P2)`` in mm⁻², mm⁻⁴, mm⁻⁶, mm⁻¹, mm⁻¹, ``poses`` ``(n_views, 6)`` with the
+    camera frame x right, y up, z backward; optionally a points block.
+
+    Parameters
+    ----------
+    view : (n,) int ndarray
+    xy_mm : (n, 2) ndarray
+        Measured image coordinates in mm from the image centre, y up (:func:`pixel_to_mm`).
+    sigma_mm : float or (n, 2) ndarray
+    X, point : see :class:`FrameOpenCV`.
+    """
+
+    name = "image points (photogrammetric form)"
+
+    def __init__(self, view, xy_mm, sigma_mm, X=None, point=None, *, interior_block="interior",
+                 distortion_block="distortion_mm", **kw):
+        super().__init__(view, xy_mm, sigma_mm, X, point, **kw)
+        self.interior_block, self.distortion_block = interior_block, distortion_block
+
+    def evaluate(self, values, jacobian):
+        poses = values[self.poses_block]
+        f, x0, y0 = values[self.interior_block]
+        KP = values[self.distortion_block]
+        Xc, d_pose, d_X = camera_coordinates(poses, self.view, self._world(values), jacobian)
+        if np.any(Xc[:, 2] >= 0):
+            raise InputError(
+                f"{int(np.sum(Xc[:, 2] >= 0))} object points lie behind the camera (the "
+                "photogrammetric camera looks along −z): check the initial poses"
+            )
+        xbar = self.xy - np.array([x0, y0])
+        delta = brown_correction(xbar, KP[:3], KP[3:])
+        q = Xc[:, :2] / Xc[:, 2:3]
+        r2 = xbar + delta + f * q  # 003 collinearity with corrections at the observation
+        if not jacobian:
+            return r2.ravel(), None
+        n = r2.shape[0]
+        J_xy, J_K, J_P = brown_correction_jacobian(xbar, KP[:3], KP[3:])
+        d_int = np.zeros((n, 2, 3))
+        d_int[:, :, 0] = q
+        d_int[:, :, 1:3] = -(np.eye(2)[None] + J_xy)  # ∂/∂(x0, y0) through x̄ = x − x0
+        d_dist = np.concatenate([J_K, J_P], axis=2)
+        d_Xc = f * _dproj(Xc)
+        dp = np.einsum("nac,nck->nak", d_Xc, d_pose)
+        dX = np.einsum("nac,nck->nak", d_Xc, d_X)
+        extra = {self.interior_block: d_int.reshape(2 * n, 3),
+                 self.distortion_block: d_dist.reshape(2 * n, 5)}
+        return self._pack(r2, dp, dX, extra)

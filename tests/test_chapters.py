@@ -1,0 +1,99 @@
+"""Execute every chapter of the book (GUIDE §6, kind 6).
+
+The chapters are the MyST Markdown notebooks listed in ``book/_toc.yml``. Each one is read with
+jupytext and executed with nbclient in its own directory, at reduced size
+(``HSGEO_SCALE=small``), one test per chapter. Pages without code cells are skipped. A failing
+cell fails the test with the cell's source and traceback in the message.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from pathlib import Path
+
+import pytest
+import yaml
+
+jupytext = pytest.importorskip("jupytext")
+nbclient = pytest.importorskip("nbclient")
+from nbclient.exceptions import CellExecutionError  # noqa: E402
+
+BOOK = Path(__file__).resolve().parents[1] / "book"
+TIMEOUT_S = 1800
+SUFFIXES = (".md", ".ipynb")
+_ANSI = re.compile(r"\x1b\[[0-9;]*m")
+
+
+def _toc_files(node) -> list[str]:
+    """All ``file:`` entries of a sphinx-external-toc tree, in order."""
+    found: list[str] = []
+    if isinstance(node, dict):
+        if "file" in node:
+            found.append(node["file"])
+        for key in ("parts", "chapters", "sections"):
+            for child in node.get(key, []) or []:
+                found.extend(_toc_files(child))
+    elif isinstance(node, list):
+        for child in node:
+            found.extend(_toc_files(child))
+    return found
+
+
+def _resolve(entry: str) -> Path:
+    path = BOOK / entry
+    if path.suffix in SUFFIXES and path.is_file():
+        return path
+    for suffix in SUFFIXES:
+        candidate = path.with_name(path.name + suffix)
+        if candidate.is_file():
+            return candidate
+    raise FileNotFoundError(f"book/_toc.yml lists {entry!r}, but no {entry}.md exists in book/")
+
+
+def _read(path: Path):
+    # MyST for .md pages: only {code-cell} directives are code, never a fenced example.
+    return jupytext.read(path, fmt="md:myst" if path.suffix == ".md" else None)
+
+
+def _has_code_cells(path: Path) -> bool:
+    nb = _read(path)
+    return any(cell.cell_type == "code" for cell in nb.cells)
+
+
+def _chapters() -> list[Path]:
+    toc = yaml.safe_load((BOOK / "_toc.yml").read_text(encoding="utf-8"))
+    entries = [toc["root"], *_toc_files(toc)]
+    return [_resolve(entry) for entry in entries]
+
+
+CHAPTERS = _chapters()
+
+
+@pytest.mark.parametrize("path", CHAPTERS, ids=[p.stem for p in CHAPTERS])
+def test_chapter_executes(path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    if not _has_code_cells(path):
+        pytest.skip(f"{path.relative_to(BOOK)} has no code cells")
+    # The kernel inherits this process's environment: reduced size, headless plotting,
+    # one BLAS thread (as in the Makefile).
+    monkeypatch.setenv("HSGEO_SCALE", "small")
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+    monkeypatch.setenv("PYDEVD_DISABLE_FILE_VALIDATION", "1")
+    for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"):
+        if var not in os.environ:
+            monkeypatch.setenv(var, "1")
+
+    nb = _read(path)
+    client = nbclient.NotebookClient(
+        nb,
+        timeout=TIMEOUT_S,
+        kernel_name="python3",
+        resources={"metadata": {"path": str(path.parent)}},
+    )
+    failure = None
+    try:
+        client.execute()
+    except CellExecutionError as err:
+        failure = _ANSI.sub("", str(err))  # the cell's source, output and traceback
+    if failure is not None:
+        pytest.fail(f"{path.relative_to(BOOK)}: a cell failed\n{failure}", pytrace=False)
