@@ -1,0 +1,1 @@
+"""Measurement from pixels: image → observations."""

@@ -1,0 +1,167 @@
+"""Chapter ``frame-reference``: self-calibration with hsgeo's engine, checked against OpenCV.
+
+Three experiments:
+
+1. OpenCV's calibration-tutorial chessboard (8 views × 54 real corners, in the OpenCV file): hsgeo
+   under OpenCV's constraints (principal point fixed at the centre, square pixels, no decentering)
+   against the published result; then the same data in the photogrammetric form of Brown's model.
+2. Four real ChArUco photographs: corners detected with ``cv2.aruco``, all 9 intrinsics by hsgeo
+   and by today's ``cv2.calibrateCamera`` on the same corners.
+3. A simulated bench with the tutorial camera as truth (seeded): truth within 3σ̂.
+"""
+
+from __future__ import annotations
+
+from importlib import resources
+
+import numpy as np
+
+from hsgeo.calibration import View, calibrate_opencv, calibrate_photogrammetric
+from hsgeo.io import read_opencv_storage
+from hsgeo.measure.charuco import CharucoBoardSpec, detect_charuco
+from hsgeo.reproduce import Reproduction, Row
+
+__all__ = ["run", "chessboard_views", "charuco_views", "reference_dir", "PIXEL_PITCH_MM"]
+
+#: nominal pixel pitch of the tutorial webcam (unknown; it only scales the mm units: f/pitch,
+#: the residuals in px and the fit do not depend on it)
+PIXEL_PITCH_MM = 0.006
+
+
+def reference_dir():
+    """Folder of the shipped reference data (``src/hsgeo/data/reference``)."""
+    return resources.files("hsgeo") / "data" / "reference"
+
+
+def chessboard_views():
+    """The tutorial's 8 views of the 9×6 chessboard (50 mm squares) and OpenCV's result.
+
+    Returns
+    -------
+    views : list of View
+    image_size : (640, 480)
+    ref : dict
+        ``fx_px``, ``k1``, ``k2``, ``k3``, ``rms_px`` of OpenCV's file, and the raw file entries.
+    """
+    d = read_opencv_storage(
+        reference_dir() / "opencv-chessboard" / "out_camera_data.yml",
+        required=("Image_points", "Camera_Matrix", "Distortion_Coefficients", "board_Width",
+                  "board_Height", "square_Size", "image_Width", "image_Height"),
+    )
+    nx, ny, sq = int(d["board_Width"]), int(d["board_Height"]), d["square_Size"]
+    uv = d["Image_points"].reshape(-1, nx * ny, 2)
+    k = np.arange(nx * ny)  # row-major board order: object point k = (sq (k % nx), sq (k // nx), 0)
+    X = np.column_stack([sq * (k % nx), sq * (k // nx), np.zeros(k.size)])
+    views = [View(X, uv[i], k) for i in range(uv.shape[0])]
+    dist = d["Distortion_Coefficients"].ravel()
+    ref = {"fx_px": d["Camera_Matrix"][0, 0], "k1": dist[0], "k2": dist[1], "k3": dist[4],
+           "rms_px": d["Avg_Reprojection_Error"], "file": d}
+    return views, (int(d["image_Width"]), int(d["image_Height"])), ref
+
+
+def charuco_views(spec: CharucoBoardSpec | None = None):
+    """ChArUco corners detected in the four tutorial photographs, and the 2021 reference file."""
+    spec = spec or CharucoBoardSpec()
+    folder = reference_dir() / "opencv-charuco"
+    views = []
+    for i in range(4):
+        ids, uv, X = detect_charuco(folder / "images" / f"img_{i:02d}.jpg", spec)
+        views.append(View(X, uv, ids))
+    ref = read_opencv_storage(folder / "tutorial_camera_charuco.yml",
+                              required=("camera_matrix", "distortion_coefficients"))
+    return views, (int(ref["image_width"]), int(ref["image_height"])), ref
+
+
+def opencv_calibrate(views, image_size, flags=0):
+    """``cv2.calibrateCamera`` on the same views: (K, dist (k1, k2, p1, p2, k3), rms_px)."""
+    import cv2
+
+    obj = [v.X.astype(np.float32) for v in views]
+    img = [v.uv_px.astype(np.float32).reshape(-1, 1, 2) for v in views]
+    crit = (cv2.TERM_CRITERIA_COUNT + cv2.TERM_CRITERIA_EPS, 200, 1e-15)
+    rms, K, dist, _, _ = cv2.calibrateCamera(obj, img, image_size, None, None, flags=flags,
+                                             criteria=crit)
+    return K, dist.ravel()[:5], float(rms)
+
+
+INTRINSIC_ROWS = (("fx_px", "px"), ("fy_px", "px"), ("cx_px", "px"), ("cy_px", "px"),
+                  ("k1", "1"), ("k2", "1"), ("p1", "1"), ("p2", "1"), ("k3", "1"))
+
+
+def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
+    """Compute every table of the chapter (``scale`` is unused: the data are small)."""
+    from hsgeo.simulate.frame_bench import simulate
+    from hsgeo.simulate.scenarios import load_scenario
+
+    rows: list[Row] = []
+    extras: dict = {}
+
+    # 1. chessboard under OpenCV's constraints (flags 14)
+    views, size, ref = chessboard_views()
+    cal = calibrate_opencv(views, size, fix_principal_point=True, square_pixels=True,
+                           zero_tangent=True)
+    v, s = cal.values(), cal.sigmas()
+    t = "OpenCV chessboard"
+    for q in ("fx_px", "k1", "k2", "k3"):
+        rows.append(Row(t, q, "px" if q.endswith("px") else "1", paper=ref[q], reproduced=v[q],
+                        sigma=s[q]))
+    rows.append(Row(t, "rms_px", "px", paper=ref["rms_px"], reproduced=cal.rms_px))
+    pg = calibrate_photogrammetric(views, size, PIXEL_PITCH_MM, fix_principal_point=True,
+                                   zero_decentering=True)
+    t = "two forms of Brown's model (chessboard)"
+    f_pg, sf_pg = pg.values()["f_mm"] / PIXEL_PITCH_MM, pg.sigmas()["f_mm"] / PIXEL_PITCH_MM
+    rows += [
+        Row(t, "f_px_opencv_form", "px", reproduced=v["fx_px"], sigma=s["fx_px"]),
+        Row(t, "f_px_photogrammetric_form", "px", reproduced=f_pg, sigma=sf_pg),
+        Row(t, "rms_px_opencv_form", "px", reproduced=cal.rms_px),
+        Row(t, "rms_px_photogrammetric_form", "px", reproduced=pg.rms_px),
+    ]
+    extras["chessboard"] = {"views": views, "opencv_form": cal, "photogrammetric_form": pg,
+                            "reference": ref}
+
+    # 2. ChArUco: hsgeo vs today's cv2.calibrateCamera on the same detected corners
+    cviews, csize, cref = charuco_views()
+    ccal = calibrate_opencv(cviews, csize)
+    K, dist, rms_cv = opencv_calibrate(cviews, csize)
+    cv_vals = {"fx_px": K[0, 0], "fy_px": K[1, 1], "cx_px": K[0, 2], "cy_px": K[1, 2],
+               "k1": dist[0], "k2": dist[1], "p1": dist[2], "p2": dist[3], "k3": dist[4]}
+    hv, hs = ccal.values(), ccal.sigmas()
+    t = "OpenCV ChArUco"
+    for q, unit in INTRINSIC_ROWS:
+        rows.append(Row(t, q, unit, paper=cv_vals[q], reproduced=hv[q], sigma=hs[q]))
+    rows.append(Row(t, "rms_px", "px", paper=rms_cv, reproduced=ccal.rms_px))
+    cm, cd = cref["camera_matrix"], cref["distortion_coefficients"].ravel()
+    extras["charuco"] = {"views": cviews, "hsgeo": ccal, "opencv": cv_vals, "opencv_rms": rms_cv,
+                         "reference_2021": {"fx_px": cm[0, 0], "fy_px": cm[1, 1], "cx_px": cm[0, 2],
+                                            "cy_px": cm[1, 2], "k1": cd[0], "k2": cd[1],
+                                            "p1": cd[2], "p2": cd[3], "k3": cd[4],
+                                            "rms_px": cref["avg_reprojection_error"]}}
+
+    # 3. simulated bench, truth known
+    cfg = load_scenario("frame_bench")
+    sim = simulate(cfg, seed)
+    n_views = sim["poses"].shape[0]
+    sviews = [View(sim["X"], sim["uv_px"][sim["view"] == i]) for i in range(n_views)]
+    scal = calibrate_opencv(sviews, (cfg["camera"]["width_px"], cfg["camera"]["height_px"]),
+                            sigma_px=cfg["camera"]["sigma_px"])
+    truth = dict(zip(("fx_px", "fy_px", "cx_px", "cy_px"), sim["intrinsics"], strict=True))
+    truth.update(zip(("k1", "k2", "p1", "p2", "k3"), sim["distortion"], strict=True))
+    sv, ss = scal.values(), scal.sigmas()
+    t = "simulated bench"
+    for q, unit in INTRINSIC_ROWS:
+        rows.append(Row(t, q, unit, reproduced=sv[q], sigma=ss[q], truth=truth[q]))
+    rows.append(Row(t, "sigma0", "1", reproduced=scal.result.sigma0, truth=1.0))
+    extras["bench"] = {"calibration": scal, "truth": truth, "simulation": sim}
+
+    meta = {
+        "chessboard_source": "opencv/opencv samples/cpp/tutorial_code/calib3d/camera_calibration/"
+                             "out_camera_data.yml (flags 14)",
+        "charuco_source": "opencv_contrib aruco tutorial images img_00..03.jpg; board 5x7, "
+                          "0.04 m squares, 0.02 m markers, DICT_6X6_250",
+        "charuco_corners_per_image": [int(v.X.shape[0]) for v in cviews],
+        "charuco_reference_2021": extras["charuco"]["reference_2021"],
+        "pixel_pitch_mm_nominal": PIXEL_PITCH_MM,
+        "bench_seed": seed,
+        "iterations": {"chessboard": cal.result.iterations, "charuco": ccal.result.iterations},
+    }
+    return Reproduction("frame-reference", seed, rows, meta, extras)
