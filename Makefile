@@ -33,7 +33,7 @@ data: $(STAMP) ## regenerate data_synthetic/generated from the scenario TOMLs an
 
 test: $(STAMP) ## the whole test suite, chapters included (about 5 min on 2 cores)
 	$(PY) -m hsgeo.cli data --verify
-	$(PY) -m pytest -q -m "not slow or slow" tests
+	$(PY) -m pytest -q tests
 
 test-fast: $(STAMP) ## the test suite without the chapter executions and slow Monte Carlo tests
 	$(PY) -m pytest -q -m "not slow" --ignore=tests/test_chapters.py tests
@@ -48,7 +48,6 @@ bench: $(STAMP) ## run the benchmarks, results as JSON in bench/results/
 
 lint: $(STAMP) ## ruff (numpydoc docstring convention)
 	$(VENV)/bin/ruff check src tests bench
-	$(VENV)/bin/ruff format --check src tests bench
 
 lock: ## re-resolve the environment from pyproject.toml and rewrite requirements.lock
 	rm -rf $(VENV)

@@ -1,11 +1,11 @@
 import numpy as np
 import pytest
 from scipy.optimize import least_squares
+from toy_models import Bearings, Exponential, Line, bearing_scene
 
 from hsgeo import ConvergenceError, DatumError, InputError, ObservationError
 from hsgeo.adjust import Parameters, adjust, identifiability
 from hsgeo.adjust.checks import check_jacobian
-from toy_models import Bearings, Exponential, Line, bearing_scene
 
 
 def line_data(seed, n=50, sigma=0.1):
@@ -44,7 +44,8 @@ def test_nonlinear_matches_scipy():
 def _bearing_params(S, P, st, pt, th, points=True, n_control=2, sigma_ctrl=1e-3, seed=0):
     rng = np.random.default_rng(seed)
     p = Parameters()
-    p.add("stations", S + rng.normal(0, [2, 2, 0.02], S.shape), columns=("x_m", "y_m", "heading_rad"))
+    p.add("stations", S + rng.normal(0, [2, 2, 0.02], S.shape),
+          columns=("x_m", "y_m", "heading_rad"))
     p.add("points", P + rng.normal(0, 1.0, P.shape), points=points, columns=("x_m", "y_m"))
     for j in range(n_control):
         p.set_prior("points", sigma_ctrl, index=j, mean=P[j])

@@ -75,7 +75,8 @@ def bearing_scene(rng, n_stations=6, n_points=40, sigma_rad=1e-3, coverage=4):
     """Stations on a circle looking inward, points inside; returns truth and observations."""
     rng = np.random.default_rng(rng)
     ang = np.linspace(0, 2 * np.pi, n_stations, endpoint=False)
-    S = np.column_stack([100 * np.cos(ang), 100 * np.sin(ang), ang + np.pi + 0.1 * rng.standard_normal(n_stations)])
+    heading = ang + np.pi + 0.1 * rng.standard_normal(n_stations)
+    S = np.column_stack([100 * np.cos(ang), 100 * np.sin(ang), heading])
     P = rng.uniform(-40, 40, (n_points, 2))
     st, pt = [], []
     for j in range(n_points):

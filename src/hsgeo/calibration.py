@@ -241,8 +241,10 @@ def calibrate_photogrammetric(
     reject_k: float | None = None,
     progress=None,
 ) -> FrameCalibration:
-    """Self-calibrate a frame camera in the photogrammetric form (mm, corrections at the measured
-    coordinates; see :class:`hsgeo.sensors.frame.FramePhotogrammetric`).
+    """Self-calibrate a frame camera in the photogrammetric form.
+
+    Millimetre image coordinates, corrections at the measured coordinates; see
+    :class:`hsgeo.sensors.frame.FramePhotogrammetric`.
 
     Parameters
     ----------

@@ -8,8 +8,8 @@ of outlier rejection.
 
 Jacobians come in one of three forms, keyed by parameter-block name:
 
-* :class:`Indexed` ``(index, d)``: row ``j`` touches the items ``index[j]`` of the block viewed as an
-  ``(n_items, k)`` array, with derivatives ``d[j]`` — per-image exterior orientations, per-point
+* :class:`Indexed` ``(index, d)``: row ``j`` touches the items ``index[j]`` of the block viewed as
+  an ``(n_items, k)`` array, with derivatives ``d[j]`` — per-image exterior orientations, per-point
   coordinates, spline nodes (``index`` of shape ``(m, q)`` when a row touches ``q`` items). The
   engine needs this form for the points block.
 * a dense ``(m, block.size)`` array, for small global blocks (focal length, distortion).

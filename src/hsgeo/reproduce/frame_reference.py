@@ -73,8 +73,14 @@ def charuco_views(spec: CharucoBoardSpec | None = None):
 
 
 def opencv_calibrate(views, image_size, flags=0):
-    """``cv2.calibrateCamera`` on the same views: (K, dist (k1, k2, p1, p2, k3), rms_px)."""
+    """``cv2.calibrateCamera`` on the same views: (K, dist (k1, k2, p1, p2, k3), rms_px).
+
+    OpenCV runs single-threaded here: with its thread pool the result varies in the 7th digit from
+    call to call, and the book's numbers must be the same bits for the same input.
+    """
     import cv2
+
+    cv2.setNumThreads(1)
 
     obj = [v.X.astype(np.float32) for v in views]
     img = [v.uv_px.astype(np.float32).reshape(-1, 1, 2) for v in views]

@@ -126,7 +126,7 @@ class _FrameBase(ResidualBlock):
         return self.X if self.point is None else values[self.points_block][self.point]
 
     def _pack(self, r2, d_pose, d_X, extra):
-        """Interleave (n, 2) residuals and Jacobians into rows x0, y0, x1, y1, …"""
+        """Interleave (n, 2) residuals and Jacobians into rows x0, y0, x1, y1, …."""
         n = r2.shape[0]
         jac = dict(extra)
         jac[self.poses_block] = Indexed(np.repeat(self.view, 2), d_pose.reshape(2 * n, 6))
@@ -227,8 +227,9 @@ class FrameOpenCV(_FrameBase):
 
 
 def pixel_to_mm(uv_px, image_size, pixel_pitch_mm):
-    """Pixel (OpenCV: x right, y down, origin at the top-left pixel's centre) to mm from the
-    image centre with y up (the photogrammetric image frame).
+    """Pixel coordinates to mm from the image centre with y up (photogrammetric image frame).
+
+    Pixels in OpenCV's convention: x right, y down, origin at the centre of the top-left pixel.
 
     Parameters
     ----------

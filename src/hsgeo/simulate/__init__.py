@@ -1,4 +1,4 @@
-"""Simulators: one module per instrument scenario; every function takes ``rng`` (int or Generator)."""
+"""Simulators: one module per instrument scenario; every function takes ``rng`` (int/Generator)."""
 
 import numpy as np
 
@@ -6,7 +6,7 @@ __all__ = ["as_rng"]
 
 
 def as_rng(rng) -> np.random.Generator:
-    """A ``numpy.random.Generator`` from an int seed or a Generator (GUIDE §3: same seed, same bytes)."""
+    """A ``numpy.random.Generator`` from an int seed or a Generator (same seed, same bytes)."""
     if isinstance(rng, np.random.Generator):
         return rng
     if isinstance(rng, (int, np.integer)) and rng >= 0:
