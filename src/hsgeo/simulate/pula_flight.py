@@ -1,0 +1,190 @@
+"""An airborne line-scanner flight over a GCP calibration field (000 § Verification; 001 §2.1).
+
+The ImSpector V9 + PixelFly scanner, coupled to an iMAR iVRU-RSSC IMU (200 Hz) and a
+single-frequency GPS, flies one line over a field of ground control points. The truth is a smooth
+trajectory with helicopter-like attitude motion; the recorded navigation adds GNSS and IMU errors;
+the scanner is mounted with an unknown boresight misalignment. Each GCP is observed where the
+true sensor sees it: its line (sub-line centroid, with noise) and its pixel ζ (with noise).
+
+Every function takes ``rng``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from hsgeo.geocode import R_ENU_FROM_NED, CalibratedLine, LineGeometry
+from hsgeo.navigation import Navigation
+from hsgeo.rotations import R_from_rpy
+from hsgeo.simulate import as_rng
+
+__all__ = ["Flight", "simulate_flight", "gcp_field", "observe_gcps", "generate"]
+
+
+@dataclass
+class Flight:
+    """One simulated flight: truth, recorded navigation and GCP observations."""
+
+    true_nav: Navigation
+    recorded_nav: Navigation
+    boresight_rad: np.ndarray  # true (roll, pitch, heading) misalignment of the scanner
+    t0_s: float  # time of line 0
+    line_rate_hz: float
+    gcp_id: np.ndarray
+    gcp_enu_m: np.ndarray  # (n, 3) true GCP coordinates
+    line: np.ndarray  # (n,) measured (fractional) line of each GCP
+    zeta_px: np.ndarray  # (n,) measured pixel of each GCP
+    terrain_height_m: float
+    sensor: LineGeometry  # the true sensor
+
+
+def gcp_field(cfg: dict) -> tuple[np.ndarray, np.ndarray]:
+    """GCP ids and (E, N, U) from the scenario's ``[field]`` table."""
+    f, fl = cfg["field"], cfg["flight"]
+    ids = np.asarray(f["gcp_id"], dtype=int)
+    h = np.deg2rad(fl["heading_deg"])
+    u = np.array([np.sin(h), np.cos(h)])  # along track (E, N)
+    w = np.array([np.cos(h), -np.sin(h)])  # across track, to the right
+    across_m = np.asarray(f["across_px"]) * fl["height_agl_m"] / cfg["sensor_truth"]["c_px"]
+    EN = np.asarray(fl["start_EN_m"]) + np.outer(f["along_m"], u) + np.outer(across_m, w)
+    return ids, np.column_stack([EN, np.full(len(ids), f["height_m"])])
+
+
+def _true_trajectory(cfg: dict, rng) -> tuple[Navigation, float, float]:
+    fl = cfg["flight"]
+    v, H = fl["speed_m_s"], fl["height_agl_m"] + cfg["field"]["height_m"]
+    heading = np.deg2rad(fl["heading_deg"])
+    length = fl["strip_length_m"]
+    T = length / v
+    t = np.arange(0.0, T + 1e-9, 1.0 / cfg["imu"]["rate_hz"])
+    u = np.array([np.sin(heading), np.cos(heading)])  # flight direction in (E, N)
+    start = np.array(fl["start_EN_m"])
+    # attitude motion: a few sinusoids per axis with random phases (helicopter-like)
+    amp = np.deg2rad(np.array(fl["attitude_motion_deg"]))
+    per = np.array(fl["attitude_period_s"])
+    ph = rng.uniform(0, 2 * np.pi, 3)
+    rpy = np.stack([amp[k] * np.sin(2 * np.pi * t / per[k] + ph[k]) for k in range(3)], axis=1)
+    rpy[:, 2] += heading
+    s = v * t
+    lateral = fl["lateral_wander_m"] * np.sin(2 * np.pi * t / (2.5 * per[0]) + ph[1])
+    EN = start + s[:, None] * u + lateral[:, None] * np.array([u[1], -u[0]])
+    U = H + fl["height_wander_m"] * np.sin(2 * np.pi * t / (3 * per[1]) + ph[2])
+    return Navigation(t, np.column_stack([EN, U]), rpy), T, H
+
+
+def _recorded(nav: Navigation, cfg: dict, rng) -> Navigation:
+    """Add GNSS and IMU errors (001 §2.1: iVRU-RSSC attitude resolution < 0.01°)."""
+    g, imu = cfg["gnss"], cfg["imu"]
+    n = nav.t_s.size
+    dt = np.diff(nav.t_s, prepend=nav.t_s[0])
+    pos_bias = rng.normal(0, g["bias_m"], 3)
+    walk = np.cumsum(rng.normal(0, 1, (n, 3)) * np.sqrt(dt)[:, None], axis=0) * g["random_walk_m_per_sqrt_s"]
+    pos = nav.enu_m + pos_bias + walk + rng.normal(0, g["white_m"], (n, 3))
+    att_bias = rng.normal(0, np.deg2rad(imu["attitude_bias_deg"]), 3)
+    att = (nav.rpy_rad + att_bias + rng.normal(0, np.deg2rad(imu["attitude_noise_deg"]), (n, 3))
+           + np.deg2rad(imu["heading_drift_deg_per_s"]) * nav.t_s[:, None] * np.array([0, 0, 1]))
+    return Navigation(nav.t_s, pos, att)
+
+
+def observe_gcps(nav: Navigation, sensor: LineGeometry, boresight_rad, t0_s, line_rate_hz,
+                 gcp_enu_m, rng, sigma_line: float, sigma_px: float):
+    """Where the true sensor sees each GCP: (fractional line, ζ), with measurement noise.
+
+    The line time is where the GCP crosses the scan plane (sensor x = 0), found by bisection on
+    the true trajectory; ζ follows from the true sensor's inverse model.
+    """
+    R_bs = R_from_rpy(*boresight_rad)
+
+    def sensor_coords(t, X):
+        pos, rpy = nav.at(t)
+        R = R_ENU_FROM_NED @ R_from_rpy(rpy[:, 0], rpy[:, 1], rpy[:, 2]) @ R_bs  # map<-sensor
+        return np.einsum("nji,nj->ni", R, X - pos)
+
+    lo = np.full(len(gcp_enu_m), nav.t_s[0])
+    hi = np.full(len(gcp_enu_m), nav.t_s[-1])
+    f_lo = sensor_coords(lo, gcp_enu_m)[:, 0]
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        f_mid = sensor_coords(mid, gcp_enu_m)[:, 0]
+        left = np.sign(f_mid) == np.sign(f_lo)
+        lo = np.where(left, mid, lo)
+        f_lo = np.where(left, f_mid, f_lo)
+        hi = np.where(left, hi, mid)
+    t = 0.5 * (lo + hi)
+    xs = sensor_coords(t, gcp_enu_m)
+    zeta = sensor.zeta(xs[:, 1] / xs[:, 2])
+    line = (t - t0_s) * line_rate_hz
+    return (line + rng.normal(0, sigma_line, line.size),
+            zeta + rng.normal(0, sigma_px, zeta.size))
+
+
+def true_sensor(cfg: dict) -> CalibratedLine:
+    s = cfg["sensor_truth"]
+    return CalibratedLine(s["zeta0_px"], s["c_px"], tuple(s["K"]), s["norm_px"])
+
+
+def simulate_flight(cfg: dict, rng) -> Flight:
+    """One flight over the field (see the module docstring)."""
+    rng = as_rng(rng)
+    nav, T, _ = _true_trajectory(cfg, rng)
+    rec = _recorded(nav, cfg, rng)
+    bs = rng.normal(0, np.deg2rad(cfg["flight"]["boresight_sigma_deg"]), 3)
+    ids, enu = gcp_field(cfg)
+    sensor = true_sensor(cfg)
+    rate = cfg["scanner"]["line_rate_hz"]
+    m = cfg["measurement"]
+    line, zeta = observe_gcps(nav, sensor, bs, 0.0, rate, enu, rng, m["sigma_line"],
+                              m["sigma_px"])
+    return Flight(nav, rec, bs, 0.0, rate, ids, enu, line, zeta, cfg["field"]["height_m"], sensor)
+
+
+def generate(cfg: dict, outdir: Path) -> list[Path]:
+    """``make data``: the recorded navigation and GCP observations of the scenario's seed."""
+    fl = simulate_flight(cfg, cfg["scenario"]["seed"])
+    nav = fl.recorded_nav.write_csv(outdir / "pula_flight_navigation.csv")
+    obs = outdir / "pula_flight_gcp_observations.csv"
+    np.savetxt(obs, np.column_stack([fl.gcp_id, fl.line, fl.zeta_px, fl.gcp_enu_m]),
+               delimiter=",", fmt=["%d"] + ["%.17g"] * 5,
+               header="gcp,line,zeta_px,E_m,N_m,U_m", comments="")
+    return [nav, obs]
+
+
+def airfield_scene(E_m, N_m, gcp_enu_m=None, target_m: float = 3.0) -> np.ndarray:
+    """Radiance of a synthetic airfield: asphalt texture, painted stripes and white GCP targets.
+
+    A smooth deterministic texture (sums of sinusoids) on a mid-grey background, white stripes
+    every 30 m in both directions, and a white square of ``target_m`` with a black centre at each
+    GCP, so that misregistration shows as shifted edges in a difference image.
+    """
+    E, N = np.asarray(E_m, float), np.asarray(N_m, float)
+    val = 0.3 + 0.05 * (np.sin(E / 7.3) * np.cos(N / 5.1) + np.sin((E + N) / 11.7))
+    stripe = (np.abs(((E + 4.0) % 30.0) - 15.0) > 14.0) | (np.abs(((N + 9.0) % 30.0) - 15.0) > 14.4)
+    val = np.where(stripe, 0.8, val)
+    if gcp_enu_m is not None:
+        for e, n, _ in np.asarray(gcp_enu_m):
+            inside = (np.abs(E - e) < target_m / 2) & (np.abs(N - n) < target_m / 2)
+            centre = (np.abs(E - e) < target_m / 6) & (np.abs(N - n) < target_m / 6)
+            val = np.where(inside, 0.95, val)
+            val = np.where(centre, 0.05, val)
+    return val
+
+
+def render_line_image(fl: Flight, cfg: dict, rng=None, *, noise: float = 0.005):
+    """What the scanner records along the flight: ``(n_lines, n_px)`` radiance and the ζ of the
+    columns (pixel centres ζ0 ± usable half width), rendered with the *true* navigation, boresight
+    and sensor, with Gaussian noise."""
+    from hsgeo.geocode import PlaneTerrain, geocode_image
+
+    rng = as_rng(0 if rng is None else rng)
+    half = cfg["scanner"]["usable_half_width_px"]
+    z0 = round(cfg["sensor_truth"]["zeta0_px"])
+    zeta = np.arange(z0 - half, z0 + half + 1, dtype=float)
+    n_lines = int((fl.true_nav.t_s[-1] - fl.t0_s) * fl.line_rate_hz)
+    ground = geocode_image(fl.true_nav, fl.sensor, n_lines, zeta, t0_s=fl.t0_s,
+                           line_rate_hz=fl.line_rate_hz, terrain=PlaneTerrain(fl.terrain_height_m),
+                           boresight_rad=fl.boresight_rad)
+    img = airfield_scene(ground[..., 0], ground[..., 1], fl.gcp_enu_m)
+    return img + noise * rng.standard_normal(img.shape), zeta
