@@ -1,0 +1,1 @@
+"""Measurement: images → observations (tables of image coordinates and ids)."""
