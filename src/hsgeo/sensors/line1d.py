@@ -84,6 +84,7 @@ __all__ = [
     "make_parameters",
     "resect",
     "calibrate",
+    "calibrate_files",
 ]
 
 #: The unit of (ζ − ζ0) in the distortion polynomial: 100 px (see the module docstring).
@@ -550,3 +551,73 @@ def calibrate(params: Parameters, block: LineObservations, *, stages: bool = Tru
         p = adjust(p, block, check_datum=False, raise_on_failure=False).params
         p["K"].free = final_free["K"].copy()
     return adjust(p, block, **kw)
+
+
+def _read_csv(path, columns, what):
+    import csv
+    from pathlib import Path
+
+    p = Path(path)
+    if not p.is_file():
+        raise InputError(f"{what} file {str(p)!r} not found")
+    with p.open(newline="") as fh:
+        rd = csv.DictReader(fh)
+        if rd.fieldnames is None or not set(columns) <= {c.strip() for c in rd.fieldnames}:
+            raise InputError(f"{what} file {str(p)!r} must have a header with columns "
+                             f"{', '.join(columns)}; found {rd.fieldnames}")
+        rows = [{k.strip(): (v or "").strip() for k, v in r.items()} for r in rd]
+    if not rows:
+        raise InputError(f"{what} file {str(p)!r} has no data rows")
+    return rows
+
+
+def calibrate_files(observations, control, *, zeta0_px: float = 485.0, c_px: float = 3600.0,
+                    sigma_px: float = 0.1, reject_k: float | None = None) -> dict:
+    """Calibrate one spectral line from a user's files (``hsgeo calibrate-line``).
+
+    Parameters
+    ----------
+    observations : path
+        CSV with header ``image,point,zeta_px``: image id, point id, measured ζ [px] (pixel-centre
+        origin at column 0), one row per measured minimum.
+    control : path
+        CSV with header ``point,x_m,y_m``: control point id and its coordinates [m] in the scanner
+        plane. Every observed point must be a control point; off-line points (e.g. side signals
+        in front of the pattern) make the scale determinable (see the ``line-calibration``
+        chapter).
+    zeta0_px, c_px : float
+        Initial inner orientation (default: 000 Table 1 'uncalibrated').
+    sigma_px : float
+        A-priori σ of a measured ζ.
+
+    Returns
+    -------
+    dict with ``result`` (AdjustmentResult), ``image_ids``, ``point_ids``, ``residuals_px``.
+    """
+    obs = _read_csv(observations, ("image", "point", "zeta_px"), "observations")
+    ctl = _read_csv(control, ("point", "x_m", "y_m"), "control")
+    try:
+        pid = [r["point"] for r in ctl]
+        xy = np.array([[float(r["x_m"]), float(r["y_m"])] for r in ctl])
+        z = np.array([float(r["zeta_px"]) for r in obs])
+    except ValueError as exc:
+        raise InputError(f"non-numeric value in the input files: {exc}") from exc
+    if len(set(pid)) != len(pid):
+        raise InputError("control file lists a point id twice")
+    index = {p: i for i, p in enumerate(pid)}
+    missing = sorted({r["point"] for r in obs} - set(index))
+    if missing:
+        raise InputError(f"observed points without control coordinates: {missing[:10]}; add them "
+                         "to the control file")
+    image_ids = list(dict.fromkeys(r["image"] for r in obs))
+    img = np.array([image_ids.index(r["image"]) for r in obs])
+    pt = np.array([index[r["point"]] for r in obs])
+    blk = LineObservations(img, pt, z, sigma_px)  # NaN check
+    check_minimum_observations(img, pt, np.ones(len(pid), bool), len(image_ids))
+    eop = np.array([resect(xy[pt[img == i]], z[img == i], zeta0_px, c_px).eop
+                    for i in range(len(image_ids))])
+    p = make_parameters(eop, zeta0_px, c_px, [0.0, 0.0, 0.0], xy, np.ones(len(pid), bool),
+                        image_ids=image_ids, point_ids=pid)
+    res = calibrate(p, blk, reject_k=reject_k)
+    return {"result": res, "image_ids": image_ids, "point_ids": pid,
+            "residuals_px": res.residuals(blk.name)}
