@@ -21,6 +21,32 @@ def _cmd_reproduce(args) -> int:
     return 0
 
 
+def _cmd_calibrate_line(args) -> int:
+    import json
+
+    import numpy as np
+
+    from hsgeo.sensors.line1d import calibrate_files
+
+    out = calibrate_files(args.observations, args.control, zeta0_px=args.zeta0_px,
+                          c_px=args.c_px, sigma_px=args.sigma_px, reject_k=args.reject_k)
+    res, v = out["result"], out["residuals_px"]
+    names = [("zeta0_px", res.value("zeta0_px"), res.sigma("zeta0_px"))]
+    names += [("c_px", res.value("c_px"), res.sigma("c_px"))]
+    names += [(k, a, s) for k, a, s in zip(("K1", "K2", "K3"), res.value("K"), res.sigma("K"))]
+    stats = {"sigma0": res.sigma0, "dof": res.dof, "rms_px": float(np.sqrt(np.mean(v**2))),
+             "max_abs_px": float(np.max(np.abs(v))), "n_observations": int(v.size)}
+    if args.json:
+        print(json.dumps({"parameters": {k: {"value": float(a), "sigma": float(s)}
+                                          for k, a, s in names},
+                          "residuals": stats}, indent=1))
+    else:
+        print(res.report())
+        print(f"residuals: RMS {stats['rms_px']:.4f} px, max |v| {stats['max_abs_px']:.4f} px "
+              f"over {stats['n_observations']} observations")
+    return 0
+
+
 def _cmd_data(args) -> int:
     from hsgeo.simulate.scenarios import generate_all
 
@@ -54,6 +80,22 @@ def build_parser() -> argparse.ArgumentParser:
                    help="problem size in (0, 1] for chapters that have a size knob (default 1)")
     p.add_argument("--json", action="store_true", help="one JSON object instead of text tables")
     p.set_defaults(func=_cmd_reproduce)
+
+    p = sub.add_parser(
+        "calibrate-line",
+        help="calibrate one spectral line of a 1D line scanner (000 eq. 2) from measured minima",
+        description="OBSERVATIONS: CSV 'image,point,zeta_px' (ids, ζ in px, pixel-centre "
+        "origin); CONTROL: CSV 'point,x_m,y_m' (coordinates in the scanner plane, m). Some "
+        "control points must lie off the pattern line, or the scale c is undetermined.")
+    p.add_argument("observations", metavar="OBSERVATIONS")
+    p.add_argument("--control", required=True, metavar="CONTROL")
+    p.add_argument("--zeta0-px", type=float, default=485.0, help="initial ζ0 (000 Table 1: 485)")
+    p.add_argument("--c-px", type=float, default=3600.0, help="initial c (000 Table 1: 3600)")
+    p.add_argument("--sigma-px", type=float, default=0.1, help="a-priori σ of ζ (px)")
+    p.add_argument("--reject-k", type=float, default=None,
+                   help="reject observations beyond k robust σ (default: none)")
+    p.add_argument("--json", action="store_true", help="estimates and residual statistics as JSON")
+    p.set_defaults(func=_cmd_calibrate_line)
 
     p = sub.add_parser("data", help="generate data_synthetic/generated from the scenario TOMLs")
     p.add_argument("--verify", action="store_true",

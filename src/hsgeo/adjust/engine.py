@@ -361,7 +361,7 @@ class Identifiability:
         for vec in self.null_space[:5]:
             parts.append(
                 "the data do not determine the combination of "
-                + ", ".join(f"{n} ({w:+.2f})" for n, w in vec[:8])
+                + ", ".join(f"{n} ({w:+.2f})" for n, w in vec[:12])
             )
         head = (
             f"the normal equations are rank deficient (rank {self.rank} of {self.n_unknowns} "
@@ -372,6 +372,13 @@ class Identifiability:
             "that see it (a missing datum)."
         )
         return head + "; ".join(parts) + tail
+
+
+#: A parameter takes part in a datum defect when its component in a unit null vector of the
+#: unit-diagonal scaled normal matrix exceeds this. Numerically null components are ~1e-10; a
+#: larger threshold (0.1) hid parameters with small but real components, e.g. the principal
+#: distance of a 1D camera seeing collinear points (component 0.08, line-calibration chapter).
+_NULL_COMPONENT_MIN = 1e-3
 
 
 def _analyse(layout: _Layout, ne: _Normal, rtol: float) -> Identifiability:
@@ -401,7 +408,7 @@ def _analyse(layout: _Layout, ne: _Normal, rtol: float) -> Identifiability:
         v = evec[:, j]
         order = np.argsort(-np.abs(v))
         vecs.append(
-            [(layout.labels_c[i], float(v[i])) for i in order if abs(v[i]) > 0.1]
+            [(layout.labels_c[i], float(v[i])) for i in order if abs(v[i]) > _NULL_COMPONENT_MIN]
         )
     rank = int(layout.n_c - null.size)
     return Identifiability(rank, layout.n_c, vecs, [], unobserved, ev)

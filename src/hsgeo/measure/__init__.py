@@ -1,1 +1,1 @@
-"""Measurement from pixels: image → observations."""
+"""Measurement from pixels: images → observations (tables of image coordinates and ids)."""

@@ -1,0 +1,279 @@
+"""The simulated laboratory of the ImSpector V9 + PixelFly spatial calibration (000 §4, 001 §3.1).
+
+A crown pattern (black triangles whose tips touch the line A–B, imaged as thin dark lines, 000
+Fig. 4 / 001 Fig. 5) is seen at about 3 m from three stations whose rays intersect near 90°
+(000 §4.1). Two side signals (a thin dark line on a small white plate) stand a few centimetres in
+front of the pattern plane beyond A and B: they are the off-line control points that fix the
+scale (see the ``line-calibration`` chapter). Everything lies in the scanner plane (x along A–B,
+y towards the pattern; the pattern line is y = 0).
+
+The sensor records raw 12-bit frames of 1024 spectral rows × 1280 columns (001 Table 1): columns
+0–1169 see the scene, 1170–1279 the diffuse collector (001 §2.1). For every spectral row the true
+inner orientation comes from 001 Table 2 (000 Table 1 at row 1000), interpolated across rows, and
+the profile is rendered by tracing each sub-pixel's ray (:func:`hsgeo.sensors.line1d.tan_from_zeta`)
+to the plates and the pattern, blurring with a wavelength-dependent Gaussian PSF, integrating over
+the pixel, and adding shot noise, read noise and dark current.
+
+Assumptions (not in the papers, stated in the chapter): the wavelength of a row
+(λ = 430 nm + 0.44 nm·row, so that row 1000 is the 870 nm of 000 Table 1), the tooth pitch (20 mm)
+and line width (1.5 mm), the PSF width, the radiometry, the station scatter.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+from scipy.interpolate import PchipInterpolator
+from scipy.ndimage import gaussian_filter1d
+
+from hsgeo.errors import InputError
+from hsgeo.measure.line_minima import associate_by_order, find_minima
+from hsgeo.papers import P000_TABLE1_CALIBRATED, P001_SENSOR, P001_TABLE2
+from hsgeo.sensors import line1d
+from hsgeo.simulate import as_rng
+
+__all__ = ["LineLab", "true_iop", "wavelength_nm", "stations", "pattern_points", "render_rows",
+           "render_frame", "measure_row", "simulate_observations", "generate"]
+
+
+@dataclass(frozen=True)
+class LineLab:
+    """Configuration of the simulated bench (defaults: the papers' values or stated assumptions)."""
+
+    n_rows: int = P001_SENSOR["n_rows"]  # 001 Table 1
+    n_columns: int = P001_SENSOR["n_columns"]  # 001 Table 1
+    n_reflected: int = P001_SENSOR["n_reflected_columns"]  # 001 §2.1
+    lambda0_nm: float = 430.0  # 001 Table 1, spectral range starts at 430 nm
+    dlambda_nm_per_row: float = 0.44  # assumption: row 1000 = 870 nm (000 §4.1 / 001 Table 2)
+    distance_m: float = 3.0  # 001 §3.1 "at a distance of 3 m"
+    azimuths_deg: tuple = (-45.0, 0.0, 45.0)  # 000 §4.1: rays intersect as close to 90° as possible
+    station_sigma_m: float = 0.005  # assumption: tripod placed on marks to ±5 mm
+    alpha_sigma_deg: float = 0.1  # assumption: pointed to ±0.1°
+    tooth_pitch_m: float = 0.02  # assumption (000 Fig. 4 not in the text)
+    tooth_half_extent_m: float = 0.26  # assumption: teeth fill ±310 px of the frontal view
+    tooth_width_m: float = 0.0015  # assumption: width of the dark line where the tips cross A–B
+    board_half_m: float = 0.40  # white board beyond the teeth
+    side_x_m: float = 0.32  # side signals beyond A and B (000 §4.1 "two more signals")
+    side_offset_m: float = 0.05  # design: they stand 5 cm in front of the pattern plane
+    side_plate_m: float = 0.016  # white plate of a side signal
+    side_line_m: float = 0.002  # its dark line
+    r_max_px: float = 450.0  # the model's domain |ζ − ζ0| (001 Fig. 7 curves end at 450 px)
+    white_e: float = 7000.0  # assumption: electrons of the white board at the spectral peak
+    black_reflectance: float = 0.04
+    white_reflectance: float = 0.90
+    background_reflectance: float = 0.05  # the lab beyond the board and the domain
+    gain_e_per_dn: float = 2.0
+    offset_dn: float = 50.0
+    dark_e: float = 20.0  # dark current during the exposure
+    read_e: float = 12.0
+    psf_sigma_px: tuple = (0.8, 0.6)  # σ = a + b·((λ − 430)/440)²: blurrier in the NIR (001 §4)
+    supersample: int = 8
+    zeta_sigma_px: float = 0.05  # a-priori σ of a measured minimum (σ0 rescales it)
+    seed: int = 0
+    rows: tuple = field(default=(100, 300, 500, 1000))  # 001 Table 2
+
+    @classmethod
+    def from_config(cls, cfg: dict | None) -> LineLab:
+        """From a TOML-like dict (``[lab]`` table entries override the defaults)."""
+        if not cfg:
+            return cls()
+        known = set(cls.__dataclass_fields__)
+        bad = sorted(set(cfg) - known)
+        if bad:
+            raise InputError(f"unknown line-lab settings {bad}; known: {sorted(known)}")
+        conv = {k: tuple(v) if isinstance(v, list) else v for k, v in cfg.items()}
+        return replace(cls(), **conv)
+
+
+def wavelength_nm(row, lab: LineLab = LineLab()):
+    """Wavelength of a spectral row (assumed linear; row 1000 = 870 nm, 000 §4.1)."""
+    return lab.lambda0_nm + lab.dlambda_nm_per_row * np.asarray(row, dtype=float)
+
+
+def _truth_table():
+    rows = np.array([r.row_px for r in P001_TABLE2], dtype=float)
+    vals = np.array([[r.zeta0_px, r.c_px, r.K1, r.K2, r.K3] for r in P001_TABLE2])
+    t = P000_TABLE1_CALIBRATED  # row 1000 with 000 Table 1's extra digits
+    vals[-1] = [t.zeta0_px, t.c_px, t.K1, t.K2, t.K3]
+    return rows, vals
+
+
+def true_iop(row) -> dict:
+    """True ζ0, c, K of a spectral row: 001 Table 2 (000 Table 1 at row 1000), PCHIP across rows.
+
+    PCHIP keeps ζ0 nearly linear and c non-linear and monotone between the published lines, as
+    001 §3.1 describes; outside rows 100–1000 the end values are held.
+    """
+    rows, vals = _truth_table()
+    r = np.clip(np.asarray(row, dtype=float), rows[0], rows[-1])
+    out = PchipInterpolator(rows, vals, axis=0)(r)
+    return {"zeta0_px": out[..., 0], "c_px": out[..., 1], "K": out[..., 2:]}
+
+
+def stations(lab: LineLab, rng=None) -> np.ndarray:
+    """Stations ``(n, 3)``: x0_m, y0_m, alpha_rad on a circle around the pattern, looking at its
+    centre, scattered by the configured σ when ``rng`` is given (the truth of one experiment)."""
+    a = np.deg2rad(np.asarray(lab.azimuths_deg, dtype=float))
+    e = np.column_stack([lab.distance_m * np.sin(a), -lab.distance_m * np.cos(a), a])
+    if rng is not None:
+        rng = as_rng(rng)
+        e = e + rng.normal(0.0, [lab.station_sigma_m, lab.station_sigma_m,
+                                 np.deg2rad(lab.alpha_sigma_deg)], e.shape)
+    return e
+
+
+def pattern_points(lab: LineLab) -> tuple[np.ndarray, list[str]]:
+    """Control points ``(n, 2)`` [m] and their ids: teeth T01… along A–B, side signals S1, S2."""
+    n = int(round(2 * lab.tooth_half_extent_m / lab.tooth_pitch_m)) + 1
+    x = np.linspace(-lab.tooth_half_extent_m, lab.tooth_half_extent_m, n)
+    xy = np.column_stack([x, np.zeros(n)])
+    side = np.array([[-lab.side_x_m, -lab.side_offset_m], [lab.side_x_m, -lab.side_offset_m]])
+    ids = [f"T{i + 1:02d}" for i in range(n)] + ["S1", "S2"]
+    return np.vstack([xy, side]), ids
+
+
+def _reflectance_along_rays(lab: LineLab, eop, tan):
+    """Reflectance seen along rays ``tan θ`` (any shape) from station ``eop``."""
+    x0, y0, a = eop
+    ca, sa = np.cos(a), np.sin(a)
+    dx = tan * ca - sa  # ray direction: tan·e_X + e_Y, e_X = (cos α, sin α), e_Y = (−sin α, cos α)
+    dy = tan * sa + ca
+    out = np.full(tan.shape, lab.background_reflectance)
+    # the pattern plane y = 0
+    s = -y0 / dy
+    x = x0 + s * dx
+    on_board = (s > 0) & (np.abs(x) <= lab.board_half_m)
+    out[on_board] = lab.white_reflectance
+    pts, _ = pattern_points(lab)
+    teeth = pts[:-2, 0]
+    near = np.min(np.abs(x[..., None] - teeth), axis=-1) <= lab.tooth_width_m / 2
+    out[on_board & near] = lab.black_reflectance
+    # side plates in front of the pattern (they occlude what lies behind)
+    ys = -lab.side_offset_m
+    s2 = (ys - y0) / dy
+    xs = x0 + s2 * dx
+    for sx in (-lab.side_x_m, lab.side_x_m):
+        hit = (s2 > 0) & (np.abs(xs - sx) <= lab.side_plate_m / 2)
+        out[hit] = lab.white_reflectance
+        out[hit & (np.abs(xs - sx) <= lab.side_line_m / 2)] = lab.black_reflectance
+    return out
+
+
+def _spectral_level(lab: LineLab, lam_nm):
+    """Relative signal of the white board: halogen lamp × CCD response (assumption)."""
+    return np.exp(-(((np.asarray(lam_nm) - 650.0) / 260.0) ** 2))
+
+
+def render_rows(lab: LineLab, eop, rows, rng, iop: dict | None = None) -> np.ndarray:
+    """Raw 12-bit rows ``(len(rows), n_columns)`` (uint16) of one frame from station ``eop``.
+
+    ``iop`` overrides the true inner orientation (dict of arrays per row, as :func:`true_iop`).
+    """
+    rng = as_rng(rng)
+    rows = np.atleast_1d(np.asarray(rows))
+    if np.any((rows < 0) | (rows >= lab.n_rows)):
+        raise InputError(f"rows must lie in 0..{lab.n_rows - 1}")
+    iop = true_iop(rows) if iop is None else iop
+    ss = int(lab.supersample)
+    ncol = lab.n_reflected
+    zs = (np.arange(ncol * ss) + 0.5) / ss - 0.5  # sub-pixel centres, pixel-centre origin
+    out = np.empty((rows.size, lab.n_columns), dtype=np.uint16)
+    lam = wavelength_nm(rows, lab)
+    level = _spectral_level(lab, lam)
+    for k in range(rows.size):
+        z0 = float(np.atleast_1d(iop["zeta0_px"])[k])
+        c = float(np.atleast_1d(iop["c_px"])[k])
+        K = np.atleast_2d(iop["K"])[k]
+        valid = np.abs(zs - z0) <= lab.r_max_px
+        refl = np.full(zs.shape, lab.background_reflectance)
+        t = line1d.tan_from_zeta(zs[valid], z0, c, K)
+        refl[valid] = _reflectance_along_rays(lab, eop, t)
+        a, b = lab.psf_sigma_px
+        sig = a + b * ((lam[k] - 430.0) / 440.0) ** 2
+        refl = gaussian_filter1d(refl, sig * ss, mode="nearest")
+        pix = refl.reshape(ncol, ss).mean(axis=1)
+        e_sig = pix / lab.white_reflectance * lab.white_e * level[k]
+        inc = np.full(lab.n_columns - ncol, 0.8 * lab.white_e * level[k])  # diffuse collector
+        e = np.concatenate([e_sig, inc]) + lab.dark_e
+        e = rng.poisson(e).astype(float) + lab.read_e * rng.standard_normal(e.size)
+        dn = np.round(e / lab.gain_e_per_dn + lab.offset_dn)
+        out[k] = np.clip(dn, 0, 2 ** P001_SENSOR["bits"] - 1).astype(np.uint16)
+    return out
+
+
+def render_frame(lab: LineLab, eop, rng, supersample: int = 4) -> np.ndarray:
+    """A whole raw frame ``(n_rows, n_columns)`` uint16 (for figures; coarser supersampling)."""
+    return render_rows(replace(lab, supersample=supersample), eop, np.arange(lab.n_rows), rng)
+
+
+def measure_row(lab: LineLab, dn_row, what: str = "row", method: str = "parabola"):
+    """Measured ζ of the pattern points on one raw row, associated by their order.
+
+    Returns
+    -------
+    point_index : (k,) int ndarray (into :func:`pattern_points`), zeta_px : (k,) ndarray
+    """
+    prof = np.asarray(dn_row, dtype=float)[: lab.n_reflected] - lab.offset_dn
+    z, _ = find_minima(prof, method=method)
+    pts, _ = pattern_points(lab)
+    # ζ grows as x decreases (eq. 2: ζ − ζ0 ∝ −X): order the points by descending x
+    order = np.argsort(-pts[:, 0], kind="stable")
+    return associate_by_order(z, order, what)
+
+
+def simulate_observations(lab: LineLab, row: int, rng, eop_true=None, method: str = "parabola"):
+    """One calibration experiment for one spectral row: render, measure, associate.
+
+    Returns
+    -------
+    dict with ``eop_true`` (n_img, 3), ``iop_true`` (dict), ``image``, ``point``, ``zeta_px``
+    (observations), ``xy_m`` (control points), ``point_ids``, ``frames`` (raw rows per image).
+    """
+    rng = as_rng(rng)
+    eop_true = stations(lab, rng) if eop_true is None else np.asarray(eop_true, dtype=float)
+    iop = true_iop(row)
+    img, pt, zz, frames = [], [], [], []
+    for i, e in enumerate(eop_true):
+        dn = render_rows(lab, e, [row], rng)[0]
+        frames.append(dn)
+        p, z = measure_row(lab, dn, f"image {i}, row {row}", method)
+        img.append(np.full(p.size, i))
+        pt.append(p)
+        zz.append(z)
+    xy, ids = pattern_points(lab)
+    return {"eop_true": eop_true, "iop_true": {k: np.asarray(v) for k, v in iop.items()},
+            "image": np.concatenate(img), "point": np.concatenate(pt),
+            "zeta_px": np.concatenate(zz), "xy_m": xy, "point_ids": ids,
+            "frames": np.array(frames)}
+
+
+def generate(cfg: dict, outdir: Path) -> list[Path]:
+    """``make data``: observations and control points of one calibration (row 1000), as CSV in
+    the formats ``hsgeo calibrate-line`` reads, and the truth."""
+    lab = LineLab.from_config(cfg.get("lab"))
+    row = int(cfg.get("calibration", {}).get("row", 1000))
+    sim = simulate_observations(lab, row, int(cfg["scenario"]["seed"]))
+    ids = sim["point_ids"]
+    obs = outdir / "line_lab_observations.csv"
+    with obs.open("w") as fh:
+        fh.write("image,point,zeta_px\n")
+        for i, p, z in zip(sim["image"], sim["point"], sim["zeta_px"], strict=True):
+            fh.write(f"img{i},{ids[p]},{z:.17g}\n")
+    ctl = outdir / "line_lab_control.csv"
+    with ctl.open("w") as fh:
+        fh.write("point,x_m,y_m\n")
+        for pid, (x, y) in zip(ids, sim["xy_m"], strict=True):
+            fh.write(f"{pid},{x:.17g},{y:.17g}\n")
+    tru = outdir / "line_lab_truth.csv"
+    with tru.open("w") as fh:
+        fh.write("quantity,value\n")
+        t = sim["iop_true"]
+        for k, v in [("zeta0_px", t["zeta0_px"]), ("c_px", t["c_px"]), ("K1", t["K"][0]),
+                     ("K2", t["K"][1]), ("K3", t["K"][2])]:
+            fh.write(f"{k},{float(v):.17g}\n")
+        for i, e in enumerate(sim["eop_true"]):
+            for k, v in zip(line1d.EOP_COLUMNS, e, strict=True):
+                fh.write(f"img{i}.{k},{v:.17g}\n")
+    return [obs, ctl, tru]

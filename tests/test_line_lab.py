@@ -1,0 +1,65 @@
+import numpy as np
+import pytest
+
+from hsgeo import InputError
+from hsgeo.papers import P000_TABLE1_CALIBRATED, P001_TABLE2
+from hsgeo.reproduce.line_calibration import IOP_NAMES, calibrate_simulated
+from hsgeo.sensors import line1d
+from hsgeo.simulate import line_lab as LL
+
+LAB = LL.LineLab()
+
+
+def test_truth_at_published_lines():
+    for r in P001_TABLE2[:3]:
+        t = LL.true_iop(r.row_px)
+        assert float(t["zeta0_px"]) == pytest.approx(r.zeta0_px)
+        assert float(t["c_px"]) == pytest.approx(r.c_px)
+        np.testing.assert_allclose(t["K"], [r.K1, r.K2, r.K3])
+    t = LL.true_iop(1000)
+    assert float(t["c_px"]) == P000_TABLE1_CALIBRATED.c_px
+    assert LL.wavelength_nm(1000) == pytest.approx(870.0)
+
+
+def test_render_is_12bit_and_reproducible():
+    e = LL.stations(LAB)[1]
+    a = LL.render_rows(LAB, e, [100, 1000], 5)
+    b = LL.render_rows(LAB, e, [100, 1000], 5)
+    assert a.dtype == np.uint16 and a.shape == (2, 1280) and a.max() <= 4095
+    assert np.array_equal(a, b)
+    with pytest.raises(InputError):
+        LL.render_rows(LAB, e, [2000], 0)
+
+
+@pytest.mark.parametrize("row", [100, 1000])
+def test_measured_minima_match_projection(row):
+    sim = LL.simulate_observations(LAB, row, 3)
+    t = sim["iop_true"]
+    z = line1d.project(sim["xy_m"][sim["point"]], sim["eop_true"][sim["image"]],
+                       float(t["zeta0_px"]), float(t["c_px"]), t["K"])
+    err = sim["zeta_px"] - z
+    assert np.abs(err).max() < 0.5 and abs(err.mean()) < 0.03
+
+
+@pytest.mark.parametrize("seed", [0, 11])
+@pytest.mark.parametrize("row", [100, 300, 500, 1000])
+def test_calibration_within_3_sigma_of_truth(seed, row):
+    res, sim = calibrate_simulated(LAB, row, seed)
+    t = sim["iop_true"]
+    truth = np.r_[t["zeta0_px"], t["c_px"], t["K"]]
+    est = np.r_[res.value("zeta0_px"), res.value("c_px"), res.value("K")]
+    sig = np.r_[res.sigma("zeta0_px"), res.sigma("c_px"), res.sigma("K")]
+    for q, e, s, tr in zip(IOP_NAMES, est, sig, truth, strict=True):
+        assert abs(e - tr) < 3 * s, q
+    z = (res.value("eop") - sim["eop_true"]) / res.sigma("eop")
+    assert np.all(np.abs(z) < 3.5)
+
+
+def test_generate_writes_cli_files(tmp_path):
+    cfg = {"scenario": {"generator": "line_lab", "seed": 1}, "calibration": {"row": 1000}}
+    paths = LL.generate(cfg, tmp_path)
+    assert [p.name for p in paths] == ["line_lab_observations.csv", "line_lab_control.csv",
+                                       "line_lab_truth.csv"]
+    assert paths[0].read_text().splitlines()[0] == "image,point,zeta_px"
+    with pytest.raises(InputError, match="unknown line-lab settings"):
+        LL.LineLab.from_config({"bogus": 1})
