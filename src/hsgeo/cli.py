@@ -60,6 +60,17 @@ def _cmd_versions(args) -> int:
     return 0
 
 
+def _cmd_geocode(args) -> int:
+    from hsgeo.geocode import geocode_files
+
+    ortho, paths = geocode_files(args.lines, args.trajectory, args.sensor, output=args.output,
+                                 dem=args.dem, height_m=args.height, resolution_m=args.resolution,
+                                 envi=args.envi, progress=not args.quiet)
+    print(f"orthorectified {ortho.sizes['band']} band(s) onto {ortho.sizes['N']} x "
+          f"{ortho.sizes['E']} cells of {args.resolution} m: " + ", ".join(map(str, paths)))
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     from hsgeo import __version__
     from hsgeo.reproduce import chapter_names
@@ -103,6 +114,26 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--update-manifest", action="store_true",
                    help="rewrite the manifest from what was generated (after a deliberate change)")
     p.set_defaults(func=_cmd_data)
+
+    p = sub.add_parser(
+        "geocode", help="orthorectify a line-scanner flight line onto a map grid",
+        description="Geocode every pixel of a flight line (ray from the recorded navigation and "
+        "the sensor model, intersected with a DEM or a plane) and resample it onto a north-up "
+        "grid by nearest neighbour. LINES: NetCDF with radiance(line, pixel) or (band, line, "
+        "pixel), coordinate pixel (ζ, px), attributes t0_s and line_rate_hz. NAV: CSV "
+        "t_s,E_m,N_m,U_m,roll_deg,pitch_deg,heading_deg. SENSOR: TOML, see "
+        "hsgeo.geocode.read_sensor_toml. DEM: NetCDF with height(N, E) in metres.")
+    p.add_argument("lines", metavar="LINES")
+    p.add_argument("--trajectory", required=True, metavar="NAV")
+    p.add_argument("--sensor", required=True, metavar="SENSOR.toml")
+    g = p.add_mutually_exclusive_group(required=True)
+    g.add_argument("--dem", metavar="DEM.nc")
+    g.add_argument("--height", type=float, metavar="H", help="terrain height of a plane (m)")
+    p.add_argument("-o", "--output", required=True, metavar="ORTHO.nc")
+    p.add_argument("--envi", metavar="PATH", help="also write ENVI BSQ + .hdr with map info")
+    p.add_argument("--resolution", type=float, default=0.5, help="cell size in m (default 0.5)")
+    p.add_argument("--quiet", action="store_true", help="no progress display")
+    p.set_defaults(func=_cmd_geocode)
 
     p = sub.add_parser("versions", help="versions of hsgeo, Python and the dependencies")
     p.set_defaults(func=_cmd_versions)

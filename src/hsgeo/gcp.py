@@ -13,7 +13,6 @@ Miljković, Gajski, Vela (2017), Geodetski list 2017/2, Tables 2 and 3.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from importlib import resources
 
 import numpy as np
 import pandas as pd
@@ -23,25 +22,9 @@ from hsgeo.errors import InputError, ObservationError
 __all__ = [
     "deviation_table",
     "load_000_table",
-    "PRINTED_000",
     "recompute_printed_table",
     "Flag",
 ]
-
-#: The footers of 000 Tables 2 and 3 as printed (Σ rows, biases, σ), with their printed decimals.
-PRINTED_000 = {
-    "000 Table 2": {
-        "sum_dy_m": (-1.95, 2), "sum_dx_m": (0.25, 2), "sum_vyvy_m2": (6.98, 2),
-        "sum_vxvx_m2": (3.84, 2), "bias_y_m": (-0.2, 1), "bias_x_m": (0.0, 1),
-        "sigma_y_m": (0.88, 2), "sigma_x_m": (0.65, 2),
-    },
-    "000 Table 3": {
-        "sum_dy_m": (-0.20, 2), "sum_dx_m": (0.34, 2), "sum_vyvy_m2": (1.49, 2),
-        "sum_vxvx_m2": (0.75, 2), "bias_y_m": (-0.02, 2), "bias_x_m": (0.03, 2),
-        "sigma_y_m": (0.40, 2), "sigma_x_m": (0.29, 2),
-    },
-}
-
 
 def deviation_table(dy_m, dx_m, ids=None) -> tuple[pd.DataFrame, dict[str, float]]:
     """The 000 Table 2/3 layout computed from coordinate differences.
@@ -88,11 +71,12 @@ def deviation_table(dy_m, dx_m, ids=None) -> tuple[pd.DataFrame, dict[str, float
 
 def load_000_table(which: int) -> pd.DataFrame:
     """000 Table 2 (``which=2``, without calibration) or Table 3 (with calibration), as printed."""
+    from hsgeo import papers
+
     if which not in (2, 3):
         raise InputError(f"000 has GCP tables 2 and 3, not {which}")
-    path = resources.files("hsgeo") / "data" / "papers" / f"000_table{which}.csv"
-    with resources.as_file(path) as p:
-        return pd.read_csv(p, comment="#").set_index("gcp")
+    rows = papers.P000_TABLE2_ROWS if which == 2 else papers.P000_TABLE3_ROWS
+    return pd.DataFrame(rows, columns=papers.P000_GCP_COLUMNS).set_index("gcp")
 
 
 @dataclass(frozen=True)
@@ -142,7 +126,9 @@ def recompute_printed_table(which: int):
         for gcp, p, v in zip(printed.index, printed[col], table[col], strict=True):
             if not _follows(p, v, 2):
                 flags.append(Flag(f"GCP {gcp} {col}", p, v, 2, _why(p, v, 2)))
-    for key, (p, dec) in PRINTED_000[f"000 Table {which}"].items():
+    from hsgeo.papers import P000_GCP_FOOTERS
+
+    for key, (p, dec) in P000_GCP_FOOTERS[f"000 Table {which}"].items():
         v = summary[key]
         if not _follows(p, v, dec):
             flags.append(Flag(f"footer {key}", p, v, dec, _why(p, v, dec)))

@@ -22,9 +22,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from hsgeo.adjust import Parameters, ResidualBlock, adjust
-from hsgeo.distortion import odd_radial_1d, odd_radial_1d_jacobian
 from hsgeo.errors import ConvergenceError, InputError, ObservationError
 from hsgeo.rotations import R_from_rpy, dR_drpy
+from hsgeo.sensors import line1d
 
 __all__ = [
     "R_ENU_FROM_NED",
@@ -38,6 +38,13 @@ __all__ = [
     "geocode_observations",
     "BoresightGCP",
     "calibrate_boresight",
+    "geocode_image",
+    "orthorectify",
+    "to_map_files",
+    "read_sensor_toml",
+    "read_lines",
+    "write_lines",
+    "geocode_files",
 ]
 
 #: the fixed rotation between the north-east-down and east-north-up frames (its own inverse)
@@ -77,38 +84,20 @@ class LinearIFOV(LineGeometry):
 
 @dataclass(frozen=True)
 class CalibratedLine(LineGeometry):
-    """The calibrated 1D model of 000 eq. (2) in its ray form.
+    """The calibrated 1D model of 000 eq. (2) in its ray form (:mod:`hsgeo.sensors.line1d`).
 
-    ``ζ = ζ0 − c·t + Δ(ζ)`` with ``Δ(ζ) = K1 d³ + K2 d⁵ + K3 d⁷``, ``d = (ζ − ζ0)/norm_px``, so the
-    tangent of a measured pixel is explicit, ``t = (ζ0 − ζ + Δ(ζ))/c``, and the pixel of a given
-    tangent follows by Newton's method.
+    ``ζ = ζ0 − c·tan θ + δ(ζ − ζ0)``, δ the odd 7th-order polynomial in units of 100 px.
     """
 
     zeta0_px: float
     c_px: float
     K: tuple[float, ...] = (0.0, 0.0, 0.0)
-    norm_px: float = 100.0
 
     def tan_angle(self, zeta_px):
-        z = np.asarray(zeta_px, dtype=float)
-        delta = odd_radial_1d((z - self.zeta0_px) / self.norm_px, self.K)  # 000 eq. (2)
-        return (self.zeta0_px - z + delta) / self.c_px
+        return line1d.tan_from_zeta(zeta_px, self.zeta0_px, self.c_px, self.K)
 
-    def zeta(self, tan_angle, tol: float = 1e-10, max_iter: int = 50):
-        t = np.asarray(tan_angle, dtype=float)
-        z = self.zeta0_px - self.c_px * t
-        for _ in range(max_iter):
-            d = (z - self.zeta0_px) / self.norm_px
-            f = self.zeta0_px - self.c_px * t + odd_radial_1d(d, self.K) - z
-            dd, _ = odd_radial_1d_jacobian(d, self.K)
-            step = f / (1.0 - dd / self.norm_px)
-            z = z + step
-            if np.all(np.abs(step) < tol):
-                return z
-        raise ConvergenceError(
-            "ζ from the view angle did not converge: the angle lies outside the region where "
-            "the distortion polynomial is monotonic"
-        )
+    def zeta(self, tan_angle):
+        return line1d.zeta_from_tan(tan_angle, self.zeta0_px, self.c_px, self.K)
 
 
 @dataclass(frozen=True)
@@ -353,8 +342,11 @@ def geocode_image(nav, sensor: LineGeometry, n_lines: int, zeta_px, *, t0_s: flo
 
 
 def orthorectify(image, ground_enu_m, *, resolution_m: float, bounds=None, band_names=None,
-                 attrs=None):
-    """Resample a line-scanner image onto a north-up map grid (linear interpolation).
+                 max_distance_m: float | None = None, attrs=None):
+    """Resample a line-scanner image onto a north-up map grid by nearest neighbour.
+
+    Nearest neighbour keeps every spectrum as it was measured (no mixing of pixels), as is usual
+    for imaging spectrometers (PARGE does the same).
 
     Parameters
     ----------
@@ -365,18 +357,20 @@ def orthorectify(image, ground_enu_m, *, resolution_m: float, bounds=None, band_
         Cell size.
     bounds : (E_min, E_max, N_min, N_max), optional
         Default: the footprint of the line.
+    max_distance_m : float, optional
+        Cells farther than this from every pixel are NaN (default: a little over half the
+        diagonal of the largest pixel spacing plus half a cell, i.e. outside the footprint).
 
     Returns
     -------
     xarray.DataArray
         Dimensions ``(band, N, E)`` with cell-centre coordinates in metres, N descending (row 0 is
-        north, as in map rasters); NaN outside the footprint. ``attrs`` holds the frame and cell size.
+        north, as in map rasters). ``attrs`` holds the frame and the cell size.
     """
     import xarray as xr
-    from scipy.interpolate import LinearNDInterpolator
-    from scipy.spatial import Delaunay
+    from scipy.spatial import cKDTree
 
-    img = np.asarray(image, dtype=np.float64)
+    img = np.asarray(image)
     if img.ndim == 2:
         img = img[None]
     if img.ndim != 3 or ground_enu_m.shape[:2] != img.shape[1:]:
@@ -385,27 +379,171 @@ def orthorectify(image, ground_enu_m, *, resolution_m: float, bounds=None, band_
         )
     if not resolution_m > 0:
         raise InputError(f"resolution_m must be positive, got {resolution_m}")
-    EN = ground_enu_m[..., :2].reshape(-1, 2)
+    g = np.asarray(ground_enu_m)[..., :2]
+    EN = g.reshape(-1, 2)
     if bounds is None:
         bounds = (EN[:, 0].min(), EN[:, 0].max(), EN[:, 1].min(), EN[:, 1].max())
+    if max_distance_m is None:
+        along = np.linalg.norm(np.diff(g, axis=0), axis=-1).max() if g.shape[0] > 1 else 0.0
+        across = np.linalg.norm(np.diff(g, axis=1), axis=-1).max() if g.shape[1] > 1 else 0.0
+        max_distance_m = 0.55 * np.hypot(along, across) + 0.5 * resolution_m
     e0, e1, n0, n1 = bounds
     E = np.arange(np.floor(e0 / resolution_m) * resolution_m + resolution_m / 2, e1,
                   resolution_m)
     N = np.arange(np.ceil(n1 / resolution_m) * resolution_m - resolution_m / 2, n0,
                   -resolution_m)
     gE, gN = np.meshgrid(E, N)
-    tri = Delaunay(EN)
-    values = img.reshape(img.shape[0], -1).T
-    grid = LinearNDInterpolator(tri, values)(gE, gN)  # (nN, nE, bands)
+    dist, idx = cKDTree(EN).query(np.column_stack([gE.ravel(), gN.ravel()]),
+                                  distance_upper_bound=max_distance_m)
+    ok = np.isfinite(dist)
+    flat = img.reshape(img.shape[0], -1).astype(np.float64)
+    out = np.full((img.shape[0], gE.size), np.nan)
+    out[:, ok] = flat[:, idx[ok]]
     da = xr.DataArray(
-        np.moveaxis(grid, -1, 0),
+        out.reshape(img.shape[0], N.size, E.size),
         dims=("band", "N", "E"),
         coords={"band": band_names if band_names is not None else np.arange(img.shape[0]),
                 "N": N, "E": E},
         name="radiance",
         attrs={"crs": "local east-north-up frame (metres)", "resolution_m": resolution_m,
-               "grid_mapping": "cell centres", **(attrs or {})},
+               "resampling": "nearest neighbour", **(attrs or {})},
     )
     da["E"].attrs.update(units="m", long_name="easting")
     da["N"].attrs.update(units="m", long_name="northing")
     return da
+
+
+def to_map_files(da, path_nc=None, path_envi=None):
+    """Write an orthorectified raster as NetCDF 3 (xarray's scipy engine) and/or ENVI BSQ with map info.
+
+    Returns the paths written.
+    """
+    from hsgeo.io import write_envi
+
+    out = []
+    if path_nc is not None:
+        da.to_dataset(name=da.name or "radiance").to_netcdf(path_nc, engine="scipy")
+        out.append(path_nc)
+    if path_envi is not None:
+        res = float(da.attrs["resolution_m"])
+        E0 = float(da["E"].values[0]) - res / 2
+        N0 = float(da["N"].values[0]) + res / 2
+        out += list(write_envi(path_envi, da.values.astype(np.float32), map_info=(E0, N0, res, res),
+                               band_names=[str(b) for b in da["band"].values],
+                               description="hsgeo orthorectified line-scanner image"))
+    return out
+
+
+# ----------------------------------------------------------------------------------------------
+# Files: the `hsgeo geocode` command
+# ----------------------------------------------------------------------------------------------
+def read_sensor_toml(path):
+    """A line-scanner description: ``(LineGeometry, boresight_rad)``.
+
+    Format::
+
+        [sensor]
+        model = "calibrated"          # 000 eq. (2); or "linear-ifov" (no distortion)
+        zeta0_px = 486.8
+        c_px = 3539.0
+        K = [1.459, -0.1636, 0.00526] # calibrated only; δ in px, (ζ − ζ0) in units of 100 px
+        boresight_deg = [0.0, 0.0, 0.0]   # roll, pitch, heading of R_body_from_sensor
+    """
+    import tomllib
+    from pathlib import Path
+
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"{path}: no such sensor file")
+    try:
+        cfg = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"{path}: malformed TOML: {exc}") from None
+    s = cfg.get("sensor")
+    if s is None:
+        raise InputError(f"{path}: missing [sensor] table")
+    model = s.get("model", "calibrated")
+    try:
+        if model == "calibrated":
+            geom = CalibratedLine(float(s["zeta0_px"]), float(s["c_px"]),
+                                  tuple(float(k) for k in s.get("K", (0.0, 0.0, 0.0))))
+        elif model == "linear-ifov":
+            geom = LinearIFOV(float(s["zeta0_px"]), float(s["c_px"]))
+        else:
+            raise InputError(f"{path}: model must be 'calibrated' or 'linear-ifov', got {model!r}")
+    except KeyError as exc:
+        raise InputError(f"{path}: [sensor] needs {exc.args[0]!r}") from None
+    b = np.deg2rad(np.asarray(s.get("boresight_deg", [0.0, 0.0, 0.0]), dtype=float))
+    if b.shape != (3,):
+        raise InputError(f"{path}: boresight_deg must have 3 angles (roll, pitch, heading)")
+    return geom, b
+
+
+def read_lines(path):
+    """A flight line as recorded: NetCDF with ``radiance`` ``(line, pixel)`` or
+    ``(band, line, pixel)``, coordinate ``pixel`` (ζ in px), attributes ``t0_s`` (time of line 0)
+    and ``line_rate_hz``."""
+    import xarray as xr
+
+    try:
+        ds = xr.open_dataset(path)
+    except (OSError, ValueError) as exc:
+        raise InputError(f"{path}: not a readable NetCDF file: {exc}") from None
+    if "radiance" not in ds:
+        raise InputError(f"{path}: no variable 'radiance' (found {list(ds.data_vars)})")
+    da = ds["radiance"]
+    if "band" not in da.dims:
+        da = da.expand_dims("band")
+    if set(da.dims) != {"band", "line", "pixel"}:
+        raise InputError(f"{path}: radiance must have dimensions (band,) line, pixel; got {da.dims}")
+    for a in ("t0_s", "line_rate_hz"):
+        if a not in ds.attrs and a not in da.attrs:
+            raise InputError(f"{path}: attribute {a!r} missing (time of line 0, line rate)")
+    attrs = {**ds.attrs, **da.attrs}
+    return (da.transpose("band", "line", "pixel").load(), float(attrs["t0_s"]),
+            float(attrs["line_rate_hz"]))
+
+
+def geocode_files(lines, trajectory, sensor, *, output, dem=None, height_m=None,
+                  resolution_m=0.5, envi=None, progress=True):
+    """Orthorectify a recorded flight line from files (see ``hsgeo geocode --help``)."""
+    import xarray as xr
+
+    from hsgeo.navigation import Navigation
+
+    if (dem is None) == (height_m is None):
+        raise InputError("give exactly one of --dem DEM.nc or --height H (a plane)")
+    da, t0, rate = read_lines(lines)
+    nav = Navigation.read_csv(trajectory)
+    geom, bs = read_sensor_toml(sensor)
+    if dem is not None:
+        ds = xr.open_dataset(dem)
+        if "height" not in ds:
+            raise InputError(f"{dem}: no variable 'height' (dimensions N, E in metres)")
+        terrain = DemTerrain(ds["height"])
+    else:
+        terrain = PlaneTerrain(float(height_m))
+    ground = geocode_image(nav, geom, da.sizes["line"], da["pixel"].values, t0_s=t0,
+                           line_rate_hz=rate, terrain=terrain, boresight_rad=bs,
+                           progress=progress)
+    ortho = orthorectify(da.values, ground, resolution_m=resolution_m,
+                         band_names=da["band"].values,
+                         attrs={"source": str(lines), "sensor": str(sensor)})
+    return ortho, to_map_files(ortho, output, envi)
+
+
+def write_lines(path, radiance, zeta_px, *, t0_s: float, line_rate_hz: float, wavelength_nm=None):
+    """Write a recorded flight line in the format :func:`read_lines` reads (NetCDF 3)."""
+    import xarray as xr
+
+    r = np.asarray(radiance, dtype=np.float32)
+    if r.ndim == 2:
+        r = r[None]
+    da = xr.DataArray(r, dims=("band", "line", "pixel"),
+                      coords={"pixel": np.asarray(zeta_px, float)}, name="radiance")
+    if wavelength_nm is not None:
+        da = da.assign_coords(wavelength_nm=("band", np.asarray(wavelength_nm, float)))
+    ds = da.to_dataset()
+    ds.attrs.update(t0_s=float(t0_s), line_rate_hz=float(line_rate_hz))
+    ds.to_netcdf(path, engine="scipy")
+    return path

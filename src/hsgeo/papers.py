@@ -22,6 +22,10 @@ __all__ = [
     "P001_TABLE2",
     "P001_SENSOR",
     "P001_DISTORTION_STATEMENTS",
+    "P000_GCP_COLUMNS",
+    "P000_TABLE2_ROWS",
+    "P000_TABLE3_ROWS",
+    "P000_GCP_FOOTERS",
 ]
 
 
@@ -86,4 +90,47 @@ P001_DISTORTION_STATEMENTS = {
     "max_distortion_visible_px": (11.0, "001 §3.1: 'within a range of 0 to 11 for the visible'"),
     "distortion_450px_line1000_px": (25.0, "001 §3.1: 'rises drastically ... above 25' (NIR, at "
                                            "the line's edge, 450 px from the centre)"),
+}
+
+
+#: 000 Tables 2 and 3: deviations at the control points (geocoded − reference, m) without
+#: (Table 2, Jakšić 2009) and with (Table 3, Miljković 2017) the spatial calibration, as printed.
+#: Columns: GCP, Δy, Δx, Δy − n_y, v_y·v_y, Δx − n_x, v_x·v_x (y is east, x north).
+P000_GCP_COLUMNS = ("gcp", "dy_m", "dx_m", "dy_minus_n_m", "vyvy_m2", "dx_minus_n_m", "vxvx_m2")
+P000_TABLE2_ROWS = (
+    (2, -1.1, -1.1, -0.91, 0.82, -1.13, 1.27),
+    (3, -1.27, 0.96, -1.08, 1.16, 0.94, 0.87),
+    (7, -0.3, 0.49, -0.11, 0.01, 0.47, 0.22),
+    (8, -0.44, 0.01, -0.25, 0.06, -0.02, 0.00),
+    (11, -0.61, -0.25, -0.42, 0.17, -0.28, 0.08),
+    (12, -1.13, 0.93, -0.94, 0.87, 0.91, 0.82),
+    (16, 0.34, 0.32, 0.54, 0.29, 0.30, 0.09),
+    (17, 0.61, -0.27, 0.81, 0.65, -0.30, 0.09),
+    (20, 1.3, -0.32, 1.50, 2.24, -0.35, 0.12),
+    (22, 0.65, -0.52, 0.85, 0.71, -0.55, 0.30),
+)
+P000_TABLE3_ROWS = (
+    (2, -0.31, 0.21, -0.29, 0.08, 0.18, 0.03),
+    (3, -0.58, 0.33, -0.56, 0.31, 0.30, 0.09),
+    (7, -0.36, 0.45, -0.34, 0.12, 0.42, 0.17),
+    (8, -0.44, 0.15, -0.42, 0.18, 0.12, 0.01),
+    (11, -0.26, -0.35, -0.24, 0.06, -0.38, 0.15),
+    (12, 0.31, 0.11, 0.33, 0.11, 0.08, 0.01),
+    (16, 0.22, 0.21, 0.24, 0.06, 0.18, 0.03),
+    (17, 0.28, -0.17, 0.30, 0.09, -0.20, 0.04),
+    (20, 0.53, -0.28, 0.55, 0.30, -0.31, 0.10),
+    (22, 0.41, -0.32, 0.43, 0.18, -0.35, 0.13),
+)
+#: The footers as printed: value and printed decimals. Table 2 prints the y bias as "n_x".
+P000_GCP_FOOTERS = {
+    "000 Table 2": {
+        "sum_dy_m": (-1.95, 2), "sum_dx_m": (0.25, 2), "sum_vyvy_m2": (6.98, 2),
+        "sum_vxvx_m2": (3.84, 2), "bias_y_m": (-0.2, 1), "bias_x_m": (0.0, 1),
+        "sigma_y_m": (0.88, 2), "sigma_x_m": (0.65, 2),
+    },
+    "000 Table 3": {
+        "sum_dy_m": (-0.20, 2), "sum_dx_m": (0.34, 2), "sum_vyvy_m2": (1.49, 2),
+        "sum_vxvx_m2": (0.75, 2), "bias_y_m": (-0.02, 2), "bias_x_m": (0.03, 2),
+        "sigma_y_m": (0.40, 2), "sigma_x_m": (0.29, 2),
+    },
 }

@@ -19,6 +19,7 @@ __all__ = ["Row", "Reproduction", "CHAPTERS", "run", "chapter_names"]
 CHAPTERS: dict[str, str] = {
     "frame-reference": "frame_reference",
     "line-calibration": "line_calibration",
+    "geocoding": "geocoding",
 }
 
 

@@ -16,12 +16,21 @@ from pathlib import Path
 
 import numpy as np
 
-from hsgeo.geocode import R_ENU_FROM_NED, CalibratedLine, LineGeometry
+from hsgeo.geocode import (
+    R_ENU_FROM_NED,
+    CalibratedLine,
+    LinearIFOV,
+    LineGeometry,
+    PlaneTerrain,
+    calibrate_boresight,
+    geocode_observations,
+)
 from hsgeo.navigation import Navigation
 from hsgeo.rotations import R_from_rpy
 from hsgeo.simulate import as_rng
 
-__all__ = ["Flight", "simulate_flight", "gcp_field", "observe_gcps", "generate"]
+__all__ = ["Flight", "simulate_flight", "gcp_field", "observe_gcps", "generate", "gcp_deviations",
+           "airfield_scene", "render_line_image", "true_sensor", "nominal_sensor"]
 
 
 @dataclass
@@ -121,9 +130,16 @@ def observe_gcps(nav: Navigation, sensor: LineGeometry, boresight_rad, t0_s, lin
             zeta + rng.normal(0, sigma_px, zeta.size))
 
 
+def nominal_sensor(cfg: dict) -> LinearIFOV:
+    """The uncalibrated model of Jakšić (2009) from ``[sensor_nominal]``."""
+    s = cfg["sensor_nominal"]
+    return LinearIFOV(s["zeta0_px"], s["c_px"])
+
+
 def true_sensor(cfg: dict) -> CalibratedLine:
+    """The true sensor from ``[sensor_truth]`` (000 Table 1, calibrated)."""
     s = cfg["sensor_truth"]
-    return CalibratedLine(s["zeta0_px"], s["c_px"], tuple(s["K"]), s["norm_px"])
+    return CalibratedLine(s["zeta0_px"], s["c_px"], tuple(s["K"]))
 
 
 def simulate_flight(cfg: dict, rng) -> Flight:
@@ -139,6 +155,18 @@ def simulate_flight(cfg: dict, rng) -> Flight:
     line, zeta = observe_gcps(nav, sensor, bs, 0.0, rate, enu, rng, m["sigma_line"],
                               m["sigma_px"])
     return Flight(nav, rec, bs, 0.0, rate, ids, enu, line, zeta, cfg["field"]["height_m"], sensor)
+
+
+def gcp_deviations(fl: Flight, sensor: LineGeometry, sigma_m: float = 0.3):
+    """Geocode the flight's GCP observations with an assumed sensor, after calibrating the
+    boresight on the same GCPs (as PARGE does); returns ``(dev_EN_m (n, 2), result)``."""
+    kw = {"t0_s": fl.t0_s, "line_rate_hz": fl.line_rate_hz}
+    res = calibrate_boresight(fl.recorded_nav, sensor, fl.line, fl.zeta_px, fl.gcp_enu_m,
+                              height_m=fl.terrain_height_m, sigma_m=sigma_m, **kw)
+    X = geocode_observations(fl.recorded_nav, sensor, fl.line, fl.zeta_px,
+                             terrain=PlaneTerrain(fl.terrain_height_m),
+                             boresight_rad=res.value("boresight"), **kw)
+    return X[:, :2] - fl.gcp_enu_m[:, :2], res
 
 
 def generate(cfg: dict, outdir: Path) -> list[Path]:
@@ -161,7 +189,7 @@ def airfield_scene(E_m, N_m, gcp_enu_m=None, target_m: float = 3.0) -> np.ndarra
     """
     E, N = np.asarray(E_m, float), np.asarray(N_m, float)
     val = 0.3 + 0.05 * (np.sin(E / 7.3) * np.cos(N / 5.1) + np.sin((E + N) / 11.7))
-    stripe = (np.abs(((E + 4.0) % 30.0) - 15.0) > 14.0) | (np.abs(((N + 9.0) % 30.0) - 15.0) > 14.4)
+    stripe = (np.abs(((E + 4.0) % 30.0) - 15.0) > 13.5) | (np.abs(((N + 9.0) % 30.0) - 15.0) > 13.5)
     val = np.where(stripe, 0.8, val)
     if gcp_enu_m is not None:
         for e, n, _ in np.asarray(gcp_enu_m):
@@ -176,7 +204,7 @@ def render_line_image(fl: Flight, cfg: dict, rng=None, *, noise: float = 0.005):
     """What the scanner records along the flight: ``(n_lines, n_px)`` radiance and the ζ of the
     columns (pixel centres ζ0 ± usable half width), rendered with the *true* navigation, boresight
     and sensor, with Gaussian noise."""
-    from hsgeo.geocode import PlaneTerrain, geocode_image
+    from hsgeo.geocode import geocode_image
 
     rng = as_rng(0 if rng is None else rng)
     half = cfg["scanner"]["usable_half_width_px"]

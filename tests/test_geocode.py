@@ -1,0 +1,180 @@
+"""Geocoding: ray–terrain intersection, sensor geometries, boresight calibration, ortho, files."""
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from hsgeo import ConvergenceError, InputError, ObservationError
+from hsgeo.adjust.checks import check_jacobian
+from hsgeo.geocode import (
+    BoresightGCP,
+    CalibratedLine,
+    DemTerrain,
+    LinearIFOV,
+    PlaneTerrain,
+    calibrate_boresight,
+    geocode_files,
+    geocode_image,
+    geocode_observations,
+    intersect,
+    orthorectify,
+    read_sensor_toml,
+    write_lines,
+)
+from hsgeo.navigation import Navigation
+from hsgeo.simulate.pula_flight import observe_gcps, simulate_flight, true_sensor
+from hsgeo.simulate.scenarios import load_scenario
+
+CAL = CalibratedLine(486.8, 3539.0, (1.459, -0.1636, 0.00526))  # 000 Table 1
+
+
+def straight_nav(heading_deg=30.0, H=500.0, T=20.0, v=20.0):
+    t = np.linspace(0, T, 401)
+    h = np.deg2rad(heading_deg)
+    EN = np.outer(v * t, [np.sin(h), np.cos(h)])
+    rpy = np.column_stack([0.01 * np.sin(t), 0.005 * np.cos(t), np.full(t.size, h)])
+    return Navigation(t, np.column_stack([EN, np.full(t.size, H)]), rpy)
+
+
+def test_intersect_plane_and_dem_round_trip():
+    rng = np.random.default_rng(0)
+    O = np.column_stack([rng.uniform(-50, 50, (20, 2)), np.full(20, 800.0)])
+    X = np.column_stack([rng.uniform(-200, 200, (20, 2)), np.zeros(20)])
+    # tilted terrain as a DEM (bilinear interpolation of a plane is exact)
+    E = np.linspace(-400, 400, 81)
+    N = np.linspace(-400, 400, 81)
+    dem = xr.DataArray(10 + 0.05 * E[None, :] - 0.03 * N[:, None], dims=("N", "E"),
+                       coords={"N": N, "E": E})
+    X[:, 2] = 10 + 0.05 * X[:, 0] - 0.03 * X[:, 1]
+    got = intersect(O, 3.7 * (X - O), DemTerrain(dem), tol_m=1e-9)
+    np.testing.assert_allclose(got, X, atol=1e-6)
+    flat = X.copy()
+    flat[:, 2] = 25.0
+    np.testing.assert_allclose(intersect(O, flat - O, PlaneTerrain(25.0)), flat, atol=1e-9)
+
+
+def test_intersect_errors():
+    with pytest.raises(ObservationError, match="downwards"):
+        intersect([[0, 0, 100.0]], [[0, 0, 1.0]], PlaneTerrain(0))
+    with pytest.raises(InputError, match="NaN"):
+        intersect([[0, 0, np.nan]], [[0, 0, -1.0]], PlaneTerrain(0))
+    E = np.linspace(0, 10, 11)
+    dem = xr.DataArray(np.zeros((11, 11)), dims=("N", "E"), coords={"N": E, "E": E})
+    with pytest.raises(ObservationError, match="outside the DEM"):
+        intersect([[5.0, 5.0, 100.0]], [[1.0, 0, -0.1]], DemTerrain(dem))
+
+
+@pytest.mark.parametrize("geom", [CAL, LinearIFOV(485.0, 3600.0)])
+def test_line_geometry_round_trip(geom):
+    zeta = np.linspace(486.8 - 440, 486.8 + 440, 81)
+    np.testing.assert_allclose(geom.zeta(geom.tan_angle(zeta)), zeta, atol=1e-7)
+
+
+def test_geocoding_a_known_point_returns_it():
+    """Ray through a known pose and terrain: observe a ground point with the model, geocode it."""
+    nav = straight_nav()
+    bs = np.deg2rad([0.3, -0.2, 0.5])
+    X = np.array([[40.0, 150.0, 12.0], [10.0, 120.0, 12.0], [65.0, 180.0, 12.0]])
+    line, zeta = observe_gcps(nav, CAL, bs, 0.0, 12.5, X, np.random.default_rng(0), 0.0, 0.0)
+    got = geocode_observations(nav, CAL, line, zeta, t0_s=0.0, line_rate_hz=12.5,
+                               terrain=PlaneTerrain(12.0), boresight_rad=bs)
+    np.testing.assert_allclose(got, X, atol=1e-6)
+
+
+def test_boresight_jacobian_and_recovery():
+    nav = straight_nav()
+    bs = np.deg2rad([0.4, -0.3, 0.8])
+    rng = np.random.default_rng(1)
+    along, across = rng.uniform(60, 300, 12), rng.uniform(-50, 50, 12)  # within ±354 px
+    h = np.deg2rad(30.0)
+    X = np.column_stack([along * np.sin(h) + across * np.cos(h),
+                         along * np.cos(h) - across * np.sin(h), np.full(12, 5.0)])
+    line, zeta = observe_gcps(nav, CAL, bs, 0.0, 12.5, X, rng, 0.0, 0.0)
+    blk = BoresightGCP(nav, CAL, line, zeta, X, t0_s=0.0, line_rate_hz=12.5, height_m=5.0,
+                       sigma_m=0.1)
+    assert check_jacobian(blk, {"boresight": bs}, "boresight", 1e-7) < 1e-6
+    res = calibrate_boresight(nav, CAL, line, zeta, X, t0_s=0.0, line_rate_hz=12.5, height_m=5.0)
+    np.testing.assert_allclose(res.value("boresight"), bs, atol=1e-9)
+
+
+def test_boresight_truth_within_3_sigma():
+    cfg = load_scenario("pula_flight")
+    cfg["gnss"]["bias_m"] = 0.0
+    cfg["imu"]["attitude_bias_deg"] = 0.0
+    cfg["imu"]["heading_drift_deg_per_s"] = 0.0
+    z = []
+    for seed in range(8):
+        fl = simulate_flight(cfg, seed)
+        res = calibrate_boresight(fl.recorded_nav, fl.sensor, fl.line, fl.zeta_px, fl.gcp_enu_m,
+                                  t0_s=0.0, line_rate_hz=fl.line_rate_hz, height_m=50.0,
+                                  sigma_m=0.2)
+        z.append((res.value("boresight") - fl.boresight_rad) / res.sigma("boresight"))
+    assert np.max(np.abs(z)) < 4.0  # 24 deviates, family-wise
+
+
+def test_orthorectify_places_pixels_where_they_belong():
+    nav = straight_nav(heading_deg=0.0, T=10.0)
+    zeta = np.arange(100.0, 900.0)
+    g = geocode_image(nav, CAL, 100, zeta, t0_s=0.0, line_rate_hz=10.0,
+                      terrain=PlaneTerrain(0.0))
+    img = np.stack([g[..., 0], g[..., 1]])  # every pixel's value is its own E and N
+    da = orthorectify(img, g, resolution_m=0.5)
+    E, N = np.meshgrid(da["E"], da["N"])
+    ok = np.isfinite(da.values[0])
+    assert ok.mean() > 0.5
+    # nearest neighbour: within half the largest pixel spacing (along track 2 m here)
+    assert np.max(np.abs(da.values[0][ok] - E[ok])) < 1.5
+    assert np.max(np.abs(da.values[1][ok] - N[ok])) < 1.5
+
+
+def test_sensor_toml_errors(tmp_path):
+    p = tmp_path / "s.toml"
+    p.write_text("[sensor]\nmodel = 'pinhole'\nzeta0_px = 1\nc_px = 2\n")
+    with pytest.raises(InputError, match="model must be"):
+        read_sensor_toml(p)
+    p.write_text("[sensor]\nmodel = 'calibrated'\nzeta0_px = 1\n")
+    with pytest.raises(InputError, match="c_px"):
+        read_sensor_toml(p)
+    p.write_text("[sensor\n")
+    with pytest.raises(InputError, match="malformed"):
+        read_sensor_toml(p)
+
+
+def test_geocode_command_end_to_end(tmp_path):
+    from hsgeo.cli import main
+    from hsgeo.io import read_envi
+
+    nav = straight_nav(heading_deg=0.0, T=10.0)
+    nav.write_csv(tmp_path / "nav.csv")
+    zeta = np.arange(200.0, 800.0, 2.0)
+    g = geocode_image(nav, CAL, 80, zeta, t0_s=0.0, line_rate_hz=8.0, terrain=PlaneTerrain(3.0))
+    write_lines(tmp_path / "lines.nc", g[..., 0], zeta, t0_s=0.0, line_rate_hz=8.0)
+    (tmp_path / "sensor.toml").write_text(
+        "[sensor]\nmodel = 'calibrated'\nzeta0_px = 486.8\nc_px = 3539.0\n"
+        "K = [1.459, -0.1636, 0.00526]\n")
+    rc = main(["geocode", str(tmp_path / "lines.nc"), "--trajectory", str(tmp_path / "nav.csv"),
+               "--sensor", str(tmp_path / "sensor.toml"), "--height", "3", "-o",
+               str(tmp_path / "o.nc"), "--envi", str(tmp_path / "o_envi"), "--quiet"])
+    assert rc == 0
+    ds = xr.open_dataset(tmp_path / "o.nc")
+    E = np.broadcast_to(ds["E"].values, ds["radiance"].shape[1:])
+    v = ds["radiance"].values[0]
+    ok = np.isfinite(v)
+    # nearest neighbour: a cell holds a pixel no farther than the default maximum distance
+    # (0.55 × the diagonal of the 2.5 m × 0.28 m pixel spacing + half a cell), mostly much closer
+    err = np.abs(v[ok] - E[ok])
+    assert err.max() < 0.55 * np.hypot(2.5, 0.28) + 0.25
+    assert np.median(err) < 0.1
+    data, hdr = read_envi(tmp_path / "o_envi")
+    assert data.shape == ds["radiance"].shape and hdr["map_info"][2] == 0.5
+    assert main(["geocode", str(tmp_path / "lines.nc"), "--trajectory", str(tmp_path / "nav.csv"),
+                 "--sensor", str(tmp_path / "missing.toml"), "--height", "3", "-o",
+                 str(tmp_path / "x.nc")]) == 2
+    with pytest.raises(InputError, match="exactly one"):
+        geocode_files(tmp_path / "lines.nc", tmp_path / "nav.csv", tmp_path / "sensor.toml",
+                      output=tmp_path / "y.nc")
+
+
+def test_zeta_outside_the_model_raises():
+    with pytest.raises(ConvergenceError):
+        CAL.zeta(np.array([0.2]))  # 700 px from the centre: beyond the calibrated 450 px
