@@ -4,7 +4,7 @@ import pytest
 from hsgeo import ConvergenceError, DatumError, InputError, ObservationError
 from hsgeo.adjust import adjust, identifiability
 from hsgeo.adjust.checks import check_jacobian
-from hsgeo.papers import P000_TABLE1_CALIBRATED, P001_TABLE2
+from hsgeo.papers import P001_TABLE2
 from hsgeo.sensors import line1d as L
 
 K_NIR = np.array([1.459, -0.1636, 0.00526])  # 000 Table 1

@@ -33,7 +33,8 @@ def _cmd_calibrate_line(args) -> int:
     res, v = out["result"], out["residuals_px"]
     names = [("zeta0_px", res.value("zeta0_px"), res.sigma("zeta0_px"))]
     names += [("c_px", res.value("c_px"), res.sigma("c_px"))]
-    names += [(k, a, s) for k, a, s in zip(("K1", "K2", "K3"), res.value("K"), res.sigma("K"))]
+    names += [(k, a, s) for k, a, s in zip(("K1", "K2", "K3"), res.value("K"), res.sigma("K"),
+                                                          strict=True)]
     stats = {"sigma0": res.sigma0, "dof": res.dof, "rms_px": float(np.sqrt(np.mean(v**2))),
              "max_abs_px": float(np.max(np.abs(v))), "n_observations": int(v.size)}
     if args.json:

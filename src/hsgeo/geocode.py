@@ -406,7 +406,8 @@ def orthorectify(image, ground_enu_m, *, resolution_m: float, bounds=None, band_
                 "N": N, "E": E},
         name="radiance",
         attrs={"crs": "local east-north-up frame (metres)", "resolution_m": resolution_m,
-               "resampling": "nearest neighbour", **(attrs or {})},
+               "resampling": "nearest neighbour", "max_distance_m": float(max_distance_m),
+               **(attrs or {})},
     )
     da["E"].attrs.update(units="m", long_name="easting")
     da["N"].attrs.update(units="m", long_name="northing")
@@ -414,7 +415,9 @@ def orthorectify(image, ground_enu_m, *, resolution_m: float, bounds=None, band_
 
 
 def to_map_files(da, path_nc=None, path_envi=None):
-    """Write an orthorectified raster as NetCDF 3 (xarray's scipy engine) and/or ENVI BSQ with map info.
+    """Write an orthorectified raster as NetCDF 3 and/or ENVI BSQ with map info.
+
+    NetCDF is written with xarray's scipy engine (no further dependency).
 
     Returns the paths written.
     """
@@ -482,7 +485,8 @@ def read_sensor_toml(path):
 def read_lines(path):
     """A flight line as recorded: NetCDF with ``radiance`` ``(line, pixel)`` or
     ``(band, line, pixel)``, coordinate ``pixel`` (ζ in px), attributes ``t0_s`` (time of line 0)
-    and ``line_rate_hz``."""
+    and ``line_rate_hz``.
+    """
     import xarray as xr
 
     try:
@@ -495,7 +499,9 @@ def read_lines(path):
     if "band" not in da.dims:
         da = da.expand_dims("band")
     if set(da.dims) != {"band", "line", "pixel"}:
-        raise InputError(f"{path}: radiance must have dimensions (band,) line, pixel; got {da.dims}")
+        raise InputError(
+            f"{path}: radiance must have dimensions (band,) line, pixel; got {da.dims}"
+        )
     for a in ("t0_s", "line_rate_hz"):
         if a not in ds.attrs and a not in da.attrs:
             raise InputError(f"{path}: attribute {a!r} missing (time of line 0, line rate)")

@@ -27,7 +27,8 @@ QUANTITIES = ("bias_y_m", "bias_x_m", "sigma_y_m", "sigma_x_m")
 
 def calibrated_iop(seed: int):
     """The 870 nm inner orientation as the ``line-calibration`` chapter estimates it (same seed):
-    rendered raw frames, measured minima, adjusted; returns ``(CalibratedLine, result)``."""
+    rendered raw frames, measured minima, adjusted; returns ``(CalibratedLine, result)``.
+    """
     from hsgeo.reproduce.line_calibration import calibrate_simulated
     from hsgeo.simulate.line_lab import LineLab
 

@@ -1,4 +1,4 @@
-"""``hsgeo reproduce line-calibration``: 000 Table 1, 001 Table 2, distortion magnitudes, Monte Carlo.
+"""``hsgeo reproduce line-calibration``: 000 Table 1, 001 Table 2, distortions, Monte Carlo.
 
 Every spectral line (001 Table 2: rows 100, 300, 500, 1000; row 1000 is also 000 Table 1) is
 calibrated from raw frames rendered by :mod:`hsgeo.simulate.line_lab`, measured by
@@ -12,8 +12,12 @@ from __future__ import annotations
 import numpy as np
 
 from hsgeo.adjust import adjust
-from hsgeo.papers import (P000_TABLE1_CALIBRATED, P000_TABLE1_UNCALIBRATED,
-                          P001_DISTORTION_STATEMENTS, P001_TABLE2)
+from hsgeo.papers import (
+    P000_TABLE1_CALIBRATED,
+    P000_TABLE1_UNCALIBRATED,
+    P001_DISTORTION_STATEMENTS,
+    P001_TABLE2,
+)
 from hsgeo.reproduce import Reproduction, Row
 from hsgeo.sensors import line1d
 from hsgeo.simulate import as_rng
@@ -62,7 +66,8 @@ def monte_carlo(lab: LineLab, row: int, n: int, seed: int) -> dict:
     z = (est - tru) / sig
     return {"est": est, "sigma": sig, "truth": tru, "sigma0": np.array(s0), "z": z,
             "coverage": {k: np.mean(np.abs(z) <= k, axis=0) for k in (1, 2, 3)},
-            "bias": np.mean(est - tru, axis=0), "bias_sigma": np.std(est - tru, axis=0) / np.sqrt(n)}
+            "bias": np.mean(est - tru, axis=0),
+            "bias_sigma": np.std(est - tru, axis=0) / np.sqrt(n)}
 
 
 def design_sigma_c(lab: LineLab, row: int = 1000, *, offsets_m=(0.0,), station_sigma_m=None,
@@ -110,7 +115,8 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
     rows: list[Row] = []
     results, sims = {}, {}
     for r in lab.rows:
-        res, sim = calibrate_simulated(lab, r, np.random.SeedSequence([seed, r]).generate_state(1)[0])
+        row_seed = np.random.SeedSequence([seed, r]).generate_state(1)[0]
+        res, sim = calibrate_simulated(lab, r, row_seed)
         results[r], sims[r] = res, sim
     # 000 Table 1 (row 1000, λ = 870 nm)
     u, c = P000_TABLE1_UNCALIBRATED, P000_TABLE1_CALIBRATED

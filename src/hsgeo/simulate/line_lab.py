@@ -114,7 +114,8 @@ def true_iop(row) -> dict:
 
 def stations(lab: LineLab, rng=None) -> np.ndarray:
     """Stations ``(n, 3)``: x0_m, y0_m, alpha_rad on a circle around the pattern, looking at its
-    centre, scattered by the configured σ when ``rng`` is given (the truth of one experiment)."""
+    centre, scattered by the configured σ when ``rng`` is given (the truth of one experiment).
+    """
     a = np.deg2rad(np.asarray(lab.azimuths_deg, dtype=float))
     e = np.column_stack([lab.distance_m * np.sin(a), -lab.distance_m * np.cos(a), a])
     if rng is not None:
@@ -251,7 +252,8 @@ def simulate_observations(lab: LineLab, row: int, rng, eop_true=None, method: st
 
 def generate(cfg: dict, outdir: Path) -> list[Path]:
     """``make data``: observations and control points of one calibration (row 1000), as CSV in
-    the formats ``hsgeo calibrate-line`` reads, and the truth."""
+    the formats ``hsgeo calibrate-line`` reads, and the truth.
+    """
     lab = LineLab.from_config(cfg.get("lab"))
     row = int(cfg.get("calibration", {}).get("row", 1000))
     sim = simulate_observations(lab, row, int(cfg["scenario"]["seed"]))

@@ -90,7 +90,8 @@ def _recorded(nav: Navigation, cfg: dict, rng) -> Navigation:
     n = nav.t_s.size
     dt = np.diff(nav.t_s, prepend=nav.t_s[0])
     pos_bias = rng.normal(0, g["bias_m"], 3)
-    walk = np.cumsum(rng.normal(0, 1, (n, 3)) * np.sqrt(dt)[:, None], axis=0) * g["random_walk_m_per_sqrt_s"]
+    steps = rng.normal(0, 1, (n, 3)) * np.sqrt(dt)[:, None]
+    walk = np.cumsum(steps, axis=0) * g["random_walk_m_per_sqrt_s"]
     pos = nav.enu_m + pos_bias + walk + rng.normal(0, g["white_m"], (n, 3))
     att_bias = rng.normal(0, np.deg2rad(imu["attitude_bias_deg"]), 3)
     att = (nav.rpy_rad + att_bias + rng.normal(0, np.deg2rad(imu["attitude_noise_deg"]), (n, 3))
@@ -159,7 +160,8 @@ def simulate_flight(cfg: dict, rng) -> Flight:
 
 def gcp_deviations(fl: Flight, sensor: LineGeometry, sigma_m: float = 0.3):
     """Geocode the flight's GCP observations with an assumed sensor, after calibrating the
-    boresight on the same GCPs (as PARGE does); returns ``(dev_EN_m (n, 2), result)``."""
+    boresight on the same GCPs (as PARGE does); returns ``(dev_EN_m (n, 2), result)``.
+    """
     kw = {"t0_s": fl.t0_s, "line_rate_hz": fl.line_rate_hz}
     res = calibrate_boresight(fl.recorded_nav, sensor, fl.line, fl.zeta_px, fl.gcp_enu_m,
                               height_m=fl.terrain_height_m, sigma_m=sigma_m, **kw)
@@ -203,7 +205,8 @@ def airfield_scene(E_m, N_m, gcp_enu_m=None, target_m: float = 3.0) -> np.ndarra
 def render_line_image(fl: Flight, cfg: dict, rng=None, *, noise: float = 0.005):
     """What the scanner records along the flight: ``(n_lines, n_px)`` radiance and the ζ of the
     columns (pixel centres ζ0 ± usable half width), rendered with the *true* navigation, boresight
-    and sensor, with Gaussian noise."""
+    and sensor, with Gaussian noise.
+    """
     from hsgeo.geocode import geocode_image
 
     rng = as_rng(0 if rng is None else rng)
