@@ -41,6 +41,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from hsgeo.errors import ConvergenceError, InputError
+from hsgeo.validate import finite_array
 
 __all__ = [
     "odd_radial_1d",
@@ -58,21 +59,7 @@ __all__ = [
 # --------------------------------------------------------------------------- validation
 
 
-def _as_float(a: ArrayLike, name: str) -> NDArray[np.float64]:
-    """Convert to a finite float64 array or raise InputError."""
-    try:
-        arr = np.asarray(a, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise InputError(
-            f"{name} could not be converted to a float array ({exc}); pass numbers."
-        ) from exc
-    if not np.all(np.isfinite(arr)):
-        n_bad = int(np.size(arr) - np.count_nonzero(np.isfinite(arr)))
-        raise InputError(
-            f"{name} contains {n_bad} non-finite value(s) (NaN or inf); "
-            "remove or replace them before calling."
-        )
-    return arr
+_as_float = finite_array  # the boundary check shared by every module
 
 
 def _as_last(a: ArrayLike, name: str, n: int, what: str) -> NDArray[np.float64]:

@@ -27,6 +27,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from hsgeo.errors import InputError
+from hsgeo.validate import finite_array
 
 __all__ = [
     "R_from_opk",
@@ -51,21 +52,7 @@ _GIMBAL_EPS = 1e-12
 # --------------------------------------------------------------------------- validation
 
 
-def _as_float(a: ArrayLike, name: str) -> NDArray[np.float64]:
-    """Convert to a finite float64 array or raise InputError."""
-    try:
-        arr = np.asarray(a, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise InputError(
-            f"{name} could not be converted to a float array ({exc}); pass numbers."
-        ) from exc
-    if not np.all(np.isfinite(arr)):
-        n_bad = int(np.size(arr) - np.count_nonzero(np.isfinite(arr)))
-        raise InputError(
-            f"{name} contains {n_bad} non-finite value(s) (NaN or inf); "
-            "remove or replace them before calling."
-        )
-    return arr
+_as_float = finite_array  # the boundary check shared by every module
 
 
 def _as_vectors(a: ArrayLike, name: str, n: int) -> NDArray[np.float64]:

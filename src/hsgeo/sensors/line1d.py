@@ -68,6 +68,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from hsgeo.adjust import Indexed, Parameters, ResidualBlock
 from hsgeo.errors import ConvergenceError, InputError, ObservationError
+from hsgeo.validate import finite_array
 
 __all__ = [
     "DISTORTION_NORM_PX",
@@ -94,15 +95,7 @@ EOP_COLUMNS = ("x0_m", "y0_m", "alpha_rad")
 _EXPONENTS = np.array([3, 5, 7])
 
 
-def _finite(a: ArrayLike, name: str) -> NDArray[np.float64]:
-    try:
-        arr = np.asarray(a, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise InputError(f"{name} must be numeric ({exc})") from exc
-    if not np.all(np.isfinite(arr)):
-        n_bad = int(arr.size - np.count_nonzero(np.isfinite(arr)))
-        raise InputError(f"{name} contains {n_bad} NaN/inf value(s); remove them before calling")
-    return arr
+_finite = finite_array  # the boundary check shared by every module
 
 
 def _K3(K: ArrayLike) -> NDArray[np.float64]:
