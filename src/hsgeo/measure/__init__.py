@@ -1,0 +1,1 @@
+"""Measurement: images to observations (image coordinates, ids, bands)."""
