@@ -443,3 +443,73 @@ def predict_band(joint: JointCalibration, obs: Observations, band: int) -> np.nd
     values["df_mm"] = np.zeros_like(values["df_mm"])
     r = blk.evaluate(values, False)[0].reshape(-1, 2)
     return r / obs.pixel_mm * np.array([1.0, -1.0])
+
+
+def corner_bias(obs: Observations, truth) -> dict[int, dict[str, float]]:
+    """Corner displacement with exposure (003 §3.2), per band, against the simulated truth.
+
+    Returns
+    -------
+    dict band -> ``outward_px`` (mean displacement of the detected corners away from the
+    target's centre; negative: the target looks smaller), ``scale`` (mean ratio of detected to
+    true side length, the paper's scale factor), ``centroid_mean_px`` (x, y) and
+    ``centroid_sd_px`` (x, y) of the centroid error.
+    """
+    out = {}
+    for b in np.unique(obs.band):
+        o = obs.select(obs.band == b)
+        true = np.stack([mm_to_pixel(truth.project(int(c), int(b), X), obs.image_size,
+                                     obs.pixel_mm) for c, X in zip(o.cube, o.corners_obj,
+                                                                   strict=True)])
+        e = o.corners_px - true
+        centre = true.mean(axis=1, keepdims=True)
+        u = true - centre
+        u /= np.linalg.norm(u, axis=-1, keepdims=True)
+        side = lambda c: np.linalg.norm(np.roll(c, -1, axis=1) - c, axis=-1)  # noqa: E731
+        ce = o.centroids_px - true.mean(axis=1)
+        out[int(b)] = {"outward_px": float(np.mean(np.sum(e * u, axis=-1))),
+                       "scale": float(np.mean(side(o.corners_px) / side(true))),
+                       "centroid_mean_px": ce.mean(axis=0).tolist(),
+                       "centroid_sd_px": ce.std(axis=0).tolist()}
+    return out
+
+
+def track_targets(obs: Observations, cube: int, ref_band: int) -> dict[str, tuple[int, dict]]:
+    """Five targets of one cube — nearest the four image corners and the centre in a reference
+    band — and their centroids (px) in every band (003 §3.2, Fig. 3–4).
+
+    Returns
+    -------
+    dict label (ULC, URC, BLC, BRC, IC) -> (target id, {band: (col, row)})
+    """
+    w, h = obs.image_size
+    ref = obs.select((obs.cube == cube) & (obs.band == ref_band))
+    if len(ref.cube) < 5:
+        raise ObservationError(f"cube {cube}, band {ref_band}: fewer than 5 targets")
+    spots = {"ULC": (0, 0), "URC": (w - 1, 0), "BLC": (0, h - 1), "BRC": (w - 1, h - 1),
+             "IC": ((w - 1) / 2, (h - 1) / 2)}
+    out = {}
+    for lab, p in spots.items():
+        t = int(ref.target[np.argmin(np.linalg.norm(ref.centroids_px - p, axis=1))])
+        track = {}
+        for b in np.unique(obs.band):
+            m = (obs.cube == cube) & (obs.band == b) & (obs.target == t)
+            if m.any():
+                track[int(b)] = tuple(obs.centroids_px[m][0])
+        out[lab] = (t, track)
+    return out
+
+
+def radial_effect_px(KP, r_mm, pixel_mm: float) -> np.ndarray:
+    """Magnitude of the symmetric radial correction ``r (K1 r² + K2 r⁴ + K3 r⁶)`` in px."""
+    r = np.asarray(r_mm, float)
+    K = np.asarray(KP, float)[:3]
+    return r * (K[0] * r ** 2 + K[1] * r ** 4 + K[2] * r ** 6) / pixel_mm
+
+
+def decentering_effect_px(KP, xy_mm, pixel_mm: float) -> np.ndarray:
+    """The decentering part ``(δx, δy)`` of Brown's correction at a point, in px (003 Fig. 9)."""
+    from hsgeo.distortion import brown_correction
+
+    KP = np.asarray(KP, float)
+    return brown_correction(np.asarray(xy_mm, float), np.zeros(3), KP[3:]) / pixel_mm
