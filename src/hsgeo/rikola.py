@@ -47,6 +47,7 @@ __all__ = [
     "initial_poses",
     "BandCalibration",
     "calibrate_band",
+    "initial_focal_mm",
     "relative_orientation",
     "gap_regression",
     "JointCalibration",
@@ -190,6 +191,20 @@ def initial_poses(obs: Observations, f_mm: float) -> dict[int, np.ndarray]:
     return out
 
 
+def initial_focal_mm(obs: Observations) -> float:
+    """Focal length from ``cv2.initCameraMatrix2D`` on the views of a planar board (Z = 0)."""
+    import cv2
+
+    views = np.unique(obs.cube)
+    X = obs.corners_obj.mean(axis=1)
+    if not np.allclose(X[:, 2], 0.0):
+        raise InputError("initialisation needs a planar board with Z = 0 in board coordinates")
+    objs = [X[obs.cube == c].astype(np.float32) for c in views]
+    imgs = [obs.centroids_px[obs.cube == c].astype(np.float32) for c in views]
+    K = cv2.initCameraMatrix2D(objs, imgs, tuple(int(s) for s in obs.image_size), 1.0)
+    return float(np.sqrt(K[0, 0] * K[1, 1])) * obs.pixel_mm
+
+
 @dataclass
 class BandCalibration:
     """Self-calibration of one band (003 §3.3): ``result`` holds interior, distortion_mm and
@@ -250,14 +265,17 @@ def _band_problem(obs: Observations, band: int, f0_mm: float, sigma_px: float):
     return p, blk, cubes
 
 
-def calibrate_band(obs: Observations, band: int, *, f0_mm: float = 9.0, sigma_px: float = 0.02,
-                   reject_k: float | None = 5.0) -> BandCalibration:
+def calibrate_band(obs: Observations, band: int, *, f0_mm: float | None = 9.0,
+                   sigma_px: float = 0.02, reject_k: float | None = 5.0) -> BandCalibration:
     """Self-calibrating bundle adjustment of one band (003 §3.3: each band a camera).
 
     The datum is the plate: the target coordinates are known (fixed), as on the paper's bench
     where the distances between the targets were known (003 §3.2); the initial values are the
-    nominal focal length (003 Table 1), the image centre, zero distortion and ``solvePnP`` poses.
+    nominal focal length (003 Table 1; ``f0_mm=None``: from ``cv2.initCameraMatrix2D``), the image
+    centre, zero distortion and ``solvePnP`` poses.
     """
+    if f0_mm is None:
+        f0_mm = initial_focal_mm(obs.select(obs.band == band))
     p, blk, cubes = _band_problem(obs, band, f0_mm, sigma_px)
     res = adjust(p, blk, reject_k=reject_k)
     return BandCalibration(band, cubes, res, blk, block_pixel_mm=obs.pixel_mm)
@@ -513,3 +531,53 @@ def decentering_effect_px(KP, xy_mm, pixel_mm: float) -> np.ndarray:
 
     KP = np.asarray(KP, float)
     return brown_correction(np.asarray(xy_mm, float), np.zeros(3), KP[3:]) / pixel_mm
+
+
+def calibrate_frame_files(images, board_path, *, joint: bool = False, band_regex=None,
+                          cube_regex=None, sigma_px: float = 0.1):
+    """``hsgeo calibrate-frame``: detect a board in image files and self-calibrate, per band
+    (:func:`calibrate_band`) or jointly (:func:`calibrate_joint`, Rikola band numbering).
+
+    Returns
+    -------
+    hsgeo.reproduce.Reproduction
+        Rows ``interior band N`` (f, x0, y0, K1–K3, P1, P2 with σ̂, in mm or — without
+        ``camera.pixel_mm`` in the board file — px) or ``joint model``; ``meta`` has σ0, the
+        RMS residual and the number of points per band.
+    """
+    from hsgeo.measure.boards import load_board, observe_files
+    from hsgeo.reproduce import Reproduction, Row
+
+    board = load_board(board_path)
+    obs = observe_files(images, board, band_regex=band_regex, cube_regex=cube_regex)
+    unit = "mm" if board.pixel_mm is not None else "px"
+    rows, meta = [], {"images": len(list(images)), "points": int(len(obs.cube)),
+                      "length_unit": unit, "board": board.type}
+    if joint:
+        if band_regex is None or cube_regex is None:
+            raise InputError("--joint needs --band-regex and --cube-regex (which band and cube "
+                             "each file is)")
+        j = calibrate_joint(obs, f0_mm=initial_focal_mm(obs), sigma_px=sigma_px)
+        R = j.result
+        for blk in ("gap_model", "pp_mm", "distortion_mm", "sensor2_rotation"):
+            b = R.params[blk]
+            for lab, v, s in zip(b.labels(), b.value.ravel(), R.sigma(blk).ravel(),
+                                 strict=True):
+                rows.append(Row("joint model", lab, "", None, None, v, s, None))
+        meta.update(sigma0=R.sigma0, rms_px=float(np.sqrt(np.mean(np.sum(
+            j.residuals_px ** 2, axis=1)))))
+        return Reproduction("calibrate-frame", 0, rows, meta)
+    for band in np.unique(obs.band):
+        c = calibrate_band(obs, int(band), f0_mm=None, sigma_px=sigma_px)
+        for q, (v, s) in c.iop.items():
+            u = q.split("_", 1)[1].replace("per_", "1/") if "_" in q else ""
+            if board.pixel_mm is None:  # nominal pitch -> px: lengths /p, K_i ·p^(2i), P ·p
+                power = {"f": -1, "x0": -1, "y0": -1, "K1": 2, "K2": 4, "K3": 6, "P1": 1,
+                         "P2": 1}[q.split("_")[0]]
+                v, s = v * obs.pixel_mm ** power, s * obs.pixel_mm ** power
+            rows.append(Row(f"interior band {band}", q.split("_")[0],
+                            u.replace("mm", unit), None, None, v, s, None))
+        meta[f"band {band}"] = {"sigma0": c.result.sigma0, "points": int(np.sum(obs.band == band)),
+                                "rms_px": float(np.sqrt(np.mean(np.sum(c.residuals_px ** 2, 1)))),
+                                "views": int(len(c.cubes))}
+    return Reproduction("calibrate-frame", 0, rows, meta)
