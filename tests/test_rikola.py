@@ -185,11 +185,23 @@ def test_joint_model_recovers_truth(bench, truth):
     R = j.result
     for name, tr in (("gap_model", truth.gap_model), ("pp_mm", truth.pp_mm),
                      ("distortion_mm", truth.KP), ("sensor2_rotation", truth.rotation_rad)):
-        z = (R.value(name) - tr) / R.sigma(name)
+        z = (j.value(name) - tr) / j.sigma(name)
         assert np.all(np.abs(z) < 3.5), (name, z)
     np.testing.assert_array_equal(R.value("sensor2_offset_mm"), 0.0)  # held (one lens)
+    assert 1.0 <= j.clusters["deff"] < 5.0
     with pytest.raises(ObservationError):
         calibrate_joint(obs, exclude_bands=[2, 5, 10])
+
+
+def test_design_effect_recovers_cluster_correlation():
+    from hsgeo.rikola import design_effect
+
+    rng = np.random.default_rng(1)
+    cl = np.repeat(np.arange(4000), 6)
+    r = (0.01 * rng.standard_normal((4000, 2)))[cl] + 0.02 * rng.standard_normal((cl.size, 2))
+    d = design_effect(r, cl)
+    assert abs(d["rho"] - 0.2) < 0.03 and abs(d["deff"] - 2.0) < 0.15
+    assert design_effect(r[:5], np.arange(5))["deff"] == 1.0
 
 
 def test_gap_regression_exact_line():

@@ -14,7 +14,7 @@ from hsgeo.measure.boards import load_board
 
 ROOT = Path(__file__).resolve().parents[1]
 CHARUCO = ROOT / "src/hsgeo/data/reference/opencv-charuco/images"
-BOARD = ROOT / "examples/charuco_board.toml"
+BOARD = ROOT / "src/hsgeo/data/reference/opencv-charuco/board.toml"
 
 
 def test_charuco_photographs_match_opencv(capsys):

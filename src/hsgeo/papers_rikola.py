@@ -129,3 +129,14 @@ def band_table():
     import pandas as pd
 
     return pd.DataFrame(RIKOLA_BANDS).set_index("band")
+
+#: 003 §3.4, transformation test: mean discrepancy (columns, rows) in px between the sensor-II
+#: and sensor-I coordinates before the transformation, and after it with the best ROP set.
+RIKOLA_ROP_TEST_PX = {"before": (-6.8, 5.4), "after_best": (0.99, 0.91)}
+
+#: 003 §3.5 (Fig. 8-9): differences of the radial effect at the image corner below 1 px; largest
+#: decentering effect 1/5 px, 1/3 px at the sensor transition (bands 10-11).
+RIKOLA_FIG8_MAX_DIFF_PX = 1.0
+RIKOLA_FIG9_MAX_DECENTERING_PX = (1 / 5, 1 / 3)
+
+__all__ += ["RIKOLA_ROP_TEST_PX", "RIKOLA_FIG8_MAX_DIFF_PX", "RIKOLA_FIG9_MAX_DECENTERING_PX"]

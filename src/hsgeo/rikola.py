@@ -52,6 +52,7 @@ __all__ = [
     "gap_regression",
     "JointCalibration",
     "calibrate_joint",
+    "design_effect",
     "predict_band",
 ]
 
@@ -351,19 +352,71 @@ def gap_regression(gap_nm, f_mm) -> dict[str, float]:
             "sigma_b": float(np.sqrt(cov[1, 1])), "r2": r2, "s": float(np.sqrt(s2))}
 
 
+def design_effect(residuals_px, cluster) -> dict[str, float]:
+    """Intra-cluster correlation of residuals and the design effect of a cluster mean.
+
+    The centroid of one target in one cube has an error part that every band of a sensor
+    shares (the corner detector's response to the target's perspective and pixel phase), on
+    top of the independent noise of each band. One-way analysis of variance of the residuals
+    grouped by ``cluster`` gives the within-cluster σ, the between-cluster σ and
+    ``rho = σ_b² / (σ_b² + σ_w²)``; a parameter estimated from clusters of ``m`` correlated
+    observations has its variance multiplied by ``deff = 1 + (m − 1)·rho`` (Kish's design
+    effect) — the factor the joint model's covariance, which assumes independent observations,
+    is scaled by.
+
+    Parameters
+    ----------
+    residuals_px : (n, 2) ndarray
+    cluster : (n,) int ndarray
+
+    Returns
+    -------
+    dict with ``sigma_within_px``, ``sigma_between_px``, ``rho``, ``m`` and ``deff`` (means of
+    the two coordinates).
+    """
+    r = np.asarray(residuals_px, float)
+    u, inv, cnt = np.unique(np.asarray(cluster), return_inverse=True, return_counts=True)
+    if u.size < 2 or u.size == r.shape[0]:
+        return {"sigma_within_px": float("nan"), "sigma_between_px": 0.0, "rho": 0.0,
+                "m": 1.0, "deff": 1.0}
+    m = float(cnt.mean())
+    out = []
+    for k in range(r.shape[1]):
+        x = r[:, k]
+        means = np.bincount(inv, x) / cnt
+        s2w = float(np.sum((x - means[inv]) ** 2) / (x.size - u.size))
+        s2b = max(float(np.var(means)) - s2w / m, 0.0)
+        out.append((s2w, s2b))
+    s2w, s2b = np.mean(out, axis=0)
+    rho = s2b / (s2b + s2w)
+    return {"sigma_within_px": float(np.sqrt(s2w)), "sigma_between_px": float(np.sqrt(s2b)),
+            "rho": float(rho), "m": m, "deff": float(1.0 + (m - 1.0) * rho)}
+
+
 @dataclass
 class JointCalibration:
-    """The joint model's adjustment and its bookkeeping."""
+    """The joint model's adjustment and its bookkeeping.
+
+    ``sigma(name)`` is the adjustment's σ̂ scaled by the square root of the design effect of the
+    target clusters (:func:`design_effect`); ``result.sigma(name)`` is the unscaled one.
+    """
 
     result: AdjustmentResult
     block: JointCentroids
     cubes: np.ndarray
     bands: np.ndarray  # band numbers in the model (the held-out one excluded)
     pixel_mm: float
+    clusters: dict = field(default_factory=dict)
 
     @property
     def residuals_px(self) -> np.ndarray:
         return self.result.residuals(0).reshape(-1, 2) / self.pixel_mm * [1.0, -1.0]
+
+    def value(self, name):
+        return self.result.value(name)
+
+    def sigma(self, name):
+        return self.result.sigma(name) * np.sqrt(self.clusters.get("deff", 1.0))
 
 
 _OFF_LINE = (1, 11)  # bands whose gaps are off the linear trend (003 §3.5)
@@ -425,7 +478,11 @@ def calibrate_joint(obs: Observations, *, exclude_bands=(), scatter_mm=(0.0035, 
     blk = JointCentroids(np.searchsorted(cubes, o.cube), brow, o.corners_obj, o.centroids_mm,
                          sigma_px * obs.pixel_mm, table["gap_nm"], table["sensor"])
     res = adjust(p, blk, reject_k=reject_k)
-    return JointCalibration(res, blk, cubes, bands, obs.pixel_mm)
+    j = JointCalibration(res, blk, cubes, bands, obs.pixel_mm)
+    ok = ~res.outliers(0)  # one entry per centroid
+    key = (o.cube * 1_000_000 + o.target * 10 + table["sensor"][brow])[ok]
+    j.clusters = design_effect(j.residuals_px[ok], key)
+    return j
 
 
 def _init_from_bands(p: Parameters, cals: dict, cubes) -> None:
