@@ -89,9 +89,13 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
                                     cals[k2].pose_covariance(ROP_CUBE))[1] for k2, k1 in pairs]
     rop = rop_all.mean(axis=1)  # per pair, mean over cubes
     rop_cube0 = rop_all[:, cubes.index(ROP_CUBE)]
-    per_cube = rop_all.mean(axis=0)  # (n_cubes, 3)
-    rop_mean = per_cube.mean(axis=0)
-    rop_mean_sigma = per_cube.std(axis=0, ddof=1) / np.sqrt(len(cubes))
+    rop_mean = rop.mean(axis=0)
+    # σ̂ of the mean: the poses of all cubes of a band are correlated through the band's
+    # interior orientation, so propagate each band's full pose covariance (bands independent)
+    var = np.zeros(3)
+    for (k2, k1), per_pair in zip(pairs, rop_all, strict=True):
+        var += np.diag(_rop_mean_covariance(cals[k1], cals[k2], cubes))
+    rop_mean_sigma = np.sqrt(var) / len(pairs)
     for i, q in enumerate(("domega_deg", "dphi_deg", "dkappa_deg")):
         rows.append(Row("003 Table 4 ROP", q, "deg", RIKOLA_TABLE4_ROP_MEAN_DEG[i], None,
                         np.rad2deg(rop_mean[i]), np.rad2deg(rop_mean_sigma[i]),
@@ -209,6 +213,27 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
               "pairs": pairs, "regression": reg, "regression_truth": reg_truth, "gaps": gaps,
               "f_hat": f_hat, "f_sigma": f_sig}
     return Reproduction("rikola", seed, rows, meta, extras)
+
+
+def _rop_mean_covariance(cal1, cal2, cubes, step: float = 1e-7) -> np.ndarray:
+    """Covariance (3, 3) of the ROP averaged over cubes, from the full pose covariances of the
+    two bands' adjustments."""
+    J1 = np.zeros((3, 6 * len(cal1.cubes)))
+    J2 = np.zeros((3, 6 * len(cal2.cubes)))
+    for c in cubes:
+        p1, p2 = cal1.pose(c), cal2.pose(c)
+        i1 = int(np.flatnonzero(cal1.cubes == c)[0])
+        i2 = int(np.flatnonzero(cal2.cubes == c)[0])
+        for a in range(3):
+            d = np.zeros(6)
+            d[a] = step
+            J1[:, 6 * i1 + a] = (relative_orientation(p1 + d, p2)[0]
+                                 - relative_orientation(p1 - d, p2)[0]) / (2 * step)
+            J2[:, 6 * i2 + a] = (relative_orientation(p1, p2 + d)[0]
+                                 - relative_orientation(p1, p2 - d)[0]) / (2 * step)
+    C1, _ = cal1.result.covariance_of("poses")
+    C2, _ = cal2.result.covariance_of("poses")
+    return (J1 @ C1 @ J1.T + J2 @ C2 @ J2.T) / len(cubes) ** 2
 
 
 def _rms(r) -> float:
