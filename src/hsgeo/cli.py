@@ -45,6 +45,14 @@ def _cmd_calibrate_line(args) -> int:
         print(res.report())
         print(f"residuals: RMS {stats['rms_px']:.4f} px, max |v| {stats['max_abs_px']:.4f} px "
               f"over {stats['n_observations']} observations")
+def _cmd_calibrate_frame(args) -> int:
+    from hsgeo.rikola import calibrate_frame_files
+
+    out = calibrate_frame_files(args.images, args.board, joint=args.joint,
+                                band_regex=args.band_regex, cube_regex=args.cube_regex,
+                                sigma_px=args.sigma_px)
+    print(out.to_json() if args.json else out.to_text() + "\n\n" + "\n".join(
+        f"  {k}: {v}" for k, v in out.meta.items()))
     return 0
 
 
@@ -108,6 +116,22 @@ def build_parser() -> argparse.ArgumentParser:
                    help="reject observations beyond k robust σ (default: none)")
     p.add_argument("--json", action="store_true", help="estimates and residual statistics as JSON")
     p.set_defaults(func=_cmd_calibrate_line)
+    p = sub.add_parser("calibrate-frame", help="self-calibrate a frame camera (per band or "
+                       "jointly, 003) from images of an ArUco / ChArUco board")
+    p.add_argument("images", nargs="+", metavar="IMAGES", help="image files")
+    p.add_argument("--board", required=True, help="board description (TOML, see "
+                   "hsgeo.measure.boards)")
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("--per-band", action="store_false", dest="joint",
+                   help="one calibration per band (default)")
+    g.add_argument("--joint", action="store_true", help="one joint adjustment of all bands "
+                   "(Rikola band numbering of 003 Table 2; needs --band-regex and --cube-regex)")
+    p.add_argument("--band-regex", help="regex with one group: band number from the file name")
+    p.add_argument("--cube-regex", help="regex with one group: cube (view) from the file name")
+    p.add_argument("--sigma-px", type=float, default=0.1,
+                   help="a-priori σ of an image point in px (default 0.1)")
+    p.add_argument("--json", action="store_true", help="one JSON object instead of text")
+    p.set_defaults(func=_cmd_calibrate_frame, joint=False)
 
     p = sub.add_parser("data", help="generate data_synthetic/generated from the scenario TOMLs")
     p.add_argument("--verify", action="store_true",

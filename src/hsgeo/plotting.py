@@ -4,7 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["residual_quiver", "radial_displacement", "z_scores", "image_with_points"]
+from hsgeo.papers import RIKOLA_BANDS
+
+__all__ = ["residual_quiver", "radial_displacement", "z_scores", "image_with_points",
+"plot_band_image", "plot_corner_bias", "plot_tracks", "plot_band_eops",
+           "plot_gap_model", "plot_principal_points", "plot_distortion_effects"
+]
 
 
 def residual_quiver(ax, uv_px, residuals_px, *, scale_px: float = 100.0, image_size=None,
@@ -86,3 +91,119 @@ def image_with_points(ax, image, uv_px, *, labels=None, color="C1"):
                         color=color)
     ax.set_axis_off()
     return ax
+
+
+# ---- 003 (Rikola)
+_SENSOR_COLOR = {1: "C3", 2: "C0"}
+
+
+def plot_band_image(ax, image, detection=None, title=""):
+    """A raw band (DN) with the detected corners and centroids."""
+    ax.imshow(image, cmap="gray", vmin=0, vmax=4095)
+    if detection is not None:
+        c = detection.corners_px
+        ax.plot(c[..., 0].ravel(), c[..., 1].ravel(), "+", color="C1", ms=4)
+        ax.plot(*detection.centroids_px.T, "x", color="C2", ms=4)
+    ax.set_title(title)
+    ax.set_axis_off()
+    return ax
+
+
+def plot_corner_bias(ax, biases, white_dn, label, marker="o"):
+    """Mean outward corner displacement (px) against the band's white level (DN)."""
+    bands = sorted(biases)
+    x = [white_dn[b] for b in bands]
+    y = [biases[b]["outward_px"] for b in bands]
+    ax.plot(x, y, marker, label=label)
+    ax.set_xlabel("white level of the band (DN)")
+    ax.set_ylabel("corner displacement outward (px)")
+    return ax
+
+
+def plot_tracks(axes, tracks, sensor):
+    """Centroid column and row of five targets against the air gap (003 Fig. 3–4)."""
+    gap = dict(zip(RIKOLA_BANDS["band"], RIKOLA_BANDS["gap_nm"], strict=True))
+    sens = dict(zip(RIKOLA_BANDS["band"], RIKOLA_BANDS["sensor"], strict=True))
+    for ax, (lab, (tid, track)) in zip(axes, tracks.items(), strict=False):
+        bs = [b for b in sorted(track) if sens[b] == sensor]
+        if not bs:
+            continue
+        col = np.array([track[b][0] for b in bs])
+        row = np.array([track[b][1] for b in bs])
+        g = [gap[b] for b in bs]
+        ax.plot(g, col - col.mean(), "o-", color="C0", label="column")
+        ax.plot(g, row - row.mean(), "s-", color="C3", label="row")
+        ax.set_title(f"{lab} (target {tid})", fontsize=9)
+        ax.set_xlabel("gap (nm)")
+    axes[0].set_ylabel("− mean (px)")
+    axes[0].legend(fontsize=8)
+    return axes
+
+
+def plot_band_eops(axes, cals, cube):
+    """Exterior orientation of one cube estimated band by band (003 Fig. 5)."""
+    bands = sorted(cals)
+    P = np.array([cals[b].pose(cube) for b in bands])
+    S = np.array([np.sqrt(np.diag(cals[b].pose_covariance(cube))) for b in bands])
+    names = ["ω (°)", "φ (°)", "κ (°)", "X0 (mm)", "Y0 (mm)", "Z0 (mm)"]
+    for i, ax in enumerate(axes.ravel()):
+        v, s = P[:, i], S[:, i]
+        if i < 3:
+            v, s = np.rad2deg(v), np.rad2deg(s)
+        col = [_SENSOR_COLOR[RIKOLA_BANDS["sensor"][b - 1]] for b in bands]
+        ax.errorbar(bands, v - v.mean(), yerr=s, fmt="none", ecolor="0.6")
+        ax.scatter(bands, v - v.mean(), c=col, s=12)
+        ax.set_title(names[i] + " − mean", fontsize=9)
+        ax.set_xlabel("band")
+    return axes
+
+
+def plot_gap_model(ax, gaps, f_hat, f_sig, regression, sensor, truth_ab=None):
+    """Per-band focal length against air gap with the fitted line (003 Fig. 6)."""
+    c = _SENSOR_COLOR[sensor]
+    ax.errorbar(gaps, f_hat, yerr=f_sig, fmt="o", color=c,
+                label=f"sensor {'I' if sensor == 1 else 'II'}")
+    g = np.linspace(min(gaps) - 10, max(gaps) + 10, 2)
+    ax.plot(g, regression["a"] * g + regression["b"], "-", color=c)
+    if truth_ab is not None:
+        ax.plot(g, truth_ab[0] * g + truth_ab[1], ":", color=c)
+    ax.set_xlabel("FPI air gap (nm)")
+    ax.set_ylabel("f (mm)")
+    return ax
+
+
+def plot_principal_points(ax, cals, truth_pp=None):
+    """Principal point per band against the gap (003 Fig. 7)."""
+    for b in sorted(cals):
+        s = RIKOLA_BANDS["sensor"][b - 1]
+        g = RIKOLA_BANDS["gap_nm"][b - 1]
+        v, e = cals[b].value("interior"), cals[b].sigma("interior")
+        ax.errorbar(g, v[1], yerr=e[1], fmt="o", color=_SENSOR_COLOR[s], ms=4)
+        ax.errorbar(g, v[2], yerr=e[2], fmt="s", color=_SENSOR_COLOR[s], ms=4, mfc="none")
+    if truth_pp is not None:
+        for s in (1, 2):
+            for k in (0, 1):
+                ax.axhline(truth_pp[s - 1, k], color=_SENSOR_COLOR[s], lw=0.7, ls=":")
+    ax.set_xlabel("FPI air gap (nm)")
+    ax.set_ylabel("x0 (o), y0 (□) (mm)")
+    return ax
+
+
+def plot_distortion_effects(axes, bands, own, ref, diff, dec):
+    """003 Fig. 8 (a)–(c) and Fig. 9: radial effect at the image corner with each band's
+    coefficients, with the reference band's scaled by f, their difference, and decentering.
+    """
+    col = [_SENSOR_COLOR[RIKOLA_BANDS["sensor"][b - 1]] for b in bands]
+    axes[0].scatter(bands, own, c=col, s=14)
+    axes[0].set_title("(a) radial, own coefficients (px)", fontsize=9)
+    axes[1].scatter(bands, ref, c=col, s=14)
+    axes[1].set_title("(b) reference band, f scaled (px)", fontsize=9)
+    axes[2].scatter(bands, diff, c=col, s=14)
+    axes[2].set_title("(c) (a) − (b) (px)", fontsize=9)
+    axes[3].plot(bands, dec[:, 0], "o", label="δx")
+    axes[3].plot(bands, dec[:, 1], "s", label="δy")
+    axes[3].set_title("decentering at the corner (px)", fontsize=9)
+    axes[3].legend(fontsize=8)
+    for ax in axes:
+        ax.set_xlabel("band")
+    return axes

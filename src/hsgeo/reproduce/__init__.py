@@ -20,6 +20,7 @@ CHAPTERS: dict[str, str] = {
     "frame-reference": "frame_reference",
     "line-calibration": "line_calibration",
     "geocoding": "geocoding",
+    "rikola": "rikola",
 }
 
 

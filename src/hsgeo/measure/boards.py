@@ -1,0 +1,162 @@
+"""Calibration boards described in TOML, and their observations from image files.
+
+A board file (``--board BOARD.toml`` of ``hsgeo calibrate-frame``) has one ``[board]`` table::
+
+    [board]
+    type = "charuco"          # or "aruco_grid"
+    dictionary = "DICT_6X6_250"
+    # charuco: squares and the marker inside a white square, lengths in mm
+    squares_x = 5
+    squares_y = 7
+    square_mm = 40.0
+    marker_mm = 20.0
+    # aruco_grid instead: markers_x, markers_y, marker_mm, separation_mm (first id 0)
+
+    [camera]                  # optional
+    pixel_mm = 0.0055         # pixel pitch; without it the "mm" of the results are pixels
+
+Object coordinates are OpenCV's board frame (x right, y down, z into the board, mm). A ChArUco
+board gives chessboard corners (one point each); an ArUco grid gives targets whose four corners
+are averaged into one virtual point, as in 003 §3.2.
+"""
+
+from __future__ import annotations
+
+import re
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from hsgeo.errors import InputError, ObservationError
+
+__all__ = ["Board", "load_board", "observe_files", "NOMINAL_PIXEL_MM"]
+
+NOMINAL_PIXEL_MM = 0.005
+
+
+@dataclass(frozen=True)
+class Board:
+    """A board description (see the module docstring)."""
+
+    type: str
+    dictionary: str
+    nx: int
+    ny: int
+    a_mm: float  # square (charuco) or marker (aruco_grid)
+    b_mm: float  # marker (charuco) or separation (aruco_grid)
+    pixel_mm: float | None = None
+
+    def cv_board(self):
+        import cv2
+
+        d = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, self.dictionary))
+        if self.type == "charuco":
+            return cv2.aruco.CharucoBoard((self.nx, self.ny), self.a_mm, self.b_mm, d)
+        return cv2.aruco.GridBoard((self.nx, self.ny), self.a_mm, self.b_mm, d)
+
+
+def load_board(path) -> Board:
+    """Read a board TOML file (module docstring); errors name the missing key."""
+    import cv2
+
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"board file {path} not found")
+    try:
+        cfg = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"{path}: malformed TOML: {exc}") from exc
+    b = cfg.get("board")
+    if not isinstance(b, dict):
+        raise InputError(f"{path}: needs a [board] table (see hsgeo.measure.boards)")
+    kind = b.get("type")
+    keys = {"charuco": ("squares_x", "squares_y", "square_mm", "marker_mm"),
+            "aruco_grid": ("markers_x", "markers_y", "marker_mm", "separation_mm")}
+    if kind not in keys:
+        raise InputError(f"{path}: board type must be 'charuco' or 'aruco_grid', got {kind!r}")
+    missing = [k for k in (*keys[kind], "dictionary") if k not in b]
+    if missing:
+        raise InputError(f"{path}: [board] of type {kind} is missing {', '.join(missing)}")
+    if not hasattr(cv2.aruco, str(b["dictionary"])):
+        raise InputError(f"{path}: unknown ArUco dictionary {b['dictionary']!r}")
+    k = keys[kind]
+    pixel = cfg.get("camera", {}).get("pixel_mm")
+    if pixel is not None and not float(pixel) > 0:
+        raise InputError(f"{path}: camera.pixel_mm must be positive, got {pixel}")
+    return Board(kind, str(b["dictionary"]), int(b[k[0]]), int(b[k[1]]), float(b[k[2]]),
+                 float(b[k[3]]), None if pixel is None else float(pixel))
+
+
+def _number(pattern: str | None, name: str, default: int) -> int:
+    if pattern is None:
+        return default
+    m = re.search(pattern, name)
+    if m is None or not m.groups():
+        raise InputError(f"file name {name!r} does not match {pattern!r} (with one group)")
+    return int(m.group(1))
+
+
+def observe_files(paths, board: Board, *, band_regex: str | None = None,
+                  cube_regex: str | None = None, refine: str = "subpix"):
+    """Detect the board in image files and return :class:`hsgeo.rikola.Observations`.
+
+    Parameters
+    ----------
+    paths : sequence of path
+    board : Board
+    band_regex, cube_regex : str, optional
+        Regular expressions with one group that take the band number and the cube (view)
+        number from a file name; by default all images are band 1 and each is its own view.
+    """
+    import cv2
+
+    from hsgeo.measure.aruco import detect_targets, make_detector
+    from hsgeo.rikola import Observations
+
+    paths = [Path(p) for p in paths]
+    if not paths:
+        raise InputError("no image files given")
+    cvb = board.cv_board()
+    if board.type == "charuco":
+        det = cv2.aruco.CharucoDetector(cvb)
+        obj_all = np.asarray(cvb.getChessboardCorners(), float)
+    else:
+        det = make_detector(board.dictionary, refine=refine)
+        obj_all = np.asarray(cvb.getObjPoints(), float)
+    rows = {k: [] for k in ("cube", "band", "target", "corners", "obj")}
+    size = None
+    for i, p in enumerate(paths):
+        img = cv2.imread(str(p), cv2.IMREAD_GRAYSCALE)
+        if img is None:
+            raise InputError(f"{p}: not an image OpenCV can read")
+        if size is None:
+            size = (img.shape[1], img.shape[0])
+        elif size != (img.shape[1], img.shape[0]):
+            raise InputError(f"{p}: size {img.shape[::-1]} differs from the first image's {size}")
+        band = _number(band_regex, p.name, 1)
+        cube = _number(cube_regex, p.name, i)
+        if board.type == "charuco":
+            cc, ids, _, _ = det.detectBoard(img)
+            if ids is None or len(ids) < 6:
+                raise ObservationError(f"{p}: fewer than 6 ChArUco corners found")
+            ids = np.asarray(ids).ravel().astype(np.int64)
+            px = np.repeat(np.asarray(cc, float).reshape(-1, 1, 2), 4, axis=1)
+            obj = np.repeat(obj_all[ids][:, None, :], 4, axis=1)
+        else:
+            d = detect_targets(img, det, valid_ids=np.arange(len(obj_all)))
+            if len(d) < 4:
+                raise ObservationError(f"{p}: fewer than 4 ArUco targets found")
+            ids, px, obj = d.ids, d.corners_px, obj_all[d.ids]
+        rows["cube"].append(np.full(len(ids), cube))
+        rows["band"].append(np.full(len(ids), band))
+        rows["target"].append(ids)
+        rows["corners"].append(px)
+        rows["obj"].append(obj)
+    # without a pixel pitch, a nominal 5 µm keeps the mm quantities of order one (the
+    # results are converted to pixels by the caller)
+    pixel = board.pixel_mm if board.pixel_mm is not None else NOMINAL_PIXEL_MM
+    cat = {k: np.concatenate(v) for k, v in rows.items()}
+    return Observations(cat["cube"].astype(np.int64), cat["band"].astype(np.int64),
+                        cat["target"].astype(np.int64), cat["corners"], cat["obj"], size, pixel)

@@ -1,0 +1,333 @@
+"""``hsgeo reproduce rikola``: 003 Tables 3 and 4 and the joint model, from rendered pixels.
+
+``scale`` = 1 renders the paper's bench (20 cubes × 25 bands); below 1 fewer cubes and ten bands
+(the chapter's reduced size for the tests).
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from hsgeo.papers import (
+    RIKOLA_BANDS,
+    RIKOLA_TABLE3,
+    RIKOLA_TABLE3_SIGMA0_SQ,
+    RIKOLA_TABLE4_GAP_MODEL,
+    RIKOLA_TABLE4_ROP_MEAN_DEG,
+)
+from hsgeo.reproduce import Reproduction, Row
+from hsgeo.rikola import (
+    TargetCentroids,
+    calibrate_band,
+    calibrate_joint,
+    design_effect,
+    gap_regression,
+    observe,
+    predict_band,
+    relative_orientation,
+)
+
+__all__ = ["run", "setup"]
+
+SMALL_BANDS = (1, 2, 5, 8, 10, 11, 12, 15, 16, 20)
+HELD_OUT = (8, 16)  # one band of each sensor, inside the gap range
+TABLE3_BANDS = (5, 20)  # 003 Table 3
+ROP_CUBE = 0  # 003 Table 4 (first) uses the bands of one cube
+
+
+def setup(seed: int = 0, scale: float = 1.0):
+    """Configuration, truth, cubes and bands for a seed and size."""
+    from hsgeo.simulate.rikola import make_truth
+    from hsgeo.simulate.scenarios import load_scenario
+
+    cfg = load_scenario("rikola_bench")
+    n_full = int(cfg["geometry"]["n_cubes"])
+    if scale >= 1.0:
+        n_cubes, bands = n_full, tuple(int(b) for b in RIKOLA_BANDS["band"])
+    else:
+        n_cubes, bands = max(8, int(round(n_full * scale))), SMALL_BANDS
+    truth = make_truth(cfg, np.random.default_rng([int(seed), 0]), n_cubes=n_cubes)
+    return cfg, truth, list(range(n_cubes)), list(bands)
+
+
+def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
+    """The chapter's tables; below scale 1: 8 cubes × 10 bands instead of 20 × 25."""
+    t_start = time.time()
+    cfg, truth, cubes, bands = setup(seed, scale)
+    sigma_px = float(cfg["measure"]["sigma_px"])
+    t0 = time.time()
+    obs, obs_contour, images = observe(cfg, truth, seed, cubes, bands, compare_refine="contour",
+                                       keep_images=[(ROP_CUBE, b) for b in (1, 5, 20)])
+    t_observe = time.time() - t0
+    # 003 §3.3: every band its own camera
+    t0 = time.time()
+    cals = {b: calibrate_band(obs, b, sigma_px=sigma_px) for b in bands}
+    t_bands = time.time() - t0
+    rows: list[Row] = []
+    tbl = RIKOLA_BANDS
+    # --- 003 Table 3
+    for b in TABLE3_BANDS:
+        c = cals[b]
+        tr = dict(zip(("f_mm", "x0_mm", "y0_mm", "K1_per_mm2", "K2_per_mm4", "K3_per_mm6",
+                       "P1_per_mm", "P2_per_mm"), np.r_[truth.interior(b), truth.KP], strict=True))
+        for q, (v, s) in c.iop.items():
+            pv, ps = RIKOLA_TABLE3[b][q]
+            unit = q.split("_", 1)[1] if "_" in q else ""
+            rows.append(Row("003 Table 3", f"{q.split('_')[0]}_band{b}", unit.replace("per_", "1/"),
+                            pv, ps, v, s, tr[q]))
+        rows.append(Row("003 Table 3", f"sigma0_sq_band{b}", "", RIKOLA_TABLE3_SIGMA0_SQ[b],
+                        None, c.result.sigma0 ** 2, None, 1.0))
+    # --- 003 Table 4 (first): ROP from pairs (k, k+10). The paper uses one cube; the ROPs of
+    # one cube share that cube's systematic centroid errors (their spread understates the
+    # error), so every cube is used: rop_all[pair, cube], and σ̂ of the mean from the scatter
+    # of the per-cube means between cubes.
+    pairs = [(k, k + 10) for k in range(1, 11) if k in cals and k + 10 in cals]
+    rop_all = np.array([[relative_orientation(cals[k1].pose(c), cals[k2].pose(c))[0]
+                         for c in cubes] for k2, k1 in pairs])  # k2 sensor II, k1 sensor I
+    rop_cov = [relative_orientation(cals[k1].pose(ROP_CUBE), cals[k2].pose(ROP_CUBE),
+                                    cals[k1].pose_covariance(ROP_CUBE),
+                                    cals[k2].pose_covariance(ROP_CUBE))[1] for k2, k1 in pairs]
+    rop = rop_all.mean(axis=1)  # per pair, mean over cubes
+    rop_cube0 = rop_all[:, cubes.index(ROP_CUBE)]
+    rop_mean = rop.mean(axis=0)
+    # σ̂ of the mean: the poses of all cubes of a band are correlated through the band's
+    # interior orientation, so propagate each band's full pose covariance (bands independent)
+    var = np.zeros(3)
+    for k2, k1 in pairs:
+        var += np.diag(_rop_mean_covariance(cals[k1], cals[k2], cubes))
+    rop_mean_sigma = np.sqrt(var) / len(pairs)
+    # ... and the pairs share part of their error: a target's centroid error is partly common
+    # to all bands of a sensor (hsgeo.rikola.design_effect); its intra-cluster correlation,
+    # from the per-band residuals grouped by cube, target and sensor, gives the design effect
+    # of a mean over the pairs
+    res_pb = np.concatenate([c.residuals_px for c in cals.values()])
+    keys = np.concatenate([_cluster_keys(obs, c) for c in cals.values()])
+    pb_clusters = design_effect(res_pb, keys)
+    deff_pairs = 1.0 + (len(pairs) - 1) * pb_clusters["rho"]
+    rop_mean_sigma = rop_mean_sigma * np.sqrt(deff_pairs)
+    for i, q in enumerate(("domega_deg", "dphi_deg", "dkappa_deg")):
+        rows.append(Row("003 Table 4 ROP", q, "deg", RIKOLA_TABLE4_ROP_MEAN_DEG[i], None,
+                        np.rad2deg(rop_mean[i]), np.rad2deg(rop_mean_sigma[i]),
+                        np.rad2deg(truth.rotation_rad[i])))
+    # transformation test (003 §3.4): discrepancies of the sensor-II centroids from the
+    # sensor-I ones of the same cube and target, before and after applying the mean ROP
+    disc = _rop_transformation_test(obs, cals, truth, pairs, rop_mean)
+    # --- 003 Table 4 (second): f against gap, bands 1 and 11 excluded (003 §3.5)
+    gaps, f_hat, f_sig = {}, {}, {}
+    reg, reg_truth = {}, {}
+    for s in (1, 2):
+        bs = [b for b in bands if tbl["sensor"][b - 1] == s and b not in (1, 11)]
+        g = tbl["gap_nm"][np.array(bs) - 1]
+        fh = np.array([cals[b].value("interior")[0] for b in bs])
+        gaps[s], f_hat[s] = g, fh
+        f_sig[s] = np.array([cals[b].sigma("interior")[0] for b in bs])
+        reg[s] = gap_regression(g, fh)
+        reg_truth[s] = gap_regression(g, truth.f_mm[np.array(bs) - 1])
+        pm = RIKOLA_TABLE4_GAP_MODEL[s]
+        rows += [
+            Row("003 Table 4 gap model", f"a_sensor{s}_mm_per_nm", "mm/nm", pm["a_mm_per_nm"][0],
+                pm["a_mm_per_nm"][1], reg[s]["a"], reg[s]["sigma_a"], truth.gap_model[s - 1, 0]),
+            Row("003 Table 4 gap model", f"b_sensor{s}_mm", "mm", pm["b_mm"][0], pm["b_mm"][1],
+                reg[s]["b"], reg[s]["sigma_b"], truth.gap_model[s - 1, 1]),
+            Row("003 Table 4 gap model", f"r2_sensor{s}", "%", pm["r2_percent"], None,
+                100 * reg[s]["r2"], None, 100 * reg_truth[s]["r2"]),
+        ]
+    # --- the joint model (003 §3.5 future work); σ of a centroid from the per-band σ0
+    sigma0_pool = float(np.sqrt(np.mean([c.result.sigma0 ** 2 for c in cals.values()])))
+    sigma_joint = sigma_px * sigma0_pool
+    f_sd = np.sqrt(np.mean(np.concatenate(list(f_sig.values())) ** 2))
+    scatter = tuple(float(np.sqrt(max(reg[s]["s"] ** 2 - f_sd ** 2, (0.5 * f_sd) ** 2)))
+                    for s in (1, 2))
+    t0 = time.time()
+    joint = calibrate_joint(obs, sigma_px=sigma_joint, scatter_mm=scatter, init=cals)
+    t_joint = time.time() - t0
+    R = joint  # value() and sigma() with the design effect of the target clusters
+    jrows = [("a_sensor1_mm_per_nm", "mm/nm", R.value("gap_model")[0, 0],
+              R.sigma("gap_model")[0, 0], truth.gap_model[0, 0], RIKOLA_TABLE4_GAP_MODEL[1]),
+             ("b_sensor1_mm", "mm", R.value("gap_model")[0, 1], R.sigma("gap_model")[0, 1],
+              truth.gap_model[0, 1], None),
+             ("a_sensor2_mm_per_nm", "mm/nm", R.value("gap_model")[1, 0],
+              R.sigma("gap_model")[1, 0], truth.gap_model[1, 0], None),
+             ("b_sensor2_mm", "mm", R.value("gap_model")[1, 1], R.sigma("gap_model")[1, 1],
+              truth.gap_model[1, 1], None)]
+    paper_gap = {"a_sensor1_mm_per_nm": RIKOLA_TABLE4_GAP_MODEL[1]["a_mm_per_nm"],
+                 "b_sensor1_mm": RIKOLA_TABLE4_GAP_MODEL[1]["b_mm"],
+                 "a_sensor2_mm_per_nm": RIKOLA_TABLE4_GAP_MODEL[2]["a_mm_per_nm"],
+                 "b_sensor2_mm": RIKOLA_TABLE4_GAP_MODEL[2]["b_mm"]}
+    for q, u, v, s, t, _ in jrows:
+        rows.append(Row("joint model", q, u, paper_gap[q][0], paper_gap[q][1], v, s, t))
+    for i, q in enumerate(("x0_sensor1_mm", "y0_sensor1_mm", "x0_sensor2_mm", "y0_sensor2_mm")):
+        paper = RIKOLA_TABLE3[20 if i < 2 else 5]["x0_mm" if i % 2 == 0 else "y0_mm"]
+        rows.append(Row("joint model", q, "mm", paper[0], paper[1], R.value("pp_mm").ravel()[i],
+                        R.sigma("pp_mm").ravel()[i], truth.pp_mm.ravel()[i]))
+    for i, q in enumerate(("K1_per_mm2", "K2_per_mm4", "K3_per_mm6", "P1_per_mm", "P2_per_mm")):
+        rows.append(Row("joint model", q, q.split("_", 1)[1].replace("per_", "1/"), None, None,
+                        R.value("distortion_mm")[i], R.sigma("distortion_mm")[i], truth.KP[i]))
+    for i, q in enumerate(("domega_deg", "dphi_deg", "dkappa_deg")):
+        rows.append(Row("joint model", q, "deg", RIKOLA_TABLE4_ROP_MEAN_DEG[i], None,
+                        np.rad2deg(R.value("sensor2_rotation")[i]),
+                        np.rad2deg(R.sigma("sensor2_rotation")[i]),
+                        np.rad2deg(truth.rotation_rad[i])))
+    for i, q in enumerate(("tx_mm", "ty_mm", "tz_mm")):
+        rows.append(Row("joint model", q, "mm", None, None, R.value("sensor2_offset_mm")[i],
+                        R.sigma("sensor2_offset_mm")[i], truth.offset_mm[i]))
+    rows.append(Row("joint model", "sigma0", "", None, None, R.result.sigma0, None, 1.0))
+    # --- held-out bands: joint model vs the per-band route
+    t0 = time.time()
+    held = {}
+    for h in HELD_OUT:
+        if h not in bands:
+            continue
+        jh = calibrate_joint(obs, exclude_bands=[h], sigma_px=sigma_joint, scatter_mm=scatter,
+                             init={b: c for b, c in cals.items() if b != h})
+        r_joint = predict_band(jh, obs, h)
+        # the same prediction with the band's true focal length (an oracle): what is left is
+        # the error of everything but f
+        vals = {k: v.copy() for k, v in jh.result.params.values().items()}
+        s_row = RIKOLA_BANDS["sensor"] - 1
+        line = vals["gap_model"][s_row, 0] * RIKOLA_BANDS["gap_nm"] + vals["gap_model"][s_row, 1]
+        r_oracle = _predict_with(jh, obs, h, vals, df=truth.f_mm - line)
+        r_perband = _predict_per_band(cals, obs, h, bands)
+        held[h] = {"joint": _rms(r_joint), "joint_true_f": _rms(r_oracle),
+                   "per_band": _rms(r_perband),
+                   "calibrated": _rms(cals[h].residuals_px)}
+        for k, v in held[h].items():
+            rows.append(Row("held-out band", f"rms_band{h}_{k}", "px", None, None, v, None,
+                            None))
+    t_held = time.time() - t0
+    meta = {
+        "scale": scale, "n_cubes": len(cubes), "bands": bands,
+        "images": len(cubes) * len(bands), "targets": int(len(obs.cube)),
+        "detection_rate": obs.detection_rate,
+        "detection_rate_contour": obs_contour.detection_rate,
+        "sigma_px_apriori": sigma_px, "sigma0_pooled_bands": sigma0_pool,
+        "sigma_px_joint": sigma_joint, "df_prior_mm": list(scatter),
+        "rop_pairs": [list(p) for p in pairs],
+        "band_clusters": pb_clusters, "rop_deff_pairs": deff_pairs,
+        "rop_pairs_deg": np.rad2deg(rop).tolist(),
+        "rop_pairs_cube0_deg": np.rad2deg(rop_cube0).tolist(),
+        "rop_cube0_mean_deg": np.rad2deg(rop_cube0.mean(axis=0)).tolist(),
+        "rop_cube0_mean_sigma_deg": np.rad2deg(np.sqrt(np.diag(np.sum(rop_cov, axis=0)))
+                                               / len(pairs)).tolist(),
+        "rop_discrepancy_px": disc,
+        "held_out": {str(k): v for k, v in held.items()},
+        "rms_px_per_band": _rms(np.concatenate([c.residuals_px for c in cals.values()])),
+        "rms_px_joint": _rms(joint.residuals_px),
+        "sigma0_joint": R.result.sigma0,
+        "joint_clusters": joint.clusters,
+    }
+    # wall times vary from run to run: they stay out of the (bit-reproducible) JSON
+    extras = {"cfg": cfg, "truth": truth, "obs": obs, "obs_contour": obs_contour,
+              "images": images, "cals": cals, "joint": joint, "rop": rop, "rop_cube0": rop_cube0,
+              "rop_all": rop_all, "pairs": pairs, "regression": reg,
+              "regression_truth": reg_truth, "gaps": gaps, "f_hat": f_hat, "f_sigma": f_sig,
+              "seconds": {"observe": t_observe, "per_band": t_bands, "joint": t_joint,
+                          "held_out": t_held, "total": time.time() - t_start}}
+    return Reproduction("rikola", seed, rows, meta, extras)
+
+
+def _cluster_keys(obs, cal) -> np.ndarray:
+    """(cube, target, sensor) key of each observation of a band's adjustment, in its order."""
+    sel = obs.band == cal.band
+    sensor = RIKOLA_BANDS["sensor"][cal.band - 1]
+    return obs.cube[sel] * 1_000_000 + obs.target[sel] * 10 + sensor
+
+
+def _rop_mean_covariance(cal1, cal2, cubes, step: float = 1e-7) -> np.ndarray:
+    """Covariance (3, 3) of the ROP averaged over cubes, from the full pose covariances of the
+    two bands' adjustments.
+    """
+    J1 = np.zeros((3, 6 * len(cal1.cubes)))
+    J2 = np.zeros((3, 6 * len(cal2.cubes)))
+    for c in cubes:
+        p1, p2 = cal1.pose(c), cal2.pose(c)
+        i1 = int(np.flatnonzero(cal1.cubes == c)[0])
+        i2 = int(np.flatnonzero(cal2.cubes == c)[0])
+        for a in range(3):
+            d = np.zeros(6)
+            d[a] = step
+            J1[:, 6 * i1 + a] = (relative_orientation(p1 + d, p2)[0]
+                                 - relative_orientation(p1 - d, p2)[0]) / (2 * step)
+            J2[:, 6 * i2 + a] = (relative_orientation(p1, p2 + d)[0]
+                                 - relative_orientation(p1, p2 - d)[0]) / (2 * step)
+    C1, _ = cal1.result.covariance_of("poses")
+    C2, _ = cal2.result.covariance_of("poses")
+    return (J1 @ C1 @ J1.T + J2 @ C2 @ J2.T) / len(cubes) ** 2
+
+
+def _rms(r) -> float:
+    return float(np.sqrt(np.mean(np.sum(np.asarray(r) ** 2, axis=1))))
+
+
+def _predict_with(joint, obs, band, values, df):
+    from hsgeo.sensors.rikola import JointCentroids
+
+    sel = (obs.band == band) & np.isin(obs.cube, joint.cubes)
+    o = obs.select(sel)
+    blk = JointCentroids(np.searchsorted(joint.cubes, o.cube),
+                         np.searchsorted(RIKOLA_BANDS["band"], o.band), o.corners_obj,
+                         o.centroids_mm, 1.0, RIKOLA_BANDS["gap_nm"], RIKOLA_BANDS["sensor"])
+    values = dict(values)
+    values["df_mm"] = np.asarray(df, float)
+    return blk.evaluate(values, False)[0].reshape(-1, 2) / obs.pixel_mm * np.array([1.0, -1.0])
+
+
+def _predict_per_band(cals, obs, band, bands):
+    """The per-band route to a band without its own calibration (003 §3.5): f from the gap
+    regression of the other bands of its sensor, the mean principal point of the sensor, the
+    mean distortion, and per cube the mean exterior orientation of the sensor's other bands.
+    """
+    s = RIKOLA_BANDS["sensor"][band - 1]
+    others = [b for b in bands if b != band and RIKOLA_BANDS["sensor"][b - 1] == s
+              and b not in (1, 11)]
+    reg = gap_regression(RIKOLA_BANDS["gap_nm"][np.array(others) - 1],
+                         [cals[b].value("interior")[0] for b in others])
+    f = reg["a"] * RIKOLA_BANDS["gap_nm"][band - 1] + reg["b"]
+    pp = np.mean([cals[b].value("interior")[1:] for b in others], axis=0)
+    KP = np.mean([cals[b].value("distortion_mm") for b in cals if b != band], axis=0)
+    sel = obs.band == band
+    o = obs.select(sel)
+    cubes = np.unique(o.cube)
+    poses = np.array([np.mean([cals[b].pose(c) for b in others], axis=0) for c in cubes])
+    blk = TargetCentroids(np.searchsorted(cubes, o.cube), o.corners_obj, o.centroids_mm, 1.0)
+    r = blk.evaluate({"interior": np.r_[f, pp], "distortion_mm": KP, "poses": poses}, False)[0]
+    return r.reshape(-1, 2) / obs.pixel_mm * np.array([1.0, -1.0])
+
+
+def _rop_transformation_test(obs, cals, truth, pairs, rop_mean):
+    """003 §3.4: mean discrepancy (px) between a target's centroid in a sensor-II band and in
+    its sensor-I partner of the same cube, before and after rotating the sensor-II image rays by
+    the estimated mean ROP (with each band's own interior orientation).
+    """
+    from hsgeo.distortion import ideal_from_measured_mm
+    from hsgeo.rotations import R_from_opk
+    from hsgeo.sensors.frame import mm_to_pixel
+    from hsgeo.sensors.rikola import project_measured_mm
+
+    M = R_from_opk(*rop_mean)
+    before, after = [], []
+    for k2, k1 in pairs:
+        c1, c2 = cals[k1], cals[k2]
+        m1 = (obs.band == k1) & (obs.cube == ROP_CUBE)
+        m2 = (obs.band == k2) & (obs.cube == ROP_CUBE)
+        common, i1, i2 = np.intersect1d(obs.target[m1], obs.target[m2], return_indices=True)
+        x1 = obs.centroids_mm[m1][i1]
+        x2 = obs.centroids_mm[m2][i2]
+        f1, x01, y01 = c1.value("interior")
+        f2, x02, y02 = c2.value("interior")
+        K2 = c2.value("distortion_mm")
+        K1 = c1.value("distortion_mm")
+        ideal2 = ideal_from_measured_mm(x2 - [x02, y02], K2[:3], K2[3:])
+        ray2 = np.column_stack([ideal2, np.full(len(ideal2), -f2)])
+        ray1 = ray2 @ M.T  # X_camI = R_I_from_II X_camII
+        x2_in_1 = project_measured_mm(ray1, f1, np.array([x01, y01]), K1)
+        px = obs.pixel_mm
+        before.append(mm_to_pixel(x2, obs.image_size, px) - mm_to_pixel(x1, obs.image_size, px))
+        after.append(mm_to_pixel(x2_in_1, obs.image_size, px)
+                     - mm_to_pixel(x1, obs.image_size, px))
+    b, a = np.concatenate(before), np.concatenate(after)
+    return {"before_mean_px": b.mean(axis=0).tolist(), "after_mean_px": a.mean(axis=0).tolist(),
+            "before_rms_px": float(np.sqrt(np.mean(np.sum(b ** 2, 1)))),
+            "after_rms_px": float(np.sqrt(np.mean(np.sum(a ** 2, 1))))}

@@ -1,0 +1,640 @@
+"""The Rikola FPI camera (003): observations from pixels, per-band self-calibration, sensor
+misalignment, the gap model, and the joint model the paper leaves as future work.
+
+The road of the chapter ``rikola``:
+
+1. :func:`observe` renders every band of every cube (:mod:`hsgeo.simulate.rikola`), detects the
+   ArUco targets (:mod:`hsgeo.measure.aruco`) and keeps each target's four corners and their
+   centroid (003 §3.2);
+2. :func:`calibrate_band` — self-calibrating bundle adjustment of one band, with the plate's
+   known target coordinates as the datum (003 §3.3, Table 3);
+3. :func:`relative_orientation` — ``R = R_S1 R_S2⁻¹`` for pairs of bands from different sensors
+   (003 eq. (1), Table 4 first); :func:`gap_regression` — ``f = a·gap + b`` (003 eq. (2), Table 4
+   second);
+4. :func:`calibrate_joint` — one adjustment of all bands: one exterior orientation per cube,
+   ``f = a·gap + b`` per sensor, one distortion set, sensor II's rotation and offset;
+   :func:`predict_band` predicts a held-out band.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from hsgeo.adjust import AdjustmentResult, Parameters, adjust, identifiability
+from hsgeo.errors import InputError, ObservationError
+from hsgeo.papers import RIKOLA_BANDS
+from hsgeo.rotations import R_from_opk, R_from_rotvec, opk_from_R
+from hsgeo.sensors.frame import (
+    PHOTOGRAMMETRIC_DISTORTION,
+    PHOTOGRAMMETRIC_INTERIOR,
+    POSE_COLUMNS,
+    mm_to_pixel,
+    pixel_to_mm,
+)
+from hsgeo.sensors.rikola import (
+    GAP_MODEL_COLUMNS,
+    OFFSET_COLUMNS,
+    ROTATION_COLUMNS,
+    JointCentroids,
+    TargetCentroids,
+)
+
+__all__ = [
+    "Observations",
+    "observe",
+    "initial_poses",
+    "BandCalibration",
+    "calibrate_band",
+    "initial_focal_mm",
+    "relative_orientation",
+    "gap_regression",
+    "JointCalibration",
+    "calibrate_joint",
+    "design_effect",
+    "predict_band",
+]
+
+_FLIP = np.diag([1.0, -1.0, -1.0])  # OpenCV camera frame <-> photogrammetric camera frame
+
+
+@dataclass
+class Observations:
+    """Target observations of a set of cubes and bands (one row per target and image).
+
+    Attributes
+    ----------
+    cube, band, target : (n,) int ndarrays
+        Cube index, band number (1–25) and target id.
+    corners_px : (n, 4, 2) ndarray
+        Detected corners (OpenCV pixel convention).
+    corners_obj : (n, 4, 3) ndarray
+        Object coordinates of the corners.
+    image_size : (int, int)
+    pixel_mm : float
+    expected : dict
+        ``(cube, band) -> number of targets fully in view`` (for the detection rate), if known.
+    """
+
+    cube: np.ndarray
+    band: np.ndarray
+    target: np.ndarray
+    corners_px: np.ndarray
+    corners_obj: np.ndarray
+    image_size: tuple[int, int]
+    pixel_mm: float
+    expected: dict = field(default_factory=dict)
+
+    @property
+    def centroids_px(self) -> np.ndarray:
+        return self.corners_px.mean(axis=1)
+
+    @property
+    def centroids_mm(self) -> np.ndarray:
+        return pixel_to_mm(self.centroids_px, self.image_size, self.pixel_mm)
+
+    def select(self, mask) -> Observations:
+        m = np.asarray(mask, bool)
+        return Observations(self.cube[m], self.band[m], self.target[m], self.corners_px[m],
+                            self.corners_obj[m], self.image_size, self.pixel_mm, self.expected)
+
+    @property
+    def detection_rate(self) -> float:
+        if not self.expected:
+            return float("nan")
+        return len(self.cube) / max(1, sum(self.expected.values()))
+
+
+def observe(cfg: dict, truth, seed: int, cubes, bands, *, refine: str = "subpix",
+            compare_refine: str | None = None, keep_images=()):
+    """Render the bands of the cubes and detect the ArUco targets.
+
+    Parameters
+    ----------
+    cfg : dict
+        Scenario (``data_synthetic/rikola_bench.toml``).
+    truth : hsgeo.simulate.rikola.RikolaTruth
+    seed : int
+        Seed of the image noise.
+    cubes, bands : sequences of int
+    refine : str
+        ArUco corner refinement (:func:`hsgeo.measure.aruco.make_detector`).
+    compare_refine : str, optional
+        A second refinement run on the same images (for the corner-bias comparison of §3.2).
+    keep_images : collection of (cube, band)
+        Images to return (for figures).
+
+    Returns
+    -------
+    Observations, Observations or None (``compare_refine``), dict of (cube, band) -> image
+    """
+    from hsgeo.measure.aruco import detect_targets, make_detector, to_uint8
+    from hsgeo.simulate.rikola import Renderer
+
+    r = Renderer(cfg, truth)
+    plate = r.plate
+    dets = [make_detector(plate.dictionary, refine=refine)]
+    if compare_refine is not None:
+        dets.append(make_detector(plate.dictionary, refine=compare_refine))
+    cam = cfg["camera"]
+    size = (int(cam["width_px"]), int(cam["height_px"]))
+    obj = plate.corners()
+    rows = [{k: [] for k in ("cube", "band", "target", "corners")} for _ in dets]
+    expected, images = {}, {}
+    keep = set(map(tuple, keep_images))
+    for c in cubes:
+        for b in bands:
+            img = r.render(c, b, seed)
+            if (c, b) in keep:
+                images[(c, b)] = img
+            img8 = to_uint8(img)
+            true_px = mm_to_pixel(truth.project(c, b, obj), size, cam["pixel_mm"])
+            inside = np.all((true_px > 2) & (true_px < np.array(size) - 3), axis=(1, 2))
+            expected[(c, b)] = int(inside.sum())
+            for det, rw in zip(dets, rows, strict=True):
+                d = detect_targets(img8, det, valid_ids=plate.ids)
+                rw["cube"].append(np.full(len(d), c))
+                rw["band"].append(np.full(len(d), b))
+                rw["target"].append(d.ids)
+                rw["corners"].append(d.corners_px)
+    out = []
+    for rw in rows:
+        target = np.concatenate(rw["target"]).astype(np.int64)
+        out.append(Observations(np.concatenate(rw["cube"]).astype(np.int64),
+                                np.concatenate(rw["band"]).astype(np.int64), target,
+                                np.concatenate(rw["corners"]), obj[target], size,
+                                float(cam["pixel_mm"]), expected))
+    return out[0], (out[1] if len(out) > 1 else None), images
+
+
+def initial_poses(obs: Observations, f_mm: float) -> dict[int, np.ndarray]:
+    """Photogrammetric pose of each cube from ``cv2.solvePnP`` on the centroids (no distortion,
+    principal point at the centre), for the initial values of an adjustment.
+    """
+    import cv2
+
+    w, h = obs.image_size
+    fpx = f_mm / obs.pixel_mm
+    K = np.array([[fpx, 0, (w - 1) / 2], [0, fpx, (h - 1) / 2], [0, 0, 1.0]])
+    out = {}
+    for c in np.unique(obs.cube):
+        m = obs.cube == c
+        if m.sum() < 4:
+            raise ObservationError(f"cube {c}: {m.sum()} targets; a pose needs at least 4")
+        ok, rvec, tvec = cv2.solvePnP(obs.corners_obj[m].mean(axis=1), obs.centroids_px[m], K,
+                                      np.zeros(5), flags=cv2.SOLVEPNP_ITERATIVE)
+        if not ok:
+            raise ObservationError(f"cube {c}: no initial pose from solvePnP")
+        Rcw = R_from_rotvec(rvec.ravel())
+        X0 = -Rcw.T @ tvec.ravel()
+        out[int(c)] = np.concatenate([opk_from_R(Rcw.T @ _FLIP), X0])
+    return out
+
+
+def initial_focal_mm(obs: Observations) -> float:
+    """Focal length from ``cv2.initCameraMatrix2D`` on the views of a planar board (Z = 0)."""
+    import cv2
+
+    views = np.unique(obs.cube)
+    X = obs.corners_obj.mean(axis=1)
+    if not np.allclose(X[:, 2], 0.0):
+        raise InputError("initialisation needs a planar board with Z = 0 in board coordinates")
+    objs = [X[obs.cube == c].astype(np.float32) for c in views]
+    imgs = [obs.centroids_px[obs.cube == c].astype(np.float32) for c in views]
+    K = cv2.initCameraMatrix2D(objs, imgs, tuple(int(s) for s in obs.image_size), 1.0)
+    return float(np.sqrt(K[0, 0] * K[1, 1])) * obs.pixel_mm
+
+
+@dataclass
+class BandCalibration:
+    """Self-calibration of one band (003 §3.3): ``result`` holds interior, distortion_mm and
+    poses (one per cube, rows in ``cubes`` order).
+    """
+
+    band: int
+    cubes: np.ndarray
+    result: AdjustmentResult
+    block: TargetCentroids
+
+    def value(self, name):
+        return self.result.value(name)
+
+    def sigma(self, name):
+        return self.result.sigma(name)
+
+    @property
+    def iop(self) -> dict[str, tuple[float, float]]:
+        """Table-3 style: name -> (value, σ̂)."""
+        out = {}
+        for blk, cols in (("interior", PHOTOGRAMMETRIC_INTERIOR),
+                          ("distortion_mm", PHOTOGRAMMETRIC_DISTORTION)):
+            v, s = self.result.value(blk), self.result.sigma(blk)
+            out.update({c: (float(v[i]), float(s[i])) for i, c in enumerate(cols)})
+        return out
+
+    def pose(self, cube: int) -> np.ndarray:
+        return self.result.value("poses")[int(np.flatnonzero(self.cubes == cube)[0])]
+
+    def pose_covariance(self, cube: int) -> np.ndarray:
+        """(6, 6) covariance of a cube's pose."""
+        cov, labels = self.result.covariance_of("poses")
+        i = int(np.flatnonzero(self.cubes == cube)[0])
+        return cov[6 * i:6 * i + 6, 6 * i:6 * i + 6]
+
+    @property
+    def residuals_px(self) -> np.ndarray:
+        return self.result.residuals(0).reshape(-1, 2) / self.block_pixel_mm * [1.0, -1.0]
+
+    block_pixel_mm: float = 0.0055
+
+
+def _band_problem(obs: Observations, band: int, f0_mm: float, sigma_px: float):
+    sel = obs.band == band
+    if sel.sum() < 10:
+        raise ObservationError(f"band {band}: only {sel.sum()} targets observed; need more cubes")
+    o = obs.select(sel)
+    cubes = np.unique(o.cube)
+    view = np.searchsorted(cubes, o.cube)
+    poses = initial_poses(o, f0_mm)
+    p = Parameters()
+    p.add("interior", [f0_mm, 0.0, 0.0], columns=PHOTOGRAMMETRIC_INTERIOR)
+    p.add("distortion_mm", np.zeros(5), columns=PHOTOGRAMMETRIC_DISTORTION)
+    p.add("poses", np.array([poses[int(c)] for c in cubes]), columns=POSE_COLUMNS,
+          rows=[f"cube {c}" for c in cubes])
+    blk = TargetCentroids(view, o.corners_obj, o.centroids_mm, sigma_px * obs.pixel_mm)
+    return p, blk, cubes
+
+
+def calibrate_band(obs: Observations, band: int, *, f0_mm: float | None = 9.0,
+                   sigma_px: float = 0.02, reject_k: float | None = 5.0) -> BandCalibration:
+    """Self-calibrating bundle adjustment of one band (003 §3.3: each band a camera).
+
+    The datum is the plate: the target coordinates are known (fixed), as on the paper's bench
+    where the distances between the targets were known (003 §3.2); the initial values are the
+    nominal focal length (003 Table 1; ``f0_mm=None``: from ``cv2.initCameraMatrix2D``), the image
+    centre, zero distortion and ``solvePnP`` poses.
+    """
+    if f0_mm is None:
+        f0_mm = initial_focal_mm(obs.select(obs.band == band))
+    p, blk, cubes = _band_problem(obs, band, f0_mm, sigma_px)
+    res = adjust(p, blk, reject_k=reject_k)
+    return BandCalibration(band, cubes, res, blk, block_pixel_mm=obs.pixel_mm)
+
+
+def band_identifiability(obs: Observations, band: int, truth) -> object:
+    """Rank of the per-band design at the truth (:func:`hsgeo.adjust.identifiability`)."""
+    p, blk, cubes = _band_problem(obs, band, 9.0, 0.02)
+    p.set("interior", truth.interior(band))
+    p.set("distortion_mm", truth.KP)
+    p.set("poses", np.array([truth.band_pose(int(c), band) for c in cubes]))
+    return identifiability(p, blk)
+
+
+def relative_orientation(pose_1, pose_2, cov_1=None, cov_2=None, step: float = 1e-7):
+    """Relative orientation between the sensors, 003 eq. (1): ``R = R_S1 R_S2⁻¹``.
+
+    ``R_S`` is the rotation of each sensor's image (``R_cam_from_world``, the transpose of
+    hsgeo's ``R_world_from_cam``), so that ``R = R_camI_from_camII`` — the ``R_I_from_II`` of the
+    simulation and of the joint model.
+
+    Parameters
+    ----------
+    pose_1, pose_2 : (6,) ndarray
+        Exterior orientations (ω, φ, κ, ...) of a sensor-I band and a sensor-II band of one cube.
+    cov_1, cov_2 : (6, 6) ndarray, optional
+        Their covariances (independent adjustments), propagated to the angles.
+
+    Returns
+    -------
+    opk_rad : (3,) ndarray
+    cov : (3, 3) ndarray or None
+    """
+    def f(a1, a2):
+        R = R_from_opk(*a1).T @ R_from_opk(*a2)
+        return opk_from_R(R)
+
+    a1, a2 = np.asarray(pose_1[:3], float), np.asarray(pose_2[:3], float)
+    ang = f(a1, a2)
+    if cov_1 is None or cov_2 is None:
+        return ang, None
+    J = np.zeros((3, 6))
+    for i in range(6):
+        d = np.zeros(6)
+        d[i] = step
+        J[:, i] = (f(a1 + d[:3], a2 + d[3:]) - f(a1 - d[:3], a2 - d[3:])) / (2 * step)
+    C = np.zeros((6, 6))
+    C[:3, :3] = np.asarray(cov_1)[:3, :3]
+    C[3:, 3:] = np.asarray(cov_2)[:3, :3]
+    return ang, J @ C @ J.T
+
+
+def gap_regression(gap_nm, f_mm) -> dict[str, float]:
+    """Straight line ``f = a·gap + b`` by ordinary least squares (003 eq. (2), Table 4 second).
+
+    Returns
+    -------
+    dict with ``a``, ``b``, ``sigma_a``, ``sigma_b`` (from the residual scatter), ``r2`` (0–1)
+    and ``s`` (residual standard deviation).
+    """
+    g = np.asarray(gap_nm, float)
+    f = np.asarray(f_mm, float)
+    if g.shape != f.shape or g.size < 3:
+        raise InputError("gap_regression needs at least 3 (gap, f) pairs of equal length")
+    A = np.column_stack([g, np.ones_like(g)])
+    coef, *_ = np.linalg.lstsq(A, f, rcond=None)
+    res = f - A @ coef
+    dof = g.size - 2
+    s2 = float(res @ res / dof)
+    cov = s2 * np.linalg.inv(A.T @ A)
+    r2 = 1.0 - float(res @ res) / float(np.sum((f - f.mean()) ** 2))
+    return {"a": float(coef[0]), "b": float(coef[1]), "sigma_a": float(np.sqrt(cov[0, 0])),
+            "sigma_b": float(np.sqrt(cov[1, 1])), "r2": r2, "s": float(np.sqrt(s2))}
+
+
+def design_effect(residuals_px, cluster) -> dict[str, float]:
+    """Intra-cluster correlation of residuals and the design effect of a cluster mean.
+
+    The centroid of one target in one cube has an error part that every band of a sensor
+    shares (the corner detector's response to the target's perspective and pixel phase), on
+    top of the independent noise of each band. One-way analysis of variance of the residuals
+    grouped by ``cluster`` gives the within-cluster σ, the between-cluster σ and
+    ``rho = σ_b² / (σ_b² + σ_w²)``; a parameter estimated from clusters of ``m`` correlated
+    observations has its variance multiplied by ``deff = 1 + (m − 1)·rho`` (Kish's design
+    effect) — the factor the joint model's covariance, which assumes independent observations,
+    is scaled by.
+
+    Parameters
+    ----------
+    residuals_px : (n, 2) ndarray
+    cluster : (n,) int ndarray
+
+    Returns
+    -------
+    dict with ``sigma_within_px``, ``sigma_between_px``, ``rho``, ``m`` and ``deff`` (means of
+    the two coordinates).
+    """
+    r = np.asarray(residuals_px, float)
+    u, inv, cnt = np.unique(np.asarray(cluster), return_inverse=True, return_counts=True)
+    if u.size < 2 or u.size == r.shape[0]:
+        return {"sigma_within_px": float("nan"), "sigma_between_px": 0.0, "rho": 0.0,
+                "m": 1.0, "deff": 1.0}
+    m = float(cnt.mean())
+    out = []
+    for k in range(r.shape[1]):
+        x = r[:, k]
+        means = np.bincount(inv, x) / cnt
+        s2w = float(np.sum((x - means[inv]) ** 2) / (x.size - u.size))
+        s2b = max(float(np.var(means)) - s2w / m, 0.0)
+        out.append((s2w, s2b))
+    s2w, s2b = np.mean(out, axis=0)
+    rho = s2b / (s2b + s2w)
+    return {"sigma_within_px": float(np.sqrt(s2w)), "sigma_between_px": float(np.sqrt(s2b)),
+            "rho": float(rho), "m": m, "deff": float(1.0 + (m - 1.0) * rho)}
+
+
+@dataclass
+class JointCalibration:
+    """The joint model's adjustment and its bookkeeping.
+
+    ``sigma(name)`` is the adjustment's σ̂ scaled by the square root of the design effect of the
+    target clusters (:func:`design_effect`); ``result.sigma(name)`` is the unscaled one.
+    """
+
+    result: AdjustmentResult
+    block: JointCentroids
+    cubes: np.ndarray
+    bands: np.ndarray  # band numbers in the model (the held-out one excluded)
+    pixel_mm: float
+    clusters: dict = field(default_factory=dict)
+
+    @property
+    def residuals_px(self) -> np.ndarray:
+        return self.result.residuals(0).reshape(-1, 2) / self.pixel_mm * [1.0, -1.0]
+
+    def value(self, name):
+        return self.result.value(name)
+
+    def sigma(self, name):
+        return self.result.sigma(name) * np.sqrt(self.clusters.get("deff", 1.0))
+
+
+_OFF_LINE = (1, 11)  # bands whose gaps are off the linear trend (003 §3.5)
+
+
+def calibrate_joint(obs: Observations, *, exclude_bands=(), scatter_mm=(0.0035, 0.0028),
+                    f0_mm: float = 9.0, sigma_px: float = 0.02, estimate_offset: bool = False,
+                    reject_k: float | None = 5.0, init=None) -> JointCalibration:
+    """One adjustment of all bands (003 §3.5, the paper's future work).
+
+    Parameters
+    ----------
+    obs : Observations
+    exclude_bands : sequence of int
+        Bands left out (to predict them afterwards with :func:`predict_band`).
+    scatter_mm : (2,) floats
+        Prior σ of the per-band deviation ``df`` from the gap line (sensor I, II); bands 1 and 11,
+        off the line (003 §3.5), get a free ``df`` without prior.
+    estimate_offset : bool
+        Estimate sensor II's projection-centre offset; by default it is held at zero: both
+        sensors sit behind one lens and the beam splitter (003 Fig. 1b), so they share the
+        projection centre, and a free offset is sensitive to centroid systematics of
+        thousandths of a pixel (its σ̂ is millimetres).
+    init : BandCalibration dict, optional
+        Per-band calibrations to start from (poses of a sensor-I band, mean distortion).
+    """
+    keep = ~np.isin(obs.band, np.asarray(exclude_bands, int))
+    o = obs.select(keep)
+    bands = np.unique(o.band)
+    cubes = np.unique(o.cube)
+    table = RIKOLA_BANDS
+    brow = np.searchsorted(table["band"], o.band)
+    for s in (1, 2):
+        on = [b for b in bands if table["sensor"][b - 1] == s and b not in _OFF_LINE]
+        if len(on) < 2:
+            raise ObservationError(f"the joint model needs at least 2 on-line bands of sensor "
+                                   f"{'I' if s == 1 else 'II'}, got {on}")
+    s1 = o.band >= 11
+    poses0 = initial_poses(o.select(s1), f0_mm)
+    p = Parameters()
+    p.add("poses", np.array([poses0[int(c)] for c in cubes]), columns=POSE_COLUMNS,
+          rows=[f"cube {c}" for c in cubes])
+    p.add("gap_model", [[0.0, f0_mm], [0.0, f0_mm]], columns=GAP_MODEL_COLUMNS,
+          rows=["sensor I", "sensor II"])
+    sigma_df = np.array([scatter_mm[table["sensor"][i] - 1] for i in range(len(table))], float)
+    present = np.isin(table["band"], bands)
+    free_df = present.copy()
+    sigma_df[np.isin(table["band"], _OFF_LINE)] = np.inf
+    p.add("df_mm", np.zeros(len(table)), free=free_df, prior_sigma=np.where(present, sigma_df,
+          np.inf), rows=[f"band {b}" for b in table["band"]])
+    p.add("pp_mm", np.zeros((2, 2)), columns=("x0_mm", "y0_mm"), rows=["sensor I", "sensor II"])
+    p.add("distortion_mm", np.zeros(5), columns=PHOTOGRAMMETRIC_DISTORTION)
+    p.add("sensor2_rotation", np.zeros(3), columns=ROTATION_COLUMNS)
+    p.add("sensor2_offset_mm", np.zeros(3), columns=OFFSET_COLUMNS)
+    if not estimate_offset:
+        p.fix("sensor2_offset_mm")
+    if init is not None:
+        _init_from_bands(p, init, cubes)
+    blk = JointCentroids(np.searchsorted(cubes, o.cube), brow, o.corners_obj, o.centroids_mm,
+                         sigma_px * obs.pixel_mm, table["gap_nm"], table["sensor"])
+    res = adjust(p, blk, reject_k=reject_k)
+    j = JointCalibration(res, blk, cubes, bands, obs.pixel_mm)
+    ok = ~res.outliers(0)  # one entry per centroid
+    key = (o.cube * 1_000_000 + o.target * 10 + table["sensor"][brow])[ok]
+    j.clusters = design_effect(j.residuals_px[ok], key)
+    return j
+
+
+def _init_from_bands(p: Parameters, cals: dict, cubes) -> None:
+    """Start the joint model from per-band results: a sensor-I band's poses, mean IOPs."""
+    s1 = [b for b in cals if b >= 11]
+    if s1:
+        c = cals[s1[0]]
+        p.set("poses", np.array([c.pose(int(k)) if k in c.cubes else p.value("poses")[i]
+                                 for i, k in enumerate(cubes)]))
+    p.set("distortion_mm", np.mean([c.value("distortion_mm") for c in cals.values()], axis=0))
+    for s, rng in ((0, range(11, 26)), (1, range(1, 11))):
+        fs = [cals[b].value("interior") for b in rng if b in cals]
+        if fs:
+            fs = np.array(fs)
+            p.set("pp_mm", fs[:, 1:].mean(axis=0), index=s)
+            p.set("gap_model", [0.0, fs[:, 0].mean()], index=s)
+
+
+def predict_band(joint: JointCalibration, obs: Observations, band: int) -> np.ndarray:
+    """Predict the centroids of a band the joint model did not see: ``f = a·gap + b`` of its
+    sensor (df = 0), the sensor's principal point, the shared distortion, the cube's pose and
+    the sensor rotation. Returns the residuals (predicted − measured) in px, (n, 2), y down.
+    """
+    sel = (obs.band == band) & np.isin(obs.cube, joint.cubes)
+    if not sel.any():
+        raise ObservationError(f"no observations of band {band} in the joint model's cubes")
+    o = obs.select(sel)
+    table = RIKOLA_BANDS
+    blk = JointCentroids(np.searchsorted(joint.cubes, o.cube),
+                         np.searchsorted(table["band"], o.band), o.corners_obj, o.centroids_mm,
+                         1.0, table["gap_nm"], table["sensor"])
+    values = {k: v.copy() for k, v in joint.result.params.values().items()}
+    values["df_mm"] = np.zeros_like(values["df_mm"])
+    r = blk.evaluate(values, False)[0].reshape(-1, 2)
+    return r / obs.pixel_mm * np.array([1.0, -1.0])
+
+
+def corner_bias(obs: Observations, truth) -> dict[int, dict[str, float]]:
+    """Corner displacement with exposure (003 §3.2), per band, against the simulated truth.
+
+    Returns
+    -------
+    dict band -> ``outward_px`` (mean displacement of the detected corners away from the
+    target's centre; negative: the target looks smaller), ``scale`` (mean ratio of detected to
+    true side length, the paper's scale factor), ``centroid_mean_px`` (x, y) and
+    ``centroid_sd_px`` (x, y) of the centroid error.
+    """
+    out = {}
+    for b in np.unique(obs.band):
+        o = obs.select(obs.band == b)
+        true = np.stack([mm_to_pixel(truth.project(int(c), int(b), X), obs.image_size,
+                                     obs.pixel_mm) for c, X in zip(o.cube, o.corners_obj,
+                                                                   strict=True)])
+        e = o.corners_px - true
+        centre = true.mean(axis=1, keepdims=True)
+        u = true - centre
+        u /= np.linalg.norm(u, axis=-1, keepdims=True)
+        side = lambda c: np.linalg.norm(np.roll(c, -1, axis=1) - c, axis=-1)  # noqa: E731
+        ce = o.centroids_px - true.mean(axis=1)
+        out[int(b)] = {"outward_px": float(np.mean(np.sum(e * u, axis=-1))),
+                       "scale": float(np.mean(side(o.corners_px) / side(true))),
+                       "centroid_mean_px": ce.mean(axis=0).tolist(),
+                       "centroid_sd_px": ce.std(axis=0).tolist()}
+    return out
+
+
+def track_targets(obs: Observations, cube: int, ref_band: int) -> dict[str, tuple[int, dict]]:
+    """Five targets of one cube — nearest the four image corners and the centre in a reference
+    band — and their centroids (px) in every band (003 §3.2, Fig. 3–4).
+
+    Returns
+    -------
+    dict label (ULC, URC, BLC, BRC, IC) -> (target id, {band: (col, row)})
+    """
+    w, h = obs.image_size
+    ref = obs.select((obs.cube == cube) & (obs.band == ref_band))
+    if len(ref.cube) < 5:
+        raise ObservationError(f"cube {cube}, band {ref_band}: fewer than 5 targets")
+    spots = {"ULC": (0, 0), "URC": (w - 1, 0), "BLC": (0, h - 1), "BRC": (w - 1, h - 1),
+             "IC": ((w - 1) / 2, (h - 1) / 2)}
+    out = {}
+    for lab, p in spots.items():
+        t = int(ref.target[np.argmin(np.linalg.norm(ref.centroids_px - p, axis=1))])
+        track = {}
+        for b in np.unique(obs.band):
+            m = (obs.cube == cube) & (obs.band == b) & (obs.target == t)
+            if m.any():
+                track[int(b)] = tuple(obs.centroids_px[m][0])
+        out[lab] = (t, track)
+    return out
+
+
+def radial_effect_px(KP, r_mm, pixel_mm: float) -> np.ndarray:
+    """Magnitude of the symmetric radial correction ``r (K1 r² + K2 r⁴ + K3 r⁶)`` in px."""
+    r = np.asarray(r_mm, float)
+    K = np.asarray(KP, float)[:3]
+    return r * (K[0] * r ** 2 + K[1] * r ** 4 + K[2] * r ** 6) / pixel_mm
+
+
+def decentering_effect_px(KP, xy_mm, pixel_mm: float) -> np.ndarray:
+    """The decentering part ``(δx, δy)`` of Brown's correction at a point, in px (003 Fig. 9)."""
+    from hsgeo.distortion import brown_correction
+
+    KP = np.asarray(KP, float)
+    return brown_correction(np.asarray(xy_mm, float), np.zeros(3), KP[3:]) / pixel_mm
+
+
+def calibrate_frame_files(images, board_path, *, joint: bool = False, band_regex=None,
+                          cube_regex=None, sigma_px: float = 0.1):
+    """``hsgeo calibrate-frame``: detect a board in image files and self-calibrate, per band
+    (:func:`calibrate_band`) or jointly (:func:`calibrate_joint`, Rikola band numbering).
+
+    Returns
+    -------
+    hsgeo.reproduce.Reproduction
+        Rows ``interior band N`` (f, x0, y0, K1–K3, P1, P2 with σ̂, in mm or — without
+        ``camera.pixel_mm`` in the board file — px) or ``joint model``; ``meta`` has σ0, the
+        RMS residual and the number of points per band.
+    """
+    from hsgeo.measure.boards import load_board, observe_files
+    from hsgeo.reproduce import Reproduction, Row
+
+    board = load_board(board_path)
+    obs = observe_files(images, board, band_regex=band_regex, cube_regex=cube_regex)
+    unit = "mm" if board.pixel_mm is not None else "px"
+    rows, meta = [], {"images": len(list(images)), "points": int(len(obs.cube)),
+                      "length_unit": unit, "board": board.type}
+    if joint:
+        if band_regex is None or cube_regex is None:
+            raise InputError("--joint needs --band-regex and --cube-regex (which band and cube "
+                             "each file is)")
+        j = calibrate_joint(obs, f0_mm=initial_focal_mm(obs), sigma_px=sigma_px)
+        R = j.result
+        for blk in ("gap_model", "pp_mm", "distortion_mm", "sensor2_rotation"):
+            b = R.params[blk]
+            for lab, v, s in zip(b.labels(), b.value.ravel(), R.sigma(blk).ravel(),
+                                 strict=True):
+                rows.append(Row("joint model", lab, "", None, None, v, s, None))
+        meta.update(sigma0=R.sigma0, rms_px=float(np.sqrt(np.mean(np.sum(
+            j.residuals_px ** 2, axis=1)))))
+        return Reproduction("calibrate-frame", 0, rows, meta)
+    for band in np.unique(obs.band):
+        c = calibrate_band(obs, int(band), f0_mm=None, sigma_px=sigma_px)
+        for q, (v, s) in c.iop.items():
+            u = q.split("_", 1)[1].replace("per_", "1/") if "_" in q else ""
+            if board.pixel_mm is None:  # nominal pitch -> px: lengths /p, K_i ·p^(2i), P ·p
+                power = {"f": -1, "x0": -1, "y0": -1, "K1": 2, "K2": 4, "K3": 6, "P1": 1,
+                         "P2": 1}[q.split("_")[0]]
+                v, s = v * obs.pixel_mm ** power, s * obs.pixel_mm ** power
+            rows.append(Row(f"interior band {band}", q.split("_")[0],
+                            u.replace("mm", unit), None, None, v, s, None))
+        meta[f"band {band}"] = {"sigma0": c.result.sigma0, "points": int(np.sum(obs.band == band)),
+                                "rms_px": float(np.sqrt(np.mean(np.sum(c.residuals_px ** 2, 1)))),
+                                "views": int(len(c.cubes))}
+    return Reproduction("calibrate-frame", 0, rows, meta)

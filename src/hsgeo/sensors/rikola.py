@@ -1,0 +1,315 @@
+"""The Rikola FPI frame camera (003): target-centroid observations, per band and jointly.
+
+The camera model is :class:`hsgeo.sensors.frame.FramePhotogrammetric`'s — collinearity in mm,
+camera frame x right, y up, z backward, and Brown's corrections evaluated at the *measured*
+coordinates reduced to the principal point (003 Table 3)::
+
+    x̄ + δ(x̄) = −f·X_c/Z_c,    x̄ = x − x0                                    (collinearity)
+
+What is observed is different. The paper measures the four corners of each ArUco target and uses
+their centroid as a single virtual point (003 §3.2). The centroid of four *imaged* corners is
+not the image of the target's centre: perspective moves it by ``h·a/Z`` (``h`` the half-size of
+the target in the image, ``a`` the depth difference across it) — a third of a pixel for a
+60 mm target at 1.4 m tilted by 35° — and the curvature of the distortion adds about a tenth of
+a pixel in the image corners. Both are far above the noise of a centroid, so the observation
+equation here predicts the centroid exactly: each corner is projected to its *measured*
+position by inverting the correction (Newton, :func:`hsgeo.distortion.measured_from_ideal_mm`),
+and the four are averaged::
+
+    x_k = x0 + x̄_k,  x̄_k + δ(x̄_k) = −f·q_k,   q_k = (X_c/Z_c, Y_c/Z_c) of corner k
+    x_centroid = ¼ Σ_k x_k                                                   (model)
+
+The residual is model − observed centroid, in mm. The Jacobian follows from the implicit
+function theorem: ``(I + ∂δ/∂x̄) dx̄ = −q df − f dq − ∂δ/∂(K, P) d(K, P)``.
+
+Two residual blocks use it:
+
+* :class:`TargetCentroids` — one camera (one band): blocks ``interior`` (f, x0, y0),
+  ``distortion_mm`` (K1, K2, K3, P1, P2) and ``poses`` (one per cube), as in 003 §3.3 where
+  "each image band was approached as a single camera";
+* :class:`JointCentroids` — the model the paper leaves as future work (003 §3.5): one exterior
+  orientation per cube (the camera frame of sensor I), focal length ``f = a·gap + b`` per sensor
+  (003 eq. (2)) plus a per-band deviation ``df`` (a random effect with a prior), a principal point
+  per sensor, one distortion set, and the rotation ``R_I_from_II`` (ω, φ, κ; 003 eq. (1)) and
+  offset ``t_I`` (mm, in sensor I's frame) of sensor II, so that
+  ``X_camII = R_I_from_IIᵀ (X_camI − t_I)``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hsgeo.adjust import Indexed, ResidualBlock
+from hsgeo.distortion import brown_correction_jacobian, measured_from_ideal_mm
+from hsgeo.errors import InputError
+from hsgeo.rotations import R_from_opk, dR_dopk
+from hsgeo.sensors.frame import _dproj, camera_coordinates
+
+__all__ = [
+    "project_measured_mm",
+    "centroid_model",
+    "TargetCentroids",
+    "JointCentroids",
+    "GAP_MODEL_COLUMNS",
+    "ROTATION_COLUMNS",
+    "OFFSET_COLUMNS",
+]
+
+GAP_MODEL_COLUMNS = ("a_mm_per_nm", "b_mm")
+ROTATION_COLUMNS = ("domega_rad", "dphi_rad", "dkappa_rad")
+OFFSET_COLUMNS = ("tx_mm", "ty_mm", "tz_mm")
+
+
+def project_measured_mm(Xc, f_mm, pp_mm, KP) -> np.ndarray:
+    """Measured image coordinates (mm, y up) of camera-frame points.
+
+    Parameters
+    ----------
+    Xc : (..., 3) ndarray
+        Points in the camera frame (x right, y up, z backward; visible points have z < 0).
+    f_mm : float or (...) ndarray
+    pp_mm : (2,) or (..., 2) ndarray
+        Principal point (x0, y0).
+    KP : (5,) ndarray
+        (K1, K2, K3, P1, P2) of :func:`hsgeo.distortion.brown_correction`.
+
+    Returns
+    -------
+    xy_mm : (..., 2) ndarray
+    """
+    Xc = np.asarray(Xc, dtype=np.float64)
+    if np.any(Xc[..., 2] >= 0):
+        raise InputError("points behind the camera (the photogrammetric camera looks along −z)")
+    ideal = -np.asarray(f_mm)[..., None] * Xc[..., :2] / Xc[..., 2:3]
+    KP = np.asarray(KP, dtype=np.float64)
+    return measured_from_ideal_mm(ideal, KP[:3], KP[3:]) + np.asarray(pp_mm)
+
+
+def centroid_model(Xc, f_mm, pp_mm, KP, jacobian: bool):
+    """Predicted centroid of the four imaged corners of each target (module docstring).
+
+    Parameters
+    ----------
+    Xc : (n, 4, 3) ndarray
+        The four corners of each target in the camera frame.
+    f_mm : (n,) ndarray
+    pp_mm : (n, 2) ndarray
+    KP : (5,) ndarray
+    jacobian : bool
+
+    Returns
+    -------
+    xy_mm : (n, 2) ndarray
+    jac : dict or None
+        ``f`` (n, 2), ``KP`` (n, 2, 5), ``Xc`` (n, 4, 2, 3) — derivatives of the centroid; the
+        derivative w.r.t. the principal point is the identity.
+    """
+    if np.any(Xc[..., 2] >= 0):
+        raise InputError(
+            f"{int(np.sum(Xc[..., 2] >= 0))} target corners lie behind the camera (the "
+            "photogrammetric camera looks along −z): check the initial poses"
+        )
+    q = Xc[..., :2] / Xc[..., 2:3]  # (n, 4, 2)
+    f4 = np.asarray(f_mm, dtype=np.float64)[:, None, None]
+    ideal = -f4 * q
+    xbar = measured_from_ideal_mm(ideal, KP[:3], KP[3:])  # 003 collinearity, inverted
+    xy = xbar.mean(axis=1) + pp_mm
+    if not jacobian:
+        return xy, None
+    J_xy, J_K, J_P = brown_correction_jacobian(xbar, KP[:3], KP[3:])
+    A_inv = np.linalg.inv(np.eye(2) + J_xy)  # (n, 4, 2, 2): dx̄ = A⁻¹ d(ideal − δ_params)
+    d_f = np.einsum("nkab,nkb->na", A_inv, -q) / 4.0
+    J_KP = np.concatenate([J_K, J_P], axis=-1)  # (n, 4, 2, 5)
+    d_KP = -np.einsum("nkab,nkbc->nac", A_inv, J_KP) / 4.0
+    n = Xc.shape[0]
+    dq = _dproj(Xc.reshape(-1, 3)).reshape(n, 4, 2, 3)
+    d_Xc = np.einsum("nkab,nkbc->nkac", A_inv, -f4[..., None] * dq) / 4.0
+    return xy, {"f": d_f, "KP": d_KP, "Xc": d_Xc}
+
+
+def _check_obs(name, view, corners, xy):
+    view = np.asarray(view)
+    corners = np.asarray(corners, dtype=np.float64)
+    xy = np.asarray(xy, dtype=np.float64)
+    n = xy.shape[0] if xy.ndim == 2 else -1
+    if xy.ndim != 2 or xy.shape[1] != 2:
+        raise InputError(f"{name}: centroids must be (n, 2) in mm, got {xy.shape}")
+    if corners.shape != (n, 4, 3):
+        raise InputError(f"{name}: target corners must be (n, 4, 3) object coordinates, got "
+                         f"{corners.shape} for {n} centroids")
+    if view.shape != (n,) or not np.issubdtype(view.dtype, np.integer):
+        raise InputError(f"{name}: view/cube indices must be (n,) integers")
+    if not (np.all(np.isfinite(xy)) and np.all(np.isfinite(corners))):
+        raise InputError(f"{name}: NaN or inf in the centroids or the target corners")
+    return view.astype(np.int64), corners, xy
+
+
+class TargetCentroids(ResidualBlock):
+    """Centroid observations of one camera (one band): 003 §3.3, one IOP set per band.
+
+    Parameter blocks: ``interior`` (f, x0, y0) mm, ``distortion_mm`` (K1, K2, K3, P1, P2) and
+    ``poses`` (n_views, 6) ``(ω, φ, κ, X0, Y0, Z0)`` of ``R_world_from_cam``.
+
+    Parameters
+    ----------
+    view : (n,) int ndarray
+        The view (cube) of each centroid.
+    corners : (n, 4, 3) ndarray
+        Object coordinates of the target's four corners.
+    xy_mm : (n, 2) ndarray
+        Measured centroids, mm from the image centre, y up.
+    sigma_mm : float or (n, 2) ndarray
+    """
+
+    name = "target centroids"
+    group_size = 2
+
+    def __init__(self, view, corners, xy_mm, sigma_mm, *, interior_block="interior",
+                 distortion_block="distortion_mm", poses_block="poses", name=None):
+        view, corners, xy = _check_obs(type(self).__name__, view, corners, xy_mm)
+        super().__init__(np.broadcast_to(np.asarray(sigma_mm, float), xy.shape).ravel(),
+                         name=name)
+        self.view, self.corners, self.xy = view, corners, xy
+        self.interior_block, self.distortion_block = interior_block, distortion_block
+        self.poses_block = poses_block
+
+    def predict(self, values) -> np.ndarray:
+        """Model centroids (n, 2) mm."""
+        return self._model(values, False)[0]
+
+    def _model(self, values, jacobian):
+        f, x0, y0 = values[self.interior_block]
+        n = self.xy.shape[0]
+        Xc, d_pose, _ = camera_coordinates(values[self.poses_block], np.repeat(self.view, 4),
+                                           self.corners.reshape(-1, 3), jacobian)
+        xy, J = centroid_model(Xc.reshape(n, 4, 3), np.full(n, f), np.array([x0, y0]),
+                               values[self.distortion_block], jacobian)
+        return xy, J, d_pose
+
+    def evaluate(self, values, jacobian):
+        xy, J, d_pose = self._model(values, jacobian)
+        r = xy - self.xy
+        if not jacobian:
+            return r.ravel(), None
+        n = r.shape[0]
+        d_int = np.zeros((n, 2, 3))
+        d_int[:, :, 0] = J["f"]
+        d_int[:, 0, 1] = 1.0
+        d_int[:, 1, 2] = 1.0
+        dp = np.einsum("nkac,nkcj->naj", J["Xc"], d_pose.reshape(n, 4, 3, 6))
+        jac = {self.interior_block: d_int.reshape(2 * n, 3),
+               self.distortion_block: J["KP"].reshape(2 * n, 5),
+               self.poses_block: Indexed(np.repeat(self.view, 2), dp.reshape(2 * n, 6))}
+        return r.ravel(), jac
+
+
+class JointCentroids(ResidualBlock):
+    """Centroid observations of all bands of all cubes in one model (003 §3.5, future work).
+
+    Parameter blocks (names configurable):
+
+    ``poses`` (n_cubes, 6)
+        Exterior orientation of sensor I's camera frame per cube (the camera is static during a
+        cube, 003 §3.4).
+    ``gap_model`` (2, 2)
+        Rows sensor I, sensor II; columns (a mm/nm, b mm): ``f = a·gap + b`` (003 eq. (2)).
+    ``df_mm`` (n_bands,)
+        Per-band deviation from the line (give it a prior; bands off the line free).
+    ``pp_mm`` (2, 2)
+        Principal point (x0, y0) per sensor (rows I, II).
+    ``distortion_mm`` (5,)
+        One set (K1, K2, K3, P1, P2) for all bands (003 §3.5, Fig. 8).
+    ``sensor2_rotation`` (3,)
+        (dω, dφ, dκ) of ``R_I_from_II`` (003 eq. (1), Table 4).
+    ``sensor2_offset_mm`` (3,)
+        Projection centre of sensor II in sensor I's frame.
+
+    Parameters
+    ----------
+    cube : (n,) int ndarray
+    band_index : (n,) int ndarray
+        Index into ``gap_nm`` / ``sensor`` (0-based rows of the band table).
+    corners, xy_mm, sigma_mm : as in :class:`TargetCentroids`.
+    gap_nm : (n_bands,) ndarray
+    sensor : (n_bands,) int ndarray
+        1 or 2 for each band.
+    """
+
+    name = "target centroids (joint model)"
+    group_size = 2
+
+    def __init__(self, cube, band_index, corners, xy_mm, sigma_mm, gap_nm, sensor, *,
+                 poses_block="poses", gap_block="gap_model", df_block="df_mm", pp_block="pp_mm",
+                 distortion_block="distortion_mm", rotation_block="sensor2_rotation",
+                 offset_block="sensor2_offset_mm", name=None):
+        cube, corners, xy = _check_obs(type(self).__name__, cube, corners, xy_mm)
+        band_index = np.asarray(band_index)
+        gap_nm = np.asarray(gap_nm, dtype=np.float64)
+        sensor = np.asarray(sensor)
+        if band_index.shape != cube.shape or not np.issubdtype(band_index.dtype, np.integer):
+            raise InputError("JointCentroids: band_index must be (n,) integers")
+        if gap_nm.shape != sensor.shape or np.any(~np.isin(sensor, (1, 2))):
+            raise InputError("JointCentroids: gap_nm and sensor must be (n_bands,), sensor 1 or 2")
+        if band_index.min() < 0 or band_index.max() >= gap_nm.size:
+            raise InputError("JointCentroids: band_index outside the band table")
+        super().__init__(np.broadcast_to(np.asarray(sigma_mm, float), xy.shape).ravel(),
+                         name=name)
+        self.cube, self.band, self.corners, self.xy = cube, band_index.astype(np.int64), \
+            corners, xy
+        self.gap = gap_nm[self.band]
+        self.srow = sensor[self.band].astype(np.int64) - 1  # 0: sensor I, 1: sensor II
+        self.names = dict(poses=poses_block, gap=gap_block, df=df_block, pp=pp_block,
+                          dist=distortion_block, rot=rotation_block, off=offset_block)
+
+    def predict(self, values) -> np.ndarray:
+        return self._model(values, False)[0]
+
+    def _model(self, values, jacobian):
+        nm = self.names
+        n = self.xy.shape[0]
+        ab = values[nm["gap"]]
+        f = ab[self.srow, 0] * self.gap + ab[self.srow, 1] + values[nm["df"]][self.band]
+        pp = values[nm["pp"]][self.srow]
+        XcI, d_pose, _ = camera_coordinates(values[nm["poses"]], np.repeat(self.cube, 4),
+                                            self.corners.reshape(-1, 3), jacobian)
+        XcI = XcI.reshape(n, 4, 3)
+        rot = values[nm["rot"]]
+        t = values[nm["off"]]
+        M = R_from_opk(*rot)  # R_I_from_II
+        two = self.srow == 1
+        Xc = XcI.copy()
+        Xc[two] = np.einsum("ji,nkj->nki", M, XcI[two] - t)  # X_camII = Mᵀ (X_camI − t)
+        xy, J = centroid_model(Xc, f, pp, values[nm["dist"]], jacobian)
+        return xy, J, (d_pose, XcI, M, two, t, rot)
+
+    def evaluate(self, values, jacobian):
+        nm = self.names
+        xy, J, aux = self._model(values, jacobian)
+        r = xy - self.xy
+        if not jacobian:
+            return r.ravel(), None
+        d_pose, XcI, M, two, t, rot = aux
+        n = r.shape[0]
+        # chain through sensor II's rotation: dXc = Mᵀ dXcI for sensor II rows
+        dXcI = J["Xc"].copy()  # (n, 4, 2, 3) ∂centroid/∂Xc
+        dXcI[two] = np.einsum("nkac,ci->nkai", J["Xc"][two], M.T)
+        dp = np.einsum("nkac,nkcj->naj", dXcI, d_pose.reshape(n, 4, 3, 6))
+        d_rot = np.zeros((n, 2, 3))
+        d_off = np.zeros((n, 2, 3))
+        if np.any(two):
+            dM = dR_dopk(*rot)  # (3, 3, 3): ∂M/∂angle
+            v = XcI[two] - t  # (m, 4, 3)
+            dXc_drot = np.einsum("aji,nkj->nkia", dM, v)  # (m, 4, 3 xyz, 3 angles)
+            d_rot[two] = np.einsum("nkac,nkcj->naj", J["Xc"][two], dXc_drot)
+            d_off[two] = -np.einsum("nkac,ci->nai", J["Xc"][two], M.T)
+        d_ab = np.stack([J["f"] * self.gap[:, None], J["f"]], axis=-1)  # (n, 2, 2)
+        jac = {
+            nm["poses"]: Indexed(np.repeat(self.cube, 2), dp.reshape(2 * n, 6)),
+            nm["gap"]: Indexed(np.repeat(self.srow, 2), d_ab.reshape(2 * n, 2)),
+            nm["df"]: Indexed(np.repeat(self.band, 2), J["f"].reshape(2 * n, 1)),
+            nm["pp"]: Indexed(np.repeat(self.srow, 2), np.tile(np.eye(2), (n, 1))),
+            nm["dist"]: J["KP"].reshape(2 * n, 5),
+            nm["rot"]: d_rot.reshape(2 * n, 3),
+            nm["off"]: d_off.reshape(2 * n, 3),
+        }
+        return r.ravel(), jac

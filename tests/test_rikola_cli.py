@@ -1,0 +1,75 @@
+"""``hsgeo calibrate-frame``: board files, the real ChArUco photographs, a rendered ArUco bench."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from hsgeo.cli import main
+from hsgeo.errors import InputError
+from hsgeo.measure.boards import load_board
+
+ROOT = Path(__file__).resolve().parents[1]
+CHARUCO = ROOT / "src/hsgeo/data/reference/opencv-charuco/images"
+BOARD = ROOT / "src/hsgeo/data/reference/opencv-charuco/board.toml"
+
+
+def test_charuco_photographs_match_opencv(capsys):
+    """The four tutorial photographs: RMS and principal distance agree with OpenCV's own
+    calibration of the same images (SOURCE.md: RMS 0.1878 px, fx, fy 457.3, 461.3 px)."""
+    assert main(["calibrate-frame", *map(str, sorted(CHARUCO.glob("*.jpg"))), "--board",
+                 str(BOARD), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    rows = {r["quantity"]: r for r in out["rows"]}
+    assert abs(out["meta"]["band 1"]["rms_px"] - 0.1878) < 0.01
+    f = rows["f"]
+    assert abs(f["reproduced"] - 459.3) < 3 * f["sigma"]
+    assert abs(rows["x0"]["reproduced"] - (317.22 - 319.5)) < 3 * rows["x0"]["sigma"]
+
+
+def test_rendered_aruco_grid_recovers_truth(tmp_path, capsys):
+    import cv2
+
+    from hsgeo.measure.aruco import to_uint8
+    from hsgeo.simulate.rikola import Renderer, make_truth
+    from hsgeo.simulate.scenarios import load_scenario
+
+    cfg = load_scenario("rikola_bench")
+    truth = make_truth(cfg, np.random.default_rng([5, 0]), n_cubes=6)
+    r = Renderer(cfg, truth)
+    files = []
+    for c in range(6):
+        p = tmp_path / f"cube{c}_band20.png"
+        cv2.imwrite(str(p), to_uint8(r.render(c, 20, 5)))
+        files.append(str(p))
+    board = tmp_path / "plate.toml"
+    board.write_text('[board]\ntype = "aruco_grid"\ndictionary = "DICT_4X4_100"\n'
+                     "markers_x = 9\nmarkers_y = 6\nmarker_mm = 60.0\nseparation_mm = 20.0\n"
+                     "[camera]\npixel_mm = 0.0055\n")
+    assert main(["calibrate-frame", *files, "--board", str(board), "--band-regex",
+                 r"band(\d+)", "--sigma-px", "0.02", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    rows = {r["quantity"]: r for r in out["rows"]}
+    for q, t in zip(("f", "x0", "y0"), truth.interior(20), strict=True):
+        assert abs(rows[q]["reproduced"] - t) < 3.5 * rows[q]["sigma"], q
+
+
+def test_bad_board_files(tmp_path, capsys):
+    with pytest.raises(InputError, match="not found"):
+        load_board(tmp_path / "none.toml")
+    p = tmp_path / "b.toml"
+    p.write_text('[board]\ntype = "charuco"\ndictionary = "DICT_6X6_250"\nsquares_x = 5\n')
+    with pytest.raises(InputError, match="missing"):
+        load_board(p)
+    p.write_text('[board]\ntype = "hexagons"\n')
+    with pytest.raises(InputError, match="type"):
+        load_board(p)
+    p.write_text("[board\n")
+    with pytest.raises(InputError, match="malformed"):
+        load_board(p)
+    assert main(["calibrate-frame", str(CHARUCO / "img_00.jpg"), "--board", str(BOARD),
+                 "--joint"]) == 2
+    assert "--band-regex" in capsys.readouterr().err
