@@ -163,14 +163,19 @@ class AdjustmentResult:
             raise ValueError("this problem has no points block")
         p = lay.p
         s2 = self.sigma0**2 if np.isfinite(self.sigma0) else 1.0
-        Vinv = np.linalg.inv(ne.V)
+        # a point left with too few rays after outlier rejection has a singular V: NaN for it
+        ev = np.linalg.eigvalsh(ne.V)
+        ok = ev[:, 0] > 1e-12 * np.maximum(ev[:, -1], 1e-300)
+        Vinv = np.full_like(ne.V, np.nan)
+        Vinv[ok] = np.linalg.inv(ne.V[ok])
+        Vinv_w = np.where(ok[:, None, None], Vinv, 0.0)
         out = Vinv.copy()
         if lay.n_c:
             Wd = ne.W.tocsc()
             for a in range(0, lay.n_pts, chunk):
                 b = min(lay.n_pts, a + chunk)
                 Wi = Wd[:, a * p : b * p].toarray().T.reshape(b - a, p, lay.n_c)  # (k, p, n_c)
-                A = np.einsum("kij,kjc->kic", Vinv[a:b], Wi)  # V⁻¹ Wᵀ
+                A = np.einsum("kij,kjc->kic", Vinv_w[a:b], Wi)  # V⁻¹ Wᵀ
                 out[a:b] += np.einsum("kic,cd,kjd->kij", A, self._S_inv, A)
         out *= s2
         fixed = ~lay.pfree
