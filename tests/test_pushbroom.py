@@ -94,3 +94,27 @@ def test_same_seed_same_bits():
     a, b = simulate(0.001, rng=7), simulate(0.001, rng=7)
     assert np.array_equal(a.obs["xy_px"], b.obs["xy_px"])
     assert np.array_equal(a.truth["nodes"], b.truth["nodes"])
+
+
+def test_compiled_schur_equals_generic_on_pushbroom(tiny, monkeypatch):
+    from hsgeo.adjust import engine as E
+
+    p, blocks, _ = _problem(tiny)
+    lay = E._Layout(p)
+    sy = E._evaluate(lay, blocks, [np.ones(b.m, bool) for b in blocks], True)
+    got = {}
+    for fast in (True, False):
+        monkeypatch.setattr(E, "FAST", fast)
+        ne = E._normal(lay, sy)
+        S, rhs, _, _ = E._reduced(lay, ne, 1e-4)
+        got[fast] = (S, rhs)
+    for a, b in zip(got[True], got[False], strict=True):
+        np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-9 * np.max(np.abs(b)))
+
+
+def test_point_covariance_subset_equals_all(tiny):
+    p, blocks, _ = _problem(tiny)
+    res = adjust(p, blocks, reject_k=5.0)
+    sub = res.point_covariance(index=tiny.cp_index)
+    full = res.point_covariance()[tiny.cp_index]
+    np.testing.assert_allclose(sub, full, rtol=1e-12)
