@@ -18,6 +18,7 @@ __all__ = ["Row", "Reproduction", "CHAPTERS", "run", "chapter_names"]
 #: chapter name -> module (relative to this package) with a ``run(seed, scale)`` function.
 CHAPTERS: dict[str, str] = {
     "frame-reference": "frame_reference",
+    "pushbroom-ba": "pushbroom_ba",
 }
 
 

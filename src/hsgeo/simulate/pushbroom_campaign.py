@@ -55,7 +55,7 @@ class CampaignConfig:
     c_mean_mm: float = 40.3  # 002 Fig. 8: mean of the estimated principal distances
     # per-band principal distance minus the mean, µm: spread ≤ 11.8 µm (002 Fig. 8); the
     # shape (decreasing with wavelength) is our choice
-    c_offsets_um: tuple = (7.1, 4.2, 1.9, -0.6, -2.9, -4.7, -5.0)
+    c_offsets_um: tuple = (11.0, 6.5, 2.9, -1.0, -4.6, -7.3, -7.5)
     wavelengths_nm: tuple = (450.0, 527.0, 604.0, 681.0, 758.0, 835.0, 912.0)  # ~77 nm, 002 §4
     speed_m_s: float = 67.0  # 002 §4
     line_rate_hz: float = 200.0  # 002 §4: 200 lines ≈ 1 s
