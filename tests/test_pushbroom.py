@@ -118,3 +118,19 @@ def test_point_covariance_subset_equals_all(tiny):
     sub = res.point_covariance(index=tiny.cp_index)
     full = res.point_covariance()[tiny.cp_index]
     np.testing.assert_allclose(sub, full, rtol=1e-12)
+
+
+def test_compiled_block_equals_numpy_block(tiny):
+    _, blocks, _ = _problem(tiny)
+    b = blocks[0]
+    vals = dict(tiny.truth)
+    vals["nodes"] = vals["nodes"] + 0.01
+    r1, j1 = b.evaluate(vals, True)
+    r2, j2 = b.evaluate_numpy(vals, True)
+    np.testing.assert_allclose(r1, r2, rtol=0, atol=1e-9)
+    for k in j2:
+        a, c = j1[k], j2[k]
+        if hasattr(c, "d"):
+            np.testing.assert_array_equal(a.index, c.index)
+            a, c = a.d, c.d
+        np.testing.assert_allclose(a, c, rtol=1e-9, atol=1e-9 * np.max(np.abs(c)), err_msg=k)

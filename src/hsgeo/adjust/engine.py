@@ -111,13 +111,17 @@ class _RowJac:
         return np.where(self.cols >= 0, self.cols, self.n_cols)
 
     def matvec(self, x: np.ndarray) -> np.ndarray:
-        xe = np.append(np.asarray(x, dtype=np.float64), 0.0)
-        return np.einsum("ij,ij->i", self.vals, xe[self._safe_cols()])
+        from hsgeo.adjust._fast import matvec
 
-    def rmatvec(self, y: np.ndarray) -> np.ndarray:
-        w = self.vals * np.asarray(y, dtype=np.float64)[:, None]
-        return np.bincount(self._safe_cols().ravel(), weights=w.ravel(),
-                           minlength=self.n_cols + 1)[: self.n_cols]
+        return matvec(self.cols, self.vals, np.ascontiguousarray(x, dtype=np.float64))
+
+    def rmatvec(self, y: np.ndarray, diag: bool = False):
+        """``Jᵀ y`` (and ``diag(JᵀJ)`` with ``diag=True``)."""
+        from hsgeo.adjust._fast import rmatvec_diag
+
+        g, d = rmatvec_diag(self.cols, self.vals, np.ascontiguousarray(y, dtype=np.float64),
+                            self.n_cols, diag)
+        return (g, d) if diag else g
 
     def tocsr(self) -> sp.csr_matrix:
         keep = self.cols >= 0
@@ -150,39 +154,94 @@ class _System:
         return self.Jrc.tocsr()
 
 
-def _row_slots(J, m: int, size: int, name: str, colmap: np.ndarray):
-    """Row-compressed (cols, vals) of a block Jacobian in any accepted form, global columns."""
-    if isinstance(J, Indexed):
-        m_j, q, k = J.d.shape
-        if m_j != m:
-            raise InputError(f"Jacobian w.r.t. {name!r} has {m_j} rows, residuals have {m}")
-        if size % k:
-            raise InputError(f"Jacobian w.r.t. {name!r}: item width {k} does not divide {size}")
-        valid = J.index >= 0
-        if np.any(J.index[valid] >= size // k):
-            raise InputError(f"Jacobian w.r.t. {name!r} indexes past the block's items")
-        lc = np.where(valid, J.index, 0)[:, :, None] * k + np.arange(k)
-        cols = colmap[lc].reshape(m, q * k)
-        if not valid.all():
-            cols[np.repeat(~valid, k, axis=1)] = -1
-        return cols, J.d.reshape(m, q * k)
-    if sp.issparse(J):
-        c = J.tocsr()
-        if c.shape != (m, size):
-            raise InputError(f"Jacobian w.r.t. {name!r} has shape {c.shape}, expected {(m, size)}")
-        nnz = np.diff(c.indptr)
-        K = int(nnz.max()) if m else 0
-        slot = np.arange(c.indices.size) - np.repeat(c.indptr[:-1], nnz)
-        rows = np.repeat(np.arange(m), nnz)
-        cols = np.full((m, K), -1, dtype=np.int64)
-        vals = np.zeros((m, K))
-        cols[rows, slot] = colmap[c.indices]
-        vals[rows, slot] = c.data
-        return cols, vals
-    arr = np.asarray(J, dtype=np.float64)
-    if arr.shape != (m, size):
-        raise InputError(f"Jacobian w.r.t. {name!r} has shape {arr.shape}, expected {(m, size)}")
-    return np.broadcast_to(colmap, (m, size)), arr
+class _Slots:
+    """One block Jacobian's share of the row-compressed matrix, written on request.
+
+    Writing straight into the final ``(M, K)`` arrays avoids intermediate copies of what can be
+    tens of millions of entries (GUIDE §9).
+    """
+
+    def __init__(self, J, m: int, size: int, name: str, colmap: np.ndarray, rows, w):
+        self.colmap, self.rows, self.w = colmap, rows, w  # rows: kept rows, or None for all
+        if isinstance(J, Indexed):
+            m_j, q, k = J.d.shape
+            if m_j != m:
+                raise InputError(f"Jacobian w.r.t. {name!r} has {m_j} rows, residuals have {m}")
+            if size % k:
+                raise InputError(
+                    f"Jacobian w.r.t. {name!r}: item width {k} does not divide {size}")
+            if J.index.size and int(J.index.max()) >= size // k:
+                raise InputError(f"Jacobian w.r.t. {name!r} indexes past the block's items")
+            self.kind, self.J, self.width, self.qk = "indexed", J, q * k, (q, k)
+        elif sp.issparse(J):
+            c = J.tocsr()
+            if c.shape != (m, size):
+                raise InputError(
+                    f"Jacobian w.r.t. {name!r} has shape {c.shape}, expected {(m, size)}")
+            nnz = np.diff(c.indptr)
+            K = int(nnz.max()) if m else 0
+            slot = np.arange(c.indices.size) - np.repeat(c.indptr[:-1], nnz)
+            rr = np.repeat(np.arange(m), nnz)
+            cols = np.full((m, K), -1, dtype=np.int64)
+            vals = np.zeros((m, K))
+            cols[rr, slot] = colmap[c.indices]
+            vals[rr, slot] = c.data
+            self.kind, self.J, self.width = "dense_slots", (cols, vals), K
+        else:
+            arr = np.asarray(J, dtype=np.float64)
+            if arr.shape != (m, size):
+                raise InputError(
+                    f"Jacobian w.r.t. {name!r} has shape {arr.shape}, expected {(m, size)}")
+            self.kind, self.J, self.width = "dense", arr, size
+
+    def _take(self, a):
+        return a if self.rows is None else a[self.rows]
+
+    def fill(self, cols_dst: np.ndarray, vals_dst: np.ndarray) -> None:
+        n = cols_dst.shape[0]
+        wr = self._take(self.w)
+        cm = self.colmap
+        if self.kind == "indexed":
+            q, k = self.qk
+            idx = self._take(self.J.index)
+            cd = cols_dst.reshape(n, q, k)
+            vd = vals_dst.reshape(n, q, k)
+            if not (np.shares_memory(cd, cols_dst) and np.shares_memory(vd, vals_dst)):
+                raise AssertionError("slot views must not copy")  # pragma: no cover
+            contiguous = cm.size and cm[0] >= 0 and np.all(np.diff(cm) == 1)
+            if contiguous:
+                np.add((idx * k)[:, :, None], int(cm[0]) + np.arange(k), out=cd,
+                       casting="unsafe")
+                bad = idx < 0
+                if bad.any():
+                    cd[bad] = -1
+            else:
+                lc = np.where(idx >= 0, idx, 0)[:, :, None] * k + np.arange(k)
+                cd[:] = np.where((idx >= 0)[:, :, None], cm[lc], -1)
+            np.multiply(self._take(self.J.d), wr[:, None, None], out=vd)
+            if not contiguous or (idx < 0).any():
+                vals_dst[cols_dst < 0] = 0.0
+        elif self.kind == "dense":
+            cols_dst[:] = cm
+            np.multiply(self._take(self.J), wr[:, None], out=vals_dst)
+            if (cm < 0).any():
+                vals_dst[:, cm < 0] = 0.0
+        else:
+            cols, vals = self.J
+            cols_dst[:] = self._take(cols)
+            np.multiply(self._take(vals), wr[:, None], out=vals_dst)
+            vals_dst[cols_dst < 0] = 0.0
+
+
+class _PriorSlots:
+    width = 1
+
+    def __init__(self, cols, vals):
+        self.cols, self.vals = cols, vals
+
+    def fill(self, cols_dst, vals_dst):
+        cols_dst[:, 0] = self.cols
+        vals_dst[:, 0] = self.vals
 
 
 def _evaluate(layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian: bool) -> _System:
@@ -226,15 +285,8 @@ def _evaluate(layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian:
                     jp = J.d[rows_kept, 0, :] * w[rows_kept, None]
                     jp = np.where(pidx[:, None] >= 0, jp * layout.pfree[np.maximum(pidx, 0)], 0.0)
                     continue
-                cols, vals = _row_slots(J, blk.m, b.size, name, layout.colmap[name])
-                if all_kept:  # no copies of the (often large) slot arrays
-                    vals = vals * w[:, None]
-                else:
-                    cols, vals = cols[rows_kept], vals[rows_kept] * w[rows_kept, None]
-                empty = cols < 0
-                if empty.any():
-                    vals[empty] = 0.0
-                blk_slots.append((cols, vals))
+                blk_slots.append(_Slots(J, blk.m, b.size, name, layout.colmap[name],
+                                        None if all_kept else rows_kept, w))
             slot_parts.append(blk_slots)
             pidx_parts.append(pidx)
             jp_parts.append(jp)
@@ -258,7 +310,7 @@ def _evaluate(layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian:
                 pidx_parts.append(pt)
                 jp_parts.append(jp)
             else:
-                slot_parts.append([(layout.colmap[b.name][idx][:, None], (1.0 / s)[:, None])])
+                slot_parts.append([_PriorSlots(layout.colmap[b.name][idx], 1.0 / s)])
                 pidx_parts.append(np.full(idx.size, -1, dtype=np.int64))
                 jp_parts.append(np.zeros((idx.size, layout.p)))
         offset += idx.size
@@ -268,17 +320,20 @@ def _evaluate(layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian:
         return _System(r_all, None, None, None, n_obs_rows)
     M = offset
     # one (M, K) row-compressed matrix: each part's slots side by side, padded to the widest
-    K = max([sum(c.shape[1] for c, _ in part) for part in slot_parts] + [1])
-    cols_all = np.full((M, K), -1, dtype=np.int32 if layout.n_c < 2**31 else np.int64)
-    vals_all = np.zeros((M, K))
+    K = max([sum(sl.width for sl in part) for part in slot_parts] + [1])
+    cols_all = np.empty((M, K), dtype=np.int32 if layout.n_c < 2**31 else np.int64)
+    vals_all = np.empty((M, K))
     row0 = 0
     for part, pi in zip(slot_parts, pidx_parts, strict=True):
         n = pi.size
         k0 = 0
-        for c, v in part:
-            cols_all[row0 : row0 + n, k0 : k0 + c.shape[1]] = c
-            vals_all[row0 : row0 + n, k0 : k0 + c.shape[1]] = v
-            k0 += c.shape[1]
+        for sl in part:
+            sl.fill(cols_all[row0 : row0 + n, k0 : k0 + sl.width],
+                    vals_all[row0 : row0 + n, k0 : k0 + sl.width])
+            k0 += sl.width
+        if k0 < K:  # padding
+            cols_all[row0 : row0 + n, k0:] = -1
+            vals_all[row0 : row0 + n, k0:] = 0.0
         row0 += n
     pidx = np.concatenate(pidx_parts) if pidx_parts else np.full(M, -1)
     Jp = np.concatenate(jp_parts) if jp_parts else np.zeros((M, layout.p))
@@ -365,10 +420,8 @@ def _normal(layout: _Layout, sy: _System) -> _Normal:
                 [[0], np.cumsum(np.bincount(pi_all[rows_p], minlength=layout.n_pts))]
             ).astype(np.int64)
         row_order, pt_order = locality_orders(sy.Jrc.cols, layout.n_c, order, ptr)
-        gc = sy.Jrc.rmatvec(sy.r)
         Jrc = sy.Jrc
-        diag_cc = np.bincount(Jrc._safe_cols().ravel(), weights=(Jrc.vals**2).ravel(),
-                              minlength=layout.n_c + 1)[: layout.n_c]
+        gc, diag_cc = Jrc.rmatvec(sy.r, diag=True)
         if layout.pblock is None:
             Ncc = normal_cc(Jrc.cols, Jrc.vals, layout.n_c, row_order)
             return _Normal(Ncc, gc, None, None, diag_cc=diag_cc)

@@ -34,6 +34,7 @@ Jonassen et al. (2024), 002 eq. (2)–(4), §3.3–3.5.
 from __future__ import annotations
 
 import numpy as np
+from numba import njit, prange
 
 from hsgeo.adjust import Indexed, ResidualBlock
 from hsgeo.errors import InputError
@@ -88,6 +89,139 @@ def project(values, names, nodes, t_s, xyz_nav, rpy_nav, pidx, band, beta0, x0_m
     x = xb + K1 * xb**3 + K2 * xb**5 + 3 * P1 * xb**2 + x0_mm  # 002 eq. (3)
     y = yb + P2 * xb**2 + y0_mm
     return np.column_stack([x, y]), p
+
+
+@njit(cache=True, inline="always")
+def _rot_rpy(ro, pi, ya, R, dR):  # pragma: no cover - compiled
+    """R = Rz(yaw) Ry(pitch) Rx(roll) and its derivatives (same as hsgeo.rotations)."""
+    cr, sr, cp, sp, cy, sy = np.cos(ro), np.sin(ro), np.cos(pi), np.sin(pi), np.cos(ya), np.sin(ya)
+    R[0, 0] = cy * cp
+    R[0, 1] = cy * sp * sr - sy * cr
+    R[0, 2] = cy * sp * cr + sy * sr
+    R[1, 0] = sy * cp
+    R[1, 1] = sy * sp * sr + cy * cr
+    R[1, 2] = sy * sp * cr - cy * sr
+    R[2, 0] = -sp
+    R[2, 1] = cp * sr
+    R[2, 2] = cp * cr
+    # roll
+    dR[0, 0, 0] = 0.0
+    dR[0, 0, 1] = cy * sp * cr + sy * sr
+    dR[0, 0, 2] = -cy * sp * sr + sy * cr
+    dR[0, 1, 0] = 0.0
+    dR[0, 1, 1] = sy * sp * cr - cy * sr
+    dR[0, 1, 2] = -sy * sp * sr - cy * cr
+    dR[0, 2, 0] = 0.0
+    dR[0, 2, 1] = cp * cr
+    dR[0, 2, 2] = -cp * sr
+    # pitch
+    dR[1, 0, 0] = -cy * sp
+    dR[1, 0, 1] = cy * cp * sr
+    dR[1, 0, 2] = cy * cp * cr
+    dR[1, 1, 0] = -sy * sp
+    dR[1, 1, 1] = sy * cp * sr
+    dR[1, 1, 2] = sy * cp * cr
+    dR[1, 2, 0] = -cp
+    dR[1, 2, 1] = -sp * sr
+    dR[1, 2, 2] = -sp * cr
+    # yaw
+    dR[2, 0, 0] = -sy * cp
+    dR[2, 0, 1] = -sy * sp * sr - cy * cr
+    dR[2, 0, 2] = -sy * sp * cr + cy * sr
+    dR[2, 1, 0] = cy * cp
+    dR[2, 1, 1] = cy * sp * sr - sy * cr
+    dR[2, 1, 2] = cy * sp * cr + sy * sr
+    dR[2, 2, 0] = 0.0
+    dR[2, 2, 1] = 0.0
+    dR[2, 2, 2] = 0.0
+
+
+@njit(cache=True, parallel=True)
+def _lines_kernel(P, pidx, idx, w, nodes, xyz_nav, rpy_nav, band, c_b, dist, beta, dbeta,
+                  lever, x0, y0, k_px, xy_obs, jac, r, dP, dN, dB, dL, dD, dC):  # pragma: no cover
+    """002 eq. (2)–(4) and their derivatives, one observation per iteration (rows 2j, 2j+1)."""
+    m = pidx.size
+    K1, K2, P1, P2 = dist[0], dist[1], dist[2], dist[3]
+    n_chunks = 64 if m > 6400 else 1
+    step = (m + n_chunks - 1) // n_chunks
+    for ch in prange(n_chunks):
+        R = np.empty((3, 3))
+        dR = np.empty((3, 3, 3))
+        d = np.empty(3)
+        q = np.empty(3)
+        p = np.empty(3)
+        dl = np.empty(6)
+        Jp = np.empty((2, 3))
+        JpB = np.empty((2, 3))
+        for j in range(ch * step, min(m, (ch + 1) * step)):
+            for a in range(6):
+                acc = 0.0
+                for b in range(4):
+                    acc += w[j, b] * nodes[idx[j, b], a]
+                dl[a] = acc
+            _rot_rpy(rpy_nav[j, 0] + dl[3], rpy_nav[j, 1] + dl[4], rpy_nav[j, 2] + dl[5], R, dR)
+            pt = pidx[j]
+            for a in range(3):
+                d[a] = P[pt, a] - xyz_nav[j, a] - dl[a]
+            for a in range(3):  # q = Rᵀ d − l
+                q[a] = R[0, a] * d[0] + R[1, a] * d[1] + R[2, a] * d[2] - lever[a]
+            for a in range(3):  # p = β q
+                p[a] = beta[a, 0] * q[0] + beta[a, 1] * q[1] + beta[a, 2] * q[2]
+            c = c_b[band[j]]
+            iz = 1.0 / p[2]
+            xb = c * p[0] * iz
+            yb = c * p[1] * iz
+            x = xb + K1 * xb**3 + K2 * xb**5 + 3 * P1 * xb**2 + x0  # 002 eq. (3)
+            y = yb + P2 * xb**2 + y0
+            r[2 * j] = x * k_px - xy_obs[j, 0]
+            r[2 * j + 1] = y * k_px - xy_obs[j, 1]
+            if not jac:
+                continue
+            gx = 1.0 + 3 * K1 * xb**2 + 5 * K2 * xb**4 + 6 * P1 * xb
+            gy = 2 * P2 * xb
+            a_ = c * iz
+            Jp[0, 0] = gx * a_ * k_px
+            Jp[0, 1] = 0.0
+            Jp[0, 2] = -gx * xb * iz * k_px
+            Jp[1, 0] = gy * a_ * k_px
+            Jp[1, 1] = a_ * k_px
+            Jp[1, 2] = (-yb * iz - gy * xb * iz) * k_px
+            for u in range(2):
+                for a in range(3):
+                    JpB[u, a] = Jp[u, 0] * beta[0, a] + Jp[u, 1] * beta[1, a] + Jp[u, 2] * beta[2, a]
+            for u in range(2):
+                row = 2 * j + u
+                for a in range(3):
+                    # dp/dP = β Rᵀ: (JpB Rᵀ)[u, a] = Σ_i JpB[u, i] R[a, i]
+                    v = JpB[u, 0] * R[a, 0] + JpB[u, 1] * R[a, 1] + JpB[u, 2] * R[a, 2]
+                    dP[row, a] = v
+                    for b in range(4):
+                        dN[row, b, a] = -v * w[j, b]
+                    dL[row, a] = -JpB[u, a]
+                for kk in range(3):
+                    # attitude: dq_i/drpy_k = Σ_j dR[k, j, i] d_j
+                    v = 0.0
+                    for i in range(3):
+                        dq = dR[kk, 0, i] * d[0] + dR[kk, 1, i] * d[1] + dR[kk, 2, i] * d[2]
+                        v += JpB[u, i] * dq
+                    for b in range(4):
+                        dN[row, b, 3 + kk] = v * w[j, b]
+                    # boresight: dp/dbore_k = dβ_k q
+                    v = 0.0
+                    for i in range(3):
+                        v += Jp[u, i] * (dbeta[kk, i, 0] * q[0] + dbeta[kk, i, 1] * q[1]
+                                         + dbeta[kk, i, 2] * q[2])
+                    dB[row, kk] = v
+            dC[2 * j, 0] = gx * xb / c * k_px
+            dC[2 * j + 1, 0] = (yb / c + gy * xb / c) * k_px
+            dD[2 * j, 0] = xb**3 * k_px
+            dD[2 * j, 1] = xb**5 * k_px
+            dD[2 * j, 2] = 3 * xb**2 * k_px
+            dD[2 * j, 3] = 0.0
+            dD[2 * j + 1, 0] = 0.0
+            dD[2 * j + 1, 1] = 0.0
+            dD[2 * j + 1, 2] = 0.0
+            dD[2 * j + 1, 3] = xb**2 * k_px
 
 
 class PushbroomLines(ResidualBlock):
@@ -157,6 +291,10 @@ class PushbroomLines(ResidualBlock):
         self.names = dict(BLOCK_NAMES if names is None else names)
         self.beta0 = np.asarray(beta0, dtype=np.float64)
         self._basis = nodes.basis(self.t_s)
+        self._pidx2 = np.repeat(self.point, 2)
+        self._idx2 = np.repeat(self._basis[0], 2, axis=0)
+        for a in ("xyz_nav", "rpy_nav", "xy_px"):
+            setattr(self, a, np.ascontiguousarray(getattr(self, a)))
 
     def image_mm(self, values):
         """Modelled image coordinates in mm, ``(m, 2)``."""
@@ -164,7 +302,8 @@ class PushbroomLines(ResidualBlock):
                         self.point, self.band, self.beta0, self.x0_mm, self.y0_mm)
         return xy
 
-    def evaluate(self, values, jacobian):
+    def evaluate_numpy(self, values, jacobian):
+        """The same as :meth:`evaluate`, in plain numpy (the reference for the tests)."""
         nm = self.names
         g = _camera_geometry(values, nm, self.nodes, self.t_s, self.xyz_nav, self.rpy_nav,
                              self.point, self.band, self.beta0, jacobian)
@@ -223,5 +362,41 @@ class PushbroomLines(ResidualBlock):
             nm["lever_arm"]: dLever.reshape(2 * m, 3),
             nm["distortion"]: dDist.reshape(2 * m, 4),
             nm["c"]: Indexed(rep(self.band, 2), dC.reshape(2 * m, 1)),
+        }
+        return r, jac
+
+    def evaluate(self, values, jacobian):
+        nm = self.names
+        m = self.point.size
+        idx, w = self._basis
+        bore = values[nm["boresight"]]
+        beta = R_from_opk(bore[0], bore[1], bore[2]) @ self.beta0
+        dbeta = dR_dopk(bore[0], bore[1], bore[2]) @ self.beta0
+        r = np.empty(2 * m)
+        shp = (2 * m,) if jacobian else (0,)
+        dP = np.empty(shp + (3,))
+        dN = np.empty(shp + (4, 6))
+        dB = np.empty(shp + (3,))
+        dL = np.empty(shp + (3,))
+        dD = np.empty(shp + (4,))
+        dC = np.empty(shp + (1,))
+        _lines_kernel(np.ascontiguousarray(values[nm["points"]], dtype=np.float64), self.point,
+                      idx, w, np.ascontiguousarray(values[nm["nodes"]], dtype=np.float64),
+                      self.xyz_nav, self.rpy_nav, self.band,
+                      np.asarray(values[nm["c"]], dtype=np.float64),
+                      np.asarray(values[nm["distortion"]], dtype=np.float64), beta, dbeta,
+                      np.asarray(values[nm["lever_arm"]], dtype=np.float64), self.x0_mm,
+                      self.y0_mm, 1.0 / self.pixel_mm, self.xy_px, bool(jacobian), r, dP, dN,
+                      dB, dL, dD, dC)
+        if not jacobian:
+            return r, None
+        rep = np.repeat
+        jac = {
+            nm["points"]: Indexed(self._pidx2, dP),
+            nm["nodes"]: Indexed(self._idx2, dN),
+            nm["boresight"]: dB,
+            nm["lever_arm"]: dL,
+            nm["distortion"]: dD,
+            nm["c"]: Indexed(rep(self.band, 2), dC),
         }
         return r, jac
