@@ -158,3 +158,140 @@ def build_problem(obs: dict, n_points: int, cam: CameraPrior, *, node_interval_s
                          obs["rpy_nav_rad"], nodes, cam.pixel_mm, cam.sigma_obs_px,
                          cam.x0_mm, cam.y0_mm)
     return p, [blk], nodes
+
+
+# ----------------------------------------------------------------------------------------------
+# Files: ``hsgeo adjust-pushbroom``
+# ----------------------------------------------------------------------------------------------
+#: Required columns of the input tables (CSV or Parquet).
+OBS_COLUMNS = ("point_id", "band", "t_s", "x_px", "y_px")
+NAV_COLUMNS = ("t_s", "E_m", "N_m", "H_m", "roll_rad", "pitch_rad", "yaw_rad")
+GCP_COLUMNS = ("point_id", "E_m", "N_m", "H_m")
+
+
+def read_table(path, columns, what: str):
+    """A CSV or Parquet table with the required ``columns`` (extra columns are ignored)."""
+    import pandas as pd
+    from pathlib import Path
+
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"{what} file {str(path)!r} does not exist")
+    try:
+        if path.suffix.lower() in (".parquet", ".pq"):
+            df = pd.read_parquet(path)
+        else:
+            df = pd.read_csv(path)
+    except Exception as exc:  # noqa: BLE001 - any parser error becomes an InputError
+        raise InputError(f"{what} file {str(path)!r} cannot be read: {exc}") from exc
+    missing = [c for c in columns if c not in df.columns]
+    if missing:
+        raise InputError(
+            f"{what} file {str(path)!r} lacks the column(s) {missing}; required: "
+            f"{list(columns)} (see `hsgeo adjust-pushbroom --help`)"
+        )
+    if df[list(columns)].isna().any().any():
+        raise InputError(f"{what} file {str(path)!r} has empty or NaN values in {list(columns)}")
+    return df
+
+
+def read_camera(path) -> CameraPrior:
+    """Camera and GNSS/INS priors from a TOML file (see :func:`adjust_files`)."""
+    import tomllib
+    from pathlib import Path
+
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"camera file {str(path)!r} does not exist")
+    try:
+        cfg = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"camera file {str(path)!r}: malformed TOML: {exc}") from exc
+    cam = cfg.get("camera", {})
+    nav = cfg.get("gnss_ins", {})
+    if "n_bands" not in cam or "pixel_mm" not in cam or "c_mm" not in cam:
+        raise InputError(
+            f"camera file {str(path)!r} needs a [camera] table with n_bands, pixel_mm and c_mm"
+        )
+    return CameraPrior(
+        n_bands=int(cam["n_bands"]), pixel_mm=float(cam["pixel_mm"]), c_mm=float(cam["c_mm"]),
+        x0_mm=float(cam.get("x0_mm", 0.0)), y0_mm=float(cam.get("y0_mm", 0.0)),
+        lever_arm_m=tuple(cam.get("lever_arm_m", (0.0, 0.0, 0.0))),
+        sigma_lever_m=float(cam.get("sigma_lever_m", 0.02)),
+        sigma_pos_m=tuple(nav.get("sigma_pos_m", (0.013, 0.013, 0.020))),
+        sigma_att_rad=tuple(np.deg2rad(nav.get("sigma_att_deg", (0.005, 0.005, 0.008)))),
+        sigma_obs_px=float(cfg.get("observations", {}).get("sigma_px", 0.5)),
+        sigma_gcp_m=float(cfg.get("gcp", {}).get("sigma_m", 0.01)),
+    )
+
+
+def adjust_files(observations, trajectory, camera, gcp=None, *, node_interval_s: float = 10.0,
+                 reject_k: float | None = 5.0, progress=None) -> dict:
+    """Adjust a user's pushbroom observations (``hsgeo adjust-pushbroom``).
+
+    Parameters
+    ----------
+    observations : path
+        CSV or Parquet with ``point_id, band, t_s, x_px, y_px``: tie point, band index
+        (0-based), exposure time of the line (s, the navigation's time scale), image
+        coordinates in pixels from the line centre (x along the line, y across it; 0 = the line).
+    trajectory : path
+        CSV or Parquet with ``t_s, E_m, N_m, H_m, roll_rad, pitch_rad, yaw_rad``: the GNSS/INS
+        solution (map frame east-north-up, ``R_map_from_platform = R_from_rpy``), interpolated
+        linearly to the line times.
+    camera : path
+        TOML: ``[camera] n_bands, pixel_mm, c_mm, x0_mm, y0_mm, lever_arm_m, sigma_lever_m``,
+        ``[gnss_ins] sigma_pos_m = [E, N, H], sigma_att_deg = [roll, pitch, yaw]``,
+        ``[observations] sigma_px``, ``[gcp] sigma_m``.
+    gcp : path, optional
+        CSV or Parquet with ``point_id, E_m, N_m, H_m`` (points of the observation table).
+
+    Returns
+    -------
+    dict
+        Summary, the camera parameters with σ̂, the node corrections and the adjusted points.
+    """
+    from hsgeo.adjust import adjust
+    from hsgeo.trajectory import Trajectory
+
+    obs_df = read_table(observations, OBS_COLUMNS, "observation")
+    nav_df = read_table(trajectory, NAV_COLUMNS, "trajectory")
+    cam = read_camera(camera)
+    ids, point = np.unique(obs_df["point_id"].to_numpy(), return_inverse=True)
+    traj = Trajectory(nav_df["t_s"].to_numpy(), nav_df[["E_m", "N_m", "H_m"]].to_numpy(),
+                      nav_df[["roll_rad", "pitch_rad", "yaw_rad"]].to_numpy())
+    t = obs_df["t_s"].to_numpy(dtype=float)
+    xyz, rpy = traj.pose(t)
+    obs = {"point": point.astype(np.int64), "band": obs_df["band"].to_numpy().astype(np.int64),
+           "t_s": t, "xy_px": obs_df[["x_px", "y_px"]].to_numpy(dtype=float),
+           "xyz_nav_m": xyz, "rpy_nav_rad": rpy}
+    gi = gx = None
+    if gcp is not None:
+        g = read_table(gcp, GCP_COLUMNS, "GCP")
+        pos = {v: i for i, v in enumerate(ids)}
+        unknown = [v for v in g["point_id"] if v not in pos]
+        if unknown:
+            raise InputError(f"GCP point_id(s) {unknown[:5]} are not in the observation table")
+        gi = np.array([pos[v] for v in g["point_id"]])
+        gx = g[["E_m", "N_m", "H_m"]].to_numpy(dtype=float)
+    p, blocks, nodes = build_problem(obs, ids.size, cam, node_interval_s=node_interval_s,
+                                     gcp_index=gi, gcp_xyz_m=gx)
+    res = adjust(p, blocks, reject_k=reject_k, ftol=1e-8, progress=progress)
+    out = {
+        "converged": res.converged, "iterations": res.iterations, "sigma0": res.sigma0,
+        "n_observations_2d": int(len(obs_df)), "n_points": int(ids.size),
+        "n_unknowns": int(res.n_unknowns), "rejected": int(res.outliers(0).sum()),
+        "solver_seconds": res.seconds, "node_interval_s": node_interval_s,
+        "parameters": {},
+    }
+    for name, f in [("boresight_rad", 180 / np.pi), ("lever_arm_m", 1.0), ("distortion", 1.0),
+                    ("c_mm", 1.0)]:
+        key = name.replace("_rad", "_deg")
+        out["parameters"][key] = {"value": (res.value(name) * f).tolist(),
+                                  "sigma": (res.sigma(name) * f).tolist()}
+    out["nodes"] = {"t_s": nodes.t_nodes_s.tolist(), "value": res.value("nodes").tolist(),
+                    "sigma": res.sigma("nodes").tolist(),
+                    "columns": list(res.params["nodes"].columns)}
+    out["points"] = {"point_id": ids.tolist(), "xyz_m": res.value("points_m").tolist()}
+    out["_result"] = res
+    return out
