@@ -30,8 +30,8 @@ HERE = Path(__file__).resolve().parent
 
 
 def _problem(scale, seed, with_gcp=True):
-    from hsgeo.reproduce.pushbroom_ba import camera_prior
     from hsgeo.pushbroom_ba import build_problem
+    from hsgeo.reproduce.pushbroom_ba import camera_prior
     from hsgeo.simulate.pushbroom_campaign import simulate
 
     camp = simulate(scale, rng=seed)

@@ -24,8 +24,8 @@ def test_spline_reproduces_linear_and_is_local():
     t = np.linspace(0, 95, 500)
     # a cubic B-spline reproduces linear functions when the nodes sample them at node times
     nodes = np.column_stack([2.0 + 0.5 * sn.t_nodes_s, np.full(sn.n_nodes, -1.0)])
-    np.testing.assert_allclose(sn.evaluate(nodes, t), np.column_stack([2 + 0.5 * t, -np.ones_like(t)]),
-                               atol=1e-12)
+    expect = np.column_stack([2 + 0.5 * t, -np.ones_like(t)])
+    np.testing.assert_allclose(sn.evaluate(nodes, t), expect, atol=1e-12)
     idx, w = sn.basis(t)
     assert idx.shape == (500, 4) and np.all(idx[:, 3] - idx[:, 0] == 3)
     assert idx.min() == 0 and idx.max() == sn.n_nodes - 1

@@ -171,8 +171,9 @@ GCP_COLUMNS = ("point_id", "E_m", "N_m", "H_m")
 
 def read_table(path, columns, what: str):
     """A CSV or Parquet table with the required ``columns`` (extra columns are ignored)."""
-    import pandas as pd
     from pathlib import Path
+
+    import pandas as pd
 
     path = Path(path)
     if not path.is_file():

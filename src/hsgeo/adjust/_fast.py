@@ -86,7 +86,8 @@ def _normal_cc_kernel(cols, vals, row_order, n_c, n_chunks):  # pragma: no cover
 
 
 @njit(cache=True, parallel=True, fastmath=True)
-def _reduced_kernel(cols, vals, jp, order, ptr, pt_order, Vinv, n_c, cap, n_chunks):  # pragma: no cover
+def _reduced_kernel(cols, vals, jp, order, ptr, pt_order, Vinv, n_c, cap,
+                    n_chunks):  # pragma: no cover - compiled
     """Σ_i (J_c,iᵀ J_c,i − W_i V_i⁻¹ W_iᵀ) over the points (upper triangle).
 
     Rows of point i are ``order[ptr[i]:ptr[i+1]]``; points are visited in ``pt_order``. Per

@@ -1,4 +1,6 @@
-"""Linear pushbroom (LP) lines as pinhole exposures with spline trajectory corrections (002 eq. 2–4).
+"""Linear pushbroom (LP) lines as pinhole exposures with spline trajectory corrections.
+
+002 eq. 2–4.
 
 Every LP image line is a pinhole exposure at its time ``t_e``. An observation is a tie point
 ``k`` seen in one line of one spectral band at image coordinates ``(x, y)`` in pixels from the
@@ -188,7 +190,8 @@ def _lines_kernel(P, pidx, idx, w, nodes, xyz_nav, rpy_nav, band, c_b, dist, bet
             Jp[1, 2] = (-yb * iz - gy * xb * iz) * k_px
             for u in range(2):
                 for a in range(3):
-                    JpB[u, a] = Jp[u, 0] * beta[0, a] + Jp[u, 1] * beta[1, a] + Jp[u, 2] * beta[2, a]
+                    JpB[u, a] = (Jp[u, 0] * beta[0, a] + Jp[u, 1] * beta[1, a]
+                                 + Jp[u, 2] * beta[2, a])
             for u in range(2):
                 row = 2 * j + u
                 for a in range(3):
