@@ -10,7 +10,7 @@ from hsgeo.simulate.pushbroom_campaign import simulate
 from hsgeo.stats import nmad
 
 
-def _problem(camp, with_gcp=True, node_interval_s=10.0):
+def _problem(camp, with_gcp=True, node_interval_s=10.0, y_as_time=False):
     cfg = camp.cfg
     cam = CameraPrior(n_bands=len(cfg.c_offsets_um), x0_mm=cfg.x0_mm,
                       lever_arm_m=tuple(camp.lever_arm_measured_m))
@@ -18,7 +18,7 @@ def _problem(camp, with_gcp=True, node_interval_s=10.0):
         camp.obs, camp.n_points, cam, node_interval_s=node_interval_s,
         t_span_s=(0.0, camp.nodes.t_end_s), node_prior_mean=camp.node_prior_mean,
         gcp_index=camp.gcp_index if with_gcp else None,
-        gcp_xyz_m=camp.gcp_xyz_m if with_gcp else None)
+        gcp_xyz_m=camp.gcp_xyz_m if with_gcp else None, y_as_time=y_as_time)
 
 
 @pytest.fixture(scope="module")
@@ -36,16 +36,18 @@ def test_model_is_exact_at_truth_noise_free():
 @pytest.mark.parametrize("name,step", [
     ("points_m", 1e-3), ("boresight_rad", 1e-7), ("lever_arm_m", 1e-4),
     ("distortion", [1e-7, 1e-9, 1e-7, 1e-7]), ("c_mm", 1e-5)])
-def test_jacobians_against_finite_differences(tiny, name, step):
-    _, blocks, _ = _problem(tiny)
+@pytest.mark.parametrize("y_as_time", [False, True])
+def test_jacobians_against_finite_differences(tiny, name, step, y_as_time):
+    _, blocks, _ = _problem(tiny, y_as_time=y_as_time)
     vals = dict(tiny.truth)
     vals["nodes"] = vals["nodes"] + 0.01  # away from zero corrections
     assert check_jacobian(blocks[0], vals, name, step) < 1e-6
 
 
-def test_node_jacobian_against_finite_differences(tiny):
+@pytest.mark.parametrize("y_as_time", [False, True])
+def test_node_jacobian_against_finite_differences(tiny, y_as_time):
     """Every correction of the nodes that the first observations touch."""
-    _, blocks, _ = _problem(tiny)
+    _, blocks, _ = _problem(tiny, y_as_time=y_as_time)
     b = blocks[0]
     vals = dict(tiny.truth)
     vals["nodes"] = vals["nodes"] + 0.01
@@ -64,7 +66,7 @@ def test_node_jacobian_against_finite_differences(tiny):
 
 def test_noise_free_recovers_truth():
     camp = simulate(0.001, rng=11, noise_free=True)
-    p, blocks, _ = _problem(camp)
+    p, blocks, _ = _problem(camp, y_as_time=True)
     assert identifiability(p, blocks).full_rank
     res = adjust(p, blocks, ftol=1e-15)
     for k, v in camp.truth.items():
@@ -74,7 +76,7 @@ def test_noise_free_recovers_truth():
 @pytest.mark.parametrize("seed", [0])
 def test_truth_within_3_sigma_small_scale(seed):
     camp = simulate(0.01, rng=seed)
-    p, blocks, _ = _problem(camp)
+    p, blocks, _ = _problem(camp, y_as_time=True)
     res = adjust(p, blocks, reject_k=5.0)
     for k in ["boresight_rad", "lever_arm_m", "distortion", "c_mm"]:
         z = (res.value(k) - camp.truth[k]) / res.sigma(k)
@@ -137,8 +139,9 @@ def test_point_covariance_subset_equals_all(tiny):
     np.testing.assert_allclose(sub, full, rtol=1e-12)
 
 
-def test_compiled_block_equals_numpy_block(tiny):
-    _, blocks, _ = _problem(tiny)
+@pytest.mark.parametrize("y_as_time", [False, True])
+def test_compiled_block_equals_numpy_block(tiny, y_as_time):
+    _, blocks, _ = _problem(tiny, y_as_time=y_as_time)
     b = blocks[0]
     vals = dict(tiny.truth)
     vals["nodes"] = vals["nodes"] + 0.01

@@ -33,7 +33,8 @@ def _cmd_adjust_pushbroom(args) -> int:
     from hsgeo.pushbroom_ba import adjust_files
 
     out = adjust_files(args.observations, args.trajectory, args.camera, args.gcp,
-                       node_interval_s=args.node_interval, progress=True)
+                       node_interval_s=args.node_interval, progress=True,
+                       y_as_time=not args.image_y)
     res = out.pop("_result")
     print(json.dumps(out, indent=1) if args.json else res.report(max_block_size=20))
     return 0
@@ -86,6 +87,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--gcp", help="ground control points table (optional)")
     p.add_argument("--node-interval", type=float, default=10.0,
                    help="spline node interval in s (default 10, 002 §4)")
+    p.add_argument("--image-y", action="store_true",
+                   help="residual across the line as the image y of 002 eq. 2 (default: as a "
+                   "time, which avoids a bias of the principal distance)")
     p.add_argument("--json", action="store_true", help="JSON instead of the text report")
     p.set_defaults(func=_cmd_adjust_pushbroom)
 

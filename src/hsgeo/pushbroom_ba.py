@@ -104,7 +104,8 @@ def intersect_two_rays(point, origin, direction, n_points):
 
 
 def build_problem(obs: dict, n_points: int, cam: CameraPrior, *, node_interval_s: float = 10.0,
-                  gcp_index=None, gcp_xyz_m=None, t_span_s=None, node_prior_mean=None):
+                  gcp_index=None, gcp_xyz_m=None, t_span_s=None, node_prior_mean=None,
+                  y_as_time: bool = False):
     """Parameters and residual blocks of the LP bundle adjustment.
 
     Parameters
@@ -123,6 +124,12 @@ def build_problem(obs: dict, n_points: int, cam: CameraPrior, *, node_interval_s
         Time span of the nodes (default: the observations' span).
     node_prior_mean : (n_nodes, 6) ndarray, optional
         Prior mean of the node corrections (default zero: the GNSS/INS solution as it is).
+    y_as_time : bool
+        Residual across the line as a *time* (the line a point is registered in) rather than
+        the image y of 002 eq. (2): the y residual is multiplied by ``c_ref p_z / (c Z_ref)``
+        (``c_ref`` the initial principal distance, ``Z_ref`` the median initial depth), which
+        keeps its zero and its size but removes its dependence on c and on the depth. See the
+        chapter for the bias this avoids.
 
     Returns
     -------
@@ -154,9 +161,13 @@ def build_problem(obs: dict, n_points: int, cam: CameraPrior, *, node_interval_s
         gi = np.asarray(gcp_index)
         p.set(names["points"], np.asarray(gcp_xyz_m, float), index=gi)
         p.set_prior(names["points"], cam.sigma_gcp_m, index=gi, mean=np.asarray(gcp_xyz_m, float))
+    y_time_k = 0.0
+    if y_as_time:
+        z_ref = float(np.median(obs["xyz_nav_m"][:, 2] - P0[obs["point"], 2]))
+        y_time_k = cam.c_mm / z_ref
     blk = PushbroomLines(obs["point"], obs["band"], t, obs["xy_px"], obs["xyz_nav_m"],
                          obs["rpy_nav_rad"], nodes, cam.pixel_mm, cam.sigma_obs_px,
-                         cam.x0_mm, cam.y0_mm)
+                         cam.x0_mm, cam.y0_mm, y_time_k=y_time_k)
     return p, [blk], nodes
 
 
@@ -227,7 +238,7 @@ def read_camera(path) -> CameraPrior:
 
 
 def adjust_files(observations, trajectory, camera, gcp=None, *, node_interval_s: float = 10.0,
-                 reject_k: float | None = 5.0, progress=None) -> dict:
+                 reject_k: float | None = 5.0, progress=None, y_as_time: bool = True) -> dict:
     """Adjust a user's pushbroom observations (``hsgeo adjust-pushbroom``).
 
     Parameters
@@ -276,7 +287,7 @@ def adjust_files(observations, trajectory, camera, gcp=None, *, node_interval_s:
         gi = np.array([pos[v] for v in g["point_id"]])
         gx = g[["E_m", "N_m", "H_m"]].to_numpy(dtype=float)
     p, blocks, nodes = build_problem(obs, ids.size, cam, node_interval_s=node_interval_s,
-                                     gcp_index=gi, gcp_xyz_m=gx)
+                                     gcp_index=gi, gcp_xyz_m=gx, y_as_time=y_as_time)
     res = adjust(p, blocks, reject_k=reject_k, ftol=1e-8, progress=progress)
     out = {
         "converged": res.converged, "iterations": res.iterations, "sigma0": res.sigma0,

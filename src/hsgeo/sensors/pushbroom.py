@@ -140,7 +140,8 @@ def _rot_rpy(ro, pi, ya, R, dR):  # pragma: no cover - compiled
 
 @njit(cache=True, parallel=True)
 def _lines_kernel(P, pidx, idx, w, nodes, xyz_nav, rpy_nav, band, c_b, dist, beta, dbeta,
-                  lever, x0, y0, k_px, xy_obs, jac, r, dP, dN, dB, dL, dD, dC):  # pragma: no cover
+                  lever, x0, y0, k_px, xy_obs, jac, r, dP, dN, dB, dL, dD, dC,
+                  y_time_k):  # pragma: no cover
     """002 eq. (2)–(4) and their derivatives, one observation per iteration (rows 2j, 2j+1)."""
     m = pidx.size
     K1, K2, P1, P2 = dist[0], dist[1], dist[2], dist[3]
@@ -176,7 +177,9 @@ def _lines_kernel(P, pidx, idx, w, nodes, xyz_nav, rpy_nav, band, c_b, dist, bet
             x = xb + K1 * xb**3 + K2 * xb**5 + 3 * P1 * xb**2 + x0  # 002 eq. (3)
             y = yb + P2 * xb**2 + y0
             r[2 * j] = x * k_px - xy_obs[j, 0]
-            r[2 * j + 1] = y * k_px - xy_obs[j, 1]
+            ry = y * k_px - xy_obs[j, 1]
+            kap = y_time_k * p[2] / c if y_time_k > 0 else 1.0
+            r[2 * j + 1] = kap * ry
             if not jac:
                 continue
             gx = 1.0 + 3 * K1 * xb**2 + 5 * K2 * xb**4 + 6 * P1 * xb
@@ -225,6 +228,28 @@ def _lines_kernel(P, pidx, idx, w, nodes, xyz_nav, rpy_nav, band, c_b, dist, bet
             dD[2 * j + 1, 1] = 0.0
             dD[2 * j + 1, 2] = 0.0
             dD[2 * j + 1, 3] = xb**2 * k_px
+            if y_time_k > 0:
+                # y as a time: r_y·κ with κ = c_ref p_z / (c Z_ref); d(κ r) = κ dr + r dκ
+                row = 2 * j + 1
+                f = ry * kap / p[2]
+                for a in range(3):
+                    v2 = beta[2, 0] * R[a, 0] + beta[2, 1] * R[a, 1] + beta[2, 2] * R[a, 2]
+                    dP[row, a] = kap * dP[row, a] + f * v2
+                    for b in range(4):
+                        dN[row, b, a] = kap * dN[row, b, a] - f * v2 * w[j, b]
+                    dL[row, a] = kap * dL[row, a] - f * beta[2, a]
+                for kk in range(3):
+                    v2 = 0.0
+                    for i in range(3):
+                        v2 += beta[2, i] * (dR[kk, 0, i] * d[0] + dR[kk, 1, i] * d[1]
+                                            + dR[kk, 2, i] * d[2])
+                    for b in range(4):
+                        dN[row, b, 3 + kk] = kap * dN[row, b, 3 + kk] + f * v2 * w[j, b]
+                    vb = dbeta[kk, 2, 0] * q[0] + dbeta[kk, 2, 1] * q[1] + dbeta[kk, 2, 2] * q[2]
+                    dB[row, kk] = kap * dB[row, kk] + f * vb
+                dC[row, 0] = kap * dC[row, 0] - ry * kap / c
+                for a in range(4):
+                    dD[row, a] *= kap
 
 
 class PushbroomLines(ResidualBlock):
@@ -263,7 +288,7 @@ class PushbroomLines(ResidualBlock):
     def __init__(self, point, band, t_s, xy_px, xyz_nav_m, rpy_nav_rad, nodes: SplineNodes,
                  pixel_mm: float, sigma_px: float = 0.5, x0_mm: float = 0.0,
                  y0_mm: float = 0.0, names: dict | None = None,
-                 beta0=BETA0_CAM_FROM_PLATFORM):
+                 beta0=BETA0_CAM_FROM_PLATFORM, y_time_k: float = 0.0):
         point = np.asarray(point)
         m = point.size
         xy = np.asarray(xy_px, dtype=np.float64)
@@ -294,6 +319,9 @@ class PushbroomLines(ResidualBlock):
         self.names = dict(BLOCK_NAMES if names is None else names)
         self.beta0 = np.asarray(beta0, dtype=np.float64)
         self._basis = nodes.basis(self.t_s)
+        if not (np.isfinite(y_time_k) and y_time_k >= 0):
+            raise InputError(f"y_time_k must be ≥ 0 (0: the image y of 002 eq. 2), got {y_time_k}")
+        self.y_time_k = float(y_time_k)
         self._pidx2 = np.repeat(self.point, 2)
         self._idx2 = np.repeat(self._basis[0], 2, axis=0)
         for a in ("xyz_nav", "rpy_nav", "xy_px"):
@@ -322,7 +350,9 @@ class PushbroomLines(ResidualBlock):
         m = self.point.size
         r = np.empty(2 * m)
         r[0::2] = x * k - self.xy_px[:, 0]
-        r[1::2] = y * k - self.xy_px[:, 1]
+        ry = y * k - self.xy_px[:, 1]
+        kap = self.y_time_k * p[:, 2] / c if self.y_time_k > 0 else np.ones(m)
+        r[1::2] = kap * ry
         if not jacobian:
             return r, None
         # d(x, y)/d p^c  (2 × 3 per observation), in px
@@ -357,6 +387,21 @@ class PushbroomLines(ResidualBlock):
         dDist[:, 0, 1] = xb**5 * k
         dDist[:, 0, 2] = 3 * xb**2 * k
         dDist[:, 1, 3] = xb**2 * k
+        if self.y_time_k > 0:
+            # y as a time: d(κ r_y) = κ dr_y + r_y dκ, κ = c_ref p_z / (c Z_ref)
+            f = ry * kap / p[:, 2]
+            bR = np.einsum("i,mai->ma", beta[2], R)  # d p_z / d P
+            dP[:, 1] = kap[:, None] * dP[:, 1] + f[:, None] * bR
+            d6[:, 1, :3] = kap[:, None] * d6[:, 1, :3] - f[:, None] * bR
+            d6[:, 1, 3:] = kap[:, None] * d6[:, 1, 3:] + f[:, None] * np.einsum(
+                "i,mik->mk", beta[2], dq_drpy)
+            dnodes = w[:, None, :, None] * d6[:, :, None, :]
+            dLever = dLever.copy()
+            dLever[:, 1] = kap[:, None] * dLever[:, 1] - f[:, None] * beta[2]
+            dBore[:, 1] = kap[:, None] * dBore[:, 1] + f[:, None] * np.einsum(
+                "kj,mj->mk", dbeta[:, 2, :], q)
+            dC[:, 1] = kap * dC[:, 1] - ry * kap / c
+            dDist[:, 1] *= kap[:, None]
         rep = np.repeat
         jac = {
             nm["points"]: Indexed(rep(self.point, 2), dP.reshape(2 * m, 3)),
@@ -390,7 +435,7 @@ class PushbroomLines(ResidualBlock):
                       np.asarray(values[nm["distortion"]], dtype=np.float64), beta, dbeta,
                       np.asarray(values[nm["lever_arm"]], dtype=np.float64), self.x0_mm,
                       self.y0_mm, 1.0 / self.pixel_mm, self.xy_px, bool(jacobian), r, dP, dN,
-                      dB, dL, dD, dC)
+                      dB, dL, dD, dC, self.y_time_k)
         if not jacobian:
             return r, None
         rep = np.repeat
