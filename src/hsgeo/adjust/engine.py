@@ -38,7 +38,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 from hsgeo.adjust.parameters import Parameters
-from hsgeo.adjust.residuals import Indexed, ResidualBlock, to_coo
+from hsgeo.adjust.residuals import Indexed, ResidualBlock
 from hsgeo.errors import ConvergenceError, DatumError, InputError, ObservationError
 
 __all__ = ["adjust", "identifiability", "Identifiability"]
@@ -93,12 +93,53 @@ class _Layout:
             b.value = v.copy()
 
 
+class _RowJac:
+    """A row-compressed sparse matrix: row ``i`` has entries ``vals[i, s]`` at ``cols[i, s]``.
+
+    ``cols = -1`` marks an empty slot. See :mod:`hsgeo.adjust._fast`.
+    """
+
+    def __init__(self, cols: np.ndarray, vals: np.ndarray, n_cols: int):
+        self.cols, self.vals, self.n_cols = cols, vals, n_cols
+
+    @property
+    def shape(self):
+        return (self.cols.shape[0], self.n_cols)
+
+    def _safe_cols(self):
+        # index n_cols (an appended zero) for the empty slots
+        return np.where(self.cols >= 0, self.cols, self.n_cols)
+
+    def matvec(self, x: np.ndarray) -> np.ndarray:
+        from hsgeo.adjust._fast import matvec
+
+        return matvec(self.cols, self.vals, np.ascontiguousarray(x, dtype=np.float64))
+
+    def rmatvec(self, y: np.ndarray, diag: bool = False):
+        """``Jᵀ y`` (and ``diag(JᵀJ)`` with ``diag=True``)."""
+        from hsgeo.adjust._fast import rmatvec_diag
+
+        g, d = rmatvec_diag(self.cols, self.vals, np.ascontiguousarray(y, dtype=np.float64),
+                            self.n_cols, diag)
+        return (g, d) if diag else g
+
+    def tocsr(self) -> sp.csr_matrix:
+        keep = self.cols >= 0
+        rows = np.broadcast_to(np.arange(self.cols.shape[0])[:, None], self.cols.shape)
+        return sp.csr_matrix((self.vals[keep], (rows[keep], self.cols[keep])), shape=self.shape)
+
+
+#: Use the compiled row-compressed path (True) or the generic scipy.sparse path (False).
+#: Both compute the same normal equations; the tests compare them.
+FAST = True
+
+
 @dataclass
 class _System:
     """The whitened, linearised problem at one point x."""
 
     r: np.ndarray  # (M,) whitened residuals, observation rows then prior rows
-    Jc: sp.csr_matrix | None  # (M, n_c)
+    Jrc: _RowJac | None  # (M, n_c) row-compressed
     pidx: np.ndarray | None  # (M,) point touched by each row (-1: none)
     Jp: np.ndarray | None  # (M, p)
     n_obs_rows: int  # rows that are observations (the rest are priors)
@@ -107,10 +148,105 @@ class _System:
     def cost(self) -> float:
         return 0.5 * float(self.r @ self.r)
 
+    @property
+    def Jc(self) -> sp.csr_matrix:
+        """The Jacobian of the non-point unknowns as scipy.sparse (generic path)."""
+        return self.Jrc.tocsr()
+
+
+class _Slots:
+    """One block Jacobian's share of the row-compressed matrix, written on request.
+
+    Writing straight into the final ``(M, K)`` arrays avoids intermediate copies of what can be
+    tens of millions of entries (GUIDE §9).
+    """
+
+    def __init__(self, J, m: int, size: int, name: str, colmap: np.ndarray, rows, w):
+        self.colmap, self.rows, self.w = colmap, rows, w  # rows: kept rows, or None for all
+        if isinstance(J, Indexed):
+            m_j, q, k = J.d.shape
+            if m_j != m:
+                raise InputError(f"Jacobian w.r.t. {name!r} has {m_j} rows, residuals have {m}")
+            if size % k:
+                raise InputError(
+                    f"Jacobian w.r.t. {name!r}: item width {k} does not divide {size}")
+            if J.index.size and int(J.index.max()) >= size // k:
+                raise InputError(f"Jacobian w.r.t. {name!r} indexes past the block's items")
+            self.kind, self.J, self.width, self.qk = "indexed", J, q * k, (q, k)
+        elif sp.issparse(J):
+            c = J.tocsr()
+            if c.shape != (m, size):
+                raise InputError(
+                    f"Jacobian w.r.t. {name!r} has shape {c.shape}, expected {(m, size)}")
+            nnz = np.diff(c.indptr)
+            K = int(nnz.max()) if m else 0
+            slot = np.arange(c.indices.size) - np.repeat(c.indptr[:-1], nnz)
+            rr = np.repeat(np.arange(m), nnz)
+            cols = np.full((m, K), -1, dtype=np.int64)
+            vals = np.zeros((m, K))
+            cols[rr, slot] = colmap[c.indices]
+            vals[rr, slot] = c.data
+            self.kind, self.J, self.width = "dense_slots", (cols, vals), K
+        else:
+            arr = np.asarray(J, dtype=np.float64)
+            if arr.shape != (m, size):
+                raise InputError(
+                    f"Jacobian w.r.t. {name!r} has shape {arr.shape}, expected {(m, size)}")
+            self.kind, self.J, self.width = "dense", arr, size
+
+    def _take(self, a):
+        return a if self.rows is None else a[self.rows]
+
+    def fill(self, cols_dst: np.ndarray, vals_dst: np.ndarray) -> None:
+        n = cols_dst.shape[0]
+        wr = self._take(self.w)
+        cm = self.colmap
+        if self.kind == "indexed":
+            q, k = self.qk
+            idx = self._take(self.J.index)
+            cd = cols_dst.reshape(n, q, k)
+            vd = vals_dst.reshape(n, q, k)
+            if not (np.shares_memory(cd, cols_dst) and np.shares_memory(vd, vals_dst)):
+                raise AssertionError("slot views must not copy")  # pragma: no cover
+            contiguous = cm.size and cm[0] >= 0 and np.all(np.diff(cm) == 1)
+            if contiguous:
+                np.add((idx * k)[:, :, None], int(cm[0]) + np.arange(k), out=cd,
+                       casting="unsafe")
+                bad = idx < 0
+                if bad.any():
+                    cd[bad] = -1
+            else:
+                lc = np.where(idx >= 0, idx, 0)[:, :, None] * k + np.arange(k)
+                cd[:] = np.where((idx >= 0)[:, :, None], cm[lc], -1)
+            np.multiply(self._take(self.J.d), wr[:, None, None], out=vd)
+            if not contiguous or (idx < 0).any():
+                vals_dst[cols_dst < 0] = 0.0
+        elif self.kind == "dense":
+            cols_dst[:] = cm
+            np.multiply(self._take(self.J), wr[:, None], out=vals_dst)
+            if (cm < 0).any():
+                vals_dst[:, cm < 0] = 0.0
+        else:
+            cols, vals = self.J
+            cols_dst[:] = self._take(cols)
+            np.multiply(self._take(vals), wr[:, None], out=vals_dst)
+            vals_dst[cols_dst < 0] = 0.0
+
+
+class _PriorSlots:
+    width = 1
+
+    def __init__(self, cols, vals):
+        self.cols, self.vals = cols, vals
+
+    def fill(self, cols_dst, vals_dst):
+        cols_dst[:, 0] = self.cols
+        vals_dst[:, 0] = self.vals
+
 
 def _evaluate(layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian: bool) -> _System:
     values = layout.params.values()
-    r_parts, rows_c, cols_c, vals_c, pidx_parts, jp_parts = [], [], [], [], [], []
+    r_parts, slot_parts, pidx_parts, jp_parts = [], [], [], []
     offset = 0
     pname = layout.pblock.name if layout.pblock is not None else None
     for blk, keep in zip(blocks, masks, strict=True):
@@ -129,12 +265,14 @@ def _evaluate(layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian:
             )
         w = 1.0 / blk.sigma
         rows_kept = np.flatnonzero(keep)
+        all_kept = rows_kept.size == blk.m
         newrow = np.full(blk.m, -1, dtype=np.int64)
         newrow[rows_kept] = np.arange(offset, offset + rows_kept.size)
         r_parts.append(r[rows_kept] * w[rows_kept])
         if jacobian:
             pidx = np.full(rows_kept.size, -1, dtype=np.int64)
             jp = np.zeros((rows_kept.size, layout.p))
+            blk_slots = []
             for name, J in jac.items():
                 b = layout.params[name]
                 if name == pname:
@@ -147,13 +285,9 @@ def _evaluate(layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian:
                     jp = J.d[rows_kept, 0, :] * w[rows_kept, None]
                     jp = np.where(pidx[:, None] >= 0, jp * layout.pfree[np.maximum(pidx, 0)], 0.0)
                     continue
-                rr, cc, vv = to_coo(J, blk.m, b.size, name)
-                gc = layout.colmap[name][cc]
-                nr = newrow[rr]
-                sel = (gc >= 0) & (nr >= 0)
-                rows_c.append(nr[sel])
-                cols_c.append(gc[sel])
-                vals_c.append(vv[sel] * w[rr[sel]])
+                blk_slots.append(_Slots(J, blk.m, b.size, name, layout.colmap[name],
+                                        None if all_kept else rows_kept, w))
+            slot_parts.append(blk_slots)
             pidx_parts.append(pidx)
             jp_parts.append(jp)
         offset += rows_kept.size
@@ -168,17 +302,15 @@ def _evaluate(layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian:
         s = b.prior_sigma.ravel()[idx]
         r_parts.append((b.value.ravel()[idx] - b.prior_mean.ravel()[idx]) / s)
         if jacobian:
-            nr = np.arange(offset, offset + idx.size)
             if b.points:
                 pt, comp = np.divmod(idx, layout.p)
                 jp = np.zeros((idx.size, layout.p))
                 jp[np.arange(idx.size), comp] = 1.0 / s
+                slot_parts.append([])
                 pidx_parts.append(pt)
                 jp_parts.append(jp)
             else:
-                rows_c.append(nr)
-                cols_c.append(layout.colmap[b.name][idx])
-                vals_c.append(1.0 / s)
+                slot_parts.append([_PriorSlots(layout.colmap[b.name][idx], 1.0 / s)])
                 pidx_parts.append(np.full(idx.size, -1, dtype=np.int64))
                 jp_parts.append(np.zeros((idx.size, layout.p)))
         offset += idx.size
@@ -187,16 +319,25 @@ def _evaluate(layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian:
     if not jacobian:
         return _System(r_all, None, None, None, n_obs_rows)
     M = offset
-    if rows_c:
-        Jc = sp.csr_matrix(
-            (np.concatenate(vals_c), (np.concatenate(rows_c), np.concatenate(cols_c))),
-            shape=(M, layout.n_c),
-        )
-    else:
-        Jc = sp.csr_matrix((M, layout.n_c))
+    # one (M, K) row-compressed matrix: each part's slots side by side, padded to the widest
+    K = max([sum(sl.width for sl in part) for part in slot_parts] + [1])
+    cols_all = np.empty((M, K), dtype=np.int32 if layout.n_c < 2**31 else np.int64)
+    vals_all = np.empty((M, K))
+    row0 = 0
+    for part, pi in zip(slot_parts, pidx_parts, strict=True):
+        n = pi.size
+        k0 = 0
+        for sl in part:
+            sl.fill(cols_all[row0 : row0 + n, k0 : k0 + sl.width],
+                    vals_all[row0 : row0 + n, k0 : k0 + sl.width])
+            k0 += sl.width
+        if k0 < K:  # padding
+            cols_all[row0 : row0 + n, k0:] = -1
+            vals_all[row0 : row0 + n, k0:] = 0.0
+        row0 += n
     pidx = np.concatenate(pidx_parts) if pidx_parts else np.full(M, -1)
     Jp = np.concatenate(jp_parts) if jp_parts else np.zeros((M, layout.p))
-    return _System(r_all, Jc, pidx, Jp, n_obs_rows)
+    return _System(r_all, _RowJac(cols_all, vals_all, layout.n_c), pidx, Jp, n_obs_rows)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -204,19 +345,95 @@ def _evaluate(layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian:
 # ----------------------------------------------------------------------------------------------
 @dataclass
 class _Normal:
-    Ncc: np.ndarray  # (n_c, n_c) dense
+    _Ncc: np.ndarray | None  # (n_c, n_c) dense (on the compiled path: built on request)
     gc: np.ndarray  # (n_c,)
     V: np.ndarray | None  # (n_pts, p, p)
     gp: np.ndarray | None  # (n_pts, p)
-    W: sp.csr_matrix | None  # (n_c, n_pts * p)
+    _W: sp.csr_matrix | None = None  # (n_c, n_pts * p), generic path (built on request)
+    sy: _System | None = None  # the rows, for the compiled path
+    order: np.ndarray | None = None  # rows sorted by point
+    ptr: np.ndarray | None = None  # rows of point i: order[ptr[i]:ptr[i + 1]]
+    n_pts: int = 0
+    pt_order: np.ndarray | None = None  # order in which the kernel visits the points
+    Ncc_free: np.ndarray | None = None  # J_cᵀ J_c of the rows without a point (compiled path)
+    diag_cc: np.ndarray | None = None  # diag(N_cc)
+
+    @property
+    def Ncc(self) -> np.ndarray:
+        """``J_cᵀ J_c`` (dense)."""
+        if self._Ncc is None:
+            from hsgeo.adjust._fast import normal_cc
+
+            self._Ncc = normal_cc(self.sy.Jrc.cols, self.sy.Jrc.vals, self.sy.Jrc.n_cols)
+        return self._Ncc
+
+    @property
+    def W(self) -> sp.csr_matrix | None:
+        """``J_cᵀ J_p`` as scipy.sparse (built on first use on the compiled path)."""
+        if self._W is None and self.V is not None:
+            self._W = _W_sparse(self.sy, self.n_pts)
+        return self._W
+
+    def Wt_dot(self, dc: np.ndarray) -> np.ndarray:
+        """``Wᵀ dc`` as ``(n_pts, p)``."""
+        if self._W is not None or self.sy is None:
+            return (self.W.T @ dc).reshape(self.n_pts, -1)
+        u = self.sy.Jrc.matvec(dc)
+        jp = self.sy.Jp
+        pi = self.sy.pidx
+        sel = pi >= 0
+        return np.stack(
+            [np.bincount(pi[sel], weights=(u * jp[:, k])[sel], minlength=self.n_pts)
+             for k in range(jp.shape[1])], axis=1)
+
+    def W_dot(self, y: np.ndarray) -> np.ndarray:
+        """``W y`` for ``y`` of shape ``(n_pts, p)``."""
+        if self._W is not None or self.sy is None:
+            return self.W @ y.ravel()
+        pi = self.sy.pidx
+        u = np.where(pi >= 0, np.einsum("ij,ij->i", self.sy.Jp, y[np.maximum(pi, 0)]), 0.0)
+        return self.sy.Jrc.rmatvec(u)
+
+
+def _W_sparse(sy: _System, n_pts: int) -> sp.csr_matrix:
+    p = sy.Jp.shape[1]
+    rows = np.flatnonzero(sy.pidx >= 0)
+    pi = sy.pidx[rows]
+    jp = sy.Jp[rows]
+    Jp_sp = sp.csr_matrix(
+        (jp.ravel(), (np.repeat(rows, p), (pi[:, None] * p + np.arange(p)).ravel())),
+        shape=(sy.r.size, n_pts * p),
+    )
+    return (sy.Jc.T @ Jp_sp).tocsr()
 
 
 def _normal(layout: _Layout, sy: _System) -> _Normal:
-    Jc = sy.Jc
-    Ncc = (Jc.T @ Jc).toarray() if layout.n_c else np.zeros((0, 0))
-    gc = Jc.T @ sy.r
+    order = ptr = pt_order = None
+    if FAST:
+        from hsgeo.adjust._fast import locality_orders, normal_cc
+
+        if layout.pblock is not None:
+            pi_all = sy.pidx
+            rows_p = np.flatnonzero(pi_all >= 0)
+            order = rows_p[np.argsort(pi_all[rows_p], kind="stable")].astype(np.int64)
+            ptr = np.concatenate(
+                [[0], np.cumsum(np.bincount(pi_all[rows_p], minlength=layout.n_pts))]
+            ).astype(np.int64)
+        row_order, pt_order = locality_orders(sy.Jrc.cols, layout.n_c, order, ptr)
+        Jrc = sy.Jrc
+        gc, diag_cc = Jrc.rmatvec(sy.r, diag=True)
+        if layout.pblock is None:
+            Ncc = normal_cc(Jrc.cols, Jrc.vals, layout.n_c, row_order)
+            return _Normal(Ncc, gc, None, None, diag_cc=diag_cc)
+        free_rows = row_order[sy.pidx[row_order] < 0]
+        Ncc_free = normal_cc(Jrc.cols, Jrc.vals, layout.n_c, free_rows)
+        Ncc = None
+    else:
+        Jc = sy.Jc
+        Ncc = (Jc.T @ Jc).toarray() if layout.n_c else np.zeros((0, 0))
+        gc = Jc.T @ sy.r
     if layout.pblock is None:
-        return _Normal(Ncc, gc, None, None, None)
+        return _Normal(Ncc, gc, None, None)
     n_pts, p = layout.n_pts, layout.p
     rows = np.flatnonzero(sy.pidx >= 0)
     pi = sy.pidx[rows]
@@ -231,12 +448,9 @@ def _normal(layout: _Layout, sy: _System) -> _Normal:
     ii = np.nonzero(fixed)
     V[ii[0], ii[1], ii[1]] = 1.0
     gp[fixed] = 0.0
-    Jp_sp = sp.csr_matrix(
-        (jp.ravel(), (np.repeat(rows, p), (pi[:, None] * p + np.arange(p)).ravel())),
-        shape=(sy.r.size, n_pts * p),
-    )
-    W = (Jc.T @ Jp_sp).tocsr()
-    return _Normal(Ncc, gc, V, gp, W)
+    if not FAST:
+        return _Normal(Ncc, gc, V, gp, _W_sparse(sy, n_pts), n_pts=n_pts)
+    return _Normal(Ncc, gc, V, gp, None, sy, order, ptr, n_pts, pt_order, Ncc_free, diag_cc)
 
 
 def _damped(A: np.ndarray, lam: float) -> np.ndarray:
@@ -251,6 +465,13 @@ def _damped(A: np.ndarray, lam: float) -> np.ndarray:
     return A
 
 
+def _inv_blocks(Vd: np.ndarray) -> np.ndarray:
+    try:
+        return np.linalg.inv(Vd)
+    except np.linalg.LinAlgError:
+        return np.linalg.pinv(Vd)
+
+
 def _block_diag(Vinv: np.ndarray) -> sp.csr_matrix:
     n, p, _ = Vinv.shape
     rows = np.repeat(np.arange(n * p), p)
@@ -260,15 +481,27 @@ def _block_diag(Vinv: np.ndarray) -> sp.csr_matrix:
 
 def _reduced(layout: _Layout, ne: _Normal, lam: float):
     """S, rhs and the pieces for back-substitution, at damping λ."""
-    S = _damped(ne.Ncc, lam)
     rhs = ne.gc.copy()
+    if ne.V is not None and ne.sy is not None and ne._W is None and ne._Ncc is None:
+        # compiled path: S = N_cc − Σ W_i V_i⁻¹ W_iᵀ accumulated point by point from the rows
+        # grouped by point; neither W nor the full N_cc is formed
+        from hsgeo.adjust._fast import reduced_points
+
+        Vinv = _inv_blocks(_damped(ne.V, lam))
+        sy = ne.sy
+        S = ne.Ncc_free + reduced_points(sy.Jrc.cols, sy.Jrc.vals, sy.Jp, ne.order, ne.ptr,
+                                         Vinv, layout.n_c, ne.pt_order)
+        if lam != 0.0 and layout.n_c:
+            d = ne.diag_cc
+            floor = 1e-12 * max(float(np.max(d)), 1e-300)
+            S[np.diag_indices_from(S)] += lam * np.maximum(d, floor)
+        if layout.n_c:
+            rhs = rhs - ne.W_dot(np.einsum("nij,nj->ni", Vinv, ne.gp))
+        return S, rhs, Vinv, None
+    S = _damped(ne.Ncc, lam)
     if ne.V is None:
         return S, rhs, None, None
-    Vd = _damped(ne.V, lam)
-    try:
-        Vinv = np.linalg.inv(Vd)
-    except np.linalg.LinAlgError:
-        Vinv = np.linalg.pinv(Vd)
+    Vinv = _inv_blocks(_damped(ne.V, lam))
     WVinv = (ne.W @ _block_diag(Vinv)).tocsr()
     if layout.n_c:
         S = S - (WVinv @ ne.W.T).toarray()
@@ -287,14 +520,17 @@ def _step(layout: _Layout, ne: _Normal, lam: float):
         dc = np.zeros(0)
     dp = None
     if Vinv is not None:
-        b = ne.gp + (ne.W.T @ dc).reshape(layout.n_pts, layout.p)
+        b = ne.gp + ne.Wt_dot(dc)
         dp = -np.einsum("nij,nj->ni", Vinv, b)
     return dc, dp
 
 
 def _predicted_decrease(layout, ne: _Normal, lam, dc, dp) -> float:
     """L(0) - L(h) = ½ hᵀ(λ D h - g) for the damped Gauss–Newton step h (Madsen et al. eq. 3.14)."""
-    Dc = np.maximum(np.diag(ne.Ncc), 0.0) if layout.n_c else np.zeros(0)
+    if not layout.n_c:
+        Dc = np.zeros(0)
+    else:
+        Dc = np.maximum(ne.diag_cc if ne.diag_cc is not None else np.diag(ne.Ncc), 0.0)
     pred = 0.5 * float(dc @ (lam * Dc * dc - ne.gc))
     if dp is not None:
         Dp = np.maximum(np.diagonal(ne.V, axis1=1, axis2=2), 0.0)

@@ -151,33 +151,52 @@ class AdjustmentResult:
         d = np.sqrt(np.diag(self.covariance))
         return self.covariance / np.outer(d, d)
 
-    def point_covariance(self, chunk: int = 20000) -> np.ndarray:
+    def point_covariance(self, chunk: int = 20000, index=None) -> np.ndarray:
         """σ0²·(V⁻¹ + V⁻¹ Wᵀ S⁻¹ W V⁻¹) for every point: ``(n_points, p, p)``.
 
-        Computed on first request, in chunks of points to bound the memory.
+        Computed on first request, in chunks of points to bound the memory. With ``index``
+        (point rows), only those points are computed: ``(len(index), p, p)``, not cached.
         """
-        if self._point_cov is not None:
+        if self._point_cov is not None and index is None:
             return self._point_cov
         lay, ne = self._layout, self._normal
         if lay.pblock is None:
             raise ValueError("this problem has no points block")
         p = lay.p
+        pts = np.arange(lay.n_pts) if index is None else np.atleast_1d(np.asarray(index))
         s2 = self.sigma0**2 if np.isfinite(self.sigma0) else 1.0
-        Vinv = np.linalg.inv(ne.V)
+        # a point left with too few rays after outlier rejection has a singular V: NaN for it
+        V = ne.V[pts]
+        ev = np.linalg.eigvalsh(V)
+        ok = ev[:, 0] > 1e-12 * np.maximum(ev[:, -1], 1e-300)
+        Vinv = np.full_like(V, np.nan)
+        Vinv[ok] = np.linalg.inv(V[ok])
+        Vinv_w = np.where(ok[:, None, None], Vinv, 0.0)
         out = Vinv.copy()
-        if lay.n_c:
+        if lay.n_c and ne.sy is not None and ne.order is not None:
+            # compiled path: each point's W_i from its rows, on its local columns
+            from hsgeo.adjust._fast import point_covariance as _pc
+
+            Vfull = np.zeros_like(ne.V)
+            Vfull[pts] = Vinv_w
+            sy = ne.sy
+            cov = _pc(sy.Jrc.cols, sy.Jrc.vals, sy.Jp, ne.order, ne.ptr, pts, Vfull, self._S_inv)
+            out = np.where(ok[:, None, None], cov, np.nan)
+        elif lay.n_c:
             Wd = ne.W.tocsc()
-            for a in range(0, lay.n_pts, chunk):
-                b = min(lay.n_pts, a + chunk)
-                Wi = Wd[:, a * p : b * p].toarray().T.reshape(b - a, p, lay.n_c)  # (k, p, n_c)
-                A = np.einsum("kij,kjc->kic", Vinv[a:b], Wi)  # V⁻¹ Wᵀ
-                out[a:b] += np.einsum("kic,cd,kjd->kij", A, self._S_inv, A)
+            for a0 in range(0, pts.size, chunk):
+                sel = pts[a0 : a0 + chunk]
+                colidx = (sel[:, None] * p + np.arange(p)).ravel()
+                Wi = Wd[:, colidx].toarray().T.reshape(sel.size, p, lay.n_c)  # (k, p, n_c)
+                A = np.einsum("kij,kjc->kic", Vinv_w[a0 : a0 + sel.size], Wi)  # V⁻¹ Wᵀ
+                out[a0 : a0 + sel.size] += np.einsum("kic,cd,kjd->kij", A, self._S_inv, A)
         out *= s2
-        fixed = ~lay.pfree
+        fixed = ~lay.pfree[pts]
         for j in range(p):
             out[fixed[:, j], j, :] = np.nan
             out[fixed[:, j], :, j] = np.nan
-        self._point_cov = out
+        if index is None:
+            self._point_cov = out
         return out
 
     # -- residuals ----------------------------------------------------------------------------

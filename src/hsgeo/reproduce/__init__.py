@@ -21,6 +21,7 @@ CHAPTERS: dict[str, str] = {
     "line-calibration": "line_calibration",
     "geocoding": "geocoding",
     "rikola": "rikola",
+    "pushbroom-ba": "pushbroom_ba",
 }
 
 

@@ -1,0 +1,184 @@
+"""``make bench``: time the pushbroom bundle adjustment (002) at full size, against scipy.
+
+Writes ``bench/results/pushbroom_ba.json`` (GUIDE §7: benchmarks are scripts, never timed
+assertions). Every case runs in its own subprocess so that its peak memory (max RSS) and its
+BLAS thread count are its own:
+
+* ``full``: the paper's size (113,758 tie points, ≈441,000 2-D observations), with outlier
+  rejection as in the chapter, once with ``OPENBLAS_NUM_THREADS=1`` and once with 2;
+* ``ours``/``scipy`` at the baseline scale (0.3): the same problem without outlier rejection,
+  adjusted by hsgeo's engine and by ``scipy.optimize.least_squares(method="trf",
+  tr_solver="lsmr", x_scale="jac")`` with the same analytic sparse Jacobian; the final costs
+  are compared.
+
+Usage: ``python bench/bench_pushbroom_ba.py [--scale 1.0] [--baseline-scale 0.3] [--seed 0]``
+(``make bench`` runs it with the defaults).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import resource
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+
+
+def _problem(scale, seed, with_gcp=True):
+    from hsgeo.pushbroom_ba import build_problem
+    from hsgeo.reproduce.pushbroom_ba import Y_AS_TIME, camera_prior
+    from hsgeo.simulate.pushbroom_campaign import simulate
+
+    camp = simulate(scale, rng=seed)
+    p, blocks, _ = build_problem(
+        camp.obs, camp.n_points, camera_prior(camp), t_span_s=(0.0, camp.nodes.t_end_s),
+        gcp_index=camp.gcp_index if with_gcp else None,
+        gcp_xyz_m=camp.gcp_xyz_m if with_gcp else None, y_as_time=Y_AS_TIME)
+    return camp, p, blocks
+
+
+def case_ours(scale, seed, reject):
+    from hsgeo.adjust import adjust
+    from hsgeo.reproduce.pushbroom_ba import FTOL, REJECT_K
+
+    camp, p, blocks = _problem(scale, seed)
+    t0 = time.perf_counter()
+    res = adjust(p, blocks, reject_k=REJECT_K if reject else None, ftol=FTOL)
+    wall = time.perf_counter() - t0
+    return {"n_observations": int(camp.obs["point"].size), "n_unknowns": int(res.n_unknowns),
+            "solver_seconds": res.seconds, "wall_seconds": wall, "iterations": res.iterations,
+            "final_cost": float(res.cost_history[-1]), "sigma0": res.sigma0}
+
+
+def case_scipy(scale, seed, max_seconds):
+    import numpy as np
+    import scipy.sparse as sp
+    from scipy.optimize import least_squares
+
+    from hsgeo.adjust import engine as E
+
+    camp, p, blocks = _problem(scale, seed)
+    lay = E._Layout(p)
+    masks = [np.ones(b.m, bool) for b in blocks]
+    n_c, n_p = lay.n_c, lay.n_pts * lay.p
+
+    def unpack(x):
+        lay.apply(x[:n_c] - cur["c"], (x[n_c:] - cur["p"]).reshape(lay.n_pts, lay.p))
+        cur["c"], cur["p"] = x[:n_c].copy(), x[n_c:].copy()
+
+    cur = {"c": np.zeros(n_c), "p": np.zeros(n_p)}
+    x0 = np.zeros(n_c + n_p)  # increments from the initial values
+
+    def fun(x):
+        unpack(x)
+        return E._evaluate(lay, blocks, masks, False).r
+
+    def jac(x):
+        unpack(x)
+        sy = E._evaluate(lay, blocks, masks, True)
+        rows = np.flatnonzero(sy.pidx >= 0)
+        Jp = sp.csr_matrix(
+            (sy.Jp[rows].ravel(), (np.repeat(rows, lay.p),
+                                   (sy.pidx[rows, None] * lay.p + np.arange(lay.p)).ravel())),
+            shape=(sy.r.size, n_p))
+        return sp.hstack([sy.Jrc.tocsr(), Jp]).tocsr()
+
+    t0 = time.perf_counter()
+    res = least_squares(fun, x0, jac=jac, method="trf", tr_solver="lsmr", x_scale="jac",
+                        ftol=1e-10, xtol=1e-12, gtol=1e-10, max_nfev=200, verbose=0)
+    return {"baseline_seconds": time.perf_counter() - t0, "final_cost": float(res.cost),
+            "nfev": int(res.nfev), "status": int(res.status), "message": res.message}
+
+
+def _child(args):
+    if args.case == "ours":
+        out = case_ours(args.scale, args.seed, args.reject)
+    else:
+        out = case_scipy(args.scale, args.seed, args.max_seconds)
+    out["peak_rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    out["openblas_threads"] = os.environ.get("OPENBLAS_NUM_THREADS")
+    print("RESULT " + json.dumps(out), flush=True)
+
+
+def _spawn(case, scale, seed, blas, reject=False, timeout=3600):
+    env = dict(os.environ, OPENBLAS_NUM_THREADS=str(blas), OMP_NUM_THREADS=str(blas))
+    src = str(HERE.parent / "src")
+    env["PYTHONPATH"] = src + os.pathsep + env.get("PYTHONPATH", "")
+    cmd = [sys.executable, __file__, "--child", case, "--scale", str(scale), "--seed", str(seed)]
+    if reject:
+        cmd.append("--reject")
+    print(f"bench: {case} scale={scale} OPENBLAS_NUM_THREADS={blas} ...", file=sys.stderr,
+          flush=True)
+    t0 = time.perf_counter()
+    try:
+        cp = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return {"timeout_seconds": timeout}
+    for line in cp.stdout.splitlines():
+        if line.startswith("RESULT "):
+            out = json.loads(line[7:])
+            out["process_seconds"] = time.perf_counter() - t0
+            return out
+    raise RuntimeError(f"bench case {case} failed:\n{cp.stderr[-3000:]}")
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--scale", type=float, default=1.0)
+    ap.add_argument("--baseline-scale", type=float, default=0.3)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--child", choices=("ours", "scipy"))
+    ap.add_argument("--reject", action="store_true")
+    ap.add_argument("--max-seconds", type=float, default=3600)
+    ap.add_argument("--out", default=str(HERE / "results" / "pushbroom_ba.json"))
+    args = ap.parse_args(argv)
+    if args.child:
+        args.case = args.child
+        return _child(args)
+    load0 = os.getloadavg()
+    full = {b: _spawn("ours", args.scale, args.seed, b, reject=True) for b in (1, 2)}
+    best = min(full, key=lambda b: full[b]["solver_seconds"])
+    ours_b = _spawn("ours", args.baseline_scale, args.seed, best)
+    base = _spawn("scipy", args.baseline_scale, args.seed, best, timeout=args.max_seconds)
+    f = full[best]
+    out = {
+        "problem": "002 pushbroom bundle adjustment, spline nodes every 10 s, with 4 GCPs, "
+                   "residual across the line as a time (as in the chapter)",
+        "scale": args.scale,
+        "n_observations": f["n_observations"],
+        "n_unknowns": f["n_unknowns"],
+        "solver_seconds": f["solver_seconds"],
+        "iterations": f["iterations"],
+        "peak_rss_mb": f["peak_rss_mb"],
+        "openblas_threads": best,
+        "solver_seconds_by_openblas_threads": {str(b): full[b]["solver_seconds"] for b in full},
+        "peak_rss_mb_by_openblas_threads": {str(b): full[b]["peak_rss_mb"] for b in full},
+        "baseline_scale": args.baseline_scale,
+        "baseline_seconds": base.get("baseline_seconds"),
+        "baseline_nfev": base.get("nfev"),
+        "baseline_message": base.get("message"),
+        "ours_seconds_at_baseline_scale": ours_b["solver_seconds"],
+        "final_cost_ratio": (base["final_cost"] / ours_b["final_cost"]
+                             if "final_cost" in base else None),
+        "speedup_at_baseline_scale": (base["baseline_seconds"] / ours_b["solver_seconds"]
+                                      if "baseline_seconds" in base else None),
+        "goals": {"solver_seconds_max": 5.0, "peak_rss_mb_max": 1536, "speedup_min": 30},
+        "machine": {"cpus": os.cpu_count(), "loadavg_at_start": load0,
+                    "loadavg_at_end": os.getloadavg(), "python": platform.python_version(),
+                    "numba_threads": os.environ.get("NUMBA_NUM_THREADS", "default")},
+        "seed": args.seed,
+    }
+    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+    Path(args.out).write_text(json.dumps(out, indent=1) + "\n")
+    print(json.dumps(out, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

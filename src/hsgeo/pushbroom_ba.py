@@ -1,0 +1,309 @@
+"""Bundle adjustment of LP lines with spline trajectory corrections (002 §3.4): set-up and run.
+
+:func:`build_problem` turns observations, the navigation poses at the line times, a camera and
+optional GCPs into the engine's :class:`~hsgeo.adjust.Parameters` and residual blocks;
+:func:`intersect_two_rays` gives the tie points their initial coordinates (002 §3.4: "the point
+of intersection between the image rays from two observations"). The book chapter, ``hsgeo
+reproduce pushbroom-ba`` and ``hsgeo adjust-pushbroom`` all go through these functions.
+
+What is estimated (002 §4): six corrections per trajectory node (GNSS/INS priors with their σ),
+the boresight (3), K1, K2, P1, P2, one principal distance per band, the lever arm (with the
+prior of its tape measurement) and the tie-point coordinates (eliminated by the Schur
+complement). The principal point is fixed (002 §3.4).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from hsgeo.adjust import Parameters
+from hsgeo.errors import InputError
+from hsgeo.rotations import R_from_opk, R_from_rpy
+from hsgeo.sensors.pushbroom import BETA0_CAM_FROM_PLATFORM, BLOCK_NAMES, PushbroomLines
+from hsgeo.trajectory import CORRECTION_COLUMNS, SplineNodes
+
+__all__ = ["CameraPrior", "build_problem", "intersect_two_rays"]
+
+
+@dataclass(frozen=True)
+class CameraPrior:
+    """A-priori camera and GNSS/INS values (the adjustment's starting point and priors)."""
+
+    n_bands: int
+    pixel_mm: float = 0.0065
+    c_mm: float = 40.0
+    x0_mm: float = 0.0
+    y0_mm: float = 0.0
+    lever_arm_m: tuple = (0.0, 0.0, 0.0)
+    sigma_lever_m: float = 0.02
+    sigma_pos_m: tuple = (0.013, 0.013, 0.020)
+    sigma_att_rad: tuple = tuple(np.deg2rad([0.005, 0.005, 0.008]))
+    sigma_obs_px: float = 0.5
+    sigma_gcp_m: float = 0.01
+
+
+def _rays(obs, cam: CameraPrior, c_mm, boresight_rad, lever_arm_m):
+    xy_mm = obs["xy_px"] * cam.pixel_mm - np.array([cam.x0_mm, cam.y0_mm])
+    m = xy_mm.shape[0]
+    d_cam = np.column_stack([xy_mm, np.broadcast_to(c_mm, (m,))])
+    beta = R_from_opk(*boresight_rad) @ BETA0_CAM_FROM_PLATFORM
+    rpy = obs["rpy_nav_rad"]
+    R = R_from_rpy(rpy[:, 0], rpy[:, 1], rpy[:, 2])
+    d = np.einsum("mij,mj->mi", R, d_cam @ beta)  # R βᵀ d_cam
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    o = obs["xyz_nav_m"] + R @ np.asarray(lever_arm_m)
+    return o, d
+
+
+def intersect_two_rays(point, origin, direction, n_points):
+    """Initial point coordinates from the two most divergent rays of each point.
+
+    For each point, the first ray and the ray making the largest angle with it are intersected
+    (midpoint of their closest approach).
+
+    Returns
+    -------
+    xyz : (n_points, 3) ndarray
+    """
+    point = np.asarray(point)
+    order = np.argsort(point, kind="stable")
+    ps = point[order]
+    starts = np.searchsorted(ps, np.arange(n_points))
+    counts = np.bincount(ps, minlength=n_points)
+    if np.any(counts < 2):
+        bad = np.flatnonzero(counts < 2)[:5].tolist()
+        raise InputError(
+            f"points {bad} have fewer than two observations: a tie point needs two rays "
+            "(drop them from the observation table)"
+        )
+    first = order[starts]
+    cosang = np.einsum("mi,mi->m", direction[order], direction[first][ps])
+    # per point, the ray with the smallest cosine to the first ray
+    key = np.lexsort((cosang, ps))
+    second = order[key[starts]]
+    o1, d1, o2, d2 = origin[first], direction[first], origin[second], direction[second]
+    w = o1 - o2
+    b = np.einsum("mi,mi->m", d1, d2)
+    dd = np.einsum("mi,mi->m", d1, w)
+    e = np.einsum("mi,mi->m", d2, w)
+    den = np.maximum(1 - b * b, 1e-12)
+    s = (b * e - dd) / den
+    u = (e - b * dd) / den
+    xyz = 0.5 * (o1 + s[:, None] * d1 + o2 + u[:, None] * d2)
+    # nearly parallel rays (e.g. the two headings of one flight line) do not intersect well:
+    # put those points on the plane of the median height of the others instead
+    good = (b < np.cos(np.deg2rad(0.5))) & (s > 0) & (u > 0)
+    h_med = np.median(xyz[good, 2]) if good.any() else 0.0
+    far = np.abs(xyz[:, 2] - h_med) > 0.25 * np.median(np.abs(o1[:, 2] - h_med))
+    bad = ~good | far
+    lam = (h_med - o1[bad, 2]) / np.where(np.abs(d1[bad, 2]) > 1e-9, d1[bad, 2], -1e-9)
+    xyz[bad] = o1[bad] + lam[:, None] * d1[bad]
+    return xyz
+
+
+def build_problem(obs: dict, n_points: int, cam: CameraPrior, *, node_interval_s: float = 10.0,
+                  gcp_index=None, gcp_xyz_m=None, t_span_s=None, node_prior_mean=None,
+                  y_as_time: bool = False):
+    """Parameters and residual blocks of the LP bundle adjustment.
+
+    Parameters
+    ----------
+    obs : dict
+        ``point`` (m,), ``band`` (m,), ``t_s`` (m,), ``xy_px`` (m, 2), ``xyz_nav_m`` (m, 3),
+        ``rpy_nav_rad`` (m, 3): the observations and the GNSS/INS pose at their line times.
+    n_points : int
+    cam : CameraPrior
+    node_interval_s : float
+        Spacing of the trajectory-correction nodes (002 §4: 10 s).
+    gcp_index, gcp_xyz_m : optional
+        Rows of the points that are GCPs and their surveyed coordinates (prior σ
+        ``cam.sigma_gcp_m``). None: no GCPs (002 Table 3).
+    t_span_s : (float, float), optional
+        Time span of the nodes (default: the observations' span).
+    node_prior_mean : (n_nodes, 6) ndarray, optional
+        Prior mean of the node corrections (default zero: the GNSS/INS solution as it is).
+    y_as_time : bool
+        Residual across the line as a *time* (the line a point is registered in) rather than
+        the image y of 002 eq. (2): the y residual is multiplied by ``c_ref p_z / (c Z_ref)``
+        (``c_ref`` the initial principal distance, ``Z_ref`` the median initial depth), which
+        keeps its zero and its size but removes its dependence on c and on the depth. See the
+        chapter for the bias this avoids.
+
+    Returns
+    -------
+    params : Parameters
+    blocks : list of ResidualBlock
+    nodes : SplineNodes
+    """
+    t = np.asarray(obs["t_s"], dtype=float)
+    if t.size == 0:
+        raise InputError("no observations")
+    t0, t1 = (t.min(), t.max()) if t_span_s is None else t_span_s
+    nodes = SplineNodes(float(t0), float(t1), float(node_interval_s))
+    names = BLOCK_NAMES
+    if np.any(np.asarray(obs["band"]) >= cam.n_bands):
+        raise InputError(f"band index ≥ the camera's {cam.n_bands} bands")
+    o, d = _rays(obs, cam, cam.c_mm, np.zeros(3), cam.lever_arm_m)
+    P0 = intersect_two_rays(obs["point"], o, d, n_points)
+    p = Parameters()
+    p.add(names["points"], P0, points=True, columns=("E_m", "N_m", "H_m"))
+    p.add(names["nodes"], np.zeros((nodes.n_nodes, 6)), columns=CORRECTION_COLUMNS,
+          prior_mean=0.0 if node_prior_mean is None else node_prior_mean,
+          prior_sigma=np.r_[cam.sigma_pos_m, cam.sigma_att_rad][None, :])
+    p.add(names["boresight"], np.zeros(3), columns=("omega_rad", "phi_rad", "kappa_rad"))
+    p.add(names["lever_arm"], np.asarray(cam.lever_arm_m, float), columns=("x_m", "y_m", "z_m"),
+          prior_sigma=cam.sigma_lever_m)
+    p.add(names["distortion"], np.zeros(4), columns=("K1", "K2", "P1", "P2"))
+    p.add(names["c"], np.full(cam.n_bands, cam.c_mm))
+    if gcp_index is not None:
+        gi = np.asarray(gcp_index)
+        p.set(names["points"], np.asarray(gcp_xyz_m, float), index=gi)
+        p.set_prior(names["points"], cam.sigma_gcp_m, index=gi, mean=np.asarray(gcp_xyz_m, float))
+    y_time_k = 0.0
+    if y_as_time:
+        z_ref = float(np.median(obs["xyz_nav_m"][:, 2] - P0[obs["point"], 2]))
+        y_time_k = cam.c_mm / z_ref
+    blk = PushbroomLines(obs["point"], obs["band"], t, obs["xy_px"], obs["xyz_nav_m"],
+                         obs["rpy_nav_rad"], nodes, cam.pixel_mm, cam.sigma_obs_px,
+                         cam.x0_mm, cam.y0_mm, y_time_k=y_time_k)
+    return p, [blk], nodes
+
+
+# ----------------------------------------------------------------------------------------------
+# Files: ``hsgeo adjust-pushbroom``
+# ----------------------------------------------------------------------------------------------
+#: Required columns of the input tables (CSV or Parquet).
+OBS_COLUMNS = ("point_id", "band", "t_s", "x_px", "y_px")
+NAV_COLUMNS = ("t_s", "E_m", "N_m", "H_m", "roll_rad", "pitch_rad", "yaw_rad")
+GCP_COLUMNS = ("point_id", "E_m", "N_m", "H_m")
+
+
+def read_table(path, columns, what: str):
+    """A CSV or Parquet table with the required ``columns`` (extra columns are ignored)."""
+    from pathlib import Path
+
+    import pandas as pd
+
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"{what} file {str(path)!r} does not exist")
+    try:
+        if path.suffix.lower() in (".parquet", ".pq"):
+            df = pd.read_parquet(path)
+        else:
+            df = pd.read_csv(path)
+    except Exception as exc:  # noqa: BLE001 - any parser error becomes an InputError
+        raise InputError(f"{what} file {str(path)!r} cannot be read: {exc}") from exc
+    missing = [c for c in columns if c not in df.columns]
+    if missing:
+        raise InputError(
+            f"{what} file {str(path)!r} lacks the column(s) {missing}; required: "
+            f"{list(columns)} (see `hsgeo adjust-pushbroom --help`)"
+        )
+    if df[list(columns)].isna().any().any():
+        raise InputError(f"{what} file {str(path)!r} has empty or NaN values in {list(columns)}")
+    return df
+
+
+def read_camera(path) -> CameraPrior:
+    """Camera and GNSS/INS priors from a TOML file (see :func:`adjust_files`)."""
+    import tomllib
+    from pathlib import Path
+
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"camera file {str(path)!r} does not exist")
+    try:
+        cfg = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"camera file {str(path)!r}: malformed TOML: {exc}") from exc
+    cam = cfg.get("camera", {})
+    nav = cfg.get("gnss_ins", {})
+    if "n_bands" not in cam or "pixel_mm" not in cam or "c_mm" not in cam:
+        raise InputError(
+            f"camera file {str(path)!r} needs a [camera] table with n_bands, pixel_mm and c_mm"
+        )
+    return CameraPrior(
+        n_bands=int(cam["n_bands"]), pixel_mm=float(cam["pixel_mm"]), c_mm=float(cam["c_mm"]),
+        x0_mm=float(cam.get("x0_mm", 0.0)), y0_mm=float(cam.get("y0_mm", 0.0)),
+        lever_arm_m=tuple(cam.get("lever_arm_m", (0.0, 0.0, 0.0))),
+        sigma_lever_m=float(cam.get("sigma_lever_m", 0.02)),
+        sigma_pos_m=tuple(nav.get("sigma_pos_m", (0.013, 0.013, 0.020))),
+        sigma_att_rad=tuple(np.deg2rad(nav.get("sigma_att_deg", (0.005, 0.005, 0.008)))),
+        sigma_obs_px=float(cfg.get("observations", {}).get("sigma_px", 0.5)),
+        sigma_gcp_m=float(cfg.get("gcp", {}).get("sigma_m", 0.01)),
+    )
+
+
+def adjust_files(observations, trajectory, camera, gcp=None, *, node_interval_s: float = 10.0,
+                 reject_k: float | None = 5.0, progress=None, y_as_time: bool = True) -> dict:
+    """Adjust a user's pushbroom observations (``hsgeo adjust-pushbroom``).
+
+    Parameters
+    ----------
+    observations : path
+        CSV or Parquet with ``point_id, band, t_s, x_px, y_px``: tie point, band index
+        (0-based), exposure time of the line (s, the navigation's time scale), image
+        coordinates in pixels from the line centre (x along the line, y across it; 0 = the line).
+    trajectory : path
+        CSV or Parquet with ``t_s, E_m, N_m, H_m, roll_rad, pitch_rad, yaw_rad``: the GNSS/INS
+        solution (map frame east-north-up, ``R_map_from_platform = R_from_rpy``), interpolated
+        linearly to the line times.
+    camera : path
+        TOML: ``[camera] n_bands, pixel_mm, c_mm, x0_mm, y0_mm, lever_arm_m, sigma_lever_m``,
+        ``[gnss_ins] sigma_pos_m = [E, N, H], sigma_att_deg = [roll, pitch, yaw]``,
+        ``[observations] sigma_px``, ``[gcp] sigma_m``.
+    gcp : path, optional
+        CSV or Parquet with ``point_id, E_m, N_m, H_m`` (points of the observation table).
+
+    Returns
+    -------
+    dict
+        Summary, the camera parameters with σ̂, the node corrections and the adjusted points.
+    """
+    from hsgeo.adjust import adjust
+    from hsgeo.trajectory import Trajectory
+
+    obs_df = read_table(observations, OBS_COLUMNS, "observation")
+    nav_df = read_table(trajectory, NAV_COLUMNS, "trajectory")
+    cam = read_camera(camera)
+    ids, point = np.unique(obs_df["point_id"].to_numpy(), return_inverse=True)
+    traj = Trajectory(nav_df["t_s"].to_numpy(), nav_df[["E_m", "N_m", "H_m"]].to_numpy(),
+                      nav_df[["roll_rad", "pitch_rad", "yaw_rad"]].to_numpy())
+    t = obs_df["t_s"].to_numpy(dtype=float)
+    xyz, rpy = traj.pose(t)
+    obs = {"point": point.astype(np.int64), "band": obs_df["band"].to_numpy().astype(np.int64),
+           "t_s": t, "xy_px": obs_df[["x_px", "y_px"]].to_numpy(dtype=float),
+           "xyz_nav_m": xyz, "rpy_nav_rad": rpy}
+    gi = gx = None
+    if gcp is not None:
+        g = read_table(gcp, GCP_COLUMNS, "GCP")
+        pos = {v: i for i, v in enumerate(ids)}
+        unknown = [v for v in g["point_id"] if v not in pos]
+        if unknown:
+            raise InputError(f"GCP point_id(s) {unknown[:5]} are not in the observation table")
+        gi = np.array([pos[v] for v in g["point_id"]])
+        gx = g[["E_m", "N_m", "H_m"]].to_numpy(dtype=float)
+    p, blocks, nodes = build_problem(obs, ids.size, cam, node_interval_s=node_interval_s,
+                                     gcp_index=gi, gcp_xyz_m=gx, y_as_time=y_as_time)
+    res = adjust(p, blocks, reject_k=reject_k, ftol=1e-8, progress=progress)
+    out = {
+        "converged": res.converged, "iterations": res.iterations, "sigma0": res.sigma0,
+        "n_observations_2d": int(len(obs_df)), "n_points": int(ids.size),
+        "n_unknowns": int(res.n_unknowns), "rejected": int(res.outliers(0).sum()),
+        "solver_seconds": res.seconds, "node_interval_s": node_interval_s,
+        "parameters": {},
+    }
+    for name, f in [("boresight_rad", 180 / np.pi), ("lever_arm_m", 1.0), ("distortion", 1.0),
+                    ("c_mm", 1.0)]:
+        key = name.replace("_rad", "_deg")
+        out["parameters"][key] = {"value": (res.value(name) * f).tolist(),
+                                  "sigma": (res.sigma(name) * f).tolist()}
+    out["nodes"] = {"t_s": nodes.t_nodes_s.tolist(), "value": res.value("nodes").tolist(),
+                    "sigma": res.sigma("nodes").tolist(),
+                    "columns": list(res.params["nodes"].columns)}
+    out["points"] = {"point_id": ids.tolist(), "xyz_m": res.value("points_m").tolist()}
+    out["_result"] = res
+    return out

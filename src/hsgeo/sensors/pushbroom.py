@@ -1,0 +1,450 @@
+"""Linear pushbroom (LP) lines as pinhole exposures with spline trajectory corrections.
+
+002 eq. 2–4.
+
+Every LP image line is a pinhole exposure at its time ``t_e``. An observation is a tie point
+``k`` seen in one line of one spectral band at image coordinates ``(x, y)`` in pixels from the
+line's centre (``x`` along the line, ``y`` across it: ``y = 0`` is the line itself).
+
+Model, for an observation at time ``t`` (002 eq. 4)::
+
+    δ(t)     = Σ_a B_a(t) c_{j_a}                      local cubic B-spline of node corrections
+    x(t)     = x_nav(t) + δ_xyz(t)                     platform position, map frame (E, N, U)
+    R(t)     = R_from_rpy(rpy_nav(t) + δ_rpy(t))       R_map_from_platform
+    p^c      = β (R(t)ᵀ (p^m − x(t)) − l^p)            = β R⁻¹ (p^m − x − R l)   (002 eq. 4)
+    β        = R_from_opk(ω_b, φ_b, κ_b) β₀            boresight: small angles on the nominal mount
+
+and the image coordinates in mm (002 eq. 2–3)::
+
+    x̄ = c_b p^c_x / p^c_z,   ȳ = c_b p^c_y / p^c_z     one principal distance c_b per band
+    x = x̄ + K1 x̄³ + K2 x̄⁵ + 3 P1 x̄² + x0
+    y = ȳ + P2 x̄² + y0
+
+Eq. (3) is printed with powers of ``p^c_x``; we evaluate the distortion at the ideal image
+coordinate ``x̄`` (mm), which is what a distortion polynomial of an image line means (units:
+K1 mm⁻², K2 mm⁻⁴, P1 and P2 mm⁻¹). The principal point ``(x0, y0)`` is fixed at its calibrated
+value (002 §3.4: it correlates with the tangential terms and is not estimated).
+
+The nominal mount ``β₀`` maps the platform frame (x forward, y left, z up) to the camera frame
+(x along the line to the right, y backward, z down the viewing direction).
+
+References
+----------
+Jonassen et al. (2024), 002 eq. (2)–(4), §3.3–3.5.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+from hsgeo.adjust import Indexed, ResidualBlock
+from hsgeo.errors import InputError
+from hsgeo.rotations import R_from_opk, R_from_rpy, dR_dopk, dR_drpy
+from hsgeo.trajectory import SplineNodes
+
+__all__ = ["PushbroomLines", "BETA0_CAM_FROM_PLATFORM", "BLOCK_NAMES", "project"]
+
+#: Nominal camera-from-platform rotation (platform x forward, y left, z up → camera x right,
+#: y backward, z down).
+BETA0_CAM_FROM_PLATFORM = np.array([[0.0, -1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
+
+#: Default parameter block names used by :class:`PushbroomLines`.
+BLOCK_NAMES = {
+    "points": "points_m",
+    "nodes": "nodes",
+    "boresight": "boresight_rad",
+    "lever_arm": "lever_arm_m",
+    "distortion": "distortion",
+    "c": "c_mm",
+}
+
+
+def _camera_geometry(values, names, nodes: SplineNodes, t_s, xyz_nav, rpy_nav, pidx, band,
+                     beta0, jacobian):
+    """p^c and intermediate quantities for every observation (002 eq. 4)."""
+    P = values[names["points"]][pidx]
+    idx, w = nodes.basis(t_s)
+    node_vals = values[names["nodes"]]
+    delta = np.einsum("ma,mak->mk", w, node_vals[idx])
+    x = xyz_nav + delta[:, :3]
+    rpy = rpy_nav + delta[:, 3:]
+    R = R_from_rpy(rpy[:, 0], rpy[:, 1], rpy[:, 2])
+    bore = values[names["boresight"]]
+    beta = R_from_opk(bore[0], bore[1], bore[2]) @ beta0
+    lever = values[names["lever_arm"]]
+    d = P - x
+    q = np.einsum("mji,mj->mi", R, d) - lever  # Rᵀ d − l
+    p = q @ beta.T
+    out = {"p": p, "q": q, "d": d, "R": R, "beta": beta, "idx": idx, "w": w, "rpy": rpy}
+    return out
+
+
+def project(values, names, nodes, t_s, xyz_nav, rpy_nav, pidx, band, beta0, x0_mm, y0_mm):
+    """Image coordinates (mm) of every observation (002 eq. 2–4), without derivatives."""
+    g = _camera_geometry(values, names, nodes, t_s, xyz_nav, rpy_nav, pidx, band, beta0, False)
+    p = g["p"]
+    c = values[names["c"]][band]
+    K1, K2, P1, P2 = values[names["distortion"]]
+    xb = c * p[:, 0] / p[:, 2]
+    yb = c * p[:, 1] / p[:, 2]
+    x = xb + K1 * xb**3 + K2 * xb**5 + 3 * P1 * xb**2 + x0_mm  # 002 eq. (3)
+    y = yb + P2 * xb**2 + y0_mm
+    return np.column_stack([x, y]), p
+
+
+@njit(cache=True, inline="always")
+def _rot_rpy(ro, pi, ya, R, dR):  # pragma: no cover - compiled
+    """R = Rz(yaw) Ry(pitch) Rx(roll) and its derivatives (same as hsgeo.rotations)."""
+    cr, sr, cp, sp, cy, sy = np.cos(ro), np.sin(ro), np.cos(pi), np.sin(pi), np.cos(ya), np.sin(ya)
+    R[0, 0] = cy * cp
+    R[0, 1] = cy * sp * sr - sy * cr
+    R[0, 2] = cy * sp * cr + sy * sr
+    R[1, 0] = sy * cp
+    R[1, 1] = sy * sp * sr + cy * cr
+    R[1, 2] = sy * sp * cr - cy * sr
+    R[2, 0] = -sp
+    R[2, 1] = cp * sr
+    R[2, 2] = cp * cr
+    # roll
+    dR[0, 0, 0] = 0.0
+    dR[0, 0, 1] = cy * sp * cr + sy * sr
+    dR[0, 0, 2] = -cy * sp * sr + sy * cr
+    dR[0, 1, 0] = 0.0
+    dR[0, 1, 1] = sy * sp * cr - cy * sr
+    dR[0, 1, 2] = -sy * sp * sr - cy * cr
+    dR[0, 2, 0] = 0.0
+    dR[0, 2, 1] = cp * cr
+    dR[0, 2, 2] = -cp * sr
+    # pitch
+    dR[1, 0, 0] = -cy * sp
+    dR[1, 0, 1] = cy * cp * sr
+    dR[1, 0, 2] = cy * cp * cr
+    dR[1, 1, 0] = -sy * sp
+    dR[1, 1, 1] = sy * cp * sr
+    dR[1, 1, 2] = sy * cp * cr
+    dR[1, 2, 0] = -cp
+    dR[1, 2, 1] = -sp * sr
+    dR[1, 2, 2] = -sp * cr
+    # yaw
+    dR[2, 0, 0] = -sy * cp
+    dR[2, 0, 1] = -sy * sp * sr - cy * cr
+    dR[2, 0, 2] = -sy * sp * cr + cy * sr
+    dR[2, 1, 0] = cy * cp
+    dR[2, 1, 1] = cy * sp * sr - sy * cr
+    dR[2, 1, 2] = cy * sp * cr + sy * sr
+    dR[2, 2, 0] = 0.0
+    dR[2, 2, 1] = 0.0
+    dR[2, 2, 2] = 0.0
+
+
+@njit(cache=True, parallel=True)
+def _lines_kernel(P, pidx, idx, w, nodes, xyz_nav, rpy_nav, band, c_b, dist, beta, dbeta,
+                  lever, x0, y0, k_px, xy_obs, jac, r, dP, dN, dB, dL, dD, dC,
+                  y_time_k):  # pragma: no cover
+    """002 eq. (2)–(4) and their derivatives, one observation per iteration (rows 2j, 2j+1)."""
+    m = pidx.size
+    K1, K2, P1, P2 = dist[0], dist[1], dist[2], dist[3]
+    n_chunks = 64 if m > 6400 else 1
+    step = (m + n_chunks - 1) // n_chunks
+    for ch in prange(n_chunks):
+        R = np.empty((3, 3))
+        dR = np.empty((3, 3, 3))
+        d = np.empty(3)
+        q = np.empty(3)
+        p = np.empty(3)
+        dl = np.empty(6)
+        Jp = np.empty((2, 3))
+        JpB = np.empty((2, 3))
+        for j in range(ch * step, min(m, (ch + 1) * step)):
+            for a in range(6):
+                acc = 0.0
+                for b in range(4):
+                    acc += w[j, b] * nodes[idx[j, b], a]
+                dl[a] = acc
+            _rot_rpy(rpy_nav[j, 0] + dl[3], rpy_nav[j, 1] + dl[4], rpy_nav[j, 2] + dl[5], R, dR)
+            pt = pidx[j]
+            for a in range(3):
+                d[a] = P[pt, a] - xyz_nav[j, a] - dl[a]
+            for a in range(3):  # q = Rᵀ d − l
+                q[a] = R[0, a] * d[0] + R[1, a] * d[1] + R[2, a] * d[2] - lever[a]
+            for a in range(3):  # p = β q
+                p[a] = beta[a, 0] * q[0] + beta[a, 1] * q[1] + beta[a, 2] * q[2]
+            c = c_b[band[j]]
+            iz = 1.0 / p[2]
+            xb = c * p[0] * iz
+            yb = c * p[1] * iz
+            x = xb + K1 * xb**3 + K2 * xb**5 + 3 * P1 * xb**2 + x0  # 002 eq. (3)
+            y = yb + P2 * xb**2 + y0
+            r[2 * j] = x * k_px - xy_obs[j, 0]
+            ry = y * k_px - xy_obs[j, 1]
+            kap = y_time_k * p[2] / c if y_time_k > 0 else 1.0
+            r[2 * j + 1] = kap * ry
+            if not jac:
+                continue
+            gx = 1.0 + 3 * K1 * xb**2 + 5 * K2 * xb**4 + 6 * P1 * xb
+            gy = 2 * P2 * xb
+            a_ = c * iz
+            Jp[0, 0] = gx * a_ * k_px
+            Jp[0, 1] = 0.0
+            Jp[0, 2] = -gx * xb * iz * k_px
+            Jp[1, 0] = gy * a_ * k_px
+            Jp[1, 1] = a_ * k_px
+            Jp[1, 2] = (-yb * iz - gy * xb * iz) * k_px
+            for u in range(2):
+                for a in range(3):
+                    JpB[u, a] = (Jp[u, 0] * beta[0, a] + Jp[u, 1] * beta[1, a]
+                                 + Jp[u, 2] * beta[2, a])
+            for u in range(2):
+                row = 2 * j + u
+                for a in range(3):
+                    # dp/dP = β Rᵀ: (JpB Rᵀ)[u, a] = Σ_i JpB[u, i] R[a, i]
+                    v = JpB[u, 0] * R[a, 0] + JpB[u, 1] * R[a, 1] + JpB[u, 2] * R[a, 2]
+                    dP[row, a] = v
+                    for b in range(4):
+                        dN[row, b, a] = -v * w[j, b]
+                    dL[row, a] = -JpB[u, a]
+                for kk in range(3):
+                    # attitude: dq_i/drpy_k = Σ_j dR[k, j, i] d_j
+                    v = 0.0
+                    for i in range(3):
+                        dq = dR[kk, 0, i] * d[0] + dR[kk, 1, i] * d[1] + dR[kk, 2, i] * d[2]
+                        v += JpB[u, i] * dq
+                    for b in range(4):
+                        dN[row, b, 3 + kk] = v * w[j, b]
+                    # boresight: dp/dbore_k = dβ_k q
+                    v = 0.0
+                    for i in range(3):
+                        v += Jp[u, i] * (dbeta[kk, i, 0] * q[0] + dbeta[kk, i, 1] * q[1]
+                                         + dbeta[kk, i, 2] * q[2])
+                    dB[row, kk] = v
+            dC[2 * j, 0] = gx * xb / c * k_px
+            dC[2 * j + 1, 0] = (yb / c + gy * xb / c) * k_px
+            dD[2 * j, 0] = xb**3 * k_px
+            dD[2 * j, 1] = xb**5 * k_px
+            dD[2 * j, 2] = 3 * xb**2 * k_px
+            dD[2 * j, 3] = 0.0
+            dD[2 * j + 1, 0] = 0.0
+            dD[2 * j + 1, 1] = 0.0
+            dD[2 * j + 1, 2] = 0.0
+            dD[2 * j + 1, 3] = xb**2 * k_px
+            if y_time_k > 0:
+                # y as a time: r_y·κ with κ = c_ref p_z / (c Z_ref); d(κ r) = κ dr + r dκ
+                row = 2 * j + 1
+                f = ry * kap / p[2]
+                for a in range(3):
+                    v2 = beta[2, 0] * R[a, 0] + beta[2, 1] * R[a, 1] + beta[2, 2] * R[a, 2]
+                    dP[row, a] = kap * dP[row, a] + f * v2
+                    for b in range(4):
+                        dN[row, b, a] = kap * dN[row, b, a] - f * v2 * w[j, b]
+                    dL[row, a] = kap * dL[row, a] - f * beta[2, a]
+                for kk in range(3):
+                    v2 = 0.0
+                    for i in range(3):
+                        v2 += beta[2, i] * (dR[kk, 0, i] * d[0] + dR[kk, 1, i] * d[1]
+                                            + dR[kk, 2, i] * d[2])
+                    for b in range(4):
+                        dN[row, b, 3 + kk] = kap * dN[row, b, 3 + kk] + f * v2 * w[j, b]
+                    vb = dbeta[kk, 2, 0] * q[0] + dbeta[kk, 2, 1] * q[1] + dbeta[kk, 2, 2] * q[2]
+                    dB[row, kk] = kap * dB[row, kk] + f * vb
+                dC[row, 0] = kap * dC[row, 0] - ry * kap / c
+                for a in range(4):
+                    dD[row, a] *= kap
+
+
+class PushbroomLines(ResidualBlock):
+    """Image observations of tie points in LP lines (002 eq. 2–4) as a residual block.
+
+    Residuals are model − observation in pixels, interleaved ``(x0, y0, x1, y1, ...)``; one
+    observation (x and y) is the unit of outlier rejection.
+
+    Parameters
+    ----------
+    point : (m,) int ndarray
+        Row of the points block each observation sees.
+    band : (m,) int ndarray
+        Spectral band (index into the per-band principal distance ``c_mm``).
+    t_s : (m,) ndarray
+        Exposure time of the line.
+    xy_px : (m, 2) ndarray
+        Observed image coordinates in pixels from the line centre.
+    xyz_nav_m, rpy_nav_rad : (m, 3) ndarray
+        The GNSS/INS pose at ``t_s`` (uncorrected).
+    nodes : SplineNodes
+        The spline node layout of the trajectory corrections.
+    pixel_mm : float
+        Pixel pitch (002 §4: 6.5 µm).
+    sigma_px : float
+        A-priori σ of an image coordinate (002 §4: 1/2 px).
+    x0_mm, y0_mm : float
+        Principal point (fixed).
+    names : dict, optional
+        Parameter block names (defaults :data:`BLOCK_NAMES`).
+    """
+
+    name = "image points"
+    group_size = 2
+
+    def __init__(self, point, band, t_s, xy_px, xyz_nav_m, rpy_nav_rad, nodes: SplineNodes,
+                 pixel_mm: float, sigma_px: float = 0.5, x0_mm: float = 0.0,
+                 y0_mm: float = 0.0, names: dict | None = None,
+                 beta0=BETA0_CAM_FROM_PLATFORM, y_time_k: float = 0.0):
+        point = np.asarray(point)
+        m = point.size
+        xy = np.asarray(xy_px, dtype=np.float64)
+        for nm, arr, shape in [("band", band, (m,)), ("t_s", t_s, (m,)), ("xy_px", xy, (m, 2)),
+                               ("xyz_nav_m", xyz_nav_m, (m, 3)),
+                               ("rpy_nav_rad", rpy_nav_rad, (m, 3))]:
+            if np.shape(arr) != shape:
+                raise InputError(
+                    f"PushbroomLines: {nm} has shape {np.shape(arr)}, expected {shape} "
+                    f"for {m} observations"
+                )
+        if not np.issubdtype(point.dtype, np.integer) or np.any(point < 0):
+            raise InputError("PushbroomLines: point indices must be non-negative integers")
+        if not np.issubdtype(np.asarray(band).dtype, np.integer) or np.any(np.asarray(band) < 0):
+            raise InputError("PushbroomLines: band indices must be non-negative integers")
+        if not (pixel_mm > 0):
+            raise InputError(f"pixel pitch must be positive, got {pixel_mm!r} mm")
+        super().__init__(np.full(2 * m, float(sigma_px)))
+        self.point = point.astype(np.int64)
+        self.band = np.asarray(band, dtype=np.int64)
+        self.t_s = np.asarray(t_s, dtype=np.float64)
+        self.xy_px = xy
+        self.xyz_nav = np.asarray(xyz_nav_m, dtype=np.float64)
+        self.rpy_nav = np.asarray(rpy_nav_rad, dtype=np.float64)
+        self.nodes = nodes
+        self.pixel_mm = float(pixel_mm)
+        self.x0_mm, self.y0_mm = float(x0_mm), float(y0_mm)
+        self.names = dict(BLOCK_NAMES if names is None else names)
+        self.beta0 = np.asarray(beta0, dtype=np.float64)
+        self._basis = nodes.basis(self.t_s)
+        if not (np.isfinite(y_time_k) and y_time_k >= 0):
+            raise InputError(f"y_time_k must be ≥ 0 (0: the image y of 002 eq. 2), got {y_time_k}")
+        self.y_time_k = float(y_time_k)
+        self._pidx2 = np.repeat(self.point, 2)
+        self._idx2 = np.repeat(self._basis[0], 2, axis=0)
+        for a in ("xyz_nav", "rpy_nav", "xy_px"):
+            setattr(self, a, np.ascontiguousarray(getattr(self, a)))
+
+    def image_mm(self, values):
+        """Modelled image coordinates in mm, ``(m, 2)``."""
+        xy, _ = project(values, self.names, self.nodes, self.t_s, self.xyz_nav, self.rpy_nav,
+                        self.point, self.band, self.beta0, self.x0_mm, self.y0_mm)
+        return xy
+
+    def evaluate_numpy(self, values, jacobian):
+        """The same as :meth:`evaluate`, in plain numpy (the reference for the tests)."""
+        nm = self.names
+        g = _camera_geometry(values, nm, self.nodes, self.t_s, self.xyz_nav, self.rpy_nav,
+                             self.point, self.band, self.beta0, jacobian)
+        p, q, d, R, beta = g["p"], g["q"], g["d"], g["R"], g["beta"]
+        c = values[nm["c"]][self.band]
+        K1, K2, P1, P2 = values[nm["distortion"]]
+        iz = 1.0 / p[:, 2]
+        xb = c * p[:, 0] * iz
+        yb = c * p[:, 1] * iz
+        x = xb + K1 * xb**3 + K2 * xb**5 + 3 * P1 * xb**2 + self.x0_mm  # 002 eq. (3)
+        y = yb + P2 * xb**2 + self.y0_mm
+        k = 1.0 / self.pixel_mm
+        m = self.point.size
+        r = np.empty(2 * m)
+        r[0::2] = x * k - self.xy_px[:, 0]
+        ry = y * k - self.xy_px[:, 1]
+        kap = self.y_time_k * p[:, 2] / c if self.y_time_k > 0 else np.ones(m)
+        r[1::2] = kap * ry
+        if not jacobian:
+            return r, None
+        # d(x, y)/d p^c  (2 × 3 per observation), in px
+        gx = 1.0 + 3 * K1 * xb**2 + 5 * K2 * xb**4 + 6 * P1 * xb  # dx/dx̄
+        gy = 2 * P2 * xb  # dy/dx̄
+        a = c * iz
+        dxb = np.stack([a, np.zeros(m), -xb * iz], axis=1)
+        dyb = np.stack([np.zeros(m), a, -yb * iz], axis=1)
+        Jp = np.empty((m, 2, 3))
+        Jp[:, 0] = gx[:, None] * dxb
+        Jp[:, 1] = dyb + gy[:, None] * dxb
+        Jp *= k
+        JpB = Jp @ beta  # d/d q  (m, 2, 3)
+        # points: p = β Rᵀ (P − x) − β l  →  dp/dP = β Rᵀ
+        dP = JpB @ np.transpose(R, (0, 2, 1))
+        # attitude: dq/drpy_k = (dR_k)ᵀ d
+        rpy = g["rpy"]
+        dR = dR_drpy(rpy[:, 0], rpy[:, 1], rpy[:, 2])  # (m, 3, 3, 3)
+        dq_drpy = np.einsum("mkji,mj->mik", dR, d)  # (m, 3(i), 3(k))
+        dAtt = JpB @ dq_drpy
+        d6 = np.concatenate([-dP, dAtt], axis=2)  # (m, 2, 6): position, attitude
+        idx, w = g["idx"], g["w"]
+        dnodes = w[:, None, :, None] * d6[:, :, None, :]  # (m, 2, 4, 6)
+        # boresight: dp/dbore_k = dβ_k q
+        bore = values[nm["boresight"]]
+        dbeta = dR_dopk(bore[0], bore[1], bore[2]) @ self.beta0  # (3, 3, 3)
+        dBore = np.einsum("mrj,kji,mi->mrk", Jp, dbeta, q)
+        dLever = -JpB
+        dC = np.stack([gx * xb / c, yb / c + gy * xb / c], axis=1) * k  # (m, 2)
+        dDist = np.zeros((m, 2, 4))
+        dDist[:, 0, 0] = xb**3 * k
+        dDist[:, 0, 1] = xb**5 * k
+        dDist[:, 0, 2] = 3 * xb**2 * k
+        dDist[:, 1, 3] = xb**2 * k
+        if self.y_time_k > 0:
+            # y as a time: d(κ r_y) = κ dr_y + r_y dκ, κ = c_ref p_z / (c Z_ref)
+            f = ry * kap / p[:, 2]
+            bR = np.einsum("i,mai->ma", beta[2], R)  # d p_z / d P
+            dP[:, 1] = kap[:, None] * dP[:, 1] + f[:, None] * bR
+            d6[:, 1, :3] = kap[:, None] * d6[:, 1, :3] - f[:, None] * bR
+            d6[:, 1, 3:] = kap[:, None] * d6[:, 1, 3:] + f[:, None] * np.einsum(
+                "i,mik->mk", beta[2], dq_drpy)
+            dnodes = w[:, None, :, None] * d6[:, :, None, :]
+            dLever = dLever.copy()
+            dLever[:, 1] = kap[:, None] * dLever[:, 1] - f[:, None] * beta[2]
+            dBore[:, 1] = kap[:, None] * dBore[:, 1] + f[:, None] * np.einsum(
+                "kj,mj->mk", dbeta[:, 2, :], q)
+            dC[:, 1] = kap * dC[:, 1] - ry * kap / c
+            dDist[:, 1] *= kap[:, None]
+        rep = np.repeat
+        jac = {
+            nm["points"]: Indexed(rep(self.point, 2), dP.reshape(2 * m, 3)),
+            nm["nodes"]: Indexed(rep(idx, 2, axis=0), dnodes.reshape(2 * m, 4, 6)),
+            nm["boresight"]: dBore.reshape(2 * m, 3),
+            nm["lever_arm"]: dLever.reshape(2 * m, 3),
+            nm["distortion"]: dDist.reshape(2 * m, 4),
+            nm["c"]: Indexed(rep(self.band, 2), dC.reshape(2 * m, 1)),
+        }
+        return r, jac
+
+    def evaluate(self, values, jacobian):
+        nm = self.names
+        m = self.point.size
+        idx, w = self._basis
+        bore = values[nm["boresight"]]
+        beta = R_from_opk(bore[0], bore[1], bore[2]) @ self.beta0
+        dbeta = dR_dopk(bore[0], bore[1], bore[2]) @ self.beta0
+        r = np.empty(2 * m)
+        shp = (2 * m,) if jacobian else (0,)
+        dP = np.empty(shp + (3,))
+        dN = np.empty(shp + (4, 6))
+        dB = np.empty(shp + (3,))
+        dL = np.empty(shp + (3,))
+        dD = np.empty(shp + (4,))
+        dC = np.empty(shp + (1,))
+        _lines_kernel(np.ascontiguousarray(values[nm["points"]], dtype=np.float64), self.point,
+                      idx, w, np.ascontiguousarray(values[nm["nodes"]], dtype=np.float64),
+                      self.xyz_nav, self.rpy_nav, self.band,
+                      np.asarray(values[nm["c"]], dtype=np.float64),
+                      np.asarray(values[nm["distortion"]], dtype=np.float64), beta, dbeta,
+                      np.asarray(values[nm["lever_arm"]], dtype=np.float64), self.x0_mm,
+                      self.y0_mm, 1.0 / self.pixel_mm, self.xy_px, bool(jacobian), r, dP, dN,
+                      dB, dL, dD, dC, self.y_time_k)
+        if not jacobian:
+            return r, None
+        rep = np.repeat
+        jac = {
+            nm["points"]: Indexed(self._pidx2, dP),
+            nm["nodes"]: Indexed(self._idx2, dN),
+            nm["boresight"]: dB,
+            nm["lever_arm"]: dL,
+            nm["distortion"]: dD,
+            nm["c"]: Indexed(rep(self.band, 2), dC),
+        }
+        return r, jac

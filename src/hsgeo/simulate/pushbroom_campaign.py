@@ -1,0 +1,293 @@
+"""The aerial HySpex VNIR-1800 campaign of 002 §4, simulated with its published values as truth.
+
+Geometry (002 §4, Fig. 5): a 600 m × 600 m area; 8 flight lines at 1875 m AGL and 4 at 2500 m
+AGL (the 2500 m ones over the centre), each flown twice with opposite headings (24 strips), at
+67 m/s, 200 lines per second, 1800 px of 6.5 µm, principal distance ≈ 40 mm (FoV 16.6°), seven
+bands ~77 nm apart. One continuous trajectory, turns included (the turns carry no observations;
+their spline nodes are held by the GNSS/INS priors).
+
+Truth and errors:
+
+* the platform attitude has high-frequency motion of a gyro-stabilised mount, which the INS
+  records exactly (it is in both the truth and the navigation solution);
+* the navigation solution differs from the truth by a smooth low-frequency error: a local cubic
+  B-spline (:mod:`hsgeo.trajectory`) with nodes every 10 s (002 §4) whose node values are drawn
+  from the GNSS/INS σ (002 §4: < 1.3 cm E/N, < 2 cm H; attitude from the POS-AV 510 class,
+  heading worst). The adjustment's node corrections therefore have a true value;
+* boresight of a few tenths of a degree, a lever arm measured to 2 cm, Brown K1, K2, P1, P2 of a
+  few tenths of a pixel at the line's end, and one principal distance per band whose spread
+  about the 40.3 mm mean is ≤ 11.8 µm (002 Fig. 8);
+* tie points: ``round(113758 · scale)`` (002 §4), each seen in one band in ≥ 3 lines of ≥ 3
+  different strips (on average 3.88 observations, 441587 / 113758, 002 §4), registered at the
+  pixel centre (uniform error within the pixel) in the line closest in time to the point's
+  crossing, plus 0.3 % gross errors;
+* 17 reference squares (4 GCPs, 13 CPs, RTK σ ≈ 1 cm), seen in every strip that covers them.
+
+``noise_free=True`` records the exact image coordinates of each line (no pixel quantisation,
+no gross errors, and the GCP coordinates exact): the adjustment must then recover the truth to
+numerical precision.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from hsgeo.errors import InputError
+from hsgeo.sensors.pushbroom import BETA0_CAM_FROM_PLATFORM, BLOCK_NAMES, project
+from hsgeo.trajectory import SplineNodes
+
+__all__ = ["CampaignConfig", "Campaign", "simulate"]
+
+DEG = np.pi / 180
+
+
+@dataclass(frozen=True)
+class CampaignConfig:
+    """Published values of 002 §4 (and the simulation's own choices, marked)."""
+
+    n_tie_points_full: int = 113758  # 002 §4
+    obs_per_point_mean: float = 441587 / 113758  # 002 §4: 2D observations / tie points
+    pixels_per_line: int = 1800  # 002 §4
+    pixel_mm: float = 0.0065  # 002 §4: 6.5 µm
+    c_nominal_mm: float = 40.0  # 002 §4: initial principal distance 4 cm
+    c_mean_mm: float = 40.3  # 002 Fig. 8: mean of the estimated principal distances
+    # per-band principal distance minus the mean, µm: spread ≤ 11.8 µm (002 Fig. 8); the
+    # shape (decreasing with wavelength) is our choice
+    c_offsets_um: tuple = (11.0, 6.5, 2.9, -1.0, -4.6, -7.3, -7.5)
+    wavelengths_nm: tuple = (450.0, 527.0, 604.0, 681.0, 758.0, 835.0, 912.0)  # ~77 nm, 002 §4
+    speed_m_s: float = 67.0  # 002 §4
+    line_rate_hz: float = 200.0  # 002 §4: 200 lines ≈ 1 s
+    area_m: float = 600.0  # 002 §4
+    agl_low_m: float = 1875.0  # 002 §4
+    agl_high_m: float = 2500.0  # 002 §4
+    lines_low_east_m: tuple = (-350.0, -250.0, -150.0, -50.0, 50.0, 150.0, 250.0, 350.0)  # ours
+    lines_high_east_m: tuple = (-150.0, -50.0, 50.0, 150.0)  # ours: over the centre (Fig. 5)
+    strip_half_length_m: float = 480.0  # ours: imaged length along each strip
+    turn_s: float = 60.0  # ours: time between strips
+    node_interval_s: float = 10.0  # 002 §4
+    sigma_pos_m: tuple = (0.013, 0.013, 0.020)  # 002 §4: GNSS/INS STD E, N, H
+    # POS-AV 510 post-processed attitude (Applanix spec: roll/pitch 0.005°, heading 0.008°)
+    sigma_att_rad: tuple = (0.005 * DEG, 0.005 * DEG, 0.008 * DEG)
+    boresight_deg: tuple = (0.25, -0.35, 0.15)  # ours: "a few tenths of a degree"
+    lever_arm_m: tuple = (0.12, -0.05, -0.30)  # ours
+    sigma_lever_m: float = 0.02  # ours: tape-measured lever arm
+    # Brown terms of 002 eq. (3), x̄ in mm: ≈ −1.2, 0.3, 0.5, −0.15 px at the line's end (ours)
+    distortion: tuple = (-4.0e-5, 3.0e-7, 2.5e-5, -3.0e-5)
+    x0_mm: float = 0.013  # principal point (fixed, calibrated), ours
+    y0_mm: float = 0.0
+    sigma_obs_px: float = 0.5  # 002 §4: observation precision 1/2 px
+    # ours, tuned: key-point localisation error before the registration at pixel centres, so
+    # that localisation ⊕ quantisation (≈ 0.42 px in x) is near the paper's conservative 1/2 px
+    sigma_keypoint_px: float = 0.35
+    outlier_share: float = 0.003  # ours: gross errors left after RANSAC
+    sigma_gcp_m: float = 0.01  # 002 §4: RTK ≈ 1 cm
+    terrain_relief_m: float = 15.0  # ours: tie points between 0 and 15 m above the datum
+    mount_motion_rad: float = 0.02 * DEG  # ours: residual motion of the stabilised mount
+
+
+@dataclass
+class Campaign:
+    """Truth, navigation and observations of one simulated campaign."""
+
+    cfg: CampaignConfig
+    scale: float
+    truth: dict  # parameter block name -> true value
+    nodes: SplineNodes  # the node layout of the true trajectory error
+    obs: dict  # point, band, t_s, xy_px, strip, xyz_nav_m, rpy_nav_rad, outlier
+    gcp_index: np.ndarray  # rows of the points block that are GCPs
+    cp_index: np.ndarray  # rows that are check points
+    gcp_xyz_m: np.ndarray  # RTK coordinates of the GCPs (with their error)
+    strips: list = field(default_factory=list)  # (t0, t1, east, agl, heading sign)
+    lever_arm_measured_m: np.ndarray | None = None
+    #: GNSS/INS prior mean of the node corrections: zero (the solution's own estimate), or the
+    #: truth in the noise-free mode (every pseudo-observation exact)
+    node_prior_mean: np.ndarray | None = None
+
+    @property
+    def n_points(self) -> int:
+        return self.truth[BLOCK_NAMES["points"]].shape[0]
+
+
+def _strip_plan(cfg: CampaignConfig):
+    """Strips in flight order: (t_start, t_end, east_m, agl_m, direction ±1)."""
+    L = 2 * cfg.strip_half_length_m / cfg.speed_m_s
+    plan = []
+    t = 0.0
+    lines = [(e, cfg.agl_low_m) for e in cfg.lines_low_east_m] + [
+        (e, cfg.agl_high_m) for e in cfg.lines_high_east_m
+    ]
+    for e, h in lines:
+        for direction in (+1, -1):
+            plan.append((t, t + L, e, h, direction))
+            t += L + cfg.turn_s
+    return plan
+
+
+def _mount_motion(t, amp):
+    """High-frequency residual attitude of the stabilised mount (recorded by the INS)."""
+    roll = amp * (0.6 * np.sin(2 * np.pi * 0.7 * t) + 0.4 * np.sin(2 * np.pi * 1.9 * t + 1.0))
+    pitch = amp * (0.5 * np.sin(2 * np.pi * 0.5 * t + 2.0) + 0.3 * np.sin(2 * np.pi * 2.3 * t))
+    yaw = amp * 0.5 * np.sin(2 * np.pi * 0.3 * t + 0.5)
+    return np.column_stack([roll, pitch, yaw])
+
+
+def _true_pose(plan, strip, t, amp, speed_m_s):
+    """True platform position and attitude at times ``t`` within strips ``strip``."""
+    t0 = np.array([p[0] for p in plan])[strip]
+    t1 = np.array([p[1] for p in plan])[strip]
+    east = np.array([p[2] for p in plan])[strip]
+    agl = np.array([p[3] for p in plan])[strip]
+    dirn = np.array([p[4] for p in plan], dtype=float)[strip]
+    tc = 0.5 * (t0 + t1)
+    north = dirn * (t - tc) * speed_m_s
+    xyz = np.column_stack([east, north, agl])
+    yaw = np.where(dirn > 0, np.pi / 2, -np.pi / 2)  # ENU yaw: platform x → north or south
+    rpy = _mount_motion(t, amp)
+    rpy[:, 2] += yaw
+    return xyz, rpy
+
+
+def simulate(scale: float = 1.0, rng=0, noise_free: bool = False,
+             cfg: CampaignConfig | None = None) -> Campaign:
+    """Simulate the campaign at ``scale`` (the share of the paper's tie points).
+
+    Parameters
+    ----------
+    scale : float in (0, 1]
+        Thins the tie points (1.0: 113,758 as in 002 §4). The flight, the reference squares and
+        the parameters do not change.
+    rng : int or numpy.random.Generator
+    noise_free : bool
+        Exact image coordinates, no outliers, exact GCPs (for the noise-free recovery test).
+    cfg : CampaignConfig, optional
+        Defaults to 002's values.
+    """
+    if not (0 < scale <= 1.0):
+        raise InputError(f"scale must be in (0, 1], got {scale!r}")
+    cfg = cfg or CampaignConfig()
+    rng = np.random.default_rng(rng)
+    plan = _strip_plan(cfg)
+    t_end = plan[-1][1]
+    nodes = SplineNodes(0.0, t_end, cfg.node_interval_s)
+    nb = len(cfg.c_offsets_um)
+    names = BLOCK_NAMES
+
+    # -- truth of the camera and the trajectory errors
+    node_err = rng.standard_normal((nodes.n_nodes, 6)) * np.r_[cfg.sigma_pos_m, cfg.sigma_att_rad]
+    lever = np.array(cfg.lever_arm_m)
+    truth = {
+        names["nodes"]: node_err,
+        names["boresight"]: np.array(cfg.boresight_deg) * DEG,
+        names["lever_arm"]: lever,
+        names["distortion"]: np.array(cfg.distortion),
+        names["c"]: cfg.c_mean_mm + (np.array(cfg.c_offsets_um)
+                                     - np.mean(cfg.c_offsets_um)) * 1e-3,
+    }
+    lever_measured = lever + (0.0 if noise_free else 1.0) * cfg.sigma_lever_m * (
+        rng.standard_normal(3))
+
+    # -- points: reference squares first, then tie points
+    half = cfg.area_m / 2
+    n_tie = max(int(round(cfg.n_tie_points_full * scale)), 50)
+    ref_en = np.array([[-270, -270], [270, -270], [-270, 270], [270, 270],  # 4 GCPs (corners)
+                       [0, 0], [-150, 0], [150, 0], [0, -150], [0, 150], [-150, -150],
+                       [150, 150], [-150, 150], [150, -150], [-270, 0], [270, 0], [0, -270],
+                       [0, 270]], dtype=float)
+    ref_en += rng.uniform(-20, 20, ref_en.shape)
+    tie_en = rng.uniform(-half, half, (n_tie, 2))
+    en = np.vstack([ref_en, tie_en])
+    h = np.r_[rng.uniform(0, 2, len(ref_en)), rng.uniform(0, cfg.terrain_relief_m, n_tie)]
+    P = np.column_stack([en, h])
+    truth[names["points"]] = P
+    n_pts = len(P)
+    is_ref = np.zeros(n_pts, bool)
+    is_ref[: len(ref_en)] = True
+    band_of_point = np.r_[rng.integers(0, 3, len(ref_en)), rng.integers(0, nb, n_tie)]
+
+    # -- which strips see which points: inside the swath (with a 3 % margin) and the strip
+    c_fov = cfg.c_nominal_mm
+    half_line_mm = cfg.pixels_per_line / 2 * cfg.pixel_mm
+    east = np.array([p[2] for p in plan])
+    agl = np.array([p[3] for p in plan])
+    half_swath = 0.97 * half_line_mm / c_fov * (agl - 0)  # m on the ground
+    covers = np.abs(en[:, 0:1] - east[None, :]) < half_swath[None, :] * (
+        1 - h[:, None] / agl[None, :])
+    covers &= np.abs(en[:, 1:2]) < cfg.strip_half_length_m - 30
+    ncov = covers.sum(axis=1)
+    if np.any(ncov < 3):
+        raise InputError("simulated flight plan leaves points seen by fewer than 3 strips")
+    extra = cfg.obs_per_point_mean - 3.0
+    n_obs = np.where(is_ref, ncov, np.minimum(ncov, 3 + rng.poisson(extra, n_pts)))
+    pt_list, strip_list = [], []
+    for i in range(n_pts):  # vectorising this is not worth it: 114k cheap iterations
+        cand = np.flatnonzero(covers[i])
+        chosen = cand if is_ref[i] else rng.choice(cand, n_obs[i], replace=False)
+        pt_list.append(np.full(len(chosen), i))
+        strip_list.append(chosen)
+    pidx = np.concatenate(pt_list)
+    strip = np.concatenate(strip_list)
+    band = band_of_point[pidx]
+    m = pidx.size
+
+    # -- the line that sees each point: Newton on the true y image coordinate in time
+    beta0 = BETA0_CAM_FROM_PLATFORM
+    t0s = np.array([p[0] for p in plan])
+    t1s = np.array([p[1] for p in plan])
+    tc = 0.5 * (t0s + t1s)[strip]
+    dirn = np.array([p[4] for p in plan], float)[strip]
+    t = tc + dirn * P[pidx, 1] / cfg.speed_m_s
+
+    def true_xy(tt):
+        xyz, rpy = _true_pose(plan, strip, tt, cfg.mount_motion_rad, cfg.speed_m_s)
+        # truth = nav + δ(t): project with the true pose, zero corrections
+        vals = dict(truth)
+        vals[names["nodes"]] = np.zeros_like(node_err)
+        xy, p = project(vals, names, nodes, tt, xyz, rpy, pidx, band, beta0,
+                        cfg.x0_mm, cfg.y0_mm)
+        return xy, p
+
+    for _ in range(6):
+        xy, _ = true_xy(t)
+        dt = 1e-3
+        xy2, _ = true_xy(t + dt)
+        deriv = (xy2[:, 1] - xy[:, 1]) / dt
+        t = t - xy[:, 1] / deriv  # the line is y = 0 (pixel centre of the line)
+    line_dt = 1.0 / cfg.line_rate_hz
+    # key-point localisation error (ours, see CampaignConfig): x along the line, and in y an
+    # error of the matched line, i.e. of the time
+    loc = (0.0 if noise_free else cfg.sigma_keypoint_px) * rng.standard_normal((m, 2))
+    t_loc = t - loc[:, 1] * cfg.pixel_mm / deriv
+    t_line = np.round(t_loc / line_dt) * line_dt
+    xy_true_mm, pc = true_xy(t_line)
+    if np.any(pc[:, 2] <= 0):
+        raise InputError("simulated points behind the camera: check the flight plan")
+    xy_true_px = xy_true_mm / cfg.pixel_mm
+    # navigation solution at the line times: truth minus the spline error
+    xyz_true, rpy_true = _true_pose(plan, strip, t_line, cfg.mount_motion_rad, cfg.speed_m_s)
+    delta = nodes.evaluate(node_err, t_line)
+    xyz_nav = xyz_true - delta[:, :3]
+    rpy_nav = rpy_true - delta[:, 3:]
+
+    if noise_free:
+        xy_obs = xy_true_px.copy()
+        outlier = np.zeros(m, bool)
+        gcp_xyz = P[:4].copy()
+    else:
+        # registered at pixel centres along the line, and in the line itself (y = 0)
+        # registered at the pixel centre along the line, and in the line itself (y = 0)
+        xy_obs = np.column_stack([np.floor(xy_true_px[:, 0] + loc[:, 0]) + 0.5, np.zeros(m)])
+        outlier = rng.random(m) < cfg.outlier_share
+        n_out = int(outlier.sum())
+        mag = rng.uniform(3, 20, n_out) * rng.choice([-1, 1], n_out)
+        comp = rng.integers(0, 2, n_out)
+        xy_obs[np.flatnonzero(outlier), comp] += mag
+        gcp_xyz = P[:4] + cfg.sigma_gcp_m * rng.standard_normal((4, 3))
+    obs = {"point": pidx, "band": band, "t_s": t_line, "xy_px": xy_obs, "strip": strip,
+           "xyz_nav_m": xyz_nav, "rpy_nav_rad": rpy_nav, "outlier": outlier,
+           "xy_true_px": xy_true_px}
+    return Campaign(cfg=cfg, scale=scale, truth=truth, nodes=nodes, obs=obs,
+                    gcp_index=np.arange(4), cp_index=np.arange(4, 17), gcp_xyz_m=gcp_xyz,
+                    strips=plan, lever_arm_measured_m=lever_measured,
+                    node_prior_mean=node_err.copy() if noise_free else np.zeros_like(node_err))
