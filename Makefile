@@ -9,7 +9,6 @@ STAMP := $(VENV)/.hsgeo-installed
 # than one thread on the small dense solves of our adjustments (GUIDE §9; `make bench` measures it).
 export OPENBLAS_NUM_THREADS ?= 1
 export OMP_NUM_THREADS ?= 1
-export MPLBACKEND := Agg
 export PYDEVD_DISABLE_FILE_VALIDATION := 1
 
 .DEFAULT_GOAL := help
