@@ -45,7 +45,7 @@ book/_build/.library-stamp: $(shell find src/hsgeo data_synthetic -name '*.py' -
 
 book: $(STAMP) book/_build/.library-stamp ## execute every chapter and render the HTML book to book/_build/html (offline; ~15 min on 2 cores from an empty cache)
 	$(PY) -m hsgeo.cli data --verify
-	rm -rf book/_build/html
+	rm -rf book/_build/html book/_build/.doctrees book/_build/jupyter_execute
 	$(VENV)/bin/jupyter-book build book -W -n --keep-going
 
 bench: $(STAMP) ## run the benchmarks, results as JSON in bench/results/
