@@ -452,16 +452,9 @@ def read_sensor_toml(path):
         K = [1.459, -0.1636, 0.00526] # calibrated only; δ in px, (ζ − ζ0) in units of 100 px
         boresight_deg = [0.0, 0.0, 0.0]   # roll, pitch, heading of R_body_from_sensor
     """
-    import tomllib
-    from pathlib import Path
+    from hsgeo.io import read_toml
 
-    path = Path(path)
-    if not path.is_file():
-        raise InputError(f"{path}: no such sensor file")
-    try:
-        cfg = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{path}: malformed TOML: {exc}") from None
+    cfg = read_toml(path, "sensor file")
     s = cfg.get("sensor")
     if s is None:
         raise InputError(f"{path}: missing [sensor] table")

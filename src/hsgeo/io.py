@@ -190,3 +190,19 @@ def read_envi(path) -> tuple[np.ndarray, dict]:
         parts = [p.strip() for p in hdr["map info"].strip("{}").split(",")]
         hdr["map_info"] = tuple(float(x) for x in parts[3:7])
     return data, hdr
+
+
+def read_toml(path, what: str = "file") -> dict:
+    """Read a TOML file; a missing or malformed file raises :class:`~hsgeo.InputError`.
+
+    ``what`` names the file's role in the message (``"sensor file"``, ``"board file"``).
+    """
+    import tomllib
+
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"{what} {path} not found")
+    try:
+        return tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"{path}: malformed TOML: {exc}") from None

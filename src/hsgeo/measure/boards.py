@@ -23,7 +23,6 @@ are averaged into one virtual point, as in 003 §3.2.
 from __future__ import annotations
 
 import re
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -61,13 +60,10 @@ def load_board(path) -> Board:
     """Read a board TOML file (module docstring); errors name the missing key."""
     import cv2
 
+    from hsgeo.io import read_toml
+
     path = Path(path)
-    if not path.is_file():
-        raise InputError(f"board file {path} not found")
-    try:
-        cfg = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{path}: malformed TOML: {exc}") from exc
+    cfg = read_toml(path, "board file")
     b = cfg.get("board")
     if not isinstance(b, dict):
         raise InputError(f"{path}: needs a [board] table (see hsgeo.measure.boards)")

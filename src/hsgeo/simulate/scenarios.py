@@ -13,7 +13,6 @@ from __future__ import annotations
 import hashlib
 import importlib
 import sys
-import tomllib
 from pathlib import Path
 
 from hsgeo.errors import InputError
@@ -36,11 +35,9 @@ def load_scenario(name: str) -> dict:
     if not path.is_file():
         known = sorted(p.stem for p in data_dir().glob("*.toml"))
         raise InputError(f"no scenario {name!r} in {data_dir()}; known: {known}")
-    try:
-        with path.open("rb") as fh:
-            cfg = tomllib.load(fh)
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{path}: malformed TOML: {exc}") from exc
+    from hsgeo.io import read_toml
+
+    cfg = read_toml(path, "scenario")
     if "scenario" not in cfg or "generator" not in cfg["scenario"]:
         raise InputError(f"{path}: missing [scenario] table with a 'generator' entry")
     return cfg
