@@ -81,8 +81,11 @@ def test_truth_within_3_sigma_small_scale(seed):
     for k in ["boresight_rad", "lever_arm_m", "distortion", "c_mm"]:
         z = (res.value(k) - camp.truth[k]) / res.sigma(k)
         assert np.max(np.abs(z)) < 3.5, (k, z)  # 17 values: family-wise ≈ 1 % false alarms
+    # ~1,000 node corrections: a few |z| > 3 are expected (0.27 %), so assert the coverage and
+    # the spread of z rather than max |z| < 3
     z = (res.value("nodes") - camp.truth["nodes"]) / res.sigma("nodes")
-    assert np.mean(np.abs(z) < 3) > 0.99
+    assert np.mean(np.abs(z) < 3) >= 0.99
+    assert 0.8 <= np.std(z) <= 1.2, np.std(z, axis=0)
     r = res.residuals(0).reshape(-1, 2)[~res.outliers(0)]
     assert np.all((nmad(r, axis=0) > 0.2) & (nmad(r, axis=0) < 0.5))
     cp = res.value("points_m")[camp.cp_index] - camp.truth["points_m"][camp.cp_index]

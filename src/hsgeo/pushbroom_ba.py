@@ -57,11 +57,18 @@ def _rays(obs, cam: CameraPrior, c_mm, boresight_rad, lever_arm_m):
     return o, d
 
 
-def intersect_two_rays(point, origin, direction, n_points):
+def intersect_two_rays(point, origin, direction, n_points, min_angle_deg: float = 20.0):
     """Initial point coordinates from the two most divergent rays of each point.
 
     For each point, the first ray and the ray making the largest angle with it are intersected
-    (midpoint of their closest approach).
+    (midpoint of their closest approach). An intersection is only as good as the angle between
+    the rays: before the adjustment the boresight is unknown (a few tenths of a degree, i.e.
+    ~10 m across the ray at 2 km), so a ray pair at 3° puts the point ~200 m off along the ray,
+    far outside the range where the model is nearly linear (the first Gauss–Newton steps then
+    fail and the damping grows). Points whose best pair meets at less than ``min_angle_deg``
+    are therefore put where their first ray meets the plane of the median intersection height
+    (the usual "mean terrain height" start of aerial triangulation); at the 16.6° field of view
+    of 002 that is every point.
 
     Returns
     -------
@@ -97,7 +104,7 @@ def intersect_two_rays(point, origin, direction, n_points):
     good = (b < np.cos(np.deg2rad(0.5))) & (s > 0) & (u > 0)
     h_med = np.median(xyz[good, 2]) if good.any() else 0.0
     far = np.abs(xyz[:, 2] - h_med) > 0.25 * np.median(np.abs(o1[:, 2] - h_med))
-    bad = ~good | far
+    bad = ~good | far | (b > np.cos(np.deg2rad(min_angle_deg)))
     lam = (h_med - o1[bad, 2]) / np.where(np.abs(d1[bad, 2]) > 1e-9, d1[bad, 2], -1e-9)
     xyz[bad] = o1[bad] + lam[:, None] * d1[bad]
     return xyz
@@ -288,7 +295,7 @@ def adjust_files(observations, trajectory, camera, gcp=None, *, node_interval_s:
         gx = g[["E_m", "N_m", "H_m"]].to_numpy(dtype=float)
     p, blocks, nodes = build_problem(obs, ids.size, cam, node_interval_s=node_interval_s,
                                      gcp_index=gi, gcp_xyz_m=gx, y_as_time=y_as_time)
-    res = adjust(p, blocks, reject_k=reject_k, ftol=1e-8, progress=progress)
+    res = adjust(p, blocks, reject_k=reject_k, ftol=1e-6, progress=progress)
     out = {
         "converged": res.converged, "iterations": res.iterations, "sigma0": res.sigma0,
         "n_observations_2d": int(len(obs_df)), "n_points": int(ids.size),

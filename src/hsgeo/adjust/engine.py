@@ -133,6 +133,9 @@ class _RowJac:
 #: Both compute the same normal equations; the tests compare them.
 FAST = True
 
+#: Relative cost decrease at which an intermediate outlier-rejection round stops (see adjust).
+REJECT_ROUND_FTOL = 1e-4
+
 
 @dataclass
 class _System:
@@ -407,19 +410,33 @@ def _W_sparse(sy: _System, n_pts: int) -> sp.csr_matrix:
     return (sy.Jc.T @ Jp_sp).tocsr()
 
 
+#: The last sparsity structure seen by _normal and its processing orders (one entry).
+_ORDER_CACHE: dict = {}
+
+
 def _normal(layout: _Layout, sy: _System) -> _Normal:
     order = ptr = pt_order = None
     if FAST:
         from hsgeo.adjust._fast import locality_orders, normal_cc
 
-        if layout.pblock is not None:
-            pi_all = sy.pidx
-            rows_p = np.flatnonzero(pi_all >= 0)
-            order = rows_p[np.argsort(pi_all[rows_p], kind="stable")].astype(np.int64)
-            ptr = np.concatenate(
-                [[0], np.cumsum(np.bincount(pi_all[rows_p], minlength=layout.n_pts))]
-            ).astype(np.int64)
-        row_order, pt_order = locality_orders(sy.Jrc.cols, layout.n_c, order, ptr)
+        key = _ORDER_CACHE.get("key")
+        if (key is not None and key[0] == layout.n_c and key[1] == layout.n_pts
+                and key[3] == sy.Jrc.cols.shape and np.array_equal(key[2], sy.pidx)):
+            # same rows and points as the previous iteration: reuse the processing orders
+            # (order and ptr depend only on pidx; row_order is a permutation of the rows that
+            # only affects speed, so a changed column pattern cannot make it wrong)
+            order, ptr, row_order, pt_order = _ORDER_CACHE["value"]
+        else:
+            if layout.pblock is not None:
+                pi_all = sy.pidx
+                rows_p = np.flatnonzero(pi_all >= 0)
+                order = rows_p[np.argsort(pi_all[rows_p], kind="stable")].astype(np.int64)
+                ptr = np.concatenate(
+                    [[0], np.cumsum(np.bincount(pi_all[rows_p], minlength=layout.n_pts))]
+                ).astype(np.int64)
+            row_order, pt_order = locality_orders(sy.Jrc.cols, layout.n_c, order, ptr)
+            _ORDER_CACHE["key"] = (layout.n_c, layout.n_pts, sy.pidx.copy(), sy.Jrc.cols.shape)
+            _ORDER_CACHE["value"] = (order, ptr, row_order, pt_order)
         Jrc = sy.Jrc
         gc, diag_cc = Jrc.rmatvec(sy.r, diag=True)
         if layout.pblock is None:
@@ -772,7 +789,13 @@ def adjust(
     rounds = 0
     converged = False
     message = ""
+    # while outliers are still being rejected, a round only needs to get close to its minimum
+    # (the residuals that decide the rejection do not change at 1e-4 relative cost); once a
+    # rejection pass finds nothing new, the iteration continues to ``ftol``
+    final = reject_k is None
     while True:
+        tol = ftol if final else max(ftol, REJECT_ROUND_FTOL)
+        sy = ne = full = None  # free the previous round's Jacobian first (peak memory)
         sy = _evaluate(layout, blocks, masks, jacobian=True)
         dof = sy.r.size - layout.n_unknowns
         if dof < 0 or (dof == 0 and sy.n_obs_rows < layout.n_unknowns):
@@ -812,7 +835,7 @@ def adjust(
                     break
             if lam > 1e16:
                 # no step decreases the cost: we are at the minimum to machine precision
-                converged = pred <= 1e3 * ftol * max(cost, 1e-300) or cost <= atol * sy.r.size
+                converged = pred <= 1e3 * tol * max(cost, 1e-300) or cost <= atol * sy.r.size
                 message = "no further decrease possible" if converged else (
                     "the damping grew without bound: the cost could not be decreased"
                 )
@@ -829,8 +852,9 @@ def adjust(
                         "rejected": int(sum((~m).sum() for m in masks)),
                     }
                 )
-            small = (cost - new_cost) <= ftol * cost and pred <= ftol * cost
+            small = (cost - new_cost) <= tol * cost and pred <= tol * cost
             cost = new_cost
+            sy = ne = trial = None  # free the old Jacobian before forming the new one
             sy = _evaluate(layout, blocks, masks, jacobian=True)
             ne = _normal(layout, sy)
             if small or cost <= atol * sy.r.size:
@@ -841,8 +865,11 @@ def adjust(
                 break
         else:
             message = f"not converged within max_iter={max_iter} iterations"
-        if not converged or reject_k is None or rounds >= max_reject_rounds:
+        if not converged or final:
             break
+        if rounds >= max_reject_rounds:
+            final = True
+            continue
         # -- outlier rejection: whole groups whose whitened residual exceeds reject_k robust σ
         scale = _robust_scale(sy)
         full = _evaluate(layout, blocks, [np.ones(b.m, dtype=bool) for b in blocks], False)
@@ -859,7 +886,9 @@ def adjust(
                 new_any = True
         rounds += 1
         if not new_any:
-            break
+            if tol <= ftol:
+                break
+            final = True
 
     result = AdjustmentResult._build(
         layout=layout,
