@@ -216,16 +216,9 @@ def read_table(path, columns, what: str):
 
 def read_camera(path) -> CameraPrior:
     """Camera and GNSS/INS priors from a TOML file (see :func:`adjust_files`)."""
-    import tomllib
-    from pathlib import Path
+    from hsgeo.io import read_toml
 
-    path = Path(path)
-    if not path.is_file():
-        raise InputError(f"camera file {str(path)!r} does not exist")
-    try:
-        cfg = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"camera file {str(path)!r}: malformed TOML: {exc}") from exc
+    cfg = read_toml(path, "camera file")
     cam = cfg.get("camera", {})
     nav = cfg.get("gnss_ins", {})
     if "n_bands" not in cam or "pixel_mm" not in cam or "c_mm" not in cam:
