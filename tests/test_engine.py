@@ -229,3 +229,17 @@ def test_compiled_path_equals_generic_path(monkeypatch, lam):
     np.testing.assert_allclose(r_fast.value("points"), r_slow.value("points"), atol=1e-10)
     np.testing.assert_allclose(r_fast.covariance, r_slow.covariance, rtol=1e-8)
     np.testing.assert_allclose(r_fast.sigma("points"), r_slow.sigma("points"), rtol=1e-8)
+
+
+def test_factored_indexed_expands_and_checks_shapes():
+    from hsgeo.adjust import Indexed
+
+    rng = np.random.default_rng(0)
+    idx = np.array([[0, 1], [2, 3], [1, 2]])
+    w = rng.random((3, 2))
+    d = rng.random((3, 4))
+    J = Indexed(idx, d, weights=w)
+    assert J.factored and J.k == 4
+    np.testing.assert_array_equal(J.expanded().d, w[:, :, None] * d[:, None, :])
+    with pytest.raises(InputError, match="factored"):
+        Indexed(idx, d, weights=w[:, :1])

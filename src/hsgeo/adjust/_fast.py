@@ -47,9 +47,32 @@ def _runs(cl, nl, run_l, run_c, run_n):  # pragma: no cover - compiled
     return nr
 
 
+@njit(cache=True, inline="always")
+def _expand_row(i, cols, vals, fcol, fw, fd, cl, v):  # pragma: no cover - compiled
+    """The non-zero entries of row i (slots, then the factored group) into cl, v; their count."""
+    n = 0
+    for s in range(cols.shape[1]):
+        c = cols[i, s]
+        if c >= 0 and vals[i, s] != 0.0:
+            cl[n] = c
+            v[n] = vals[i, s]
+            n += 1
+    kf = fd.shape[1]
+    for a in range(fcol.shape[1]):
+        c0 = fcol[i, a]
+        if c0 >= 0:
+            wa = fw[i, a]
+            for j in range(kf):
+                cl[n] = c0 + j
+                v[n] = wa * fd[i, j]
+                n += 1
+    return n
+
+
 @njit(cache=True, parallel=True)
-def _normal_cc_kernel(cols, vals, row_order, n_c, n_chunks):  # pragma: no cover - compiled
-    K = cols.shape[1]
+def _normal_cc_kernel(cols, vals, fcol, fw, fd, row_order, n_c,
+                      n_chunks):  # pragma: no cover - compiled
+    K = cols.shape[1] + fcol.shape[1] * fd.shape[1]
     M = row_order.size
     out = np.zeros((n_chunks, n_c, n_c))
     step = (M + n_chunks - 1) // n_chunks
@@ -62,13 +85,7 @@ def _normal_cc_kernel(cols, vals, row_order, n_c, n_chunks):  # pragma: no cover
         run_n = np.empty(K, dtype=np.int64)
         for ii in range(ch * step, min(M, (ch + 1) * step)):
             i = row_order[ii]
-            nl = 0
-            for s in range(K):
-                c = cols[i, s]
-                if c >= 0 and vals[i, s] != 0.0:
-                    cl[nl] = c
-                    v[nl] = vals[i, s]
-                    nl += 1
+            nl = _expand_row(i, cols, vals, fcol, fw, fd, cl, v)
             nr = _runs(cl, nl, run_l, run_c, run_n)
             for a in range(nl):
                 ca = cl[a]
@@ -86,101 +103,188 @@ def _normal_cc_kernel(cols, vals, row_order, n_c, n_chunks):  # pragma: no cover
 
 
 @njit(cache=True, parallel=True, fastmath=True)
-def _reduced_kernel(cols, vals, jp, order, ptr, pt_order, Vinv, n_c, cap,
+def _reduced_kernel(cols, vals, fcol, fw, fd, jp, order, ptr, pt_order, Vinv, n_c, capg, capc,
                     n_chunks):  # pragma: no cover - compiled
-    """Σ_i (J_c,iᵀ J_c,i − W_i V_i⁻¹ W_iᵀ) over the points (upper triangle).
+    """A with ``A + Aᵀ = Σ_i (J_c,iᵀ J_c,i − W_i V_i⁻¹ W_iᵀ)`` over the points.
 
-    Rows of point i are ``order[ptr[i]:ptr[i+1]]``; points are visited in ``pt_order``. Per
-    point, the normal-matrix and Schur contributions are formed on the point's local columns
-    (a small dense block, in cache) and scattered once into the dense result.
+    Rows of point i are ``order[ptr[i]:ptr[i+1]]``; points are visited in ``pt_order``.
+
+    Per point, the rows are compressed to *local* columns: each run of consecutive rows with
+    the same factored group (the same items and weights, e.g. the x and y of one observation
+    on the same spline nodes) is one *group* of ``kf`` local columns holding ``fd``; every
+    distinct slot column is one local column. On the ``L`` local columns (≈ 6 per observation
+    plus the camera's) the point's normal-matrix and Schur terms form a small dense matrix
+    ``C = Yᵀ Y − Z V⁻¹ Zᵀ`` (``Y`` the compressed rows, ``Z = Yᵀ J_p``), which is then expanded
+    into the global columns: group g's local column j stands for the columns ``fcol[a] + j``
+    with weight ``fw[a]``, so the block of groups (g, h) adds ``fw_g[a] fw_h[b] C[gj, hl]`` at
+    ``(fcol_g[a] + j, fcol_h[b] + l)``. This is exact: the weights factor out of every product.
+    Only one triangle of the pairs of local units is written (the diagonal units halved), hence
+    ``A + Aᵀ``.
     """
     n_pts = ptr.size - 1
     K = cols.shape[1]
+    Q = fcol.shape[1]
+    kf = fd.shape[1]
     p = jp.shape[1]
+    Lmax = capg * kf + capc
     out = np.zeros((n_chunks, n_c, n_c))
     step = (n_pts + n_chunks - 1) // n_chunks
     for ch in prange(n_chunks):
-        S = out[ch]
+        A = out[ch]
         pos = np.full(n_c, -1, dtype=np.int64)
-        cl = np.empty(cap, dtype=np.int64)
-        G = np.zeros((cap, cap))
-        Z = np.zeros((p, cap))  # W_iᵀ on the local columns, transposed: contiguous per k
-        T = np.zeros((cap, p))  # Z V⁻¹
-        la = np.empty(K, dtype=np.int64)
+        gl = np.empty(capc, dtype=np.int64)  # global column of each local slot column
+        grow = np.empty(capg, dtype=np.int64)  # a row of each group (its items and weights)
+        C = np.zeros((Lmax, Lmax))
+        Z = np.zeros((p, Lmax))
+        T = np.zeros((Lmax, p))
+        R = np.zeros((kf, Q * kf))
+        li = np.empty(K + kf, dtype=np.int64)
+        lv = np.empty(K + kf)
         for ii in range(ch * step, min(n_pts, (ch + 1) * step)):
             i = pt_order[ii]
             a0, a1 = ptr[i], ptr[i + 1]
             if a1 == a0:
                 continue
+            # -- groups and slot columns of the point's rows
+            ng = 0
             nl = 0
-            # local column list: union over the point's rows (a row repeating the previous
-            # row's columns, e.g. the y of an x, adds nothing)
             for rr in range(a0, a1):
                 r = order[rr]
-                if rr > a0:
-                    rp = order[rr - 1]
-                    same = True
-                    for s in range(K):
-                        if cols[r, s] != cols[rp, s]:
-                            same = False
-                            break
+                has_f = False
+                for a in range(Q):
+                    if fcol[r, a] >= 0:
+                        has_f = True
+                if has_f:
+                    same = ng > 0
                     if same:
-                        continue
+                        r0 = grow[ng - 1]
+                        for a in range(Q):
+                            if fcol[r, a] != fcol[r0, a] or fw[r, a] != fw[r0, a]:
+                                same = False
+                                break
+                    if not same:
+                        grow[ng] = r
+                        ng += 1
                 for s in range(K):
                     c = cols[r, s]
                     if c >= 0 and pos[c] < 0:
-                        pos[c] = 0
-                        cl[nl] = c
+                        pos[c] = nl
+                        gl[nl] = c
                         nl += 1
-            cl[:nl].sort()
-            for a in range(nl):
-                pos[cl[a]] = a
+            L = ng * kf + nl
+            for a in range(L):
+                for b in range(L):
+                    C[a, b] = 0.0
                 for k in range(p):
                     Z[k, a] = 0.0
-                for b in range(a, nl):
-                    G[a, b] = 0.0
-            # G = J_cᵀ J_c and Z = W_iᵀ on the local columns
+            # -- C = Yᵀ Y and Z = Yᵀ J_p on the local columns
+            g = -1
             for rr in range(a0, a1):
                 r = order[rr]
+                n = 0
+                if g + 1 < ng and grow[g + 1] == r:
+                    g += 1
+                has_f = False
+                for a in range(Q):
+                    if fcol[r, a] >= 0:
+                        has_f = True
+                if has_f:
+                    for j in range(kf):
+                        li[n] = g * kf + j
+                        lv[n] = fd[r, j]
+                        n += 1
                 for s in range(K):
                     c = cols[r, s]
-                    la[s] = pos[c] if c >= 0 else -1
-                for s in range(K):
-                    l1 = la[s]
-                    if l1 < 0:
-                        continue
-                    v = vals[r, s]
+                    if c >= 0:
+                        li[n] = ng * kf + pos[c]
+                        lv[n] = vals[r, s]
+                        n += 1
+                for e in range(n):
+                    la = li[e]
+                    va = lv[e]
                     for k in range(p):
-                        Z[k, l1] += v * jp[r, k]
-                    for s2 in range(K):
-                        l2 = la[s2]
-                        if l2 >= l1:
-                            G[l1, l2] += v * vals[r, s2]
-            # T = Z V⁻¹
-            for a in range(nl):
+                        Z[k, la] += va * jp[r, k]
+                    Crow = C[la]
+                    for e2 in range(n):
+                        Crow[li[e2]] += va * lv[e2]
+            # -- C −= Z V⁻¹ Zᵀ
+            for a in range(L):
                 for k in range(p):
                     acc = 0.0
                     for j in range(p):
                         acc += Z[j, a] * Vinv[i, j, k]
                     T[a, k] = acc
-            # scatter G − T Zᵀ (upper triangle) into S
-            for a in range(nl):
-                ca = cl[a]
-                Srow = S[ca]
-                Grow = G[a]
-                if p == 3:
-                    t0, t1, t2 = T[a, 0], T[a, 1], T[a, 2]
-                    Z0, Z1, Z2 = Z[0], Z[1], Z[2]
-                    for b in range(a, nl):
-                        Srow[cl[b]] += Grow[b] - (t0 * Z0[b] + t1 * Z1[b] + t2 * Z2[b])
-                else:
-                    for b in range(a, nl):
-                        acc = 0.0
-                        for k in range(p):
-                            acc += T[a, k] * Z[k, b]
-                        Srow[cl[b]] += Grow[b] - acc
-            for a in range(nl):
-                pos[cl[a]] = -1
+            for a in range(L):
+                Crow = C[a]
+                for k in range(p):
+                    t = T[a, k]
+                    Zk = Z[k]
+                    for b in range(L):
+                        Crow[b] -= t * Zk[b]
+            # -- expand into the global columns
+            for g in range(ng):
+                rg = grow[g]
+                for h in range(g, ng):
+                    rh = grow[h]
+                    half = 0.5 if h == g else 1.0
+                    # items of h on consecutive columns (spline nodes): one contiguous run of
+                    # Q·kf columns per global row, R[j] = (fw_h ⊗ C[gj, h·])
+                    cb0 = fcol[rh, 0]
+                    run = cb0 >= 0
+                    for b in range(1, Q):
+                        if fcol[rh, b] != cb0 + b * kf:
+                            run = False
+                    if run:
+                        for j in range(kf):
+                            Crow = C[g * kf + j]
+                            for b in range(Q):
+                                wb = fw[rh, b]
+                                for l in range(kf):
+                                    R[j, b * kf + l] = wb * Crow[h * kf + l]
+                        for a in range(Q):
+                            ca = fcol[rg, a]
+                            if ca < 0:
+                                continue
+                            wa = half * fw[rg, a]
+                            for j in range(kf):
+                                Aseg = A[ca + j, cb0 : cb0 + Q * kf]
+                                Rj = R[j]
+                                for e in range(Q * kf):
+                                    Aseg[e] += wa * Rj[e]
+                        continue
+                    for a in range(Q):
+                        ca = fcol[rg, a]
+                        if ca < 0:
+                            continue
+                        wa = half * fw[rg, a]
+                        for b in range(Q):
+                            cb = fcol[rh, b]
+                            if cb < 0:
+                                continue
+                            wab = wa * fw[rh, b]
+                            for j in range(kf):
+                                Arow = A[ca + j]
+                                Crow = C[g * kf + j]
+                                for l in range(kf):
+                                    Arow[cb + l] += wab * Crow[h * kf + l]
+                for a in range(Q):
+                    ca = fcol[rg, a]
+                    if ca < 0:
+                        continue
+                    wa = fw[rg, a]
+                    for j in range(kf):
+                        Arow = A[ca + j]
+                        Crow = C[g * kf + j]
+                        for e in range(nl):
+                            Arow[gl[e]] += wa * Crow[ng * kf + e]
+            for e in range(nl):
+                Arow = A[gl[e]]
+                Crow = C[ng * kf + e]
+                Arow[gl[e]] += 0.5 * Crow[ng * kf + e]
+                for e2 in range(e + 1, nl):
+                    Arow[gl[e2]] += Crow[ng * kf + e2]
+            for e in range(nl):
+                pos[gl[e]] = -1
     return out
 
 
@@ -191,16 +295,20 @@ def _symmetrise_upper(U: np.ndarray) -> np.ndarray:
     return S
 
 
-def locality_orders(cols: np.ndarray, n_c: int, order: np.ndarray | None, ptr: np.ndarray | None):
+def locality_orders(J, n_c: int, order: np.ndarray | None, ptr: np.ndarray | None):
     """Row and point processing orders that keep consecutive updates in nearby rows of S.
 
-    Rows are sorted by their smallest column, points by the smallest and largest column of
-    their rows: consecutive points then touch mostly the same rows of the dense matrix, which
-    stay in cache (the kernels are limited by memory latency, not arithmetic).
+    Rows are sorted by their smallest column (``J`` a row-compressed Jacobian,
+    ``hsgeo.adjust.engine._RowJac``): consecutive rows then touch mostly the same rows of the
+    dense matrix, which stay in cache (the kernels are limited by memory latency, not
+    arithmetic).
     """
     big = np.int64(n_c)
+    cols = J.cols
     c = np.where(cols >= 0, cols, big)
     rmin = c.min(axis=1) if cols.shape[1] else np.full(cols.shape[0], big)
+    if J.fcol.shape[1]:
+        rmin = np.minimum(rmin, np.where(J.fcol >= 0, J.fcol, big).min(axis=1))
     row_order = np.argsort(rmin, kind="stable").astype(np.int64)
     if order is None or ptr is None or ptr.size < 2:
         return row_order, None
@@ -208,36 +316,41 @@ def locality_orders(cols: np.ndarray, n_c: int, order: np.ndarray | None, ptr: n
     return row_order, np.arange(ptr.size - 1, dtype=np.int64)
 
 
-def normal_cc(cols: np.ndarray, vals: np.ndarray, n_c: int, row_order=None) -> np.ndarray:
-    """``J_cᵀ J_c`` (dense ``n_c × n_c``) of a row-compressed Jacobian."""
+def normal_cc(arrays, n_c: int, row_order=None) -> np.ndarray:
+    """``J_cᵀ J_c`` (dense ``n_c × n_c``) of a row-compressed Jacobian's ``arrays``."""
+    cols = arrays[0]
     if n_c == 0 or cols.shape[0] == 0:
         return np.zeros((n_c, n_c))
     if row_order is None:
         row_order = np.arange(cols.shape[0], dtype=np.int64)
     row_order = np.asarray(row_order, dtype=np.int64)
     nch = max(1, min(n_threads(), row_order.size // 10000 + 1))
-    parts = _normal_cc_kernel(cols, vals, row_order, n_c, nch)
+    parts = _normal_cc_kernel(*arrays, row_order, n_c, nch)
     return _symmetrise_upper(parts.sum(axis=0) if nch > 1 else parts[0])
 
 
-def reduced_points(cols, vals, jp, order, ptr, Vinv, n_c: int, pt_order=None) -> np.ndarray:
+def reduced_points(arrays, jp, order, ptr, Vinv, n_c: int, pt_order=None) -> np.ndarray:
     """``Σ_i (J_c,iᵀ J_c,i − W_i V_i⁻¹ W_iᵀ)`` (dense ``n_c × n_c``) over the points' rows."""
     n_pts = ptr.size - 1
     if n_c == 0 or n_pts == 0:
         return np.zeros((n_c, n_c))
     if pt_order is None:
         pt_order = np.arange(n_pts, dtype=np.int64)
+    cols, _, fcol, _, _ = arrays
     max_rows = int(np.max(np.diff(ptr))) if n_pts else 0
-    cap = int(min(n_c, max(1, max_rows * cols.shape[1])))
+    capg = max_rows if fcol.shape[1] else 0
+    capc = int(min(n_c, max(1, max_rows * cols.shape[1])))
     nch = max(1, min(n_threads(), n_pts // 2000 + 1))
-    parts = _reduced_kernel(cols, vals, jp, order, ptr, pt_order, Vinv, n_c, cap, nch)
-    return _symmetrise_upper(parts.sum(axis=0) if nch > 1 else parts[0])
+    parts = _reduced_kernel(*arrays, jp, order, ptr, pt_order, Vinv, n_c, capg, capc, nch)
+    A = parts.sum(axis=0) if nch > 1 else parts[0]
+    return A + A.T
 
 
 @njit(cache=True, parallel=True)
-def _point_cov_kernel(cols, vals, jp, order, ptr, points, Vinv, S_inv, cap):  # pragma: no cover
+def _point_cov_kernel(cols, vals, fcol, fw, fd, jp, order, ptr, points, Vinv, S_inv,
+                      cap):  # pragma: no cover
     """V_i⁻¹ + V_i⁻¹ W_iᵀ S⁻¹ W_i V_i⁻¹ for the listed points, on each point's local columns."""
-    K = cols.shape[1]
+    K = cols.shape[1] + fcol.shape[1] * fd.shape[1]
     p = jp.shape[1]
     n_c = S_inv.shape[0]
     n = points.size
@@ -249,23 +362,25 @@ def _point_cov_kernel(cols, vals, jp, order, ptr, points, Vinv, S_inv, cap):  # 
         cl = np.empty(cap, dtype=np.int64)
         Z = np.zeros((p, cap))
         A = np.zeros((p, cap))
+        rc = np.empty(K, dtype=np.int64)
+        rv = np.empty(K)
         for q in range(ch * step, min(n, (ch + 1) * step)):
             i = points[q]
             nl = 0
             for rr in range(ptr[i], ptr[i + 1]):
                 r = order[rr]
-                for s in range(K):
-                    c = cols[r, s]
-                    if c >= 0:
-                        if pos[c] < 0:
-                            pos[c] = nl
-                            cl[nl] = c
-                            for k in range(p):
-                                Z[k, nl] = 0.0
-                            nl += 1
-                        la = pos[c]
+                ne = _expand_row(r, cols, vals, fcol, fw, fd, rc, rv)
+                for s in range(ne):
+                    c = rc[s]
+                    if pos[c] < 0:
+                        pos[c] = nl
+                        cl[nl] = c
                         for k in range(p):
-                            Z[k, la] += vals[r, s] * jp[r, k]
+                            Z[k, nl] = 0.0
+                        nl += 1
+                    la = pos[c]
+                    for k in range(p):
+                        Z[k, la] += rv[s] * jp[r, k]
             for k in range(p):
                 for a in range(nl):
                     acc = 0.0
@@ -287,22 +402,25 @@ def _point_cov_kernel(cols, vals, jp, order, ptr, points, Vinv, S_inv, cap):  # 
     return out
 
 
-def point_covariance(cols, vals, jp, order, ptr, points, Vinv, S_inv) -> np.ndarray:
+def point_covariance(arrays, jp, order, ptr, points, Vinv, S_inv) -> np.ndarray:
     """Unscaled covariance ``V⁻¹ + V⁻¹ Wᵀ S⁻¹ W V⁻¹`` of the listed points, ``(n, p, p)``."""
     points = np.asarray(points, dtype=np.int64)
     if points.size == 0:
         return np.zeros((0, jp.shape[1], jp.shape[1]))
+    cols, _, fcol, _, fd = arrays
     max_rows = int(np.max(np.diff(ptr)[points]))
-    cap = int(min(S_inv.shape[0], max(1, max_rows * cols.shape[1])))
-    return _point_cov_kernel(cols, vals, jp, order, ptr, points, Vinv, S_inv, cap)
+    width = cols.shape[1] + fcol.shape[1] * fd.shape[1]
+    cap = int(min(S_inv.shape[0], max(1, max_rows * width)))
+    return _point_cov_kernel(*arrays, jp, order, ptr, points, Vinv, S_inv, cap)
 
 
 @njit(cache=True)
-def rmatvec_diag(cols, vals, y, n_c, want_diag):  # pragma: no cover - compiled
+def rmatvec_diag(cols, vals, fcol, fw, fd, y, n_c, want_diag):  # pragma: no cover - compiled
     """``Jᵀ y`` and (optionally) ``diag(JᵀJ)`` of a row-compressed matrix, in one pass."""
     g = np.zeros(n_c)
     d = np.zeros(n_c)
     M, K = cols.shape
+    Q, kf = fcol.shape[1], fd.shape[1]
     for i in range(M):
         yi = y[i]
         for s in range(K):
@@ -312,13 +430,23 @@ def rmatvec_diag(cols, vals, y, n_c, want_diag):  # pragma: no cover - compiled
                 g[c] += v * yi
                 if want_diag:
                     d[c] += v * v
+        for a in range(Q):
+            c0 = fcol[i, a]
+            if c0 >= 0:
+                wa = fw[i, a]
+                for j in range(kf):
+                    v = wa * fd[i, j]
+                    g[c0 + j] += v * yi
+                    if want_diag:
+                        d[c0 + j] += v * v
     return g, d
 
 
 @njit(cache=True)
-def matvec(cols, vals, x):  # pragma: no cover - compiled
+def matvec(cols, vals, fcol, fw, fd, x):  # pragma: no cover - compiled
     """``J x`` of a row-compressed matrix."""
     M, K = cols.shape
+    Q, kf = fcol.shape[1], fd.shape[1]
     out = np.zeros(M)
     for i in range(M):
         acc = 0.0
@@ -326,5 +454,12 @@ def matvec(cols, vals, x):  # pragma: no cover - compiled
             c = cols[i, s]
             if c >= 0:
                 acc += vals[i, s] * x[c]
+        for a in range(Q):
+            c0 = fcol[i, a]
+            if c0 >= 0:
+                t = 0.0
+                for j in range(kf):
+                    t += fd[i, j] * x[c0 + j]
+                acc += fw[i, a] * t
         out[i] = acc
     return out

@@ -31,7 +31,7 @@ from __future__ import annotations
 import sys
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.linalg as sla
@@ -96,11 +96,26 @@ class _Layout:
 class _RowJac:
     """A row-compressed sparse matrix: row ``i`` has entries ``vals[i, s]`` at ``cols[i, s]``.
 
-    ``cols = -1`` marks an empty slot. See :mod:`hsgeo.adjust._fast`.
+    ``cols = -1`` marks an empty slot. Optionally each row also has one *factored* group
+    (from an :class:`~hsgeo.adjust.Indexed` Jacobian with ``weights``): entries
+    ``fw[i, a] * fd[i, j]`` at columns ``fcol[i, a] + j`` (``fcol = -1``: none). See
+    :mod:`hsgeo.adjust._fast`.
     """
 
-    def __init__(self, cols: np.ndarray, vals: np.ndarray, n_cols: int):
+    def __init__(self, cols: np.ndarray, vals: np.ndarray, n_cols: int, fcol=None, fw=None,
+                 fd=None):
         self.cols, self.vals, self.n_cols = cols, vals, n_cols
+        M = cols.shape[0]
+        if fcol is None:
+            fcol = np.full((M, 0), -1, dtype=cols.dtype)
+            fw = np.zeros((M, 0))
+            fd = np.zeros((M, 0))
+        self.fcol, self.fw, self.fd = fcol, fw, fd
+
+    @property
+    def arrays(self):
+        """``(cols, vals, fcol, fw, fd)`` for the compiled kernels."""
+        return self.cols, self.vals, self.fcol, self.fw, self.fd
 
     @property
     def shape(self):
@@ -113,20 +128,31 @@ class _RowJac:
     def matvec(self, x: np.ndarray) -> np.ndarray:
         from hsgeo.adjust._fast import matvec
 
-        return matvec(self.cols, self.vals, np.ascontiguousarray(x, dtype=np.float64))
+        return matvec(*self.arrays, np.ascontiguousarray(x, dtype=np.float64))
 
     def rmatvec(self, y: np.ndarray, diag: bool = False):
         """``Jᵀ y`` (and ``diag(JᵀJ)`` with ``diag=True``)."""
         from hsgeo.adjust._fast import rmatvec_diag
 
-        g, d = rmatvec_diag(self.cols, self.vals, np.ascontiguousarray(y, dtype=np.float64),
+        g, d = rmatvec_diag(*self.arrays, np.ascontiguousarray(y, dtype=np.float64),
                             self.n_cols, diag)
         return (g, d) if diag else g
 
     def tocsr(self) -> sp.csr_matrix:
+        M = self.cols.shape[0]
         keep = self.cols >= 0
-        rows = np.broadcast_to(np.arange(self.cols.shape[0])[:, None], self.cols.shape)
-        return sp.csr_matrix((self.vals[keep], (rows[keep], self.cols[keep])), shape=self.shape)
+        rows = np.broadcast_to(np.arange(M)[:, None], self.cols.shape)
+        r, c, v = [rows[keep]], [self.cols[keep]], [self.vals[keep]]
+        kf = self.fd.shape[1]
+        if self.fcol.shape[1] and kf:
+            fc = self.fcol[:, :, None] + np.arange(kf)  # (M, q, kf)
+            fv = self.fw[:, :, None] * self.fd[:, None, :]
+            fk = np.broadcast_to((self.fcol >= 0)[:, :, None], fc.shape)
+            r.append(np.broadcast_to(np.arange(M)[:, None, None], fc.shape)[fk])
+            c.append(fc[fk])
+            v.append(fv[fk])
+        return sp.csr_matrix((np.concatenate(v), (np.concatenate(r), np.concatenate(c))),
+                             shape=self.shape)
 
 
 #: Use the compiled row-compressed path (True) or the generic scipy.sparse path (False).
@@ -164,8 +190,21 @@ class _Slots:
     tens of millions of entries (GUIDE §9).
     """
 
-    def __init__(self, J, m: int, size: int, name: str, colmap: np.ndarray, rows, w):
+    def __init__(self, J, m: int, size: int, name: str, colmap: np.ndarray, rows, w,
+                 factored_k: int | None = None):
         self.colmap, self.rows, self.w = colmap, rows, w  # rows: kept rows, or None for all
+        self.factored = False
+        if isinstance(J, Indexed) and J.factored:
+            m_j, q = J.index.shape
+            k = J.k
+            contiguous = colmap.size and colmap[0] >= 0 and np.all(np.diff(colmap) == 1)
+            if (FAST and factored_k in (None, k) and contiguous and m_j == m and size % k == 0
+                    and not (J.index.size and int(J.index.max()) >= size // k)):
+                # kept factored: one group of q items × k columns per row (see _RowJac)
+                self.kind, self.J, self.width, self.qk = "factored", J, 0, (q, k)
+                self.factored = True
+                return
+            J = J.expanded()  # generic path, fixed entries, or a second factored Jacobian
         if isinstance(J, Indexed):
             m_j, q, k = J.d.shape
             if m_j != m:
@@ -199,6 +238,14 @@ class _Slots:
 
     def _take(self, a):
         return a if self.rows is None else a[self.rows]
+
+    def fill_factored(self, fcol_dst, fw_dst, fd_dst) -> None:
+        q, k = self.qk
+        idx = self._take(self.J.index)
+        ok = idx >= 0
+        fcol_dst[:, :q] = np.where(ok, int(self.colmap[0]) + idx * k, -1)
+        fw_dst[:, :q] = np.where(ok, self._take(self.J.weights), 0.0)
+        np.multiply(self._take(self.J.d), self._take(self.w)[:, None], out=fd_dst[:, :k])
 
     def fill(self, cols_dst: np.ndarray, vals_dst: np.ndarray) -> None:
         n = cols_dst.shape[0]
@@ -238,6 +285,7 @@ class _Slots:
 
 class _PriorSlots:
     width = 1
+    factored = False
 
     def __init__(self, cols, vals):
         self.cols, self.vals = cols, vals
@@ -250,6 +298,7 @@ class _PriorSlots:
 def _evaluate(layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian: bool) -> _System:
     values = layout.params.values()
     r_parts, slot_parts, pidx_parts, jp_parts = [], [], [], []
+    factored_k = None  # width k of the factored Jacobians (one per row, one k for all)
     offset = 0
     pname = layout.pblock.name if layout.pblock is not None else None
     for blk, keep in zip(blocks, masks, strict=True):
@@ -279,6 +328,8 @@ def _evaluate(layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian:
             for name, J in jac.items():
                 b = layout.params[name]
                 if name == pname:
+                    if isinstance(J, Indexed):
+                        J = J.expanded()
                     if not isinstance(J, Indexed) or J.index.shape[1] != 1 or J.k != layout.p:
                         raise InputError(
                             f"the Jacobian w.r.t. the points block {name!r} must be "
@@ -288,8 +339,13 @@ def _evaluate(layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian:
                     jp = J.d[rows_kept, 0, :] * w[rows_kept, None]
                     jp = np.where(pidx[:, None] >= 0, jp * layout.pfree[np.maximum(pidx, 0)], 0.0)
                     continue
-                blk_slots.append(_Slots(J, blk.m, b.size, name, layout.colmap[name],
-                                        None if all_kept else rows_kept, w))
+                has_f = any(sl.factored for sl in blk_slots)
+                sl = _Slots(J, blk.m, b.size, name, layout.colmap[name],
+                            None if all_kept else rows_kept, w,
+                            factored_k=-1 if has_f else factored_k)
+                if sl.factored:
+                    factored_k = sl.qk[1]
+                blk_slots.append(sl)
             slot_parts.append(blk_slots)
             pidx_parts.append(pidx)
             jp_parts.append(jp)
@@ -324,13 +380,22 @@ def _evaluate(layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian:
     M = offset
     # one (M, K) row-compressed matrix: each part's slots side by side, padded to the widest
     K = max([sum(sl.width for sl in part) for part in slot_parts] + [1])
-    cols_all = np.empty((M, K), dtype=np.int32 if layout.n_c < 2**31 else np.int64)
+    itype = np.int32 if layout.n_c < 2**31 else np.int64
+    cols_all = np.empty((M, K), dtype=itype)
     vals_all = np.empty((M, K))
+    Q = max([sl.qk[0] for part in slot_parts for sl in part if sl.factored] + [0])
+    Kf = factored_k if Q else 0
+    fcol = np.full((M, Q), -1, dtype=itype)
+    fw = np.zeros((M, Q))
+    fd = np.zeros((M, Kf))
     row0 = 0
     for part, pi in zip(slot_parts, pidx_parts, strict=True):
         n = pi.size
         k0 = 0
         for sl in part:
+            if sl.factored:
+                sl.fill_factored(fcol[row0 : row0 + n], fw[row0 : row0 + n], fd[row0 : row0 + n])
+                continue
             sl.fill(cols_all[row0 : row0 + n, k0 : k0 + sl.width],
                     vals_all[row0 : row0 + n, k0 : k0 + sl.width])
             k0 += sl.width
@@ -340,7 +405,8 @@ def _evaluate(layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian:
         row0 += n
     pidx = np.concatenate(pidx_parts) if pidx_parts else np.full(M, -1)
     Jp = np.concatenate(jp_parts) if jp_parts else np.zeros((M, layout.p))
-    return _System(r_all, _RowJac(cols_all, vals_all, layout.n_c), pidx, Jp, n_obs_rows)
+    Jrc = _RowJac(cols_all, vals_all, layout.n_c, *((fcol, fw, fd) if Q else ()))
+    return _System(r_all, Jrc, pidx, Jp, n_obs_rows)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -360,6 +426,7 @@ class _Normal:
     pt_order: np.ndarray | None = None  # order in which the kernel visits the points
     Ncc_free: np.ndarray | None = None  # J_cᵀ J_c of the rows without a point (compiled path)
     diag_cc: np.ndarray | None = None  # diag(N_cc)
+    reduced_cache: dict = field(default_factory=dict)  # λ_points → (S, rhs, V⁻¹), see _reduced
 
     @property
     def Ncc(self) -> np.ndarray:
@@ -367,7 +434,7 @@ class _Normal:
         if self._Ncc is None:
             from hsgeo.adjust._fast import normal_cc
 
-            self._Ncc = normal_cc(self.sy.Jrc.cols, self.sy.Jrc.vals, self.sy.Jrc.n_cols)
+            self._Ncc = normal_cc(self.sy.Jrc.arrays, self.sy.Jrc.n_cols)
         return self._Ncc
 
     @property
@@ -434,16 +501,16 @@ def _normal(layout: _Layout, sy: _System) -> _Normal:
                 ptr = np.concatenate(
                     [[0], np.cumsum(np.bincount(pi_all[rows_p], minlength=layout.n_pts))]
                 ).astype(np.int64)
-            row_order, pt_order = locality_orders(sy.Jrc.cols, layout.n_c, order, ptr)
+            row_order, pt_order = locality_orders(sy.Jrc, layout.n_c, order, ptr)
             _ORDER_CACHE["key"] = (layout.n_c, layout.n_pts, sy.pidx.copy(), sy.Jrc.cols.shape)
             _ORDER_CACHE["value"] = (order, ptr, row_order, pt_order)
         Jrc = sy.Jrc
         gc, diag_cc = Jrc.rmatvec(sy.r, diag=True)
         if layout.pblock is None:
-            Ncc = normal_cc(Jrc.cols, Jrc.vals, layout.n_c, row_order)
+            Ncc = normal_cc(Jrc.arrays, layout.n_c, row_order)
             return _Normal(Ncc, gc, None, None, diag_cc=diag_cc)
         free_rows = row_order[sy.pidx[row_order] < 0]
-        Ncc_free = normal_cc(Jrc.cols, Jrc.vals, layout.n_c, free_rows)
+        Ncc_free = normal_cc(Jrc.arrays, layout.n_c, free_rows)
         Ncc = None
     else:
         Jc = sy.Jc
@@ -496,29 +563,52 @@ def _block_diag(Vinv: np.ndarray) -> sp.csr_matrix:
     return sp.csr_matrix((Vinv.ravel(), (rows, cols)), shape=(n * p, n * p))
 
 
+#: Below this damping λ the point blocks are not damped (only the reduced system is): the
+#: reduced matrix of the undamped points is then formed once per linearisation point and
+#: shared by the datum check, every damped trial step and the covariance (see _reduced).
+LAMBDA_POINTS_MIN = 1e-4
+
+
+def _lambda_points(lam: float) -> float:
+    return lam if lam > LAMBDA_POINTS_MIN else 0.0
+
+
 def _reduced(layout: _Layout, ne: _Normal, lam: float):
-    """S, rhs and the pieces for back-substitution, at damping λ."""
+    """S, rhs and the pieces for back-substitution, at damping λ.
+
+    Marquardt damping ``λ diag(N)`` is added to the reduced system; the points' blocks ``V``
+    are damped too only when ``λ > LAMBDA_POINTS_MIN`` (at smaller λ, damping a 3 × 3 point
+    block by a factor ``1 + λ`` changes nothing but the cost of re-forming ``S``).
+    """
     rhs = ne.gc.copy()
+    lam_p = _lambda_points(lam)
     if ne.V is not None and ne.sy is not None and ne._W is None and ne._Ncc is None:
         # compiled path: S = N_cc − Σ W_i V_i⁻¹ W_iᵀ accumulated point by point from the rows
         # grouped by point; neither W nor the full N_cc is formed
         from hsgeo.adjust._fast import reduced_points
 
-        Vinv = _inv_blocks(_damped(ne.V, lam))
-        sy = ne.sy
-        S = ne.Ncc_free + reduced_points(sy.Jrc.cols, sy.Jrc.vals, sy.Jp, ne.order, ne.ptr,
-                                         Vinv, layout.n_c, ne.pt_order)
+        cached = ne.reduced_cache.get(lam_p)
+        if cached is None:
+            Vinv = _inv_blocks(_damped(ne.V, lam_p))
+            sy = ne.sy
+            S0 = ne.Ncc_free + reduced_points(sy.Jrc.arrays, sy.Jp, ne.order, ne.ptr, Vinv,
+                                              layout.n_c, ne.pt_order)
+            r0 = rhs - ne.W_dot(np.einsum("nij,nj->ni", Vinv, ne.gp)) if layout.n_c else rhs
+            if lam_p == 0.0:  # keep the undamped one (datum check, steps, covariance)
+                ne.reduced_cache[0.0] = (S0, r0, Vinv)
+        else:
+            S0, r0, Vinv = cached
+        S = S0.copy()
+        rhs = r0.copy()
         if lam != 0.0 and layout.n_c:
             d = ne.diag_cc
             floor = 1e-12 * max(float(np.max(d)), 1e-300)
             S[np.diag_indices_from(S)] += lam * np.maximum(d, floor)
-        if layout.n_c:
-            rhs = rhs - ne.W_dot(np.einsum("nij,nj->ni", Vinv, ne.gp))
         return S, rhs, Vinv, None
     S = _damped(ne.Ncc, lam)
     if ne.V is None:
         return S, rhs, None, None
-    Vinv = _inv_blocks(_damped(ne.V, lam))
+    Vinv = _inv_blocks(_damped(ne.V, lam_p))
     WVinv = (ne.W @ _block_diag(Vinv)).tocsr()
     if layout.n_c:
         S = S - (WVinv @ ne.W.T).toarray()
@@ -551,7 +641,7 @@ def _predicted_decrease(layout, ne: _Normal, lam, dc, dp) -> float:
     pred = 0.5 * float(dc @ (lam * Dc * dc - ne.gc))
     if dp is not None:
         Dp = np.maximum(np.diagonal(ne.V, axis1=1, axis2=2), 0.0)
-        pred += 0.5 * float(np.sum(dp * (lam * Dp * dp - ne.gp)))
+        pred += 0.5 * float(np.sum(dp * (_lambda_points(lam) * Dp * dp - ne.gp)))
     return pred
 
 

@@ -11,7 +11,12 @@ Jacobians come in one of three forms, keyed by parameter-block name:
 * :class:`Indexed` ``(index, d)``: row ``j`` touches the items ``index[j]`` of the block viewed as
   an ``(n_items, k)`` array, with derivatives ``d[j]`` — per-image exterior orientations, per-point
   coordinates, spline nodes (``index`` of shape ``(m, q)`` when a row touches ``q`` items). The
-  engine needs this form for the points block.
+  engine needs this form for the points block. ``Indexed(index, d, weights=w)`` is the factored
+  form of a row that touches ``q`` items through one ``k``-vector ``d[j]`` scaled by the weights
+  ``w[j]``: the derivative w.r.t. item ``index[j, a]`` is ``w[j, a] · d[j]``. That is the chain rule
+  through an interpolation, e.g. trajectory corrections on spline nodes, ``∂r/∂c_a = B_a(t) ∂r/∂δ``;
+  the engine's compiled path uses the factorisation to form the reduced normal equations with a
+  fraction of the work (:mod:`hsgeo.adjust._fast`).
 * a dense ``(m, block.size)`` array, for small global blocks (focal length, distortion).
 * a ``scipy.sparse`` matrix ``(m, block.size)``.
 
@@ -40,15 +45,33 @@ class Indexed:
         Item (row of the block viewed as ``(n_items, k)``) touched by each residual row; ``-1``
         for a row that touches none.
     d : (m, k) or (m, q, k) float ndarray
-        The derivatives of each residual row with respect to the ``k`` entries of its item(s).
+        The derivatives of each residual row with respect to the ``k`` entries of its item(s);
+        with ``weights``, ``(m, k)``: the derivative shared by the ``q`` items.
+    weights : (m, q) float ndarray, optional
+        Factored form: the derivative w.r.t. item ``index[j, a]`` is ``weights[j, a] * d[j]``.
     """
 
     index: np.ndarray
     d: np.ndarray
+    weights: np.ndarray | None = None
 
     def __post_init__(self):
         idx = np.asarray(self.index)
         d = np.asarray(self.d, dtype=np.float64)
+        if self.weights is not None:
+            w = np.asarray(self.weights, dtype=np.float64)
+            idx2 = idx[:, None] if idx.ndim == 1 else idx
+            w = w[:, None] if w.ndim == 1 else w
+            if d.ndim != 2 or w.shape != idx2.shape or d.shape[0] != idx2.shape[0]:
+                raise InputError(
+                    f"factored Indexed Jacobian: index {np.shape(self.index)}, weights "
+                    f"{np.shape(self.weights)} and derivative {np.shape(self.d)} do not match "
+                    "((m, q), (m, q) and (m, k))"
+                )
+            object.__setattr__(self, "index", idx2.astype(np.int64, copy=False))
+            object.__setattr__(self, "d", d)
+            object.__setattr__(self, "weights", w)
+            return
         if idx.ndim == 1:
             idx = idx[:, None]
             d = d[:, None, :] if d.ndim == 2 else d
@@ -62,7 +85,17 @@ class Indexed:
 
     @property
     def k(self) -> int:
-        return self.d.shape[2]
+        return self.d.shape[-1]
+
+    @property
+    def factored(self) -> bool:
+        return self.weights is not None
+
+    def expanded(self) -> Indexed:
+        """The same Jacobian with ``d`` of shape ``(m, q, k)`` (no factorisation)."""
+        if self.weights is None:
+            return self
+        return Indexed(self.index, self.weights[:, :, None] * self.d[:, None, :])
 
 
 def to_coo(jac, m: int, size: int, name: str):
@@ -73,6 +106,7 @@ def to_coo(jac, m: int, size: int, name: str):
     rows, cols, vals : 1-D ndarrays
     """
     if isinstance(jac, Indexed):
+        jac = jac.expanded()
         m_j, q, k = jac.d.shape
         if m_j != m:
             raise InputError(f"Jacobian w.r.t. {name!r} has {m_j} rows, residuals have {m}")

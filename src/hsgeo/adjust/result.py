@@ -180,7 +180,7 @@ class AdjustmentResult:
             Vfull = np.zeros_like(ne.V)
             Vfull[pts] = Vinv_w
             sy = ne.sy
-            cov = _pc(sy.Jrc.cols, sy.Jrc.vals, sy.Jp, ne.order, ne.ptr, pts, Vfull, self._S_inv)
+            cov = _pc(sy.Jrc.arrays, sy.Jp, ne.order, ne.ptr, pts, Vfull, self._S_inv)
             out = np.where(ok[:, None, None], cov, np.nan)
         elif lay.n_c:
             Wd = ne.W.tocsc()

@@ -201,8 +201,7 @@ def _lines_kernel(P, pidx, idx, w, nodes, xyz_nav, rpy_nav, band, c_b, dist, bet
                     # dp/dP = β Rᵀ: (JpB Rᵀ)[u, a] = Σ_i JpB[u, i] R[a, i]
                     v = JpB[u, 0] * R[a, 0] + JpB[u, 1] * R[a, 1] + JpB[u, 2] * R[a, 2]
                     dP[row, a] = v
-                    for b in range(4):
-                        dN[row, b, a] = -v * w[j, b]
+                    dN[row, a] = -v  # position: × the spline weights (factored Jacobian)
                     dL[row, a] = -JpB[u, a]
                 for kk in range(3):
                     # attitude: dq_i/drpy_k = Σ_j dR[k, j, i] d_j
@@ -210,8 +209,7 @@ def _lines_kernel(P, pidx, idx, w, nodes, xyz_nav, rpy_nav, band, c_b, dist, bet
                     for i in range(3):
                         dq = dR[kk, 0, i] * d[0] + dR[kk, 1, i] * d[1] + dR[kk, 2, i] * d[2]
                         v += JpB[u, i] * dq
-                    for b in range(4):
-                        dN[row, b, 3 + kk] = v * w[j, b]
+                    dN[row, 3 + kk] = v
                     # boresight: dp/dbore_k = dβ_k q
                     v = 0.0
                     for i in range(3):
@@ -235,16 +233,14 @@ def _lines_kernel(P, pidx, idx, w, nodes, xyz_nav, rpy_nav, band, c_b, dist, bet
                 for a in range(3):
                     v2 = beta[2, 0] * R[a, 0] + beta[2, 1] * R[a, 1] + beta[2, 2] * R[a, 2]
                     dP[row, a] = kap * dP[row, a] + f * v2
-                    for b in range(4):
-                        dN[row, b, a] = kap * dN[row, b, a] - f * v2 * w[j, b]
+                    dN[row, a] = kap * dN[row, a] - f * v2
                     dL[row, a] = kap * dL[row, a] - f * beta[2, a]
                 for kk in range(3):
                     v2 = 0.0
                     for i in range(3):
                         v2 += beta[2, i] * (dR[kk, 0, i] * d[0] + dR[kk, 1, i] * d[1]
                                             + dR[kk, 2, i] * d[2])
-                    for b in range(4):
-                        dN[row, b, 3 + kk] = kap * dN[row, b, 3 + kk] + f * v2 * w[j, b]
+                    dN[row, 3 + kk] = kap * dN[row, 3 + kk] + f * v2
                     vb = dbeta[kk, 2, 0] * q[0] + dbeta[kk, 2, 1] * q[1] + dbeta[kk, 2, 2] * q[2]
                     dB[row, kk] = kap * dB[row, kk] + f * vb
                 dC[row, 0] = kap * dC[row, 0] - ry * kap / c
@@ -324,6 +320,7 @@ class PushbroomLines(ResidualBlock):
         self.y_time_k = float(y_time_k)
         self._pidx2 = np.repeat(self.point, 2)
         self._idx2 = np.repeat(self._basis[0], 2, axis=0)
+        self._w2 = np.repeat(self._basis[1], 2, axis=0)
         for a in ("xyz_nav", "rpy_nav", "xy_px"):
             setattr(self, a, np.ascontiguousarray(getattr(self, a)))
 
@@ -423,7 +420,7 @@ class PushbroomLines(ResidualBlock):
         r = np.empty(2 * m)
         shp = (2 * m,) if jacobian else (0,)
         dP = np.empty(shp + (3,))
-        dN = np.empty(shp + (4, 6))
+        dN = np.empty(shp + (6,))  # d r / d δ(t); the node columns are B_a(t) × this
         dB = np.empty(shp + (3,))
         dL = np.empty(shp + (3,))
         dD = np.empty(shp + (4,))
@@ -441,7 +438,7 @@ class PushbroomLines(ResidualBlock):
         rep = np.repeat
         jac = {
             nm["points"]: Indexed(self._pidx2, dP),
-            nm["nodes"]: Indexed(self._idx2, dN),
+            nm["nodes"]: Indexed(self._idx2, dN, weights=self._w2),  # 002 eq. (4) via the spline
             nm["boresight"]: dB,
             nm["lever_arm"]: dL,
             nm["distortion"]: dD,
