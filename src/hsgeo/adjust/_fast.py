@@ -463,3 +463,54 @@ def matvec(cols, vals, fcol, fw, fd, x):  # pragma: no cover - compiled
                 acc += fw[i, a] * t
         out[i] = acc
     return out
+
+
+# ----------------------------------------------------------------------------------------------
+# Filling the row-compressed arrays from the residual blocks' Jacobians (engine._Slots)
+# ``rows[t]`` is the block row written to destination row t; ``w`` the whitening weights 1/σ;
+# ``cm`` the block's column map (-1: fixed entry, written as an empty slot).
+# ----------------------------------------------------------------------------------------------
+@njit(cache=True, parallel=True)
+def fill_indexed(index, d, rows, w, cm, cols_dst, vals_dst):  # pragma: no cover - compiled
+    """Slots of an ``Indexed(index (m, q), d (m, q, k))`` Jacobian."""
+    q = index.shape[1]
+    k = d.shape[2]
+    for t in prange(rows.size):
+        i = rows[t]
+        wi = w[i]
+        for a in range(q):
+            it = index[i, a]
+            for j in range(k):
+                c = cm[it * k + j] if it >= 0 else -1
+                cols_dst[t, a * k + j] = c
+                vals_dst[t, a * k + j] = d[i, a, j] * wi if c >= 0 else 0.0
+
+
+@njit(cache=True, parallel=True)
+def fill_dense(J, rows, w, cm, cols_dst, vals_dst):  # pragma: no cover - compiled
+    """Slots of a dense ``(m, size)`` Jacobian."""
+    k = J.shape[1]
+    for t in prange(rows.size):
+        i = rows[t]
+        wi = w[i]
+        for j in range(k):
+            c = cm[j]
+            cols_dst[t, j] = c
+            vals_dst[t, j] = J[i, j] * wi if c >= 0 else 0.0
+
+
+@njit(cache=True, parallel=True)
+def fill_factored(index, weights, d, rows, w, c0, fcol_dst, fw_dst,
+                  fd_dst):  # pragma: no cover - compiled
+    """The factored group of ``Indexed(index (m, q), d (m, k), weights (m, q))``."""
+    q = index.shape[1]
+    k = d.shape[1]
+    for t in prange(rows.size):
+        i = rows[t]
+        for a in range(q):
+            it = index[i, a]
+            fcol_dst[t, a] = c0 + it * k if it >= 0 else -1
+            fw_dst[t, a] = weights[i, a] if it >= 0 else 0.0
+        wi = w[i]
+        for j in range(k):
+            fd_dst[t, j] = d[i, j] * wi

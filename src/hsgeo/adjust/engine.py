@@ -236,50 +236,29 @@ class _Slots:
                     f"Jacobian w.r.t. {name!r} has shape {arr.shape}, expected {(m, size)}")
             self.kind, self.J, self.width = "dense", arr, size
 
-    def _take(self, a):
-        return a if self.rows is None else a[self.rows]
+    def _rows(self) -> np.ndarray:
+        return np.arange(self.w.size, dtype=np.int64) if self.rows is None else self.rows
 
     def fill_factored(self, fcol_dst, fw_dst, fd_dst) -> None:
+        from hsgeo.adjust._fast import fill_factored
+
         q, k = self.qk
-        idx = self._take(self.J.index)
-        ok = idx >= 0
-        fcol_dst[:, :q] = np.where(ok, int(self.colmap[0]) + idx * k, -1)
-        fw_dst[:, :q] = np.where(ok, self._take(self.J.weights), 0.0)
-        np.multiply(self._take(self.J.d), self._take(self.w)[:, None], out=fd_dst[:, :k])
+        fill_factored(self.J.index, self.J.weights, self.J.d, self._rows(), self.w,
+                      int(self.colmap[0]), fcol_dst[:, :q], fw_dst[:, :q], fd_dst[:, :k])
 
     def fill(self, cols_dst: np.ndarray, vals_dst: np.ndarray) -> None:
-        n = cols_dst.shape[0]
-        wr = self._take(self.w)
+        from hsgeo.adjust._fast import fill_dense, fill_indexed
+
         cm = self.colmap
         if self.kind == "indexed":
-            q, k = self.qk
-            idx = self._take(self.J.index)
-            cd = cols_dst.reshape(n, q, k)
-            vd = vals_dst.reshape(n, q, k)
-            if not (np.shares_memory(cd, cols_dst) and np.shares_memory(vd, vals_dst)):
-                raise AssertionError("slot views must not copy")  # pragma: no cover
-            contiguous = cm.size and cm[0] >= 0 and np.all(np.diff(cm) == 1)
-            if contiguous:
-                np.add((idx * k)[:, :, None], int(cm[0]) + np.arange(k), out=cd,
-                       casting="unsafe")
-                bad = idx < 0
-                if bad.any():
-                    cd[bad] = -1
-            else:
-                lc = np.where(idx >= 0, idx, 0)[:, :, None] * k + np.arange(k)
-                cd[:] = np.where((idx >= 0)[:, :, None], cm[lc], -1)
-            np.multiply(self._take(self.J.d), wr[:, None, None], out=vd)
-            if not contiguous or (idx < 0).any():
-                vals_dst[cols_dst < 0] = 0.0
+            fill_indexed(self.J.index, self.J.d, self._rows(), self.w, cm, cols_dst, vals_dst)
         elif self.kind == "dense":
-            cols_dst[:] = cm
-            np.multiply(self._take(self.J), wr[:, None], out=vals_dst)
-            if (cm < 0).any():
-                vals_dst[:, cm < 0] = 0.0
+            fill_dense(self.J, self._rows(), self.w, cm, cols_dst, vals_dst)
         else:
             cols, vals = self.J
-            cols_dst[:] = self._take(cols)
-            np.multiply(self._take(vals), wr[:, None], out=vals_dst)
+            rows = self._rows()
+            cols_dst[:] = cols[rows]
+            np.multiply(vals[rows], self.w[rows, None], out=vals_dst)
             vals_dst[cols_dst < 0] = 0.0
 
 
@@ -553,7 +532,15 @@ def _inv_blocks(Vd: np.ndarray) -> np.ndarray:
     try:
         return np.linalg.inv(Vd)
     except np.linalg.LinAlgError:
-        return np.linalg.pinv(Vd)
+        # some blocks are singular (e.g. a point whose observations were all rejected):
+        # pseudo-inverse for those only
+        d = np.abs(np.linalg.det(Vd))
+        scale = np.max(np.abs(Vd), axis=(1, 2)) ** Vd.shape[-1]
+        bad = ~(d > 1e-12 * scale)
+        out = np.empty_like(Vd)
+        out[~bad] = np.linalg.inv(Vd[~bad])
+        out[bad] = np.linalg.pinv(Vd[bad])
+        return out
 
 
 def _block_diag(Vinv: np.ndarray) -> sp.csr_matrix:
@@ -805,6 +792,31 @@ def _progress_printer(progress):
     return show
 
 
+#: Each-iteration rejection starts once an iteration decreases the cost by less than this share.
+REJECT_START = 1e-2
+
+
+def _reject(blocks, masks, sy: _System, reject_k: float) -> bool:
+    """Reject the kept groups whose whitened residual in ``sy`` exceeds ``reject_k`` robust σ.
+
+    ``masks`` is updated in place; returns True if any group was rejected.
+    """
+    scale = _robust_scale(sy)
+    off = 0
+    new_any = False
+    for i, b in enumerate(blocks):
+        kept = np.flatnonzero(masks[i])
+        rw = sy.r[off : off + kept.size] / scale
+        off += kept.size
+        bad = np.zeros(b.m, dtype=bool)
+        bad[kept] = np.abs(rw) > reject_k
+        bad = np.repeat(bad.reshape(-1, b.group_size).any(axis=1), b.group_size)
+        if bad.any():
+            masks[i] &= ~bad
+            new_any = True
+    return new_any
+
+
 def _robust_scale(sy: _System) -> float:
     r = np.abs(sy.r[: sy.n_obs_rows])
     return max(1.4826 * float(np.median(r)), 1e-300) if r.size else 1.0
@@ -824,6 +836,7 @@ def adjust(
     rank_rtol: float = 1e-11,
     raise_on_failure: bool = True,
     progress: bool | Callable | None = None,
+    reject_every_iteration: bool = False,
 ):
     """Adjust ``params`` to the observations of ``blocks`` by least squares.
 
@@ -845,6 +858,12 @@ def adjust(
         Reject observations whose whitened residual exceeds ``reject_k`` robust σ (NMAD of the
         whitened residuals) after convergence, and adjust again; repeated until none is rejected
         or ``max_reject_rounds``. A whole group (e.g. x and y of one point) is rejected together.
+    reject_every_iteration : bool
+        With ``reject_k``: test the residuals after every iteration (once the cost has nearly
+        settled, see ``REJECT_START``) instead of in rounds after convergence, as 002 §3.4 does
+        ("observation outliers are identified and rejected in each iteration"); the adjustment
+        has converged when the predicted decrease is below ``ftol`` and the last test rejected
+        nothing.
     check_datum : bool
         Check the rank before the first step and raise :class:`~hsgeo.DatumError` if deficient.
     rank_rtol : float
@@ -879,10 +898,11 @@ def adjust(
     rounds = 0
     converged = False
     message = ""
-    # while outliers are still being rejected, a round only needs to get close to its minimum
-    # (the residuals that decide the rejection do not change at 1e-4 relative cost); once a
-    # rejection pass finds nothing new, the iteration continues to ``ftol``
-    final = reject_k is None
+    each = reject_k is not None and reject_every_iteration
+    # rounds mode: while outliers are still being rejected, a round only needs to get close to
+    # its minimum (the residuals that decide the rejection do not change at 1e-4 relative
+    # cost); once a rejection pass finds nothing new, the iteration continues to ``ftol``
+    final = reject_k is None or each
     while True:
         tol = ftol if final else max(ftol, REJECT_ROUND_FTOL)
         sy = ne = full = None  # free the previous round's Jacobian first (peak memory)
@@ -904,12 +924,32 @@ def adjust(
         cost = sy.cost
         history.append(cost)
         converged = False
-        for _ in range(max_iter):
+        rejecting = False  # each-iteration mode: rejection has started
+        tested = False  # each-iteration mode: the current point passed the rejection test
+        n_iter = 0
+        while True:
+            if cost <= atol * sy.r.size:
+                converged, message = True, "cost below atol (noise-free data)"
+                break
+            dc, dp = _step(layout, ne, lam)
+            pred = _predicted_decrease(layout, ne, lam, dc, dp)
+            if lam <= LAMBDA_POINTS_MIN and pred <= tol * cost:
+                if each and not tested:
+                    # converged before any rejection test (e.g. at the initial values)
+                    if _reject(blocks, masks, sy, reject_k):
+                        break  # adjust again with the new masks (next pass of the outer loop)
+                    tested = True
+                # the Gauss–Newton step would decrease the cost by less than ftol: this is the
+                # minimum, and the reduced system just formed gives its covariance
+                converged, message = True, "predicted decrease of the cost below ftol"
+                break
+            if n_iter >= max_iter:
+                message = f"not converged within max_iter={max_iter} iterations"
+                break
+            n_iter += 1
             total_iter += 1
             state = layout.get_state()
             while True:
-                dc, dp = _step(layout, ne, lam)
-                pred = _predicted_decrease(layout, ne, lam, dc, dp)
                 layout.apply(dc, dp)
                 trial = _evaluate(layout, blocks, masks, jacobian=False)
                 actual = cost - trial.cost
@@ -923,6 +963,8 @@ def adjust(
                 nu *= 2.0
                 if lam > 1e16:
                     break
+                dc, dp = _step(layout, ne, lam)
+                pred = _predicted_decrease(layout, ne, lam, dc, dp)
             if lam > 1e16:
                 # no step decreases the cost: we are at the minimum to machine precision
                 converged = pred <= 1e3 * tol * max(cost, 1e-300) or cost <= atol * sy.r.size
@@ -932,6 +974,13 @@ def adjust(
                 break
             new_cost = trial.cost
             history.append(new_cost)
+            tested = False
+            if each and (rejecting or actual <= REJECT_START * cost):
+                # 002 §3.4: outliers are rejected in each iteration, on the residuals at the
+                # new point (from the first iteration whose decrease shows the solution near its
+                # minimum: before that, residuals reflect the initial values, not gross errors)
+                rejecting = True
+                tested = not _reject(blocks, masks, trial, reject_k)
             if show:
                 show(
                     {
@@ -942,20 +991,16 @@ def adjust(
                         "rejected": int(sum((~m).sum() for m in masks)),
                     }
                 )
-            small = (cost - new_cost) <= tol * cost and pred <= tol * cost
-            cost = new_cost
             sy = ne = trial = None  # free the old Jacobian before forming the new one
             sy = _evaluate(layout, blocks, masks, jacobian=True)
             ne = _normal(layout, sy)
-            if small or cost <= atol * sy.r.size:
-                converged = True
-                message = "relative decrease of the cost below ftol" if small else (
-                    "cost below atol (noise-free data)"
-                )
-                break
-        else:
-            message = f"not converged within max_iter={max_iter} iterations"
-        if not converged or final:
+            cost = sy.cost  # (lower than new_cost when observations were just rejected)
+        if not converged:
+            if each and not message:
+                rounds += 1  # a rejection at convergence: adjust again
+                continue
+            break
+        if final:
             break
         if rounds >= max_reject_rounds:
             final = True
