@@ -49,7 +49,8 @@ def case_ours(scale, seed, reject):
 
     camp, p, blocks = _problem(scale, seed)
     t0 = time.perf_counter()
-    res = adjust(p, blocks, reject_k=REJECT_K if reject else None, ftol=FTOL)
+    res = adjust(p, blocks, reject_k=REJECT_K if reject else None, ftol=FTOL,
+                 reject_every_iteration=True)
     wall = time.perf_counter() - t0
     return {"n_observations": int(camp.obs["point"].size), "n_unknowns": int(res.n_unknowns),
             "solver_seconds": res.seconds, "wall_seconds": wall, "iterations": res.iterations,

@@ -243,3 +243,19 @@ def test_factored_indexed_expands_and_checks_shapes():
     np.testing.assert_array_equal(J.expanded().d, w[:, :, None] * d[:, None, :])
     with pytest.raises(InputError, match="factored"):
         Indexed(idx, d, weights=w[:, :1])
+
+
+def test_outliers_rejected_every_iteration_like_rounds():
+    """Rejecting in every iteration (002 §3.4) finds the same gross errors as rounds."""
+    rng = np.random.default_rng(4)
+    t = np.linspace(0, 10, 200)
+    y = 1.5 + 0.3 * t + rng.normal(0, 0.1, t.size)
+    bad = rng.choice(t.size, 8, replace=False)
+    y[bad] += rng.choice([-1, 1], 8) * rng.uniform(1.0, 3.0, 8)
+    p = Parameters()
+    p.add("ab", np.zeros(2))
+    r_rounds = adjust(p, Line(t, y, 0.1), reject_k=4.0)
+    r_each = adjust(p, Line(t, y, 0.1), reject_k=4.0, reject_every_iteration=True)
+    assert set(np.flatnonzero(r_each.outliers(0))) == set(bad)
+    np.testing.assert_array_equal(r_each.outliers(0), r_rounds.outliers(0))
+    np.testing.assert_allclose(r_each.value("ab"), r_rounds.value("ab"), rtol=1e-8)

@@ -288,7 +288,8 @@ def adjust_files(observations, trajectory, camera, gcp=None, *, node_interval_s:
         gx = g[["E_m", "N_m", "H_m"]].to_numpy(dtype=float)
     p, blocks, nodes = build_problem(obs, ids.size, cam, node_interval_s=node_interval_s,
                                      gcp_index=gi, gcp_xyz_m=gx, y_as_time=y_as_time)
-    res = adjust(p, blocks, reject_k=reject_k, ftol=1e-6, progress=progress)
+    res = adjust(p, blocks, reject_k=reject_k, ftol=1e-6, progress=progress,
+                 reject_every_iteration=True)  # 002 §3.4
     out = {
         "converged": res.converged, "iterations": res.iterations, "sigma0": res.sigma0,
         "n_observations_2d": int(len(obs_df)), "n_points": int(ids.size),

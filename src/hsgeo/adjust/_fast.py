@@ -195,7 +195,7 @@ def _reduced_kernel(cols, vals, fcol, fw, fd, jp, order, ptr, pt_order, Vinv, n_
                         n += 1
                 for s in range(K):
                     c = cols[r, s]
-                    if c >= 0:
+                    if c >= 0 and vals[r, s] != 0.0:
                         li[n] = ng * kf + pos[c]
                         lv[n] = vals[r, s]
                         n += 1
@@ -245,12 +245,19 @@ def _reduced_kernel(cols, vals, fcol, fw, fd, jp, order, ptr, pt_order, Vinv, n_
                             ca = fcol[rg, a]
                             if ca < 0:
                                 continue
-                            wa = half * fw[rg, a]
+                            wa = fw[rg, a]
                             for j in range(kf):
                                 Aseg = A[ca + j, cb0 : cb0 + Q * kf]
                                 Rj = R[j]
-                                for e in range(Q * kf):
-                                    Aseg[e] += wa * Rj[e]
+                                if h == g:
+                                    # a diagonal block: its upper triangle (A + Aᵀ restores it)
+                                    x = a * kf + j
+                                    Aseg[x] += 0.5 * wa * Rj[x]
+                                    for e in range(x + 1, Q * kf):
+                                        Aseg[e] += wa * Rj[e]
+                                else:
+                                    for e in range(Q * kf):
+                                        Aseg[e] += wa * Rj[e]
                         continue
                     for a in range(Q):
                         ca = fcol[rg, a]
@@ -514,3 +521,21 @@ def fill_factored(index, weights, d, rows, w, c0, fcol_dst, fw_dst,
         wi = w[i]
         for j in range(k):
             fd_dst[t, j] = d[i, j] * wi
+
+
+@njit(cache=True)
+def point_normals(pidx, jp, r, n_pts):  # pragma: no cover - compiled
+    """``V_i = Σ jpᵀ jp`` and ``g_p,i = Σ jpᵀ r`` over the rows of each point (pidx ≥ 0)."""
+    p = jp.shape[1]
+    V = np.zeros((n_pts, p, p))
+    g = np.zeros((n_pts, p))
+    for t in range(pidx.size):
+        i = pidx[t]
+        if i < 0:
+            continue
+        for a in range(p):
+            ja = jp[t, a]
+            g[i, a] += ja * r[t]
+            for b in range(p):
+                V[i, a, b] += ja * jp[t, b]
+    return V, g

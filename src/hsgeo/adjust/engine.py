@@ -316,7 +316,10 @@ def _evaluate(layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian:
                         )
                     pidx = J.index[rows_kept, 0]
                     jp = J.d[rows_kept, 0, :] * w[rows_kept, None]
-                    jp = np.where(pidx[:, None] >= 0, jp * layout.pfree[np.maximum(pidx, 0)], 0.0)
+                    if not layout.pfree.all():
+                        jp = jp * layout.pfree[np.maximum(pidx, 0)]
+                    if (pidx < 0).any():
+                        jp = np.where(pidx[:, None] >= 0, jp, 0.0)
                     continue
                 has_f = any(sl.factored for sl in blk_slots)
                 sl = _Slots(J, blk.m, b.size, name, layout.colmap[name],
@@ -498,13 +501,20 @@ def _normal(layout: _Layout, sy: _System) -> _Normal:
     if layout.pblock is None:
         return _Normal(Ncc, gc, None, None)
     n_pts, p = layout.n_pts, layout.p
-    rows = np.flatnonzero(sy.pidx >= 0)
-    pi = sy.pidx[rows]
-    jp = sy.Jp[rows]
-    # V_i = Σ_rows jpᵀ jp, g_p,i = Σ jpᵀ r  (sparse aggregation instead of a Python loop)
-    agg = sp.csr_matrix((np.ones(rows.size), (pi, np.arange(rows.size))), shape=(n_pts, rows.size))
-    V = (agg @ (jp[:, :, None] * jp[:, None, :]).reshape(rows.size, p * p)).reshape(n_pts, p, p)
-    gp = agg @ (jp * sy.r[rows, None])
+    if FAST:
+        from hsgeo.adjust._fast import point_normals
+
+        V, gp = point_normals(sy.pidx, sy.Jp, sy.r, n_pts)
+    else:
+        rows = np.flatnonzero(sy.pidx >= 0)
+        pi = sy.pidx[rows]
+        jp = sy.Jp[rows]
+        # V_i = Σ_rows jpᵀ jp, g_p,i = Σ jpᵀ r  (sparse aggregation instead of a Python loop)
+        agg = sp.csr_matrix((np.ones(rows.size), (pi, np.arange(rows.size))),
+                            shape=(n_pts, rows.size))
+        V = (agg @ (jp[:, :, None] * jp[:, None, :]).reshape(rows.size, p * p)).reshape(
+            n_pts, p, p)
+        gp = agg @ (jp * sy.r[rows, None])
     # fixed point entries: unit diagonal, zero gradient -> zero update
     # (their Jacobian columns were zeroed in _evaluate, so V has zero rows/columns there)
     fixed = ~layout.pfree
