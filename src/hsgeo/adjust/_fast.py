@@ -302,21 +302,24 @@ def _symmetrise_upper(U: np.ndarray) -> np.ndarray:
     return S
 
 
-def locality_orders(J, n_c: int, order: np.ndarray | None, ptr: np.ndarray | None):
+def locality_orders(J, n_c: int, order: np.ndarray | None, ptr: np.ndarray | None,
+                    rows: np.ndarray | None = None):
     """Row and point processing orders that keep consecutive updates in nearby rows of S.
 
-    Rows are sorted by their smallest column (``J`` a row-compressed Jacobian,
-    ``hsgeo.adjust.engine._RowJac``): consecutive rows then touch mostly the same rows of the
-    dense matrix, which stay in cache (the kernels are limited by memory latency, not
-    arithmetic).
+    ``rows`` (default all) are sorted by their smallest column (``J`` a row-compressed
+    Jacobian, ``hsgeo.adjust.engine._RowJac``): consecutive rows then touch mostly the same
+    rows of the dense matrix, which stay in cache (the kernels are limited by memory latency,
+    not arithmetic).
     """
     big = np.int64(n_c)
-    cols = J.cols
+    rows = np.arange(J.cols.shape[0], dtype=np.int64) if rows is None else rows
+    cols = J.cols[rows]
     c = np.where(cols >= 0, cols, big)
     rmin = c.min(axis=1) if cols.shape[1] else np.full(cols.shape[0], big)
     if J.fcol.shape[1]:
-        rmin = np.minimum(rmin, np.where(J.fcol >= 0, J.fcol, big).min(axis=1))
-    row_order = np.argsort(rmin, kind="stable").astype(np.int64)
+        fc = J.fcol[rows]
+        rmin = np.minimum(rmin, np.where(fc >= 0, fc, big).min(axis=1))
+    row_order = rows[np.argsort(rmin, kind="stable")].astype(np.int64)
     if order is None or ptr is None or ptr.size < 2:
         return row_order, None
     # (sorting the points by the segments that see them was tried and gave no measurable gain)
@@ -539,3 +542,37 @@ def point_normals(pidx, jp, r, n_pts):  # pragma: no cover - compiled
             for b in range(p):
                 V[i, a, b] += ja * jp[t, b]
     return V, g
+
+
+@njit(cache=True, parallel=True)
+def inv3(V):  # pragma: no cover - compiled
+    """Inverses of ``(n, 3, 3)`` blocks by cofactors; ``ok`` False where (nearly) singular."""
+    n = V.shape[0]
+    out = np.zeros_like(V)
+    ok = np.zeros(n, dtype=np.bool_)
+    for i in prange(n):
+        a, b, c = V[i, 0, 0], V[i, 0, 1], V[i, 0, 2]
+        d, e, f = V[i, 1, 0], V[i, 1, 1], V[i, 1, 2]
+        g, h, k = V[i, 2, 0], V[i, 2, 1], V[i, 2, 2]
+        A = e * k - f * h
+        B = f * g - d * k
+        C = d * h - e * g
+        det = a * A + b * B + c * C
+        m = 0.0
+        for x in range(3):
+            for y in range(3):
+                m = max(m, abs(V[i, x, y]))
+        if not (abs(det) > 1e-12 * m * m * m):
+            continue
+        ok[i] = True
+        r = 1.0 / det
+        out[i, 0, 0] = A * r
+        out[i, 0, 1] = (c * h - b * k) * r
+        out[i, 0, 2] = (b * f - c * e) * r
+        out[i, 1, 0] = B * r
+        out[i, 1, 1] = (a * k - c * g) * r
+        out[i, 1, 2] = (c * d - a * f) * r
+        out[i, 2, 0] = C * r
+        out[i, 2, 1] = (b * g - a * h) * r
+        out[i, 2, 2] = (a * e - b * d) * r
+    return out, ok

@@ -483,7 +483,10 @@ def _normal(layout: _Layout, sy: _System) -> _Normal:
                 ptr = np.concatenate(
                     [[0], np.cumsum(np.bincount(pi_all[rows_p], minlength=layout.n_pts))]
                 ).astype(np.int64)
-            row_order, pt_order = locality_orders(sy.Jrc, layout.n_c, order, ptr)
+            # the rows without a point (priors) form N_cc directly; the others go through the
+            # Schur kernel point by point
+            rows_np = np.flatnonzero(sy.pidx < 0) if layout.pblock is not None else None
+            row_order, pt_order = locality_orders(sy.Jrc, layout.n_c, order, ptr, rows_np)
             _ORDER_CACHE["key"] = (layout.n_c, layout.n_pts, sy.pidx.copy(), sy.Jrc.cols.shape)
             _ORDER_CACHE["value"] = (order, ptr, row_order, pt_order)
         Jrc = sy.Jrc
@@ -491,8 +494,7 @@ def _normal(layout: _Layout, sy: _System) -> _Normal:
         if layout.pblock is None:
             Ncc = normal_cc(Jrc.arrays, layout.n_c, row_order)
             return _Normal(Ncc, gc, None, None, diag_cc=diag_cc)
-        free_rows = row_order[sy.pidx[row_order] < 0]
-        Ncc_free = normal_cc(Jrc.arrays, layout.n_c, free_rows)
+        Ncc_free = normal_cc(Jrc.arrays, layout.n_c, row_order)
         Ncc = None
     else:
         Jc = sy.Jc
@@ -539,6 +541,13 @@ def _damped(A: np.ndarray, lam: float) -> np.ndarray:
 
 
 def _inv_blocks(Vd: np.ndarray) -> np.ndarray:
+    if FAST and Vd.ndim == 3 and Vd.shape[1:] == (3, 3):
+        from hsgeo.adjust._fast import inv3
+
+        out, ok = inv3(np.ascontiguousarray(Vd))
+        if not ok.all():
+            out[~ok] = np.linalg.pinv(Vd[~ok])
+        return out
     try:
         return np.linalg.inv(Vd)
     except np.linalg.LinAlgError:
