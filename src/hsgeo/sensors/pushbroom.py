@@ -25,6 +25,23 @@ coordinate ``x̄`` (mm), which is what a distortion polynomial of an image line 
 K1 mm⁻², K2 mm⁻⁴, P1 and P2 mm⁻¹). The principal point ``(x0, y0)`` is fixed at its calibrated
 value (002 §3.4: it correlates with the tangential terms and is not estimated).
 
+**The residual across the line is a time.** What an LP observation records across the line is
+*which line* saw the point, i.e. a time ``t_e``; its error is the time between the crossing of
+the point (``y = 0``) and the line's exposure (line quantisation and the key-point
+localisation). The residual of 002 eq. (2), ``y(θ, t_e) − 0``, is that time error multiplied by
+the image rate ``ẏ = ∂y/∂t`` — which depends on the parameters θ (``c``, depth, the pitch rate
+of the trajectory corrections, ...). The derivatives of the residual then contain the error
+itself, and least squares is biased by a fixed amount (∝ σ_t² Σ ẏ ∂ẏ/∂θ) that becomes visible as
+σ̂ shrinks with the number of observations. With the navigation rates given, the residual
+across the line is instead the crossing time in the model minus the line time (to first order),
+expressed in pixels at a reference image rate ``ẏ_ref``::
+
+    r_y = ẏ_ref (y(θ, t_e) − y_obs) / ẏ(θ, t_e),   ẏ = (y(θ, t_e + h) − y(θ, t_e)) / h
+
+where ``y(θ, t_e + h)`` uses the navigation pose propagated with its velocity and angular rate
+and the same four spline nodes continued to ``t_e + h`` (h = 1 ms). Its Jacobian follows from
+those of ``y`` at both times (no second derivatives).
+
 The nominal mount ``β₀`` maps the platform frame (x forward, y left, z up) to the camera frame
 (x along the line to the right, y backward, z down the viewing direction).
 
@@ -61,10 +78,10 @@ BLOCK_NAMES = {
 
 
 def _camera_geometry(values, names, nodes: SplineNodes, t_s, xyz_nav, rpy_nav, pidx, band,
-                     beta0, jacobian):
+                     beta0, jacobian, basis=None):
     """p^c and intermediate quantities for every observation (002 eq. 4)."""
     P = values[names["points"]][pidx]
-    idx, w = nodes.basis(t_s)
+    idx, w = nodes.basis(t_s) if basis is None else basis
     node_vals = values[names["nodes"]]
     delta = np.einsum("ma,mak->mk", w, node_vals[idx])
     x = xyz_nav + delta[:, :3]
@@ -140,8 +157,7 @@ def _rot_rpy(ro, pi, ya, R, dR):  # pragma: no cover - compiled
 
 @njit(cache=True, parallel=True)
 def _lines_kernel(P, pidx, idx, w, nodes, xyz_nav, rpy_nav, band, c_b, dist, beta, dbeta,
-                  lever, x0, y0, k_px, xy_obs, jac, r, dP, dN, dB, dL, dD, dC,
-                  y_time_k):  # pragma: no cover
+                  lever, x0, y0, k_px, xy_obs, jac, r, dP, dN, dB, dL, dD, dC):  # pragma: no cover
     """002 eq. (2)–(4) and their derivatives, one observation per iteration (rows 2j, 2j+1)."""
     m = pidx.size
     K1, K2, P1, P2 = dist[0], dist[1], dist[2], dist[3]
@@ -177,9 +193,7 @@ def _lines_kernel(P, pidx, idx, w, nodes, xyz_nav, rpy_nav, band, c_b, dist, bet
             x = xb + K1 * xb**3 + K2 * xb**5 + 3 * P1 * xb**2 + x0  # 002 eq. (3)
             y = yb + P2 * xb**2 + y0
             r[2 * j] = x * k_px - xy_obs[j, 0]
-            ry = y * k_px - xy_obs[j, 1]
-            kap = y_time_k * p[2] / c if y_time_k > 0 else 1.0
-            r[2 * j + 1] = kap * ry
+            r[2 * j + 1] = y * k_px - xy_obs[j, 1]
             if not jac:
                 continue
             gx = 1.0 + 3 * K1 * xb**2 + 5 * K2 * xb**4 + 6 * P1 * xb
@@ -228,28 +242,30 @@ def _lines_kernel(P, pidx, idx, w, nodes, xyz_nav, rpy_nav, band, c_b, dist, bet
             dD[2 * j + 1, 1] = 0.0
             dD[2 * j + 1, 2] = 0.0
             dD[2 * j + 1, 3] = xb**2 * k_px
-            if y_time_k > 0:
-                # y as a time: r_y·κ with κ = c_ref p_z / (c Z_ref); d(κ r) = κ dr + r dκ
-                row = 2 * j + 1
-                f = ry * kap / p[2]
-                for a in range(3):
-                    v2 = beta[2, 0] * R[a, 0] + beta[2, 1] * R[a, 1] + beta[2, 2] * R[a, 2]
-                    dP[row, a] = kap * dP[row, a] + f * v2
-                    for b in range(4):
-                        dN[row, b, a] = kap * dN[row, b, a] - f * v2 * w[j, b]
-                    dL[row, a] = kap * dL[row, a] - f * beta[2, a]
-                for kk in range(3):
-                    v2 = 0.0
-                    for i in range(3):
-                        v2 += beta[2, i] * (dR[kk, 0, i] * d[0] + dR[kk, 1, i] * d[1]
-                                            + dR[kk, 2, i] * d[2])
-                    for b in range(4):
-                        dN[row, b, 3 + kk] = kap * dN[row, b, 3 + kk] + f * v2 * w[j, b]
-                    vb = dbeta[kk, 2, 0] * q[0] + dbeta[kk, 2, 1] * q[1] + dbeta[kk, 2, 2] * q[2]
-                    dB[row, kk] = kap * dB[row, kk] + f * vb
-                dC[row, 0] = kap * dC[row, 0] - ry * kap / c
-                for a in range(4):
-                    dD[row, a] *= kap
+
+
+def _time_rows(r0, arrays0, r1, arrays1, h, s):
+    """Turn the y rows of ``(r0, arrays0)`` (at t) into the time residual (module docstring).
+
+    ``r1, arrays1``: the same at ``t + h``. Rows ``1::2`` of ``r0`` and of every array in
+    ``arrays0`` are overwritten with ``s · ry0 / D`` and its derivative, ``D = (ry1 − ry0)/h``.
+    ``D`` is floored at ``s / 4``: far from the solution (a trial step that throws a point far
+    off) the image rate of a few observations can vanish or change sign, and the time residual
+    would be undefined; every real geometry has ``D`` near ``s``.
+    """
+    ry0, ry1 = r0[1::2].copy(), r1[1::2]
+    D = (ry1 - ry0) / h
+    floor = 0.25 * s
+    live = D > floor
+    D = np.where(live, D, floor)
+    r0[1::2] = s * ry0 / D
+    if arrays0 is None:
+        return
+    b = np.where(live, -s * ry0 / (D * D * h), 0.0)  # ∂/∂ry1
+    a = s / D - b  # ∂/∂ry0
+    for A0, A1 in zip(arrays0, arrays1, strict=True):
+        shp = (-1,) + (1,) * (A0.ndim - 1)
+        A0[1::2] = a.reshape(shp) * A0[1::2] + b.reshape(shp) * A1[1::2]
 
 
 class PushbroomLines(ResidualBlock):
@@ -280,6 +296,15 @@ class PushbroomLines(ResidualBlock):
         Principal point (fixed).
     names : dict, optional
         Parameter block names (defaults :data:`BLOCK_NAMES`).
+    xyz_rate_m_s, rpy_rate_rad_s : (m, 3) ndarray, optional
+        GNSS/INS velocity and attitude-angle rates at ``t_s``. Given, the residual across the
+        line is a time (see the module docstring), in pixels at ``y_rate_ref_px_s``; omitted,
+        it is the image y of 002 eq. (2).
+    y_rate_ref_px_s : float, optional
+        Reference image rate across the line (px/s) that converts the time residual to pixels
+        (required with the rates; e.g. ``c V / (Z pixel)``).
+    time_step_s : float
+        The step ``h`` of the image rate (default 1 ms).
     """
 
     name = "image points"
@@ -288,13 +313,20 @@ class PushbroomLines(ResidualBlock):
     def __init__(self, point, band, t_s, xy_px, xyz_nav_m, rpy_nav_rad, nodes: SplineNodes,
                  pixel_mm: float, sigma_px: float = 0.5, x0_mm: float = 0.0,
                  y0_mm: float = 0.0, names: dict | None = None,
-                 beta0=BETA0_CAM_FROM_PLATFORM, y_time_k: float = 0.0):
+                 beta0=BETA0_CAM_FROM_PLATFORM, xyz_rate_m_s=None, rpy_rate_rad_s=None,
+                 y_rate_ref_px_s: float | None = None, time_step_s: float = 1e-3):
         point = np.asarray(point)
         m = point.size
         xy = np.asarray(xy_px, dtype=np.float64)
-        for nm, arr, shape in [("band", band, (m,)), ("t_s", t_s, (m,)), ("xy_px", xy, (m, 2)),
-                               ("xyz_nav_m", xyz_nav_m, (m, 3)),
-                               ("rpy_nav_rad", rpy_nav_rad, (m, 3))]:
+        checks = [("band", band, (m,)), ("t_s", t_s, (m,)), ("xy_px", xy, (m, 2)),
+                  ("xyz_nav_m", xyz_nav_m, (m, 3)), ("rpy_nav_rad", rpy_nav_rad, (m, 3))]
+        if (xyz_rate_m_s is None) != (rpy_rate_rad_s is None):
+            raise InputError("PushbroomLines: give both xyz_rate_m_s and rpy_rate_rad_s, or none")
+        timed = xyz_rate_m_s is not None
+        if timed:
+            checks += [("xyz_rate_m_s", xyz_rate_m_s, (m, 3)),
+                       ("rpy_rate_rad_s", rpy_rate_rad_s, (m, 3))]
+        for nm, arr, shape in checks:
             if np.shape(arr) != shape:
                 raise InputError(
                     f"PushbroomLines: {nm} has shape {np.shape(arr)}, expected {shape} "
@@ -319,9 +351,24 @@ class PushbroomLines(ResidualBlock):
         self.names = dict(BLOCK_NAMES if names is None else names)
         self.beta0 = np.asarray(beta0, dtype=np.float64)
         self._basis = nodes.basis(self.t_s)
-        if not (np.isfinite(y_time_k) and y_time_k >= 0):
-            raise InputError(f"y_time_k must be ≥ 0 (0: the image y of 002 eq. 2), got {y_time_k}")
-        self.y_time_k = float(y_time_k)
+        self.timed = timed
+        if timed:
+            if not (y_rate_ref_px_s is not None and np.isfinite(y_rate_ref_px_s)
+                    and y_rate_ref_px_s > 0):
+                raise InputError(
+                    "PushbroomLines: the time residual needs y_rate_ref_px_s > 0 (the image "
+                    f"rate across the line in px/s, c V / (Z pixel)), got {y_rate_ref_px_s!r}")
+            if not (np.isfinite(time_step_s) and time_step_s > 0):
+                raise InputError(f"time_step_s must be positive, got {time_step_s!r}")
+            h = float(time_step_s)
+            self.time_step_s = h
+            self.y_rate_ref_px_s = float(y_rate_ref_px_s)
+            # the navigation pose at t + h, and the same four nodes' weights at t + h
+            self.xyz_nav_h = np.ascontiguousarray(
+                self.xyz_nav + h * np.asarray(xyz_rate_m_s, dtype=np.float64))
+            self.rpy_nav_h = np.ascontiguousarray(
+                self.rpy_nav + h * np.asarray(rpy_rate_rad_s, dtype=np.float64))
+            self._basis_h = nodes.basis_shifted(self.t_s, h)
         self._pidx2 = np.repeat(self.point, 2)
         self._idx2 = np.repeat(self._basis[0], 2, axis=0)
         for a in ("xyz_nav", "rpy_nav", "xy_px"):
@@ -333,11 +380,11 @@ class PushbroomLines(ResidualBlock):
                         self.point, self.band, self.beta0, self.x0_mm, self.y0_mm)
         return xy
 
-    def evaluate_numpy(self, values, jacobian):
-        """The same as :meth:`evaluate`, in plain numpy (the reference for the tests)."""
+    def _numpy_at(self, values, jacobian, xyz_nav, rpy_nav, basis):
+        """Image residuals (px) and their derivative arrays at one pose, in plain numpy."""
         nm = self.names
-        g = _camera_geometry(values, nm, self.nodes, self.t_s, self.xyz_nav, self.rpy_nav,
-                             self.point, self.band, self.beta0, jacobian)
+        g = _camera_geometry(values, nm, self.nodes, self.t_s, xyz_nav, rpy_nav,
+                             self.point, self.band, self.beta0, jacobian, basis)
         p, q, d, R, beta = g["p"], g["q"], g["d"], g["R"], g["beta"]
         c = values[nm["c"]][self.band]
         K1, K2, P1, P2 = values[nm["distortion"]]
@@ -350,11 +397,9 @@ class PushbroomLines(ResidualBlock):
         m = self.point.size
         r = np.empty(2 * m)
         r[0::2] = x * k - self.xy_px[:, 0]
-        ry = y * k - self.xy_px[:, 1]
-        kap = self.y_time_k * p[:, 2] / c if self.y_time_k > 0 else np.ones(m)
-        r[1::2] = kap * ry
+        r[1::2] = y * k - self.xy_px[:, 1]
         if not jacobian:
-            return r, None
+            return r, None, None
         # d(x, y)/d p^c  (2 × 3 per observation), in px
         gx = 1.0 + 3 * K1 * xb**2 + 5 * K2 * xb**4 + 6 * P1 * xb  # dx/dx̄
         gy = 2 * P2 * xb  # dy/dx̄
@@ -387,36 +432,37 @@ class PushbroomLines(ResidualBlock):
         dDist[:, 0, 1] = xb**5 * k
         dDist[:, 0, 2] = 3 * xb**2 * k
         dDist[:, 1, 3] = xb**2 * k
-        if self.y_time_k > 0:
-            # y as a time: d(κ r_y) = κ dr_y + r_y dκ, κ = c_ref p_z / (c Z_ref)
-            f = ry * kap / p[:, 2]
-            bR = np.einsum("i,mai->ma", beta[2], R)  # d p_z / d P
-            dP[:, 1] = kap[:, None] * dP[:, 1] + f[:, None] * bR
-            d6[:, 1, :3] = kap[:, None] * d6[:, 1, :3] - f[:, None] * bR
-            d6[:, 1, 3:] = kap[:, None] * d6[:, 1, 3:] + f[:, None] * np.einsum(
-                "i,mik->mk", beta[2], dq_drpy)
-            dnodes = w[:, None, :, None] * d6[:, :, None, :]
-            dLever = dLever.copy()
-            dLever[:, 1] = kap[:, None] * dLever[:, 1] - f[:, None] * beta[2]
-            dBore[:, 1] = kap[:, None] * dBore[:, 1] + f[:, None] * np.einsum(
-                "kj,mj->mk", dbeta[:, 2, :], q)
-            dC[:, 1] = kap * dC[:, 1] - ry * kap / c
-            dDist[:, 1] *= kap[:, None]
+        arrays = [dP.reshape(2 * m, 3), dnodes.reshape(2 * m, 4, 6), dBore.reshape(2 * m, 3),
+                  dLever.reshape(2 * m, 3), dDist.reshape(2 * m, 4), dC.reshape(2 * m, 1)]
+        return r, arrays, idx
+
+    def evaluate_numpy(self, values, jacobian):
+        """The same as :meth:`evaluate`, in plain numpy (the reference for the tests)."""
+        nm = self.names
+        r, arrays, idx = self._numpy_at(values, jacobian, self.xyz_nav, self.rpy_nav,
+                                        self._basis)
+        if self.timed:
+            r1, arrays1, _ = self._numpy_at(values, jacobian, self.xyz_nav_h, self.rpy_nav_h,
+                                            self._basis_h)
+            _time_rows(r, arrays, r1, arrays1, self.time_step_s, self.y_rate_ref_px_s)
+        if not jacobian:
+            return r, None
+        dP, dnodes, dBore, dLever, dDist, dC = arrays
         rep = np.repeat
         jac = {
-            nm["points"]: Indexed(rep(self.point, 2), dP.reshape(2 * m, 3)),
-            nm["nodes"]: Indexed(rep(idx, 2, axis=0), dnodes.reshape(2 * m, 4, 6)),
-            nm["boresight"]: dBore.reshape(2 * m, 3),
-            nm["lever_arm"]: dLever.reshape(2 * m, 3),
-            nm["distortion"]: dDist.reshape(2 * m, 4),
-            nm["c"]: Indexed(rep(self.band, 2), dC.reshape(2 * m, 1)),
+            nm["points"]: Indexed(rep(self.point, 2), dP),
+            nm["nodes"]: Indexed(rep(idx, 2, axis=0), dnodes),
+            nm["boresight"]: dBore,
+            nm["lever_arm"]: dLever,
+            nm["distortion"]: dDist,
+            nm["c"]: Indexed(rep(self.band, 2), dC),
         }
         return r, jac
 
-    def evaluate(self, values, jacobian):
+    def _kernel_at(self, values, jacobian, xyz_nav, rpy_nav, basis):
         nm = self.names
         m = self.point.size
-        idx, w = self._basis
+        idx, w = basis
         bore = values[nm["boresight"]]
         beta = R_from_opk(bore[0], bore[1], bore[2]) @ self.beta0
         dbeta = dR_dopk(bore[0], bore[1], bore[2]) @ self.beta0
@@ -430,14 +476,25 @@ class PushbroomLines(ResidualBlock):
         dC = np.empty(shp + (1,))
         _lines_kernel(np.ascontiguousarray(values[nm["points"]], dtype=np.float64), self.point,
                       idx, w, np.ascontiguousarray(values[nm["nodes"]], dtype=np.float64),
-                      self.xyz_nav, self.rpy_nav, self.band,
+                      xyz_nav, rpy_nav, self.band,
                       np.asarray(values[nm["c"]], dtype=np.float64),
                       np.asarray(values[nm["distortion"]], dtype=np.float64), beta, dbeta,
                       np.asarray(values[nm["lever_arm"]], dtype=np.float64), self.x0_mm,
                       self.y0_mm, 1.0 / self.pixel_mm, self.xy_px, bool(jacobian), r, dP, dN,
-                      dB, dL, dD, dC, self.y_time_k)
+                      dB, dL, dD, dC)
+        return r, [dP, dN, dB, dL, dD, dC]
+
+    def evaluate(self, values, jacobian):
+        nm = self.names
+        r, arrays = self._kernel_at(values, jacobian, self.xyz_nav, self.rpy_nav, self._basis)
+        if self.timed:
+            r1, arrays1 = self._kernel_at(values, jacobian, self.xyz_nav_h, self.rpy_nav_h,
+                                          self._basis_h)
+            _time_rows(r, arrays if jacobian else None, r1, arrays1, self.time_step_s,
+                       self.y_rate_ref_px_s)
         if not jacobian:
             return r, None
+        dP, dN, dB, dL, dD, dC = arrays
         rep = np.repeat
         jac = {
             nm["points"]: Indexed(self._pidx2, dP),
