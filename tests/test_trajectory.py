@@ -61,3 +61,28 @@ def test_trajectory_interpolation_and_errors():
         Trajectory([0, 0, 1], xyz, rpy)
     with pytest.raises(InputError, match="expected"):
         Trajectory(t, xyz[:2], rpy)
+
+
+def test_spline_rate_and_shifted_basis_against_differences():
+    sn = SplineNodes(0.0, 35.0, 10.0)
+    rng = np.random.default_rng(0)
+    c = rng.standard_normal((sn.n_nodes, 2))
+    t = np.r_[rng.uniform(0.01, 34.99, 200), 10.0, 20.0, 0.0, 35.0]
+    h = 1e-5
+    tp, tm = np.clip(t + h, 0, 35), np.clip(t - h, 0, 35)
+    num = (sn.evaluate(c, tp) - sn.evaluate(c, tm)) / (tp - tm)[:, None]
+    np.testing.assert_allclose(sn.evaluate_rate(c, t), num, atol=1e-6)  # one-sided at the ends
+    # the shifted basis: same nodes as t, the spline at t + dt (continued piece: O(dt³))
+    idx, w = sn.basis_shifted(t[:-1], 1e-3)
+    np.testing.assert_array_equal(idx, sn.basis(t[:-1])[0])
+    got = np.einsum("ma,mak->mk", w, c[idx])
+    np.testing.assert_allclose(got, sn.evaluate(c, t[:-1] + 1e-3), atol=1e-9)
+
+
+def test_trajectory_rates():
+    t = np.linspace(0, 10, 11)
+    tr = Trajectory(t, np.column_stack([2 * t, -t, 0 * t + 5]),
+                    np.column_stack([0.1 * t, 0 * t, 0.02 * t]))
+    v, w = tr.rates(np.array([0.0, 3.3, 10.0]))
+    np.testing.assert_allclose(v, [[2, -1, 0]] * 3, atol=1e-9)
+    np.testing.assert_allclose(w, [[0.1, 0, 0.02]] * 3, atol=1e-9)

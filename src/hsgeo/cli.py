@@ -187,7 +187,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="spline node interval in s (default 10, 002 §4)")
     p.add_argument("--image-y", action="store_true",
                    help="residual across the line as the image y of 002 eq. 2 (default: as a "
-                   "time, which avoids a bias of the principal distance)")
+                   "time, the image y over its rate from the trajectory's velocity and angular "
+                   "rate, which avoids a bias of the principal distance and the pitch "
+                   "corrections)")
     p.add_argument("--json", action="store_true", help="JSON instead of the text report")
     p.set_defaults(func=_cmd_adjust_pushbroom)
 

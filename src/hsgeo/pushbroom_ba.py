@@ -119,7 +119,9 @@ def build_problem(obs: dict, n_points: int, cam: CameraPrior, *, node_interval_s
     ----------
     obs : dict
         ``point`` (m,), ``band`` (m,), ``t_s`` (m,), ``xy_px`` (m, 2), ``xyz_nav_m`` (m, 3),
-        ``rpy_nav_rad`` (m, 3): the observations and the GNSS/INS pose at their line times.
+        ``rpy_nav_rad`` (m, 3): the observations and the GNSS/INS pose at their line times;
+        with ``y_as_time`` also ``xyz_rate_nav_m_s`` and ``rpy_rate_nav_rad_s`` (m, 3), the
+        GNSS/INS velocity and attitude rates there.
     n_points : int
     cam : CameraPrior
     node_interval_s : float
@@ -133,10 +135,12 @@ def build_problem(obs: dict, n_points: int, cam: CameraPrior, *, node_interval_s
         Prior mean of the node corrections (default zero: the GNSS/INS solution as it is).
     y_as_time : bool
         Residual across the line as a *time* (the line a point is registered in) rather than
-        the image y of 002 eq. (2): the y residual is multiplied by ``c_ref p_z / (c Z_ref)``
-        (``c_ref`` the initial principal distance, ``Z_ref`` the median initial depth), which
-        keeps its zero and its size but removes its dependence on c and on the depth. See the
-        chapter for the bias this avoids.
+        the image y of 002 eq. (2): the modelled y divided by the modelled image rate ẏ
+        across the line (:class:`~hsgeo.sensors.pushbroom.PushbroomLines`), in pixels at the
+        reference rate ``c_ref V / (Z_ref pixel)`` (``c_ref`` the initial principal distance,
+        ``V`` the median speed, ``Z_ref`` the median initial depth). Its derivatives do not
+        contain the error itself, as those of the image y do when the error is one of time.
+        See the chapter for the bias this avoids.
 
     Returns
     -------
@@ -168,13 +172,21 @@ def build_problem(obs: dict, n_points: int, cam: CameraPrior, *, node_interval_s
         gi = np.asarray(gcp_index)
         p.set(names["points"], np.asarray(gcp_xyz_m, float), index=gi)
         p.set_prior(names["points"], cam.sigma_gcp_m, index=gi, mean=np.asarray(gcp_xyz_m, float))
-    y_time_k = 0.0
+    timed = {}
     if y_as_time:
+        missing = [k for k in ("xyz_rate_nav_m_s", "rpy_rate_nav_rad_s") if k not in obs]
+        if missing:
+            raise InputError(
+                f"y_as_time needs the GNSS/INS rates at the line times ({missing}): give them "
+                "(e.g. hsgeo.trajectory.Trajectory.rates) or use y_as_time=False")
         z_ref = float(np.median(obs["xyz_nav_m"][:, 2] - P0[obs["point"], 2]))
-        y_time_k = cam.c_mm / z_ref
+        v_ref = float(np.median(np.linalg.norm(obs["xyz_rate_nav_m_s"], axis=1)))
+        timed = {"xyz_rate_m_s": obs["xyz_rate_nav_m_s"],
+                 "rpy_rate_rad_s": obs["rpy_rate_nav_rad_s"],
+                 "y_rate_ref_px_s": cam.c_mm * v_ref / (z_ref * cam.pixel_mm)}
     blk = PushbroomLines(obs["point"], obs["band"], t, obs["xy_px"], obs["xyz_nav_m"],
                          obs["rpy_nav_rad"], nodes, cam.pixel_mm, cam.sigma_obs_px,
-                         cam.x0_mm, cam.y0_mm, y_time_k=y_time_k)
+                         cam.x0_mm, cam.y0_mm, **timed)
     return p, [blk], nodes
 
 
@@ -250,7 +262,8 @@ def adjust_files(observations, trajectory, camera, gcp=None, *, node_interval_s:
     trajectory : path
         CSV or Parquet with ``t_s, E_m, N_m, H_m, roll_rad, pitch_rad, yaw_rad``: the GNSS/INS
         solution (map frame east-north-up, ``R_map_from_platform = R_from_rpy``), interpolated
-        linearly to the line times.
+        linearly to the line times; its velocity and angular rates (for the time residual,
+        ``y_as_time``) are central differences of that interpolation.
     camera : path
         TOML: ``[camera] n_bands, pixel_mm, c_mm, x0_mm, y0_mm, lever_arm_m, sigma_lever_m``,
         ``[gnss_ins] sigma_pos_m = [E, N, H], sigma_att_deg = [roll, pitch, yaw]``,
@@ -274,9 +287,11 @@ def adjust_files(observations, trajectory, camera, gcp=None, *, node_interval_s:
                       nav_df[["roll_rad", "pitch_rad", "yaw_rad"]].to_numpy())
     t = obs_df["t_s"].to_numpy(dtype=float)
     xyz, rpy = traj.pose(t)
+    vel, rate = traj.rates(t)
     obs = {"point": point.astype(np.int64), "band": obs_df["band"].to_numpy().astype(np.int64),
            "t_s": t, "xy_px": obs_df[["x_px", "y_px"]].to_numpy(dtype=float),
-           "xyz_nav_m": xyz, "rpy_nav_rad": rpy}
+           "xyz_nav_m": xyz, "rpy_nav_rad": rpy, "xyz_rate_nav_m_s": vel,
+           "rpy_rate_nav_rad_s": rate}
     gi = gx = None
     if gcp is not None:
         g = read_table(gcp, GCP_COLUMNS, "GCP")

@@ -40,7 +40,7 @@ import numpy as np
 from hsgeo.errors import InputError
 from hsgeo.rotations import R_from_rpy
 
-__all__ = ["Trajectory", "SplineNodes", "bspline_basis"]
+__all__ = ["Trajectory", "SplineNodes", "bspline_basis", "bspline_basis_derivative"]
 
 #: Names of the six corrections per node, in order.
 CORRECTION_COLUMNS = ("dE_m", "dN_m", "dH_m", "droll_rad", "dpitch_rad", "dyaw_rad")
@@ -59,6 +59,15 @@ def bspline_basis(u):
     return np.stack(
         [(1 - u) ** 3 / 6, (3 * u3 - 6 * u2 + 4) / 6, (-3 * u3 + 3 * u2 + 3 * u + 1) / 6, u3 / 6],
         axis=-1,
+    )
+
+
+def bspline_basis_derivative(u):
+    """Derivatives ``dB_a/du`` of :func:`bspline_basis` (divide by Δt for a rate per second)."""
+    u = np.asarray(u, dtype=np.float64)
+    u2 = u * u
+    return np.stack(
+        [-((1 - u) ** 2) / 2, (3 * u2 - 4 * u) / 2, (-3 * u2 + 2 * u + 1) / 2, u2 / 2], axis=-1
     )
 
 
@@ -113,11 +122,38 @@ class SplineNodes:
                 f"times outside the spline span [{self.t_start_s}, {self.t_end_s}] s: build "
                 "SplineNodes over the observations' time range"
             )
+        index, u = self._piece(t)
+        return index, bspline_basis(u)
+
+    def _piece(self, t):
         x = (t - self.t_start_s) / self.interval_s
         k = np.clip(np.floor(x).astype(np.int64), 0, self.n_nodes - 4)
-        u = x - k
         index = k[:, None] + np.arange(4)  # nodes k-1..k+2 in 0-based j = k .. k+3
+        return index, x - k
+
+    def basis_shifted(self, t_s, dt_s: float):
+        """The four nodes of ``t_s`` and the weights of *their* cubic piece at ``t_s + dt_s``.
+
+        For a small ``dt_s`` this is the spline at ``t_s + dt_s`` (the pieces join C², so
+        continuing a piece a millisecond past its node differs from the next piece by
+        O(dt³)), with the same four nodes as ``t_s``: a difference in time of anything that
+        depends on the correction touches the same 24 unknowns.
+        """
+        t = np.asarray(t_s, dtype=np.float64).ravel()
+        index, _ = self.basis(t)
+        u = (t + dt_s - self.t_start_s) / self.interval_s - index[:, 0]
         return index, bspline_basis(u)
+
+    def evaluate_rate(self, nodes, t_s) -> np.ndarray:
+        """Time derivative of the correction at ``t_s`` (per second), ``(m, k)``."""
+        nodes = np.asarray(nodes, dtype=np.float64)
+        if nodes.ndim != 2 or nodes.shape[0] != self.n_nodes:
+            raise InputError(f"node values must be ({self.n_nodes}, k), got {nodes.shape}")
+        t = np.asarray(t_s, dtype=np.float64).ravel()
+        self.basis(t)  # span check
+        idx, u = self._piece(t)
+        dw = bspline_basis_derivative(u) / self.interval_s
+        return np.einsum("ma,mak->mk", dw, nodes[idx])
 
     def evaluate(self, nodes, t_s) -> np.ndarray:
         """Correction at ``t_s`` from node values ``nodes`` ``(n_nodes, k)`` -> ``(m, k)``."""
@@ -180,6 +216,21 @@ class Trajectory:
         xyz = np.column_stack([np.interp(t, self.t_s, self.xyz_m[:, i]) for i in range(3)])
         rpy = np.column_stack([np.interp(t, self.t_s, self.rpy_rad[:, i]) for i in range(3)])
         return xyz, rpy
+
+    def rates(self, t_s, step_s: float = 1e-3):
+        """Velocity ``(m, 3)`` m/s and attitude-angle rates ``(m, 3)`` rad/s at ``t_s``.
+
+        Central differences of :meth:`pose` over ``± step_s`` (one-sided at the ends of the
+        trajectory): the slope of the linear interpolation, averaged at the epochs.
+        """
+        t = np.asarray(t_s, dtype=np.float64).ravel()
+        self.pose(t)  # span check
+        ta = np.maximum(t - step_s, self.t_s[0])
+        tb = np.minimum(t + step_s, self.t_s[-1])
+        xa, ra = self.pose(ta)
+        xb, rb = self.pose(tb)
+        dt = (tb - ta)[:, None]
+        return (xb - xa) / dt, (rb - ra) / dt
 
     def R_map_from_platform(self, t_s) -> np.ndarray:
         _, rpy = self.pose(t_s)

@@ -25,6 +25,26 @@ coordinate ``x̄`` (mm), which is what a distortion polynomial of an image line 
 K1 mm⁻², K2 mm⁻⁴, P1 and P2 mm⁻¹). The principal point ``(x0, y0)`` is fixed at its calibrated
 value (002 §3.4: it correlates with the tangential terms and is not estimated).
 
+**The residual across the line is a time.** What an LP observation records across the line is
+*which line* saw the point, i.e. a time ``t_e``; its error is the time between the crossing of
+the point (``y = 0``) and the line's exposure (line quantisation and the key-point
+localisation). The residual of 002 eq. (2), ``y(θ, t_e) − 0``, is that time error multiplied by
+the image rate ``ẏ = ∂y/∂t`` — which depends on the parameters θ (``c``, depth, the pitch rate
+of the trajectory corrections, ...). The derivatives of the residual then contain the error
+itself, and least squares is biased by a fixed amount (∝ σ_t² Σ ẏ ∂ẏ/∂θ) that becomes visible as
+σ̂ shrinks with the number of observations. With the navigation rates given, the residual
+across the line is instead a time: the model's crossing time ``t*`` of the line,
+``y(θ, t*) = y_obs``, minus the line time, in pixels at a reference image rate ``ẏ_ref``::
+
+    r_y = ẏ_ref (t_e − t*),   r_x = x(θ, t*) − x_obs,   ∂t*/∂θ = −(∂y/∂θ) / ẏ
+
+``t*`` is found by Newton's method from ``t_e`` (to 1e-11 s, usually in two steps), with the
+navigation pose moved by its velocity and angular rate and the spline piece of ``t_e``
+continued; ``ẏ`` and ``ẋ`` are the image rates along the corrected trajectory. The derivatives
+are evaluated at ``t*``, so they do not contain the time error, and the node derivatives keep
+the factored form ``B_a(t*) ∂r/∂δ``. Evaluating x at ``t*`` rather than ``t_e`` adds
+``ẋ (t* − t_e)`` (≈ 0.1 px at the mount's angular rates) to the x residual, zero-mean.
+
 The nominal mount ``β₀`` maps the platform frame (x forward, y left, z up) to the camera frame
 (x along the line to the right, y backward, z down the viewing direction).
 
@@ -61,10 +81,10 @@ BLOCK_NAMES = {
 
 
 def _camera_geometry(values, names, nodes: SplineNodes, t_s, xyz_nav, rpy_nav, pidx, band,
-                     beta0, jacobian):
+                     beta0, jacobian, basis=None):
     """p^c and intermediate quantities for every observation (002 eq. 4)."""
     P = values[names["points"]][pidx]
-    idx, w = nodes.basis(t_s)
+    idx, w = nodes.basis(t_s) if basis is None else basis
     node_vals = values[names["nodes"]]
     delta = np.einsum("ma,mak->mk", w, node_vals[idx])
     x = xyz_nav + delta[:, :3]
@@ -138,11 +158,39 @@ def _rot_rpy(ro, pi, ya, R, dR):  # pragma: no cover - compiled
     dR[2, 2, 2] = 0.0
 
 
+#: The crossing time is sought within ± this of the line time (s): 0.25 s is ~55 px of image
+#: motion, beyond any gross error left after RANSAC; a trial step that throws a weakly
+#: intersected point far off is held there (without the bound the time of such a point runs
+#: off with the spline extrapolated, and the first iterations are damped to a crawl).
+T_MAX = 0.25
+
+
+@njit(cache=True, inline="always")
+def _spline_weights(u, inv_dt, w, dw):  # pragma: no cover - compiled
+    """Uniform cubic B-spline weights at local coordinate u and their time derivatives."""
+    v = 1.0 - u
+    w[0] = v * v * v / 6.0
+    w[1] = (3.0 * u * u * u - 6.0 * u * u + 4.0) / 6.0
+    w[2] = (-3.0 * u * u * u + 3.0 * u * u + 3.0 * u + 1.0) / 6.0
+    w[3] = u * u * u / 6.0
+    dw[0] = -v * v / 2.0 * inv_dt
+    dw[1] = (3.0 * u * u - 4.0 * u) / 2.0 * inv_dt
+    dw[2] = (-3.0 * u * u + 2.0 * u + 1.0) / 2.0 * inv_dt
+    dw[3] = u * u / 2.0 * inv_dt
+
+
 @njit(cache=True, parallel=True)
-def _lines_kernel(P, pidx, idx, w, nodes, xyz_nav, rpy_nav, band, c_b, dist, beta, dbeta,
-                  lever, x0, y0, k_px, xy_obs, jac, r, dP, dN, dB, dL, dD, dC,
-                  y_time_k):  # pragma: no cover
-    """002 eq. (2)–(4) and their derivatives, one observation per iteration (rows 2j, 2j+1)."""
+def _lines_kernel(P, pidx, idx, u0, inv_dt, nodes, xyz_nav, rpy_nav, xyz_rate, rpy_rate, band,
+                  c_b, dist, beta, dbeta, lever, x0, y0, k_px, xy_obs, timed, n_newton,
+                  y_rate_ref, jac, r, w_out, dP, dN, dB, dL, dD, dC):  # pragma: no cover
+    """002 eq. (2)–(4) and their derivatives, one observation per iteration (rows 2j, 2j+1).
+
+    ``timed``: the observation is evaluated at the model's crossing time ``t*`` of the line
+    (``y(t*) = y_obs``, Newton from the line time ``t_e`` with the navigation pose moved by its
+    rates and the spline piece of ``t_e`` continued); the residuals are ``x(t*) − x_obs`` and
+    ``ẏ_ref (t_e − t*)``, and their derivatives follow from the implicit function theorem,
+    ``∂t*/∂θ = −(∂y/∂θ)/ẏ``. The spline weights used are returned in ``w_out``.
+    """
     m = pidx.size
     K1, K2, P1, P2 = dist[0], dist[1], dist[2], dist[3]
     n_chunks = 64 if m > 6400 else 1
@@ -154,62 +202,101 @@ def _lines_kernel(P, pidx, idx, w, nodes, xyz_nav, rpy_nav, band, c_b, dist, bet
         q = np.empty(3)
         p = np.empty(3)
         dl = np.empty(6)
+        rate = np.empty(6)
         Jp = np.empty((2, 3))
         JpB = np.empty((2, 3))
+        d6 = np.empty((2, 6))
+        w = np.empty(4)
+        dw = np.empty(4)
         for j in range(ch * step, min(m, (ch + 1) * step)):
-            for a in range(6):
-                acc = 0.0
-                for b in range(4):
-                    acc += w[j, b] * nodes[idx[j, b], a]
-                dl[a] = acc
-            _rot_rpy(rpy_nav[j, 0] + dl[3], rpy_nav[j, 1] + dl[4], rpy_nav[j, 2] + dl[5], R, dR)
-            pt = pidx[j]
-            for a in range(3):
-                d[a] = P[pt, a] - xyz_nav[j, a] - dl[a]
-            for a in range(3):  # q = Rᵀ d − l
-                q[a] = R[0, a] * d[0] + R[1, a] * d[1] + R[2, a] * d[2] - lever[a]
-            for a in range(3):  # p = β q
-                p[a] = beta[a, 0] * q[0] + beta[a, 1] * q[1] + beta[a, 2] * q[2]
-            c = c_b[band[j]]
-            iz = 1.0 / p[2]
-            xb = c * p[0] * iz
-            yb = c * p[1] * iz
-            x = xb + K1 * xb**3 + K2 * xb**5 + 3 * P1 * xb**2 + x0  # 002 eq. (3)
-            y = yb + P2 * xb**2 + y0
-            r[2 * j] = x * k_px - xy_obs[j, 0]
-            ry = y * k_px - xy_obs[j, 1]
-            kap = y_time_k * p[2] / c if y_time_k > 0 else 1.0
-            r[2 * j + 1] = kap * ry
+            dt = 0.0  # t − t_e
+            xdot = 0.0
+            ydot = 1.0
+            ey = 0.0
+            n_it = n_newton if timed else 0
+            for it in range(n_it + 1):
+                _spline_weights(u0[j] + dt * inv_dt, inv_dt, w, dw)
+                for a in range(6):
+                    acc = 0.0
+                    acc_r = 0.0
+                    for b in range(4):
+                        acc += w[b] * nodes[idx[j, b], a]
+                        acc_r += dw[b] * nodes[idx[j, b], a]
+                    dl[a] = acc
+                    rate[a] = acc_r + (xyz_rate[j, a] if a < 3 else rpy_rate[j, a - 3])
+                _rot_rpy(rpy_nav[j, 0] + dt * rpy_rate[j, 0] + dl[3],
+                         rpy_nav[j, 1] + dt * rpy_rate[j, 1] + dl[4],
+                         rpy_nav[j, 2] + dt * rpy_rate[j, 2] + dl[5], R, dR)
+                pt = pidx[j]
+                for a in range(3):
+                    d[a] = P[pt, a] - xyz_nav[j, a] - dt * xyz_rate[j, a] - dl[a]
+                for a in range(3):  # q = Rᵀ d − l
+                    q[a] = R[0, a] * d[0] + R[1, a] * d[1] + R[2, a] * d[2] - lever[a]
+                for a in range(3):  # p = β q
+                    p[a] = beta[a, 0] * q[0] + beta[a, 1] * q[1] + beta[a, 2] * q[2]
+                c = c_b[band[j]]
+                iz = 1.0 / p[2]
+                xb = c * p[0] * iz
+                yb = c * p[1] * iz
+                x = xb + K1 * xb**3 + K2 * xb**5 + 3 * P1 * xb**2 + x0  # 002 eq. (3)
+                y = yb + P2 * xb**2 + y0
+                gx = 1.0 + 3 * K1 * xb**2 + 5 * K2 * xb**4 + 6 * P1 * xb
+                gy = 2 * P2 * xb
+                a_ = c * iz
+                Jp[0, 0] = gx * a_ * k_px
+                Jp[0, 1] = 0.0
+                Jp[0, 2] = -gx * xb * iz * k_px
+                Jp[1, 0] = gy * a_ * k_px
+                Jp[1, 1] = a_ * k_px
+                Jp[1, 2] = (-yb * iz - gy * xb * iz) * k_px
+                for u in range(2):
+                    for a in range(3):
+                        JpB[u, a] = (Jp[u, 0] * beta[0, a] + Jp[u, 1] * beta[1, a]
+                                     + Jp[u, 2] * beta[2, a])
+                # d6: derivatives w.r.t. the pose (position, attitude) of the platform
+                for u in range(2):
+                    for a in range(3):
+                        d6[u, a] = -(JpB[u, 0] * R[a, 0] + JpB[u, 1] * R[a, 1]
+                                     + JpB[u, 2] * R[a, 2])
+                    for kk in range(3):
+                        v = 0.0
+                        for i in range(3):
+                            dq = dR[kk, 0, i] * d[0] + dR[kk, 1, i] * d[1] + dR[kk, 2, i] * d[2]
+                            v += JpB[u, i] * dq
+                        d6[u, 3 + kk] = v
+                if not timed:
+                    break
+                # image rates (px/s) along the trajectory: ∂(x, y)/∂pose · pose rate
+                xdot = 0.0
+                ydot = 0.0
+                for a in range(6):
+                    xdot += d6[0, a] * rate[a]
+                    ydot += d6[1, a] * rate[a]
+                # every real geometry has ẏ near ẏ_ref; a far-off trial point may not
+                ydot = max(ydot, 0.25 * y_rate_ref)
+                ey = (y * k_px - xy_obs[j, 1]) / ydot
+                if abs(ey) < 1e-11:
+                    break  # converged: the last correction is kept in the residual
+                if it < n_it:
+                    dt = min(max(dt - ey, -T_MAX), T_MAX)
+            for b in range(4):
+                w_out[j, b] = w[b]
+            r[2 * j] = x * k_px - xy_obs[j, 0] - xdot * ey  # x at t* (0 if not timed)
+            if timed:
+                # ẏ_ref (t_e − t*), t* = t_e + dt − ey (the last Newton correction included)
+                r[2 * j + 1] = y_rate_ref * (ey - dt)
+            else:
+                r[2 * j + 1] = y * k_px - xy_obs[j, 1]
             if not jac:
                 continue
-            gx = 1.0 + 3 * K1 * xb**2 + 5 * K2 * xb**4 + 6 * P1 * xb
-            gy = 2 * P2 * xb
-            a_ = c * iz
-            Jp[0, 0] = gx * a_ * k_px
-            Jp[0, 1] = 0.0
-            Jp[0, 2] = -gx * xb * iz * k_px
-            Jp[1, 0] = gy * a_ * k_px
-            Jp[1, 1] = a_ * k_px
-            Jp[1, 2] = (-yb * iz - gy * xb * iz) * k_px
-            for u in range(2):
-                for a in range(3):
-                    JpB[u, a] = (Jp[u, 0] * beta[0, a] + Jp[u, 1] * beta[1, a]
-                                 + Jp[u, 2] * beta[2, a])
             for u in range(2):
                 row = 2 * j + u
                 for a in range(3):
-                    # dp/dP = β Rᵀ: (JpB Rᵀ)[u, a] = Σ_i JpB[u, i] R[a, i]
-                    v = JpB[u, 0] * R[a, 0] + JpB[u, 1] * R[a, 1] + JpB[u, 2] * R[a, 2]
-                    dP[row, a] = v
-                    dN[row, a] = -v  # position: × the spline weights (factored Jacobian)
+                    dP[row, a] = -d6[u, a]  # dp/dP = β Rᵀ = −dp/dx
+                    dN[row, a] = d6[u, a]  # × the spline weights (factored Jacobian)
                     dL[row, a] = -JpB[u, a]
+                    dN[row, 3 + a] = d6[u, 3 + a]
                 for kk in range(3):
-                    # attitude: dq_i/drpy_k = Σ_j dR[k, j, i] d_j
-                    v = 0.0
-                    for i in range(3):
-                        dq = dR[kk, 0, i] * d[0] + dR[kk, 1, i] * d[1] + dR[kk, 2, i] * d[2]
-                        v += JpB[u, i] * dq
-                    dN[row, 3 + kk] = v
                     # boresight: dp/dbore_k = dβ_k q
                     v = 0.0
                     for i in range(3):
@@ -226,26 +313,26 @@ def _lines_kernel(P, pidx, idx, w, nodes, xyz_nav, rpy_nav, band, c_b, dist, bet
             dD[2 * j + 1, 1] = 0.0
             dD[2 * j + 1, 2] = 0.0
             dD[2 * j + 1, 3] = xb**2 * k_px
-            if y_time_k > 0:
-                # y as a time: r_y·κ with κ = c_ref p_z / (c Z_ref); d(κ r) = κ dr + r dκ
-                row = 2 * j + 1
-                f = ry * kap / p[2]
+            if timed:
+                # x(t*(θ)): ∂x/∂θ − (ẋ/ẏ) ∂y/∂θ; ẏ_ref (t_e − t*): (ẏ_ref/ẏ) ∂y/∂θ
+                fx = xdot / ydot
+                fy = y_rate_ref / ydot
+                rx, ry = 2 * j, 2 * j + 1
                 for a in range(3):
-                    v2 = beta[2, 0] * R[a, 0] + beta[2, 1] * R[a, 1] + beta[2, 2] * R[a, 2]
-                    dP[row, a] = kap * dP[row, a] + f * v2
-                    dN[row, a] = kap * dN[row, a] - f * v2
-                    dL[row, a] = kap * dL[row, a] - f * beta[2, a]
-                for kk in range(3):
-                    v2 = 0.0
-                    for i in range(3):
-                        v2 += beta[2, i] * (dR[kk, 0, i] * d[0] + dR[kk, 1, i] * d[1]
-                                            + dR[kk, 2, i] * d[2])
-                    dN[row, 3 + kk] = kap * dN[row, 3 + kk] + f * v2
-                    vb = dbeta[kk, 2, 0] * q[0] + dbeta[kk, 2, 1] * q[1] + dbeta[kk, 2, 2] * q[2]
-                    dB[row, kk] = kap * dB[row, kk] + f * vb
-                dC[row, 0] = kap * dC[row, 0] - ry * kap / c
+                    dP[rx, a] -= fx * dP[ry, a]
+                    dL[rx, a] -= fx * dL[ry, a]
+                    dB[rx, a] -= fx * dB[ry, a]
+                    dP[ry, a] *= fy
+                    dL[ry, a] *= fy
+                    dB[ry, a] *= fy
+                for a in range(6):
+                    dN[rx, a] -= fx * dN[ry, a]
+                    dN[ry, a] *= fy
                 for a in range(4):
-                    dD[row, a] *= kap
+                    dD[rx, a] -= fx * dD[ry, a]
+                    dD[ry, a] *= fy
+                dC[rx, 0] -= fx * dC[ry, 0]
+                dC[ry, 0] *= fy
 
 
 class PushbroomLines(ResidualBlock):
@@ -276,6 +363,16 @@ class PushbroomLines(ResidualBlock):
         Principal point (fixed).
     names : dict, optional
         Parameter block names (defaults :data:`BLOCK_NAMES`).
+    xyz_rate_m_s, rpy_rate_rad_s : (m, 3) ndarray, optional
+        GNSS/INS velocity and attitude-angle rates at ``t_s``. Given, the residual across the
+        line is a time (see the module docstring), in pixels at ``y_rate_ref_px_s``; omitted,
+        it is the image y of 002 eq. (2).
+    y_rate_ref_px_s : float, optional
+        Reference image rate across the line (px/s) that converts the time residual to pixels
+        (required with the rates; e.g. ``c V / (Z pixel)``).
+    newton_iterations : int
+        Most Newton iterations for the crossing time (from the line time; they stop when the
+        correction falls below 1e-11 s, usually after two).
     """
 
     name = "image points"
@@ -284,13 +381,20 @@ class PushbroomLines(ResidualBlock):
     def __init__(self, point, band, t_s, xy_px, xyz_nav_m, rpy_nav_rad, nodes: SplineNodes,
                  pixel_mm: float, sigma_px: float = 0.5, x0_mm: float = 0.0,
                  y0_mm: float = 0.0, names: dict | None = None,
-                 beta0=BETA0_CAM_FROM_PLATFORM, y_time_k: float = 0.0):
+                 beta0=BETA0_CAM_FROM_PLATFORM, xyz_rate_m_s=None, rpy_rate_rad_s=None,
+                 y_rate_ref_px_s: float | None = None, newton_iterations: int = 8):
         point = np.asarray(point)
         m = point.size
         xy = np.asarray(xy_px, dtype=np.float64)
-        for nm, arr, shape in [("band", band, (m,)), ("t_s", t_s, (m,)), ("xy_px", xy, (m, 2)),
-                               ("xyz_nav_m", xyz_nav_m, (m, 3)),
-                               ("rpy_nav_rad", rpy_nav_rad, (m, 3))]:
+        checks = [("band", band, (m,)), ("t_s", t_s, (m,)), ("xy_px", xy, (m, 2)),
+                  ("xyz_nav_m", xyz_nav_m, (m, 3)), ("rpy_nav_rad", rpy_nav_rad, (m, 3))]
+        if (xyz_rate_m_s is None) != (rpy_rate_rad_s is None):
+            raise InputError("PushbroomLines: give both xyz_rate_m_s and rpy_rate_rad_s, or none")
+        timed = xyz_rate_m_s is not None
+        if timed:
+            checks += [("xyz_rate_m_s", xyz_rate_m_s, (m, 3)),
+                       ("rpy_rate_rad_s", rpy_rate_rad_s, (m, 3))]
+        for nm, arr, shape in checks:
             if np.shape(arr) != shape:
                 raise InputError(
                     f"PushbroomLines: {nm} has shape {np.shape(arr)}, expected {shape} "
@@ -315,12 +419,25 @@ class PushbroomLines(ResidualBlock):
         self.names = dict(BLOCK_NAMES if names is None else names)
         self.beta0 = np.asarray(beta0, dtype=np.float64)
         self._basis = nodes.basis(self.t_s)
-        if not (np.isfinite(y_time_k) and y_time_k >= 0):
-            raise InputError(f"y_time_k must be ≥ 0 (0: the image y of 002 eq. 2), got {y_time_k}")
-        self.y_time_k = float(y_time_k)
+        self._u0 = np.ascontiguousarray(nodes._piece(self.t_s)[1])
+        self.timed = timed
+        zeros = np.zeros((m, 3))
+        self.xyz_rate = np.ascontiguousarray(xyz_rate_m_s if timed else zeros, dtype=np.float64)
+        self.rpy_rate = np.ascontiguousarray(rpy_rate_rad_s if timed else zeros,
+                                             dtype=np.float64)
+        self.y_rate_ref_px_s = 1.0
+        if timed:
+            if not (y_rate_ref_px_s is not None and np.isfinite(y_rate_ref_px_s)
+                    and y_rate_ref_px_s > 0):
+                raise InputError(
+                    "PushbroomLines: the time residual needs y_rate_ref_px_s > 0 (the image "
+                    f"rate across the line in px/s, c V / (Z pixel)), got {y_rate_ref_px_s!r}")
+            self.y_rate_ref_px_s = float(y_rate_ref_px_s)
+        if not (isinstance(newton_iterations, int | np.integer) and newton_iterations >= 1):
+            raise InputError(f"newton_iterations must be an integer ≥ 1, got {newton_iterations!r}")
+        self.newton_iterations = int(newton_iterations)
         self._pidx2 = np.repeat(self.point, 2)
         self._idx2 = np.repeat(self._basis[0], 2, axis=0)
-        self._w2 = np.repeat(self._basis[1], 2, axis=0)
         for a in ("xyz_nav", "rpy_nav", "xy_px"):
             setattr(self, a, np.ascontiguousarray(getattr(self, a)))
 
@@ -330,11 +447,11 @@ class PushbroomLines(ResidualBlock):
                         self.point, self.band, self.beta0, self.x0_mm, self.y0_mm)
         return xy
 
-    def evaluate_numpy(self, values, jacobian):
-        """The same as :meth:`evaluate`, in plain numpy (the reference for the tests)."""
+    def _numpy_at(self, values, jacobian, xyz_nav, rpy_nav, basis):
+        """Image residuals (px) and their derivative arrays at one pose, in plain numpy."""
         nm = self.names
-        g = _camera_geometry(values, nm, self.nodes, self.t_s, self.xyz_nav, self.rpy_nav,
-                             self.point, self.band, self.beta0, jacobian)
+        g = _camera_geometry(values, nm, self.nodes, self.t_s, xyz_nav, rpy_nav,
+                             self.point, self.band, self.beta0, jacobian, basis)
         p, q, d, R, beta = g["p"], g["q"], g["d"], g["R"], g["beta"]
         c = values[nm["c"]][self.band]
         K1, K2, P1, P2 = values[nm["distortion"]]
@@ -347,11 +464,9 @@ class PushbroomLines(ResidualBlock):
         m = self.point.size
         r = np.empty(2 * m)
         r[0::2] = x * k - self.xy_px[:, 0]
-        ry = y * k - self.xy_px[:, 1]
-        kap = self.y_time_k * p[:, 2] / c if self.y_time_k > 0 else np.ones(m)
-        r[1::2] = kap * ry
+        r[1::2] = y * k - self.xy_px[:, 1]
         if not jacobian:
-            return r, None
+            return r, None, None
         # d(x, y)/d p^c  (2 × 3 per observation), in px
         gx = 1.0 + 3 * K1 * xb**2 + 5 * K2 * xb**4 + 6 * P1 * xb  # dx/dx̄
         gy = 2 * P2 * xb  # dy/dx̄
@@ -384,40 +499,41 @@ class PushbroomLines(ResidualBlock):
         dDist[:, 0, 1] = xb**5 * k
         dDist[:, 0, 2] = 3 * xb**2 * k
         dDist[:, 1, 3] = xb**2 * k
-        if self.y_time_k > 0:
-            # y as a time: d(κ r_y) = κ dr_y + r_y dκ, κ = c_ref p_z / (c Z_ref)
-            f = ry * kap / p[:, 2]
-            bR = np.einsum("i,mai->ma", beta[2], R)  # d p_z / d P
-            dP[:, 1] = kap[:, None] * dP[:, 1] + f[:, None] * bR
-            d6[:, 1, :3] = kap[:, None] * d6[:, 1, :3] - f[:, None] * bR
-            d6[:, 1, 3:] = kap[:, None] * d6[:, 1, 3:] + f[:, None] * np.einsum(
-                "i,mik->mk", beta[2], dq_drpy)
-            dnodes = w[:, None, :, None] * d6[:, :, None, :]
-            dLever = dLever.copy()
-            dLever[:, 1] = kap[:, None] * dLever[:, 1] - f[:, None] * beta[2]
-            dBore[:, 1] = kap[:, None] * dBore[:, 1] + f[:, None] * np.einsum(
-                "kj,mj->mk", dbeta[:, 2, :], q)
-            dC[:, 1] = kap * dC[:, 1] - ry * kap / c
-            dDist[:, 1] *= kap[:, None]
+        arrays = [dP.reshape(2 * m, 3), dnodes.reshape(2 * m, 4, 6), dBore.reshape(2 * m, 3),
+                  dLever.reshape(2 * m, 3), dDist.reshape(2 * m, 4), dC.reshape(2 * m, 1)]
+        return r, arrays, idx
+
+    def evaluate_numpy(self, values, jacobian):
+        """:meth:`evaluate` in plain numpy, for the image y of 002 eq. (2) (the tests' reference;
+        the time residual is checked against a bisection for the crossing time instead)."""
+        if self.timed:
+            raise NotImplementedError("the numpy reference covers the image-y residual only")
+        nm = self.names
+        r, arrays, idx = self._numpy_at(values, jacobian, self.xyz_nav, self.rpy_nav,
+                                        self._basis)
+        if not jacobian:
+            return r, None
+        dP, dnodes, dBore, dLever, dDist, dC = arrays
         rep = np.repeat
         jac = {
-            nm["points"]: Indexed(rep(self.point, 2), dP.reshape(2 * m, 3)),
-            nm["nodes"]: Indexed(rep(idx, 2, axis=0), dnodes.reshape(2 * m, 4, 6)),
-            nm["boresight"]: dBore.reshape(2 * m, 3),
-            nm["lever_arm"]: dLever.reshape(2 * m, 3),
-            nm["distortion"]: dDist.reshape(2 * m, 4),
-            nm["c"]: Indexed(rep(self.band, 2), dC.reshape(2 * m, 1)),
+            nm["points"]: Indexed(rep(self.point, 2), dP),
+            nm["nodes"]: Indexed(rep(idx, 2, axis=0), dnodes),
+            nm["boresight"]: dBore,
+            nm["lever_arm"]: dLever,
+            nm["distortion"]: dDist,
+            nm["c"]: Indexed(rep(self.band, 2), dC),
         }
         return r, jac
 
     def evaluate(self, values, jacobian):
         nm = self.names
         m = self.point.size
-        idx, w = self._basis
+        idx = self._basis[0]
         bore = values[nm["boresight"]]
         beta = R_from_opk(bore[0], bore[1], bore[2]) @ self.beta0
         dbeta = dR_dopk(bore[0], bore[1], bore[2]) @ self.beta0
         r = np.empty(2 * m)
+        w_out = np.empty((m, 4))
         shp = (2 * m,) if jacobian else (0,)
         dP = np.empty(shp + (3,))
         dN = np.empty(shp + (6,))  # d r / d δ(t); the node columns are B_a(t) × this
@@ -426,19 +542,22 @@ class PushbroomLines(ResidualBlock):
         dD = np.empty(shp + (4,))
         dC = np.empty(shp + (1,))
         _lines_kernel(np.ascontiguousarray(values[nm["points"]], dtype=np.float64), self.point,
-                      idx, w, np.ascontiguousarray(values[nm["nodes"]], dtype=np.float64),
-                      self.xyz_nav, self.rpy_nav, self.band,
+                      idx, self._u0, 1.0 / self.nodes.interval_s,
+                      np.ascontiguousarray(values[nm["nodes"]], dtype=np.float64),
+                      self.xyz_nav, self.rpy_nav, self.xyz_rate, self.rpy_rate, self.band,
                       np.asarray(values[nm["c"]], dtype=np.float64),
                       np.asarray(values[nm["distortion"]], dtype=np.float64), beta, dbeta,
                       np.asarray(values[nm["lever_arm"]], dtype=np.float64), self.x0_mm,
-                      self.y0_mm, 1.0 / self.pixel_mm, self.xy_px, bool(jacobian), r, dP, dN,
-                      dB, dL, dD, dC, self.y_time_k)
+                      self.y0_mm, 1.0 / self.pixel_mm, self.xy_px, self.timed,
+                      self.newton_iterations, self.y_rate_ref_px_s, bool(jacobian), r, w_out,
+                      dP, dN, dB, dL, dD, dC)
         if not jacobian:
             return r, None
         rep = np.repeat
         jac = {
             nm["points"]: Indexed(self._pidx2, dP),
-            nm["nodes"]: Indexed(self._idx2, dN, weights=self._w2),  # 002 eq. (4) via the spline
+            # 002 eq. (4) through the spline: ∂r/∂c_a = B_a(t) ∂r/∂δ (factored)
+            nm["nodes"]: Indexed(self._idx2, dN, weights=rep(w_out, 2, axis=0)),
             nm["boresight"]: dB,
             nm["lever_arm"]: dL,
             nm["distortion"]: dD,

@@ -95,7 +95,8 @@ class Campaign:
     scale: float
     truth: dict  # parameter block name -> true value
     nodes: SplineNodes  # the node layout of the true trajectory error
-    obs: dict  # point, band, t_s, xy_px, strip, xyz_nav_m, rpy_nav_rad, outlier
+    obs: dict  # point, band, t_s, xy_px, strip, xyz_nav_m, rpy_nav_rad, xyz_rate_nav_m_s,
+    #            rpy_rate_nav_rad_s, outlier, xy_true_px
     gcp_index: np.ndarray  # rows of the points block that are GCPs
     cp_index: np.ndarray  # rows that are check points
     gcp_xyz_m: np.ndarray  # RTK coordinates of the GCPs (with their error)
@@ -130,6 +131,15 @@ def _mount_motion(t, amp):
     roll = amp * (0.6 * np.sin(2 * np.pi * 0.7 * t) + 0.4 * np.sin(2 * np.pi * 1.9 * t + 1.0))
     pitch = amp * (0.5 * np.sin(2 * np.pi * 0.5 * t + 2.0) + 0.3 * np.sin(2 * np.pi * 2.3 * t))
     yaw = amp * 0.5 * np.sin(2 * np.pi * 0.3 * t + 0.5)
+    return np.column_stack([roll, pitch, yaw])
+
+
+def _mount_motion_rate(t, amp):
+    """Time derivative of :func:`_mount_motion`, rad/s."""
+    w = 2 * np.pi
+    roll = amp * (0.6 * w * 0.7 * np.cos(w * 0.7 * t) + 0.4 * w * 1.9 * np.cos(w * 1.9 * t + 1.0))
+    pitch = amp * (0.5 * w * 0.5 * np.cos(w * 0.5 * t + 2.0) + 0.3 * w * 2.3 * np.cos(w * 2.3 * t))
+    yaw = amp * 0.5 * w * 0.3 * np.cos(w * 0.3 * t + 0.5)
     return np.column_stack([roll, pitch, yaw])
 
 
@@ -269,6 +279,13 @@ def simulate(scale: float = 1.0, rng=0, noise_free: bool = False,
     delta = nodes.evaluate(node_err, t_line)
     xyz_nav = xyz_true - delta[:, :3]
     rpy_nav = rpy_true - delta[:, 3:]
+    # and its rates (a GNSS/INS solution gives velocity and angular rate): the observation is
+    # a time, and its residual needs the image motion across the line (see PushbroomLines)
+    ddelta = nodes.evaluate_rate(node_err, t_line)
+    dirn_obs = np.array([p[4] for p in plan], float)[strip]
+    xyz_rate_true = np.column_stack([np.zeros(m), dirn_obs * cfg.speed_m_s, np.zeros(m)])
+    xyz_rate_nav = xyz_rate_true - ddelta[:, :3]
+    rpy_rate_nav = _mount_motion_rate(t_line, cfg.mount_motion_rad) - ddelta[:, 3:]
 
     if noise_free:
         xy_obs = xy_true_px.copy()
@@ -285,7 +302,8 @@ def simulate(scale: float = 1.0, rng=0, noise_free: bool = False,
         xy_obs[np.flatnonzero(outlier), comp] += mag
         gcp_xyz = P[:4] + cfg.sigma_gcp_m * rng.standard_normal((4, 3))
     obs = {"point": pidx, "band": band, "t_s": t_line, "xy_px": xy_obs, "strip": strip,
-           "xyz_nav_m": xyz_nav, "rpy_nav_rad": rpy_nav, "outlier": outlier,
+           "xyz_nav_m": xyz_nav, "rpy_nav_rad": rpy_nav, "xyz_rate_nav_m_s": xyz_rate_nav,
+           "rpy_rate_nav_rad_s": rpy_rate_nav, "outlier": outlier,
            "xy_true_px": xy_true_px}
     return Campaign(cfg=cfg, scale=scale, truth=truth, nodes=nodes, obs=obs,
                     gcp_index=np.arange(4), cp_index=np.arange(4, 17), gcp_xyz_m=gcp_xyz,
