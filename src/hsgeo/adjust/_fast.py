@@ -424,14 +424,30 @@ def point_covariance(arrays, jp, order, ptr, points, Vinv, S_inv) -> np.ndarray:
     return _point_cov_kernel(*arrays, jp, order, ptr, points, Vinv, S_inv, cap)
 
 
-@njit(cache=True)
+@njit(cache=True, parallel=True)
 def rmatvec_diag(cols, vals, fcol, fw, fd, y, n_c, want_diag):  # pragma: no cover - compiled
     """``Jᵀ y`` and (optionally) ``diag(JᵀJ)`` of a row-compressed matrix, in one pass."""
-    g = np.zeros(n_c)
-    d = np.zeros(n_c)
     M, K = cols.shape
+    n_chunks = 8 if M > 80000 else 1
+    gs = np.zeros((n_chunks, n_c))
+    ds = np.zeros((n_chunks, n_c))
+    step = (M + n_chunks - 1) // n_chunks
+    for ch in prange(n_chunks):
+        _rmatvec_rows(cols, vals, fcol, fw, fd, y, want_diag, ch * step, min(M, (ch + 1) * step),
+                      gs[ch], ds[ch])
+    g = gs[0].copy()
+    d = ds[0].copy()
+    for ch in range(1, n_chunks):  # fixed order: the same bits for any thread count
+        g += gs[ch]
+        d += ds[ch]
+    return g, d
+
+
+@njit(cache=True, inline="always")
+def _rmatvec_rows(cols, vals, fcol, fw, fd, y, want_diag, i0, i1, g, d):  # pragma: no cover
+    K = cols.shape[1]
     Q, kf = fcol.shape[1], fd.shape[1]
-    for i in range(M):
+    for i in range(i0, i1):
         yi = y[i]
         for s in range(K):
             c = cols[i, s]
@@ -449,7 +465,6 @@ def rmatvec_diag(cols, vals, fcol, fw, fd, y, n_c, want_diag):  # pragma: no cov
                     g[c0 + j] += v * yi
                     if want_diag:
                         d[c0 + j] += v * v
-    return g, d
 
 
 @njit(cache=True)

@@ -38,7 +38,7 @@ across the line is instead a time: the model's crossing time ``t*`` of the line,
 
     r_y = ẏ_ref (t_e − t*),   r_x = x(θ, t*) − x_obs,   ∂t*/∂θ = −(∂y/∂θ) / ẏ
 
-``t*`` is found by Newton's method from ``t_e`` (to 1e-11 s, usually in two steps), with the
+``t*`` is found by Newton's method from ``t_e`` (to 1e-8 s, usually in one step), with the
 navigation pose moved by its velocity and angular rate and the spline piece of ``t_e``
 continued; ``ẏ`` and ``ẋ`` are the image rates along the corrected trajectory. The derivatives
 are evaluated at ``t*``, so they do not contain the time error, and the node derivatives keep
@@ -275,8 +275,10 @@ def _lines_kernel(P, pidx, idx, u0, inv_dt, nodes, xyz_nav, rpy_nav, xyz_rate, r
                 # every real geometry has ẏ near ẏ_ref; a far-off trial point may not
                 ydot = max(ydot, 0.25 * y_rate_ref)
                 ey = (y * k_px - xy_obs[j, 1]) / ydot
-                if abs(ey) < 1e-11:
-                    break  # converged: the last correction is kept in the residual
+                if abs(ey) < 1e-8:
+                    # converged (≈ 2e-6 px): the last correction is kept in the residual, which
+                    # is then exact to O(ey²)
+                    break
                 if it < n_it:
                     dt = min(max(dt - ey, -T_MAX), T_MAX)
             for b in range(4):
@@ -372,7 +374,7 @@ class PushbroomLines(ResidualBlock):
         (required with the rates; e.g. ``c V / (Z pixel)``).
     newton_iterations : int
         Most Newton iterations for the crossing time (from the line time; they stop when the
-        correction falls below 1e-11 s, usually after two).
+        correction falls below 1e-8 s, usually after one).
     """
 
     name = "image points"
@@ -504,8 +506,10 @@ class PushbroomLines(ResidualBlock):
         return r, arrays, idx
 
     def evaluate_numpy(self, values, jacobian):
-        """:meth:`evaluate` in plain numpy, for the image y of 002 eq. (2) (the tests' reference;
-        the time residual is checked against a bisection for the crossing time instead)."""
+        """:meth:`evaluate` in plain numpy, for the image y of 002 eq. (2) (tests' reference).
+
+        The time residual is checked against a bisection for the crossing time instead.
+        """
         if self.timed:
             raise NotImplementedError("the numpy reference covers the image-y residual only")
         nm = self.names
