@@ -9,14 +9,20 @@ Gauss–Newton with Levenberg–Marquardt damping on the whitened observation eq
   with ``N = [[N_cc, W], [Wᵀ, V]]`` and ``V`` block diagonal (one ``p × p`` block per point), the
   reduced system ``S Δc = -(g_c - W V⁻¹ g_p)`` with ``S = N_cc - W V⁻¹ Wᵀ`` is solved densely
   (Cholesky) and the points follow as ``Δp = -V⁻¹ (g_p + Wᵀ Δc)``;
-* damping is Marquardt's ``N + λ diag(N)`` with Nielsen's update of λ;
-* convergence: relative decrease of the cost and the predicted decrease both below ``ftol``, or
-  the cost below ``atol`` (noise-free data);
+* damping is Marquardt's ``N + λ diag(N)`` with Nielsen's update of λ (the point blocks are
+  damped only above ``LAMBDA_POINTS_MIN``, so one reduced matrix per linearisation point serves
+  the datum check, the damped retries and the covariance);
+* convergence: the decrease the Gauss–Newton step predicts at the current point is below
+  ``ftol`` times the cost (the reduced matrix just formed then gives the covariance), or the
+  cost is below ``atol`` (noise-free data);
 * before the first step the datum is checked: a parameter without observations, a point that is
   not determined, or a rank-deficient reduced normal matrix raises :class:`~hsgeo.DatumError`
   naming the parameters involved;
-* after convergence, optional rounds of outlier rejection remove observations whose normalised
-  residual exceeds ``reject_k`` robust standard deviations, and the adjustment is repeated;
+* optional outlier rejection removes observations whose normalised residual exceeds
+  ``reject_k`` robust standard deviations: in rounds after convergence, or in every iteration
+  once the cost has nearly settled (``reject_every_iteration``, as 002 §3.4 does);
+* Jacobians that are a weighted sum over items of one derivative (``Indexed(..., weights=)``,
+  e.g. spline nodes) are kept factored by the compiled path (:mod:`hsgeo.adjust._fast`);
 * the a-posteriori σ0 and the covariance of the non-point parameters (points on request) are in
   the :class:`~hsgeo.adjust.result.AdjustmentResult`.
 
