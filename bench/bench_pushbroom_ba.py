@@ -5,7 +5,8 @@ assertions). Every case runs in its own subprocess so that its peak memory (max 
 BLAS thread count are its own:
 
 * ``full``: the paper's size (113,758 tie points, ≈441,000 2-D observations), with outlier
-  rejection as in the chapter, once with ``OPENBLAS_NUM_THREADS=1`` and once with 2;
+  rejection as in the chapter, once with ``OPENBLAS_NUM_THREADS=1`` and once with 2, then
+  ``--repeats`` runs in all of the faster setting (``solver_seconds`` is their median);
 * ``ours``/``scipy`` at the baseline scale (0.3): the same problem without outlier rejection,
   adjusted by hsgeo's engine and by ``scipy.optimize.least_squares(method="trf",
   tr_solver="lsmr", x_scale="jac")`` with the same analytic sparse Jacobian; the final costs
@@ -137,6 +138,7 @@ def main(argv=None):
     ap.add_argument("--child", choices=("ours", "scipy"))
     ap.add_argument("--reject", action="store_true")
     ap.add_argument("--max-seconds", type=float, default=3600)
+    ap.add_argument("--repeats", type=int, default=3, help="full-size runs of the best setting")
     ap.add_argument("--out", default=str(HERE / "results" / "pushbroom_ba.json"))
     args = ap.parse_args(argv)
     if args.child:
@@ -145,6 +147,12 @@ def main(argv=None):
     load0 = os.getloadavg()
     full = {b: _spawn("ours", args.scale, args.seed, b, reject=True) for b in (1, 2)}
     best = min(full, key=lambda b: full[b]["solver_seconds"])
+    # this machine's speed varies from run to run (shared cores): repeat the best setting and
+    # report the median, with every run
+    runs = [full[best]] + [_spawn("ours", args.scale, args.seed, best, reject=True)
+                           for _ in range(args.repeats - 1)]
+    seconds = sorted(r["solver_seconds"] for r in runs)
+    median = seconds[len(seconds) // 2]
     ours_b = _spawn("ours", args.baseline_scale, args.seed, best)
     base = _spawn("scipy", args.baseline_scale, args.seed, best, timeout=args.max_seconds)
     f = full[best]
@@ -154,9 +162,10 @@ def main(argv=None):
         "scale": args.scale,
         "n_observations": f["n_observations"],
         "n_unknowns": f["n_unknowns"],
-        "solver_seconds": f["solver_seconds"],
+        "solver_seconds": median,
+        "solver_seconds_runs": seconds,
         "iterations": f["iterations"],
-        "peak_rss_mb": f["peak_rss_mb"],
+        "peak_rss_mb": max(r["peak_rss_mb"] for r in runs),
         "openblas_threads": best,
         "solver_seconds_by_openblas_threads": {str(b): full[b]["solver_seconds"] for b in full},
         "peak_rss_mb_by_openblas_threads": {str(b): full[b]["peak_rss_mb"] for b in full},
