@@ -9,6 +9,10 @@ STAMP := $(VENV)/.hsgeo-installed
 # than one thread on the small dense solves of our adjustments (GUIDE §9; `make bench` measures it).
 export OPENBLAS_NUM_THREADS ?= 1
 export OMP_NUM_THREADS ?= 1
+# glibc malloc keeps freed memory instead of returning it to the system: the large arrays an
+# adjustment allocates in every iteration then reuse pages instead of having fresh ones zeroed by
+# the kernel (≈ 1 s of system time, 10-20 % of the full-size pushbroom solve; `make bench`).
+export GLIBC_TUNABLES ?= glibc.malloc.mmap_max=0:glibc.malloc.trim_threshold=4294967296
 export PYDEVD_DISABLE_FILE_VALIDATION := 1
 
 .DEFAULT_GOAL := help

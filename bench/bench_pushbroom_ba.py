@@ -181,7 +181,8 @@ def main(argv=None):
         "goals": {"solver_seconds_max": 5.0, "peak_rss_mb_max": 1536, "speedup_min": 30},
         "machine": {"cpus": os.cpu_count(), "loadavg_at_start": load0,
                     "loadavg_at_end": os.getloadavg(), "python": platform.python_version(),
-                    "numba_threads": os.environ.get("NUMBA_NUM_THREADS", "default")},
+                    "numba_threads": os.environ.get("NUMBA_NUM_THREADS", "default"),
+                    "glibc_tunables": os.environ.get("GLIBC_TUNABLES", "")},
         "seed": args.seed,
     }
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
