@@ -135,12 +135,12 @@ def build_problem(obs: dict, n_points: int, cam: CameraPrior, *, node_interval_s
         Prior mean of the node corrections (default zero: the GNSS/INS solution as it is).
     y_as_time : bool
         Residual across the line as a *time* (the line a point is registered in) rather than
-        the image y of 002 eq. (2): the modelled y divided by the modelled image rate ẏ
-        across the line (:class:`~hsgeo.sensors.pushbroom.PushbroomLines`), in pixels at the
-        reference rate ``c_ref V / (Z_ref pixel)`` (``c_ref`` the initial principal distance,
-        ``V`` the median speed, ``Z_ref`` the median initial depth). Its derivatives do not
-        contain the error itself, as those of the image y do when the error is one of time.
-        See the chapter for the bias this avoids.
+        the image y of 002 eq. (2): the line time minus the model's crossing time of the line
+        (:class:`~hsgeo.sensors.pushbroom.PushbroomLines`), in pixels at the reference rate
+        ``c_ref V / (Z_ref pixel)`` (``c_ref`` the initial principal distance, ``V`` the median
+        speed, ``Z_ref`` the median initial depth). Its derivatives, taken at the crossing, do
+        not contain the error itself, as those of the image y do when the error is one of
+        time. See the chapter for the bias this avoids.
 
     Returns
     -------
