@@ -63,7 +63,7 @@ def test_trajectory_interpolation_and_errors():
         Trajectory(t, xyz[:2], rpy)
 
 
-def test_spline_rate_and_shifted_basis_against_differences():
+def test_spline_rate_against_differences():
     sn = SplineNodes(0.0, 35.0, 10.0)
     rng = np.random.default_rng(0)
     c = rng.standard_normal((sn.n_nodes, 2))
@@ -72,11 +72,18 @@ def test_spline_rate_and_shifted_basis_against_differences():
     tp, tm = np.clip(t + h, 0, 35), np.clip(t - h, 0, 35)
     num = (sn.evaluate(c, tp) - sn.evaluate(c, tm)) / (tp - tm)[:, None]
     np.testing.assert_allclose(sn.evaluate_rate(c, t), num, atol=1e-6)  # one-sided at the ends
-    # the shifted basis: same nodes as t, the spline at t + dt (continued piece: O(dt³))
-    idx, w = sn.basis_shifted(t[:-1], 1e-3)
-    np.testing.assert_array_equal(idx, sn.basis(t[:-1])[0])
-    got = np.einsum("ma,mak->mk", w, c[idx])
-    np.testing.assert_allclose(got, sn.evaluate(c, t[:-1] + 1e-3), atol=1e-9)
+
+
+def test_compiled_spline_weights_equal_the_basis():
+    """The pushbroom kernel's own copy of the B-spline weights (numba) against the basis."""
+    from hsgeo.sensors.pushbroom import _spline_weights
+    from hsgeo.trajectory import bspline_basis_derivative
+
+    w, dw = np.empty(4), np.empty(4)
+    for u in (-0.01, 0.0, 0.3, 0.999, 1.02):  # the kernel also continues a piece a little
+        _spline_weights(u, 0.1, w, dw)
+        np.testing.assert_allclose(w, bspline_basis(u), rtol=0, atol=1e-15)
+        np.testing.assert_allclose(dw, 0.1 * bspline_basis_derivative(u), rtol=0, atol=1e-15)
 
 
 def test_trajectory_rates():

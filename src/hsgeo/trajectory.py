@@ -115,6 +115,18 @@ class SplineNodes:
         weight : (m, 4) ndarray
             Their B-spline weights (the Jacobian of the correction w.r.t. the node values).
         """
+        index, u = self.piece(t_s)
+        return index, bspline_basis(u)
+
+    def piece(self, t_s):
+        """The four nodes of each time's cubic piece and the local coordinate ``u`` in it.
+
+        Returns
+        -------
+        index : (m, 4) int ndarray
+        u : (m,) ndarray
+            In [0, 1] (at ``t_end_s``, 1 on the last piece).
+        """
         t = np.asarray(t_s, dtype=np.float64).ravel()
         eps = 1e-9 * self.interval_s
         if np.any(t < self.t_start_s - eps) or np.any(t > self.t_end_s + eps):
@@ -122,36 +134,17 @@ class SplineNodes:
                 f"times outside the spline span [{self.t_start_s}, {self.t_end_s}] s: build "
                 "SplineNodes over the observations' time range"
             )
-        index, u = self._piece(t)
-        return index, bspline_basis(u)
-
-    def _piece(self, t):
         x = (t - self.t_start_s) / self.interval_s
         k = np.clip(np.floor(x).astype(np.int64), 0, self.n_nodes - 4)
         index = k[:, None] + np.arange(4)  # nodes k-1..k+2 in 0-based j = k .. k+3
         return index, x - k
-
-    def basis_shifted(self, t_s, dt_s: float):
-        """The four nodes of ``t_s`` and the weights of *their* cubic piece at ``t_s + dt_s``.
-
-        For a small ``dt_s`` this is the spline at ``t_s + dt_s`` (the pieces join C², so
-        continuing a piece a millisecond past its node differs from the next piece by
-        O(dt³)), with the same four nodes as ``t_s``: a difference in time of anything that
-        depends on the correction touches the same 24 unknowns.
-        """
-        t = np.asarray(t_s, dtype=np.float64).ravel()
-        index, _ = self.basis(t)
-        u = (t + dt_s - self.t_start_s) / self.interval_s - index[:, 0]
-        return index, bspline_basis(u)
 
     def evaluate_rate(self, nodes, t_s) -> np.ndarray:
         """Time derivative of the correction at ``t_s`` (per second), ``(m, k)``."""
         nodes = np.asarray(nodes, dtype=np.float64)
         if nodes.ndim != 2 or nodes.shape[0] != self.n_nodes:
             raise InputError(f"node values must be ({self.n_nodes}, k), got {nodes.shape}")
-        t = np.asarray(t_s, dtype=np.float64).ravel()
-        self.basis(t)  # span check
-        idx, u = self._piece(t)
+        idx, u = self.piece(t_s)
         dw = bspline_basis_derivative(u) / self.interval_s
         return np.einsum("ma,mak->mk", dw, nodes[idx])
 

@@ -245,19 +245,12 @@ def _reduced_kernel(cols, vals, fcol, fw, fd, jp, order, ptr, pt_order, Vinv, n_
                             ca = fcol[rg, a]
                             if ca < 0:
                                 continue
-                            wa = fw[rg, a]
+                            wa = half * fw[rg, a]
                             for j in range(kf):
                                 Aseg = A[ca + j, cb0 : cb0 + Q * kf]
                                 Rj = R[j]
-                                if h == g:
-                                    # a diagonal block: its upper triangle (A + Aᵀ restores it)
-                                    x = a * kf + j
-                                    Aseg[x] += 0.5 * wa * Rj[x]
-                                    for e in range(x + 1, Q * kf):
-                                        Aseg[e] += wa * Rj[e]
-                                else:
-                                    for e in range(Q * kf):
-                                        Aseg[e] += wa * Rj[e]
+                                for e in range(Q * kf):
+                                    Aseg[e] += wa * Rj[e]
                         continue
                     for a in range(Q):
                         ca = fcol[rg, a]

@@ -37,7 +37,7 @@ from __future__ import annotations
 import sys
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg as sla
@@ -414,7 +414,7 @@ class _Normal:
     pt_order: np.ndarray | None = None  # order in which the kernel visits the points
     Ncc_free: np.ndarray | None = None  # J_cᵀ J_c of the rows without a point (compiled path)
     diag_cc: np.ndarray | None = None  # diag(N_cc)
-    reduced_cache: dict = field(default_factory=dict)  # λ_points → (S, rhs, V⁻¹), see _reduced
+    reduced0: tuple | None = None  # (S, rhs, V⁻¹) with undamped point blocks, see _reduced
 
     @property
     def Ncc(self) -> np.ndarray:
@@ -599,7 +599,7 @@ def _reduced(layout: _Layout, ne: _Normal, lam: float):
         # grouped by point; neither W nor the full N_cc is formed
         from hsgeo.adjust._fast import reduced_points
 
-        cached = ne.reduced_cache.get(lam_p)
+        cached = ne.reduced0 if lam_p == 0.0 else None
         if cached is None:
             Vinv = _inv_blocks(_damped(ne.V, lam_p))
             sy = ne.sy
@@ -607,7 +607,7 @@ def _reduced(layout: _Layout, ne: _Normal, lam: float):
                                               layout.n_c, ne.pt_order)
             r0 = rhs - ne.W_dot(np.einsum("nij,nj->ni", Vinv, ne.gp)) if layout.n_c else rhs
             if lam_p == 0.0:  # keep the undamped one (datum check, steps, covariance)
-                ne.reduced_cache[0.0] = (S0, r0, Vinv)
+                ne.reduced0 = (S0, r0, Vinv)
         else:
             S0, r0, Vinv = cached
         S = S0.copy()

@@ -61,7 +61,7 @@ from numba import njit, prange
 from hsgeo.adjust import Indexed, ResidualBlock
 from hsgeo.errors import InputError
 from hsgeo.rotations import R_from_opk, R_from_rpy, dR_dopk, dR_drpy
-from hsgeo.trajectory import SplineNodes
+from hsgeo.trajectory import SplineNodes, bspline_basis
 
 __all__ = ["PushbroomLines", "BETA0_CAM_FROM_PLATFORM", "BLOCK_NAMES", "project"]
 
@@ -81,10 +81,10 @@ BLOCK_NAMES = {
 
 
 def _camera_geometry(values, names, nodes: SplineNodes, t_s, xyz_nav, rpy_nav, pidx, band,
-                     beta0, jacobian, basis=None):
+                     beta0, jacobian):
     """p^c and intermediate quantities for every observation (002 eq. 4)."""
     P = values[names["points"]][pidx]
-    idx, w = nodes.basis(t_s) if basis is None else basis
+    idx, w = nodes.basis(t_s)
     node_vals = values[names["nodes"]]
     delta = np.einsum("ma,mak->mk", w, node_vals[idx])
     x = xyz_nav + delta[:, :3]
@@ -420,8 +420,9 @@ class PushbroomLines(ResidualBlock):
         self.x0_mm, self.y0_mm = float(x0_mm), float(y0_mm)
         self.names = dict(BLOCK_NAMES if names is None else names)
         self.beta0 = np.asarray(beta0, dtype=np.float64)
-        self._basis = nodes.basis(self.t_s)
-        self._u0 = np.ascontiguousarray(nodes._piece(self.t_s)[1])
+        index, u = nodes.piece(self.t_s)
+        self._basis = (index, bspline_basis(u))
+        self._u0 = np.ascontiguousarray(u)  # the kernel's Newton moves along this piece
         self.timed = timed
         zeros = np.zeros((m, 3))
         self.xyz_rate = np.ascontiguousarray(xyz_rate_m_s if timed else zeros, dtype=np.float64)
@@ -440,6 +441,7 @@ class PushbroomLines(ResidualBlock):
         self.newton_iterations = int(newton_iterations)
         self._pidx2 = np.repeat(self.point, 2)
         self._idx2 = np.repeat(self._basis[0], 2, axis=0)
+        self._band2 = np.repeat(self.band, 2)
         for a in ("xyz_nav", "rpy_nav", "xy_px"):
             setattr(self, a, np.ascontiguousarray(getattr(self, a)))
 
@@ -449,11 +451,16 @@ class PushbroomLines(ResidualBlock):
                         self.point, self.band, self.beta0, self.x0_mm, self.y0_mm)
         return xy
 
-    def _numpy_at(self, values, jacobian, xyz_nav, rpy_nav, basis):
-        """Image residuals (px) and their derivative arrays at one pose, in plain numpy."""
+    def evaluate_numpy(self, values, jacobian):
+        """:meth:`evaluate` in plain numpy, for the image y of 002 eq. (2) (tests' reference).
+
+        The time residual is checked against a bisection for the crossing time instead.
+        """
+        if self.timed:
+            raise NotImplementedError("the numpy reference covers the image-y residual only")
         nm = self.names
-        g = _camera_geometry(values, nm, self.nodes, self.t_s, xyz_nav, rpy_nav,
-                             self.point, self.band, self.beta0, jacobian, basis)
+        g = _camera_geometry(values, nm, self.nodes, self.t_s, self.xyz_nav, self.rpy_nav,
+                             self.point, self.band, self.beta0, jacobian)
         p, q, d, R, beta = g["p"], g["q"], g["d"], g["R"], g["beta"]
         c = values[nm["c"]][self.band]
         K1, K2, P1, P2 = values[nm["distortion"]]
@@ -468,7 +475,7 @@ class PushbroomLines(ResidualBlock):
         r[0::2] = x * k - self.xy_px[:, 0]
         r[1::2] = y * k - self.xy_px[:, 1]
         if not jacobian:
-            return r, None, None
+            return r, None
         # d(x, y)/d p^c  (2 × 3 per observation), in px
         gx = 1.0 + 3 * K1 * xb**2 + 5 * K2 * xb**4 + 6 * P1 * xb  # dx/dx̄
         gy = 2 * P2 * xb  # dy/dx̄
@@ -501,31 +508,13 @@ class PushbroomLines(ResidualBlock):
         dDist[:, 0, 1] = xb**5 * k
         dDist[:, 0, 2] = 3 * xb**2 * k
         dDist[:, 1, 3] = xb**2 * k
-        arrays = [dP.reshape(2 * m, 3), dnodes.reshape(2 * m, 4, 6), dBore.reshape(2 * m, 3),
-                  dLever.reshape(2 * m, 3), dDist.reshape(2 * m, 4), dC.reshape(2 * m, 1)]
-        return r, arrays, idx
-
-    def evaluate_numpy(self, values, jacobian):
-        """:meth:`evaluate` in plain numpy, for the image y of 002 eq. (2) (tests' reference).
-
-        The time residual is checked against a bisection for the crossing time instead.
-        """
-        if self.timed:
-            raise NotImplementedError("the numpy reference covers the image-y residual only")
-        nm = self.names
-        r, arrays, idx = self._numpy_at(values, jacobian, self.xyz_nav, self.rpy_nav,
-                                        self._basis)
-        if not jacobian:
-            return r, None
-        dP, dnodes, dBore, dLever, dDist, dC = arrays
-        rep = np.repeat
         jac = {
-            nm["points"]: Indexed(rep(self.point, 2), dP),
-            nm["nodes"]: Indexed(rep(idx, 2, axis=0), dnodes),
-            nm["boresight"]: dBore,
-            nm["lever_arm"]: dLever,
-            nm["distortion"]: dDist,
-            nm["c"]: Indexed(rep(self.band, 2), dC),
+            nm["points"]: Indexed(self._pidx2, dP.reshape(2 * m, 3)),
+            nm["nodes"]: Indexed(np.repeat(idx, 2, axis=0), dnodes.reshape(2 * m, 4, 6)),
+            nm["boresight"]: dBore.reshape(2 * m, 3),
+            nm["lever_arm"]: dLever.reshape(2 * m, 3),
+            nm["distortion"]: dDist.reshape(2 * m, 4),
+            nm["c"]: Indexed(self._band2, dC.reshape(2 * m, 1)),
         }
         return r, jac
 
@@ -557,14 +546,13 @@ class PushbroomLines(ResidualBlock):
                       dP, dN, dB, dL, dD, dC)
         if not jacobian:
             return r, None
-        rep = np.repeat
         jac = {
             nm["points"]: Indexed(self._pidx2, dP),
-            # 002 eq. (4) through the spline: ∂r/∂c_a = B_a(t) ∂r/∂δ (factored)
-            nm["nodes"]: Indexed(self._idx2, dN, weights=rep(w_out, 2, axis=0)),
+            # 002 eq. (4) through the spline: ∂r/∂c_a = B_a(t*) ∂r/∂δ (factored)
+            nm["nodes"]: Indexed(self._idx2, dN, weights=np.repeat(w_out, 2, axis=0)),
             nm["boresight"]: dB,
             nm["lever_arm"]: dL,
             nm["distortion"]: dD,
-            nm["c"]: Indexed(rep(self.band, 2), dC),
+            nm["c"]: Indexed(self._band2, dC),
         }
         return r, jac
