@@ -23,7 +23,7 @@ import numba
 import numpy as np
 from numba import njit, prange
 
-__all__ = ["normal_cc", "reduced_points", "point_covariance", "locality_orders", "n_threads"]
+__all__ = ["normal_cc", "reduced_points", "factored_tiles", "point_covariance", "locality_orders", "n_threads"]
 
 
 def n_threads() -> int:
@@ -104,7 +104,7 @@ def _normal_cc_kernel(cols, vals, fcol, fw, fd, row_order, n_c,
 
 @njit(cache=True, parallel=True, fastmath=True)
 def _reduced_kernel(cols, vals, fcol, fw, fd, jp, order, ptr, pt_order, Vinv, n_c, capg, capc,
-                    n_chunks):  # pragma: no cover - compiled
+                    tile_of, n_tiles, n_chunks):  # pragma: no cover - compiled
     """A with ``A + Aᵀ = Σ_i (J_c,iᵀ J_c,i − W_i V_i⁻¹ W_iᵀ)`` over the points.
 
     Rows of point i are ``order[ptr[i]:ptr[i+1]]``; points are visited in ``pt_order``.
@@ -127,17 +127,20 @@ def _reduced_kernel(cols, vals, fcol, fw, fd, jp, order, ptr, pt_order, Vinv, n_
     kf = fd.shape[1]
     p = jp.shape[1]
     Lmax = capg * kf + capc
+    kk = kf * kf
     out = np.zeros((n_chunks, n_c, n_c))
+    out_t = np.zeros((n_chunks, n_tiles, n_tiles * kk))
     step = (n_pts + n_chunks - 1) // n_chunks
     for ch in prange(n_chunks):
         A = out[ch]
+        tiles = out_t[ch]
         pos = np.full(n_c, -1, dtype=np.int64)
         gl = np.empty(capc, dtype=np.int64)  # global column of each local slot column
         grow = np.empty(capg, dtype=np.int64)  # a row of each group (its items and weights)
         C = np.zeros((Lmax, Lmax))
         Z = np.zeros((p, Lmax))
         T = np.zeros((Lmax, p))
-        R = np.zeros((kf, Q * kf))
+        R = np.zeros(Q * kk)
         li = np.empty(K + kf, dtype=np.int64)
         lv = np.empty(K + kf)
         for ii in range(ch * step, min(n_pts, (ch + 1) * step)):
@@ -221,52 +224,46 @@ def _reduced_kernel(cols, vals, fcol, fw, fd, jp, order, ptr, pt_order, Vinv, n_
                     Zk = Z[k]
                     for b in range(L):
                         Crow[b] -= t * Zk[b]
-            # -- expand into the global columns
+            # -- expand into the global columns: group × group into the tiles
             for g in range(ng):
                 rg = grow[g]
                 for h in range(g, ng):
                     rh = grow[h]
                     half = 0.5 if h == g else 1.0
-                    # items of h on consecutive columns (spline nodes): one contiguous run of
-                    # Q·kf columns per global row, R[j] = (fw_h ⊗ C[gj, h·])
-                    cb0 = fcol[rh, 0]
-                    run = cb0 >= 0
-                    for b in range(1, Q):
-                        if fcol[rh, b] != cb0 + b * kf:
-                            run = False
-                    if run:
+                    # R[b, j, l] = fw_h[b] C[gj, hl]: the tiles of item a of g against the
+                    # items b of h are fw_g[a] R[b]
+                    for b in range(Q):
+                        wb = fw[rh, b]
                         for j in range(kf):
                             Crow = C[g * kf + j]
-                            for b in range(Q):
-                                wb = fw[rh, b]
-                                for l in range(kf):
-                                    R[j, b * kf + l] = wb * Crow[h * kf + l]
-                        for a in range(Q):
-                            ca = fcol[rg, a]
-                            if ca < 0:
-                                continue
-                            wa = half * fw[rg, a]
-                            for j in range(kf):
-                                Aseg = A[ca + j, cb0 : cb0 + Q * kf]
-                                Rj = R[j]
-                                for e in range(Q * kf):
-                                    Aseg[e] += wa * Rj[e]
-                        continue
+                            for l in range(kf):
+                                R[(b * kf + j) * kf + l] = wb * Crow[h * kf + l]
+                    # items of h on consecutive tiles (spline nodes): one contiguous segment
+                    # of Q·kf² values in each tile row
+                    tb0 = tile_of[fcol[rh, 0]] if fcol[rh, 0] >= 0 else -1
+                    run = tb0 >= 0
+                    for b in range(1, Q):
+                        cb = fcol[rh, b]
+                        if cb < 0 or tile_of[cb] != tb0 + b:
+                            run = False
                     for a in range(Q):
                         ca = fcol[rg, a]
                         if ca < 0:
                             continue
                         wa = half * fw[rg, a]
+                        Trow = tiles[tile_of[ca]]
+                        if run:
+                            Tseg = Trow[tb0 * kk : (tb0 + Q) * kk]
+                            for e in range(Q * kk):
+                                Tseg[e] += wa * R[e]
+                            continue
                         for b in range(Q):
                             cb = fcol[rh, b]
                             if cb < 0:
                                 continue
-                            wab = wa * fw[rh, b]
-                            for j in range(kf):
-                                Arow = A[ca + j]
-                                Crow = C[g * kf + j]
-                                for l in range(kf):
-                                    Arow[cb + l] += wab * Crow[h * kf + l]
+                            Tseg = Trow[tile_of[cb] * kk : (tile_of[cb] + 1) * kk]
+                            for e in range(kk):
+                                Tseg[e] += wa * R[b * kk + e]
                 for a in range(Q):
                     ca = fcol[rg, a]
                     if ca < 0:
@@ -285,7 +282,7 @@ def _reduced_kernel(cols, vals, fcol, fw, fd, jp, order, ptr, pt_order, Vinv, n_
                     Arow[gl[e2]] += Crow[ng * kf + e2]
             for e in range(nl):
                 pos[gl[e]] = -1
-    return out
+    return out, out_t
 
 
 def _symmetrise_upper(U: np.ndarray) -> np.ndarray:
@@ -332,20 +329,51 @@ def normal_cc(arrays, n_c: int, row_order=None) -> np.ndarray:
     return _symmetrise_upper(parts.sum(axis=0) if nch > 1 else parts[0])
 
 
-def reduced_points(arrays, jp, order, ptr, Vinv, n_c: int, pt_order=None) -> np.ndarray:
-    """``Σ_i (J_c,iᵀ J_c,i − W_i V_i⁻¹ W_iᵀ)`` (dense ``n_c × n_c``) over the points' rows."""
+def factored_tiles(fcol: np.ndarray, kf: int, n_c: int):
+    """Tiles of the factored columns: ``tile_of[c]`` numbers each distinct item start column c.
+
+    Item t owns the columns ``starts[t] + (0 … kf−1)``; ``tile_of`` is −1 elsewhere. Distinct
+    items never share columns, so the tiles of two items are disjoint ``kf × kf`` blocks of S.
+    """
+    used = np.zeros(n_c + 1, dtype=bool)
+    used[fcol.ravel()] = True  # (−1, no item, lands on the extra last entry)
+    starts = np.flatnonzero(used[:n_c])
+    tile_of = np.full(n_c, -1, dtype=np.int64)
+    tile_of[starts] = np.arange(starts.size)
+    return tile_of, starts
+
+
+def reduced_points(arrays, jp, order, ptr, Vinv, n_c: int, pt_order=None, tiles=None
+                   ) -> np.ndarray:
+    """``Σ_i (J_c,iᵀ J_c,i − W_i V_i⁻¹ W_iᵀ)`` (dense ``n_c × n_c``) over the points' rows.
+
+    ``tiles`` is :func:`factored_tiles` of the factored columns (computed when not given).
+    """
     n_pts = ptr.size - 1
     if n_c == 0 or n_pts == 0:
         return np.zeros((n_c, n_c))
     if pt_order is None:
         pt_order = np.arange(n_pts, dtype=np.int64)
-    cols, _, fcol, _, _ = arrays
+    cols, _, fcol, _, fd = arrays
+    kf = fd.shape[1]
+    tile_of, starts = factored_tiles(fcol, kf, n_c) if tiles is None else tiles
     max_rows = int(np.max(np.diff(ptr))) if n_pts else 0
     capg = max_rows if fcol.shape[1] else 0
     capc = int(min(n_c, max(1, max_rows * cols.shape[1])))
     nch = max(1, min(n_threads(), n_pts // 2000 + 1))
-    parts = _reduced_kernel(*arrays, jp, order, ptr, pt_order, Vinv, n_c, capg, capc, nch)
+    parts, tparts = _reduced_kernel(*arrays, jp, order, ptr, pt_order, Vinv, n_c, capg, capc,
+                                    tile_of, starts.size, nch)
     A = parts.sum(axis=0) if nch > 1 else parts[0]
+    if starts.size:
+        # the tiles T[t, u] (kf × kf, row-major in each tile) into the columns of their items
+        T = tparts.sum(axis=0) if nch > 1 else tparts[0]
+        n = starts.size
+        Tm = T.reshape(n, n, kf, kf).transpose(0, 2, 1, 3).reshape(n * kf, n * kf)
+        idx = (starts[:, None] + np.arange(kf)).ravel()
+        if idx[-1] - idx[0] + 1 == idx.size:  # the items' columns are one contiguous range
+            A[idx[0] : idx[-1] + 1, idx[0] : idx[-1] + 1] += Tm
+        else:
+            A[np.ix_(idx, idx)] += Tm
     return A + A.T
 
 

@@ -755,9 +755,12 @@ def _analyse(layout: _Layout, ne: _Normal, rtol: float) -> Identifiability:
     unobserved = [layout.labels_c[i] for i in np.flatnonzero(d <= 0)]
     d = np.sqrt(np.where(d > 0, d, 1.0))
     Ss = S / d[:, None] / d[None, :]
-    ev, evec = np.linalg.eigh(Ss)
+    ev = np.linalg.eigvalsh(Ss)
     thresh = rtol * max(float(ev[-1]), 1e-300)
     null = np.flatnonzero(ev < thresh)
+    if null.size:  # the null vectors name the parameters involved
+        ev, evec = np.linalg.eigh(Ss)
+        null = np.flatnonzero(ev < thresh)
     vecs = []
     for j in null:
         v = evec[:, j]
@@ -817,7 +820,13 @@ def _progress_printer(progress):
     return show
 
 
-#: Each-iteration rejection starts once an iteration decreases the cost by less than this share.
+#: Each-iteration rejection starts once the iterate is within this share of the cost of its
+#: minimum: when the last step decreased the cost by less than this share, or when its actual
+#: decrease matched the predicted one to within this share of the new cost. The mismatch
+#: ``|actual − predicted|`` is the part of the decrease the linearised model did not explain;
+#: a Gauss–Newton step from the new point removes a decrease of that order (its gradient comes
+#: from the same second-order terms), so a small mismatch shows the new point at its minimum
+#: one iteration before the decrease itself does.
 REJECT_START = 1e-2
 
 
@@ -1000,10 +1009,11 @@ def adjust(
             new_cost = trial.cost
             history.append(new_cost)
             tested = False
-            if each and (rejecting or actual <= REJECT_START * cost):
+            settled = max(min(actual, abs(actual - pred)), 0.0) <= REJECT_START * new_cost
+            if each and (rejecting or settled):
                 # 002 §3.4: outliers are rejected in each iteration, on the residuals at the
-                # new point (from the first iteration whose decrease shows the solution near its
-                # minimum: before that, residuals reflect the initial values, not gross errors)
+                # new point, from the first iterate shown near its minimum (REJECT_START):
+                # before that, residuals reflect the initial values, not gross errors
                 rejecting = True
                 tested = not _reject(blocks, masks, trial, reject_k)
             if show:
