@@ -305,3 +305,15 @@ def test_reduced_kernel_equals_dense_schur(consecutive):
     ptr = np.concatenate([[0], np.cumsum(rows_per_pt)]).astype(np.int64)
     S = reduced_points(J.arrays, jp, order, ptr, Vinv, n_c)
     np.testing.assert_allclose(S, S_ref, rtol=1e-12, atol=1e-12 * np.abs(S_ref).max())
+
+
+def test_spd_inverse_against_numpy_and_singular():
+    from hsgeo.adjust.result import _spd_inverse
+
+    rng = np.random.default_rng(1)
+    A = rng.normal(size=(30, 12))
+    N = A.T @ A
+    np.testing.assert_allclose(_spd_inverse(N), np.linalg.inv(N), rtol=1e-10, atol=1e-12)
+    N[:, 3] = N[3, :] = 0.0
+    with pytest.raises(np.linalg.LinAlgError, match="not positive definite"):
+        _spd_inverse(N)

@@ -305,7 +305,7 @@ def _evaluate(layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian:
         all_kept = rows_kept.size == blk.m
         newrow = np.full(blk.m, -1, dtype=np.int64)
         newrow[rows_kept] = np.arange(offset, offset + rows_kept.size)
-        r_parts.append(r[rows_kept] * w[rows_kept])
+        r_parts.append(r * w if all_kept else r.take(rows_kept) * w.take(rows_kept))
         if jacobian:
             pidx = np.full(rows_kept.size, -1, dtype=np.int64)
             jp = np.zeros((rows_kept.size, layout.p))
@@ -320,8 +320,12 @@ def _evaluate(layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian:
                             f"the Jacobian w.r.t. the points block {name!r} must be "
                             f"Indexed((m,), (m, {layout.p})): each row touches one point"
                         )
-                    pidx = J.index[rows_kept, 0]
-                    jp = J.d[rows_kept, 0, :] * w[rows_kept, None]
+                    pidx, jp = J.index[:, 0], J.d[:, 0, :]
+                    if all_kept:
+                        jp = jp * w[:, None]
+                    else:
+                        pidx = pidx.take(rows_kept)
+                        jp = jp.take(rows_kept, axis=0) * w.take(rows_kept)[:, None]
                     if not layout.pfree.all():
                         jp = jp * layout.pfree[np.maximum(pidx, 0)]
                     if (pidx < 0).any():
