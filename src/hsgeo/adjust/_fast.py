@@ -23,7 +23,8 @@ import numba
 import numpy as np
 from numba import njit, prange
 
-__all__ = ["normal_cc", "reduced_points", "factored_tiles", "point_covariance", "locality_orders", "n_threads"]
+__all__ = ["normal_cc", "reduced_points", "factored_tiles", "point_covariance", "locality_orders",
+           "n_threads"]
 
 
 def n_threads() -> int:

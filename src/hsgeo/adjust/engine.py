@@ -419,6 +419,18 @@ class _Normal:
     Ncc_free: np.ndarray | None = None  # J_cᵀ J_c of the rows without a point (compiled path)
     diag_cc: np.ndarray | None = None  # diag(N_cc)
     reduced0: tuple | None = None  # (S, rhs, V⁻¹) with undamped point blocks, see _reduced
+    S_chord: np.ndarray | None = None  # a reduced matrix formed at an earlier point, see adjust
+
+    @property
+    def compiled_schur(self) -> bool:
+        """The reduced matrix is formed point by point by the compiled kernel."""
+        return self.V is not None and self.sy is not None and self._W is None and self._Ncc is None
+
+    def exact(self) -> None:
+        """Drop a chord matrix: the next reduced system is formed at this point."""
+        if self.S_chord is not None:
+            self.S_chord = None
+            self.reduced0 = None
 
     @property
     def Ncc(self) -> np.ndarray:
@@ -598,7 +610,7 @@ def _reduced(layout: _Layout, ne: _Normal, lam: float):
     """
     rhs = ne.gc.copy()
     lam_p = _lambda_points(lam)
-    if ne.V is not None and ne.sy is not None and ne._W is None and ne._Ncc is None:
+    if ne.compiled_schur:
         # compiled path: S = N_cc − Σ W_i V_i⁻¹ W_iᵀ accumulated point by point from the rows
         # grouped by point; neither W nor the full N_cc is formed
         from hsgeo.adjust._fast import reduced_points
@@ -607,8 +619,11 @@ def _reduced(layout: _Layout, ne: _Normal, lam: float):
         if cached is None:
             Vinv = _inv_blocks(_damped(ne.V, lam_p))
             sy = ne.sy
-            S0 = ne.Ncc_free + reduced_points(sy.Jrc.arrays, sy.Jp, ne.order, ne.ptr, Vinv,
-                                              layout.n_c, ne.pt_order)
+            if ne.S_chord is not None and lam_p == 0.0:
+                S0 = ne.S_chord  # a chord step: the matrix of an earlier point (see adjust)
+            else:
+                S0 = ne.Ncc_free + reduced_points(sy.Jrc.arrays, sy.Jp, ne.order, ne.ptr,
+                                                  Vinv, layout.n_c, ne.pt_order)
             r0 = rhs - ne.W_dot(np.einsum("nij,nj->ni", Vinv, ne.gp)) if layout.n_c else rhs
             if lam_p == 0.0:  # keep the undamped one (datum check, steps, covariance)
                 ne.reduced0 = (S0, r0, Vinv)
@@ -834,6 +849,12 @@ def _progress_printer(progress):
 REJECT_START = 1e-2
 
 
+#: Chord steps end when their predicted decrease falls below this share of ``ftol · cost``:
+#: they converge linearly, so the margin leaves the final iterate as close to the minimum as
+#: the quadratically converging Gauss–Newton steps would.
+CHORD_END = 1e-3
+
+
 def _reject(blocks, masks, sy: _System, reject_k: float) -> bool:
     """Reject the kept groups whose whitened residual in ``sy`` exceeds ``reject_k`` robust σ.
 
@@ -971,7 +992,14 @@ def adjust(
                 break
             dc, dp = _step(layout, ne, lam)
             pred = _predicted_decrease(layout, ne, lam, dc, dp)
-            if lam <= LAMBDA_POINTS_MIN and pred <= tol * cost:
+            chord_done = ne.S_chord is not None and pred <= CHORD_END * tol * cost
+            if lam <= LAMBDA_POINTS_MIN and chord_done:
+                # the chord steps have converged (they converge linearly, hence the margin):
+                # form the reduced matrix here to confirm it, and for the covariance
+                ne.exact()
+                dc, dp = _step(layout, ne, lam)
+                pred = _predicted_decrease(layout, ne, lam, dc, dp)
+            if lam <= LAMBDA_POINTS_MIN and pred <= tol * cost and ne.S_chord is None:
                 if each and not tested:
                     # converged before any rejection test (e.g. at the initial values)
                     if _reject(blocks, masks, sy, reject_k):
@@ -997,10 +1025,13 @@ def adjust(
                     nu = 2.0
                     break
                 layout.set_state(state)
-                lam *= nu
-                nu *= 2.0
-                if lam > 1e16:
-                    break
+                if ne.S_chord is not None:
+                    ne.exact()  # the chord step failed: retry with the matrix of this point
+                else:
+                    lam *= nu
+                    nu *= 2.0
+                    if lam > 1e16:
+                        break
                 dc, dp = _step(layout, ne, lam)
                 pred = _predicted_decrease(layout, ne, lam, dc, dp)
             if lam > 1e16:
@@ -1030,9 +1061,17 @@ def adjust(
                         "rejected": int(sum((~m).sum() for m in masks)),
                     }
                 )
+            # chord steps (Kelley 1995, §5.4): from a settled iterate on, the reduced matrix
+            # barely changes, so the next steps reuse the last one formed (the gradient and
+            # the points' blocks are always those of the current point); it is formed again
+            # where the convergence test passes, or when a chord step fails
+            chord = (ne.reduced0[0] if settled and ne.compiled_schur and ne.reduced0 is not None
+                     else None)
             sy = ne = trial = None  # free the old Jacobian before forming the new one
             sy = _evaluate(layout, blocks, masks, jacobian=True)
             ne = _normal(layout, sy)
+            if chord is not None and ne.compiled_schur:
+                ne.S_chord = chord
             cost = sy.cost  # (lower than new_cost when observations were just rejected)
         if not converged:
             if each and not message:

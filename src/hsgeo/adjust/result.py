@@ -17,8 +17,10 @@ __all__ = ["AdjustmentResult"]
 
 
 def _spd_inverse(S: np.ndarray) -> np.ndarray:
-    """The inverse of a symmetric positive definite matrix from its Cholesky factor (LAPACK
-    potrf + potri: a third of the work of solving for the identity)."""
+    """The inverse of a symmetric positive definite matrix from its Cholesky factor.
+
+    LAPACK potrf + potri: a third of the work of solving for the identity.
+    """
     from scipy.linalg import lapack
 
     c, info = lapack.dpotrf(S, lower=True, clean=False)
@@ -88,6 +90,7 @@ class AdjustmentResult:
         dof = int(system.r.size - n_unk)
         vtpv = float(system.r @ system.r)
         sigma0 = float(np.sqrt(vtpv / dof)) if dof > 0 else float("nan")
+        normal.exact()  # the covariance needs the reduced matrix of this point
         S, _, _, _ = _reduced(layout, normal, 0.0)
         if layout.n_c:
             try:
