@@ -839,14 +839,19 @@ def _progress_printer(progress):
     return show
 
 
-#: Each-iteration rejection starts once the iterate is within this share of the cost of its
-#: minimum: when the last step decreased the cost by less than this share, or when its actual
-#: decrease matched the predicted one to within this share of the new cost. The mismatch
-#: ``|actual − predicted|`` is the part of the decrease the linearised model did not explain;
-#: a Gauss–Newton step from the new point removes a decrease of that order (its gradient comes
-#: from the same second-order terms), so a small mismatch shows the new point at its minimum
-#: one iteration before the decrease itself does.
-REJECT_START = 1e-2
+#: An iterate is *settled* (near its minimum) when the last step decreased the cost by less than
+#: this share of it, or when its actual decrease matched the predicted one to within this share
+#: of the new cost. The mismatch ``|actual − predicted|`` is the part of the decrease the
+#: linearised model did not explain; a Gauss–Newton step from the new point removes a decrease
+#: of that order (its gradient comes from the same second-order terms), so a small mismatch
+#: shows the new point near its minimum one iteration before the decrease itself does. From a
+#: settled iterate on, each-iteration rejection tests the residuals and the steps are chord
+#: steps (see :func:`adjust`).
+SETTLED = 1e-2
+
+
+def _settled(actual: float, pred: float, new_cost: float) -> bool:
+    return max(min(actual, abs(actual - pred)), 0.0) <= SETTLED * new_cost
 
 
 #: Chord steps end when their predicted decrease falls below this share of ``ftol · cost``:
@@ -918,8 +923,8 @@ def adjust(
         whitened residuals) after convergence, and adjust again; repeated until none is rejected
         or ``max_reject_rounds``. A whole group (e.g. x and y of one point) is rejected together.
     reject_every_iteration : bool
-        With ``reject_k``: test the residuals after every iteration (once the cost has nearly
-        settled, see ``REJECT_START``) instead of in rounds after convergence, as 002 §3.4 does
+        With ``reject_k``: test the residuals after every iteration (once the iterate has
+        settled, see ``SETTLED``) instead of in rounds after convergence, as 002 §3.4 does
         ("observation outliers are identified and rejected in each iteration"); the adjustment
         has converged when the predicted decrease is below ``ftol`` and the last test rejected
         nothing.
@@ -936,6 +941,18 @@ def adjust(
     Returns
     -------
     AdjustmentResult
+
+    Notes
+    -----
+    Levenberg–Marquardt on the Schur-reduced normal equations (the points eliminated). When
+    the reduced matrix is formed point by point by the compiled kernel (the costly part of an
+    iteration), the steps after a settled iterate (``SETTLED``) are *chord steps* (C. T.
+    Kelley, *Iterative Methods for Linear and Nonlinear Equations*, SIAM 1995, ch. 5): they
+    reuse the last reduced matrix formed, with the gradient and the points' blocks of the
+    current iterate, so they still descend to the same minimum, linearly. Where they have
+    converged (to ``CHORD_END · ftol``), or when one fails to decrease the cost, the matrix is
+    formed again; convergence is only declared with the matrix of the final iterate, which
+    also gives the covariance.
     """
     from hsgeo.adjust.result import AdjustmentResult
 
@@ -1044,10 +1061,10 @@ def adjust(
             new_cost = trial.cost
             history.append(new_cost)
             tested = False
-            settled = max(min(actual, abs(actual - pred)), 0.0) <= REJECT_START * new_cost
+            settled = _settled(actual, pred, new_cost)
             if each and (rejecting or settled):
                 # 002 §3.4: outliers are rejected in each iteration, on the residuals at the
-                # new point, from the first iterate shown near its minimum (REJECT_START):
+                # new point, from the first settled iterate (SETTLED):
                 # before that, residuals reflect the initial values, not gross errors
                 rejecting = True
                 tested = not _reject(blocks, masks, trial, reject_k)
@@ -1061,7 +1078,7 @@ def adjust(
                         "rejected": int(sum((~m).sum() for m in masks)),
                     }
                 )
-            # chord steps (Kelley 1995, §5.4): from a settled iterate on, the reduced matrix
+            # chord steps (Kelley 1995, ch. 5): from a settled iterate on, the reduced matrix
             # barely changes, so the next steps reuse the last one formed (the gradient and
             # the points' blocks are always those of the current point); it is formed again
             # where the convergence test passes, or when a chord step fails
