@@ -489,13 +489,13 @@ def _rmatvec_rows(cols, vals, fcol, fw, fd, y, want_diag, i0, i1, g, d):  # prag
                         d[c0 + j] += v * v
 
 
-@njit(cache=True)
+@njit(cache=True, parallel=True)
 def matvec(cols, vals, fcol, fw, fd, x):  # pragma: no cover - compiled
     """``J x`` of a row-compressed matrix."""
     M, K = cols.shape
     Q, kf = fcol.shape[1], fd.shape[1]
     out = np.zeros(M)
-    for i in range(M):
+    for i in prange(M):
         acc = 0.0
         for s in range(K):
             c = cols[i, s]
@@ -509,6 +509,34 @@ def matvec(cols, vals, fcol, fw, fd, x):  # pragma: no cover - compiled
                     t += fd[i, j] * x[c0 + j]
                 acc += fw[i, a] * t
         out[i] = acc
+    return out
+
+
+@njit(cache=True, parallel=True)
+def point_rows_dot(jp, pidx, y):  # pragma: no cover - compiled
+    """``u_i = J_p,i · y[pidx_i]`` (0 for rows without a point): ``J_p y`` row by row."""
+    M, p = jp.shape
+    u = np.zeros(M)
+    for i in prange(M):
+        q = pidx[i]
+        if q >= 0:
+            acc = 0.0
+            for k in range(p):
+                acc += jp[i, k] * y[q, k]
+            u[i] = acc
+    return u
+
+
+@njit(cache=True)
+def scatter_points(jp, pidx, u, n_pts):  # pragma: no cover - compiled
+    """``J_pᵀ u`` as ``(n_pts, p)``: row i adds ``u_i J_p,i`` to its point."""
+    M, p = jp.shape
+    out = np.zeros((n_pts, p))
+    for i in range(M):
+        q = pidx[i]
+        if q >= 0:
+            for k in range(p):
+                out[q, k] += u[i] * jp[i, k]
     return out
 
 

@@ -452,21 +452,18 @@ class _Normal:
         """``Wᵀ dc`` as ``(n_pts, p)``."""
         if self._W is not None or self.sy is None:
             return (self.W.T @ dc).reshape(self.n_pts, -1)
-        u = self.sy.Jrc.matvec(dc)
-        jp = self.sy.Jp
-        pi = self.sy.pidx
-        sel = pi >= 0
-        return np.stack(
-            [np.bincount(pi[sel], weights=(u * jp[:, k])[sel], minlength=self.n_pts)
-             for k in range(jp.shape[1])], axis=1)
+        from hsgeo.adjust._fast import scatter_points
+
+        return scatter_points(self.sy.Jp, self.sy.pidx, self.sy.Jrc.matvec(dc), self.n_pts)
 
     def W_dot(self, y: np.ndarray) -> np.ndarray:
         """``W y`` for ``y`` of shape ``(n_pts, p)``."""
         if self._W is not None or self.sy is None:
             return self.W @ y.ravel()
-        pi = self.sy.pidx
-        u = np.where(pi >= 0, np.einsum("ij,ij->i", self.sy.Jp, y[np.maximum(pi, 0)]), 0.0)
-        return self.sy.Jrc.rmatvec(u)
+        from hsgeo.adjust._fast import point_rows_dot
+
+        return self.sy.Jrc.rmatvec(point_rows_dot(self.sy.Jp, self.sy.pidx,
+                                                  np.ascontiguousarray(y)))
 
 
 def _W_sparse(sy: _System, n_pts: int) -> sp.csr_matrix:
@@ -762,8 +759,14 @@ def _analyse(layout: _Layout, ne: _Normal, rtol: float) -> Identifiability:
         dz = dv == 0
         dv = np.where(dz, 1.0, dv)
         Vs = ne.V / dv[:, :, None] / dv[:, None, :]
-        ev = np.linalg.eigvalsh(Vs)
-        bad = (ev[:, 0] < rtol * np.maximum(ev[:, -1], 1e-300) ** 1) | dz.any(axis=1)
+        # unit diagonal: λ_max ≤ p and λ_min ≥ det / λ_max^(p−1), so det ≥ rtol·p^p proves
+        # λ_min ≥ rtol·λ_max; only the other blocks need their eigenvalues
+        p = Vs.shape[-1]
+        bad = dz.any(axis=1)
+        doubt = np.flatnonzero(~(np.linalg.det(Vs) >= rtol * p**p) & ~bad)
+        if doubt.size:
+            ev = np.linalg.eigvalsh(Vs[doubt])
+            bad[doubt] = ev[:, 0] < rtol * np.maximum(ev[:, -1], 1e-300)
         undetermined = np.flatnonzero(bad & layout.pfree.any(axis=1)).tolist()
     if layout.n_c == 0:
         return Identifiability(0, 0, [], undetermined, [], np.zeros(0))
