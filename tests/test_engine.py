@@ -350,3 +350,19 @@ def test_chord_steps_end_with_the_covariance_of_the_final_point():
     S_final = E._reduced(lay, ne, 0.0)[0]
     np.testing.assert_allclose(r.covariance, r.sigma0**2 * np.linalg.inv(S_final), rtol=1e-9,
                                atol=1e-12 * np.abs(r.covariance).max())
+
+
+def test_chord_steps_from_the_first_iterate_still_converge(monkeypatch):
+    """Chord steps from far from the minimum (forced): failed ones fall back to the matrix of
+    the current point, and the adjustment reaches the same minimum."""
+    from hsgeo.adjust import engine as E
+
+    S, P, st, pt, th = bearing_scene(8)
+    p, blk = _bearing_params(S, P, st, pt, th, seed=8)
+    ref = adjust(p, blk, ftol=1e-14)
+    monkeypatch.setattr(E, "_settled", lambda actual, pred, new_cost: True)
+    r = adjust(p, blk, ftol=1e-14)
+    assert r.converged
+    for name in ("points", "stations"):
+        np.testing.assert_array_less(np.abs(r.value(name) - ref.value(name)),
+                                     1e-4 * np.nan_to_num(ref.sigma(name)) + 1e-12)

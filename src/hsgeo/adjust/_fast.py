@@ -119,8 +119,12 @@ def _reduced_kernel(cols, vals, fcol, fw, fd, jp, order, ptr, pt_order, Vinv, n_
     into the global columns: group g's local column j stands for the columns ``fcol[a] + j``
     with weight ``fw[a]``, so the block of groups (g, h) adds ``fw_g[a] fw_h[b] C[gj, hl]`` at
     ``(fcol_g[a] + j, fcol_h[b] + l)``. This is exact: the weights factor out of every product.
-    Only one triangle of the pairs of local units is written (the diagonal units halved), hence
-    ``A + Aᵀ``.
+    These group × group blocks go to the second output, *tiles* ``(n_tiles, n_tiles·kf²)``:
+    tile ``(t, u)`` is the ``kf × kf`` block of the items ``t = tile_of[fcol]`` and ``u``
+    (row-major), so an item's block against consecutive items (spline nodes) is one contiguous
+    segment, which vectorises; written into rows of S it ran scalar, at about one cycle a
+    value. Only one triangle of the pairs of local units is written (the diagonal units
+    halved), hence ``A + Aᵀ``.
     """
     n_pts = ptr.size - 1
     K = cols.shape[1]
