@@ -366,3 +366,29 @@ def test_chord_steps_from_the_first_iterate_still_converge(monkeypatch):
     for name in ("points", "stations"):
         np.testing.assert_array_less(np.abs(r.value(name) - ref.value(name)),
                                      1e-4 * np.nan_to_num(ref.sigma(name)) + 1e-12)
+
+
+@pytest.mark.parametrize("each", [False, True])
+def test_gross_errors_rejected_without_swamping_their_points(each):
+    """A gross error drags its point: its point's other rays get large residuals too. Only the
+    largest standardised residual per point is rejected per test, so the gross errors go and
+    the good rays of their points stay (five bearings per 2-D point: a redundancy of 3)."""
+    S, P, st, pt, th = bearing_scene(11, n_points=60, coverage=5)
+    rng = np.random.default_rng(2)
+    # one gross error on each of 6 points (not the control points)
+    gross = np.array([rng.choice(np.flatnonzero(pt == j)) for j in
+                      rng.choice(np.arange(2, 60), 6, replace=False)])
+    th = th.copy()
+    th[gross] += rng.choice([-1, 1], gross.size) * rng.uniform(0.02, 0.05, gross.size)
+    p, blk = _bearing_params(S, P, st, pt, th, n_control=2, seed=11)
+    # the swamping is real: with the gross errors in, other rays of their points exceed 5 σ
+    r0 = adjust(p, blk)
+    z = np.abs(r0.residuals(0)) / 1e-3 / (1.4826 * np.median(np.abs(r0.residuals(0)) / 1e-3))
+    others = np.isin(pt, pt[gross]) & ~np.isin(np.arange(pt.size), gross)
+    assert (z[others] > 5).sum() >= 3  # rejecting every ray above 5 σ would take these too
+    r = adjust(p, blk, reject_k=5.0, reject_every_iteration=each)
+    rejected = set(np.flatnonzero(r.outliers(0)).tolist())
+    assert set(gross.tolist()) <= rejected
+    # (a ray of a near-opposite pair of stations can carry the same error as its partner: the
+    # geometry may leave one such pair undecided)
+    assert len(rejected - set(gross.tolist())) <= 1

@@ -75,6 +75,8 @@ class _Layout:
         else:
             self.n_pts, self.p = 0, 0
             self.pfree = np.zeros((0, 0), dtype=bool)
+        #: the point of each row of residual block i (from its Jacobian), for _reject
+        self.row_point: dict[int, np.ndarray] = {}
 
     @property
     def n_unknowns(self) -> int:
@@ -286,7 +288,7 @@ def _evaluate(layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian:
     factored_k = None  # width k of the factored Jacobians (one per row, one k for all)
     offset = 0
     pname = layout.pblock.name if layout.pblock is not None else None
-    for blk, keep in zip(blocks, masks, strict=True):
+    for ib, (blk, keep) in enumerate(zip(blocks, masks, strict=True)):
         r, jac = blk.evaluate(values, jacobian)
         r = np.asarray(r, dtype=np.float64)
         if r.shape != (blk.m,):
@@ -321,6 +323,7 @@ def _evaluate(layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian:
                             f"Indexed((m,), (m, {layout.p})): each row touches one point"
                         )
                     pidx, jp = J.index[:, 0], J.d[:, 0, :]
+                    layout.row_point[ib] = pidx
                     if all_kept:
                         jp = jp * w[:, None]
                     else:
@@ -863,30 +866,61 @@ def _settled(actual: float, pred: float, new_cost: float) -> bool:
 CHORD_END = 1e-3
 
 
-def _reject(blocks, masks, sy: _System, reject_k: float) -> bool:
+def _leverage(ne: _Normal) -> np.ndarray | None:
+    """Each row's leverage on its point, ``h = j_pᵀ V⁻¹ j_p`` (0 for rows without a point)."""
+    if ne.V is None:
+        return None
+    Vinv = ne.reduced0[2] if ne.reduced0 is not None else _inv_blocks(ne.V)
+    pi, jp = ne.sy.pidx, ne.sy.Jp
+    h = np.zeros(pi.size)
+    on = np.flatnonzero(pi >= 0)
+    h[on] = np.einsum("ij,ijk,ik->i", jp[on], Vinv[pi[on]], jp[on])
+    return h
+
+
+def _reject(blocks, masks, sy: _System, reject_k: float, row_point=None,
+            leverage=None) -> bool:
     """Reject the kept groups whose whitened residual in ``sy`` exceeds ``reject_k`` robust σ.
 
-    ``masks`` is updated in place; returns True if any group was rejected.
+    With ``leverage`` (of each row of ``sy`` on its point, see :func:`_leverage`) the residuals
+    are standardised first, ``r / √(1 − h)`` (Baarda's w-test with the points' share of the
+    redundancy): a ray of a point seen three times has a residual shrunk by its point. Of one
+    point's groups only the one with the largest is rejected in a test: a gross error drags
+    its point, so the point's other observations show large residuals too (swamping); they
+    are tested again at the next iterate, without it. ``row_point[i]`` is the point of each
+    row of block ``i`` (blocks without points: every group on its own). ``masks`` is updated
+    in place; returns True if any group was rejected.
     """
-    scale = _robust_scale(sy)
+    r = np.abs(sy.r[: sy.n_obs_rows])
+    if leverage is not None:
+        r = r / np.sqrt(np.maximum(1.0 - leverage[: sy.n_obs_rows], 1e-2))
+    r /= max(1.4826 * float(np.median(r)), 1e-300) if r.size else 1.0
     off = 0
     new_any = False
     for i, b in enumerate(blocks):
+        g = b.group_size
         kept = np.flatnonzero(masks[i])
-        rw = sy.r[off : off + kept.size] / scale
+        score = np.zeros(b.m)
+        score[kept] = r[off : off + kept.size]
         off += kept.size
-        bad = np.zeros(b.m, dtype=bool)
-        bad[kept] = np.abs(rw) > reject_k
-        bad = np.repeat(bad.reshape(-1, b.group_size).any(axis=1), b.group_size)
-        if bad.any():
-            masks[i] &= ~bad
-            new_any = True
+        score = score.reshape(-1, g).max(axis=1)  # per group
+        cand = np.flatnonzero(score > reject_k)
+        if not cand.size:
+            continue
+        if row_point is not None and i in row_point:
+            pt = row_point[i][cand * g]
+            on = pt >= 0
+            c, pc = cand[on], pt[on]
+            o = np.lexsort((-score[c], pc))  # by point, the largest residual first
+            c, pc = c[o], pc[o]
+            first = np.ones(c.size, dtype=bool)
+            first[1:] = pc[1:] != pc[:-1]
+            cand = np.concatenate([cand[~on], c[first]])
+        bad = np.zeros(b.m // g, dtype=bool)
+        bad[cand] = True
+        masks[i] &= ~np.repeat(bad, g)
+        new_any = True
     return new_any
-
-
-def _robust_scale(sy: _System) -> float:
-    r = np.abs(sy.r[: sy.n_obs_rows])
-    return max(1.4826 * float(np.median(r)), 1e-300) if r.size else 1.0
 
 
 def adjust(
@@ -984,7 +1018,7 @@ def adjust(
     final = reject_k is None or each
     while True:
         tol = ftol if final else max(ftol, REJECT_ROUND_FTOL)
-        sy = ne = full = None  # free the previous round's Jacobian first (peak memory)
+        sy = ne = None  # free the previous round's Jacobian first (peak memory)
         sy = _evaluate(layout, blocks, masks, jacobian=True)
         dof = sy.r.size - layout.n_unknowns
         if dof < 0 or (dof == 0 and sy.n_obs_rows < layout.n_unknowns):
@@ -1022,7 +1056,8 @@ def adjust(
             if lam <= LAMBDA_POINTS_MIN and pred <= tol * cost and ne.S_chord is None:
                 if each and not tested:
                     # converged before any rejection test (e.g. at the initial values)
-                    if _reject(blocks, masks, sy, reject_k):
+                    if _reject(blocks, masks, sy, reject_k, layout.row_point,
+                               _leverage(ne)):
                         break  # adjust again with the new masks (next pass of the outer loop)
                     tested = True
                 # the Gauss–Newton step would decrease the cost by less than ftol: this is the
@@ -1070,7 +1105,8 @@ def adjust(
                 # new point, from the first settled iterate (SETTLED):
                 # before that, residuals reflect the initial values, not gross errors
                 rejecting = True
-                tested = not _reject(blocks, masks, trial, reject_k)
+                tested = not _reject(blocks, masks, trial, reject_k, layout.row_point,
+                                     _leverage(ne))
             if show:
                 show(
                     {
@@ -1103,20 +1139,8 @@ def adjust(
         if rounds >= max_reject_rounds:
             final = True
             continue
-        # -- outlier rejection: whole groups whose whitened residual exceeds reject_k robust σ
-        scale = _robust_scale(sy)
-        full = _evaluate(layout, blocks, [np.ones(b.m, dtype=bool) for b in blocks], False)
-        new_any = False
-        off = 0
-        for i, b in enumerate(blocks):
-            rw = full.r[off : off + b.m] / scale
-            off += b.m
-            bad = (np.abs(rw) > reject_k).reshape(-1, b.group_size).any(axis=1)
-            bad = np.repeat(bad, b.group_size)
-            newly = bad & masks[i]
-            if newly.any():
-                masks[i] = masks[i] & ~bad
-                new_any = True
+        # -- outlier rejection round (see _reject)
+        new_any = _reject(blocks, masks, sy, reject_k, layout.row_point, _leverage(ne))
         rounds += 1
         if not new_any:
             if tol <= ftol:
