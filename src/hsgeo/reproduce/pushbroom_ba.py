@@ -187,6 +187,14 @@ def run(seed: int = 0, scale: float = 1.0, progress=None) -> Reproduction:
         "rejected_gcp": int(res.outliers(0).sum()),
         "simulated_outliers": int(camp.obs["outlier"].sum()),
         "outliers_found": int((res.outliers(0) & camp.obs["outlier"]).sum()),
+        "false_rejections": int((res.outliers(0) & ~camp.obs["outlier"]).sum()),
+        "false_rejections_on_gross_points": int(np.isin(
+            camp.obs["point"][res.outliers(0) & ~camp.obs["outlier"]],
+            camp.obs["point"][camp.obs["outlier"]]).sum()),
+        # the gross errors kept: their largest normalised residual (x or y), median
+        "missed_outlier_median_abs_z": float(np.median(np.abs(
+            res.normalized_residuals(0).reshape(-1, 2)[camp.obs["outlier"] & ~res.outliers(0)]
+        ).max(axis=1))) if (camp.obs["outlier"] & ~res.outliers(0)).any() else float("nan"),
         "share_params_within_3sigma": float(np.mean(np.abs(z) < 3)),
         "z_std_parameters": float(np.std(z)),
         "z_std_nodes": np.std((nv - nt) / ns_, axis=0).tolist(),
