@@ -392,3 +392,15 @@ def test_gross_errors_rejected_without_swamping_their_points(each):
     # (a ray of a near-opposite pair of stations can carry the same error as its partner: the
     # geometry may leave one such pair undecided)
     assert len(rejected - set(gross.tolist())) <= 1
+
+
+def test_point_leverage_kernel_equals_einsum():
+    from hsgeo.adjust._fast import point_leverage
+
+    rng = np.random.default_rng(5)
+    jp = rng.normal(size=(50, 3))
+    pidx = rng.integers(-1, 10, 50)
+    A = rng.normal(size=(10, 3, 3))
+    Vinv = A @ A.transpose(0, 2, 1)
+    ref = np.where(pidx >= 0, np.einsum("ij,ijk,ik->i", jp, Vinv[np.maximum(pidx, 0)], jp), 0.0)
+    np.testing.assert_allclose(point_leverage(jp, pidx, Vinv), ref, rtol=1e-13, atol=1e-13)

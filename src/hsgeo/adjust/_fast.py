@@ -531,6 +531,24 @@ def point_rows_dot(jp, pidx, y):  # pragma: no cover - compiled
     return u
 
 
+@njit(cache=True, parallel=True)
+def point_leverage(jp, pidx, Vinv):  # pragma: no cover - compiled
+    """``h_i = J_p,iᵀ V⁻¹ J_p,i`` of each row on its point (0 for rows without a point)."""
+    M, p = jp.shape
+    h = np.zeros(M)
+    for i in prange(M):
+        q = pidx[i]
+        if q >= 0:
+            acc = 0.0
+            for j in range(p):
+                t = 0.0
+                for k in range(p):
+                    t += Vinv[q, j, k] * jp[i, k]
+                acc += jp[i, j] * t
+            h[i] = acc
+    return h
+
+
 @njit(cache=True)
 def scatter_points(jp, pidx, u, n_pts):  # pragma: no cover - compiled
     """``J_pᵀ u`` as ``(n_pts, p)``: row i adds ``u_i J_p,i`` to its point."""

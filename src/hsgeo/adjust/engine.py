@@ -872,6 +872,10 @@ def _leverage(ne: _Normal) -> np.ndarray | None:
         return None
     Vinv = ne.reduced0[2] if ne.reduced0 is not None else _inv_blocks(ne.V)
     pi, jp = ne.sy.pidx, ne.sy.Jp
+    if FAST:
+        from hsgeo.adjust._fast import point_leverage
+
+        return point_leverage(jp, pi, np.ascontiguousarray(Vinv))
     h = np.zeros(pi.size)
     on = np.flatnonzero(pi >= 0)
     h[on] = np.einsum("ij,ijk,ik->i", jp[on], Vinv[pi[on]], jp[on])
