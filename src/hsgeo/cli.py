@@ -126,7 +126,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--c-px", type=float, default=3600.0, help="initial c (000 Table 1: 3600)")
     p.add_argument("--sigma-px", type=float, default=0.1, help="a-priori σ of ζ (px)")
     p.add_argument("--reject-k", type=float, default=None,
-                   help="reject observations beyond k robust σ (default: none)")
+                   help="reject observations whose standardised residual exceeds k robust σ "
+                        "(default: none)")
     p.add_argument("--json", action="store_true", help="estimates and residual statistics as JSON")
     p.set_defaults(func=_cmd_calibrate_line)
     p = sub.add_parser("calibrate-frame", help="self-calibrate a frame camera (per band or "

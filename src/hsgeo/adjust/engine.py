@@ -884,7 +884,7 @@ def _leverage(ne: _Normal) -> np.ndarray | None:
 
 def _reject(blocks, masks, sy: _System, reject_k: float, row_point=None,
             leverage=None) -> bool:
-    """Reject the kept groups whose whitened residual in ``sy`` exceeds ``reject_k`` robust σ.
+    """Reject the kept groups whose residual in ``sy`` exceeds ``reject_k`` robust σ.
 
     With ``leverage`` (of each row of ``sy`` on its point, see :func:`_leverage`) the residuals
     are standardised first, ``r / √(1 − h)`` (Baarda's w-test with the points' share of the
@@ -960,9 +960,12 @@ def adjust(
     lambda0 : float
         Initial Marquardt damping (relative to diag N); small means Gauss–Newton first.
     reject_k : float, optional
-        Reject observations whose whitened residual exceeds ``reject_k`` robust σ (NMAD of the
-        whitened residuals) after convergence, and adjust again; repeated until none is rejected
-        or ``max_reject_rounds``. A whole group (e.g. x and y of one point) is rejected together.
+        Reject observations whose standardised residual (whitened, and divided by
+        ``√(1 − h)`` with ``h`` the observation's leverage on its point) exceeds ``reject_k``
+        robust σ (NMAD of those residuals) after convergence, and adjust again; repeated until
+        none is rejected or ``max_reject_rounds``. A whole group (e.g. x and y of one
+        observation) is rejected together, and of one point's groups only the largest per test
+        (see ``_reject``).
     reject_every_iteration : bool
         With ``reject_k``: test the residuals after every iteration (once the iterate has
         settled, see ``SETTLED``) instead of in rounds after convergence, as 002 §3.4 does

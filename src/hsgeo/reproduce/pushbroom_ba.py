@@ -40,7 +40,7 @@ PAPER = {
     "n_observations_2d": 441587,  # 002 §4
 }
 
-#: The reject threshold, in robust σ of the whitened residuals (ours: about the largest
+#: The reject threshold, in robust σ of the standardised residuals (ours: about the largest
 #: residual / NMAD ratio of 002 Table 1, ≈ 6, with a margin).
 REJECT_K = 5.0
 #: Relative cost decrease at which the iteration stops: at full size 1e-6 of the cost is
