@@ -18,9 +18,12 @@ Gauss–Newton with Levenberg–Marquardt damping on the whitened observation eq
 * before the first step the datum is checked: a parameter without observations, a point that is
   not determined, or a rank-deficient reduced normal matrix raises :class:`~hsgeo.DatumError`
   naming the parameters involved;
-* optional outlier rejection removes observations whose normalised residual exceeds
-  ``reject_k`` robust standard deviations: in rounds after convergence, or in every iteration
-  once the cost has nearly settled (``reject_every_iteration``, as 002 §3.4 does);
+* optional outlier rejection removes observations whose standardised residual (divided by
+  ``√(1 − h)``, ``h`` the leverage on its point) exceeds ``reject_k`` robust standard
+  deviations, one observation per point and test: in rounds after convergence, or in every
+  iteration from a settled iterate on (``reject_every_iteration``, as 002 §3.4 does);
+* from a settled iterate on, the compiled path takes chord steps (the last reduced matrix
+  reused) and forms the matrix again at the final iterate;
 * Jacobians that are a weighted sum over items of one derivative (``Indexed(..., weights=)``,
   e.g. spline nodes) are kept factored by the compiled path (:mod:`hsgeo.adjust._fast`);
 * the a-posteriori σ0 and the covariance of the non-point parameters (points on request) are in
@@ -46,6 +49,7 @@ import scipy.sparse as sp
 from hsgeo.adjust.parameters import Parameters
 from hsgeo.adjust.residuals import Indexed, ResidualBlock
 from hsgeo.errors import ConvergenceError, DatumError, InputError, ObservationError
+from hsgeo.stats import NMAD_SCALE
 
 __all__ = ["adjust", "identifiability", "Identifiability"]
 
@@ -305,8 +309,6 @@ def _evaluate(layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian:
         w = 1.0 / blk.sigma
         rows_kept = np.flatnonzero(keep)
         all_kept = rows_kept.size == blk.m
-        newrow = np.full(blk.m, -1, dtype=np.int64)
-        newrow[rows_kept] = np.arange(offset, offset + rows_kept.size)
         r_parts.append(r * w if all_kept else r.take(rows_kept) * w.take(rows_kept))
         if jacobian:
             pidx = np.full(rows_kept.size, -1, dtype=np.int64)
@@ -870,16 +872,10 @@ def _leverage(ne: _Normal) -> np.ndarray | None:
     """Each row's leverage on its point, ``h = j_pᵀ V⁻¹ j_p`` (0 for rows without a point)."""
     if ne.V is None:
         return None
-    Vinv = ne.reduced0[2] if ne.reduced0 is not None else _inv_blocks(ne.V)
-    pi, jp = ne.sy.pidx, ne.sy.Jp
-    if FAST:
-        from hsgeo.adjust._fast import point_leverage
+    from hsgeo.adjust._fast import point_leverage
 
-        return point_leverage(jp, pi, np.ascontiguousarray(Vinv))
-    h = np.zeros(pi.size)
-    on = np.flatnonzero(pi >= 0)
-    h[on] = np.einsum("ij,ijk,ik->i", jp[on], Vinv[pi[on]], jp[on])
-    return h
+    Vinv = ne.reduced0[2] if ne.reduced0 is not None else _inv_blocks(ne.V)
+    return point_leverage(ne.sy.Jp, ne.sy.pidx, np.ascontiguousarray(Vinv))
 
 
 def _reject(blocks, masks, sy: _System, reject_k: float, row_point=None,
@@ -898,7 +894,7 @@ def _reject(blocks, masks, sy: _System, reject_k: float, row_point=None,
     r = np.abs(sy.r[: sy.n_obs_rows])
     if leverage is not None:
         r = r / np.sqrt(np.maximum(1.0 - leverage[: sy.n_obs_rows], 1e-2))
-    r /= max(1.4826 * float(np.median(r)), 1e-300) if r.size else 1.0
+    r /= max(NMAD_SCALE * float(np.median(r)), 1e-300) if r.size else 1.0  # robust σ about 0
     off = 0
     new_any = False
     for i, b in enumerate(blocks):
