@@ -55,8 +55,9 @@ book: $(STAMP) book/_build/.library-stamp ## execute every chapter and render th
 bench: $(STAMP) ## run the benchmarks, results as JSON in bench/results/
 	$(PY) bench/run.py
 
-lint: $(STAMP) ## ruff (numpydoc docstring convention)
+lint: $(STAMP) ## ruff check and format check, and the import contracts of the layout (GUIDE §2)
 	$(VENV)/bin/ruff check src tests bench
+	$(VENV)/bin/lint-imports --no-cache
 
 lock: ## re-resolve the environment from pyproject.toml and rewrite requirements.lock
 	rm -rf $(VENV)

@@ -32,9 +32,9 @@ HERE = Path(__file__).resolve().parent
 
 
 def _problem(scale, seed, with_gcp=True):
-    from hsgeo.pushbroom_ba import build_problem
     from hsgeo.reproduce.pushbroom_ba import Y_AS_TIME, camera_prior
     from hsgeo.simulate.pushbroom_campaign import simulate
+    from hsgeo.workflows.pushbroom_ba import build_problem
 
     camp = simulate(scale, rng=seed)
     p, blocks, _ = build_problem(

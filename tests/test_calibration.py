@@ -5,10 +5,10 @@ import numpy as np
 import pytest
 
 from hsgeo import InputError, ObservationError
-from hsgeo.calibration import View, calibrate_opencv, calibrate_photogrammetric
 from hsgeo.reproduce.frame_reference import charuco_views, chessboard_views, opencv_calibrate
 from hsgeo.simulate.frame_bench import simulate
 from hsgeo.simulate.scenarios import load_scenario
+from hsgeo.workflows.frame_calibration import View, calibrate_opencv, calibrate_photogrammetric
 
 
 @pytest.fixture(scope="module")

@@ -44,6 +44,6 @@ def test_console_script_runs():
 
 
 def test_data_manifest_verifies():
-    from hsgeo.simulate.scenarios import generate_all
+    from hsgeo.reproduce.data import generate_all
 
     assert generate_all(verify=True) == 0

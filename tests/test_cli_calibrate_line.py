@@ -3,7 +3,7 @@ import json
 import pytest
 
 from hsgeo.cli import main
-from hsgeo.simulate.line_lab import generate
+from hsgeo.reproduce.line_calibration import generate
 
 
 @pytest.fixture(scope="module")

@@ -13,7 +13,6 @@ from hsgeo.geocode import (
     LinearIFOV,
     PlaneTerrain,
     calibrate_boresight,
-    geocode_files,
     geocode_image,
     geocode_observations,
     intersect,
@@ -24,6 +23,7 @@ from hsgeo.geocode import (
 from hsgeo.navigation import Navigation
 from hsgeo.simulate.pula_flight import observe_gcps, simulate_flight
 from hsgeo.simulate.scenarios import load_scenario
+from hsgeo.workflows.geocoding import geocode_files
 
 CAL = CalibratedLine(486.8, 3539.0, (1.459, -0.1636, 0.00526))  # 000 Table 1
 

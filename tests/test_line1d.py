@@ -6,6 +6,7 @@ from hsgeo.adjust import adjust, identifiability
 from hsgeo.adjust.checks import check_jacobian
 from hsgeo.papers import P001_TABLE2
 from hsgeo.sensors import line1d as L
+from hsgeo.workflows.line_calibration import calibrate
 
 K_NIR = np.array([1.459, -0.1636, 0.00526])  # 000 Table 1
 
@@ -114,7 +115,7 @@ def test_truth_within_3_sigma(seed):
     eop, pts, img, pt, z = bench(seed=seed)
     p = L.make_parameters(eop + [0.02, -0.03, 0.01], 485.0, 3600.0, [0, 0, 0], pts,
                           np.ones(len(pts), bool))
-    res = L.calibrate(p, L.LineObservations(img, pt, z, 0.05))
+    res = calibrate(p, L.LineObservations(img, pt, z, 0.05))
     for name, truth in [("zeta0_px", 486.8), ("c_px", 3539.0), ("K", K_NIR), ("eop", eop)]:
         assert np.all(np.abs(res.value(name) - truth) < 3.5 * res.sigma(name)), name
     lo, hi = res.chi2_interval()

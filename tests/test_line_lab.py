@@ -3,7 +3,12 @@ import pytest
 
 from hsgeo import InputError
 from hsgeo.papers import P000_TABLE1_CALIBRATED, P001_TABLE2
-from hsgeo.reproduce.line_calibration import IOP_NAMES, calibrate_simulated
+from hsgeo.reproduce.line_calibration import (
+    IOP_NAMES,
+    calibrate_simulated,
+    generate,
+    simulate_observations,
+)
 from hsgeo.sensors import line1d
 from hsgeo.simulate import line_lab as LL
 
@@ -33,7 +38,7 @@ def test_render_is_12bit_and_reproducible():
 
 @pytest.mark.parametrize("row", [100, 1000])
 def test_measured_minima_match_projection(row):
-    sim = LL.simulate_observations(LAB, row, 3)
+    sim = simulate_observations(LAB, row, 3)
     t = sim["iop_true"]
     z = line1d.project(sim["xy_m"][sim["point"]], sim["eop_true"][sim["image"]],
                        float(t["zeta0_px"]), float(t["c_px"]), t["K"])
@@ -57,7 +62,7 @@ def test_calibration_within_3_sigma_of_truth(seed, row):
 
 def test_generate_writes_cli_files(tmp_path):
     cfg = {"scenario": {"generator": "line_lab", "seed": 1}, "calibration": {"row": 1000}}
-    paths = LL.generate(cfg, tmp_path)
+    paths = generate(cfg, tmp_path)
     assert [p.name for p in paths] == ["line_lab_observations.csv", "line_lab_control.csv",
                                        "line_lab_truth.csv"]
     assert paths[0].read_text().splitlines()[0] == "image,point,zeta_px"

@@ -6,10 +6,10 @@ import pytest
 from hsgeo import InputError
 from hsgeo.adjust import adjust, identifiability
 from hsgeo.adjust.checks import analytic_jacobian, check_jacobian
-from hsgeo.pushbroom_ba import CameraPrior, build_problem
 from hsgeo.sensors.pushbroom import PushbroomLines
 from hsgeo.simulate.pushbroom_campaign import simulate
 from hsgeo.stats import nmad
+from hsgeo.workflows.pushbroom_ba import CameraPrior, build_problem
 
 
 def _problem(camp, with_gcp=True, node_interval_s=10.0, y_as_time=False):

@@ -10,18 +10,18 @@ from hsgeo.adjust.checks import check_jacobian
 from hsgeo.errors import InputError, ObservationError
 from hsgeo.measure.aruco import detect_targets, detection_rate, make_detector, to_uint8
 from hsgeo.papers import RIKOLA_BANDS, RIKOLA_TABLE4_ROP_DEG, RIKOLA_TABLE4_ROP_MEAN_DEG
-from hsgeo.rikola import (
-    calibrate_band,
-    calibrate_joint,
-    gap_regression,
-    observe,
-    relative_orientation,
-)
+from hsgeo.reproduce.rikola import observe
 from hsgeo.rotations import R_from_opk, opk_from_R
 from hsgeo.sensors.frame import FramePhotogrammetric
 from hsgeo.sensors.rikola import JointCentroids, TargetCentroids, project_measured_mm
 from hsgeo.simulate.rikola import Plate, Renderer, make_truth
 from hsgeo.simulate.scenarios import load_scenario
+from hsgeo.workflows.rikola import (
+    calibrate_band,
+    calibrate_joint,
+    gap_regression,
+    relative_orientation,
+)
 
 
 @pytest.fixture(scope="module")
@@ -194,7 +194,7 @@ def test_joint_model_recovers_truth(bench, truth):
 
 
 def test_design_effect_recovers_cluster_correlation():
-    from hsgeo.rikola import design_effect
+    from hsgeo.workflows.rikola import design_effect
 
     rng = np.random.default_rng(1)
     cl = np.repeat(np.arange(4000), 6)

@@ -26,7 +26,7 @@ def _cmd_calibrate_line(args) -> int:
 
     import numpy as np
 
-    from hsgeo.sensors.line1d import calibrate_files
+    from hsgeo.workflows.line_calibration import calibrate_files
 
     out = calibrate_files(args.observations, args.control, zeta0_px=args.zeta0_px,
                           c_px=args.c_px, sigma_px=args.sigma_px, reject_k=args.reject_k)
@@ -46,7 +46,7 @@ def _cmd_calibrate_line(args) -> int:
         print(f"residuals: RMS {stats['rms_px']:.4f} px, max |v| {stats['max_abs_px']:.4f} px "
               f"over {stats['n_observations']} observations")
 def _cmd_calibrate_frame(args) -> int:
-    from hsgeo.rikola import calibrate_frame_files
+    from hsgeo.workflows.rikola import calibrate_frame_files
 
     out = calibrate_frame_files(args.images, args.board, joint=args.joint,
                                 band_regex=args.band_regex, cube_regex=args.cube_regex,
@@ -57,7 +57,7 @@ def _cmd_calibrate_frame(args) -> int:
 
 
 def _cmd_data(args) -> int:
-    from hsgeo.simulate.scenarios import generate_all
+    from hsgeo.reproduce.data import generate_all
 
     return generate_all(verify=args.verify, update=args.update_manifest)
 
@@ -65,7 +65,7 @@ def _cmd_data(args) -> int:
 def _cmd_adjust_pushbroom(args) -> int:
     import json
 
-    from hsgeo.pushbroom_ba import adjust_files
+    from hsgeo.workflows.pushbroom_ba import adjust_files
 
     out = adjust_files(args.observations, args.trajectory, args.camera, args.gcp,
                        node_interval_s=args.node_interval, progress=True,
@@ -83,7 +83,7 @@ def _cmd_versions(args) -> int:
 
 
 def _cmd_geocode(args) -> int:
-    from hsgeo.geocode import geocode_files
+    from hsgeo.workflows.geocoding import geocode_files
 
     ortho, paths = geocode_files(args.lines, args.trajectory, args.sensor, output=args.output,
                                  dem=args.dem, height_m=args.height, resolution_m=args.resolution,
@@ -179,7 +179,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="bundle-adjust LP lines with spline trajectory corrections (002 eq. 2-4)",
         description="Observation table: point_id, band, t_s, x_px, y_px; trajectory: t_s, E_m, "
         "N_m, H_m, roll_rad, pitch_rad, yaw_rad; GCPs: point_id, E_m, N_m, H_m (CSV or "
-        "Parquet); camera TOML: see hsgeo.pushbroom_ba.adjust_files.")
+        "Parquet); camera TOML: see hsgeo.workflows.pushbroom_ba.adjust_files.")
     p.add_argument("observations", help="observation table (CSV or Parquet)")
     p.add_argument("--trajectory", required=True, help="GNSS/INS trajectory table")
     p.add_argument("--camera", required=True, help="camera and prior σ (TOML)")

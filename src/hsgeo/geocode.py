@@ -44,7 +44,6 @@ __all__ = [
     "read_sensor_toml",
     "read_lines",
     "write_lines",
-    "geocode_files",
 ]
 
 #: the fixed rotation between the north-east-down and east-north-up frames (its own inverse)
@@ -501,34 +500,6 @@ def read_lines(path):
     attrs = {**ds.attrs, **da.attrs}
     return (da.transpose("band", "line", "pixel").load(), float(attrs["t0_s"]),
             float(attrs["line_rate_hz"]))
-
-
-def geocode_files(lines, trajectory, sensor, *, output, dem=None, height_m=None,
-                  resolution_m=0.5, envi=None, progress=True):
-    """Orthorectify a recorded flight line from files (see ``hsgeo geocode --help``)."""
-    import xarray as xr
-
-    from hsgeo.navigation import Navigation
-
-    if (dem is None) == (height_m is None):
-        raise InputError("give exactly one of --dem DEM.nc or --height H (a plane)")
-    da, t0, rate = read_lines(lines)
-    nav = Navigation.read_csv(trajectory)
-    geom, bs = read_sensor_toml(sensor)
-    if dem is not None:
-        ds = xr.open_dataset(dem)
-        if "height" not in ds:
-            raise InputError(f"{dem}: no variable 'height' (dimensions N, E in metres)")
-        terrain = DemTerrain(ds["height"])
-    else:
-        terrain = PlaneTerrain(float(height_m))
-    ground = geocode_image(nav, geom, da.sizes["line"], da["pixel"].values, t0_s=t0,
-                           line_rate_hz=rate, terrain=terrain, boresight_rad=bs,
-                           progress=progress)
-    ortho = orthorectify(da.values, ground, resolution_m=resolution_m,
-                         band_names=da["band"].values,
-                         attrs={"source": str(lines), "sensor": str(sensor)})
-    return ortho, to_map_files(ortho, output, envi)
 
 
 def write_lines(path, radiance, zeta_px, *, t0_s: float, line_rate_hz: float, wavelength_nm=None):

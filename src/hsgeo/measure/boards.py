@@ -96,7 +96,7 @@ def _number(pattern: str | None, name: str, default: int) -> int:
 
 def observe_files(paths, board: Board, *, band_regex: str | None = None,
                   cube_regex: str | None = None, refine: str = "subpix"):
-    """Detect the board in image files and return :class:`hsgeo.rikola.Observations`.
+    """Detect the board in image files and return :class:`hsgeo.workflows.rikola.Observations`.
 
     Parameters
     ----------
@@ -109,7 +109,7 @@ def observe_files(paths, board: Board, *, band_regex: str | None = None,
     import cv2
 
     from hsgeo.measure.aruco import detect_targets, make_detector
-    from hsgeo.rikola import Observations
+    from hsgeo.measure.targets import Observations
 
     paths = [Path(p) for p in paths]
     if not paths:

@@ -16,10 +16,10 @@ from importlib import resources
 
 import numpy as np
 
-from hsgeo.calibration import View, calibrate_opencv, calibrate_photogrammetric
 from hsgeo.io import read_opencv_storage
 from hsgeo.measure.charuco import CharucoBoardSpec, detect_charuco
-from hsgeo.reproduce import Reproduction, Row
+from hsgeo.report import Reproduction, Row
+from hsgeo.workflows.frame_calibration import View, calibrate_opencv, calibrate_photogrammetric
 
 __all__ = ["run", "chessboard_views", "charuco_views", "reference_dir", "PIXEL_PITCH_MM"]
 

@@ -15,7 +15,7 @@ import numpy as np
 from hsgeo.gcp import deviation_table, recompute_printed_table
 from hsgeo.geocode import CalibratedLine
 from hsgeo.papers import P000_GCP_FOOTERS
-from hsgeo.reproduce import Reproduction, Row
+from hsgeo.report import Reproduction, Row
 from hsgeo.simulate.pula_flight import gcp_deviations, nominal_sensor, simulate_flight
 from hsgeo.simulate.scenarios import load_scenario
 from hsgeo.stats import nmad

@@ -9,6 +9,8 @@ distortion) and the nominal bench stations.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from hsgeo.adjust import adjust
@@ -18,14 +20,39 @@ from hsgeo.papers import (
     P001_DISTORTION_STATEMENTS,
     P001_TABLE2,
 )
-from hsgeo.reproduce import Reproduction, Row
+from hsgeo.report import Reproduction, Row
 from hsgeo.sensors import line1d
 from hsgeo.simulate import as_rng
-from hsgeo.simulate.line_lab import LineLab, pattern_points, simulate_observations, stations
+from hsgeo.simulate.line_lab import LineLab, pattern_points, record, stations
+from hsgeo.workflows.line_calibration import calibrate, observe_rows
 
-__all__ = ["run", "calibrate_simulated", "design_sigma_c", "monte_carlo", "IOP_NAMES"]
+__all__ = [
+    "run",
+    "simulate_observations",
+    "generate",
+    "calibrate_simulated",
+    "design_sigma_c",
+    "monte_carlo",
+    "IOP_NAMES",
+]
 
 IOP_NAMES = ("zeta0_px", "c_px", "K1", "K2", "K3")
+
+
+def simulate_observations(lab: LineLab, row: int, rng, eop_true=None, method: str = "parabola"):
+    """One calibration experiment for one spectral row: render (:func:`~hsgeo.simulate.line_lab.
+    record`), then measure as a user would (:func:`~hsgeo.workflows.line_calibration.observe_rows`).
+
+    Returns
+    -------
+    dict with ``eop_true`` (n_img, 3), ``iop_true`` (dict), ``image``, ``point``, ``zeta_px``
+    (observations), ``xy_m`` (control points), ``point_ids``, ``frames`` (raw rows per image).
+    """
+    rec, truth = record(lab, row, rng, eop_true)
+    img, pt, z = observe_rows(rec.frames_dn, rec.xy_m, offset_dn=lab.offset_dn,
+                              n_columns=lab.n_reflected, method=method, row=row)
+    return {"eop_true": truth.eop, "iop_true": truth.iop, "image": img, "point": pt,
+            "zeta_px": z, "xy_m": rec.xy_m, "point_ids": rec.point_ids, "frames": rec.frames_dn}
 
 
 def calibrate_simulated(lab: LineLab, row: int, rng, method: str = "parabola"):
@@ -37,7 +64,7 @@ def calibrate_simulated(lab: LineLab, row: int, rng, method: str = "parabola"):
     p = line1d.make_parameters(stations(lab), u.zeta0_px, u.c_px, [0.0, 0.0, 0.0], xy,
                                np.ones(len(xy), bool), point_ids=sim["point_ids"])
     blk = line1d.LineObservations(sim["image"], sim["point"], sim["zeta_px"], lab.zeta_sigma_px)
-    return line1d.calibrate(p, blk), sim
+    return calibrate(p, blk), sim
 
 
 def _iop(res):
@@ -165,3 +192,35 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
             "sigma0": {str(r): results[r].sigma0 for r in lab.rows}}
     return Reproduction("line-calibration", seed, rows, meta,
                         extras={"lab": lab, "results": results, "sims": sims, "mc": mc})
+
+
+def generate(cfg: dict, outdir: Path) -> list[Path]:
+    """``make data`` (generator ``line_lab``): observations and control points of one
+    calibration (row 1000), as CSV in
+    the formats ``hsgeo calibrate-line`` reads, and the truth.
+    """
+    lab = LineLab.from_config(cfg.get("lab"))
+    row = int(cfg.get("calibration", {}).get("row", 1000))
+    sim = simulate_observations(lab, row, int(cfg["scenario"]["seed"]))
+    ids = sim["point_ids"]
+    obs = outdir / "line_lab_observations.csv"
+    with obs.open("w") as fh:
+        fh.write("image,point,zeta_px\n")
+        for i, p, z in zip(sim["image"], sim["point"], sim["zeta_px"], strict=True):
+            fh.write(f"img{i},{ids[p]},{z:.17g}\n")
+    ctl = outdir / "line_lab_control.csv"
+    with ctl.open("w") as fh:
+        fh.write("point,x_m,y_m\n")
+        for pid, (x, y) in zip(ids, sim["xy_m"], strict=True):
+            fh.write(f"{pid},{x:.17g},{y:.17g}\n")
+    tru = outdir / "line_lab_truth.csv"
+    with tru.open("w") as fh:
+        fh.write("quantity,value\n")
+        t = sim["iop_true"]
+        for k, v in [("zeta0_px", t["zeta0_px"]), ("c_px", t["c_px"]), ("K1", t["K"][0]),
+                     ("K2", t["K"][1]), ("K3", t["K"][2])]:
+            fh.write(f"{k},{float(v):.17g}\n")
+        for i, e in enumerate(sim["eop_true"]):
+            for k, v in zip(line1d.EOP_COLUMNS, e, strict=True):
+                fh.write(f"img{i}.{k},{v:.17g}\n")
+    return [obs, ctl, tru]

@@ -13,10 +13,10 @@ import time
 import numpy as np
 
 from hsgeo.adjust import adjust, identifiability
-from hsgeo.pushbroom_ba import CameraPrior, build_problem
-from hsgeo.reproduce import Reproduction, Row
+from hsgeo.report import Reproduction, Row
 from hsgeo.simulate.pushbroom_campaign import Campaign, simulate
 from hsgeo.stats import describe
+from hsgeo.workflows.pushbroom_ba import CameraPrior, build_problem
 
 __all__ = ["run", "adjust_campaign", "node_interval_study", "y_model_comparison", "PAPER"]
 
@@ -46,7 +46,8 @@ REJECT_K = 5.0
 #: Relative cost decrease at which the iteration stops: at full size 1e-6 of the cost is
 #: ≈ 0.3, below half a unit of χ², i.e. far below any statistical effect.
 FTOL = 1e-6
-#: Model the residual across the line as a time (see hsgeo.pushbroom_ba.build_problem): with
+#: Model the residual across the line as a time (see
+#: hsgeo.workflows.pushbroom_ba.build_problem): with
 #: the image y of 002 eq. (2) the principal distance and the pitch corrections are biased (the
 #: chapter shows by how much).
 Y_AS_TIME = True

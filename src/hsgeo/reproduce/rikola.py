@@ -10,6 +10,8 @@ import time
 
 import numpy as np
 
+from hsgeo.adjust import identifiability
+from hsgeo.measure.targets import Observations
 from hsgeo.papers import (
     RIKOLA_BANDS,
     RIKOLA_TABLE3,
@@ -17,24 +19,109 @@ from hsgeo.papers import (
     RIKOLA_TABLE4_GAP_MODEL,
     RIKOLA_TABLE4_ROP_MEAN_DEG,
 )
-from hsgeo.reproduce import Reproduction, Row
-from hsgeo.rikola import (
+from hsgeo.report import Reproduction, Row
+from hsgeo.sensors.frame import mm_to_pixel
+from hsgeo.workflows.rikola import (
     TargetCentroids,
+    band_problem,
     calibrate_band,
     calibrate_joint,
     design_effect,
+    detect_targets_in_images,
     gap_regression,
-    observe,
     predict_band,
     relative_orientation,
 )
 
-__all__ = ["run", "setup"]
+__all__ = ["run", "setup", "observe", "corner_bias", "band_identifiability"]
 
 SMALL_BANDS = (1, 2, 5, 8, 10, 11, 12, 15, 16, 20)
 HELD_OUT = (8, 16)  # one band of each sensor, inside the gap range
 TABLE3_BANDS = (5, 20)  # 003 Table 3
 ROP_CUBE = 0  # 003 Table 4 (first) uses the bands of one cube
+
+
+def observe(cfg: dict, truth, seed: int, cubes, bands, *, refine: str = "subpix",
+            compare_refine: str | None = None, keep_images=()):
+    """Render the bands of the cubes and measure them as a user would (the experiment of 003 §3.2).
+
+    The images are rendered one at a time (:class:`hsgeo.simulate.rikola.Renderer`) and measured
+    by the truth-free :func:`hsgeo.workflows.rikola.detect_targets_in_images`; the truth only
+    counts the targets fully in view, for the detection rate.
+
+    Returns
+    -------
+    Observations (with ``expected``), Observations or None (``compare_refine``), and a dict
+    ``(cube, band) -> image`` of ``keep_images``.
+    """
+    from dataclasses import replace
+
+    from hsgeo.simulate.rikola import Renderer
+
+    r = Renderer(cfg, truth)
+    plate = r.plate
+    cam = cfg["camera"]
+    size = (int(cam["width_px"]), int(cam["height_px"]))
+    obj = plate.corners()
+    expected, images = {}, {}
+    keep = set(map(tuple, keep_images))
+
+    def rendered():
+        for c in cubes:
+            for b in bands:
+                img = r.render(c, b, seed)
+                if (c, b) in keep:
+                    images[(c, b)] = img
+                true_px = mm_to_pixel(truth.project(c, b, obj), size, cam["pixel_mm"])
+                inside = np.all((true_px > 2) & (true_px < np.array(size) - 3), axis=(1, 2))
+                expected[(c, b)] = int(inside.sum())
+                yield (c, b), img
+
+    obs, obs_cmp = detect_targets_in_images(
+        rendered(), obj, plate.ids, size, float(cam["pixel_mm"]), dictionary=plate.dictionary,
+        refine=refine, compare_refine=compare_refine)
+    obs = replace(obs, expected=expected)
+    if obs_cmp is not None:
+        obs_cmp = replace(obs_cmp, expected=expected)
+    return obs, obs_cmp, images
+
+
+def band_identifiability(obs: Observations, band: int, truth) -> object:
+    """Rank of the per-band design at the truth (:func:`hsgeo.adjust.identifiability`)."""
+    p, blk, cubes = band_problem(obs, band, 9.0, 0.02)
+    p.set("interior", truth.interior(band))
+    p.set("distortion_mm", truth.KP)
+    p.set("poses", np.array([truth.band_pose(int(c), band) for c in cubes]))
+    return identifiability(p, blk)
+
+
+def corner_bias(obs: Observations, truth) -> dict[int, dict[str, float]]:
+    """Corner displacement with exposure (003 §3.2), per band, against the simulated truth.
+
+    Returns
+    -------
+    dict band -> ``outward_px`` (mean displacement of the detected corners away from the
+    target's centre; negative: the target looks smaller), ``scale`` (mean ratio of detected to
+    true side length, the paper's scale factor), ``centroid_mean_px`` (x, y) and
+    ``centroid_sd_px`` (x, y) of the centroid error.
+    """
+    out = {}
+    for b in np.unique(obs.band):
+        o = obs.select(obs.band == b)
+        true = np.stack([mm_to_pixel(truth.project(int(c), int(b), X), obs.image_size,
+                                     obs.pixel_mm) for c, X in zip(o.cube, o.corners_obj,
+                                                                   strict=True)])
+        e = o.corners_px - true
+        centre = true.mean(axis=1, keepdims=True)
+        u = true - centre
+        u /= np.linalg.norm(u, axis=-1, keepdims=True)
+        side = lambda c: np.linalg.norm(np.roll(c, -1, axis=1) - c, axis=-1)  # noqa: E731
+        ce = o.centroids_px - true.mean(axis=1)
+        out[int(b)] = {"outward_px": float(np.mean(np.sum(e * u, axis=-1))),
+                       "scale": float(np.mean(side(o.corners_px) / side(true))),
+                       "centroid_mean_px": ce.mean(axis=0).tolist(),
+                       "centroid_sd_px": ce.std(axis=0).tolist()}
+    return out
 
 
 def setup(seed: int = 0, scale: float = 1.0):
@@ -99,7 +186,8 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
         var += np.diag(_rop_mean_covariance(cals[k1], cals[k2], cubes))
     rop_mean_sigma = np.sqrt(var) / len(pairs)
     # ... and the pairs share part of their error: a target's centroid error is partly common
-    # to all bands of a sensor (hsgeo.rikola.design_effect); its intra-cluster correlation,
+    # to all bands of a sensor (hsgeo.workflows.rikola.design_effect); its intra-cluster
+    # correlation,
     # from the per-band residuals grouped by cube, target and sensor, gives the design effect
     # of a mean over the pairs
     res_pb = np.concatenate([c.residuals_px for c in cals.values()])

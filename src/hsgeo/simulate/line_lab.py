@@ -22,20 +22,18 @@ and line width (1.5 mm), the PSF width, the radiometry, the station scatter.
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from pathlib import Path
 
 import numpy as np
 from scipy.interpolate import PchipInterpolator
 from scipy.ndimage import gaussian_filter1d
 
 from hsgeo.errors import InputError
-from hsgeo.measure.line_minima import associate_by_order, find_minima
 from hsgeo.papers import P000_TABLE1_CALIBRATED, P001_SENSOR, P001_TABLE2
 from hsgeo.sensors import line1d
 from hsgeo.simulate import as_rng
 
 __all__ = ["LineLab", "true_iop", "wavelength_nm", "stations", "pattern_points", "render_rows",
-           "render_frame", "measure_row", "simulate_observations", "generate"]
+           "render_frame", "LabRecording", "LabTruth", "record"]
 
 
 @dataclass(frozen=True)
@@ -209,73 +207,50 @@ def render_frame(lab: LineLab, eop, rng, supersample: int = 4) -> np.ndarray:
     return render_rows(replace(lab, supersample=supersample), eop, np.arange(lab.n_rows), rng)
 
 
-def measure_row(lab: LineLab, dn_row, what: str = "row", method: str = "parabola"):
-    """Measured ζ of the pattern points on one raw row, associated by their order.
+@dataclass(frozen=True)
+class LabRecording:
+    """What the bench records and the operator knows: raw rows and the surveyed control points.
 
-    Returns
-    -------
-    point_index : (k,) int ndarray (into :func:`pattern_points`), zeta_px : (k,) ndarray
+    Attributes
+    ----------
+    row : int
+        The spectral row (001 Table 2).
+    frames_dn : (n_images, n_columns) uint16 ndarray
+        The raw row of each station's frame.
+    xy_m : (n_points, 2) ndarray
+        Control-point coordinates in the scanner plane (surveyed).
+    point_ids : list of str
     """
-    prof = np.asarray(dn_row, dtype=float)[: lab.n_reflected] - lab.offset_dn
-    z, _ = find_minima(prof, method=method)
-    pts, _ = pattern_points(lab)
-    # ζ grows as x decreases (eq. 2: ζ − ζ0 ∝ −X): order the points by descending x
-    order = np.argsort(-pts[:, 0], kind="stable")
-    return associate_by_order(z, order, what)
+
+    row: int
+    frames_dn: np.ndarray
+    xy_m: np.ndarray
+    point_ids: list
 
 
-def simulate_observations(lab: LineLab, row: int, rng, eop_true=None, method: str = "parabola"):
-    """One calibration experiment for one spectral row: render, measure, associate.
+@dataclass(frozen=True)
+class LabTruth:
+    """The simulation's truth: station orientations ``(n_images, 3)`` and the row's IOP."""
 
-    Returns
-    -------
-    dict with ``eop_true`` (n_img, 3), ``iop_true`` (dict), ``image``, ``point``, ``zeta_px``
-    (observations), ``xy_m`` (control points), ``point_ids``, ``frames`` (raw rows per image).
+    eop: np.ndarray
+    iop: dict
+
+
+def record(lab: LineLab, row: int, rng, eop_true=None) -> tuple[LabRecording, LabTruth]:
+    """Render one spectral row from every station: ``(recording, truth)``.
+
+    Parameters
+    ----------
+    lab : LineLab
+    row : int
+    rng : int or numpy.random.Generator
+    eop_true : (n_images, 3) array_like, optional
+        Station orientations (default: :func:`stations` drawn from ``rng``).
     """
     rng = as_rng(rng)
     eop_true = stations(lab, rng) if eop_true is None else np.asarray(eop_true, dtype=float)
     iop = true_iop(row)
-    img, pt, zz, frames = [], [], [], []
-    for i, e in enumerate(eop_true):
-        dn = render_rows(lab, e, [row], rng)[0]
-        frames.append(dn)
-        p, z = measure_row(lab, dn, f"image {i}, row {row}", method)
-        img.append(np.full(p.size, i))
-        pt.append(p)
-        zz.append(z)
+    frames = np.array([render_rows(lab, e, [row], rng)[0] for e in eop_true])
     xy, ids = pattern_points(lab)
-    return {"eop_true": eop_true, "iop_true": {k: np.asarray(v) for k, v in iop.items()},
-            "image": np.concatenate(img), "point": np.concatenate(pt),
-            "zeta_px": np.concatenate(zz), "xy_m": xy, "point_ids": ids,
-            "frames": np.array(frames)}
-
-
-def generate(cfg: dict, outdir: Path) -> list[Path]:
-    """``make data``: observations and control points of one calibration (row 1000), as CSV in
-    the formats ``hsgeo calibrate-line`` reads, and the truth.
-    """
-    lab = LineLab.from_config(cfg.get("lab"))
-    row = int(cfg.get("calibration", {}).get("row", 1000))
-    sim = simulate_observations(lab, row, int(cfg["scenario"]["seed"]))
-    ids = sim["point_ids"]
-    obs = outdir / "line_lab_observations.csv"
-    with obs.open("w") as fh:
-        fh.write("image,point,zeta_px\n")
-        for i, p, z in zip(sim["image"], sim["point"], sim["zeta_px"], strict=True):
-            fh.write(f"img{i},{ids[p]},{z:.17g}\n")
-    ctl = outdir / "line_lab_control.csv"
-    with ctl.open("w") as fh:
-        fh.write("point,x_m,y_m\n")
-        for pid, (x, y) in zip(ids, sim["xy_m"], strict=True):
-            fh.write(f"{pid},{x:.17g},{y:.17g}\n")
-    tru = outdir / "line_lab_truth.csv"
-    with tru.open("w") as fh:
-        fh.write("quantity,value\n")
-        t = sim["iop_true"]
-        for k, v in [("zeta0_px", t["zeta0_px"]), ("c_px", t["c_px"]), ("K1", t["K"][0]),
-                     ("K2", t["K"][1]), ("K3", t["K"][2])]:
-            fh.write(f"{k},{float(v):.17g}\n")
-        for i, e in enumerate(sim["eop_true"]):
-            for k, v in zip(line1d.EOP_COLUMNS, e, strict=True):
-                fh.write(f"img{i}.{k},{v:.17g}\n")
-    return [obs, ctl, tru]
+    truth = LabTruth(eop_true, {k: np.asarray(v) for k, v in iop.items()})
+    return LabRecording(int(row), frames, xy, ids), truth

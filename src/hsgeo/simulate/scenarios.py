@@ -1,23 +1,17 @@
-"""``make data``: generate ``data_synthetic/generated/`` from the scenario TOMLs, bit for bit.
+"""The scenarios of ``data_synthetic/*.toml``: where they are and how to load them.
 
-Each ``data_synthetic/<name>.toml`` has a ``[scenario]`` table with ``generator`` (a module under
-``hsgeo.simulate`` with a ``generate(config: dict, outdir: Path) -> list[Path]`` function) and
-``seed``; the rest of the file is the scenario's configuration, every value citing its source.
-The SHA-256 of every generated file is listed in ``data_synthetic/MANIFEST.sha256``; ``--verify``
-fails when a file differs, which shows a reader that the data are reproducible bit for bit.
-Generated files are text (CSV with ``%.17g``) so that they are byte-identical across runs.
+Each ``data_synthetic/<name>.toml`` has a ``[scenario]`` table with ``generator`` (see
+:mod:`hsgeo.reproduce.data`, which writes ``data_synthetic/generated/``) and ``seed``; the rest of
+the file is the scenario's configuration, every value citing its source.
 """
 
 from __future__ import annotations
 
-import hashlib
-import importlib
-import sys
 from pathlib import Path
 
 from hsgeo.errors import InputError
 
-__all__ = ["data_dir", "load_scenario", "generate_all"]
+__all__ = ["data_dir", "load_scenario"]
 
 
 def data_dir() -> Path:
@@ -41,38 +35,3 @@ def load_scenario(name: str) -> dict:
     if "scenario" not in cfg or "generator" not in cfg["scenario"]:
         raise InputError(f"{path}: missing [scenario] table with a 'generator' entry")
     return cfg
-
-
-def _sha256(path: Path) -> str:
-    return hashlib.sha256(path.read_bytes()).hexdigest()
-
-
-def generate_all(verify: bool = False, update: bool = False) -> int:
-    """Generate every scenario; compare with (or rewrite) the manifest. Returns an exit status."""
-    ddir = data_dir()
-    out = ddir / "generated"
-    out.mkdir(exist_ok=True)
-    sums: dict[str, str] = {}
-    for toml in sorted(ddir.glob("*.toml")):
-        cfg = load_scenario(toml.stem)
-        mod = importlib.import_module(f"hsgeo.simulate.{cfg['scenario']['generator']}")
-        for path in mod.generate(cfg, out):
-            sums[str(path.relative_to(ddir))] = _sha256(path)
-            print(f"  generated {path.relative_to(ddir.parent)}", file=sys.stderr)
-    manifest = ddir / "MANIFEST.sha256"
-    text = "".join(f"{h}  {p}\n" for p, h in sorted(sums.items()))
-    if update or not manifest.exists():
-        manifest.write_text(text)
-        print(f"wrote {manifest} ({len(sums)} files)", file=sys.stderr)
-        return 0
-    expected = {}
-    for line in manifest.read_text().splitlines():
-        h, p = line.split(maxsplit=1)
-        expected[p] = h
-    bad = [p for p in sorted(set(expected) | set(sums)) if expected.get(p) != sums.get(p)]
-    if bad:
-        print("data_synthetic: generated files differ from MANIFEST.sha256: " + ", ".join(bad)
-              + "\n  (if the change is deliberate: hsgeo data --update-manifest)", file=sys.stderr)
-        return 1 if verify else 0
-    print(f"data_synthetic: {len(sums)} files match MANIFEST.sha256", file=sys.stderr)
-    return 0

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from hsgeo.adjust import AdjustmentResult, Parameters, adjust, identifiability
+from hsgeo.adjust import AdjustmentResult, Parameters, adjust
 from hsgeo.errors import InputError, ObservationError
 from hsgeo.papers import RIKOLA_BANDS
 from hsgeo.rotations import R_from_opk, R_from_rotvec, opk_from_R
@@ -30,8 +30,6 @@ from hsgeo.sensors.frame import (
     PHOTOGRAMMETRIC_DISTORTION,
     PHOTOGRAMMETRIC_INTERIOR,
     POSE_COLUMNS,
-    mm_to_pixel,
-    pixel_to_mm,
 )
 from hsgeo.sensors.rikola import (
     GAP_MODEL_COLUMNS,
@@ -43,10 +41,11 @@ from hsgeo.sensors.rikola import (
 
 __all__ = [
     "Observations",
-    "observe",
+    "detect_targets_in_images",
     "initial_poses",
     "BandCalibration",
     "calibrate_band",
+    "band_problem",
     "initial_focal_mm",
     "relative_orientation",
     "gap_regression",
@@ -59,113 +58,62 @@ __all__ = [
 _FLIP = np.diag([1.0, -1.0, -1.0])  # OpenCV camera frame <-> photogrammetric camera frame
 
 
-@dataclass
-class Observations:
-    """Target observations of a set of cubes and bands (one row per target and image).
-
-    Attributes
-    ----------
-    cube, band, target : (n,) int ndarrays
-        Cube index, band number (1–25) and target id.
-    corners_px : (n, 4, 2) ndarray
-        Detected corners (OpenCV pixel convention).
-    corners_obj : (n, 4, 3) ndarray
-        Object coordinates of the corners.
-    image_size : (int, int)
-    pixel_mm : float
-    expected : dict
-        ``(cube, band) -> number of targets fully in view`` (for the detection rate), if known.
-    """
-
-    cube: np.ndarray
-    band: np.ndarray
-    target: np.ndarray
-    corners_px: np.ndarray
-    corners_obj: np.ndarray
-    image_size: tuple[int, int]
-    pixel_mm: float
-    expected: dict = field(default_factory=dict)
-
-    @property
-    def centroids_px(self) -> np.ndarray:
-        return self.corners_px.mean(axis=1)
-
-    @property
-    def centroids_mm(self) -> np.ndarray:
-        return pixel_to_mm(self.centroids_px, self.image_size, self.pixel_mm)
-
-    def select(self, mask) -> Observations:
-        m = np.asarray(mask, bool)
-        return Observations(self.cube[m], self.band[m], self.target[m], self.corners_px[m],
-                            self.corners_obj[m], self.image_size, self.pixel_mm, self.expected)
-
-    @property
-    def detection_rate(self) -> float:
-        if not self.expected:
-            return float("nan")
-        return len(self.cube) / max(1, sum(self.expected.values()))
+from hsgeo.measure.targets import Observations  # noqa: E402  (re-exported)
 
 
-def observe(cfg: dict, truth, seed: int, cubes, bands, *, refine: str = "subpix",
-            compare_refine: str | None = None, keep_images=()):
-    """Render the bands of the cubes and detect the ArUco targets.
+def detect_targets_in_images(images, corners_obj, target_ids, image_size, pixel_mm: float, *,
+                             dictionary: str = "DICT_4X4_100", refine: str = "subpix",
+                             compare_refine: str | None = None):
+    """Detect the ArUco targets of a plate in a sequence of images (003 §3.2).
+
+    Each target keeps its four corners and their centroid (the virtual point of 003 §3.2).
 
     Parameters
     ----------
-    cfg : dict
-        Scenario (``data_synthetic/rikola_bench.toml``).
-    truth : hsgeo.simulate.rikola.RikolaTruth
-    seed : int
-        Seed of the image noise.
-    cubes, bands : sequences of int
-    refine : str
-        ArUco corner refinement (:func:`hsgeo.measure.aruco.make_detector`).
+    images : iterable of ((cube, band), image)
+        The images in the order they are to be measured; ``image`` is ``(rows, cols)``, any
+        dtype (:func:`hsgeo.measure.aruco.to_uint8` scales it). A generator keeps only one image
+        in memory at a time.
+    corners_obj : (n_targets, 4, 3) ndarray
+        Object coordinates of each target's corners, indexed by target id.
+    target_ids : (k,) int array_like
+        The ids on the plate (detections of other ids are dropped).
+    image_size : (int, int)
+        Width and height in pixels.
+    pixel_mm : float
+        Pixel pitch.
+    dictionary, refine : str
+        ArUco dictionary and corner refinement (:func:`hsgeo.measure.aruco.make_detector`).
     compare_refine : str, optional
         A second refinement run on the same images (for the corner-bias comparison of §3.2).
-    keep_images : collection of (cube, band)
-        Images to return (for figures).
 
     Returns
     -------
-    Observations, Observations or None (``compare_refine``), dict of (cube, band) -> image
+    Observations, and Observations or None (``compare_refine``)
     """
     from hsgeo.measure.aruco import detect_targets, make_detector, to_uint8
-    from hsgeo.simulate.rikola import Renderer
 
-    r = Renderer(cfg, truth)
-    plate = r.plate
-    dets = [make_detector(plate.dictionary, refine=refine)]
+    dets = [make_detector(dictionary, refine=refine)]
     if compare_refine is not None:
-        dets.append(make_detector(plate.dictionary, refine=compare_refine))
-    cam = cfg["camera"]
-    size = (int(cam["width_px"]), int(cam["height_px"]))
-    obj = plate.corners()
+        dets.append(make_detector(dictionary, refine=compare_refine))
+    size = (int(image_size[0]), int(image_size[1]))
     rows = [{k: [] for k in ("cube", "band", "target", "corners")} for _ in dets]
-    expected, images = {}, {}
-    keep = set(map(tuple, keep_images))
-    for c in cubes:
-        for b in bands:
-            img = r.render(c, b, seed)
-            if (c, b) in keep:
-                images[(c, b)] = img
-            img8 = to_uint8(img)
-            true_px = mm_to_pixel(truth.project(c, b, obj), size, cam["pixel_mm"])
-            inside = np.all((true_px > 2) & (true_px < np.array(size) - 3), axis=(1, 2))
-            expected[(c, b)] = int(inside.sum())
-            for det, rw in zip(dets, rows, strict=True):
-                d = detect_targets(img8, det, valid_ids=plate.ids)
-                rw["cube"].append(np.full(len(d), c))
-                rw["band"].append(np.full(len(d), b))
-                rw["target"].append(d.ids)
-                rw["corners"].append(d.corners_px)
+    for (c, b), img in images:
+        img8 = to_uint8(img)
+        for det, rw in zip(dets, rows, strict=True):
+            d = detect_targets(img8, det, valid_ids=target_ids)
+            rw["cube"].append(np.full(len(d), c))
+            rw["band"].append(np.full(len(d), b))
+            rw["target"].append(d.ids)
+            rw["corners"].append(d.corners_px)
     out = []
     for rw in rows:
         target = np.concatenate(rw["target"]).astype(np.int64)
         out.append(Observations(np.concatenate(rw["cube"]).astype(np.int64),
                                 np.concatenate(rw["band"]).astype(np.int64), target,
-                                np.concatenate(rw["corners"]), obj[target], size,
-                                float(cam["pixel_mm"]), expected))
-    return out[0], (out[1] if len(out) > 1 else None), images
+                                np.concatenate(rw["corners"]), corners_obj[target], size,
+                                float(pixel_mm)))
+    return out[0], (out[1] if len(out) > 1 else None)
 
 
 def initial_poses(obs: Observations, f_mm: float) -> dict[int, np.ndarray]:
@@ -249,7 +197,16 @@ class BandCalibration:
     block_pixel_mm: float = 0.0055
 
 
-def _band_problem(obs: Observations, band: int, f0_mm: float, sigma_px: float):
+def band_problem(obs: Observations, band: int, f0_mm: float, sigma_px: float):
+    """Parameters and residual block of one band's self-calibration (003 §3.3).
+
+    Returns
+    -------
+    params : Parameters
+    block : TargetCentroids
+    cubes : (k,) int ndarray
+        The cubes (views) of the band, in the order of the ``poses`` block.
+    """
     sel = obs.band == band
     if sel.sum() < 10:
         raise ObservationError(f"band {band}: only {sel.sum()} targets observed; need more cubes")
@@ -277,18 +234,9 @@ def calibrate_band(obs: Observations, band: int, *, f0_mm: float | None = 9.0,
     """
     if f0_mm is None:
         f0_mm = initial_focal_mm(obs.select(obs.band == band))
-    p, blk, cubes = _band_problem(obs, band, f0_mm, sigma_px)
+    p, blk, cubes = band_problem(obs, band, f0_mm, sigma_px)
     res = adjust(p, blk, reject_k=reject_k)
     return BandCalibration(band, cubes, res, blk, block_pixel_mm=obs.pixel_mm)
-
-
-def band_identifiability(obs: Observations, band: int, truth) -> object:
-    """Rank of the per-band design at the truth (:func:`hsgeo.adjust.identifiability`)."""
-    p, blk, cubes = _band_problem(obs, band, 9.0, 0.02)
-    p.set("interior", truth.interior(band))
-    p.set("distortion_mm", truth.KP)
-    p.set("poses", np.array([truth.band_pose(int(c), band) for c in cubes]))
-    return identifiability(p, blk)
 
 
 def relative_orientation(pose_1, pose_2, cov_1=None, cov_2=None, step: float = 1e-7):
@@ -520,35 +468,6 @@ def predict_band(joint: JointCalibration, obs: Observations, band: int) -> np.nd
     return r / obs.pixel_mm * np.array([1.0, -1.0])
 
 
-def corner_bias(obs: Observations, truth) -> dict[int, dict[str, float]]:
-    """Corner displacement with exposure (003 §3.2), per band, against the simulated truth.
-
-    Returns
-    -------
-    dict band -> ``outward_px`` (mean displacement of the detected corners away from the
-    target's centre; negative: the target looks smaller), ``scale`` (mean ratio of detected to
-    true side length, the paper's scale factor), ``centroid_mean_px`` (x, y) and
-    ``centroid_sd_px`` (x, y) of the centroid error.
-    """
-    out = {}
-    for b in np.unique(obs.band):
-        o = obs.select(obs.band == b)
-        true = np.stack([mm_to_pixel(truth.project(int(c), int(b), X), obs.image_size,
-                                     obs.pixel_mm) for c, X in zip(o.cube, o.corners_obj,
-                                                                   strict=True)])
-        e = o.corners_px - true
-        centre = true.mean(axis=1, keepdims=True)
-        u = true - centre
-        u /= np.linalg.norm(u, axis=-1, keepdims=True)
-        side = lambda c: np.linalg.norm(np.roll(c, -1, axis=1) - c, axis=-1)  # noqa: E731
-        ce = o.centroids_px - true.mean(axis=1)
-        out[int(b)] = {"outward_px": float(np.mean(np.sum(e * u, axis=-1))),
-                       "scale": float(np.mean(side(o.corners_px) / side(true))),
-                       "centroid_mean_px": ce.mean(axis=0).tolist(),
-                       "centroid_sd_px": ce.std(axis=0).tolist()}
-    return out
-
-
 def track_targets(obs: Observations, cube: int, ref_band: int) -> dict[str, tuple[int, dict]]:
     """Five targets of one cube — nearest the four image corners and the centre in a reference
     band — and their centroids (px) in every band (003 §3.2, Fig. 3–4).
@@ -603,7 +522,7 @@ def calibrate_frame_files(images, board_path, *, joint: bool = False, band_regex
         RMS residual and the number of points per band.
     """
     from hsgeo.measure.boards import load_board, observe_files
-    from hsgeo.reproduce import Reproduction, Row
+    from hsgeo.report import Reproduction, Row
 
     board = load_board(board_path)
     obs = observe_files(images, board, band_regex=band_regex, cube_regex=cube_regex)

@@ -1,0 +1,114 @@
+"""``hsgeo data`` / ``make data``: generate ``data_synthetic/generated/`` from the scenario TOMLs.
+
+Each scenario's ``[scenario] generator`` names a function ``generate(config: dict, outdir: Path)
+-> list[Path]`` (:data:`GENERATORS`): the simulators write what a sensor records, and where the
+files hold *measurements* (the line-scanner calibration's minima) the generator is the chapter's
+experiment, which renders and then measures as a user would. Generated files are text (CSV with
+``%.17g``).
+
+The SHA-256 of every generated file is listed in ``data_synthetic/MANIFEST.sha256``. With
+``--verify`` a file whose bytes differ fails unless every number in it agrees with the
+committed file to :data:`VERIFY_RTOL` relative: on another CPU the same seed can give results
+that differ in the last bit (a vectorised ``sin`` of another instruction set), which is the same
+data, and is reported as such; anything more is a difference.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib
+import shutil
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from hsgeo.simulate.scenarios import data_dir, load_scenario
+
+__all__ = ["GENERATORS", "VERIFY_RTOL", "generate_all"]
+
+#: scenario generator name -> module with its ``generate(config, outdir)`` function.
+GENERATORS = {
+    "frame_bench": "hsgeo.simulate.frame_bench",
+    "line_lab": "hsgeo.reproduce.line_calibration",
+    "pula_flight": "hsgeo.simulate.pula_flight",
+    "rikola": "hsgeo.simulate.rikola",
+}
+#: relative agreement of every number for a file whose bytes differ from the manifest's.
+VERIFY_RTOL = 1e-12
+
+
+def _sha256(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _numbers(text: str) -> tuple[list[str], np.ndarray]:
+    """The non-numeric tokens and the numbers of a CSV text, in order."""
+    words, nums = [], []
+    for tok in text.replace("\n", ",").split(","):
+        try:
+            nums.append(float(tok))
+        except ValueError:
+            words.append(tok)
+    return words, np.asarray(nums)
+
+
+def _same_numbers(a: str, b: str, rtol: float) -> bool:
+    wa, na = _numbers(a)
+    wb, nb = _numbers(b)
+    if wa != wb or na.shape != nb.shape:
+        return False
+    return bool(np.all(np.abs(na - nb) <= rtol * np.maximum(np.abs(na), np.abs(nb))))
+
+
+def generate_all(verify: bool = False, update: bool = False) -> int:
+    """Generate every scenario; compare with (or rewrite) the manifest. Returns an exit status."""
+    ddir = data_dir()
+    out = ddir / "generated"
+    out.mkdir(exist_ok=True)
+    sums: dict[str, str] = {}
+    close: list[str] = []
+    previous: dict[str, str] = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for toml in sorted(ddir.glob("*.toml")):
+            cfg = load_scenario(toml.stem)
+            mod = importlib.import_module(GENERATORS[cfg["scenario"]["generator"]])
+            for path in mod.generate(cfg, Path(tmp)):
+                dest = out / path.name
+                if dest.is_file():
+                    previous[path.name] = dest.read_text()
+                shutil.copyfile(path, dest)
+                sums[str(dest.relative_to(ddir))] = _sha256(dest)
+                print(f"  generated {dest.relative_to(ddir.parent)}", file=sys.stderr)
+    manifest = ddir / "MANIFEST.sha256"
+    text = "".join(f"{h}  {p}\n" for p, h in sorted(sums.items()))
+    if update or not manifest.exists():
+        manifest.write_text(text)
+        print(f"wrote {manifest} ({len(sums)} files)", file=sys.stderr)
+        return 0
+    expected = {}
+    for line in manifest.read_text().splitlines():
+        h, p = line.split(maxsplit=1)
+        expected[p] = h
+    bad = []
+    for p in sorted(set(expected) | set(sums)):
+        if expected.get(p) == sums.get(p):
+            continue
+        name = Path(p).name
+        old = previous.get(name)
+        if (old is not None and p in sums and p in expected
+                and hashlib.sha256(old.encode()).hexdigest() == expected[p]
+                and _same_numbers(old, (ddir / p).read_text(), VERIFY_RTOL)):
+            close.append(p)
+            (ddir / p).write_text(old)  # keep the committed bytes
+            continue
+        bad.append(p)
+    if bad:
+        print("data_synthetic: generated files differ from MANIFEST.sha256: " + ", ".join(bad)
+              + "\n  (if the change is deliberate: hsgeo data --update-manifest)", file=sys.stderr)
+        return 1 if verify else 0
+    note = (f"; {len(close)} differ only in the last bits, every number within "
+            f"{VERIFY_RTOL:g} relative ({', '.join(close)})" if close else "")
+    print(f"data_synthetic: {len(sums)} files match MANIFEST.sha256{note}", file=sys.stderr)
+    return 0

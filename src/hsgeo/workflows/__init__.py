@@ -1,0 +1,18 @@
+"""Truth-free pipelines a user runs on their own files (GUIDE §1–§2).
+
+Each workflow goes measure → model → adjust → products with the same code whether the input
+comes from a user's files or from :mod:`hsgeo.simulate`; none of them ever sees a simulation's
+truth (only :mod:`hsgeo.reproduce` compares results with the truth and the papers).
+
+=========================  =====================================================================
+module                     what it does
+=========================  =====================================================================
+``line_calibration``       1D spatial calibration of a line scanner (000 §4,
+                           ``hsgeo calibrate-line``)
+``frame_calibration``      frame-camera self-calibration, OpenCV and photogrammetric forms
+``rikola``                 per-band and joint calibration of the Rikola FPI camera (003,
+                           ``hsgeo calibrate-frame``)
+``pushbroom_ba``           bundle adjustment of pushbroom lines (002, ``hsgeo adjust-pushbroom``)
+``geocoding``              orthorectification of a recorded flight line (000, ``hsgeo geocode``)
+=========================  =====================================================================
+"""
