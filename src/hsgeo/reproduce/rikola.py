@@ -22,15 +22,16 @@ from hsgeo.papers import (
 from hsgeo.report import Reproduction, Row
 from hsgeo.sensors.frame import mm_to_pixel
 from hsgeo.workflows.rikola import (
-    TargetCentroids,
     band_problem,
     calibrate_band,
     calibrate_joint,
-    design_effect,
     detect_targets_in_images,
     gap_regression,
+    mean_relative_orientation,
     predict_band,
+    predict_per_band,
     relative_orientation,
+    rop_transformation_test,
 )
 
 __all__ = ["run", "setup", "observe", "corner_bias", "band_identifiability"]
@@ -176,32 +177,17 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
     rop_cov = [relative_orientation(cals[k1].pose(ROP_CUBE), cals[k2].pose(ROP_CUBE),
                                     cals[k1].pose_covariance(ROP_CUBE),
                                     cals[k2].pose_covariance(ROP_CUBE))[1] for k2, k1 in pairs]
-    rop = rop_all.mean(axis=1)  # per pair, mean over cubes
+    m = mean_relative_orientation(cals, obs, cubes, pairs, rop_all=rop_all)
+    rop, rop_mean, rop_mean_sigma = m["rop_pairs"], m["rop_mean"], m["rop_mean_sigma"]
+    pb_clusters, deff_pairs = m["band_clusters"], m["deff_pairs"]
     rop_cube0 = rop_all[:, cubes.index(ROP_CUBE)]
-    rop_mean = rop.mean(axis=0)
-    # σ̂ of the mean: the poses of all cubes of a band are correlated through the band's
-    # interior orientation, so propagate each band's full pose covariance (bands independent)
-    var = np.zeros(3)
-    for k2, k1 in pairs:
-        var += np.diag(_rop_mean_covariance(cals[k1], cals[k2], cubes))
-    rop_mean_sigma = np.sqrt(var) / len(pairs)
-    # ... and the pairs share part of their error: a target's centroid error is partly common
-    # to all bands of a sensor (hsgeo.workflows.rikola.design_effect); its intra-cluster
-    # correlation,
-    # from the per-band residuals grouped by cube, target and sensor, gives the design effect
-    # of a mean over the pairs
-    res_pb = np.concatenate([c.residuals_px for c in cals.values()])
-    keys = np.concatenate([_cluster_keys(obs, c) for c in cals.values()])
-    pb_clusters = design_effect(res_pb, keys)
-    deff_pairs = 1.0 + (len(pairs) - 1) * pb_clusters["rho"]
-    rop_mean_sigma = rop_mean_sigma * np.sqrt(deff_pairs)
     for i, q in enumerate(("domega_deg", "dphi_deg", "dkappa_deg")):
         rows.append(Row("003 Table 4 ROP", q, "deg", RIKOLA_TABLE4_ROP_MEAN_DEG[i], None,
                         np.rad2deg(rop_mean[i]), np.rad2deg(rop_mean_sigma[i]),
                         np.rad2deg(truth.rotation_rad[i])))
     # transformation test (003 §3.4): discrepancies of the sensor-II centroids from the
     # sensor-I ones of the same cube and target, before and after applying the mean ROP
-    disc = _rop_transformation_test(obs, cals, truth, pairs, rop_mean)
+    disc = rop_transformation_test(obs, cals, pairs, rop_mean, ROP_CUBE)
     # --- 003 Table 4 (second): f against gap, bands 1 and 11 excluded (003 §3.5)
     gaps, f_hat, f_sig = {}, {}, {}
     reg, reg_truth = {}, {}
@@ -277,7 +263,7 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
         s_row = RIKOLA_BANDS["sensor"] - 1
         line = vals["gap_model"][s_row, 0] * RIKOLA_BANDS["gap_nm"] + vals["gap_model"][s_row, 1]
         r_oracle = _predict_with(jh, obs, h, vals, df=truth.f_mm - line)
-        r_perband = _predict_per_band(cals, obs, h, bands)
+        r_perband = predict_per_band(cals, obs, h, bands)
         held[h] = {"joint": _rms(r_joint), "joint_true_f": _rms(r_oracle),
                    "per_band": _rms(r_perband),
                    "calibrated": _rms(cals[h].residuals_px)}
@@ -316,35 +302,6 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
     return Reproduction("rikola", seed, rows, meta, extras)
 
 
-def _cluster_keys(obs, cal) -> np.ndarray:
-    """(cube, target, sensor) key of each observation of a band's adjustment, in its order."""
-    sel = obs.band == cal.band
-    sensor = RIKOLA_BANDS["sensor"][cal.band - 1]
-    return obs.cube[sel] * 1_000_000 + obs.target[sel] * 10 + sensor
-
-
-def _rop_mean_covariance(cal1, cal2, cubes, step: float = 1e-7) -> np.ndarray:
-    """Covariance (3, 3) of the ROP averaged over cubes, from the full pose covariances of the
-    two bands' adjustments.
-    """
-    J1 = np.zeros((3, 6 * len(cal1.cubes)))
-    J2 = np.zeros((3, 6 * len(cal2.cubes)))
-    for c in cubes:
-        p1, p2 = cal1.pose(c), cal2.pose(c)
-        i1 = int(np.flatnonzero(cal1.cubes == c)[0])
-        i2 = int(np.flatnonzero(cal2.cubes == c)[0])
-        for a in range(3):
-            d = np.zeros(6)
-            d[a] = step
-            J1[:, 6 * i1 + a] = (relative_orientation(p1 + d, p2)[0]
-                                 - relative_orientation(p1 - d, p2)[0]) / (2 * step)
-            J2[:, 6 * i2 + a] = (relative_orientation(p1, p2 + d)[0]
-                                 - relative_orientation(p1, p2 - d)[0]) / (2 * step)
-    C1, _ = cal1.result.covariance_of("poses")
-    C2, _ = cal2.result.covariance_of("poses")
-    return (J1 @ C1 @ J1.T + J2 @ C2 @ J2.T) / len(cubes) ** 2
-
-
 def _rms(r) -> float:
     return float(np.sqrt(np.mean(np.sum(np.asarray(r) ** 2, axis=1))))
 
@@ -362,60 +319,3 @@ def _predict_with(joint, obs, band, values, df):
     return blk.evaluate(values, False)[0].reshape(-1, 2) / obs.pixel_mm * np.array([1.0, -1.0])
 
 
-def _predict_per_band(cals, obs, band, bands):
-    """The per-band route to a band without its own calibration (003 §3.5): f from the gap
-    regression of the other bands of its sensor, the mean principal point of the sensor, the
-    mean distortion, and per cube the mean exterior orientation of the sensor's other bands.
-    """
-    s = RIKOLA_BANDS["sensor"][band - 1]
-    others = [b for b in bands if b != band and RIKOLA_BANDS["sensor"][b - 1] == s
-              and b not in (1, 11)]
-    reg = gap_regression(RIKOLA_BANDS["gap_nm"][np.array(others) - 1],
-                         [cals[b].value("interior")[0] for b in others])
-    f = reg["a"] * RIKOLA_BANDS["gap_nm"][band - 1] + reg["b"]
-    pp = np.mean([cals[b].value("interior")[1:] for b in others], axis=0)
-    KP = np.mean([cals[b].value("distortion_mm") for b in cals if b != band], axis=0)
-    sel = obs.band == band
-    o = obs.select(sel)
-    cubes = np.unique(o.cube)
-    poses = np.array([np.mean([cals[b].pose(c) for b in others], axis=0) for c in cubes])
-    blk = TargetCentroids(np.searchsorted(cubes, o.cube), o.corners_obj, o.centroids_mm, 1.0)
-    r = blk.evaluate({"interior": np.r_[f, pp], "distortion_mm": KP, "poses": poses}, False)[0]
-    return r.reshape(-1, 2) / obs.pixel_mm * np.array([1.0, -1.0])
-
-
-def _rop_transformation_test(obs, cals, truth, pairs, rop_mean):
-    """003 §3.4: mean discrepancy (px) between a target's centroid in a sensor-II band and in
-    its sensor-I partner of the same cube, before and after rotating the sensor-II image rays by
-    the estimated mean ROP (with each band's own interior orientation).
-    """
-    from hsgeo.distortion import ideal_from_measured_mm
-    from hsgeo.rotations import R_from_opk
-    from hsgeo.sensors.frame import mm_to_pixel
-    from hsgeo.sensors.rikola import project_measured_mm
-
-    M = R_from_opk(*rop_mean)
-    before, after = [], []
-    for k2, k1 in pairs:
-        c1, c2 = cals[k1], cals[k2]
-        m1 = (obs.band == k1) & (obs.cube == ROP_CUBE)
-        m2 = (obs.band == k2) & (obs.cube == ROP_CUBE)
-        common, i1, i2 = np.intersect1d(obs.target[m1], obs.target[m2], return_indices=True)
-        x1 = obs.centroids_mm[m1][i1]
-        x2 = obs.centroids_mm[m2][i2]
-        f1, x01, y01 = c1.value("interior")
-        f2, x02, y02 = c2.value("interior")
-        K2 = c2.value("distortion_mm")
-        K1 = c1.value("distortion_mm")
-        ideal2 = ideal_from_measured_mm(x2 - [x02, y02], K2[:3], K2[3:])
-        ray2 = np.column_stack([ideal2, np.full(len(ideal2), -f2)])
-        ray1 = ray2 @ M.T  # X_camI = R_I_from_II X_camII
-        x2_in_1 = project_measured_mm(ray1, f1, np.array([x01, y01]), K1)
-        px = obs.pixel_mm
-        before.append(mm_to_pixel(x2, obs.image_size, px) - mm_to_pixel(x1, obs.image_size, px))
-        after.append(mm_to_pixel(x2_in_1, obs.image_size, px)
-                     - mm_to_pixel(x1, obs.image_size, px))
-    b, a = np.concatenate(before), np.concatenate(after)
-    return {"before_mean_px": b.mean(axis=0).tolist(), "after_mean_px": a.mean(axis=0).tolist(),
-            "before_rms_px": float(np.sqrt(np.mean(np.sum(b ** 2, 1)))),
-            "after_rms_px": float(np.sqrt(np.mean(np.sum(a ** 2, 1))))}

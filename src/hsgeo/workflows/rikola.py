@@ -23,13 +23,16 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from hsgeo.adjust import AdjustmentResult, Parameters, adjust
+from hsgeo.distortion import ideal_from_measured_mm
 from hsgeo.errors import InputError, ObservationError
+from hsgeo.measure.targets import Observations
 from hsgeo.papers import RIKOLA_BANDS
 from hsgeo.rotations import R_from_opk, R_from_rotvec, opk_from_R
 from hsgeo.sensors.frame import (
     PHOTOGRAMMETRIC_DISTORTION,
     PHOTOGRAMMETRIC_INTERIOR,
     POSE_COLUMNS,
+    mm_to_pixel,
 )
 from hsgeo.sensors.rikola import (
     GAP_MODEL_COLUMNS,
@@ -37,6 +40,7 @@ from hsgeo.sensors.rikola import (
     ROTATION_COLUMNS,
     JointCentroids,
     TargetCentroids,
+    project_measured_mm,
 )
 
 __all__ = [
@@ -53,12 +57,14 @@ __all__ = [
     "calibrate_joint",
     "design_effect",
     "predict_band",
+    "predict_per_band",
+    "mean_relative_orientation",
+    "rop_mean_covariance",
+    "rop_transformation_test",
+    "cluster_keys",
 ]
 
 _FLIP = np.diag([1.0, -1.0, -1.0])  # OpenCV camera frame <-> photogrammetric camera frame
-
-
-from hsgeo.measure.targets import Observations  # noqa: E402  (re-exported)
 
 
 def detect_targets_in_images(images, corners_obj, target_ids, image_size, pixel_mm: float, *,
@@ -557,3 +563,143 @@ def calibrate_frame_files(images, board_path, *, joint: bool = False, band_regex
                                 "rms_px": float(np.sqrt(np.mean(np.sum(c.residuals_px ** 2, 1)))),
                                 "views": int(len(c.cubes))}
     return Reproduction("calibrate-frame", 0, rows, meta)
+
+
+def cluster_keys(obs, cal) -> np.ndarray:
+    """(cube, target, sensor) key of each observation of a band's adjustment, in its order."""
+    sel = obs.band == cal.band
+    sensor = RIKOLA_BANDS["sensor"][cal.band - 1]
+    return obs.cube[sel] * 1_000_000 + obs.target[sel] * 10 + sensor
+
+
+def rop_mean_covariance(cal1, cal2, cubes, step: float = 1e-7) -> np.ndarray:
+    """Covariance (3, 3) of the ROP averaged over cubes, from the full pose covariances of the
+    two bands' adjustments.
+    """
+    J1 = np.zeros((3, 6 * len(cal1.cubes)))
+    J2 = np.zeros((3, 6 * len(cal2.cubes)))
+    for c in cubes:
+        p1, p2 = cal1.pose(c), cal2.pose(c)
+        i1 = int(np.flatnonzero(cal1.cubes == c)[0])
+        i2 = int(np.flatnonzero(cal2.cubes == c)[0])
+        for a in range(3):
+            d = np.zeros(6)
+            d[a] = step
+            J1[:, 6 * i1 + a] = (relative_orientation(p1 + d, p2)[0]
+                                 - relative_orientation(p1 - d, p2)[0]) / (2 * step)
+            J2[:, 6 * i2 + a] = (relative_orientation(p1, p2 + d)[0]
+                                 - relative_orientation(p1, p2 - d)[0]) / (2 * step)
+    C1, _ = cal1.result.covariance_of("poses")
+    C2, _ = cal2.result.covariance_of("poses")
+    return (J1 @ C1 @ J1.T + J2 @ C2 @ J2.T) / len(cubes) ** 2
+
+
+def mean_relative_orientation(cals: dict, obs: Observations, cubes, pairs, *,
+                              rop_all=None) -> dict:
+    """The mean relative orientation of sensor II to sensor I over band pairs and cubes, with σ̂
+    (003 eq. (1), Table 4 first).
+
+    003 uses the bands of one cube; the ROPs of one cube share that cube's systematic centroid
+    errors (their spread understates the error), so every cube is used. σ̂ of the mean
+    propagates each band's full pose covariance (the poses of all cubes of a band are correlated
+    through the band's interior orientation; bands independent, :func:`rop_mean_covariance`),
+    times the square root of the design effect of a mean over pairs whose centroid errors are
+    partly common to all bands of a sensor (:func:`design_effect` of the per-band residuals
+    grouped by cube, target and sensor, :func:`cluster_keys`).
+
+    Parameters
+    ----------
+    cals : dict band -> BandCalibration
+    obs : Observations
+    cubes : sequence of int
+    pairs : sequence of (band of sensor II, band of sensor I)
+    rop_all : (n_pairs, n_cubes, 3) ndarray, optional
+        The per-pair, per-cube ROPs if already computed.
+
+    Returns
+    -------
+    dict with ``rop_all`` (n_pairs, n_cubes, 3) rad, ``rop_pairs`` (n_pairs, 3) rad (mean over
+    cubes), ``rop_mean`` (3,) rad, ``rop_mean_sigma`` (3,) rad, ``band_clusters`` (the
+    :func:`design_effect` summary) and ``deff_pairs``.
+    """
+    if rop_all is None:
+        rop_all = np.array([[relative_orientation(cals[k1].pose(c), cals[k2].pose(c))[0]
+                             for c in cubes] for k2, k1 in pairs])  # k2 sensor II, k1 sensor I
+    rop = rop_all.mean(axis=1)  # per pair, mean over cubes
+    rop_mean = rop.mean(axis=0)
+    # σ̂ of the mean: the poses of all cubes of a band are correlated through the band's
+    # interior orientation, so propagate each band's full pose covariance (bands independent)
+    var = np.zeros(3)
+    for k2, k1 in pairs:
+        var += np.diag(rop_mean_covariance(cals[k1], cals[k2], cubes))
+    rop_mean_sigma = np.sqrt(var) / len(pairs)
+    # ... and the pairs share part of their error: a target's centroid error is partly common
+    # to all bands of a sensor (design_effect); its intra-cluster correlation, from the
+    # per-band residuals grouped by cube, target and sensor, gives the design effect of a mean
+    # over the pairs
+    res_pb = np.concatenate([c.residuals_px for c in cals.values()])
+    keys = np.concatenate([cluster_keys(obs, c) for c in cals.values()])
+    pb_clusters = design_effect(res_pb, keys)
+    deff_pairs = 1.0 + (len(pairs) - 1) * pb_clusters["rho"]
+    rop_mean_sigma = rop_mean_sigma * np.sqrt(deff_pairs)
+    return {"rop_all": rop_all, "rop_pairs": rop, "rop_mean": rop_mean,
+            "rop_mean_sigma": rop_mean_sigma, "band_clusters": pb_clusters,
+            "deff_pairs": deff_pairs}
+
+
+def predict_per_band(cals, obs, band, bands):
+    """The per-band route to a band without its own calibration (003 §3.5): f from the gap
+    regression of the other bands of its sensor, the mean principal point of the sensor, the
+    mean distortion, and per cube the mean exterior orientation of the sensor's other bands.
+    """
+    s = RIKOLA_BANDS["sensor"][band - 1]
+    others = [b for b in bands if b != band and RIKOLA_BANDS["sensor"][b - 1] == s
+              and b not in (1, 11)]
+    reg = gap_regression(RIKOLA_BANDS["gap_nm"][np.array(others) - 1],
+                         [cals[b].value("interior")[0] for b in others])
+    f = reg["a"] * RIKOLA_BANDS["gap_nm"][band - 1] + reg["b"]
+    pp = np.mean([cals[b].value("interior")[1:] for b in others], axis=0)
+    KP = np.mean([cals[b].value("distortion_mm") for b in cals if b != band], axis=0)
+    sel = obs.band == band
+    o = obs.select(sel)
+    cubes = np.unique(o.cube)
+    poses = np.array([np.mean([cals[b].pose(c) for b in others], axis=0) for c in cubes])
+    blk = TargetCentroids(np.searchsorted(cubes, o.cube), o.corners_obj, o.centroids_mm, 1.0)
+    r = blk.evaluate({"interior": np.r_[f, pp], "distortion_mm": KP, "poses": poses}, False)[0]
+    return r.reshape(-1, 2) / obs.pixel_mm * np.array([1.0, -1.0])
+
+
+def rop_transformation_test(obs, cals, pairs, rop_mean, cube: int):
+    """003 §3.4: mean discrepancy (px) between a target's centroid in a sensor-II band and in
+    its sensor-I partner of the same cube ``cube``, before and after rotating the sensor-II
+    image rays by the estimated mean ROP (with each band's own interior orientation).
+
+    Returns
+    -------
+    dict with ``before_mean_px``, ``after_mean_px`` (x, y) and ``before_rms_px``, ``after_rms_px``.
+    """
+    M = R_from_opk(*rop_mean)
+    before, after = [], []
+    for k2, k1 in pairs:
+        c1, c2 = cals[k1], cals[k2]
+        m1 = (obs.band == k1) & (obs.cube == cube)
+        m2 = (obs.band == k2) & (obs.cube == cube)
+        common, i1, i2 = np.intersect1d(obs.target[m1], obs.target[m2], return_indices=True)
+        x1 = obs.centroids_mm[m1][i1]
+        x2 = obs.centroids_mm[m2][i2]
+        f1, x01, y01 = c1.value("interior")
+        f2, x02, y02 = c2.value("interior")
+        K2 = c2.value("distortion_mm")
+        K1 = c1.value("distortion_mm")
+        ideal2 = ideal_from_measured_mm(x2 - [x02, y02], K2[:3], K2[3:])
+        ray2 = np.column_stack([ideal2, np.full(len(ideal2), -f2)])
+        ray1 = ray2 @ M.T  # X_camI = R_I_from_II X_camII
+        x2_in_1 = project_measured_mm(ray1, f1, np.array([x01, y01]), K1)
+        px = obs.pixel_mm
+        before.append(mm_to_pixel(x2, obs.image_size, px) - mm_to_pixel(x1, obs.image_size, px))
+        after.append(mm_to_pixel(x2_in_1, obs.image_size, px)
+                     - mm_to_pixel(x1, obs.image_size, px))
+    b, a = np.concatenate(before), np.concatenate(after)
+    return {"before_mean_px": b.mean(axis=0).tolist(), "after_mean_px": a.mean(axis=0).tolist(),
+            "before_rms_px": float(np.sqrt(np.mean(np.sum(b ** 2, 1)))),
+            "after_rms_px": float(np.sqrt(np.mean(np.sum(a ** 2, 1))))}
