@@ -33,15 +33,16 @@ HERE = Path(__file__).resolve().parent
 
 def _problem(scale, seed, with_gcp=True):
     from hsgeo.reproduce.pushbroom_ba import Y_AS_TIME, camera_prior
-    from hsgeo.simulate.pushbroom_campaign import simulate
+    from hsgeo.simulate.pushbroom_campaign import CampaignConfig, simulate
     from hsgeo.workflows.pushbroom_ba import build_problem
 
-    camp = simulate(scale, rng=seed)
+    cfg = CampaignConfig()
+    obs, _ = simulate(scale, rng=seed, cfg=cfg)
     p, blocks, _ = build_problem(
-        camp.obs, camp.n_points, camera_prior(camp), t_span_s=(0.0, camp.nodes.t_end_s),
-        gcp_index=camp.gcp_index if with_gcp else None,
-        gcp_xyz_m=camp.gcp_xyz_m if with_gcp else None, y_as_time=Y_AS_TIME)
-    return camp, p, blocks
+        obs.lines, obs.n_points, camera_prior(cfg, obs), t_span_s=obs.t_span_s,
+        gcp_index=obs.gcp_index if with_gcp else None,
+        gcp_xyz_m=obs.gcp_xyz_m if with_gcp else None, y_as_time=Y_AS_TIME)
+    return obs, p, blocks
 
 
 def _load_compiled_kernels(seed):
@@ -61,13 +62,13 @@ def case_ours(scale, seed, reject):
     from hsgeo.adjust import adjust
     from hsgeo.reproduce.pushbroom_ba import FTOL, REJECT_K
 
-    camp, p, blocks = _problem(scale, seed)
+    obs, p, blocks = _problem(scale, seed)
     jit = _load_compiled_kernels(seed)
     t0 = time.perf_counter()
     res = adjust(p, blocks, reject_k=REJECT_K if reject else None, ftol=FTOL,
                  reject_every_iteration=True)
     wall = time.perf_counter() - t0
-    return {"n_observations": int(camp.obs["point"].size), "n_unknowns": int(res.n_unknowns),
+    return {"n_observations": obs.lines.n, "n_unknowns": int(res.n_unknowns),
             "solver_seconds": res.seconds, "wall_seconds": wall, "iterations": res.iterations,
             "final_cost": float(res.cost_history[-1]), "sigma0": res.sigma0,
             "jit_load_seconds": jit}
@@ -80,7 +81,7 @@ def case_scipy(scale, seed, max_seconds):
 
     from hsgeo.adjust import engine as E
 
-    camp, p, blocks = _problem(scale, seed)
+    _, p, blocks = _problem(scale, seed)
     _load_compiled_kernels(seed)  # the model's kernels, as for ours
     lay = E._Layout(p)
     masks = [np.ones(b.m, bool) for b in blocks]

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from hsgeo.reproduce.pushbroom_ba import adjust_campaign, cp_errors
-from hsgeo.simulate.pushbroom_campaign import simulate
+from hsgeo.simulate.pushbroom_campaign import CampaignConfig, simulate
 from hsgeo.stats import nmad
 
 CAMERA = ("boresight_rad", "lever_arm_m", "distortion", "c_mm")
@@ -31,17 +31,18 @@ CAMERA = ("boresight_rad", "lever_arm_m", "distortion", "c_mm")
 
 def one(scale: float, seed: int) -> dict:
     t0 = time.perf_counter()
-    camp = simulate(scale, rng=seed)
-    res, _, _, _ = adjust_campaign(camp)
-    zn = (res.value("nodes") - camp.truth["nodes"]) / res.sigma("nodes")
-    zc = np.concatenate([(res.value(k) - camp.truth[k]).ravel() / res.sigma(k).ravel()
+    cfg = CampaignConfig()
+    obs, truth = simulate(scale, rng=seed, cfg=cfg)
+    res, _, _, _ = adjust_campaign(obs, cfg)
+    zn = (res.value("nodes") - truth.values["nodes"]) / res.sigma("nodes")
+    zc = np.concatenate([(res.value(k) - truth.values[k]).ravel() / res.sigma(k).ravel()
                          for k in CAMERA])
     z = np.r_[zn.ravel(), zc]
     r = res.residuals(0).reshape(-1, 2)[~res.outliers(0)]
-    E = cp_errors(res, camp)
-    gsd = camp.cfg.agl_low_m * camp.cfg.pixel_mm / camp.cfg.c_mean_mm
+    E = cp_errors(res, truth)
+    gsd = cfg.agl_low_m * cfg.pixel_mm / cfg.c_mean_mm
     return {
-        "scale": scale, "seed": seed, "n_observations_2d": int(camp.obs["point"].size),
+        "scale": scale, "seed": seed, "n_observations_2d": obs.lines.n,
         "sigma0": res.sigma0, "iterations": res.iterations,
         "share_within_3sigma": float(np.mean(np.abs(z) < 3)),
         "node_z_mean": np.mean(zn, axis=0).round(3).tolist(),

@@ -1,5 +1,7 @@
 """Self-calibration against OpenCV on real data, and against the truth on a simulated bench."""
 
+import dataclasses
+
 import cv2
 import numpy as np
 import pytest
@@ -69,14 +71,28 @@ def test_photogrammetric_form_differs_but_fits(chessboard):
     assert pg2.values()["f_mm"] / 0.01 == pytest.approx(f_px, rel=1e-7)
 
 
+def _views(sim):
+    return [View(sim.X_mm[sim.point[sim.view == i]], sim.uv_px[sim.view == i])
+            for i in range(sim.n_views)]
+
+
+def test_simulated_bench_observations_are_frozen_and_truth_free():
+    sim, truth = simulate(load_scenario("frame_bench"), 0)
+    names = {f.name for f in dataclasses.fields(sim)}
+    assert sim.__dataclass_params__.frozen and truth.__dataclass_params__.frozen
+    assert not names & {"poses", "intrinsics", "distortion", "uv_true_px"}, names
+    assert sim.n_views == truth.poses.shape[0] and sim.uv_px.shape == truth.uv_true_px.shape
+    assert 0 < np.std(sim.uv_px - truth.uv_true_px) < 3 * sim.sigma_px
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        sim.uv_px = truth.uv_true_px
+
+
 @pytest.mark.parametrize("seed", [0, 1, 2, 3])
 def test_simulated_bench_truth_within_3_sigma(seed):
     cfg = load_scenario("frame_bench")
-    sim = simulate(cfg, seed)
-    n = sim["poses"].shape[0]
-    views = [View(sim["X"], sim["uv_px"][sim["view"] == i]) for i in range(n)]
-    cal = calibrate_opencv(views, (640, 480), sigma_px=cfg["camera"]["sigma_px"])
-    truth = np.concatenate([sim["intrinsics"], sim["distortion"]])
+    sim, sim_truth = simulate(cfg, seed)
+    cal = calibrate_opencv(_views(sim), sim.image_size_px, sigma_px=sim.sigma_px)
+    truth = np.concatenate([sim_truth.intrinsics, sim_truth.distortion])
     est, sig = np.array(list(cal.values().values())), np.array(list(cal.sigmas().values()))
     assert np.all(np.abs(est - truth) < 3 * sig)
     lo, hi = cal.result.chi2_interval(0.001)
@@ -86,11 +102,9 @@ def test_simulated_bench_truth_within_3_sigma(seed):
 def test_simulated_bench_noise_free():
     cfg = load_scenario("frame_bench")
     cfg["camera"]["sigma_px"] = 0.0
-    sim = simulate(cfg, 5)
-    n = sim["poses"].shape[0]
-    views = [View(sim["X"], sim["uv_px"][sim["view"] == i]) for i in range(n)]
-    cal = calibrate_opencv(views, (640, 480))
-    truth = np.concatenate([sim["intrinsics"], sim["distortion"]])
+    sim, sim_truth = simulate(cfg, 5)
+    cal = calibrate_opencv(_views(sim), (640, 480))
+    truth = np.concatenate([sim_truth.intrinsics, sim_truth.distortion])
     np.testing.assert_allclose(np.array(list(cal.values().values())), truth, atol=1e-6)
 
 

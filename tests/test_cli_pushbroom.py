@@ -4,31 +4,31 @@ import numpy as np
 import pandas as pd
 
 from hsgeo.cli import main
-from hsgeo.simulate.pushbroom_campaign import simulate
+from hsgeo.simulate.pushbroom_campaign import CampaignConfig, simulate
 
 
-def _write(tmp_path, camp):
-    o = camp.obs
-    pd.DataFrame({"point_id": o["point"] + 1000, "band": o["band"], "t_s": o["t_s"],
-                  "x_px": o["xy_px"][:, 0], "y_px": o["xy_px"][:, 1]}).to_parquet(
+def _write(tmp_path, obs):
+    o = obs.lines
+    pd.DataFrame({"point_id": o.point + 1000, "band": o.band, "t_s": o.t_s,
+                  "x_px": o.xy_px[:, 0], "y_px": o.xy_px[:, 1]}).to_parquet(
         tmp_path / "obs.parquet")
     # navigation at the line times (the simulator's solution), sorted and unique
-    t, i = np.unique(o["t_s"], return_index=True)
-    nav = np.column_stack([t, o["xyz_nav_m"][i], o["rpy_nav_rad"][i]])
+    t, i = np.unique(o.t_s, return_index=True)
+    nav = np.column_stack([t, o.xyz_nav_m[i], o.rpy_nav_rad[i]])
     pd.DataFrame(nav, columns=["t_s", "E_m", "N_m", "H_m", "roll_rad", "pitch_rad",
                                "yaw_rad"]).to_csv(tmp_path / "nav.csv", index=False)
-    g = camp.gcp_xyz_m
-    pd.DataFrame({"point_id": camp.gcp_index + 1000, "E_m": g[:, 0], "N_m": g[:, 1],
+    g = obs.gcp_xyz_m
+    pd.DataFrame({"point_id": obs.gcp_index + 1000, "E_m": g[:, 0], "N_m": g[:, 1],
                   "H_m": g[:, 2]}).to_csv(tmp_path / "gcp.csv", index=False)
-    la = ", ".join(f"{v:.6f}" for v in camp.lever_arm_measured_m)
+    la = ", ".join(f"{v:.6f}" for v in obs.lever_arm_m)
     (tmp_path / "cam.toml").write_text(
-        f"[camera]\nn_bands = 7\npixel_mm = 0.0065\nc_mm = 40.0\nx0_mm = {camp.cfg.x0_mm}\n"
+        f"[camera]\nn_bands = 7\npixel_mm = 0.0065\nc_mm = 40.0\nx0_mm = {CampaignConfig().x0_mm}\n"
         f"lever_arm_m = [{la}]\n")
 
 
 def test_adjust_pushbroom_cli(tmp_path, capsys):
-    camp = simulate(0.002, rng=4)
-    _write(tmp_path, camp)
+    obs, truth = simulate(0.002, rng=4)
+    _write(tmp_path, obs)
     rc = main(["adjust-pushbroom", str(tmp_path / "obs.parquet"), "--trajectory",
                str(tmp_path / "nav.csv"), "--camera", str(tmp_path / "cam.toml"), "--gcp",
                str(tmp_path / "gcp.csv"), "--json"])
@@ -37,12 +37,12 @@ def test_adjust_pushbroom_cli(tmp_path, capsys):
     assert out["converged"]
     c = np.array(out["parameters"]["c_mm"]["value"])
     s = np.array(out["parameters"]["c_mm"]["sigma"])
-    assert np.all(np.abs(c - camp.truth["c_mm"]) < 4 * s)
+    assert np.all(np.abs(c - truth.values["c_mm"]) < 4 * s)
 
 
 def test_adjust_pushbroom_cli_bad_input(tmp_path, capsys):
-    camp = simulate(0.001, rng=4)
-    _write(tmp_path, camp)
+    obs, _ = simulate(0.001, rng=4)
+    _write(tmp_path, obs)
     pd.read_csv(tmp_path / "nav.csv").drop(columns="yaw_rad").to_csv(tmp_path / "bad.csv")
     rc = main(["adjust-pushbroom", str(tmp_path / "obs.parquet"), "--trajectory",
                str(tmp_path / "bad.csv"), "--camera", str(tmp_path / "cam.toml")])

@@ -1,5 +1,7 @@
 """Geocoding: ray–terrain intersection, sensor geometries, boresight calibration, ortho, files."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 import xarray as xr
@@ -23,7 +25,7 @@ from hsgeo.geocode import (
 from hsgeo.navigation import Navigation
 from hsgeo.simulate.pula_flight import observe_gcps, simulate_flight
 from hsgeo.simulate.scenarios import load_scenario
-from hsgeo.workflows.geocoding import geocode_files
+from hsgeo.workflows.geocoding import gcp_deviations, geocode_files
 
 CAL = CalibratedLine(486.8, 3539.0, (1.459, -0.1636, 0.00526))  # 000 Table 1
 
@@ -104,12 +106,47 @@ def test_boresight_truth_within_3_sigma():
     cfg["imu"]["heading_drift_deg_per_s"] = 0.0
     z = []
     for seed in range(8):
-        fl = simulate_flight(cfg, seed)
-        res = calibrate_boresight(fl.recorded_nav, fl.sensor, fl.line, fl.zeta_px, fl.gcp_enu_m,
-                                  t0_s=0.0, line_rate_hz=fl.line_rate_hz, height_m=50.0,
-                                  sigma_m=0.2)
-        z.append((res.value("boresight") - fl.boresight_rad) / res.sigma("boresight"))
+        fl, truth = simulate_flight(cfg, seed)
+        # the true sensor as the assumed one: only the boresight is tested here
+        res = calibrate_boresight(fl.recorded_nav, truth.sensor, fl.line, fl.zeta_px,
+                                  fl.gcp_enu_m, t0_s=0.0, line_rate_hz=fl.line_rate_hz,
+                                  height_m=50.0, sigma_m=0.2)
+        z.append((res.value("boresight") - truth.boresight_rad) / res.sigma("boresight"))
     assert np.max(np.abs(z)) < 4.0  # 24 deviates, family-wise
+
+
+def test_flight_observations_are_frozen_and_truth_free():
+    fl, truth = simulate_flight(load_scenario("pula_flight"), 3)
+    names = {f.name for f in dataclasses.fields(fl)}
+    assert fl.__dataclass_params__.frozen and truth.__dataclass_params__.frozen
+    assert not names & {"true_nav", "sensor", "boresight_rad"}, names
+    assert {"recorded_nav", "line", "zeta_px", "gcp_enu_m", "sensor_nominal"} <= names
+    assert isinstance(fl.sensor_nominal, LinearIFOV) and fl.recorded_nav is not truth.true_nav
+    assert not np.allclose(fl.recorded_nav.enu_m, truth.true_nav.enu_m, atol=0.1)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        fl.line = fl.line + 1
+
+
+def test_gcp_deviations_vanish_with_exact_navigation_and_sensor():
+    """Noise-free observations, true navigation and sensor: the workflow returns the boresight
+    and zero deviations (the GCPs are where they were surveyed)."""
+    nav = straight_nav()
+    bs = np.deg2rad([0.4, -0.3, 0.8])
+    rng = np.random.default_rng(2)
+    along, across = rng.uniform(60, 300, 10), rng.uniform(-50, 50, 10)
+    h = np.deg2rad(30.0)
+    X = np.column_stack([along * np.sin(h) + across * np.cos(h),
+                         along * np.cos(h) - across * np.sin(h), np.full(10, 5.0)])
+    line, zeta = observe_gcps(nav, CAL, bs, 0.0, 12.5, X, rng, 0.0, 0.0)
+    dev, res = gcp_deviations(nav, CAL, line, zeta, X, height_m=5.0, t0_s=0.0,
+                              line_rate_hz=12.5)
+    assert dev.shape == (10, 2)
+    np.testing.assert_allclose(dev, 0.0, atol=1e-6)
+    np.testing.assert_allclose(res.value("boresight"), bs, atol=1e-9)
+    # a wrong sensor model shows up as deviations
+    dev_nom, _ = gcp_deviations(nav, LinearIFOV(485.0, 3600.0), line, zeta, X, height_m=5.0,
+                                t0_s=0.0, line_rate_hz=12.5)
+    assert np.max(np.abs(dev_nom)) > 0.05
 
 
 def test_orthorectify_places_pixels_where_they_belong():

@@ -26,6 +26,18 @@ def test_truth_at_published_lines():
     assert LL.wavelength_nm(1000) == pytest.approx(870.0)
 
 
+def test_recording_is_frozen_and_truth_free():
+    import dataclasses
+
+    rec, truth = LL.record(LAB, 1000, 3)
+    names = {f.name for f in dataclasses.fields(rec)}
+    assert rec.__dataclass_params__.frozen and truth.__dataclass_params__.frozen
+    assert not names & {"eop", "iop", "eop_true", "iop_true"}, names
+    assert rec.frames_dn.dtype == np.uint16 and rec.frames_dn.shape[0] == truth.eop.shape[0]
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        rec.row = 5
+
+
 def test_render_is_12bit_and_reproducible():
     e = LL.stations(LAB)[1]
     a = LL.render_rows(LAB, e, [100, 1000], 5)

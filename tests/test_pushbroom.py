@@ -7,20 +7,21 @@ from hsgeo import InputError
 from hsgeo.adjust import adjust, identifiability
 from hsgeo.adjust.checks import analytic_jacobian, check_jacobian
 from hsgeo.sensors.pushbroom import PushbroomLines
-from hsgeo.simulate.pushbroom_campaign import simulate
+from hsgeo.simulate.pushbroom_campaign import CampaignConfig, CampaignObservations, simulate
 from hsgeo.stats import nmad
-from hsgeo.workflows.pushbroom_ba import CameraPrior, build_problem
+from hsgeo.workflows.pushbroom_ba import CameraPrior, PushbroomObservations, build_problem
+
+CFG = CampaignConfig()
 
 
-def _problem(camp, with_gcp=True, node_interval_s=10.0, y_as_time=False):
-    cfg = camp.cfg
-    cam = CameraPrior(n_bands=len(cfg.c_offsets_um), x0_mm=cfg.x0_mm,
-                      lever_arm_m=tuple(camp.lever_arm_measured_m))
+def _problem(obs, with_gcp=True, node_interval_s=10.0, y_as_time=False):
+    cam = CameraPrior(n_bands=len(CFG.c_offsets_um), x0_mm=CFG.x0_mm,
+                      lever_arm_m=tuple(obs.lever_arm_m))
     return build_problem(
-        camp.obs, camp.n_points, cam, node_interval_s=node_interval_s,
-        t_span_s=(0.0, camp.nodes.t_end_s), node_prior_mean=camp.node_prior_mean,
-        gcp_index=camp.gcp_index if with_gcp else None,
-        gcp_xyz_m=camp.gcp_xyz_m if with_gcp else None, y_as_time=y_as_time)
+        obs.lines, obs.n_points, cam, node_interval_s=node_interval_s,
+        t_span_s=obs.t_span_s, node_prior_mean=obs.node_prior_mean,
+        gcp_index=obs.gcp_index if with_gcp else None,
+        gcp_xyz_m=obs.gcp_xyz_m if with_gcp else None, y_as_time=y_as_time)
 
 
 @pytest.fixture(scope="module")
@@ -28,11 +29,47 @@ def tiny():
     return simulate(0.001, rng=3)
 
 
+#: What a simulation knows and an adjustment must not see.
+TRUTH_ONLY = {"outlier", "xy_true_px", "strip", "strips", "truth", "values", "nodes", "cp_index",
+              "node_err", "cfg", "scale"}
+
+
+def test_observations_are_frozen_and_truth_free(tiny):
+    obs, truth = tiny
+    for o in (obs, obs.lines):
+        assert dataclasses.is_dataclass(o) and o.__dataclass_params__.frozen
+        names = {f.name for f in dataclasses.fields(o)}
+        assert not names & TRUTH_ONLY, names & TRUTH_ONLY
+        with pytest.raises(dataclasses.FrozenInstanceError):
+            o.n_points = 0
+    assert {f.name for f in dataclasses.fields(obs.lines)} == {
+        "point", "band", "t_s", "xy_px", "xyz_nav_m", "rpy_nav_rad", "xyz_rate_nav_m_s",
+        "rpy_rate_nav_rad_s"}
+    # the truth-only quantities are on the truth side, and differ from what was observed
+    assert truth.__dataclass_params__.frozen
+    assert truth.outlier.shape == (obs.lines.n,) and truth.outlier.any()
+    assert not np.array_equal(obs.lines.xy_px, truth.xy_true_px)
+    with pytest.raises(TypeError):
+        truth.values["c_mm"] = 0.0  # read-only mapping
+
+
+def test_observations_validate_shapes(tiny):
+    o = tiny[0].lines
+    with pytest.raises(InputError, match="xy_px has shape"):
+        dataclasses.replace(o, xy_px=o.xy_px[:-1])
+    with pytest.raises(InputError, match="both GNSS/INS rates"):
+        dataclasses.replace(o, rpy_rate_nav_rad_s=None)
+    with pytest.raises(InputError, match="non-negative integers"):
+        dataclasses.replace(o, band=o.band.astype(float))
+    with pytest.raises(InputError, match="PushbroomObservations"):
+        build_problem(dataclasses.asdict(o), tiny[0].n_points, CameraPrior(n_bands=7))
+
+
 @pytest.mark.parametrize("y_as_time", [False, True])
 def test_model_is_exact_at_truth_noise_free(y_as_time):
-    camp = simulate(0.001, rng=5, noise_free=True)
-    _, blocks, _ = _problem(camp, y_as_time=y_as_time)
-    r, _ = blocks[0].evaluate(camp.truth, False)
+    obs, truth = simulate(0.001, rng=5, noise_free=True)
+    _, blocks, _ = _problem(obs, y_as_time=y_as_time)
+    r, _ = blocks[0].evaluate(truth.values, False)
     assert np.max(np.abs(r)) < 1e-9
 
 
@@ -41,8 +78,8 @@ def test_model_is_exact_at_truth_noise_free(y_as_time):
     ("distortion", [1e-7, 1e-9, 1e-7, 1e-7]), ("c_mm", 1e-5)])
 @pytest.mark.parametrize("y_as_time", [False, True])
 def test_jacobians_against_finite_differences(tiny, name, step, y_as_time):
-    _, blocks, _ = _problem(tiny, y_as_time=y_as_time)
-    vals = dict(tiny.truth)
+    _, blocks, _ = _problem(tiny[0], y_as_time=y_as_time)
+    vals = dict(tiny[1].values)
     # away from zero corrections (1 cm, 0.1 mrad: the crossing time stays within T_MAX)
     vals["nodes"] = vals["nodes"] + np.r_[0.01, 0.01, 0.01, 1e-4, 1e-4, 1e-4]
     assert check_jacobian(blocks[0], vals, name, step) < 1e-6
@@ -51,9 +88,9 @@ def test_jacobians_against_finite_differences(tiny, name, step, y_as_time):
 @pytest.mark.parametrize("y_as_time", [False, True])
 def test_node_jacobian_against_finite_differences(tiny, y_as_time):
     """Every correction of the nodes that the first observations touch."""
-    _, blocks, _ = _problem(tiny, y_as_time=y_as_time)
+    _, blocks, _ = _problem(tiny[0], y_as_time=y_as_time)
     b = blocks[0]
-    vals = dict(tiny.truth)
+    vals = dict(tiny[1].values)
     vals["nodes"] = vals["nodes"] + np.r_[0.01, 0.01, 0.01, 1e-4, 1e-4, 1e-4]
     A = analytic_jacobian(b, vals, "nodes")
     nodes = np.unique(b._basis[0][:3])
@@ -72,27 +109,27 @@ def test_node_jacobian_against_finite_differences(tiny, y_as_time):
             assert np.max(np.abs(col - num)) <= tol * max(np.max(np.abs(num)), 1e-12)
 
 
-def _time_shifted(camp, a_s):
+def _time_shifted(obs: CampaignObservations, a_s):
     """Every noise-free observation twice, attributed to the lines at t + a and t − a.
 
     The image coordinates stay those of time t; the navigation pose moves with its rates. This
     is an observation error purely in time, exactly symmetric: an unbiased model must return
     the truth (up to O(a³)), whatever the size of σ̂.
     """
-    o = camp.obs
-    m = o["t_s"].size
+    o = obs.lines
+    m = o.n
     sgn = np.r_[np.ones(m), -np.ones(m)]
 
     def two(x):
         return np.concatenate([x, x])
 
-    obs = {"point": two(o["point"]), "band": two(o["band"]), "t_s": two(o["t_s"]) + a_s * sgn,
-           "xy_px": two(o["xy_px"]),
-           "xyz_rate_nav_m_s": two(o["xyz_rate_nav_m_s"]),
-           "rpy_rate_nav_rad_s": two(o["rpy_rate_nav_rad_s"])}
-    obs["xyz_nav_m"] = two(o["xyz_nav_m"]) + a_s * sgn[:, None] * obs["xyz_rate_nav_m_s"]
-    obs["rpy_nav_rad"] = two(o["rpy_nav_rad"]) + a_s * sgn[:, None] * obs["rpy_rate_nav_rad_s"]
-    return dataclasses.replace(camp, obs=obs)
+    vel, rate = two(o.xyz_rate_nav_m_s), two(o.rpy_rate_nav_rad_s)
+    lines = PushbroomObservations(
+        point=two(o.point), band=two(o.band), t_s=two(o.t_s) + a_s * sgn, xy_px=two(o.xy_px),
+        xyz_nav_m=two(o.xyz_nav_m) + a_s * sgn[:, None] * vel,
+        rpy_nav_rad=two(o.rpy_nav_rad) + a_s * sgn[:, None] * rate,
+        xyz_rate_nav_m_s=vel, rpy_rate_nav_rad_s=rate)
+    return dataclasses.replace(obs, lines=lines)
 
 
 @pytest.mark.parametrize("y_as_time", [True, False])
@@ -104,11 +141,11 @@ def test_symmetric_time_errors_do_not_bias(y_as_time):
     depth-scaled y) is biased by a fixed amount, which at full size (σ̂ 10× smaller than here)
     is several σ̂.
     """
-    camp = _time_shifted(simulate(0.005, rng=2, noise_free=True), 2.5e-3)
-    p, blocks, _ = _problem(camp, y_as_time=y_as_time)
+    obs, truth = simulate(0.005, rng=2, noise_free=True)
+    p, blocks, _ = _problem(_time_shifted(obs, 2.5e-3), y_as_time=y_as_time)
     res = adjust(p, blocks, ftol=1e-12)
-    zn = (res.value("nodes") - camp.truth["nodes"]) / res.sigma("nodes")
-    zc = np.concatenate([(res.value(k) - camp.truth[k]) / res.sigma(k)
+    zn = (res.value("nodes") - truth.values["nodes"]) / res.sigma("nodes")
+    zc = np.concatenate([(res.value(k) - truth.values[k]) / res.sigma(k)
                          for k in ["boresight_rad", "lever_arm_m", "distortion", "c_mm"]])
     if y_as_time:
         assert np.max(np.abs(zn)) < 0.01 and np.max(np.abs(zc)) < 0.01
@@ -117,63 +154,62 @@ def test_symmetric_time_errors_do_not_bias(y_as_time):
 
 
 def test_noise_free_recovers_truth():
-    camp = simulate(0.001, rng=11, noise_free=True)
-    p, blocks, _ = _problem(camp, y_as_time=True)
+    obs, truth = simulate(0.001, rng=11, noise_free=True)
+    p, blocks, _ = _problem(obs, y_as_time=True)
     assert identifiability(p, blocks).full_rank
     res = adjust(p, blocks, ftol=1e-15)
-    for k, v in camp.truth.items():
+    for k, v in truth.values.items():
         np.testing.assert_allclose(res.value(k), v, rtol=0, atol=1e-7, err_msg=k)
 
 
 @pytest.mark.parametrize("seed", [0])
 def test_truth_within_3_sigma_small_scale(seed):
-    camp = simulate(0.01, rng=seed)
-    p, blocks, _ = _problem(camp, y_as_time=True)
+    obs, truth = simulate(0.01, rng=seed)
+    p, blocks, _ = _problem(obs, y_as_time=True)
     res = adjust(p, blocks, reject_k=5.0, reject_every_iteration=True)
     for k in ["boresight_rad", "lever_arm_m", "distortion", "c_mm"]:
-        z = (res.value(k) - camp.truth[k]) / res.sigma(k)
+        z = (res.value(k) - truth.values[k]) / res.sigma(k)
         assert np.max(np.abs(z)) < 3.5, (k, z)  # 17 values: family-wise ≈ 1 % false alarms
     # ~1,000 node corrections: a few |z| > 3 are expected (0.27 %), so assert the coverage and
     # the spread of z rather than max |z| < 3
-    z = (res.value("nodes") - camp.truth["nodes"]) / res.sigma("nodes")
+    z = (res.value("nodes") - truth.values["nodes"]) / res.sigma("nodes")
     assert np.mean(np.abs(z) < 3) >= 0.99
     assert 0.8 <= np.std(z) <= 1.2, np.std(z, axis=0)
     r = res.residuals(0).reshape(-1, 2)[~res.outliers(0)]
     assert np.all((nmad(r, axis=0) > 0.2) & (nmad(r, axis=0) < 0.5))
-    cp = res.value("points_m")[camp.cp_index] - camp.truth["points_m"][camp.cp_index]
+    cp = res.value("points_m")[truth.cp_index] - truth.values["points_m"][truth.cp_index]
     assert np.all(nmad(cp[:, :2], axis=0) < 0.15)  # half the 0.3 m GSD
     # most simulated gross errors are found
-    assert np.mean(res.outliers(0)[camp.obs["outlier"]]) > 0.75  # 3 px ones can hide
+    assert np.mean(res.outliers(0)[truth.outlier]) > 0.75  # 3 px ones can hide
 
 
 def test_bad_input(tiny):
-    o = tiny.obs
-    _, blocks, nodes = _problem(tiny)
+    o = tiny[0].lines
+    _, blocks, nodes = _problem(tiny[0])
     with pytest.raises(InputError, match="shape"):
-        PushbroomLines(o["point"], o["band"][:-1], o["t_s"], o["xy_px"], o["xyz_nav_m"],
-                       o["rpy_nav_rad"], nodes, 0.0065)
+        PushbroomLines(o.point, o.band[:-1], o.t_s, o.xy_px, o.xyz_nav_m, o.rpy_nav_rad, nodes,
+                       0.0065)
     with pytest.raises(InputError, match="pixel pitch"):
-        PushbroomLines(o["point"], o["band"], o["t_s"], o["xy_px"], o["xyz_nav_m"],
-                       o["rpy_nav_rad"], nodes, 0.0)
+        PushbroomLines(o.point, o.band, o.t_s, o.xy_px, o.xyz_nav_m, o.rpy_nav_rad, nodes, 0.0)
     with pytest.raises(InputError, match="scale"):
         simulate(0.0)
-    obs = dict(o)
-    obs["point"] = o["point"].copy()
-    obs["point"][obs["point"] == 5] = 6  # point 5 unobserved
+    point = o.point.copy()
+    point[point == 5] = 6  # point 5 unobserved
     with pytest.raises(InputError, match="fewer than two"):
-        build_problem(obs, tiny.n_points, CameraPrior(n_bands=7))
+        build_problem(dataclasses.replace(o, point=point), tiny[0].n_points,
+                      CameraPrior(n_bands=7))
 
 
 def test_same_seed_same_bits():
-    a, b = simulate(0.001, rng=7), simulate(0.001, rng=7)
-    assert np.array_equal(a.obs["xy_px"], b.obs["xy_px"])
-    assert np.array_equal(a.truth["nodes"], b.truth["nodes"])
+    (a, ta), (b, tb) = simulate(0.001, rng=7), simulate(0.001, rng=7)
+    assert np.array_equal(a.lines.xy_px, b.lines.xy_px)
+    assert np.array_equal(ta.values["nodes"], tb.values["nodes"])
 
 
 def test_compiled_schur_equals_generic_on_pushbroom(tiny, monkeypatch):
     from hsgeo.adjust import engine as E
 
-    p, blocks, _ = _problem(tiny)
+    p, blocks, _ = _problem(tiny[0])
     lay = E._Layout(p)
     sy = E._evaluate(lay, blocks, [np.ones(b.m, bool) for b in blocks], True)
     got = {}
@@ -187,10 +223,11 @@ def test_compiled_schur_equals_generic_on_pushbroom(tiny, monkeypatch):
 
 
 def test_point_covariance_subset_equals_all(tiny):
-    p, blocks, _ = _problem(tiny)
+    p, blocks, _ = _problem(tiny[0])
     res = adjust(p, blocks, reject_k=5.0)
-    sub = res.point_covariance(index=tiny.cp_index)
-    full = res.point_covariance()[tiny.cp_index]
+    cp_index = tiny[1].cp_index
+    sub = res.point_covariance(index=cp_index)
+    full = res.point_covariance()[cp_index]
     np.testing.assert_allclose(sub, full, rtol=1e-12)
 
 
@@ -198,19 +235,19 @@ def test_time_residual_is_the_crossing_time_by_bisection(tiny):
     """The compiled time residual against the crossing time found by bisection with numpy."""
     from hsgeo.sensors.pushbroom import project
 
-    _, blocks, nodes = _problem(tiny, y_as_time=True)
+    _, blocks, nodes = _problem(tiny[0], y_as_time=True)
     b = blocks[0]
-    vals = dict(tiny.truth)
+    vals = dict(tiny[1].values)
     vals["nodes"] = vals["nodes"] + 0.002
     vals["boresight_rad"] = vals["boresight_rad"] + 1e-4
     r, _ = b.evaluate(vals, False)
-    o = tiny.obs
+    o = tiny[0].lines
     k = 1.0 / b.pixel_mm
 
     def xy_at(dt):
-        t = o["t_s"] + dt
-        xyz = o["xyz_nav_m"] + dt[:, None] * o["xyz_rate_nav_m_s"]
-        rpy = o["rpy_nav_rad"] + dt[:, None] * o["rpy_rate_nav_rad_s"]
+        t = o.t_s + dt
+        xyz = o.xyz_nav_m + dt[:, None] * o.xyz_rate_nav_m_s
+        rpy = o.rpy_nav_rad + dt[:, None] * o.rpy_rate_nav_rad_s
         xy, _ = project(vals, b.names, nodes, t, xyz, rpy, b.point, b.band, b.beta0,
                         b.x0_mm, b.y0_mm)
         return xy * k - b.xy_px
@@ -223,16 +260,16 @@ def test_time_residual_is_the_crossing_time_by_bisection(tiny):
         lo, hi = np.where(neg, mid, lo), np.where(neg, hi, mid)
     t_star = 0.5 * (lo + hi)
     # same spline piece as the line time (the model continues the piece of t_e)
-    same = (nodes.basis(o["t_s"] + t_star)[0][:, 0] == nodes.basis(o["t_s"])[0][:, 0])
+    same = (nodes.basis(o.t_s + t_star)[0][:, 0] == nodes.basis(o.t_s)[0][:, 0])
     assert same.mean() > 0.95
     np.testing.assert_allclose(r[1::2][same], -b.y_rate_ref_px_s * t_star[same], atol=1e-6)
     np.testing.assert_allclose(r[0::2][same], xy_at(t_star)[same, 0], atol=1e-6)
 
 
 def test_compiled_block_equals_numpy_block(tiny):
-    _, blocks, _ = _problem(tiny, y_as_time=False)
+    _, blocks, _ = _problem(tiny[0], y_as_time=False)
     b = blocks[0]
-    vals = dict(tiny.truth)
+    vals = dict(tiny[1].values)
     vals["nodes"] = vals["nodes"] + 0.01
     r1, j1 = b.evaluate(vals, True)
     r2, j2 = b.evaluate_numpy(vals, True)
@@ -256,7 +293,7 @@ def test_factored_node_jacobian_compiled_equals_generic(tiny, monkeypatch, lam, 
     """
     from hsgeo.adjust import engine as E
 
-    p, blocks, _ = _problem(tiny, y_as_time=True)
+    p, blocks, _ = _problem(tiny[0], y_as_time=True)
     if fix_node:
         p.fix("nodes", index=(3, 4))
     lay = E._Layout(p)
@@ -274,37 +311,36 @@ def test_factored_node_jacobian_compiled_equals_generic(tiny, monkeypatch, lam, 
 
 
 def test_time_residual_needs_rates_and_reference(tiny):
-    o = tiny.obs
-    _, _, nodes = _problem(tiny)
-    args = (o["point"], o["band"], o["t_s"], o["xy_px"], o["xyz_nav_m"], o["rpy_nav_rad"],
-            nodes, 0.0065)
+    o = tiny[0].lines
+    _, _, nodes = _problem(tiny[0])
+    args = (o.point, o.band, o.t_s, o.xy_px, o.xyz_nav_m, o.rpy_nav_rad, nodes, 0.0065)
     with pytest.raises(InputError, match="both"):
-        PushbroomLines(*args, xyz_rate_m_s=o["xyz_rate_nav_m_s"])
+        PushbroomLines(*args, xyz_rate_m_s=o.xyz_rate_nav_m_s)
     with pytest.raises(InputError, match="y_rate_ref_px_s"):
-        PushbroomLines(*args, xyz_rate_m_s=o["xyz_rate_nav_m_s"],
-                       rpy_rate_rad_s=o["rpy_rate_nav_rad_s"])
+        PushbroomLines(*args, xyz_rate_m_s=o.xyz_rate_nav_m_s,
+                       rpy_rate_rad_s=o.rpy_rate_nav_rad_s)
     with pytest.raises(InputError, match="shape"):
-        PushbroomLines(*args, xyz_rate_m_s=o["xyz_rate_nav_m_s"][:-1],
-                       rpy_rate_rad_s=o["rpy_rate_nav_rad_s"], y_rate_ref_px_s=220.0)
-    obs = {k: v for k, v in o.items() if k != "rpy_rate_nav_rad_s"}
+        PushbroomLines(*args, xyz_rate_m_s=o.xyz_rate_nav_m_s[:-1],
+                       rpy_rate_rad_s=o.rpy_rate_nav_rad_s, y_rate_ref_px_s=220.0)
+    no_rates = dataclasses.replace(o, xyz_rate_nav_m_s=None, rpy_rate_nav_rad_s=None)
     with pytest.raises(InputError, match="rates"):
-        build_problem(obs, tiny.n_points, CameraPrior(n_bands=7), y_as_time=True)
+        build_problem(no_rates, tiny[0].n_points, CameraPrior(n_bands=7), y_as_time=True)
 
 
 def test_simulated_navigation_rates_are_the_derivative_of_the_poses():
     """The simulator's GNSS/INS rates against central differences of its poses."""
     from hsgeo.simulate import pushbroom_campaign as pc
 
-    camp = simulate(0.001, rng=1)
-    o, cfg, h = camp.obs, camp.cfg, 1e-5
+    obs, truth = simulate(0.001, rng=1)
+    o, cfg, h = obs.lines, truth.cfg, 1e-5
     poses = []
     for dt in (h, -h):
-        t = o["t_s"] + dt
-        xyz, rpy = pc._true_pose(camp.strips, o["strip"], t, cfg.mount_motion_rad,
+        t = o.t_s + dt
+        xyz, rpy = pc._true_pose(truth.strips, truth.strip, t, cfg.mount_motion_rad,
                                  cfg.speed_m_s)
-        d = camp.nodes.evaluate(camp.truth["nodes"], t)
+        d = truth.nodes.evaluate(truth.values["nodes"], t)
         poses.append((xyz - d[:, :3], rpy - d[:, 3:]))
-    np.testing.assert_allclose(o["xyz_rate_nav_m_s"], (poses[0][0] - poses[1][0]) / (2 * h),
+    np.testing.assert_allclose(o.xyz_rate_nav_m_s, (poses[0][0] - poses[1][0]) / (2 * h),
                                atol=1e-6)
-    np.testing.assert_allclose(o["rpy_rate_nav_rad_s"], (poses[0][1] - poses[1][1]) / (2 * h),
+    np.testing.assert_allclose(o.rpy_rate_nav_rad_s, (poses[0][1] - poses[1][1]) / (2 * h),
                                atol=1e-9)

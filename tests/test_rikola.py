@@ -12,13 +12,14 @@ from hsgeo.measure.aruco import detect_targets, detection_rate, make_detector, t
 from hsgeo.papers import RIKOLA_BANDS, RIKOLA_TABLE4_ROP_DEG, RIKOLA_TABLE4_ROP_MEAN_DEG
 from hsgeo.reproduce.rikola import observe
 from hsgeo.rotations import R_from_opk, opk_from_R
-from hsgeo.sensors.frame import FramePhotogrammetric
+from hsgeo.sensors.frame import FramePhotogrammetric, mm_to_pixel
 from hsgeo.sensors.rikola import JointCentroids, TargetCentroids, project_measured_mm
 from hsgeo.simulate.rikola import Plate, Renderer, make_truth
 from hsgeo.simulate.scenarios import load_scenario
 from hsgeo.workflows.rikola import (
     calibrate_band,
     calibrate_joint,
+    detect_targets_in_images,
     gap_regression,
     relative_orientation,
 )
@@ -156,6 +157,22 @@ def test_truth_and_render_deterministic(cfg, truth):
     # sensor II band poses carry the misalignment: R_I_from_II = R_S1 R_S2^-1 (003 eq. (1))
     ang, _ = relative_orientation(truth.band_pose(0, 20), truth.band_pose(0, 5))
     np.testing.assert_allclose(ang, truth.rotation_rad, atol=1e-12)
+
+
+def test_rendered_image_is_measured_without_the_truth(cfg, truth):
+    """The simulator gives pixels only; the truth-free detection fills no truth-derived field
+    (``expected`` is left for reproduce), and its corners lie where the truth projects them."""
+    r = Renderer(cfg, truth)
+    img = r.render(0, 5, 7)
+    assert isinstance(img, np.ndarray) and img.dtype == np.uint16
+    plate, cam = r.plate, cfg["camera"]
+    size = (int(cam["width_px"]), int(cam["height_px"]))
+    obs, cmp_ = detect_targets_in_images([((0, 5), img)], plate.corners(), plate.ids, size,
+                                         float(cam["pixel_mm"]), dictionary=plate.dictionary)
+    assert cmp_ is None and obs.expected == {} and len(obs.target) > 10
+    true_px = mm_to_pixel(truth.project(0, 5, plate.corners()[obs.target]), size,
+                          cam["pixel_mm"])
+    assert np.median(np.abs(obs.corners_px - true_px)) < 0.5
 
 
 def test_detection_every_band(bench):

@@ -145,19 +145,19 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
 
     # 3. simulated bench, truth known
     cfg = load_scenario("frame_bench")
-    sim = simulate(cfg, seed)
-    n_views = sim["poses"].shape[0]
-    sviews = [View(sim["X"], sim["uv_px"][sim["view"] == i]) for i in range(n_views)]
-    scal = calibrate_opencv(sviews, (cfg["camera"]["width_px"], cfg["camera"]["height_px"]),
-                            sigma_px=cfg["camera"]["sigma_px"])
-    truth = dict(zip(("fx_px", "fy_px", "cx_px", "cy_px"), sim["intrinsics"], strict=True))
-    truth.update(zip(("k1", "k2", "p1", "p2", "k3"), sim["distortion"], strict=True))
+    sim, sim_truth = simulate(cfg, seed)
+    sviews = [View(sim.X_mm[sim.point[sim.view == i]], sim.uv_px[sim.view == i])
+              for i in range(sim.n_views)]
+    scal = calibrate_opencv(sviews, sim.image_size_px, sigma_px=sim.sigma_px)
+    truth = dict(zip(("fx_px", "fy_px", "cx_px", "cy_px"), sim_truth.intrinsics, strict=True))
+    truth.update(zip(("k1", "k2", "p1", "p2", "k3"), sim_truth.distortion, strict=True))
     sv, ss = scal.values(), scal.sigmas()
     t = "simulated bench"
     for q, unit in INTRINSIC_ROWS:
         rows.append(Row(t, q, unit, reproduced=sv[q], sigma=ss[q], truth=truth[q]))
     rows.append(Row(t, "sigma0", "1", reproduced=scal.result.sigma0, truth=1.0))
-    extras["bench"] = {"calibration": scal, "truth": truth, "simulation": sim}
+    extras["bench"] = {"calibration": scal, "truth": truth, "observations": sim,
+                       "simulation_truth": sim_truth}
 
     meta = {
         "chessboard_source": "opencv/opencv samples/cpp/tutorial_code/calib3d/camera_calibration/"

@@ -16,11 +16,12 @@ from hsgeo.gcp import deviation_table, recompute_printed_table
 from hsgeo.geocode import CalibratedLine
 from hsgeo.papers import P000_GCP_FOOTERS
 from hsgeo.report import Reproduction, Row
-from hsgeo.simulate.pula_flight import gcp_deviations, nominal_sensor, simulate_flight
+from hsgeo.simulate.pula_flight import FlightObservations, nominal_sensor, simulate_flight
 from hsgeo.simulate.scenarios import load_scenario
 from hsgeo.stats import nmad
+from hsgeo.workflows.geocoding import gcp_deviations
 
-__all__ = ["run", "calibrated_iop", "monte_carlo", "QUANTITIES"]
+__all__ = ["run", "calibrated_iop", "monte_carlo", "flight_deviations", "QUANTITIES"]
 
 QUANTITIES = ("bias_y_m", "bias_x_m", "sigma_y_m", "sigma_x_m")
 
@@ -38,6 +39,15 @@ def calibrated_iop(seed: int):
     return CalibratedLine(float(res.value("zeta0_px")), float(res.value("c_px")), K), res
 
 
+def flight_deviations(obs: FlightObservations, sensor, sigma_m: float = 0.3):
+    """:func:`hsgeo.workflows.geocoding.gcp_deviations` on one simulated flight's observations:
+    ``(dev_EN_m (n, 2), result)``.
+    """
+    return gcp_deviations(obs.recorded_nav, sensor, obs.line, obs.zeta_px, obs.gcp_enu_m,
+                          height_m=obs.terrain_height_m, t0_s=obs.t0_s,
+                          line_rate_hz=obs.line_rate_hz, sigma_m=sigma_m)
+
+
 def monte_carlo(cfg: dict, sensors: dict, n_flights: int, seed: int) -> dict:
     """Per-flight bias and σ (n − 1) of the GCP deviations for each sensor model.
 
@@ -45,20 +55,22 @@ def monte_carlo(cfg: dict, sensors: dict, n_flights: int, seed: int) -> dict:
     -------
     dict
         ``{model: (n_flights, 4) array of bias_y, bias_x, sigma_y, sigma_x}``, plus the first
-        flight and its deviations under ``"flight0"``.
+        flight (``"observations"``, ``"truth"``) and its deviations per model under
+        ``"flight0"``.
     """
     out = {name: np.empty((n_flights, 4)) for name in sensors}
     first = {}
     for i in range(n_flights):
-        fl = simulate_flight(cfg, np.random.SeedSequence([seed, i]).generate_state(1)[0])
+        obs, truth = simulate_flight(cfg,
+                                     np.random.SeedSequence([seed, i]).generate_state(1)[0])
         for name, sensor in sensors.items():
-            dev, res = gcp_deviations(fl, sensor)
-            _, s = deviation_table(dev[:, 0], dev[:, 1], fl.gcp_id)
+            dev, res = flight_deviations(obs, sensor)
+            _, s = deviation_table(dev[:, 0], dev[:, 1], obs.gcp_id)
             out[name][i] = [s[q] for q in QUANTITIES]
             if i == 0:
                 first[name] = (dev, res)
         if i == 0:
-            first["flight"] = fl
+            first["observations"], first["truth"] = obs, truth
     out["flight0"] = first
     return out
 

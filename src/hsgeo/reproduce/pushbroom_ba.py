@@ -1,9 +1,11 @@
 """``hsgeo reproduce pushbroom-ba``: 002 Tables 1–3 and Fig. 8 from a simulated campaign.
 
-The campaign (:mod:`hsgeo.simulate.pushbroom_campaign`) is adjusted twice, with the four GCPs
-(002 Tables 1, 2, Fig. 8) and without (Table 3). ``scale`` thins the tie points (1.0: the
+The campaign (:mod:`hsgeo.simulate.pushbroom_campaign`) is simulated as ``(observations,
+truth)``; the observations are adjusted (:mod:`hsgeo.workflows.pushbroom_ba`) twice, with the
+four GCPs (002 Tables 1, 2, Fig. 8) and without (Table 3). ``scale`` thins the tie points (1.0: the
 paper's 113,758). The node-interval study (:func:`node_interval_study`) is separate because it
-runs one adjustment per interval.
+runs one adjustment per interval. This module is the only place where the adjustment's
+results meet the campaign's truth (check points, parameters, gross errors).
 """
 
 from __future__ import annotations
@@ -14,11 +16,17 @@ import numpy as np
 
 from hsgeo.adjust import adjust, identifiability
 from hsgeo.report import Reproduction, Row
-from hsgeo.simulate.pushbroom_campaign import Campaign, simulate
+from hsgeo.simulate.pushbroom_campaign import (
+    CampaignConfig,
+    CampaignObservations,
+    CampaignTruth,
+    simulate,
+)
 from hsgeo.stats import describe
 from hsgeo.workflows.pushbroom_ba import CameraPrior, build_problem
 
-__all__ = ["run", "adjust_campaign", "node_interval_study", "y_model_comparison", "PAPER"]
+__all__ = ["run", "adjust_campaign", "camera_prior", "cp_errors", "outlier_detection",
+           "node_interval_study", "y_model_comparison", "PAPER"]
 
 RAD2DEG = 180 / np.pi
 STATS = ("min", "max", "median", "mean", "std", "nmad")
@@ -53,31 +61,40 @@ FTOL = 1e-6
 Y_AS_TIME = True
 
 
-def camera_prior(camp: Campaign) -> CameraPrior:
-    cfg = camp.cfg
+def camera_prior(cfg: CampaignConfig, obs: CampaignObservations) -> CameraPrior:
+    """What the operator knows of the camera: the scenario's nominal values (the initial
+    principal distance, pixel pitch, calibrated principal point, a-priori σ) and the measured
+    lever arm.
+    """
     return CameraPrior(n_bands=len(cfg.c_offsets_um), pixel_mm=cfg.pixel_mm,
                        c_mm=cfg.c_nominal_mm, x0_mm=cfg.x0_mm, y0_mm=cfg.y0_mm,
-                       lever_arm_m=tuple(camp.lever_arm_measured_m),
+                       lever_arm_m=tuple(obs.lever_arm_m),
                        sigma_lever_m=cfg.sigma_lever_m, sigma_pos_m=cfg.sigma_pos_m,
                        sigma_att_rad=cfg.sigma_att_rad, sigma_obs_px=cfg.sigma_obs_px,
                        sigma_gcp_m=cfg.sigma_gcp_m)
 
 
-def adjust_campaign(camp: Campaign, *, with_gcp: bool = True, node_interval_s: float = 10.0,
-                    reject_k: float | None = REJECT_K, ftol: float = FTOL, progress=None,
-                    check_truth_rank: bool = False, y_as_time: bool = Y_AS_TIME):
-    """Set up and adjust one campaign; returns ``(result, params, blocks, info)``."""
+def adjust_campaign(obs: CampaignObservations, cfg: CampaignConfig, *, with_gcp: bool = True,
+                    node_interval_s: float = 10.0, reject_k: float | None = REJECT_K,
+                    ftol: float = FTOL, progress=None, truth: CampaignTruth | None = None,
+                    y_as_time: bool = Y_AS_TIME):
+    """Set up and adjust one campaign's observations; returns ``(result, params, blocks, info)``.
+
+    ``cfg`` is the scenario (the operator's nominal camera and σ). With ``truth``, the rank of
+    the normal equations at the true values is added to ``info`` (``rank_at_truth``,
+    ``n_nonpoint_unknowns``); the adjustment itself never sees it.
+    """
     t0 = time.perf_counter()
     p, blocks, nodes = build_problem(
-        camp.obs, camp.n_points, camera_prior(camp), node_interval_s=node_interval_s,
-        t_span_s=(0.0, camp.nodes.t_end_s), node_prior_mean=(
-            camp.node_prior_mean if node_interval_s == camp.cfg.node_interval_s else None),
-        gcp_index=camp.gcp_index if with_gcp else None,
-        gcp_xyz_m=camp.gcp_xyz_m if with_gcp else None, y_as_time=y_as_time)
+        obs.lines, obs.n_points, camera_prior(cfg, obs), node_interval_s=node_interval_s,
+        t_span_s=obs.t_span_s, node_prior_mean=(
+            obs.node_prior_mean if node_interval_s == cfg.node_interval_s else None),
+        gcp_index=obs.gcp_index if with_gcp else None,
+        gcp_xyz_m=obs.gcp_xyz_m if with_gcp else None, y_as_time=y_as_time)
     info = {"setup_seconds": time.perf_counter() - t0, "nodes": nodes}
-    if check_truth_rank:
+    if truth is not None:
         q = p.copy()
-        for k, v in camp.truth.items():
+        for k, v in truth.values.items():
             if q[k].shape == np.shape(v):
                 q.set(k, v)
         ident = identifiability(q, blocks)
@@ -99,9 +116,36 @@ def _stats_rows(table, names, data, unit, paper):
     return rows
 
 
-def cp_errors(res, camp: Campaign) -> np.ndarray:
+def cp_errors(res, truth: CampaignTruth) -> np.ndarray:
     """Estimated minus true check-point coordinates ``(13, 3)`` in m (E, N, H)."""
-    return res.value("points_m")[camp.cp_index] - camp.truth["points_m"][camp.cp_index]
+    return res.value("points_m")[truth.cp_index] - truth.values["points_m"][truth.cp_index]
+
+
+def outlier_detection(res, obs: CampaignObservations, truth: CampaignTruth) -> dict:
+    """The rejected observations of ``res`` against the simulated gross errors.
+
+    Returns
+    -------
+    dict
+        ``simulated_outliers``, ``outliers_found`` (rejected gross errors),
+        ``false_rejections`` (rejected good observations), ``false_rejections_on_gross_points``
+        (of those, on points that also carry a gross error) and
+        ``missed_outlier_median_abs_z`` (median over the gross errors kept of their larger
+        normalised residual, x or y; NaN if none is kept).
+    """
+    rej, gross, point = res.outliers(0), truth.outlier, obs.lines.point
+    missed = gross & ~rej
+    return {
+        "simulated_outliers": int(gross.sum()),
+        "outliers_found": int((rej & gross).sum()),
+        "false_rejections": int((rej & ~gross).sum()),
+        "false_rejections_on_gross_points": int(np.isin(point[rej & ~gross],
+                                                        point[gross]).sum()),
+        # the gross errors kept: their largest normalised residual (x or y), median
+        "missed_outlier_median_abs_z": float(np.median(np.abs(
+            res.normalized_residuals(0).reshape(-1, 2)[missed]).max(axis=1)))
+        if missed.any() else float("nan"),
+    }
 
 
 def c_minus_mean(res, truth_c):
@@ -118,23 +162,23 @@ def c_minus_mean(res, truth_c):
 def run(seed: int = 0, scale: float = 1.0, progress=None) -> Reproduction:
     """The chapter's numbers: 002 Tables 1–3, Fig. 8 and the estimated parameters."""
     t_start = time.perf_counter()
-    camp = simulate(scale, rng=seed)
-    cfg = camp.cfg
+    cfg = CampaignConfig()
+    obs, truth = simulate(scale, rng=seed, cfg=cfg)
     rows: list[Row] = []
-    res, p, blocks, info = adjust_campaign(camp, with_gcp=True, progress=progress,
-                                           check_truth_rank=True)
-    res0, _, _, info0 = adjust_campaign(camp, with_gcp=False, progress=progress)
+    res, p, blocks, info = adjust_campaign(obs, cfg, with_gcp=True, progress=progress,
+                                           truth=truth)
+    res0, _, _, info0 = adjust_campaign(obs, cfg, with_gcp=False, progress=progress)
 
     # -- 002 Table 1: reprojection errors of the tie points (with GCPs), px
     keep = ~res.outliers(0)
     r_px = res.residuals(0).reshape(-1, 2)[keep]
     rows += _stats_rows("002 Table 1", ("x", "y"), r_px, "px", PAPER["002 Table 1"])
     # -- 002 Tables 2 and 3: check points, m
-    E_gcp, E_nogcp = cp_errors(res, camp), cp_errors(res0, camp)
+    E_gcp, E_nogcp = cp_errors(res, truth), cp_errors(res0, truth)
     rows += _stats_rows("002 Table 2", ("e", "n", "h"), E_gcp, "m", PAPER["002 Table 2"])
     rows += _stats_rows("002 Table 3", ("e", "n", "h"), E_nogcp, "m", PAPER["002 Table 3"])
     # -- 002 Fig. 8: principal distance per band minus the mean
-    d_um, s_um, t_um = c_minus_mean(res, camp.truth["c_mm"])
+    d_um, s_um, t_um = c_minus_mean(res, truth.values["c_mm"])
     for b, wl in enumerate(cfg.wavelengths_nm):
         rows.append(Row("002 Fig. 8", f"c_minus_mean_band{b}_{wl:.0f}nm_um", "um",
                         reproduced=d_um[b], sigma=s_um[b], truth=t_um[b]))
@@ -146,18 +190,18 @@ def run(seed: int = 0, scale: float = 1.0, progress=None) -> Reproduction:
     shift = np.max(np.abs(d_um)) * 1e-3 / c_mean * half_px  # chromatic shift at the line's end
     rows.append(Row("002 Fig. 8", "chromatic_shift_at_edge_px", "px",
                     paper=PAPER["chromatic_shift_px"], reproduced=shift,
-                    truth=np.max(np.abs(t_um)) * 1e-3 / camp.truth["c_mm"].mean() * half_px))
+                    truth=np.max(np.abs(t_um)) * 1e-3 / truth.values["c_mm"].mean() * half_px))
     # -- parameters: boresight, lever arm, distortion, c, nodes (with GCPs)
     par = []
     for name, unit, f in [("boresight_rad", "deg", RAD2DEG), ("lever_arm_m", "m", 1.0),
                           ("distortion", "", 1.0), ("c_mm", "mm", 1.0)]:
         lab = res.params[name].labels()
-        v, s, t = res.value(name).ravel(), res.sigma(name).ravel(), camp.truth[name].ravel()
+        v, s, t = res.value(name).ravel(), res.sigma(name).ravel(), truth.values[name].ravel()
         for j in range(v.size):
             qn = lab[j].replace("_rad", "_deg") if unit == "deg" else lab[j]
             par.append(Row("parameters", qn, unit, reproduced=v[j] * f, sigma=s[j] * f,
                            truth=t[j] * f))
-    nv, ns_, nt = res.value("nodes"), res.sigma("nodes"), camp.truth["nodes"]
+    nv, ns_, nt = res.value("nodes"), res.sigma("nodes"), truth.values["nodes"]
     lab = res.params["nodes"].labels()
     for j in range(nv.size):
         par.append(Row("parameters", lab[j], "m" if j % 6 < 3 else "rad",
@@ -165,12 +209,12 @@ def run(seed: int = 0, scale: float = 1.0, progress=None) -> Reproduction:
     rows += par
     z = np.array([(r.reproduced - r.truth) / r.sigma for r in par])
 
-    n_lines = int(round(sum(s[1] - s[0] for s in camp.strips) * cfg.line_rate_hz))
-    cp_sigma = np.sqrt(np.diagonal(res.point_covariance(index=camp.cp_index), axis1=1, axis2=2))
+    n_lines = int(round(sum(s[1] - s[0] for s in truth.strips) * cfg.line_rate_hz))
+    cp_sigma = np.sqrt(np.diagonal(res.point_covariance(index=truth.cp_index), axis1=1, axis2=2))
     meta = {
         "scale": scale,
-        "n_tie_points": camp.n_points,
-        "n_observations_2d": int(camp.obs["point"].size),
+        "n_tie_points": obs.n_points,
+        "n_observations_2d": obs.lines.n,
         "n_unknowns": int(res.n_unknowns),
         "n_nonpoint_unknowns": int(info["n_nonpoint_unknowns"]),
         "rank_at_truth": int(info["rank_at_truth"]),
@@ -186,16 +230,7 @@ def run(seed: int = 0, scale: float = 1.0, progress=None) -> Reproduction:
         "solver_seconds_gcp": info["solver_seconds"],
         "solver_seconds_nogcp": info0["solver_seconds"],
         "rejected_gcp": int(res.outliers(0).sum()),
-        "simulated_outliers": int(camp.obs["outlier"].sum()),
-        "outliers_found": int((res.outliers(0) & camp.obs["outlier"]).sum()),
-        "false_rejections": int((res.outliers(0) & ~camp.obs["outlier"]).sum()),
-        "false_rejections_on_gross_points": int(np.isin(
-            camp.obs["point"][res.outliers(0) & ~camp.obs["outlier"]],
-            camp.obs["point"][camp.obs["outlier"]]).sum()),
-        # the gross errors kept: their largest normalised residual (x or y), median
-        "missed_outlier_median_abs_z": float(np.median(np.abs(
-            res.normalized_residuals(0).reshape(-1, 2)[camp.obs["outlier"] & ~res.outliers(0)]
-        ).max(axis=1))) if (camp.obs["outlier"] & ~res.outliers(0)).any() else float("nan"),
+        **outlier_detection(res, obs, truth),
         "share_params_within_3sigma": float(np.mean(np.abs(z) < 3)),
         "z_std_parameters": float(np.std(z)),
         "z_std_nodes": np.std((nv - nt) / ns_, axis=0).tolist(),
@@ -205,7 +240,7 @@ def run(seed: int = 0, scale: float = 1.0, progress=None) -> Reproduction:
                   cfg.agl_high_m * cfg.pixel_mm / cfg.c_mean_mm],
         "total_seconds": time.perf_counter() - t_start,
     }
-    extras = {"campaign": camp, "result_gcp": res, "result_nogcp": res0,
+    extras = {"observations": obs, "truth": truth, "result_gcp": res, "result_nogcp": res0,
               "cp_errors_gcp": E_gcp, "cp_errors_nogcp": E_nogcp, "cp_sigma_m": cp_sigma,
               "residuals_px": r_px, "c_minus_mean_um": (d_um, s_um, t_um), "z_parameters": z}
     return Reproduction("pushbroom-ba", seed, rows, meta, extras)
@@ -215,13 +250,14 @@ def y_model_comparison(seed: int = 0, scale: float = 0.3) -> list[dict]:
     """Principal-distance bias, pitch-node z spread and CP errors without GCPs: image y vs time."""
     from hsgeo.stats import nmad
 
-    camp = simulate(scale, rng=seed)
+    cfg = CampaignConfig()
+    obs, truth = simulate(scale, rng=seed, cfg=cfg)
     out = []
     for yt in (False, True):
-        res, _, _, info = adjust_campaign(camp, with_gcp=False, y_as_time=yt)
-        E = cp_errors(res, camp)
-        dc = res.value("c_mm") - camp.truth["c_mm"]
-        zn = (res.value("nodes") - camp.truth["nodes"]) / res.sigma("nodes")
+        res, _, _, info = adjust_campaign(obs, cfg, with_gcp=False, y_as_time=yt)
+        E = cp_errors(res, truth)
+        dc = res.value("c_mm") - truth.values["c_mm"]
+        zn = (res.value("nodes") - truth.values["nodes"]) / res.sigma("nodes")
         out.append({"y_residual": "time" if yt else "image y (002 eq. 2)",
                     "mean_c_error_um": float(dc.mean() * 1e3),
                     "mean_z_c": float(np.mean(dc / res.sigma("c_mm"))),
@@ -242,12 +278,12 @@ def node_interval_study(seed: int = 0, scale: float = 0.05,
     """
     from hsgeo.stats import nmad
 
-    camp = simulate(scale, rng=seed)
+    cfg = CampaignConfig()
+    obs, truth = simulate(scale, rng=seed, cfg=cfg)
     out = []
     for dt in intervals_s:
-        res, p, blocks, info = adjust_campaign(camp, with_gcp=True, node_interval_s=dt,
-                                               check_truth_rank=False)
-        E = cp_errors(res, camp)
+        res, p, blocks, info = adjust_campaign(obs, cfg, with_gcp=True, node_interval_s=dt)
+        E = cp_errors(res, truth)
         r = res.residuals(0).reshape(-1, 2)[~res.outliers(0)]
         out.append({"interval_s": dt, "n_nonpoint_unknowns": len(res.labels),
                     "nmad_x_px": float(nmad(r[:, 0])), "nmad_y_px": float(nmad(r[:, 1])),

@@ -55,6 +55,8 @@ Jonassen et al. (2024), 002 eq. (2)–(4), §3.3–3.5.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from numba import njit, prange
 
@@ -63,7 +65,8 @@ from hsgeo.errors import InputError
 from hsgeo.rotations import R_from_opk, R_from_rpy, dR_dopk, dR_drpy
 from hsgeo.trajectory import SplineNodes, bspline_basis
 
-__all__ = ["PushbroomLines", "BETA0_CAM_FROM_PLATFORM", "BLOCK_NAMES", "project"]
+__all__ = ["PushbroomLines", "PushbroomObservations", "BETA0_CAM_FROM_PLATFORM", "BLOCK_NAMES",
+           "project"]
 
 #: Nominal camera-from-platform rotation (platform x forward, y left, z up → camera x right,
 #: y backward, z down).
@@ -335,6 +338,73 @@ def _lines_kernel(P, pidx, idx, u0, inv_dt, nodes, xyz_nav, rpy_nav, xyz_rate, r
                     dD[ry, a] *= fy
                 dC[rx, 0] -= fx * dC[ry, 0]
                 dC[ry, 0] *= fy
+
+
+@dataclass(frozen=True)
+class PushbroomObservations:
+    """Tie-point observations in LP lines and the GNSS/INS pose at their line times.
+
+    What a user's files give once the navigation is read at the line times (``hsgeo
+    adjust-pushbroom``), and what a simulator hands to the adjustment: nothing here is truth.
+    Arrays are converted (integers to int64, the rest to float64) and their shapes checked.
+
+    Parameters
+    ----------
+    point : (m,) int ndarray
+        Tie point of each observation (0-based row of the points block).
+    band : (m,) int ndarray
+        Spectral band (0-based).
+    t_s : (m,) ndarray
+        Exposure time of the line, s (the navigation's time scale).
+    xy_px : (m, 2) ndarray
+        Image coordinates, px from the line centre (x along the line, y across it).
+    xyz_nav_m, rpy_nav_rad : (m, 3) ndarray
+        GNSS/INS position (map frame E, N, U, m) and attitude (roll, pitch, yaw, rad) at ``t_s``.
+    xyz_rate_nav_m_s, rpy_rate_nav_rad_s : (m, 3) ndarray, optional
+        GNSS/INS velocity (m/s) and attitude rates (rad/s) at ``t_s``: both or neither (the
+        residual across the line as a time needs them).
+    """
+
+    point: np.ndarray
+    band: np.ndarray
+    t_s: np.ndarray
+    xy_px: np.ndarray
+    xyz_nav_m: np.ndarray
+    rpy_nav_rad: np.ndarray
+    xyz_rate_nav_m_s: np.ndarray | None = None
+    rpy_rate_nav_rad_s: np.ndarray | None = None
+
+    def __post_init__(self):
+        if (self.xyz_rate_nav_m_s is None) != (self.rpy_rate_nav_rad_s is None):
+            raise InputError("give both GNSS/INS rates (xyz_rate_nav_m_s and rpy_rate_nav_rad_s) "
+                             "or neither")
+        point = np.asarray(self.point)
+        band = np.asarray(self.band)
+        for nm, arr in (("point", point), ("band", band)):
+            if arr.size and (not np.issubdtype(arr.dtype, np.integer) or np.any(arr < 0)):
+                raise InputError(f"{nm} indices must be non-negative integers")
+        m = point.size
+        shapes = {"point": (m,), "band": (m,), "t_s": (m,), "xy_px": (m, 2), "xyz_nav_m": (m, 3),
+                  "rpy_nav_rad": (m, 3), "xyz_rate_nav_m_s": (m, 3), "rpy_rate_nav_rad_s": (m, 3)}
+        for nm, shape in shapes.items():
+            v = getattr(self, nm)
+            if v is None:
+                continue
+            v = np.asarray(v, dtype=np.int64 if nm in ("point", "band") else np.float64)
+            if v.shape != shape:
+                raise InputError(f"observations: {nm} has shape {v.shape}, expected {shape} "
+                                 f"for {m} observations")
+            object.__setattr__(self, nm, v)
+
+    @property
+    def n(self) -> int:
+        """Number of observations (each an x and a y)."""
+        return int(self.point.size)
+
+    @property
+    def has_rates(self) -> bool:
+        """Whether the GNSS/INS rates are given."""
+        return self.xyz_rate_nav_m_s is not None
 
 
 class PushbroomLines(ResidualBlock):

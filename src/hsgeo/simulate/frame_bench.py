@@ -7,6 +7,7 @@ one of the ``frame-reference`` chapter; the poses are random but seeded.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -15,7 +16,62 @@ from hsgeo.rotations import R_from_opk, opk_from_R
 from hsgeo.sensors.frame import project_opencv
 from hsgeo.simulate import as_rng
 
-__all__ = ["simulate", "generate"]
+__all__ = ["BenchObservations", "BenchTruth", "board_points", "simulate", "generate"]
+
+
+@dataclass(frozen=True)
+class BenchObservations:
+    """What the bench records and the operator knows: nothing here is truth.
+
+    Attributes
+    ----------
+    X_mm : (n_board, 3) ndarray
+        Board corners (the board's design), mm, row-major, Z = 0.
+    view : (n,) int ndarray
+        View of each observation.
+    point : (n,) int ndarray
+        Board corner of each observation (row of ``X_mm``).
+    uv_px : (n, 2) ndarray
+        Measured image coordinates, px (OpenCV convention), with noise.
+    image_size_px : (int, int)
+        Width and height of the images, px.
+    sigma_px : float
+        A-priori σ of an image coordinate, px.
+    """
+
+    X_mm: np.ndarray
+    view: np.ndarray
+    point: np.ndarray
+    uv_px: np.ndarray
+    image_size_px: tuple
+    sigma_px: float
+
+    @property
+    def n_views(self) -> int:
+        """Number of views."""
+        return int(self.view.max()) + 1 if self.view.size else 0
+
+
+@dataclass(frozen=True)
+class BenchTruth:
+    """The truth of a simulated bench (for :mod:`hsgeo.reproduce` only).
+
+    Attributes
+    ----------
+    poses : (n_views, 6) ndarray
+        ω, φ, κ (rad) and the projection centre X0, Y0, Z0 (mm) of each view.
+    intrinsics : (4,) ndarray
+        fx, fy, cx, cy, px.
+    distortion : (5,) ndarray
+        k1, k2, p1, p2, k3 (OpenCV).
+    uv_true_px : (n, 2) ndarray
+        Exact image coordinates of each observation, px.
+    """
+
+    poses: np.ndarray
+    intrinsics: np.ndarray
+    distortion: np.ndarray
+    uv_true_px: np.ndarray
 
 
 def board_points(nx: int, ny: int, square: float) -> np.ndarray:
@@ -24,13 +80,19 @@ def board_points(nx: int, ny: int, square: float) -> np.ndarray:
     return np.column_stack([square * (k % nx), square * (k // nx), np.zeros(k.size)])
 
 
-def simulate(cfg: dict, rng) -> dict:
-    """Truth and noisy observations of the bench.
+def simulate(cfg: dict, rng) -> tuple[BenchObservations, BenchTruth]:
+    """Noisy observations and the truth of the bench.
+
+    Parameters
+    ----------
+    cfg : dict
+        The ``frame_bench`` scenario (``[camera]``, ``[board]``, ``[geometry]``).
+    rng : int or numpy.random.Generator
 
     Returns
     -------
-    dict with ``X`` (n_board, 3), ``poses`` (n_views, 6), ``intrinsics`` (4,), ``distortion``
-    (5,), ``view`` (n,), ``point`` (n,), ``uv_px`` (n, 2) noisy, ``uv_true_px`` (n, 2).
+    observations : BenchObservations
+    truth : BenchTruth
     """
     rng = as_rng(rng)
     cam, board, geo = cfg["camera"], cfg["board"], cfg["geometry"]
@@ -64,20 +126,20 @@ def simulate(cfg: dict, rng) -> dict:
             uv.append(p)
     uv_true = np.concatenate(uv)
     noisy = uv_true + cam["sigma_px"] * rng.standard_normal(uv_true.shape)
-    return {"X": X, "poses": np.array(poses), "intrinsics": intr, "distortion": dist,
-            "view": np.concatenate(views), "point": np.concatenate(pts),
-            "uv_px": noisy, "uv_true_px": uv_true}
+    obs = BenchObservations(X, np.concatenate(views), np.concatenate(pts), noisy,
+                            (int(w), int(h)), float(cam["sigma_px"]))
+    return obs, BenchTruth(np.array(poses), intr, dist, uv_true)
 
 
 def generate(cfg: dict, outdir: Path) -> list[Path]:
     """Write ``frame_bench_observations.csv`` and ``frame_bench_truth.csv``."""
-    sim = simulate(cfg, cfg["scenario"]["seed"])
+    sim, truth = simulate(cfg, cfg["scenario"]["seed"])
     obs = outdir / "frame_bench_observations.csv"
-    X = sim["X"][sim["point"]]
-    table = np.column_stack([sim["view"], sim["point"], X, sim["uv_px"]])
+    X = sim.X_mm[sim.point]
+    table = np.column_stack([sim.view, sim.point, X, sim.uv_px])
     np.savetxt(obs, table, delimiter=",", fmt=["%d", "%d"] + ["%.17g"] * 5,
                header="view,point,X_mm,Y_mm,Z_mm,u_px,v_px", comments="")
-    truth = outdir / "frame_bench_truth.csv"
-    np.savetxt(truth, sim["poses"], delimiter=",", fmt="%.17g",
+    truth_csv = outdir / "frame_bench_truth.csv"
+    np.savetxt(truth_csv, truth.poses, delimiter=",", fmt="%.17g",
                header="omega_rad,phi_rad,kappa_rad,X0_mm,Y0_mm,Z0_mm", comments="")
-    return [obs, truth]
+    return [obs, truth_csv]

@@ -6,6 +6,11 @@ trajectory with helicopter-like attitude motion; the recorded navigation adds GN
 the scanner is mounted with an unknown boresight misalignment. Each GCP is observed where the
 true sensor sees it: its line (sub-line centroid, with noise) and its pixel ζ (with noise).
 
+:func:`simulate_flight` returns ``(observations, truth)``: the recorded navigation, the GCP
+image observations and what the operator knows (surveyed GCPs, nominal sensor) in
+:class:`FlightObservations`; the true navigation, sensor and boresight in :class:`FlightTruth`.
+Geocoding the GCPs is a workflow (:func:`hsgeo.workflows.geocoding.gcp_deviations`).
+
 Every function takes ``rng``.
 """
 
@@ -22,32 +27,79 @@ from hsgeo.geocode import (
     LinearIFOV,
     LineGeometry,
     PlaneTerrain,
-    calibrate_boresight,
-    geocode_observations,
 )
 from hsgeo.navigation import Navigation
 from hsgeo.rotations import R_from_rpy
 from hsgeo.simulate import as_rng
 
-__all__ = ["Flight", "simulate_flight", "gcp_field", "observe_gcps", "generate", "gcp_deviations",
-           "airfield_scene", "render_line_image", "true_sensor", "nominal_sensor"]
+__all__ = ["FlightObservations", "FlightTruth", "simulate_flight", "gcp_field", "observe_gcps",
+           "generate", "airfield_scene", "render_line_image", "true_sensor", "nominal_sensor"]
 
 
-@dataclass
-class Flight:
-    """One simulated flight: truth, recorded navigation and GCP observations."""
+@dataclass(frozen=True)
+class FlightObservations:
+    """What the operator of one simulated flight has: nothing here is truth.
 
-    true_nav: Navigation
+    Attributes
+    ----------
+    recorded_nav : Navigation
+        The recorded GNSS/IMU navigation (with its errors).
+    t0_s : float
+        Time of line 0, s.
+    line_rate_hz : float
+        Scanner line rate, Hz.
+    gcp_id : (n,) int ndarray
+        GCP labels.
+    gcp_enu_m : (n, 3) ndarray
+        Surveyed GCP coordinates, E, N, U in m.
+    line : (n,) ndarray
+        Measured (fractional) line of each GCP.
+    zeta_px : (n,) ndarray
+        Measured pixel of each GCP, px.
+    terrain_height_m : float
+        Height of the (flat) field, m.
+    sensor_nominal : LinearIFOV
+        The uncalibrated sensor model the operator starts from (Jakšić 2009).
+    """
+
     recorded_nav: Navigation
-    boresight_rad: np.ndarray  # true (roll, pitch, heading) misalignment of the scanner
-    t0_s: float  # time of line 0
+    t0_s: float
     line_rate_hz: float
     gcp_id: np.ndarray
-    gcp_enu_m: np.ndarray  # (n, 3) true GCP coordinates
-    line: np.ndarray  # (n,) measured (fractional) line of each GCP
-    zeta_px: np.ndarray  # (n,) measured pixel of each GCP
+    gcp_enu_m: np.ndarray
+    line: np.ndarray
+    zeta_px: np.ndarray
     terrain_height_m: float
-    sensor: LineGeometry  # the true sensor
+    sensor_nominal: LinearIFOV
+
+
+@dataclass(frozen=True)
+class FlightTruth:
+    """The truth of one simulated flight (for :mod:`hsgeo.reproduce` and rendering only).
+
+    Attributes
+    ----------
+    true_nav : Navigation
+        The true trajectory.
+    sensor : CalibratedLine
+        The true sensor (000 Table 1).
+    boresight_rad : (3,) ndarray
+        True (roll, pitch, heading) misalignment of the scanner, rad.
+    gcp_enu_m : (n, 3) ndarray
+        True GCP coordinates, m (the surveyed ones are exact in this scenario).
+    terrain_height_m : float
+        True height of the field, m.
+    t0_s, line_rate_hz : float
+        Time of line 0 (s) and line rate (Hz) of the scanner.
+    """
+
+    true_nav: Navigation
+    sensor: CalibratedLine
+    boresight_rad: np.ndarray
+    gcp_enu_m: np.ndarray
+    terrain_height_m: float
+    t0_s: float
+    line_rate_hz: float
 
 
 def gcp_field(cfg: dict) -> tuple[np.ndarray, np.ndarray]:
@@ -143,8 +195,8 @@ def true_sensor(cfg: dict) -> CalibratedLine:
     return CalibratedLine(s["zeta0_px"], s["c_px"], tuple(s["K"]))
 
 
-def simulate_flight(cfg: dict, rng) -> Flight:
-    """One flight over the field (see the module docstring)."""
+def simulate_flight(cfg: dict, rng) -> tuple[FlightObservations, FlightTruth]:
+    """One flight over the field (see the module docstring): ``(observations, truth)``."""
     rng = as_rng(rng)
     nav, T, _ = _true_trajectory(cfg, rng)
     rec = _recorded(nav, cfg, rng)
@@ -155,25 +207,15 @@ def simulate_flight(cfg: dict, rng) -> Flight:
     m = cfg["measurement"]
     line, zeta = observe_gcps(nav, sensor, bs, 0.0, rate, enu, rng, m["sigma_line"],
                               m["sigma_px"])
-    return Flight(nav, rec, bs, 0.0, rate, ids, enu, line, zeta, cfg["field"]["height_m"], sensor)
-
-
-def gcp_deviations(fl: Flight, sensor: LineGeometry, sigma_m: float = 0.3):
-    """Geocode the flight's GCP observations with an assumed sensor, after calibrating the
-    boresight on the same GCPs (as PARGE does); returns ``(dev_EN_m (n, 2), result)``.
-    """
-    kw = {"t0_s": fl.t0_s, "line_rate_hz": fl.line_rate_hz}
-    res = calibrate_boresight(fl.recorded_nav, sensor, fl.line, fl.zeta_px, fl.gcp_enu_m,
-                              height_m=fl.terrain_height_m, sigma_m=sigma_m, **kw)
-    X = geocode_observations(fl.recorded_nav, sensor, fl.line, fl.zeta_px,
-                             terrain=PlaneTerrain(fl.terrain_height_m),
-                             boresight_rad=res.value("boresight"), **kw)
-    return X[:, :2] - fl.gcp_enu_m[:, :2], res
+    h = cfg["field"]["height_m"]
+    obs = FlightObservations(rec, 0.0, rate, ids, enu.copy(), line, zeta, h,
+                             nominal_sensor(cfg))
+    return obs, FlightTruth(nav, sensor, bs, enu, h, 0.0, rate)
 
 
 def generate(cfg: dict, outdir: Path) -> list[Path]:
     """``make data``: the recorded navigation and GCP observations of the scenario's seed."""
-    fl = simulate_flight(cfg, cfg["scenario"]["seed"])
+    fl, _ = simulate_flight(cfg, cfg["scenario"]["seed"])
     nav = fl.recorded_nav.write_csv(outdir / "pula_flight_navigation.csv")
     obs = outdir / "pula_flight_gcp_observations.csv"
     np.savetxt(obs, np.column_stack([fl.gcp_id, fl.line, fl.zeta_px, fl.gcp_enu_m]),
@@ -202,11 +244,12 @@ def airfield_scene(E_m, N_m, gcp_enu_m=None, target_m: float = 3.0) -> np.ndarra
     return val
 
 
-def render_line_image(fl: Flight, cfg: dict, rng=None, *, noise: float = 0.005):
+def render_line_image(truth: FlightTruth, cfg: dict, rng=None, *, noise: float = 0.005):
     """What the scanner records along the flight: ``(n_lines, n_px)`` radiance and the ζ of the
     columns (pixel centres ζ0 ± usable half width), rendered with the *true* navigation, boresight
     and sensor, with Gaussian noise.
     """
+    fl = truth
     from hsgeo.geocode import geocode_image
 
     rng = as_rng(0 if rng is None else rng)

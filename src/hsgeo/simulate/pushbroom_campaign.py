@@ -30,15 +30,22 @@ numerical precision.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from types import MappingProxyType
 
 import numpy as np
 
 from hsgeo.errors import InputError
-from hsgeo.sensors.pushbroom import BETA0_CAM_FROM_PLATFORM, BLOCK_NAMES, project
+from hsgeo.sensors.pushbroom import (
+    BETA0_CAM_FROM_PLATFORM,
+    BLOCK_NAMES,
+    PushbroomObservations,
+    project,
+)
 from hsgeo.trajectory import SplineNodes
 
-__all__ = ["CampaignConfig", "Campaign", "simulate"]
+__all__ = ["CampaignConfig", "CampaignObservations", "CampaignTruth", "simulate"]
 
 DEG = np.pi / 180
 
@@ -87,28 +94,74 @@ class CampaignConfig:
     mount_motion_rad: float = 0.02 * DEG  # ours: residual motion of the stabilised mount
 
 
-@dataclass
-class Campaign:
-    """Truth, navigation and observations of one simulated campaign."""
+@dataclass(frozen=True)
+class CampaignObservations:
+    """What the operator of the simulated campaign has: nothing here is truth.
+
+    Attributes
+    ----------
+    lines : PushbroomObservations
+        The tie-point observations and the GNSS/INS solution at their line times.
+    n_points : int
+        Number of points (rows of the points block: 17 reference squares, then the tie points).
+    gcp_index : (4,) int ndarray
+        Rows of the points that are GCPs.
+    gcp_xyz_m : (4, 3) ndarray
+        Their RTK coordinates, E, N, H in m (σ ``cfg.sigma_gcp_m``; exact when noise-free).
+    lever_arm_m : (3,) ndarray
+        The tape-measured lever arm, m (σ ``cfg.sigma_lever_m``; exact when noise-free).
+    node_prior_mean : (n_nodes, 6) ndarray
+        GNSS/INS prior mean of the node corrections at the campaign's node interval: zero (the
+        solution's own estimate), or the exact corrections in the noise-free mode (every
+        pseudo-observation exact).
+    t_span_s : (float, float)
+        Time span of the navigation solution, s (the whole flight, turns included).
+    """
+
+    lines: PushbroomObservations
+    n_points: int
+    gcp_index: np.ndarray
+    gcp_xyz_m: np.ndarray
+    lever_arm_m: np.ndarray
+    node_prior_mean: np.ndarray
+    t_span_s: tuple
+
+
+@dataclass(frozen=True)
+class CampaignTruth:
+    """The truth of one simulated campaign (for :mod:`hsgeo.reproduce` only).
+
+    Attributes
+    ----------
+    cfg : CampaignConfig
+    scale : float
+    values : mapping
+        Parameter block name (:data:`~hsgeo.sensors.pushbroom.BLOCK_NAMES`) -> true value: the
+        points ``(n_points, 3)`` m, the node errors of the navigation ``(n_nodes, 6)``, the
+        boresight (3,) rad, the lever arm (3,) m, K1, K2, P1, P2 and c per band (mm).
+    nodes : SplineNodes
+        The node layout of the true trajectory error.
+    strips : list of tuple
+        The flight plan: (t_start_s, t_end_s, east_m, agl_m, heading sign) per strip.
+    strip : (m,) int ndarray
+        Strip of each observation.
+    cp_index : (13,) int ndarray
+        Rows of the points that are check points.
+    outlier : (m,) bool ndarray
+        Observations with a gross error.
+    xy_true_px : (m, 2) ndarray
+        Exact image coordinates of each observation in its line.
+    """
 
     cfg: CampaignConfig
     scale: float
-    truth: dict  # parameter block name -> true value
-    nodes: SplineNodes  # the node layout of the true trajectory error
-    obs: dict  # point, band, t_s, xy_px, strip, xyz_nav_m, rpy_nav_rad, xyz_rate_nav_m_s,
-    #            rpy_rate_nav_rad_s, outlier, xy_true_px
-    gcp_index: np.ndarray  # rows of the points block that are GCPs
-    cp_index: np.ndarray  # rows that are check points
-    gcp_xyz_m: np.ndarray  # RTK coordinates of the GCPs (with their error)
-    strips: list = field(default_factory=list)  # (t0, t1, east, agl, heading sign)
-    lever_arm_measured_m: np.ndarray | None = None
-    #: GNSS/INS prior mean of the node corrections: zero (the solution's own estimate), or the
-    #: truth in the noise-free mode (every pseudo-observation exact)
-    node_prior_mean: np.ndarray | None = None
-
-    @property
-    def n_points(self) -> int:
-        return self.truth[BLOCK_NAMES["points"]].shape[0]
+    values: Mapping[str, np.ndarray]
+    nodes: SplineNodes
+    strips: list = field(default_factory=list)
+    strip: np.ndarray | None = None
+    cp_index: np.ndarray | None = None
+    outlier: np.ndarray | None = None
+    xy_true_px: np.ndarray | None = None
 
 
 def _strip_plan(cfg: CampaignConfig):
@@ -160,7 +213,7 @@ def _true_pose(plan, strip, t, amp, speed_m_s):
 
 
 def simulate(scale: float = 1.0, rng=0, noise_free: bool = False,
-             cfg: CampaignConfig | None = None) -> Campaign:
+             cfg: CampaignConfig | None = None) -> tuple[CampaignObservations, CampaignTruth]:
     """Simulate the campaign at ``scale`` (the share of the paper's tie points).
 
     Parameters
@@ -173,6 +226,13 @@ def simulate(scale: float = 1.0, rng=0, noise_free: bool = False,
         Exact image coordinates, no outliers, exact GCPs (for the noise-free recovery test).
     cfg : CampaignConfig, optional
         Defaults to 002's values.
+
+    Returns
+    -------
+    observations : CampaignObservations
+        What the adjustment may use.
+    truth : CampaignTruth
+        What only :mod:`hsgeo.reproduce` compares with.
     """
     if not (0 < scale <= 1.0):
         raise InputError(f"scale must be in (0, 1], got {scale!r}")
@@ -301,11 +361,15 @@ def simulate(scale: float = 1.0, rng=0, noise_free: bool = False,
         comp = rng.integers(0, 2, n_out)
         xy_obs[np.flatnonzero(outlier), comp] += mag
         gcp_xyz = P[:4] + cfg.sigma_gcp_m * rng.standard_normal((4, 3))
-    obs = {"point": pidx, "band": band, "t_s": t_line, "xy_px": xy_obs, "strip": strip,
-           "xyz_nav_m": xyz_nav, "rpy_nav_rad": rpy_nav, "xyz_rate_nav_m_s": xyz_rate_nav,
-           "rpy_rate_nav_rad_s": rpy_rate_nav, "outlier": outlier,
-           "xy_true_px": xy_true_px}
-    return Campaign(cfg=cfg, scale=scale, truth=truth, nodes=nodes, obs=obs,
-                    gcp_index=np.arange(4), cp_index=np.arange(4, 17), gcp_xyz_m=gcp_xyz,
-                    strips=plan, lever_arm_measured_m=lever_measured,
-                    node_prior_mean=node_err.copy() if noise_free else np.zeros_like(node_err))
+    lines = PushbroomObservations(point=pidx, band=band, t_s=t_line, xy_px=xy_obs,
+                                  xyz_nav_m=xyz_nav, rpy_nav_rad=rpy_nav,
+                                  xyz_rate_nav_m_s=xyz_rate_nav, rpy_rate_nav_rad_s=rpy_rate_nav)
+    observations = CampaignObservations(
+        lines=lines, n_points=n_pts, gcp_index=np.arange(4), gcp_xyz_m=gcp_xyz,
+        lever_arm_m=lever_measured,
+        node_prior_mean=node_err.copy() if noise_free else np.zeros_like(node_err),
+        t_span_s=(0.0, float(t_end)))
+    truth = CampaignTruth(cfg=cfg, scale=scale, values=MappingProxyType(truth), nodes=nodes,
+                          strips=plan, strip=strip, cp_index=np.arange(4, 17), outlier=outlier,
+                          xy_true_px=xy_true_px)
+    return observations, truth

@@ -21,10 +21,15 @@ import numpy as np
 from hsgeo.adjust import Parameters
 from hsgeo.errors import InputError
 from hsgeo.rotations import R_from_opk, R_from_rpy
-from hsgeo.sensors.pushbroom import BETA0_CAM_FROM_PLATFORM, BLOCK_NAMES, PushbroomLines
+from hsgeo.sensors.pushbroom import (
+    BETA0_CAM_FROM_PLATFORM,
+    BLOCK_NAMES,
+    PushbroomLines,
+    PushbroomObservations,
+)
 from hsgeo.trajectory import CORRECTION_COLUMNS, SplineNodes
 
-__all__ = ["CameraPrior", "build_problem", "intersect_two_rays"]
+__all__ = ["CameraPrior", "PushbroomObservations", "build_problem", "intersect_two_rays"]
 
 
 @dataclass(frozen=True)
@@ -44,16 +49,16 @@ class CameraPrior:
     sigma_gcp_m: float = 0.01
 
 
-def _rays(obs, cam: CameraPrior, c_mm, boresight_rad, lever_arm_m):
-    xy_mm = obs["xy_px"] * cam.pixel_mm - np.array([cam.x0_mm, cam.y0_mm])
+def _rays(obs: PushbroomObservations, cam: CameraPrior, c_mm, boresight_rad, lever_arm_m):
+    xy_mm = obs.xy_px * cam.pixel_mm - np.array([cam.x0_mm, cam.y0_mm])
     m = xy_mm.shape[0]
     d_cam = np.column_stack([xy_mm, np.broadcast_to(c_mm, (m,))])
     beta = R_from_opk(*boresight_rad) @ BETA0_CAM_FROM_PLATFORM
-    rpy = obs["rpy_nav_rad"]
+    rpy = obs.rpy_nav_rad
     R = R_from_rpy(rpy[:, 0], rpy[:, 1], rpy[:, 2])
     d = np.einsum("mij,mj->mi", R, d_cam @ beta)  # R βᵀ d_cam
     d /= np.linalg.norm(d, axis=1, keepdims=True)
-    o = obs["xyz_nav_m"] + R @ np.asarray(lever_arm_m)
+    o = obs.xyz_nav_m + R @ np.asarray(lever_arm_m)
     return o, d
 
 
@@ -110,18 +115,16 @@ def intersect_two_rays(point, origin, direction, n_points, min_angle_deg: float 
     return xyz
 
 
-def build_problem(obs: dict, n_points: int, cam: CameraPrior, *, node_interval_s: float = 10.0,
-                  gcp_index=None, gcp_xyz_m=None, t_span_s=None, node_prior_mean=None,
-                  y_as_time: bool = False):
+def build_problem(obs: PushbroomObservations, n_points: int, cam: CameraPrior, *,
+                  node_interval_s: float = 10.0, gcp_index=None, gcp_xyz_m=None,
+                  t_span_s=None, node_prior_mean=None, y_as_time: bool = False):
     """Parameters and residual blocks of the LP bundle adjustment.
 
     Parameters
     ----------
-    obs : dict
-        ``point`` (m,), ``band`` (m,), ``t_s`` (m,), ``xy_px`` (m, 2), ``xyz_nav_m`` (m, 3),
-        ``rpy_nav_rad`` (m, 3): the observations and the GNSS/INS pose at their line times;
-        with ``y_as_time`` also ``xyz_rate_nav_m_s`` and ``rpy_rate_nav_rad_s`` (m, 3), the
-        GNSS/INS velocity and attitude rates there.
+    obs : PushbroomObservations
+        The observations and the GNSS/INS pose at their line times; with ``y_as_time`` also
+        the GNSS/INS velocity and attitude rates there.
     n_points : int
     cam : CameraPrior
     node_interval_s : float
@@ -148,16 +151,20 @@ def build_problem(obs: dict, n_points: int, cam: CameraPrior, *, node_interval_s
     blocks : list of ResidualBlock
     nodes : SplineNodes
     """
-    t = np.asarray(obs["t_s"], dtype=float)
+    if not isinstance(obs, PushbroomObservations):
+        raise InputError(
+            f"build_problem takes a PushbroomObservations, got {type(obs).__name__}: wrap the "
+            "arrays with hsgeo.workflows.pushbroom_ba.PushbroomObservations(point=..., ...)")
+    t = obs.t_s
     if t.size == 0:
         raise InputError("no observations")
     t0, t1 = (t.min(), t.max()) if t_span_s is None else t_span_s
     nodes = SplineNodes(float(t0), float(t1), float(node_interval_s))
     names = BLOCK_NAMES
-    if np.any(np.asarray(obs["band"]) >= cam.n_bands):
+    if np.any(obs.band >= cam.n_bands):
         raise InputError(f"band index ≥ the camera's {cam.n_bands} bands")
     o, d = _rays(obs, cam, cam.c_mm, np.zeros(3), cam.lever_arm_m)
-    P0 = intersect_two_rays(obs["point"], o, d, n_points)
+    P0 = intersect_two_rays(obs.point, o, d, n_points)
     p = Parameters()
     p.add(names["points"], P0, points=True, columns=("E_m", "N_m", "H_m"))
     p.add(names["nodes"], np.zeros((nodes.n_nodes, 6)), columns=CORRECTION_COLUMNS,
@@ -174,18 +181,18 @@ def build_problem(obs: dict, n_points: int, cam: CameraPrior, *, node_interval_s
         p.set_prior(names["points"], cam.sigma_gcp_m, index=gi, mean=np.asarray(gcp_xyz_m, float))
     timed = {}
     if y_as_time:
-        missing = [k for k in ("xyz_rate_nav_m_s", "rpy_rate_nav_rad_s") if k not in obs]
-        if missing:
+        if not obs.has_rates:
             raise InputError(
-                f"y_as_time needs the GNSS/INS rates at the line times ({missing}): give them "
-                "(e.g. hsgeo.trajectory.Trajectory.rates) or use y_as_time=False")
-        z_ref = float(np.median(obs["xyz_nav_m"][:, 2] - P0[obs["point"], 2]))
-        v_ref = float(np.median(np.linalg.norm(obs["xyz_rate_nav_m_s"], axis=1)))
-        timed = {"xyz_rate_m_s": obs["xyz_rate_nav_m_s"],
-                 "rpy_rate_rad_s": obs["rpy_rate_nav_rad_s"],
+                "y_as_time needs the GNSS/INS rates at the line times (xyz_rate_nav_m_s, "
+                "rpy_rate_nav_rad_s): give them (e.g. hsgeo.trajectory.Trajectory.rates) or use "
+                "y_as_time=False")
+        z_ref = float(np.median(obs.xyz_nav_m[:, 2] - P0[obs.point, 2]))
+        v_ref = float(np.median(np.linalg.norm(obs.xyz_rate_nav_m_s, axis=1)))
+        timed = {"xyz_rate_m_s": obs.xyz_rate_nav_m_s,
+                 "rpy_rate_rad_s": obs.rpy_rate_nav_rad_s,
                  "y_rate_ref_px_s": cam.c_mm * v_ref / (z_ref * cam.pixel_mm)}
-    blk = PushbroomLines(obs["point"], obs["band"], t, obs["xy_px"], obs["xyz_nav_m"],
-                         obs["rpy_nav_rad"], nodes, cam.pixel_mm, cam.sigma_obs_px,
+    blk = PushbroomLines(obs.point, obs.band, t, obs.xy_px, obs.xyz_nav_m,
+                         obs.rpy_nav_rad, nodes, cam.pixel_mm, cam.sigma_obs_px,
                          cam.x0_mm, cam.y0_mm, **timed)
     return p, [blk], nodes
 
@@ -288,10 +295,10 @@ def adjust_files(observations, trajectory, camera, gcp=None, *, node_interval_s:
     t = obs_df["t_s"].to_numpy(dtype=float)
     xyz, rpy = traj.pose(t)
     vel, rate = traj.rates(t)
-    obs = {"point": point.astype(np.int64), "band": obs_df["band"].to_numpy().astype(np.int64),
-           "t_s": t, "xy_px": obs_df[["x_px", "y_px"]].to_numpy(dtype=float),
-           "xyz_nav_m": xyz, "rpy_nav_rad": rpy, "xyz_rate_nav_m_s": vel,
-           "rpy_rate_nav_rad_s": rate}
+    obs = PushbroomObservations(
+        point=point.astype(np.int64), band=obs_df["band"].to_numpy().astype(np.int64), t_s=t,
+        xy_px=obs_df[["x_px", "y_px"]].to_numpy(dtype=float), xyz_nav_m=xyz, rpy_nav_rad=rpy,
+        xyz_rate_nav_m_s=vel, rpy_rate_nav_rad_s=rate)
     gi = gx = None
     if gcp is not None:
         g = read_table(gcp, GCP_COLUMNS, "GCP")
