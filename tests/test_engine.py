@@ -462,3 +462,49 @@ def test_point_covariance_needs_the_kept_jacobian():
     kept = adjust(p, blk, keep_jacobian=True)
     np.testing.assert_array_equal(kept.covariance, r.covariance)
     assert kept.point_covariance().shape == (P.shape[0], 2, 2)
+
+
+def test_residual_block_roles_are_renamed_by_blocks():
+    """One convention: ``blocks`` maps a role to a parameter-block name (class defaults)."""
+    t, y = line_data(5)
+    p = Parameters()
+    p.add("ab", [0.0, 0.0])
+    q = Parameters()
+    q.add("line_coefficients", [0.0, 0.0])
+    assert dict(Line(t, y, 0.1).blocks) == {"ab": "ab"}
+    blk = Line(t, y, 0.1, blocks={"ab": "line_coefficients"})
+    assert blk.blocks["ab"] == "line_coefficients"
+    ref, got = adjust(p, Line(t, y, 0.1)), adjust(q, blk)
+    np.testing.assert_array_equal(got.value("line_coefficients"), ref.value("ab"))
+    with pytest.raises(InputError, match="no parameter role 'a_b'.*did you mean 'ab'"):
+        Line(t, y, 0.1, blocks={"a_b": "x"})
+    with pytest.raises(InputError, match="non-empty string"):
+        Line(t, y, 0.1, blocks={"ab": ""})
+    with pytest.raises(TypeError):
+        blk.blocks["ab"] = "other"  # read-only
+
+
+def test_sensor_blocks_declare_their_roles():
+    from hsgeo.geocode import BoresightGCP
+    from hsgeo.sensors.frame import FrameOpenCV, FramePhotogrammetric
+    from hsgeo.sensors.line1d import LineObservations
+    from hsgeo.sensors.pushbroom import BLOCK_NAMES, PushbroomLines
+    from hsgeo.sensors.rikola import JointCentroids, TargetCentroids
+
+    assert set(FrameOpenCV.BLOCKS) == {"poses", "points", "intrinsics", "distortion"}
+    assert FramePhotogrammetric.BLOCKS["distortion"] == "distortion_mm"
+    assert PushbroomLines.BLOCKS == BLOCK_NAMES
+    assert set(JointCentroids.BLOCKS) == {"poses", "gap", "df", "pp", "distortion", "rotation",
+                                          "offset"}
+    assert TargetCentroids.BLOCKS["interior"] == "interior"
+    assert LineObservations.BLOCKS["xy"] == "xy_m"
+    assert BoresightGCP.BLOCKS == {"boresight": "boresight"}
+    rng = np.random.default_rng(0)
+    view = np.zeros(4, int)
+    X = rng.normal(size=(4, 3)) + [0, 0, 5]
+    blk = FrameOpenCV(view, rng.normal(size=(4, 2)), 1.0, X=X,
+                      blocks={"intrinsics": "K_band2"})
+    vals = {"poses": np.zeros((1, 6)), "K_band2": np.array([500.0, 500.0, 10.0, 10.0]),
+            "distortion": np.zeros(5)}
+    r, jac = blk.evaluate(vals, True)
+    assert set(jac) == {"K_band2", "distortion", "poses"} and r.shape == (8,)

@@ -212,7 +212,7 @@ def test_time_residual_is_the_crossing_time_by_bisection(tiny):
         t = o["t_s"] + dt
         xyz = o["xyz_nav_m"] + dt[:, None] * o["xyz_rate_nav_m_s"]
         rpy = o["rpy_nav_rad"] + dt[:, None] * o["rpy_rate_nav_rad_s"]
-        xy, _ = project(vals, b.names, nodes, t, xyz, rpy, b.point, b.band, b.beta0,
+        xy, _ = project(vals, b.blocks, nodes, t, xyz, rpy, b.point, b.band, b.beta0,
                         b.x0_mm, b.y0_mm)
         return xy * k - b.xy_px
 
