@@ -508,3 +508,74 @@ def test_sensor_blocks_declare_their_roles():
             "distortion": np.zeros(5)}
     r, jac = blk.evaluate(vals, True)
     assert set(jac) == {"K_band2", "distortion", "poses"} and r.shape == (8,)
+
+
+def _square_pixel_problem(seed=3, n=30, n_views=4):
+    from hsgeo.sensors.frame import project_opencv
+
+    rng = np.random.default_rng(seed)
+    X = np.column_stack([rng.uniform(-1, 1, n), rng.uniform(-1, 1, n), rng.uniform(-0.2, 0.2, n)])
+    poses = np.column_stack([rng.normal(0, 0.1, (n_views, 3)),
+                             rng.normal(0, 0.3, (n_views, 2)), rng.uniform(-5, -3, n_views)])
+    view = np.repeat(np.arange(n_views), n)
+    Xall = np.tile(X, (n_views, 1))
+    intr = np.array([800.0, 800.0, 320.0, 240.0])
+    dist = np.array([-0.2, 0.1, 0.0, 0.0, 0.0])
+    uv = project_opencv(poses, view, Xall, intr, dist) + 0.3 * rng.standard_normal((view.size, 2))
+    p = Parameters()
+    p.add("intrinsics", intr + [5.0, 5.0, 0.0, 0.0])
+    p.add("distortion", np.zeros(5))
+    p.add("poses", poses + 1e-3)
+    p.fix("poses", index=0)
+    p.fix("distortion", index=[2, 3, 4])
+    return p, view, uv, Xall
+
+
+def test_tie_equals_square_pixel_model():
+    """fy tied to fx (one column) gives the fit of the model that uses fx for both axes, and
+    reports fy = fx with fx's σ̂ (no patching of the result)."""
+    from hsgeo.sensors.frame import FrameOpenCV
+
+    p, view, uv, X = _square_pixel_problem()
+    old = p.copy()
+    old.fix("intrinsics", index=1)
+    r_old = adjust(old, FrameOpenCV(view, uv, 0.3, X=X, square_pixels=True))
+    p.tie("intrinsics", index=1, to=("intrinsics", 0))
+    r_tie = adjust(p, FrameOpenCV(view, uv, 0.3, X=X))
+    fx, fy = r_tie.value("intrinsics")[:2]
+    assert fx == fy
+    np.testing.assert_allclose(r_tie.value("intrinsics")[[0, 2, 3]],
+                               r_old.value("intrinsics")[[0, 2, 3]], rtol=1e-9)
+    for name in ("distortion", "poses"):
+        np.testing.assert_allclose(r_tie.value(name), r_old.value(name), rtol=1e-9, atol=1e-12)
+    s_tie, s_old = r_tie.sigma("intrinsics"), r_old.sigma("intrinsics")
+    assert np.isnan(s_old[1]) and s_tie[1] == s_tie[0]
+    np.testing.assert_allclose(s_tie[[0, 2, 3]], s_old[[0, 2, 3]], rtol=1e-9)
+    np.testing.assert_allclose(r_tie.covariance, r_old.covariance, rtol=1e-9,
+                               atol=1e-12 * np.abs(r_old.covariance).max())
+    assert r_tie.n_unknowns == r_old.n_unknowns and r_tie.sigma0 == pytest.approx(r_old.sigma0,
+                                                                                   rel=1e-12)
+    assert r_tie.labels == r_old.labels and "intrinsics[1]" not in r_tie.labels
+    # the input is untouched apart from the tie itself
+    assert p.ties == {("intrinsics", 1): ("intrinsics", 0)}
+
+
+def test_tie_checks():
+    p = Parameters()
+    p.add("a", [1.0, 2.0, 3.0])
+    p.add("pts", np.zeros((2, 2)), points=True)
+    with pytest.raises(InputError, match="points block"):
+        p.tie("pts", index=(0, 1), to=("pts", (0, 0)))
+    with pytest.raises(InputError, match="selects 2 entries"):
+        p.tie("a", index=slice(0, 2), to=("a", 2))
+    with pytest.raises(InputError, match="itself"):
+        p.tie("a", index=1, to=("a", 1))
+    p.fix("a", index=2)
+    with pytest.raises(InputError, match="is fixed"):
+        p.tie("a", index=1, to=("a", 2))
+    p.tie("a", index=1, to=("a", 0))
+    assert p.value("a")[1] == 1.0 and p.n_free == 3 + 4 - 1 - 1  # a[2] fixed, a[1] tied
+    with pytest.raises(InputError, match="itself tied"):
+        p.tie("a", index=2, to=("a", 1))
+    with pytest.raises(InputError, match="cannot be tied in turn"):
+        p.tie("a", index=0, to=("a", 2))

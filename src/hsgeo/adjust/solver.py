@@ -188,6 +188,7 @@ class _Solve:
                  progress):
         self.options = options
         self.blocks = blocks
+        params._sync_ties()  # a tied entry starts at its target's value
         self.layout = _Layout(params)
         if self.layout.n_unknowns == 0:
             raise ObservationError(

@@ -25,17 +25,39 @@ __all__: list[str] = []
 
 
 class _Layout:
+    """Columns of the reduced system: one per free non-point entry, a tied entry sharing the
+    column of its target (:meth:`Parameters.tie`).
+    """
+
     def __init__(self, params: Parameters):
         self.params = params
         self.cblocks = [b for b in params.blocks() if not b.points]
         self.colmap: dict[str, np.ndarray] = {}
+        ties = params.ties
+        tied = {}  # block name → flat indices of its tied entries
+        for (name, i), _ in ties.items():
+            b = params[name]
+            if not b.free.ravel()[i]:
+                raise InputError(f"{b.labels()[i]} is tied and fixed: fix its target instead")
+            if np.isfinite(b.prior_sigma.ravel()[i]):
+                raise InputError(
+                    f"{b.labels()[i]} is tied and has a prior: put the prior on its target")
+            tied.setdefault(name, []).append(i)
         n = 0
         for b in self.cblocks:
             free = b.free.ravel()
+            if b.name in tied:
+                free = free.copy()
+                free[tied[b.name]] = False
             cm = np.full(b.size, -1, dtype=np.int64)
             cm[free] = np.arange(n, n + free.sum())
             n += int(free.sum())
             self.colmap[b.name] = cm
+        for (name, i), (tname, j) in ties.items():
+            self.colmap[name][i] = self.colmap[tname][j]  # (-1: the target is fixed)
+        #: blocks with a tied entry or a tie target: their Jacobians are not kept factored,
+        #: and rows with two entries in one column are merged (see _merge_tied_columns)
+        self.tie_blocks = {name for name, _ in ties} | {name for name, _ in ties.values()}
         self.n_c = n
         self.labels_c = params.free_labels([b.name for b in self.cblocks])
         pb = params.points_block
@@ -301,6 +323,8 @@ def _evaluate(layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian:
                     if (pidx < 0).any():
                         jp = np.where(pidx[:, None] >= 0, jp, 0.0)
                     continue
+                if name in layout.tie_blocks and isinstance(J, Indexed):
+                    J = J.expanded()
                 has_f = any(sl.factored for sl in blk_slots)
                 sl = _Slots(J, blk.m, b.size, name, layout.colmap[name],
                             None if all_kept else rows_kept, w,
@@ -365,7 +389,25 @@ def _evaluate(layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian:
             cols_all[row0 : row0 + n, k0:] = -1
             vals_all[row0 : row0 + n, k0:] = 0.0
         row0 += n
+    if layout.tie_blocks:
+        _merge_tied_columns(cols_all, vals_all)
     pidx = np.concatenate(pidx_parts) if pidx_parts else np.full(M, -1)
     Jp = np.concatenate(jp_parts) if jp_parts else np.zeros((M, layout.p))
     Jrc = _RowJac(cols_all, vals_all, layout.n_c, *((fcol, fw, fd) if Q else ()))
     return _System(r_all, Jrc, pidx, Jp, n_obs_rows)
+
+
+def _merge_tied_columns(cols: np.ndarray, vals: np.ndarray) -> None:
+    """Sum the entries of a row that fall in one column (tied parameters) into its first slot.
+
+    In place; the other slots become empty (``-1``, 0). Each row then has each column once, as
+    the compiled kernels expect.
+    """
+    K = cols.shape[1]
+    for s in range(K):
+        for t in range(s + 1, K):
+            dup = (cols[:, t] == cols[:, s]) & (cols[:, s] >= 0)
+            if dup.any():
+                vals[dup, s] += vals[dup, t]
+                cols[dup, t] = -1
+                vals[dup, t] = 0.0
