@@ -579,3 +579,42 @@ def test_tie_checks():
         p.tie("a", index=2, to=("a", 1))
     with pytest.raises(InputError, match="cannot be tied in turn"):
         p.tie("a", index=0, to=("a", 2))
+
+
+def test_adjust_modules_import_without_cycles():
+    """The engine's modules form a layered graph (imports inside functions included), and the
+    result depends on no solver internals."""
+    import ast
+    from pathlib import Path
+
+    import hsgeo.adjust
+
+    pkg = Path(hsgeo.adjust.__file__).parent
+    graph = {}
+    for f in pkg.glob("*.py"):
+        deps = set()
+        for node in ast.walk(ast.parse(f.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and node.module:
+                mods = [node.module]
+            elif isinstance(node, ast.Import):
+                mods = [a.name for a in node.names]
+            else:
+                continue
+            deps |= {m.split(".")[2] for m in mods
+                     if m.startswith("hsgeo.adjust.") and m.count(".") >= 2}
+        graph[f.stem] = deps - {f.stem}
+    assert graph["result"] <= {"parameters"}, graph["result"]
+    assert "engine" not in graph
+    state = {}
+
+    def visit(m, path):
+        if state.get(m) == "done":
+            return
+        assert state.get(m) != "open", f"import cycle: {' -> '.join(path + [m])}"
+        state[m] = "open"
+        for d in graph.get(m, ()):
+            visit(d, path + [m])
+        state[m] = "done"
+
+    for m in graph:
+        visit(m, [])
