@@ -618,3 +618,11 @@ def test_adjust_modules_import_without_cycles():
 
     for m in graph:
         visit(m, [])
+
+
+def test_parameters_docstring_examples():
+    import doctest
+
+    import hsgeo.adjust.parameters as mod
+
+    assert doctest.testmod(mod).failed == 0

@@ -12,19 +12,25 @@ Examples
 >>> from hsgeo.adjust import Parameters
 >>> p = Parameters()
 >>> p.add("c_px", 3600.0)
+<block 'c_px' shape=() free=1/1>
 >>> p.add("K", [0.0, 0.0, 0.0], columns=("K1", "K2", "K3"))
+<block 'K' shape=(3,) free=3/3>
 >>> p.add("eop", np.zeros((3, 3)), columns=("x0_m", "y0_m", "alpha_rad"))
+<block 'eop' shape=(3, 3) free=9/9>
 >>> p.fix("K", index=2)
 >>> p.n_free
-13
+12
 
 An equality *tie* makes one entry an alias of another: both are estimated as one unknown (one
 column of the normal equations), so the result reports them equal, with the same σ̂:
 
->>> p.add("f_px", [3600.0, 3600.0], columns=("fx", "fy"))
+>>> p.add("f_px", [3500.0, 3600.0], columns=("fx", "fy"))
+<block 'f_px' shape=(2,) free=2/2>
 >>> p.tie("f_px", index=1, to=("f_px", 0))
+>>> p.value("f_px")
+array([3500., 3500.])
 >>> p.n_free
-14
+13
 """
 
 from __future__ import annotations
