@@ -131,10 +131,7 @@ def adjust(
     while True:
         tol = opts.ftol if final else max(opts.ftol, opts.reject_round_ftol)
         sy = ne = None  # free the previous round's Jacobian first (peak memory)
-        sy, ne = solve.linearise(check_redundancy=True)
-        if opts.check_datum and rounds == 0:
-            _check_datum(solve.layout, ne, opts.rank_rtol)
-        outcome, sy, ne = solve.minimise(sy, ne, tol)
+        outcome, sy, ne = solve.minimise(tol, check_datum=opts.check_datum and rounds == 0)
         if outcome.rejected:  # each-iteration mode: a rejection at convergence, adjust again
             rounds += 1
             continue
@@ -225,12 +222,17 @@ class _Solve:
                        self.layout.row_point, _leverage(ne, sy))
 
     # -- one pass of the Levenberg–Marquardt loop -------------------------------------------
-    def minimise(self, sy: _System, ne: _Normal, tol: float):
-        """Iterate from ``sy`` to the minimum (to ``tol``) with the current masks.
+    def minimise(self, tol: float, check_datum: bool = False):
+        """Iterate from the current values to the minimum (to ``tol``) with the current masks.
 
-        Returns the outcome and the system and normal equations of the final iterate.
+        With ``check_datum``, the rank at the current values is checked first. Returns the
+        outcome and the system and normal equations of the final iterate (the only Jacobian
+        kept alive: each is dropped before the next is formed).
         """
         opts = self.options
+        sy, ne = self.linearise(check_redundancy=True)
+        if check_datum:
+            _check_datum(self.layout, ne, opts.rank_rtol)
         lam, nu = opts.lambda0, 2.0
         cost = sy.cost
         self.history.append(cost)
