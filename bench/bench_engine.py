@@ -17,7 +17,7 @@ import scipy.sparse as sp
 from scipy.optimize import least_squares
 
 from hsgeo.adjust import Parameters, adjust
-from hsgeo.adjust.engine import _evaluate, _Layout
+from hsgeo.adjust.system import _evaluate, _Layout
 from hsgeo.sensors.frame import FrameOpenCV, project_opencv
 
 

@@ -79,7 +79,7 @@ def case_scipy(scale, seed, max_seconds):
     import scipy.sparse as sp
     from scipy.optimize import least_squares
 
-    from hsgeo.adjust import engine as E
+    from hsgeo.adjust import system as E
 
     _, p, blocks = _problem(scale, seed)
     _load_compiled_kernels(seed)  # the model's kernels, as for ours

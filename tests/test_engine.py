@@ -4,7 +4,7 @@ from scipy.optimize import least_squares
 from toy_models import Bearings, Exponential, Line, bearing_scene
 
 from hsgeo import ConvergenceError, DatumError, InputError, ObservationError
-from hsgeo.adjust import Parameters, adjust, identifiability
+from hsgeo.adjust import Parameters, SolverOptions, adjust, identifiability
 from hsgeo.adjust.checks import check_jacobian
 
 
@@ -66,7 +66,8 @@ def test_schur_equals_plain_solution():
     p2, _ = _bearing_params(S, P, st, pt, th, points=False)
     # both at the minimum, by different steps (the Schur path takes chord steps once settled):
     # equal to a small fraction of σ
-    r1, r2 = adjust(p1, blk, ftol=1e-14), adjust(p2, blk, ftol=1e-14)
+    r1 = adjust(p1, blk, ftol=1e-14, keep_jacobian=True)
+    r2 = adjust(p2, blk, ftol=1e-14)
     for name in ("points", "stations"):
         np.testing.assert_array_less(np.abs(r1.value(name) - r2.value(name)),
                                      1e-4 * r2.sigma(name) + 1e-12)
@@ -80,7 +81,7 @@ def test_schur_equals_plain_solution():
 def test_truth_within_3_sigma_and_sigma0_chi2(seed):
     S, P, st, pt, th = bearing_scene(seed)
     p, blk = _bearing_params(S, P, st, pt, th, seed=seed)
-    res = adjust(p, blk)
+    res = adjust(p, blk, keep_jacobian=True)
     z_st = (res.value("stations") - S) / res.sigma("stations")
     z_pt = (res.value("points") - P) / res.sigma("points")
     # max over ~100 normal deviates: 4 sigma keeps the family-wise false alarm rate < 1 %
@@ -129,7 +130,7 @@ def test_fixed_entries_and_priors():
     S, P, st, pt, th = bearing_scene(6)
     p, blk = _bearing_params(S, P, st, pt, th, n_control=0)
     p.fix("points", index=[0, 1], value=P[:2])  # two fixed points give the datum
-    res = adjust(p, blk)
+    res = adjust(p, blk, keep_jacobian=True)
     np.testing.assert_array_equal(res.value("points")[:2], P[:2])
     assert np.all(np.isnan(res.sigma("points")[:2]))
     assert np.all(np.abs(res.value("points")[2:] - P[2:]) < 5 * res.sigma("points")[2:])
@@ -206,29 +207,28 @@ def test_progress_callback():
 
 
 @pytest.mark.parametrize("lam", [0.0, 1e-3])
-def test_compiled_path_equals_generic_path(monkeypatch, lam):
+def test_compiled_path_equals_generic_path(lam):
     """The row-compressed numba path forms the same reduced system as the scipy.sparse path."""
-    from hsgeo.adjust import engine as E
+    from hsgeo.adjust.schur import _normal, _reduced, _step
+    from hsgeo.adjust.system import _evaluate, _Layout
 
     S, P, st, pt, th = bearing_scene(8)
     p, blk = _bearing_params(S, P, st, pt, th, seed=8)
     p.fix("stations", index=(0, 2))  # a fixed entry: an empty slot in the compressed rows
     p.fix("points", index=(5, 1))  # and a fixed point coordinate
-    lay = E._Layout(p)
-    sy = E._evaluate(lay, [blk], [np.ones(blk.m, bool)], True)
+    lay = _Layout(p)
+    sy = _evaluate(lay, [blk], [np.ones(blk.m, bool)], True)
     out = {}
-    for fast in (True, False):
-        monkeypatch.setattr(E, "FAST", fast)
-        ne = E._normal(lay, sy)
-        S_, rhs, Vinv, _ = E._reduced(lay, ne, lam)
-        dc, dp = E._step(lay, ne, lam)
-        out[fast] = (S_, rhs, dc, dp, ne.Ncc, ne.W.toarray())
+    for compiled in (True, False):
+        ne = _normal(lay, sy, SolverOptions(compiled=compiled))
+        assert ne.compiled_schur == compiled
+        S_, rhs, Vinv, _ = _reduced(lay, ne, lam)
+        dc, dp = _step(lay, ne, lam)
+        out[compiled] = (S_, rhs, dc, dp, ne.Ncc, ne.W.toarray())
     for a, b in zip(out[True], out[False], strict=True):
         np.testing.assert_allclose(a, b, rtol=1e-10, atol=1e-8 * np.max(np.abs(b)))
-    monkeypatch.setattr(E, "FAST", False)
-    r_slow = adjust(p, blk, ftol=1e-14)
-    monkeypatch.setattr(E, "FAST", True)
-    r_fast = adjust(p, blk, ftol=1e-14)
+    r_slow = adjust(p, blk, ftol=1e-14, compiled=False, keep_jacobian=True)
+    r_fast = adjust(p, blk, ftol=1e-14, compiled=True, keep_jacobian=True)
     # (the compiled path takes chord steps once settled: the same minimum by other steps)
     np.testing.assert_array_less(np.abs(r_fast.value("points") - r_slow.value("points")),
                                  1e-4 * np.nan_to_num(r_slow.sigma("points")) + 1e-12)
@@ -278,7 +278,7 @@ def test_reduced_kernel_equals_dense_schur(consecutive):
     row's items are not on consecutive columns, so both expansion paths are exercised.
     """
     from hsgeo.adjust._fast import reduced_points
-    from hsgeo.adjust.engine import _RowJac
+    from hsgeo.adjust.system import _RowJac
 
     rng = np.random.default_rng(3)
     kf, q, n_pts, p = 2, 3, 40, 3
@@ -315,7 +315,7 @@ def test_reduced_kernel_equals_dense_schur(consecutive):
 
 
 def test_spd_inverse_against_numpy_and_singular():
-    from hsgeo.adjust.result import _spd_inverse
+    from hsgeo.adjust.schur import _spd_inverse
 
     rng = np.random.default_rng(1)
     A = rng.normal(size=(30, 12))
@@ -326,42 +326,39 @@ def test_spd_inverse_against_numpy_and_singular():
         _spd_inverse(N)
 
 
-def test_chord_steps_end_with_the_covariance_of_the_final_point():
+def test_chord_steps_end_with_the_covariance_of_the_final_point(monkeypatch):
     """Chord steps reuse an earlier reduced matrix; the result's must be that of its estimate."""
-    from hsgeo.adjust import engine as E
+    from hsgeo.adjust import schur
+    from hsgeo.adjust.system import _evaluate, _Layout
 
     S, P, st, pt, th = bearing_scene(8)
     p, blk = _bearing_params(S, P, st, pt, th, seed=8)
     chords = []
-    orig = E._reduced
+    orig = schur._reduced
 
     def spy(layout, ne, lam):
         chords.append(ne.S_chord is not None)
         return orig(layout, ne, lam)
 
-    E._reduced = spy
-    try:
-        r = adjust(p, blk)
-    finally:
-        E._reduced = orig
+    monkeypatch.setattr(schur, "_reduced", spy)  # (a probe: the solver's settings are options)
+    r = adjust(p, blk)
+    monkeypatch.undo()
     assert any(chords), "no chord step was taken: the test does not exercise them"
-    lay = E._Layout(r.params)
-    ne = E._normal(lay, E._evaluate(lay, [blk], [np.ones(blk.m, bool)], True))
-    S_final = E._reduced(lay, ne, 0.0)[0]
+    lay = _Layout(r.params)
+    ne = schur._normal(lay, _evaluate(lay, [blk], [np.ones(blk.m, bool)], True), SolverOptions())
+    S_final = schur._reduced(lay, ne, 0.0)[0]
     np.testing.assert_allclose(r.covariance, r.sigma0**2 * np.linalg.inv(S_final), rtol=1e-9,
                                atol=1e-12 * np.abs(r.covariance).max())
 
 
-def test_chord_steps_from_the_first_iterate_still_converge(monkeypatch):
-    """Chord steps from far from the minimum (forced): failed ones fall back to the matrix of
-    the current point, and the adjustment reaches the same minimum."""
-    from hsgeo.adjust import engine as E
-
+def test_chord_steps_from_the_first_iterate_still_converge():
+    """Chord steps from far from the minimum (forced: every iterate counts as settled): failed
+    ones fall back to the matrix of the current point, and the adjustment reaches the same
+    minimum."""
     S, P, st, pt, th = bearing_scene(8)
     p, blk = _bearing_params(S, P, st, pt, th, seed=8)
-    ref = adjust(p, blk, ftol=1e-14)
-    monkeypatch.setattr(E, "_settled", lambda actual, pred, new_cost: True)
-    r = adjust(p, blk, ftol=1e-14)
+    ref = adjust(p, blk, ftol=1e-14, keep_jacobian=True)
+    r = adjust(p, blk, ftol=1e-14, settled=np.inf)
     assert r.converged
     for name in ("points", "stations"):
         np.testing.assert_array_less(np.abs(r.value(name) - ref.value(name)),
@@ -404,3 +401,228 @@ def test_point_leverage_kernel_equals_einsum():
     Vinv = A @ A.transpose(0, 2, 1)
     ref = np.where(pidx >= 0, np.einsum("ij,ijk,ik->i", jp, Vinv[np.maximum(pidx, 0)], jp), 0.0)
     np.testing.assert_allclose(point_leverage(jp, pidx, Vinv), ref, rtol=1e-13, atol=1e-13)
+
+
+@pytest.mark.parametrize(
+    "field, value, match",
+    [
+        ("ftol", 0.0, "ftol must be a finite positive"),
+        ("ftol", float("nan"), "ftol must be a finite positive"),
+        ("max_iter", -1, "max_iter must be a non-negative integer"),
+        ("max_iter", 2.5, "max_iter must be a non-negative integer"),
+        ("reject_k", -3.0, "reject_k must be None"),
+        ("settled", -0.1, "settled must be a number"),
+        ("compiled", "yes", "compiled must be True or False"),
+        ("lambda0", 1e20, "exceeds lambda_max"),
+    ],
+)
+def test_solver_options_validate(field, value, match):
+    with pytest.raises(InputError, match=match):
+        SolverOptions(**{field: value})
+    t, y = line_data(0)
+    p = Parameters()
+    p.add("ab", [0.0, 0.0])
+    with pytest.raises(InputError, match=match):  # the same check through adjust's keywords
+        adjust(p, Line(t, y, 0.1), **{field: value})
+
+
+def test_unknown_solver_option_names_the_closest():
+    t, y = line_data(0)
+    p = Parameters()
+    p.add("ab", [0.0, 0.0])
+    with pytest.raises(InputError, match="'reject_kk'. Did you mean 'reject_k'") as ei:
+        adjust(p, Line(t, y, 0.1), reject_kk=4.0)
+    assert "max_iter" in str(ei.value)  # the valid names are listed
+    with pytest.raises(InputError, match="must be a SolverOptions"):
+        adjust(p, Line(t, y, 0.1), {"ftol": 1e-8})
+
+
+def test_options_and_keywords_give_the_same_result():
+    t, y = line_data(3)
+    p = Parameters()
+    p.add("ab", [0.0, 0.0])
+    opts = SolverOptions(ftol=1e-6, max_iter=7)
+    a = adjust(p, Line(t, y, 0.1), opts)
+    b = adjust(p, Line(t, y, 0.1), ftol=1e-6, max_iter=7)
+    c = adjust(p, Line(t, y, 0.1), SolverOptions(ftol=1e-3), ftol=1e-6, max_iter=7)
+    assert a.cost_history == b.cost_history == c.cost_history
+    np.testing.assert_array_equal(a.value("ab"), b.value("ab"))
+    assert SolverOptions().replace(ftol=1e-6, max_iter=7) == opts
+    with pytest.raises(AttributeError):
+        opts.ftol = 1.0  # frozen
+
+
+def test_point_covariance_needs_the_kept_jacobian():
+    S, P, st, pt, th = bearing_scene(3)
+    p, blk = _bearing_params(S, P, st, pt, th, seed=3)
+    r = adjust(p, blk)
+    assert np.isfinite(r.sigma("stations")).any()  # non-point σ without the Jacobian
+    with pytest.raises(InputError, match="keep_jacobian=True"):
+        r.point_covariance()
+    kept = adjust(p, blk, keep_jacobian=True)
+    np.testing.assert_array_equal(kept.covariance, r.covariance)
+    assert kept.point_covariance().shape == (P.shape[0], 2, 2)
+
+
+def test_residual_block_roles_are_renamed_by_blocks():
+    """One convention: ``blocks`` maps a role to a parameter-block name (class defaults)."""
+    t, y = line_data(5)
+    p = Parameters()
+    p.add("ab", [0.0, 0.0])
+    q = Parameters()
+    q.add("line_coefficients", [0.0, 0.0])
+    assert dict(Line(t, y, 0.1).blocks) == {"ab": "ab"}
+    blk = Line(t, y, 0.1, blocks={"ab": "line_coefficients"})
+    assert blk.blocks["ab"] == "line_coefficients"
+    ref, got = adjust(p, Line(t, y, 0.1)), adjust(q, blk)
+    np.testing.assert_array_equal(got.value("line_coefficients"), ref.value("ab"))
+    with pytest.raises(InputError, match="no parameter role 'a_b'.*did you mean 'ab'"):
+        Line(t, y, 0.1, blocks={"a_b": "x"})
+    with pytest.raises(InputError, match="non-empty string"):
+        Line(t, y, 0.1, blocks={"ab": ""})
+    with pytest.raises(TypeError):
+        blk.blocks["ab"] = "other"  # read-only
+
+
+def test_sensor_blocks_declare_their_roles():
+    from hsgeo.geocode import BoresightGCP
+    from hsgeo.sensors.frame import FrameOpenCV, FramePhotogrammetric
+    from hsgeo.sensors.line1d import LineObservations
+    from hsgeo.sensors.pushbroom import BLOCK_NAMES, PushbroomLines
+    from hsgeo.sensors.rikola import JointCentroids, TargetCentroids
+
+    assert set(FrameOpenCV.BLOCKS) == {"poses", "points", "intrinsics", "distortion"}
+    assert FramePhotogrammetric.BLOCKS["distortion"] == "distortion_mm"
+    assert PushbroomLines.BLOCKS == BLOCK_NAMES
+    assert set(JointCentroids.BLOCKS) == {"poses", "gap", "df", "pp", "distortion", "rotation",
+                                          "offset"}
+    assert TargetCentroids.BLOCKS["interior"] == "interior"
+    assert LineObservations.BLOCKS["xy"] == "xy_m"
+    assert BoresightGCP.BLOCKS == {"boresight": "boresight"}
+    rng = np.random.default_rng(0)
+    view = np.zeros(4, int)
+    X = rng.normal(size=(4, 3)) + [0, 0, 5]
+    blk = FrameOpenCV(view, rng.normal(size=(4, 2)), 1.0, X=X,
+                      blocks={"intrinsics": "K_band2"})
+    vals = {"poses": np.zeros((1, 6)), "K_band2": np.array([500.0, 500.0, 10.0, 10.0]),
+            "distortion": np.zeros(5)}
+    r, jac = blk.evaluate(vals, True)
+    assert set(jac) == {"K_band2", "distortion", "poses"} and r.shape == (8,)
+
+
+def _square_pixel_problem(seed=3, n=30, n_views=4):
+    from hsgeo.sensors.frame import project_opencv
+
+    rng = np.random.default_rng(seed)
+    X = np.column_stack([rng.uniform(-1, 1, n), rng.uniform(-1, 1, n), rng.uniform(-0.2, 0.2, n)])
+    poses = np.column_stack([rng.normal(0, 0.1, (n_views, 3)),
+                             rng.normal(0, 0.3, (n_views, 2)), rng.uniform(-5, -3, n_views)])
+    view = np.repeat(np.arange(n_views), n)
+    Xall = np.tile(X, (n_views, 1))
+    intr = np.array([800.0, 800.0, 320.0, 240.0])
+    dist = np.array([-0.2, 0.1, 0.0, 0.0, 0.0])
+    uv = project_opencv(poses, view, Xall, intr, dist) + 0.3 * rng.standard_normal((view.size, 2))
+    p = Parameters()
+    p.add("intrinsics", intr + [5.0, 5.0, 0.0, 0.0])
+    p.add("distortion", np.zeros(5))
+    p.add("poses", poses + 1e-3)
+    p.fix("poses", index=0)
+    p.fix("distortion", index=[2, 3, 4])
+    return p, view, uv, Xall
+
+
+def test_tie_equals_square_pixel_model():
+    """fy tied to fx (one column) gives the fit of the model that uses fx for both axes, and
+    reports fy = fx with fx's σ̂ (no patching of the result)."""
+    from hsgeo.sensors.frame import FrameOpenCV
+
+    p, view, uv, X = _square_pixel_problem()
+    old = p.copy()
+    old.fix("intrinsics", index=1)
+    r_old = adjust(old, FrameOpenCV(view, uv, 0.3, X=X, square_pixels=True))
+    p.tie("intrinsics", index=1, to=("intrinsics", 0))
+    r_tie = adjust(p, FrameOpenCV(view, uv, 0.3, X=X))
+    fx, fy = r_tie.value("intrinsics")[:2]
+    assert fx == fy
+    np.testing.assert_allclose(r_tie.value("intrinsics")[[0, 2, 3]],
+                               r_old.value("intrinsics")[[0, 2, 3]], rtol=1e-9)
+    for name in ("distortion", "poses"):
+        np.testing.assert_allclose(r_tie.value(name), r_old.value(name), rtol=1e-9, atol=1e-12)
+    s_tie, s_old = r_tie.sigma("intrinsics"), r_old.sigma("intrinsics")
+    assert np.isnan(s_old[1]) and s_tie[1] == s_tie[0]
+    np.testing.assert_allclose(s_tie[[0, 2, 3]], s_old[[0, 2, 3]], rtol=1e-9)
+    np.testing.assert_allclose(r_tie.covariance, r_old.covariance, rtol=1e-9,
+                               atol=1e-12 * np.abs(r_old.covariance).max())
+    assert r_tie.n_unknowns == r_old.n_unknowns and r_tie.sigma0 == pytest.approx(r_old.sigma0,
+                                                                                   rel=1e-12)
+    assert r_tie.labels == r_old.labels and "intrinsics[1]" not in r_tie.labels
+    # the input is untouched apart from the tie itself
+    assert p.ties == {("intrinsics", 1): ("intrinsics", 0)}
+
+
+def test_tie_checks():
+    p = Parameters()
+    p.add("a", [1.0, 2.0, 3.0])
+    p.add("pts", np.zeros((2, 2)), points=True)
+    with pytest.raises(InputError, match="points block"):
+        p.tie("pts", index=(0, 1), to=("pts", (0, 0)))
+    with pytest.raises(InputError, match="selects 2 entries"):
+        p.tie("a", index=slice(0, 2), to=("a", 2))
+    with pytest.raises(InputError, match="itself"):
+        p.tie("a", index=1, to=("a", 1))
+    p.fix("a", index=2)
+    with pytest.raises(InputError, match="is fixed"):
+        p.tie("a", index=1, to=("a", 2))
+    p.tie("a", index=1, to=("a", 0))
+    assert p.value("a")[1] == 1.0 and p.n_free == 3 + 4 - 1 - 1  # a[2] fixed, a[1] tied
+    with pytest.raises(InputError, match="itself tied"):
+        p.tie("a", index=2, to=("a", 1))
+    with pytest.raises(InputError, match="cannot be tied in turn"):
+        p.tie("a", index=0, to=("a", 2))
+
+
+def test_adjust_modules_import_without_cycles():
+    """The engine's modules form a layered graph (imports inside functions included), and the
+    result depends on no solver internals."""
+    import ast
+    from pathlib import Path
+
+    import hsgeo.adjust
+
+    pkg = Path(hsgeo.adjust.__file__).parent
+    graph = {}
+    for f in pkg.glob("*.py"):
+        deps = set()
+        for node in ast.walk(ast.parse(f.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and node.module:
+                mods = [node.module]
+            elif isinstance(node, ast.Import):
+                mods = [a.name for a in node.names]
+            else:
+                continue
+            deps |= {m.split(".")[2] for m in mods
+                     if m.startswith("hsgeo.adjust.") and m.count(".") >= 2}
+        graph[f.stem] = deps - {f.stem}
+    assert graph["result"] <= {"parameters"}, graph["result"]
+    assert "engine" not in graph
+    state = {}
+
+    def visit(m, path):
+        if state.get(m) == "done":
+            return
+        assert state.get(m) != "open", f"import cycle: {' -> '.join(path + [m])}"
+        state[m] = "open"
+        for d in graph.get(m, ()):
+            visit(d, path + [m])
+        state[m] = "done"
+
+    for m in graph:
+        visit(m, [])
+
+
+def test_parameters_docstring_examples():
+    import doctest
+
+    import hsgeo.adjust.parameters as mod
+
+    assert doctest.testmod(mod).failed == 0

@@ -206,25 +206,26 @@ def test_same_seed_same_bits():
     assert np.array_equal(ta.values["nodes"], tb.values["nodes"])
 
 
-def test_compiled_schur_equals_generic_on_pushbroom(tiny, monkeypatch):
-    from hsgeo.adjust import engine as E
+def test_compiled_schur_equals_generic_on_pushbroom(tiny):
+    from hsgeo.adjust import SolverOptions
+    from hsgeo.adjust.schur import _normal, _reduced
+    from hsgeo.adjust.system import _evaluate, _Layout
 
     p, blocks, _ = _problem(tiny[0])
-    lay = E._Layout(p)
-    sy = E._evaluate(lay, blocks, [np.ones(b.m, bool) for b in blocks], True)
+    lay = _Layout(p)
+    sy = _evaluate(lay, blocks, [np.ones(b.m, bool) for b in blocks], True)
     got = {}
-    for fast in (True, False):
-        monkeypatch.setattr(E, "FAST", fast)
-        ne = E._normal(lay, sy)
-        S, rhs, _, _ = E._reduced(lay, ne, 1e-4)
-        got[fast] = (S, rhs)
+    for compiled in (True, False):
+        ne = _normal(lay, sy, SolverOptions(compiled=compiled))
+        S, rhs, _, _ = _reduced(lay, ne, 1e-4)
+        got[compiled] = (S, rhs)
     for a, b in zip(got[True], got[False], strict=True):
         np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-9 * np.max(np.abs(b)))
 
 
 def test_point_covariance_subset_equals_all(tiny):
     p, blocks, _ = _problem(tiny[0])
-    res = adjust(p, blocks, reject_k=5.0)
+    res = adjust(p, blocks, reject_k=5.0, keep_jacobian=True)
     cp_index = tiny[1].cp_index
     sub = res.point_covariance(index=cp_index)
     full = res.point_covariance()[cp_index]
@@ -248,7 +249,7 @@ def test_time_residual_is_the_crossing_time_by_bisection(tiny):
         t = o.t_s + dt
         xyz = o.xyz_nav_m + dt[:, None] * o.xyz_rate_nav_m_s
         rpy = o.rpy_nav_rad + dt[:, None] * o.rpy_rate_nav_rad_s
-        xy, _ = project(vals, b.names, nodes, t, xyz, rpy, b.point, b.band, b.beta0,
+        xy, _ = project(vals, b.blocks, nodes, t, xyz, rpy, b.point, b.band, b.beta0,
                         b.x0_mm, b.y0_mm)
         return xy * k - b.xy_px
 
@@ -285,27 +286,29 @@ def test_compiled_block_equals_numpy_block(tiny):
 
 @pytest.mark.parametrize("lam", [0.0, 1e-3])
 @pytest.mark.parametrize("fix_node", [False, True])
-def test_factored_node_jacobian_compiled_equals_generic(tiny, monkeypatch, lam, fix_node):
+def test_factored_node_jacobian_compiled_equals_generic(tiny, lam, fix_node):
     """The compiled path's factored spline Jacobian forms the same normal equations as scipy.
 
     ``fix_node`` fixes one node entry, which makes the engine expand the factored Jacobian
     into ordinary slots (non-contiguous columns).
     """
-    from hsgeo.adjust import engine as E
+    from hsgeo.adjust import SolverOptions
+    from hsgeo.adjust.schur import _normal, _reduced, _step
+    from hsgeo.adjust.system import _evaluate, _Layout
 
     p, blocks, _ = _problem(tiny[0], y_as_time=True)
     if fix_node:
         p.fix("nodes", index=(3, 4))
-    lay = E._Layout(p)
+    lay = _Layout(p)
     out = {}
-    for fast in (True, False):
-        monkeypatch.setattr(E, "FAST", fast)
-        sy = E._evaluate(lay, blocks, [np.ones(b.m, bool) for b in blocks], True)
-        assert (sy.Jrc.fcol.shape[1] == 4) == (fast and not fix_node)
-        ne = E._normal(lay, sy)
-        S_, rhs, _, _ = E._reduced(lay, ne, lam)
-        dc, dp = E._step(lay, ne, lam)
-        out[fast] = (S_, rhs, dc, dp, ne.Ncc)
+    for compiled in (True, False):
+        sy = _evaluate(lay, blocks, [np.ones(b.m, bool) for b in blocks], True,
+                       compiled=compiled)
+        assert (sy.Jrc.fcol.shape[1] == 4) == (compiled and not fix_node)
+        ne = _normal(lay, sy, SolverOptions(compiled=compiled))
+        S_, rhs, _, _ = _reduced(lay, ne, lam)
+        dc, dp = _step(lay, ne, lam)
+        out[compiled] = (S_, rhs, dc, dp, ne.Ncc)
     for a, b in zip(out[True], out[False], strict=True):
         np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-9 * np.max(np.abs(b)))
 

@@ -9,35 +9,37 @@ class Line(ResidualBlock):
     """y = a + b t: a linear model, solvable in closed form with numpy.linalg.lstsq."""
 
     name = "line"
+    BLOCKS = {"ab": "ab"}
 
-    def __init__(self, t, y, sigma):
-        super().__init__(np.broadcast_to(sigma, np.shape(y)))
+    def __init__(self, t, y, sigma, blocks=None):
+        super().__init__(np.broadcast_to(sigma, np.shape(y)), blocks=blocks)
         self.t, self.y = np.asarray(t, float), np.asarray(y, float)
 
     def evaluate(self, values, jacobian):
-        a, b = values["ab"]
+        a, b = values[self.blocks["ab"]]
         r = a + b * self.t - self.y
         if not jacobian:
             return r, None
-        return r, {"ab": np.column_stack([np.ones_like(self.t), self.t])}
+        return r, {self.blocks["ab"]: np.column_stack([np.ones_like(self.t), self.t])}
 
 
 class Exponential(ResidualBlock):
     """y = A exp(-k t): non-linear, for comparison with scipy.optimize.least_squares."""
 
     name = "exponential"
+    BLOCKS = {"Ak": "Ak"}
 
-    def __init__(self, t, y, sigma):
-        super().__init__(np.broadcast_to(sigma, np.shape(y)))
+    def __init__(self, t, y, sigma, blocks=None):
+        super().__init__(np.broadcast_to(sigma, np.shape(y)), blocks=blocks)
         self.t, self.y = np.asarray(t, float), np.asarray(y, float)
 
     def evaluate(self, values, jacobian):
-        A, k = values["Ak"]
+        A, k = values[self.blocks["Ak"]]
         e = np.exp(-k * self.t)
         r = A * e - self.y
         if not jacobian:
             return r, None
-        return r, {"Ak": np.column_stack([e, -A * self.t * e])}
+        return r, {self.blocks["Ak"]: np.column_stack([e, -A * self.t * e])}
 
 
 class Bearings(ResidualBlock):
@@ -48,9 +50,10 @@ class Bearings(ResidualBlock):
     """
 
     name = "bearings"
+    BLOCKS = {"stations": "stations", "points": "points"}
 
-    def __init__(self, station, point, theta_rad, sigma_rad):
-        super().__init__(np.full(len(theta_rad), sigma_rad))
+    def __init__(self, station, point, theta_rad, sigma_rad, blocks=None):
+        super().__init__(np.full(len(theta_rad), sigma_rad), blocks=blocks)
         self.station, self.point = np.asarray(station), np.asarray(point)
         self.theta = np.asarray(theta_rad, float)
 
@@ -60,7 +63,7 @@ class Bearings(ResidualBlock):
         return np.arctan2(d[:, 1], d[:, 0]) - S[station, 2], d
 
     def evaluate(self, values, jacobian):
-        S, P = values["stations"], values["points"]
+        S, P = values[self.blocks["stations"]], values[self.blocks["points"]]
         th, d = self.model(S, P, self.station, self.point)
         r = np.angle(np.exp(1j * (th - self.theta)))
         if not jacobian:
@@ -68,7 +71,9 @@ class Bearings(ResidualBlock):
         q = (d**2).sum(axis=1)
         dth_dP = np.column_stack([-d[:, 1] / q, d[:, 0] / q])
         dth_dS = np.column_stack([-dth_dP, -np.ones(len(q))])
-        return r, {"stations": Indexed(self.station, dth_dS), "points": Indexed(self.point, dth_dP)}
+        nm = self.blocks
+        return r, {nm["stations"]: Indexed(self.station, dth_dS),
+                   nm["points"]: Indexed(self.point, dth_dP)}
 
 
 def bearing_scene(rng, n_stations=6, n_points=40, sigma_rad=1e-3, coverage=4):

@@ -17,7 +17,9 @@ on the height (:func:`intersect`).
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
+from types import MappingProxyType
 
 import numpy as np
 
@@ -256,16 +258,19 @@ class BoresightGCP(ResidualBlock):
 
     Over a plane of height h: ``X = O + s·d``, ``s = (h − O_U)/d_U`` and
     ``∂X/∂b = s·(∂d/∂b − d·(∂d_U/∂b)/d_U)`` with ``∂d/∂b = R_map_from_body (∂R_bs/∂b) d_sensor``.
-    Parameter block ``boresight``: (roll, pitch, heading) of ``R_body_from_sensor`` in rad.
+    Parameter block of role ``boresight`` (default name ``boresight``, see ``blocks``):
+    (roll, pitch, heading) of ``R_body_from_sensor`` in rad.
     """
 
     name = "GCP deviations"
     group_size = 2
+    BLOCKS = MappingProxyType({"boresight": "boresight"})
 
     def __init__(self, nav, sensor: LineGeometry, line, zeta_px, gcp_enu_m, *, t0_s: float,
-                 line_rate_hz: float, height_m: float, sigma_m: float):
+                 line_rate_hz: float, height_m: float, sigma_m: float,
+                 blocks: Mapping[str, str] | None = None):
         gcp = np.asarray(gcp_enu_m, dtype=float)
-        super().__init__(np.full(2 * gcp.shape[0], sigma_m))
+        super().__init__(np.full(2 * gcp.shape[0], sigma_m), blocks=blocks)
         pos, rpy = nav.at(t0_s + np.asarray(line, float) / line_rate_hz)
         self.pos = pos
         self.R_mb = R_ENU_FROM_NED @ R_from_rpy(rpy[:, 0], rpy[:, 1], rpy[:, 2])
@@ -275,7 +280,7 @@ class BoresightGCP(ResidualBlock):
         self.h = height_m
 
     def evaluate(self, values, jacobian):
-        b = values["boresight"]
+        b = values[self.blocks["boresight"]]
         d = np.einsum("nij,jk,nk->ni", self.R_mb, R_from_rpy(*b), self.d_s)
         if np.any(d[:, 2] >= 0):
             raise ObservationError("a GCP ray does not point downwards: check the attitude")
@@ -287,7 +292,7 @@ class BoresightGCP(ResidualBlock):
         dR = dR_drpy(*b)  # (3 angles, 3, 3)
         dd = np.einsum("nij,kjl,nl->nki", self.R_mb, dR, self.d_s)  # (n, 3 angles, 3)
         dX = s[:, None, None] * (dd - d[:, None, :] * (dd[:, :, 2:3] / d[:, None, 2:3]))
-        return r, {"boresight": np.transpose(dX[:, :, :2], (0, 2, 1)).reshape(-1, 3)}
+        return r, {self.blocks["boresight"]: np.transpose(dX[:, :, :2], (0, 2, 1)).reshape(-1, 3)}
 
 
 def calibrate_boresight(nav, sensor: LineGeometry, line, zeta_px, gcp_enu_m, *, t0_s,

@@ -13,7 +13,7 @@ is accumulated point by point from the rows grouped by point, without ever formi
 it). Only the upper triangle is accumulated; the kernels run over the rows / points in
 ``n_chunks`` independent chunks (one per thread) and sum the per-chunk matrices.
 
-The generic scipy.sparse path in :mod:`hsgeo.adjust.engine` computes the same quantities;
+The generic scipy.sparse path in :mod:`hsgeo.adjust.schur` computes the same quantities;
 ``tests/test_engine.py`` checks that the two agree.
 """
 
@@ -302,7 +302,7 @@ def locality_orders(J, n_c: int, order: np.ndarray | None, ptr: np.ndarray | Non
     """Row and point processing orders that keep consecutive updates in nearby rows of S.
 
     ``rows`` (default all) are sorted by their smallest column (``J`` a row-compressed
-    Jacobian, ``hsgeo.adjust.engine._RowJac``): consecutive rows then touch mostly the same
+    Jacobian, ``hsgeo.adjust.system._RowJac``): consecutive rows then touch mostly the same
     rows of the dense matrix, which stay in cache (the kernels are limited by memory latency,
     not arithmetic).
     """
@@ -563,7 +563,7 @@ def scatter_points(jp, pidx, u, n_pts):  # pragma: no cover - compiled
 
 
 # ----------------------------------------------------------------------------------------------
-# Filling the row-compressed arrays from the residual blocks' Jacobians (engine._Slots)
+# Filling the row-compressed arrays from the residual blocks' Jacobians (system._Slots)
 # ``rows[t]`` is the block row written to destination row t; ``w`` the whitening weights 1/σ;
 # ``cm`` the block's column map (-1: fixed entry, written as an empty slot).
 # ----------------------------------------------------------------------------------------------

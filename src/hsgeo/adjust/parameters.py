@@ -12,9 +12,23 @@ Examples
 >>> from hsgeo.adjust import Parameters
 >>> p = Parameters()
 >>> p.add("c_px", 3600.0)
+<block 'c_px' shape=() free=1/1>
 >>> p.add("K", [0.0, 0.0, 0.0], columns=("K1", "K2", "K3"))
+<block 'K' shape=(3,) free=3/3>
 >>> p.add("eop", np.zeros((3, 3)), columns=("x0_m", "y0_m", "alpha_rad"))
+<block 'eop' shape=(3, 3) free=9/9>
 >>> p.fix("K", index=2)
+>>> p.n_free
+12
+
+An equality *tie* makes one entry an alias of another: both are estimated as one unknown (one
+column of the normal equations), so the result reports them equal, with the same σ̂:
+
+>>> p.add("f_px", [3500.0, 3600.0], columns=("fx", "fy"))
+<block 'f_px' shape=(2,) free=2/2>
+>>> p.tie("f_px", index=1, to=("f_px", 0))
+>>> p.value("f_px")
+array([3500., 3500.])
 >>> p.n_free
 13
 """
@@ -131,6 +145,8 @@ class Parameters:
 
     def __init__(self) -> None:
         self._blocks: dict[str, Block] = {}
+        #: (block, flat index) of a tied entry → (block, flat index) of the entry it equals
+        self._ties: dict[tuple[str, int], tuple[str, int]] = {}
 
     # -- construction -----------------------------------------------------------------------
     def add(
@@ -250,8 +266,14 @@ class Parameters:
 
     @property
     def n_free(self) -> int:
-        """Number of estimated entries (points included)."""
-        return int(sum(b.free.sum() for b in self._blocks.values()))
+        """Number of estimated unknowns (points included; a tied entry is not one of its own)."""
+        n = int(sum(b.free.sum() for b in self._blocks.values()))
+        return n - sum(1 for (name, i) in self._ties if self[name].free.ravel()[i])
+
+    @property
+    def ties(self) -> dict[tuple[str, int], tuple[str, int]]:
+        """The equality ties: ``(block, flat index)`` of a tied entry → that of its target."""
+        return dict(self._ties)
 
     # -- modification -----------------------------------------------------------------------
     def set(self, name: str, value, index=...) -> None:
@@ -282,18 +304,106 @@ class Parameters:
         self._check_prior(name, pm, ps)
         b.prior_sigma, b.prior_mean = ps, pm
 
+    def tie(self, name: str, index, to: tuple[str, object]) -> None:
+        """Tie one entry to another: both are estimated as one unknown (equality constraint).
+
+        The tied entry takes the target's value now and at every step of the adjustment, and
+        the result reports the target's σ̂ for it (e.g. square pixels: ``fy = fx``).
+
+        Parameters
+        ----------
+        name : str
+            Block of the tied entry (not the points block).
+        index : int or tuple of int
+            The tied entry (numpy-style index selecting exactly one entry).
+        to : (str, index)
+            Block and index of the entry it equals (free, not itself tied, not a points block).
+
+        Raises
+        ------
+        InputError
+            A points block, an index that does not select one entry, a target that is fixed
+            or itself tied, a tie of an entry to itself, or a prior on the tied entry.
+        """
+        i = self._flat_index(name, index, "tied entry")
+        if not (isinstance(to, tuple) and len(to) == 2):
+            raise InputError(f"tie(): 'to' must be a (block name, index) pair, got {to!r}")
+        j = self._flat_index(to[0], to[1], "tie target")
+        tname = to[0]
+        if (name, i) == (tname, j):
+            raise InputError(f"tie(): entry {self[name].labels()[i]} cannot be tied to itself")
+        if (tname, j) in self._ties:
+            root = self._ties[(tname, j)]
+            raise InputError(
+                f"tie(): the target {self[tname].labels()[j]} is itself tied to "
+                f"{self[root[0]].labels()[root[1]]}; tie to that entry directly"
+            )
+        if any(t == (name, i) for t in self._ties.values()):
+            raise InputError(
+                f"tie(): other entries are tied to {self[name].labels()[i]}; it cannot be tied "
+                "in turn (tie them all to one entry)"
+            )
+        b, t = self[name], self[tname]
+        if not t.free.ravel()[j]:
+            raise InputError(
+                f"tie(): the target {t.labels()[j]} is fixed; fix the tied entry instead, or "
+                "free the target first"
+            )
+        if np.isfinite(b.prior_sigma.ravel()[i]):
+            raise InputError(
+                f"tie(): {b.labels()[i]} has a prior; put the prior on the target "
+                f"{t.labels()[j]} instead"
+            )
+        self._ties[(name, i)] = (tname, j)
+        np.put(b.free, i, True)  # estimated (through the target's unknown)
+        v = b.value.ravel().copy()
+        v[i] = t.value.ravel()[j]
+        b.value = v.reshape(b.shape)
+
+    def _flat_index(self, name: str, index, what: str) -> int:
+        b = self[name]
+        if b.points:
+            raise InputError(
+                f"tie(): {what} in the points block {name!r}: ties between per-point unknowns "
+                "are not supported"
+            )
+        try:
+            sel = np.arange(b.size).reshape(b.shape)[index]
+        except (IndexError, TypeError) as exc:
+            raise InputError(
+                f"tie(): index {index!r} is not valid for {name!r} of shape {b.shape}"
+            ) from exc
+        sel = np.atleast_1d(sel)
+        if sel.size != 1:
+            raise InputError(
+                f"tie(): {what} index {index!r} selects {sel.size} entries of {name!r}; a tie "
+                "joins exactly one entry to one other"
+            )
+        return int(sel[0])
+
+    def _sync_ties(self) -> None:
+        """Give every tied entry its target's current value."""
+        for (name, i), (tname, j) in self._ties.items():
+            b = self[name]
+            v = b.value.ravel().copy()
+            v[i] = self[tname].value.ravel()[j]
+            b.value = v.reshape(b.shape)
+
     def copy(self) -> Parameters:
         """A deep copy."""
         return copy.deepcopy(self)
 
     def free_labels(self, names: Iterable[str] | None = None) -> list[str]:
-        """Labels of the free entries of the given blocks (default: all), in engine order."""
+        """Labels of the free entries of the given blocks (default: all), in engine order.
+
+        A tied entry is not listed: it shares the unknown of its target.
+        """
         names = list(self._blocks) if names is None else list(names)
         out: list[str] = []
         for n in names:
             b = self[n]
             lab = b.labels()
-            out.extend(lab[i] for i in np.flatnonzero(b.free.ravel()))
+            out.extend(lab[i] for i in np.flatnonzero(b.free.ravel()) if (n, i) not in self._ties)
         return out
 
     def __repr__(self) -> str:

@@ -21,11 +21,22 @@ Jacobians come in one of three forms, keyed by parameter-block name:
 * a ``scipy.sparse`` matrix ``(m, block.size)``.
 
 Subclass :class:`ResidualBlock` and implement :meth:`~ResidualBlock.evaluate`.
+
+A residual block names the parameter blocks it depends on in one way: the mapping
+``blocks`` from *role* (what the model calls the block: ``"poses"``, ``"intrinsics"``) to the
+*name* of the parameter block in :class:`~hsgeo.adjust.Parameters`. A subclass declares its
+roles and default names in the class attribute ``BLOCKS``; an instance renames any of them
+with the constructor argument ``blocks={"poses": "poses_band3"}``. ``evaluate`` reads
+``values[self.blocks[role]]`` and keys its Jacobians by the same names.
 """
 
 from __future__ import annotations
 
+import difflib
+from collections.abc import Mapping
 from dataclasses import dataclass
+from types import MappingProxyType
+from typing import ClassVar
 
 import numpy as np
 import scipy.sparse as sp
@@ -142,14 +153,33 @@ class ResidualBlock:
         A-priori standard deviation of each residual component, in the residual's units.
     group_size : int
         Components per observation (consecutive rows), the unit of outlier rejection.
+    blocks : mapping of str to str
+        Parameter-block name of each role the residuals depend on (read-only): the class's
+        ``BLOCKS`` with the constructor's ``blocks`` applied.
+
+    Parameters
+    ----------
+    sigma : array_like
+        A-priori σ of each residual component.
+    name : str, optional
+        Overrides the class's ``name``.
+    group_size : int, optional
+        Overrides the class's ``group_size``.
+    blocks : mapping of str to str, optional
+        Parameter-block names by role, replacing the defaults of ``BLOCKS`` for the roles
+        given (e.g. ``{"poses": "poses_band3"}``).
     """
 
     name: str = "residuals"
     group_size: int = 1
+    #: The roles of the parameter blocks the residuals depend on, with their default names.
+    BLOCKS: ClassVar[Mapping[str, str]] = MappingProxyType({})
 
-    def __init__(self, sigma, name: str | None = None, group_size: int | None = None):
+    def __init__(self, sigma, name: str | None = None, group_size: int | None = None,
+                 blocks: Mapping[str, str] | None = None):
         if name is not None:
             self.name = name
+        self.blocks = self._block_names(blocks)
         if group_size is not None:
             self.group_size = int(group_size)
         s = np.asarray(sigma, dtype=np.float64).ravel()
@@ -166,6 +196,24 @@ class ResidualBlock:
                 f"group size {self.group_size}"
             )
         self.sigma = s
+
+    def _block_names(self, blocks: Mapping[str, str] | None) -> Mapping[str, str]:
+        names = dict(type(self).BLOCKS)
+        for role, block in (blocks or {}).items():
+            if role not in names:
+                close = difflib.get_close_matches(str(role), list(names), n=1)
+                hint = f" (did you mean {close[0]!r}?)" if close else ""
+                raise InputError(
+                    f"residual block {self.name!r} has no parameter role {role!r}{hint}; its "
+                    f"roles are {', '.join(names) or '(none)'}"
+                )
+            if not isinstance(block, str) or not block:
+                raise InputError(
+                    f"residual block {self.name!r}: the parameter block of role {role!r} must "
+                    f"be named by a non-empty string, got {block!r}"
+                )
+            names[role] = block
+        return MappingProxyType(names)
 
     @property
     def m(self) -> int:

@@ -3,33 +3,16 @@
 from __future__ import annotations
 
 import html
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.linalg as sla
 from scipy import stats as sst
 
-from hsgeo.adjust.engine import _evaluate, _Layout, _Normal, _reduced, _System
 from hsgeo.adjust.parameters import Parameters
-from hsgeo.errors import DatumError
+from hsgeo.errors import InputError
 
 __all__ = ["AdjustmentResult"]
-
-
-def _spd_inverse(S: np.ndarray) -> np.ndarray:
-    """The inverse of a symmetric positive definite matrix from its Cholesky factor.
-
-    LAPACK potrf + potri: a third of the work of solving for the identity.
-    """
-    from scipy.linalg import lapack
-
-    c, info = lapack.dpotrf(S, lower=True, clean=False)
-    if info != 0:
-        raise np.linalg.LinAlgError(f"the matrix is not positive definite (potrf info {info})")
-    inv, info = lapack.dpotri(c, lower=True, overwrite_c=True)
-    if info != 0:
-        raise np.linalg.LinAlgError(f"the matrix is singular (potri info {info})")
-    return np.tril(inv) + np.tril(inv, -1).T
 
 
 @dataclass
@@ -59,6 +42,11 @@ class AdjustmentResult:
         Names of the free non-point parameters.
     seconds : float
         Wall time of the adjustment.
+    reject_rounds : int
+        Outlier-rejection rounds (or passes, in each-iteration mode).
+    columns : dict of str to ndarray
+        For each non-point block, the index in ``labels``/``covariance`` of each entry
+        (flattened; -1 where fixed).
     """
 
     params: Parameters
@@ -74,62 +62,13 @@ class AdjustmentResult:
     labels: list
     seconds: float
     reject_rounds: int
-    _layout: _Layout = field(repr=False)
+    columns: dict = field(repr=False)
     _blocks: list = field(repr=False)
     _masks: list = field(repr=False)
-    _normal: _Normal = field(repr=False)
-    _S_inv: np.ndarray = field(repr=False)
     _residuals: dict = field(repr=False)
+    #: ``f(points, chunk)`` → the points' cofactor blocks (None: the Jacobian was not kept)
+    _point_cofactors: Callable | None = field(default=None, repr=False)
     _point_cov: np.ndarray | None = field(default=None, repr=False)
-
-    # -- construction -----------------------------------------------------------------------
-    @classmethod
-    def _build(cls, *, layout, blocks, masks, system: _System, normal: _Normal, converged,
-               message, iterations, history, seconds, reject_rounds):
-        n_unk = layout.n_unknowns
-        dof = int(system.r.size - n_unk)
-        vtpv = float(system.r @ system.r)
-        sigma0 = float(np.sqrt(vtpv / dof)) if dof > 0 else float("nan")
-        normal.exact()  # the covariance needs the reduced matrix of this point
-        S, _, _, _ = _reduced(layout, normal, 0.0)
-        if layout.n_c:
-            try:
-                S_inv = _spd_inverse(S)
-            except (np.linalg.LinAlgError, sla.LinAlgError) as exc:
-                raise DatumError(
-                    "the normal matrix at the solution is singular: the covariance cannot be "
-                    "computed (a datum defect that appeared during the iteration?)",
-                    layout.labels_c,
-                ) from exc
-        else:
-            S_inv = np.zeros((0, 0))
-        s2 = sigma0**2 if np.isfinite(sigma0) else 1.0
-        full = _evaluate(layout, blocks, [np.ones(b.m, dtype=bool) for b in blocks], False)
-        residuals, off = {}, 0
-        for b in blocks:
-            residuals[b.name] = full.r[off : off + b.m] * b.sigma  # back to the block's units
-            off += b.m
-        return cls(
-            params=layout.params,
-            converged=converged,
-            message=message,
-            iterations=iterations,
-            cost_history=list(history),
-            sigma0=sigma0,
-            dof=dof,
-            n_observations=int(system.n_obs_rows),
-            n_unknowns=n_unk,
-            covariance=s2 * S_inv,
-            labels=list(layout.labels_c),
-            seconds=seconds,
-            reject_rounds=reject_rounds,
-            _layout=layout,
-            _blocks=blocks,
-            _masks=[m.copy() for m in masks],
-            _normal=normal,
-            _S_inv=S_inv,
-            _residuals=residuals,
-        )
 
     # -- estimates and their σ ----------------------------------------------------------------
     def value(self, name: str) -> np.ndarray:
@@ -144,7 +83,7 @@ class AdjustmentResult:
             out = np.sqrt(np.diagonal(cov, axis1=1, axis2=2)).copy()
             out[~b.free] = np.nan
             return out
-        cm = self._layout.colmap[name]
+        cm = self.columns[name]
         out = np.full(b.size, np.nan)
         sel = cm >= 0
         out[sel] = np.sqrt(np.diag(self.covariance)[cm[sel]])
@@ -154,7 +93,7 @@ class AdjustmentResult:
         """Covariance sub-matrix of the free entries of the named (non-point) blocks."""
         idx, labs = [], []
         for n in names:
-            cm = self._layout.colmap[n]
+            cm = self.columns[n]
             lab = self.params[n].labels()
             for i in np.flatnonzero(cm >= 0):
                 idx.append(cm[i])
@@ -172,42 +111,29 @@ class AdjustmentResult:
 
         Computed on first request, in chunks of points to bound the memory. With ``index``
         (point rows), only those points are computed: ``(len(index), p, p)``, not cached.
+        Needs the Jacobian of the solution: adjust with ``keep_jacobian=True``.
+
+        Raises
+        ------
+        InputError
+            If the result was computed without ``keep_jacobian=True``.
         """
         if self._point_cov is not None and index is None:
             return self._point_cov
-        lay, ne = self._layout, self._normal
-        if lay.pblock is None:
+        pb = self.params.points_block
+        if pb is None:
             raise ValueError("this problem has no points block")
-        p = lay.p
-        pts = np.arange(lay.n_pts) if index is None else np.atleast_1d(np.asarray(index))
+        if self._point_cofactors is None:
+            raise InputError(
+                "the covariance of the points needs the Jacobian of the solution, which this "
+                "result did not keep: adjust again with keep_jacobian=True"
+            )
+        p = pb.shape[1]
+        pts = np.arange(pb.shape[0]) if index is None else np.atleast_1d(np.asarray(index))
         s2 = self.sigma0**2 if np.isfinite(self.sigma0) else 1.0
-        # a point left with too few rays after outlier rejection has a singular V: NaN for it
-        V = ne.V[pts]
-        ev = np.linalg.eigvalsh(V)
-        ok = ev[:, 0] > 1e-12 * np.maximum(ev[:, -1], 1e-300)
-        Vinv = np.full_like(V, np.nan)
-        Vinv[ok] = np.linalg.inv(V[ok])
-        Vinv_w = np.where(ok[:, None, None], Vinv, 0.0)
-        out = Vinv.copy()
-        if lay.n_c and ne.sy is not None and ne.order is not None:
-            # compiled path: each point's W_i from its rows, on its local columns
-            from hsgeo.adjust._fast import point_covariance as _pc
-
-            Vfull = np.zeros_like(ne.V)
-            Vfull[pts] = Vinv_w
-            sy = ne.sy
-            cov = _pc(sy.Jrc.arrays, sy.Jp, ne.order, ne.ptr, pts, Vfull, self._S_inv)
-            out = np.where(ok[:, None, None], cov, np.nan)
-        elif lay.n_c:
-            Wd = ne.W.tocsc()
-            for a0 in range(0, pts.size, chunk):
-                sel = pts[a0 : a0 + chunk]
-                colidx = (sel[:, None] * p + np.arange(p)).ravel()
-                Wi = Wd[:, colidx].toarray().T.reshape(sel.size, p, lay.n_c)  # (k, p, n_c)
-                A = np.einsum("kij,kjc->kic", Vinv_w[a0 : a0 + sel.size], Wi)  # V⁻¹ Wᵀ
-                out[a0 : a0 + sel.size] += np.einsum("kic,cd,kjd->kij", A, self._S_inv, A)
+        out = self._point_cofactors(pts, chunk)
         out *= s2
-        fixed = ~lay.pfree[pts]
+        fixed = ~pb.free[pts]
         for j in range(p):
             out[fixed[:, j], j, :] = np.nan
             out[fixed[:, j], :, j] = np.nan

@@ -101,7 +101,8 @@ def adjust_campaign(obs: CampaignObservations, cfg: CampaignConfig, *, with_gcp:
         info["rank_at_truth"] = ident.rank
         info["n_nonpoint_unknowns"] = ident.n_unknowns
     res = adjust(p, blocks, reject_k=reject_k, ftol=ftol, progress=progress,
-                 reject_every_iteration=True)  # 002 §3.4
+                 reject_every_iteration=True,  # 002 §3.4
+                 keep_jacobian=True)  # the check points' covariance (run)
     info["solver_seconds"] = res.seconds
     return res, p, blocks, info
 

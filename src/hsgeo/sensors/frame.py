@@ -25,6 +25,8 @@ world units, so that ``X_c = R_world_from_camᵀ (X − X0)``.
 
 from __future__ import annotations
 
+from types import MappingProxyType
+
 import numpy as np
 
 from hsgeo.adjust import Indexed, ResidualBlock
@@ -110,28 +112,28 @@ class _FrameBase(ResidualBlock):
     """Shared bookkeeping: which view and which object point each observation belongs to."""
 
     group_size = 2
+    BLOCKS = MappingProxyType({"poses": "poses", "points": "points"})
 
-    def __init__(self, view, xy, sigma, X=None, point=None, points_block="points",
-                 poses_block="poses", name=None):
+    def __init__(self, view, xy, sigma, X=None, point=None, *, blocks=None, name=None):
         view, xy, X = _check_views(type(self).__name__, view, xy, X)
         if (X is None) == (point is None):
             raise InputError("give either known object points X (n, 3) or point indices into "
                              "a points block, not both")
-        super().__init__(np.broadcast_to(np.asarray(sigma, float), xy.shape).ravel(), name=name)
+        super().__init__(np.broadcast_to(np.asarray(sigma, float), xy.shape).ravel(), name=name,
+                         blocks=blocks)
         self.view, self.xy, self.X = view, xy, X
         self.point = None if point is None else np.asarray(point, dtype=np.int64)
-        self.points_block, self.poses_block = points_block, poses_block
 
     def _world(self, values):
-        return self.X if self.point is None else values[self.points_block][self.point]
+        return self.X if self.point is None else values[self.blocks["points"]][self.point]
 
     def _pack(self, r2, d_pose, d_X, extra):
         """Interleave (n, 2) residuals and Jacobians into rows x0, y0, x1, y1, …."""
         n = r2.shape[0]
         jac = dict(extra)
-        jac[self.poses_block] = Indexed(np.repeat(self.view, 2), d_pose.reshape(2 * n, 6))
+        jac[self.blocks["poses"]] = Indexed(np.repeat(self.view, 2), d_pose.reshape(2 * n, 6))
         if self.point is not None:
-            jac[self.points_block] = Indexed(np.repeat(self.point, 2), d_X.reshape(2 * n, 3))
+            jac[self.blocks["points"]] = Indexed(np.repeat(self.point, 2), d_X.reshape(2 * n, 3))
         return r2.ravel(), jac
 
 
@@ -178,22 +180,26 @@ class FrameOpenCV(_FrameBase):
     square_pixels : bool
         Use fx for both axes (OpenCV's FIX_ASPECT_RATIO with aspect 1); ``fy`` is then unused
         and should be fixed.
+    blocks : mapping, optional
+        Parameter-block names by role (``poses``, ``points``, ``intrinsics``, ``distortion``;
+        the defaults are the role names), see :class:`~hsgeo.adjust.ResidualBlock`.
     """
 
     name = "image points (OpenCV form)"
+    BLOCKS = MappingProxyType({**_FrameBase.BLOCKS, "intrinsics": "intrinsics",
+                               "distortion": "distortion"})
 
     def __init__(self, view, uv_px, sigma_px=1.0, X=None, point=None, *, square_pixels=False,
-                 intrinsics_block="intrinsics", distortion_block="distortion", **kw):
+                 **kw):
         super().__init__(view, uv_px, sigma_px, X, point, **kw)
         self.square_pixels = square_pixels
-        self.intrinsics_block, self.distortion_block = intrinsics_block, distortion_block
 
     def evaluate(self, values, jacobian):
-        poses = values[self.poses_block]
-        fx, fy, cx, cy = values[self.intrinsics_block]
+        poses = values[self.blocks["poses"]]
+        fx, fy, cx, cy = values[self.blocks["intrinsics"]]
         if self.square_pixels:
             fy = fx
-        dist = values[self.distortion_block]
+        dist = values[self.blocks["distortion"]]
         Xc, d_pose, d_X = camera_coordinates(poses, self.view, self._world(values), jacobian)
         if np.any(Xc[:, 2] <= 0):
             raise InputError(
@@ -221,8 +227,8 @@ class FrameOpenCV(_FrameBase):
         d_Xc = F[None, :, None] * np.einsum("nab,nbc->nac", J_xy, _dproj(Xc))
         dp = np.einsum("nac,nck->nak", d_Xc, d_pose)
         dX = np.einsum("nac,nck->nak", d_Xc, d_X)
-        extra = {self.intrinsics_block: d_intr.reshape(2 * n, 4),
-                 self.distortion_block: d_dist.reshape(2 * n, 5)}
+        extra = {self.blocks["intrinsics"]: d_intr.reshape(2 * n, 4),
+                 self.blocks["distortion"]: d_dist.reshape(2 * n, 5)}
         return self._pack(r2, dp, dX, extra)
 
 
@@ -265,19 +271,22 @@ class FramePhotogrammetric(_FrameBase):
         Measured image coordinates in mm from the image centre, y up (:func:`pixel_to_mm`).
     sigma_mm : float or (n, 2) ndarray
     X, point : see :class:`FrameOpenCV`.
+    blocks : mapping, optional
+        Parameter-block names by role (``poses``, ``points``, ``interior``, ``distortion``;
+        defaults ``poses``, ``points``, ``interior``, ``distortion_mm``).
     """
 
     name = "image points (photogrammetric form)"
+    BLOCKS = MappingProxyType({**_FrameBase.BLOCKS, "interior": "interior",
+                               "distortion": "distortion_mm"})
 
-    def __init__(self, view, xy_mm, sigma_mm, X=None, point=None, *, interior_block="interior",
-                 distortion_block="distortion_mm", **kw):
+    def __init__(self, view, xy_mm, sigma_mm, X=None, point=None, **kw):
         super().__init__(view, xy_mm, sigma_mm, X, point, **kw)
-        self.interior_block, self.distortion_block = interior_block, distortion_block
 
     def evaluate(self, values, jacobian):
-        poses = values[self.poses_block]
-        f, x0, y0 = values[self.interior_block]
-        KP = values[self.distortion_block]
+        poses = values[self.blocks["poses"]]
+        f, x0, y0 = values[self.blocks["interior"]]
+        KP = values[self.blocks["distortion"]]
         Xc, d_pose, d_X = camera_coordinates(poses, self.view, self._world(values), jacobian)
         if np.any(Xc[:, 2] >= 0):
             raise InputError(
@@ -299,6 +308,6 @@ class FramePhotogrammetric(_FrameBase):
         d_Xc = f * _dproj(Xc)
         dp = np.einsum("nac,nck->nak", d_Xc, d_pose)
         dX = np.einsum("nac,nck->nak", d_Xc, d_X)
-        extra = {self.interior_block: d_int.reshape(2 * n, 3),
-                 self.distortion_block: d_dist.reshape(2 * n, 5)}
+        extra = {self.blocks["interior"]: d_int.reshape(2 * n, 3),
+                 self.blocks["distortion"]: d_dist.reshape(2 * n, 5)}
         return self._pack(r2, dp, dX, extra)

@@ -61,7 +61,9 @@ Krtalić, Miljković, Gajski, Racetin (2019), Sensors 19(19) 4267, §2.3, §3.1,
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
+from types import MappingProxyType
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -307,13 +309,18 @@ class LineObservations(ResidualBlock):
         Measured coordinates.
     sigma_px : float or (m,) array_like, px
         A-priori σ of a measurement.
+    blocks : mapping, optional
+        Parameter-block names by role (``eop``, ``zeta0``, ``c``, ``K``, ``xy``; defaults
+        ``eop``, ``zeta0_px``, ``c_px``, ``K``, ``xy_m``), see
+        :class:`~hsgeo.adjust.ResidualBlock`.
     """
 
     name = "zeta"
+    BLOCKS = MappingProxyType({"eop": "eop", "zeta0": "zeta0_px", "c": "c_px", "K": "K",
+                               "xy": "xy_m"})
 
     def __init__(self, image, point, zeta_px, sigma_px, *, name: str | None = None,
-                 eop: str = "eop", zeta0: str = "zeta0_px", c: str = "c_px", K: str = "K",
-                 xy: str = "xy_m", norm_px: float = DISTORTION_NORM_PX):
+                 blocks: Mapping[str, str] | None = None, norm_px: float = DISTORTION_NORM_PX):
         z = _finite(zeta_px, "zeta_px").ravel()
         img = np.asarray(image)
         pt = np.asarray(point)
@@ -329,14 +336,13 @@ class LineObservations(ResidualBlock):
         if img.min() < 0 or pt.min() < 0:
             raise InputError("image and point indices must be non-negative")
         super().__init__(np.broadcast_to(np.asarray(sigma_px, dtype=float), z.shape),
-                         name=name)
+                         name=name, blocks=blocks)
         self.image, self.point, self.zeta_px = img.astype(np.int64), pt.astype(np.int64), z
-        self.names = {"eop": eop, "zeta0": zeta0, "c": c, "K": K, "xy": xy}
         self.norm_px = float(norm_px)
 
     def predict(self, values) -> tuple[NDArray, dict]:
         """Model ζ for every observation and the pieces of its Jacobian."""
-        n = self.names
+        n = self.blocks
         eop = np.asarray(values[n["eop"]], dtype=float)
         xy = np.asarray(values[n["xy"]], dtype=float)
         z0 = float(values[n["zeta0"]])
@@ -358,7 +364,7 @@ class LineObservations(ResidualBlock):
         r = zeta - self.zeta_px
         if not jacobian:
             return r, None
-        n = self.names
+        n = self.blocks
         q, X, Y, ca, sa, Fp, c = w["q"], w["X"], w["Y"], w["ca"], w["sa"], w["Fp"], w["c"]
         u = (zeta - w["z0"]) / self.norm_px
         # ∂q/∂x, ∂q/∂y of the object point; ∂q/∂α = 1 + q²

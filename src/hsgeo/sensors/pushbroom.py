@@ -55,7 +55,9 @@ Jonassen et al. (2024), 002 eq. (2)–(4), §3.3–3.5.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
+from types import MappingProxyType
 
 import numpy as np
 from numba import njit, prange
@@ -72,15 +74,15 @@ __all__ = ["PushbroomLines", "PushbroomObservations", "BETA0_CAM_FROM_PLATFORM",
 #: y backward, z down).
 BETA0_CAM_FROM_PLATFORM = np.array([[0.0, -1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
 
-#: Default parameter block names used by :class:`PushbroomLines`.
-BLOCK_NAMES = {
+#: Default parameter-block names of :class:`PushbroomLines` by role (its ``BLOCKS``).
+BLOCK_NAMES = MappingProxyType({
     "points": "points_m",
     "nodes": "nodes",
     "boresight": "boresight_rad",
     "lever_arm": "lever_arm_m",
     "distortion": "distortion",
     "c": "c_mm",
-}
+})
 
 
 def _camera_geometry(values, names, nodes: SplineNodes, t_s, xyz_nav, rpy_nav, pidx, band,
@@ -433,8 +435,9 @@ class PushbroomLines(ResidualBlock):
         A-priori σ of an image coordinate (002 §4: 1/2 px).
     x0_mm, y0_mm : float
         Principal point (fixed).
-    names : dict, optional
-        Parameter block names (defaults :data:`BLOCK_NAMES`).
+    blocks : mapping, optional
+        Parameter-block names by role (defaults :data:`BLOCK_NAMES`), see
+        :class:`~hsgeo.adjust.ResidualBlock`.
     xyz_rate_m_s, rpy_rate_rad_s : (m, 3) ndarray, optional
         GNSS/INS velocity and attitude-angle rates at ``t_s``. Given, the residual across the
         line is a time (see the module docstring), in pixels at ``y_rate_ref_px_s``; omitted,
@@ -449,10 +452,11 @@ class PushbroomLines(ResidualBlock):
 
     name = "image points"
     group_size = 2
+    BLOCKS = BLOCK_NAMES
 
     def __init__(self, point, band, t_s, xy_px, xyz_nav_m, rpy_nav_rad, nodes: SplineNodes,
                  pixel_mm: float, sigma_px: float = 0.5, x0_mm: float = 0.0,
-                 y0_mm: float = 0.0, names: dict | None = None,
+                 y0_mm: float = 0.0, blocks: Mapping[str, str] | None = None,
                  beta0=BETA0_CAM_FROM_PLATFORM, xyz_rate_m_s=None, rpy_rate_rad_s=None,
                  y_rate_ref_px_s: float | None = None, newton_iterations: int = 8):
         point = np.asarray(point)
@@ -478,7 +482,7 @@ class PushbroomLines(ResidualBlock):
             raise InputError("PushbroomLines: band indices must be non-negative integers")
         if not (pixel_mm > 0):
             raise InputError(f"pixel pitch must be positive, got {pixel_mm!r} mm")
-        super().__init__(np.full(2 * m, float(sigma_px)))
+        super().__init__(np.full(2 * m, float(sigma_px)), blocks=blocks)
         self.point = point.astype(np.int64)
         self.band = np.asarray(band, dtype=np.int64)
         self.t_s = np.asarray(t_s, dtype=np.float64)
@@ -488,7 +492,6 @@ class PushbroomLines(ResidualBlock):
         self.nodes = nodes
         self.pixel_mm = float(pixel_mm)
         self.x0_mm, self.y0_mm = float(x0_mm), float(y0_mm)
-        self.names = dict(BLOCK_NAMES if names is None else names)
         self.beta0 = np.asarray(beta0, dtype=np.float64)
         index, u = nodes.piece(self.t_s)
         self._basis = (index, bspline_basis(u))
@@ -517,7 +520,7 @@ class PushbroomLines(ResidualBlock):
 
     def image_mm(self, values):
         """Modelled image coordinates in mm, ``(m, 2)``."""
-        xy, _ = project(values, self.names, self.nodes, self.t_s, self.xyz_nav, self.rpy_nav,
+        xy, _ = project(values, self.blocks, self.nodes, self.t_s, self.xyz_nav, self.rpy_nav,
                         self.point, self.band, self.beta0, self.x0_mm, self.y0_mm)
         return xy
 
@@ -528,7 +531,7 @@ class PushbroomLines(ResidualBlock):
         """
         if self.timed:
             raise NotImplementedError("the numpy reference covers the image-y residual only")
-        nm = self.names
+        nm = self.blocks
         g = _camera_geometry(values, nm, self.nodes, self.t_s, self.xyz_nav, self.rpy_nav,
                              self.point, self.band, self.beta0, jacobian)
         p, q, d, R, beta = g["p"], g["q"], g["d"], g["R"], g["beta"]
@@ -589,7 +592,7 @@ class PushbroomLines(ResidualBlock):
         return r, jac
 
     def evaluate(self, values, jacobian):
-        nm = self.names
+        nm = self.blocks
         m = self.point.size
         idx = self._basis[0]
         bore = values[nm["boresight"]]

@@ -37,6 +37,8 @@ Two residual blocks use it:
 
 from __future__ import annotations
 
+from types import MappingProxyType
+
 import numpy as np
 
 from hsgeo.adjust import Indexed, ResidualBlock
@@ -159,31 +161,33 @@ class TargetCentroids(ResidualBlock):
     xy_mm : (n, 2) ndarray
         Measured centroids, mm from the image centre, y up.
     sigma_mm : float or (n, 2) ndarray
+    blocks : mapping, optional
+        Parameter-block names by role (``interior``, ``distortion``, ``poses``; defaults
+        ``interior``, ``distortion_mm``, ``poses``), see :class:`~hsgeo.adjust.ResidualBlock`.
     """
 
     name = "target centroids"
     group_size = 2
+    BLOCKS = MappingProxyType({"interior": "interior", "distortion": "distortion_mm",
+                               "poses": "poses"})
 
-    def __init__(self, view, corners, xy_mm, sigma_mm, *, interior_block="interior",
-                 distortion_block="distortion_mm", poses_block="poses", name=None):
+    def __init__(self, view, corners, xy_mm, sigma_mm, *, blocks=None, name=None):
         view, corners, xy = _check_obs(type(self).__name__, view, corners, xy_mm)
         super().__init__(np.broadcast_to(np.asarray(sigma_mm, float), xy.shape).ravel(),
-                         name=name)
+                         name=name, blocks=blocks)
         self.view, self.corners, self.xy = view, corners, xy
-        self.interior_block, self.distortion_block = interior_block, distortion_block
-        self.poses_block = poses_block
 
     def predict(self, values) -> np.ndarray:
         """Model centroids (n, 2) mm."""
         return self._model(values, False)[0]
 
     def _model(self, values, jacobian):
-        f, x0, y0 = values[self.interior_block]
+        f, x0, y0 = values[self.blocks["interior"]]
         n = self.xy.shape[0]
-        Xc, d_pose, _ = camera_coordinates(values[self.poses_block], np.repeat(self.view, 4),
+        Xc, d_pose, _ = camera_coordinates(values[self.blocks["poses"]], np.repeat(self.view, 4),
                                            self.corners.reshape(-1, 3), jacobian)
         xy, J = centroid_model(Xc.reshape(n, 4, 3), np.full(n, f), np.array([x0, y0]),
-                               values[self.distortion_block], jacobian)
+                               values[self.blocks["distortion"]], jacobian)
         return xy, J, d_pose
 
     def evaluate(self, values, jacobian):
@@ -197,16 +201,18 @@ class TargetCentroids(ResidualBlock):
         d_int[:, 0, 1] = 1.0
         d_int[:, 1, 2] = 1.0
         dp = np.einsum("nkac,nkcj->naj", J["Xc"], d_pose.reshape(n, 4, 3, 6))
-        jac = {self.interior_block: d_int.reshape(2 * n, 3),
-               self.distortion_block: J["KP"].reshape(2 * n, 5),
-               self.poses_block: Indexed(np.repeat(self.view, 2), dp.reshape(2 * n, 6))}
+        nm = self.blocks
+        jac = {nm["interior"]: d_int.reshape(2 * n, 3),
+               nm["distortion"]: J["KP"].reshape(2 * n, 5),
+               nm["poses"]: Indexed(np.repeat(self.view, 2), dp.reshape(2 * n, 6))}
         return r.ravel(), jac
 
 
 class JointCentroids(ResidualBlock):
     """Centroid observations of all bands of all cubes in one model (003 §3.5, future work).
 
-    Parameter blocks (names configurable):
+    Parameter blocks (default names; ``blocks={role: name}`` renames them, roles ``poses``,
+    ``gap``, ``df``, ``pp``, ``distortion``, ``rotation``, ``offset`` in this order):
 
     ``poses`` (n_cubes, 6)
         Exterior orientation of sensor I's camera frame per cube (the camera is static during a
@@ -238,10 +244,12 @@ class JointCentroids(ResidualBlock):
     name = "target centroids (joint model)"
     group_size = 2
 
+    BLOCKS = MappingProxyType({"poses": "poses", "gap": "gap_model", "df": "df_mm",
+                               "pp": "pp_mm", "distortion": "distortion_mm",
+                               "rotation": "sensor2_rotation", "offset": "sensor2_offset_mm"})
+
     def __init__(self, cube, band_index, corners, xy_mm, sigma_mm, gap_nm, sensor, *,
-                 poses_block="poses", gap_block="gap_model", df_block="df_mm", pp_block="pp_mm",
-                 distortion_block="distortion_mm", rotation_block="sensor2_rotation",
-                 offset_block="sensor2_offset_mm", name=None):
+                 blocks=None, name=None):
         cube, corners, xy = _check_obs(type(self).__name__, cube, corners, xy_mm)
         band_index = np.asarray(band_index)
         gap_nm = np.asarray(gap_nm, dtype=np.float64)
@@ -253,19 +261,17 @@ class JointCentroids(ResidualBlock):
         if band_index.min() < 0 or band_index.max() >= gap_nm.size:
             raise InputError("JointCentroids: band_index outside the band table")
         super().__init__(np.broadcast_to(np.asarray(sigma_mm, float), xy.shape).ravel(),
-                         name=name)
+                         name=name, blocks=blocks)
         self.cube, self.band, self.corners, self.xy = cube, band_index.astype(np.int64), \
             corners, xy
         self.gap = gap_nm[self.band]
         self.srow = sensor[self.band].astype(np.int64) - 1  # 0: sensor I, 1: sensor II
-        self.names = dict(poses=poses_block, gap=gap_block, df=df_block, pp=pp_block,
-                          dist=distortion_block, rot=rotation_block, off=offset_block)
 
     def predict(self, values) -> np.ndarray:
         return self._model(values, False)[0]
 
     def _model(self, values, jacobian):
-        nm = self.names
+        nm = self.blocks
         n = self.xy.shape[0]
         ab = values[nm["gap"]]
         f = ab[self.srow, 0] * self.gap + ab[self.srow, 1] + values[nm["df"]][self.band]
@@ -273,17 +279,17 @@ class JointCentroids(ResidualBlock):
         XcI, d_pose, _ = camera_coordinates(values[nm["poses"]], np.repeat(self.cube, 4),
                                             self.corners.reshape(-1, 3), jacobian)
         XcI = XcI.reshape(n, 4, 3)
-        rot = values[nm["rot"]]
-        t = values[nm["off"]]
+        rot = values[nm["rotation"]]
+        t = values[nm["offset"]]
         M = R_from_opk(*rot)  # R_I_from_II
         two = self.srow == 1
         Xc = XcI.copy()
         Xc[two] = np.einsum("ji,nkj->nki", M, XcI[two] - t)  # X_camII = Mᵀ (X_camI − t)
-        xy, J = centroid_model(Xc, f, pp, values[nm["dist"]], jacobian)
+        xy, J = centroid_model(Xc, f, pp, values[nm["distortion"]], jacobian)
         return xy, J, (d_pose, XcI, M, two, t, rot)
 
     def evaluate(self, values, jacobian):
-        nm = self.names
+        nm = self.blocks
         xy, J, aux = self._model(values, jacobian)
         r = xy - self.xy
         if not jacobian:
@@ -308,8 +314,8 @@ class JointCentroids(ResidualBlock):
             nm["gap"]: Indexed(np.repeat(self.srow, 2), d_ab.reshape(2 * n, 2)),
             nm["df"]: Indexed(np.repeat(self.band, 2), J["f"].reshape(2 * n, 1)),
             nm["pp"]: Indexed(np.repeat(self.srow, 2), np.tile(np.eye(2), (n, 1))),
-            nm["dist"]: J["KP"].reshape(2 * n, 5),
-            nm["rot"]: d_rot.reshape(2 * n, 3),
-            nm["off"]: d_off.reshape(2 * n, 3),
+            nm["distortion"]: J["KP"].reshape(2 * n, 5),
+            nm["rotation"]: d_rot.reshape(2 * n, 3),
+            nm["offset"]: d_off.reshape(2 * n, 3),
         }
         return r.ravel(), jac

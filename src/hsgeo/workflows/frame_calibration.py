@@ -215,17 +215,15 @@ def calibrate_opencv(
     p.add("poses", initial_poses(views, K), columns=POSE_COLUMNS)
     if fix_principal_point:
         p.fix("intrinsics", index=[2, 3])
-    if square_pixels:
-        p.fix("intrinsics", index=1)
+    if square_pixels:  # fy = fx: one unknown
+        p.tie("intrinsics", index=1, to=("intrinsics", 0))
     if zero_tangent:
         p.fix("distortion", index=[2, 3])
     if fix_k3:
         p.fix("distortion", index=4)
     view, X, uv = _stack(views)
-    blk = FrameOpenCV(view, uv, sigma_px, X=X, square_pixels=square_pixels)
+    blk = FrameOpenCV(view, uv, sigma_px, X=X)
     res = adjust(p, blk, reject_k=reject_k, progress=progress)
-    if square_pixels:  # fy is tied to fx: report it so
-        res.params["intrinsics"].value[1] = res.params["intrinsics"].value[0]
     return FrameCalibration("opencv", res, (int(w), int(h)), views)
 
 

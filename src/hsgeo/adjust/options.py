@@ -1,0 +1,178 @@
+"""The settings of the least-squares solver, in one frozen dataclass.
+
+Every tolerance and switch of :func:`hsgeo.adjust.adjust` is a field of :class:`SolverOptions`;
+the solver keeps no module-level state. ``adjust(p, blocks, reject_k=5.0)`` is shorthand for
+``adjust(p, blocks, SolverOptions(reject_k=5.0))``.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+import numbers
+from dataclasses import dataclass, fields, replace
+from typing import Any
+
+import numpy as np
+
+from hsgeo.errors import InputError
+
+__all__ = ["SolverOptions"]
+
+
+@dataclass(frozen=True)
+class SolverOptions:
+    """Settings of the Levenberg–Marquardt solver (see :mod:`hsgeo.adjust.solver`).
+
+    Costs are ``½ Σ r_w²`` of the whitened residuals ``r_w = (f(x) − l) / σ`` (dimensionless);
+    the damping λ is relative to the diagonal of the normal matrix (dimensionless).
+
+    Parameters
+    ----------
+    max_iter : int, default 50
+        Maximum number of accepted Gauss–Newton/LM steps per rejection round.
+    ftol : float, default 1e-10
+        Convergence when the decrease of the cost the Gauss–Newton step predicts is below
+        ``ftol`` times the cost (relative, dimensionless).
+    atol : float, default 1e-24
+        Convergence when the cost per residual component falls below it (noise-free data).
+    lambda0 : float, default 1e-6
+        Initial Marquardt damping; small means Gauss–Newton first.
+    lambda_points_min : float, default 1e-4
+        Below this damping the points' blocks are not damped (only the reduced system is), so
+        one reduced matrix per linearisation point serves the datum check, the damped retries
+        and the covariance.
+    lambda_max : float, default 1e16
+        Damping at which the step search gives up: no step decreases the cost.
+    reject_k : float or None, default None
+        Reject observations whose standardised residual (whitened, divided by ``√(1 − h)``
+        with ``h`` the leverage on its point) exceeds ``reject_k`` robust σ (NMAD). ``None``:
+        no outlier rejection.
+    reject_every_iteration : bool, default False
+        With ``reject_k``: test the residuals after every iteration from a settled iterate on
+        (002 §3.4) instead of in rounds after convergence.
+    max_reject_rounds : int, default 10
+        Maximum number of rejection rounds (rounds mode).
+    reject_round_ftol : float, default 1e-4
+        Relative cost decrease at which an intermediate rejection round stops (rounds mode);
+        the final round iterates to ``ftol``.
+    settled : float, default 1e-2
+        An iterate is *settled* when the last step decreased the cost by less than this share
+        of it, or the actual decrease matched the predicted one to this share of the new cost.
+        From a settled iterate on, each-iteration rejection tests the residuals and the
+        compiled path takes chord steps. ``inf``: every iterate counts as settled.
+    chord_end : float, default 1e-3
+        Chord steps end when their predicted decrease falls below ``chord_end · ftol · cost``.
+    check_datum : bool, default True
+        Check the rank before the first step; raise :class:`~hsgeo.DatumError` if deficient.
+    rank_rtol : float, default 1e-11
+        Relative eigenvalue threshold of the datum check (see
+        :func:`~hsgeo.adjust.identifiability`).
+    raise_on_failure : bool, default True
+        Raise :class:`~hsgeo.ConvergenceError` (carrying the result) if the iteration does not
+        converge; otherwise return the result with ``converged=False``.
+    compiled : bool, default True
+        Form the normal equations with the compiled row-compressed kernels
+        (:mod:`hsgeo.adjust._fast`); ``False``: the generic scipy.sparse path (same equations,
+        no chord steps; for tests and debugging).
+    keep_jacobian : bool, default False
+        Keep the Jacobian of the final iterate in the result, which
+        :meth:`~hsgeo.adjust.AdjustmentResult.point_covariance` (and ``sigma`` of the points)
+        needs. Off by default: the Jacobian can be the largest array of a solve.
+
+    Raises
+    ------
+    InputError
+        If a value is out of its range (the message names the field and the valid range).
+    """
+
+    max_iter: int = 50
+    ftol: float = 1e-10
+    atol: float = 1e-24
+    lambda0: float = 1e-6
+    lambda_points_min: float = 1e-4
+    lambda_max: float = 1e16
+    reject_k: float | None = None
+    reject_every_iteration: bool = False
+    max_reject_rounds: int = 10
+    reject_round_ftol: float = 1e-4
+    settled: float = 1e-2
+    chord_end: float = 1e-3
+    check_datum: bool = True
+    rank_rtol: float = 1e-11
+    raise_on_failure: bool = True
+    compiled: bool = True
+    keep_jacobian: bool = False
+
+    def __post_init__(self) -> None:
+        for name in ("max_iter", "max_reject_rounds"):
+            v = getattr(self, name)
+            if isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers.Integral) or v < 0:
+                raise InputError(
+                    f"SolverOptions.{name} must be a non-negative integer, got {v!r}"
+                )
+        positive = ("ftol", "lambda0", "lambda_points_min", "lambda_max", "reject_round_ftol",
+                    "chord_end", "rank_rtol")
+        for name in positive:
+            v = getattr(self, name)
+            if not _is_real(v) or not (0.0 < v < math.inf):
+                raise InputError(
+                    f"SolverOptions.{name} must be a finite positive number, got {v!r}"
+                )
+        for name in ("atol", "settled"):
+            v = getattr(self, name)
+            if not _is_real(v) or math.isnan(v) or v < 0.0:
+                raise InputError(f"SolverOptions.{name} must be a number ≥ 0, got {v!r}")
+        if self.lambda0 > self.lambda_max:
+            raise InputError(
+                f"SolverOptions.lambda0 ({self.lambda0!r}) exceeds lambda_max "
+                f"({self.lambda_max!r}): no step could be tried"
+            )
+        if self.reject_k is not None and (
+            not _is_real(self.reject_k) or not (0.0 < self.reject_k < math.inf)
+        ):
+            raise InputError(
+                f"SolverOptions.reject_k must be None (no rejection) or a finite positive "
+                f"number of robust σ, e.g. 5.0; got {self.reject_k!r}"
+            )
+        for name in ("reject_every_iteration", "check_datum", "raise_on_failure", "compiled",
+                     "keep_jacobian"):
+            v = getattr(self, name)
+            if not isinstance(v, (bool, np.bool_)):
+                raise InputError(f"SolverOptions.{name} must be True or False, got {v!r}")
+
+    @classmethod
+    def field_names(cls) -> list[str]:
+        """The names of the settings, in declaration order."""
+        return [f.name for f in fields(cls)]
+
+    def replace(self, **changes: Any) -> SolverOptions:
+        """A copy with some fields changed; an unknown name raises :class:`InputError`.
+
+        The error names the closest valid field (``ftoll`` → ``ftol``).
+        """
+        valid = self.field_names()
+        for key in changes:
+            if key not in valid:
+                close = difflib.get_close_matches(key, valid, n=1)
+                hint = f" Did you mean {close[0]!r}?" if close else ""
+                raise InputError(
+                    f"unknown solver option {key!r}.{hint} Valid options: {', '.join(valid)}"
+                )
+        return replace(self, **changes) if changes else self
+
+    @classmethod
+    def resolve(cls, options: SolverOptions | None, overrides: dict[str, Any]) -> SolverOptions:
+        """``options`` (default: the defaults) with ``overrides`` applied (see :meth:`replace`)."""
+        if options is None:
+            options = cls()
+        elif not isinstance(options, cls):
+            raise InputError(
+                f"options must be a SolverOptions, got {type(options).__name__}; pass single "
+                "settings as keywords, e.g. adjust(params, blocks, ftol=1e-8)"
+            )
+        return options.replace(**overrides)
+
+
+def _is_real(v) -> bool:
+    return isinstance(v, numbers.Real) and not isinstance(v, (bool, np.bool_))

@@ -1,0 +1,76 @@
+"""Outlier rejection: standardised residuals tested against a robust σ.
+
+An observation whose residual, whitened and divided by ``√(1 − h)`` (``h`` its leverage on its
+point, Baarda's w-test with the points' share of the redundancy), exceeds ``reject_k`` robust
+standard deviations (NMAD) is rejected — a whole group (e.g. x and y of one image point) at a
+time, and of one point's groups only the largest per test. The solver tests in rounds after
+convergence, or in every iteration from a settled iterate on
+(``SolverOptions.reject_every_iteration``, as 002 §3.4 does).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hsgeo.adjust.schur import _inv_blocks, _Normal
+from hsgeo.adjust.system import _System
+from hsgeo.stats import NMAD_SCALE
+
+__all__: list[str] = []
+
+
+def _leverage(ne: _Normal, sy: _System) -> np.ndarray | None:
+    """Each row's leverage on its point, ``h = j_pᵀ V⁻¹ j_p`` (0 for rows without a point),
+    from the linearised system ``sy`` at which the normal equations ``ne`` were formed.
+    """
+    if ne.V is None:
+        return None
+    from hsgeo.adjust._fast import point_leverage
+
+    Vinv = ne.reduced0[2] if ne.reduced0 is not None else _inv_blocks(ne.V, ne.options.compiled)
+    return point_leverage(sy.Jp, sy.pidx, np.ascontiguousarray(Vinv))
+
+
+def _reject(blocks, masks, sy: _System, reject_k: float, row_point=None,
+            leverage=None) -> bool:
+    """Reject the kept groups whose residual in ``sy`` exceeds ``reject_k`` robust σ.
+
+    With ``leverage`` (of each row of ``sy`` on its point, see :func:`_leverage`) the residuals
+    are standardised first, ``r / √(1 − h)`` (Baarda's w-test with the points' share of the
+    redundancy): a ray of a point seen three times has a residual shrunk by its point. Of one
+    point's groups only the one with the largest is rejected in a test: a gross error drags
+    its point, so the point's other observations show large residuals too (swamping); they
+    are tested again at the next iterate, without it. ``row_point[i]`` is the point of each
+    row of block ``i`` (blocks without points: every group on its own). ``masks`` is updated
+    in place; returns True if any group was rejected.
+    """
+    r = np.abs(sy.r[: sy.n_obs_rows])
+    if leverage is not None:
+        r = r / np.sqrt(np.maximum(1.0 - leverage[: sy.n_obs_rows], 1e-2))
+    r /= max(NMAD_SCALE * float(np.median(r)), 1e-300) if r.size else 1.0  # robust σ about 0
+    off = 0
+    new_any = False
+    for i, b in enumerate(blocks):
+        g = b.group_size
+        kept = np.flatnonzero(masks[i])
+        score = np.zeros(b.m)
+        score[kept] = r[off : off + kept.size]
+        off += kept.size
+        score = score.reshape(-1, g).max(axis=1)  # per group
+        cand = np.flatnonzero(score > reject_k)
+        if not cand.size:
+            continue
+        if row_point is not None and i in row_point:
+            pt = row_point[i][cand * g]
+            on = pt >= 0
+            c, pc = cand[on], pt[on]
+            o = np.lexsort((-score[c], pc))  # by point, the largest residual first
+            c, pc = c[o], pc[o]
+            first = np.ones(c.size, dtype=bool)
+            first[1:] = pc[1:] != pc[:-1]
+            cand = np.concatenate([cand[~on], c[first]])
+        bad = np.zeros(b.m // g, dtype=bool)
+        bad[cand] = True
+        masks[i] &= ~np.repeat(bad, g)
+        new_any = True
+    return new_any

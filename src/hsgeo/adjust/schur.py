@@ -1,0 +1,394 @@
+"""Normal equations and the Schur-reduced Levenberg–Marquardt step.
+
+With ``N = [[N_cc, W], [Wᵀ, V]]`` and ``V`` block diagonal (one ``p × p`` block per point), the
+reduced system ``S Δc = −(g_c − W V⁻¹ g_p)`` with ``S = N_cc − W V⁻¹ Wᵀ`` is solved densely
+(Cholesky) and the points follow as ``Δp = −V⁻¹ (g_p + Wᵀ Δc)``. Damping is Marquardt's
+``N + λ diag(N)``; the point blocks are damped only above ``lambda_points_min``
+(:class:`~hsgeo.adjust.options.SolverOptions`), so one reduced matrix per linearisation point
+serves the datum check, the damped retries and the covariance.
+
+Two paths form the same equations: the compiled row-compressed kernels
+(:mod:`hsgeo.adjust._fast`, ``SolverOptions.compiled``) and a generic scipy.sparse path;
+``tests/test_engine.py`` compares them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import partial
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+from scipy.linalg import lapack
+
+from hsgeo.adjust.options import SolverOptions
+from hsgeo.adjust.system import _Layout, _System
+
+__all__: list[str] = []
+
+
+@dataclass
+class _Normal:
+    _Ncc: np.ndarray | None  # (n_c, n_c) dense (on the compiled path: built on request)
+    gc: np.ndarray  # (n_c,)
+    V: np.ndarray | None  # (n_pts, p, p)
+    gp: np.ndarray | None  # (n_pts, p)
+    _W: sp.csr_matrix | None = None  # (n_c, n_pts * p), generic path (built on request)
+    sy: _System | None = None  # the rows, for the compiled path
+    order: np.ndarray | None = None  # rows sorted by point
+    ptr: np.ndarray | None = None  # rows of point i: order[ptr[i]:ptr[i + 1]]
+    n_pts: int = 0
+    pt_order: np.ndarray | None = None  # order in which the kernel visits the points
+    Ncc_free: np.ndarray | None = None  # J_cᵀ J_c of the rows without a point (compiled path)
+    diag_cc: np.ndarray | None = None  # diag(N_cc)
+    reduced0: tuple | None = None  # (S, rhs, V⁻¹) with undamped point blocks, see _reduced
+    S_chord: np.ndarray | None = None  # a reduced matrix formed at an earlier point, see adjust
+    options: SolverOptions = SolverOptions()  # compiled path, lambda_points_min
+
+    @property
+    def compiled_schur(self) -> bool:
+        """The reduced matrix is formed point by point by the compiled kernel."""
+        return self.V is not None and self.sy is not None and self._W is None and self._Ncc is None
+
+    def exact(self) -> None:
+        """Drop a chord matrix: the next reduced system is formed at this point."""
+        if self.S_chord is not None:
+            self.S_chord = None
+            self.reduced0 = None
+
+    @property
+    def Ncc(self) -> np.ndarray:
+        """``J_cᵀ J_c`` (dense)."""
+        if self._Ncc is None:
+            from hsgeo.adjust._fast import normal_cc
+
+            self._Ncc = normal_cc(self.sy.Jrc.arrays, self.sy.Jrc.n_cols)
+        return self._Ncc
+
+    @property
+    def W(self) -> sp.csr_matrix | None:
+        """``J_cᵀ J_p`` as scipy.sparse (built on first use on the compiled path)."""
+        if self._W is None and self.V is not None:
+            self._W = _W_sparse(self.sy, self.n_pts)
+        return self._W
+
+    def Wt_dot(self, dc: np.ndarray) -> np.ndarray:
+        """``Wᵀ dc`` as ``(n_pts, p)``."""
+        if self._W is not None or self.sy is None:
+            return (self.W.T @ dc).reshape(self.n_pts, -1)
+        from hsgeo.adjust._fast import scatter_points
+
+        return scatter_points(self.sy.Jp, self.sy.pidx, self.sy.Jrc.matvec(dc), self.n_pts)
+
+    def W_dot(self, y: np.ndarray) -> np.ndarray:
+        """``W y`` for ``y`` of shape ``(n_pts, p)``."""
+        if self._W is not None or self.sy is None:
+            return self.W @ y.ravel()
+        from hsgeo.adjust._fast import point_rows_dot
+
+        return self.sy.Jrc.rmatvec(point_rows_dot(self.sy.Jp, self.sy.pidx,
+                                                  np.ascontiguousarray(y)))
+
+
+def _W_sparse(sy: _System, n_pts: int) -> sp.csr_matrix:
+    p = sy.Jp.shape[1]
+    rows = np.flatnonzero(sy.pidx >= 0)
+    pi = sy.pidx[rows]
+    jp = sy.Jp[rows]
+    Jp_sp = sp.csr_matrix(
+        (jp.ravel(), (np.repeat(rows, p), (pi[:, None] * p + np.arange(p)).ravel())),
+        shape=(sy.r.size, n_pts * p),
+    )
+    return (sy.Jc.T @ Jp_sp).tocsr()
+
+
+class _OrderCache:
+    """The processing orders of the last sparsity structure seen by :func:`_normal`.
+
+    One per solve (or per :func:`~hsgeo.adjust.identifiability` call): the rows and points of
+    consecutive iterations are the same, so their orders are computed once.
+    """
+
+    def __init__(self) -> None:
+        self.key: tuple | None = None
+        self.value: tuple | None = None
+
+    def get(self, layout: _Layout, sy: _System):
+        """``(order, ptr, row_order, pt_order)`` for ``sy``, computed on a change of structure."""
+        from hsgeo.adjust._fast import locality_orders
+
+        key = self.key
+        if (key is not None and key[0] == layout.n_c and key[1] == layout.n_pts
+                and key[3] == sy.Jrc.cols.shape and np.array_equal(key[2], sy.pidx)):
+            # same rows and points as the previous iteration: reuse the processing orders
+            # (order and ptr depend only on pidx; row_order is a permutation of the rows that
+            # only affects speed, so a changed column pattern cannot make it wrong)
+            return self.value
+        order = ptr = None
+        if layout.pblock is not None:
+            pi_all = sy.pidx
+            rows_p = np.flatnonzero(pi_all >= 0)
+            order = rows_p[np.argsort(pi_all[rows_p], kind="stable")].astype(np.int64)
+            ptr = np.concatenate(
+                [[0], np.cumsum(np.bincount(pi_all[rows_p], minlength=layout.n_pts))]
+            ).astype(np.int64)
+        # the rows without a point (priors) form N_cc directly; the others go through the
+        # Schur kernel point by point
+        rows_np = np.flatnonzero(sy.pidx < 0) if layout.pblock is not None else None
+        row_order, pt_order = locality_orders(sy.Jrc, layout.n_c, order, ptr, rows_np)
+        self.key = (layout.n_c, layout.n_pts, sy.pidx.copy(), sy.Jrc.cols.shape)
+        self.value = (order, ptr, row_order, pt_order)
+        return self.value
+
+
+def _normal(layout: _Layout, sy: _System, options: SolverOptions,
+            orders: _OrderCache | None = None) -> _Normal:
+    """The normal equations at ``sy`` (compiled or generic path, see ``options.compiled``).
+
+    ``orders`` carries the processing orders from one call to the next (a new cache if None).
+    """
+    order = ptr = pt_order = None
+    compiled = options.compiled
+    if compiled:
+        from hsgeo.adjust._fast import normal_cc
+
+        order, ptr, row_order, pt_order = (orders or _OrderCache()).get(layout, sy)
+        Jrc = sy.Jrc
+        gc, diag_cc = Jrc.rmatvec(sy.r, diag=True)
+        if layout.pblock is None:
+            Ncc = normal_cc(Jrc.arrays, layout.n_c, row_order)
+            return _Normal(Ncc, gc, None, None, diag_cc=diag_cc, options=options)
+        Ncc_free = normal_cc(Jrc.arrays, layout.n_c, row_order)
+        Ncc = None
+    else:
+        Jc = sy.Jc
+        Ncc = (Jc.T @ Jc).toarray() if layout.n_c else np.zeros((0, 0))
+        gc = Jc.T @ sy.r
+    if layout.pblock is None:
+        return _Normal(Ncc, gc, None, None, options=options)
+    n_pts, p = layout.n_pts, layout.p
+    if compiled:
+        from hsgeo.adjust._fast import point_normals
+
+        V, gp = point_normals(sy.pidx, sy.Jp, sy.r, n_pts)
+    else:
+        rows = np.flatnonzero(sy.pidx >= 0)
+        pi = sy.pidx[rows]
+        jp = sy.Jp[rows]
+        # V_i = Σ_rows jpᵀ jp, g_p,i = Σ jpᵀ r  (sparse aggregation instead of a Python loop)
+        agg = sp.csr_matrix((np.ones(rows.size), (pi, np.arange(rows.size))),
+                            shape=(n_pts, rows.size))
+        V = (agg @ (jp[:, :, None] * jp[:, None, :]).reshape(rows.size, p * p)).reshape(
+            n_pts, p, p)
+        gp = agg @ (jp * sy.r[rows, None])
+    # fixed point entries: unit diagonal, zero gradient -> zero update
+    # (their Jacobian columns were zeroed in _evaluate, so V has zero rows/columns there)
+    fixed = ~layout.pfree
+    ii = np.nonzero(fixed)
+    V[ii[0], ii[1], ii[1]] = 1.0
+    gp[fixed] = 0.0
+    if not compiled:
+        return _Normal(Ncc, gc, V, gp, _W_sparse(sy, n_pts), n_pts=n_pts, options=options)
+    return _Normal(Ncc, gc, V, gp, None, sy, order, ptr, n_pts, pt_order, Ncc_free, diag_cc,
+                   options=options)
+
+
+def _damped(A: np.ndarray, lam: float) -> np.ndarray:
+    """A + λ·diag(A) on the last two axes (Marquardt), with a floor on zero diagonals."""
+    if lam == 0.0:
+        return A
+    A = A.copy()
+    d = np.diagonal(A, axis1=-2, axis2=-1)
+    floor = 1e-12 * max(float(np.max(d)) if d.size else 1.0, 1e-300)
+    idx = np.arange(A.shape[-1])
+    A[..., idx, idx] += lam * np.maximum(d, floor)
+    return A
+
+
+def _inv_blocks(Vd: np.ndarray, compiled: bool = True) -> np.ndarray:
+    """The inverses of the blocks ``Vd[i]`` (pseudo-inverse for the singular ones)."""
+    if compiled and Vd.ndim == 3 and Vd.shape[1:] == (3, 3):
+        from hsgeo.adjust._fast import inv3
+
+        out, ok = inv3(np.ascontiguousarray(Vd))
+        if not ok.all():
+            out[~ok] = np.linalg.pinv(Vd[~ok])
+        return out
+    try:
+        return np.linalg.inv(Vd)
+    except np.linalg.LinAlgError:
+        # some blocks are singular (e.g. a point whose observations were all rejected):
+        # pseudo-inverse for those only
+        d = np.abs(np.linalg.det(Vd))
+        scale = np.max(np.abs(Vd), axis=(1, 2)) ** Vd.shape[-1]
+        bad = ~(d > 1e-12 * scale)
+        out = np.empty_like(Vd)
+        out[~bad] = np.linalg.inv(Vd[~bad])
+        out[bad] = np.linalg.pinv(Vd[bad])
+        return out
+
+
+def _block_diag(Vinv: np.ndarray) -> sp.csr_matrix:
+    n, p, _ = Vinv.shape
+    rows = np.repeat(np.arange(n * p), p)
+    cols = (np.arange(n)[:, None, None] * p + np.zeros((1, p, 1), dtype=int) + np.arange(p)).ravel()
+    return sp.csr_matrix((Vinv.ravel(), (rows, cols)), shape=(n * p, n * p))
+
+
+def _lambda_points(lam: float, lambda_points_min: float) -> float:
+    """The damping of the point blocks: none below ``lambda_points_min`` (see _reduced)."""
+    return lam if lam > lambda_points_min else 0.0
+
+
+def _reduced(layout: _Layout, ne: _Normal, lam: float):
+    """S, rhs and the pieces for back-substitution, at damping λ.
+
+    Marquardt damping ``λ diag(N)`` is added to the reduced system; the points' blocks ``V``
+    are damped too only when ``λ > lambda_points_min`` (at smaller λ, damping a 3 × 3 point
+    block by a factor ``1 + λ`` changes nothing but the cost of re-forming ``S``).
+    """
+    rhs = ne.gc.copy()
+    lam_p = _lambda_points(lam, ne.options.lambda_points_min)
+    if ne.compiled_schur:
+        # compiled path: S = N_cc − Σ W_i V_i⁻¹ W_iᵀ accumulated point by point from the rows
+        # grouped by point; neither W nor the full N_cc is formed
+        from hsgeo.adjust._fast import reduced_points
+
+        cached = ne.reduced0 if lam_p == 0.0 else None
+        if cached is None:
+            Vinv = _inv_blocks(_damped(ne.V, lam_p), ne.options.compiled)
+            sy = ne.sy
+            if ne.S_chord is not None and lam_p == 0.0:
+                S0 = ne.S_chord  # a chord step: the matrix of an earlier point (see adjust)
+            else:
+                S0 = ne.Ncc_free + reduced_points(sy.Jrc.arrays, sy.Jp, ne.order, ne.ptr,
+                                                  Vinv, layout.n_c, ne.pt_order)
+            r0 = rhs - ne.W_dot(np.einsum("nij,nj->ni", Vinv, ne.gp)) if layout.n_c else rhs
+            if lam_p == 0.0:  # keep the undamped one (datum check, steps, covariance)
+                ne.reduced0 = (S0, r0, Vinv)
+        else:
+            S0, r0, Vinv = cached
+        S = S0.copy()
+        rhs = r0.copy()
+        if lam != 0.0 and layout.n_c:
+            d = ne.diag_cc
+            floor = 1e-12 * max(float(np.max(d)), 1e-300)
+            S[np.diag_indices_from(S)] += lam * np.maximum(d, floor)
+        return S, rhs, Vinv, None
+    S = _damped(ne.Ncc, lam)
+    if ne.V is None:
+        return S, rhs, None, None
+    Vinv = _inv_blocks(_damped(ne.V, lam_p), ne.options.compiled)
+    WVinv = (ne.W @ _block_diag(Vinv)).tocsr()
+    if layout.n_c:
+        S = S - (WVinv @ ne.W.T).toarray()
+        rhs = rhs - WVinv @ ne.gp.ravel()
+    return S, rhs, Vinv, WVinv
+
+
+def _step(layout: _Layout, ne: _Normal, lam: float):
+    S, rhs, Vinv, _ = _reduced(layout, ne, lam)
+    if layout.n_c:
+        try:
+            dc = -sla.cho_solve(sla.cho_factor(S, check_finite=False), rhs, check_finite=False)
+        except (np.linalg.LinAlgError, sla.LinAlgError):
+            dc = -np.linalg.lstsq(S, rhs, rcond=None)[0]
+    else:
+        dc = np.zeros(0)
+    dp = None
+    if Vinv is not None:
+        b = ne.gp + ne.Wt_dot(dc)
+        dp = -np.einsum("nij,nj->ni", Vinv, b)
+    return dc, dp
+
+
+def _predicted_decrease(layout, ne: _Normal, lam, dc, dp) -> float:
+    """L(0) - L(h) = ½ hᵀ(λ D h - g) for the damped Gauss–Newton step h (Madsen et al. eq. 3.14)."""
+    if not layout.n_c:
+        Dc = np.zeros(0)
+    else:
+        Dc = np.maximum(ne.diag_cc if ne.diag_cc is not None else np.diag(ne.Ncc), 0.0)
+    pred = 0.5 * float(dc @ (lam * Dc * dc - ne.gc))
+    if dp is not None:
+        Dp = np.maximum(np.diagonal(ne.V, axis1=1, axis2=2), 0.0)
+        lam_p = _lambda_points(lam, ne.options.lambda_points_min)
+        pred += 0.5 * float(np.sum(dp * (lam_p * Dp * dp - ne.gp)))
+    return pred
+
+
+
+# ----------------------------------------------------------------------------------------------
+# Covariances at the solution
+# ----------------------------------------------------------------------------------------------
+def _spd_inverse(S: np.ndarray) -> np.ndarray:
+    """The inverse of a symmetric positive definite matrix from its Cholesky factor.
+
+    LAPACK potrf + potri: a third of the work of solving for the identity.
+    """
+    c, info = lapack.dpotrf(S, lower=True, clean=False)
+    if info != 0:
+        raise np.linalg.LinAlgError(f"the matrix is not positive definite (potrf info {info})")
+    inv, info = lapack.dpotri(c, lower=True, overwrite_c=True)
+    if info != 0:
+        raise np.linalg.LinAlgError(f"the matrix is singular (potri info {info})")
+    return np.tril(inv) + np.tril(inv, -1).T
+
+
+def _reduced_inverse(layout: _Layout, ne: _Normal) -> np.ndarray:
+    """``S⁻¹`` of the undamped reduced matrix at the point of ``ne`` (a chord matrix dropped).
+
+    Raises ``np.linalg.LinAlgError`` if ``S`` is not positive definite.
+    """
+    ne.exact()  # the covariance needs the reduced matrix of this point
+    S, _, _, _ = _reduced(layout, ne, 0.0)
+    if not layout.n_c:
+        return np.zeros((0, 0))
+    return _spd_inverse(S)
+
+
+def _point_cofactors(ne: _Normal, S_inv: np.ndarray, pts: np.ndarray,
+                     chunk: int = 20000) -> np.ndarray:
+    """``V⁻¹ + V⁻¹ Wᵀ S⁻¹ W V⁻¹`` of the points ``pts``: ``(len(pts), p, p)``, NaN for a point
+    whose ``V`` is singular (e.g. too few rays left after outlier rejection).
+
+    Needs the Jacobian of the solution (``ne.sy`` on the compiled path, ``ne.W`` otherwise).
+    """
+    n_c = S_inv.shape[0]
+    p = ne.V.shape[-1]
+    V = ne.V[pts]
+    ev = np.linalg.eigvalsh(V)
+    ok = ev[:, 0] > 1e-12 * np.maximum(ev[:, -1], 1e-300)
+    Vinv = np.full_like(V, np.nan)
+    Vinv[ok] = np.linalg.inv(V[ok])
+    Vinv_w = np.where(ok[:, None, None], Vinv, 0.0)
+    out = Vinv.copy()
+    if n_c and ne.sy is not None and ne.order is not None:
+        # compiled path: each point's W_i from its rows, on its local columns
+        from hsgeo.adjust._fast import point_covariance as _pc
+
+        Vfull = np.zeros_like(ne.V)
+        Vfull[pts] = Vinv_w
+        sy = ne.sy
+        cov = _pc(sy.Jrc.arrays, sy.Jp, ne.order, ne.ptr, pts, Vfull, S_inv)
+        out = np.where(ok[:, None, None], cov, np.nan)
+    elif n_c:
+        Wd = ne.W.tocsc()
+        for a0 in range(0, pts.size, chunk):
+            sel = pts[a0 : a0 + chunk]
+            colidx = (sel[:, None] * p + np.arange(p)).ravel()
+            Wi = Wd[:, colidx].toarray().T.reshape(sel.size, p, n_c)  # (k, p, n_c)
+            A = np.einsum("kij,kjc->kic", Vinv_w[a0 : a0 + sel.size], Wi)  # V⁻¹ Wᵀ
+            out[a0 : a0 + sel.size] += np.einsum("kic,cd,kjd->kij", A, S_inv, A)
+    return out
+
+
+def _point_cofactor_function(ne: _Normal,
+                             S_inv: np.ndarray) -> Callable[[np.ndarray, int], np.ndarray]:
+    """``f(pts, chunk)`` → the points' cofactor blocks (see :func:`_point_cofactors`).
+
+    The function holds the Jacobian of the solution; the result keeps it only on request
+    (``SolverOptions.keep_jacobian``).
+    """
+    return partial(_point_cofactors, ne, S_inv)

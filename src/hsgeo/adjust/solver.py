@@ -1,0 +1,428 @@
+"""The least-squares solver: Levenberg–Marquardt on the Schur-reduced normal equations.
+
+Gauss–Newton with Levenberg–Marquardt damping on the whitened observation equations
+``r_w = (f(x) - l) / σ``, minimising ``½ Σ r_w²`` over the free parameters:
+
+* the Jacobian is assembled sparse from the residual blocks (:mod:`hsgeo.adjust.system`);
+  priors enter as pseudo-observations ``(x - μ) / σ_prior``;
+* per-point unknowns (the ``points=True`` block) are eliminated by the Schur complement and
+  damping is Marquardt's ``N + λ diag(N)`` with Nielsen's update of λ
+  (:mod:`hsgeo.adjust.schur`);
+* convergence: the decrease the Gauss–Newton step predicts at the current point is below
+  ``ftol`` times the cost (the reduced matrix just formed then gives the covariance), or the
+  cost is below ``atol`` (noise-free data);
+* before the first step the datum is checked (:mod:`hsgeo.adjust.datum`);
+* optional outlier rejection (:mod:`hsgeo.adjust.robust`): in rounds after convergence, or in
+  every iteration from a settled iterate on (``reject_every_iteration``, as 002 §3.4 does);
+* from a settled iterate on, the compiled path takes chord steps (the last reduced matrix
+  reused) and forms the matrix again at the final iterate;
+* the a-posteriori σ0 and the covariance of the non-point parameters (points on request) are in
+  the :class:`~hsgeo.adjust.result.AdjustmentResult`.
+
+Every setting is a field of :class:`~hsgeo.adjust.options.SolverOptions`.
+
+References
+----------
+Triggs, McLauchlan, Hartley, Fitzgibbon (2000): Bundle adjustment — a modern synthesis.
+Madsen, Nielsen, Tingleff (2004): Methods for non-linear least squares problems, §3.2.
+C. T. Kelley (1995): Iterative Methods for Linear and Nonlinear Equations, SIAM, ch. 5.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import scipy.linalg as sla
+
+from hsgeo.adjust.datum import _check_datum
+from hsgeo.adjust.options import SolverOptions
+from hsgeo.adjust.parameters import Parameters
+from hsgeo.adjust.residuals import ResidualBlock
+from hsgeo.adjust.result import AdjustmentResult
+from hsgeo.adjust.robust import _leverage, _reject
+from hsgeo.adjust.schur import (
+    _Normal,
+    _normal,
+    _OrderCache,
+    _point_cofactor_function,
+    _predicted_decrease,
+    _reduced_inverse,
+    _step,
+)
+from hsgeo.adjust.system import _evaluate, _Layout, _System
+from hsgeo.errors import ConvergenceError, DatumError, ObservationError
+
+__all__ = ["adjust"]
+
+
+def adjust(
+    params: Parameters,
+    blocks: Sequence[ResidualBlock] | ResidualBlock,
+    options: SolverOptions | None = None,
+    *,
+    progress: bool | Callable[[dict], Any] | None = None,
+    **overrides: Any,
+) -> AdjustmentResult:
+    """Adjust ``params`` to the observations of ``blocks`` by least squares.
+
+    Parameters
+    ----------
+    params : Parameters
+        Initial values, free/fixed flags and priors. Not modified: the estimate is in the result.
+    blocks : ResidualBlock or sequence of them
+        The observation equations.
+    options : SolverOptions, optional
+        Tolerances and switches (default: ``SolverOptions()``).
+    progress : bool or callable, optional
+        Print iteration, cost and λ to stderr (True) or call ``progress(info_dict)`` after
+        every accepted step.
+    **overrides
+        Fields of :class:`SolverOptions` that replace those of ``options``, e.g.
+        ``adjust(p, blocks, reject_k=5.0, ftol=1e-8)``.
+
+    Returns
+    -------
+    AdjustmentResult
+
+    Raises
+    ------
+    InputError
+        An unknown or invalid setting (the message names the closest valid one).
+    ObservationError
+        No residual blocks, nothing free, or fewer observations than unknowns.
+    DatumError
+        The normal equations are rank deficient (``check_datum``), or singular at the solution.
+    ConvergenceError
+        No convergence and ``raise_on_failure`` (the last iterate is in ``.result``).
+
+    Notes
+    -----
+    Levenberg–Marquardt on the Schur-reduced normal equations (the points eliminated). When
+    the reduced matrix is formed point by point by the compiled kernel (the costly part of an
+    iteration), the steps after a settled iterate (``SolverOptions.settled``) are *chord
+    steps* (Kelley 1995, ch. 5): they reuse the last reduced matrix formed, with the gradient
+    and the points' blocks of the current iterate, so they still descend to the same minimum,
+    linearly. Where they have converged (to ``chord_end · ftol``), or when one fails to
+    decrease the cost, the matrix is formed again; convergence is only declared with the
+    matrix of the final iterate, which also gives the covariance.
+
+    With ``reject_k``, rounds mode adjusts to convergence, rejects (see
+    :mod:`hsgeo.adjust.robust`) and adjusts again until nothing is rejected or
+    ``max_reject_rounds``; while outliers are still being rejected a round only iterates to
+    ``reject_round_ftol``. Each-iteration mode (``reject_every_iteration``) tests after every
+    step from a settled iterate on and has converged when the predicted decrease is below
+    ``ftol`` and the last test rejected nothing.
+    """
+    opts = SolverOptions.resolve(options, overrides)
+    blocks = [blocks] if isinstance(blocks, ResidualBlock) else list(blocks)
+    if not blocks:
+        raise ObservationError("no residual blocks given: nothing to adjust")
+    solve = _Solve(params.copy(), blocks, opts, progress)
+    # rounds mode: while outliers are still being rejected, a round only needs to get close to
+    # its minimum (the residuals that decide the rejection do not change at 1e-4 relative
+    # cost); once a rejection pass finds nothing new, the iteration continues to ``ftol``
+    final = opts.reject_k is None or solve.each
+    rounds = 0
+    while True:
+        tol = opts.ftol if final else max(opts.ftol, opts.reject_round_ftol)
+        sy = ne = None  # free the previous round's Jacobian first (peak memory)
+        outcome, sy, ne = solve.minimise(tol, check_datum=opts.check_datum and rounds == 0)
+        if outcome.rejected:  # each-iteration mode: a rejection at convergence, adjust again
+            rounds += 1
+            continue
+        if not outcome.converged or final:
+            break
+        if rounds >= opts.max_reject_rounds:
+            final = True
+            continue
+        # -- outlier rejection round
+        new_any = solve.reject(sy, sy, ne)
+        rounds += 1
+        if not new_any:
+            if tol <= opts.ftol:
+                break
+            final = True
+    result = solve.result(sy, ne, outcome, rounds)
+    if not outcome.converged and opts.raise_on_failure:
+        raise ConvergenceError(
+            f"the adjustment did not converge: {outcome.message} (last cost "
+            f"{solve.history[-1]:.6g}). Check the initial values, increase max_iter, or look "
+            "for gross errors; the last iterate is in the exception's .result.",
+            result,
+        )
+    return result
+
+
+@dataclass(frozen=True)
+class _Outcome:
+    """How one minimisation (a pass of the LM loop) ended."""
+
+    converged: bool
+    message: str
+    rejected: bool = False  # each-iteration mode: stopped to adjust again with new masks
+
+
+@dataclass
+class _Trial:
+    """An accepted (or, with ``lam > lambda_max``, the last refused) damped step."""
+
+    system: _System  # residuals at the new point
+    actual: float  # actual decrease of the cost
+    pred: float  # decrease predicted by the linearised model
+    lam: float
+    nu: float
+
+
+class _Solve:
+    """The state of one adjustment: layout, masks, processing orders, history, counters."""
+
+    def __init__(self, params: Parameters, blocks: list[ResidualBlock], options: SolverOptions,
+                 progress):
+        self.options = options
+        self.blocks = blocks
+        params._sync_ties()  # a tied entry starts at its target's value
+        self.layout = _Layout(params)
+        if self.layout.n_unknowns == 0:
+            raise ObservationError(
+                "every parameter is fixed: there is nothing to estimate (free some with "
+                "Parameters.free())"
+            )
+        self.masks = [np.ones(b.m, dtype=bool) for b in blocks]
+        self.orders = _OrderCache()
+        self.show = _progress_printer(progress)
+        self.history: list[float] = []
+        self.t0 = time.perf_counter()
+        self.total_iter = 0
+        self.each = options.reject_k is not None and options.reject_every_iteration
+
+    # -- the linearised system -------------------------------------------------------------
+    def linearise(self, check_redundancy: bool = False) -> tuple[_System, _Normal]:
+        """The whitened system and its normal equations at the current values."""
+        layout = self.layout
+        sy = _evaluate(layout, self.blocks, self.masks, jacobian=True,
+                       compiled=self.options.compiled)
+        if check_redundancy:
+            dof = sy.r.size - layout.n_unknowns
+            if dof < 0 or (dof == 0 and sy.n_obs_rows < layout.n_unknowns):
+                raise ObservationError(
+                    f"fewer observations ({sy.r.size} residual components incl. priors) than "
+                    f"unknowns ({layout.n_unknowns}): add observations, fix parameters or add "
+                    "priors"
+                )
+        return sy, _normal(layout, sy, self.options, self.orders)
+
+    def reject(self, residuals: _System, sy: _System, ne: _Normal) -> bool:
+        """Test the residuals of ``residuals`` (leverages from ``sy``, ``ne``); see robust."""
+        return _reject(self.blocks, self.masks, residuals, self.options.reject_k,
+                       self.layout.row_point, _leverage(ne, sy))
+
+    # -- one pass of the Levenberg–Marquardt loop -------------------------------------------
+    def minimise(self, tol: float, check_datum: bool = False):
+        """Iterate from the current values to the minimum (to ``tol``) with the current masks.
+
+        With ``check_datum``, the rank at the current values is checked first. Returns the
+        outcome and the system and normal equations of the final iterate (the only Jacobian
+        kept alive: each is dropped before the next is formed).
+        """
+        opts = self.options
+        sy, ne = self.linearise(check_redundancy=True)
+        if check_datum:
+            _check_datum(self.layout, ne, opts.rank_rtol)
+        lam, nu = opts.lambda0, 2.0
+        cost = sy.cost
+        self.history.append(cost)
+        rejecting = False  # each-iteration mode: rejection has started
+        tested = False  # each-iteration mode: the current point passed the rejection test
+        n_iter = 0
+        while True:
+            if cost <= opts.atol * sy.r.size:
+                return _Outcome(True, "cost below atol (noise-free data)"), sy, ne
+            dc, dp, pred = self._gauss_newton_step(ne, lam, tol, cost)
+            if self._converged(ne, lam, pred, tol, cost):
+                # converged before any rejection test (e.g. at the initial values)
+                if self.each and not tested and self.reject(sy, sy, ne):
+                    return _Outcome(False, "", rejected=True), sy, ne
+                # the Gauss–Newton step would decrease the cost by less than ftol: this is the
+                # minimum, and the reduced system just formed gives its covariance
+                return _Outcome(True, "predicted decrease of the cost below ftol"), sy, ne
+            if n_iter >= opts.max_iter:
+                return _Outcome(False, f"not converged within max_iter={opts.max_iter} "
+                                       "iterations"), sy, ne
+            n_iter += 1
+            self.total_iter += 1
+            step = self._damped_step(ne, cost, lam, nu, dc, dp, pred)
+            lam, nu = step.lam, step.nu
+            if lam > opts.lambda_max:
+                # no step decreases the cost: we are at the minimum to machine precision
+                ok = step.pred <= 1e3 * tol * max(cost, 1e-300) or cost <= opts.atol * sy.r.size
+                return _Outcome(ok, "no further decrease possible" if ok else (
+                    "the damping grew without bound: the cost could not be decreased")), sy, ne
+            new_cost = step.system.cost
+            self.history.append(new_cost)
+            tested = False
+            settled = _settled(step.actual, step.pred, new_cost, opts.settled)
+            if self.each and (rejecting or settled):
+                # 002 §3.4: outliers are rejected in each iteration, on the residuals at the
+                # new point, from the first settled iterate: before that, residuals reflect
+                # the initial values, not gross errors
+                rejecting = True
+                tested = not self.reject(step.system, sy, ne)
+            self._report(new_cost, lam)
+            # chord steps (Kelley 1995, ch. 5): from a settled iterate on, the reduced matrix
+            # barely changes, so the next steps reuse the last one formed (the gradient and
+            # the points' blocks are always those of the current point); it is formed again
+            # where the convergence test passes, or when a chord step fails
+            chord = (ne.reduced0[0] if settled and ne.compiled_schur and ne.reduced0 is not None
+                     else None)
+            sy = ne = step = None  # free the old Jacobian before forming the new one
+            sy, ne = self.linearise()
+            if chord is not None and ne.compiled_schur:
+                ne.S_chord = chord
+            cost = sy.cost  # (lower than new_cost when observations were just rejected)
+
+    def _gauss_newton_step(self, ne: _Normal, lam: float, tol: float, cost: float):
+        """The damped step at λ and its predicted decrease; converged chord steps are
+        replaced by the step with the reduced matrix formed at this point.
+        """
+        layout = self.layout
+        dc, dp = _step(layout, ne, lam)
+        pred = _predicted_decrease(layout, ne, lam, dc, dp)
+        chord_done = ne.S_chord is not None and pred <= self.options.chord_end * tol * cost
+        if lam <= self.options.lambda_points_min and chord_done:
+            # the chord steps have converged (they converge linearly, hence the margin):
+            # form the reduced matrix here to confirm it, and for the covariance
+            ne.exact()
+            dc, dp = _step(layout, ne, lam)
+            pred = _predicted_decrease(layout, ne, lam, dc, dp)
+        return dc, dp, pred
+
+    def _converged(self, ne: _Normal, lam: float, pred: float, tol: float, cost: float) -> bool:
+        """The undamped Gauss–Newton step with this point's own matrix predicts a decrease
+        below ``tol`` times the cost.
+        """
+        return (lam <= self.options.lambda_points_min and pred <= tol * cost
+                and ne.S_chord is None)
+
+    def _damped_step(self, ne: _Normal, cost: float, lam: float, nu: float, dc, dp,
+                     pred: float) -> _Trial:
+        """Take the step, or retry with more damping (Nielsen) until the cost decreases.
+
+        A failed chord step is first retried with the matrix of this point. The parameters
+        are at the new point on return, or back at the old one if λ exceeded ``lambda_max``.
+        """
+        layout = self.layout
+        state = layout.get_state()
+        while True:
+            layout.apply(dc, dp)
+            trial = _evaluate(layout, self.blocks, self.masks, jacobian=False,
+                              compiled=self.options.compiled)
+            actual = cost - trial.cost
+            rho = actual / pred if pred > 0 else (1.0 if actual >= 0 else -1.0)
+            if rho > 0 and np.isfinite(trial.cost):
+                lam *= max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3)
+                nu = 2.0
+                return _Trial(trial, actual, pred, lam, nu)
+            layout.set_state(state)
+            if ne.S_chord is not None:
+                ne.exact()  # the chord step failed: retry with the matrix of this point
+            else:
+                lam *= nu
+                nu *= 2.0
+                if lam > self.options.lambda_max:
+                    return _Trial(trial, actual, pred, lam, nu)
+            dc, dp = _step(layout, ne, lam)
+            pred = _predicted_decrease(layout, ne, lam, dc, dp)
+
+    def _report(self, cost: float, lam: float) -> None:
+        if self.show:
+            self.show(
+                {
+                    "iteration": self.total_iter,
+                    "cost": cost,
+                    "lambda": lam,
+                    "seconds": time.perf_counter() - self.t0,
+                    "rejected": int(sum((~m).sum() for m in self.masks)),
+                }
+            )
+
+    # -- the result -------------------------------------------------------------------------
+    def result(self, sy: _System, ne: _Normal, outcome: _Outcome,
+               rounds: int) -> AdjustmentResult:
+        """σ0, covariance and residuals at the final iterate, as an :class:`AdjustmentResult`."""
+        layout, blocks = self.layout, self.blocks
+        seconds = time.perf_counter() - self.t0
+        n_unk = layout.n_unknowns
+        dof = int(sy.r.size - n_unk)
+        vtpv = float(sy.r @ sy.r)
+        sigma0 = float(np.sqrt(vtpv / dof)) if dof > 0 else float("nan")
+        try:
+            S_inv = _reduced_inverse(layout, ne)
+        except (np.linalg.LinAlgError, sla.LinAlgError) as exc:
+            raise DatumError(
+                "the normal matrix at the solution is singular: the covariance cannot be "
+                "computed (a datum defect that appeared during the iteration?)",
+                layout.labels_c,
+            ) from exc
+        s2 = sigma0**2 if np.isfinite(sigma0) else 1.0
+        full = _evaluate(layout, blocks, [np.ones(b.m, dtype=bool) for b in blocks], False)
+        residuals, off = {}, 0
+        for b in blocks:
+            residuals[b.name] = full.r[off : off + b.m] * b.sigma  # back to the block's units
+            off += b.m
+        cofactors = None
+        if self.options.keep_jacobian and layout.pblock is not None:
+            cofactors = _point_cofactor_function(ne, S_inv)
+        return AdjustmentResult(
+            params=layout.params,
+            converged=outcome.converged,
+            message=outcome.message,
+            iterations=self.total_iter,
+            cost_history=list(self.history),
+            sigma0=sigma0,
+            dof=dof,
+            n_observations=int(sy.n_obs_rows),
+            n_unknowns=n_unk,
+            covariance=s2 * S_inv,
+            labels=list(layout.labels_c),
+            seconds=seconds,
+            reject_rounds=rounds,
+            columns={name: cm.copy() for name, cm in layout.colmap.items()},
+            _blocks=blocks,
+            _masks=[m.copy() for m in self.masks],
+            _residuals=residuals,
+            _point_cofactors=cofactors,
+        )
+
+
+def _settled(actual: float, pred: float, new_cost: float, share: float) -> bool:
+    """Whether an iterate is settled (see ``SolverOptions.settled``).
+
+    The mismatch ``|actual − predicted|`` is the part of the decrease the linearised model did
+    not explain; a Gauss–Newton step from the new point removes a decrease of that order (its
+    gradient comes from the same second-order terms), so a small mismatch shows the new point
+    near its minimum one iteration before the decrease itself does.
+    """
+    return max(min(actual, abs(actual - pred)), 0.0) <= share * new_cost
+
+
+def _progress_printer(progress):
+    if progress is None or progress is False:
+        return None
+    if callable(progress):
+        return progress
+
+    def show(info):
+        print(
+            f"  iter {info['iteration']:3d}  cost {info['cost']:.6e}  λ {info['lambda']:.1e}"
+            f"  {info['seconds']:.2f} s" + (f"  rejected {info['rejected']}" if info.get(
+                "rejected") else ""),
+            file=sys.stderr,
+            flush=True,
+        )
+
+    return show

@@ -1,0 +1,413 @@
+"""The linearised, whitened system at one point: parameter layout and row-compressed Jacobian.
+
+:class:`_Layout` maps the free entries of the non-point parameter blocks to the columns of the
+reduced system (the points block is kept apart, see :mod:`hsgeo.adjust.schur`).
+:func:`_evaluate` evaluates the residual blocks and, on request, assembles the whitened Jacobian
+as a row-compressed matrix (:class:`_RowJac`): observation rows first, then the priors as
+pseudo-observations ``(x − μ) / σ_prior``. Jacobians that are a weighted sum over items of one
+derivative (``Indexed(..., weights=)``, e.g. spline nodes) are kept factored on the compiled
+path (:mod:`hsgeo.adjust._fast`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from hsgeo.adjust.parameters import Parameters
+from hsgeo.adjust.residuals import Indexed, ResidualBlock
+from hsgeo.errors import InputError
+
+__all__: list[str] = []
+
+
+class _Layout:
+    """Columns of the reduced system: one per free non-point entry, a tied entry sharing the
+    column of its target (:meth:`Parameters.tie`).
+    """
+
+    def __init__(self, params: Parameters):
+        self.params = params
+        self.cblocks = [b for b in params.blocks() if not b.points]
+        self.colmap: dict[str, np.ndarray] = {}
+        ties = params.ties
+        tied = {}  # block name → flat indices of its tied entries
+        for (name, i), _ in ties.items():
+            b = params[name]
+            if not b.free.ravel()[i]:
+                raise InputError(f"{b.labels()[i]} is tied and fixed: fix its target instead")
+            if np.isfinite(b.prior_sigma.ravel()[i]):
+                raise InputError(
+                    f"{b.labels()[i]} is tied and has a prior: put the prior on its target")
+            tied.setdefault(name, []).append(i)
+        n = 0
+        for b in self.cblocks:
+            free = b.free.ravel()
+            if b.name in tied:
+                free = free.copy()
+                free[tied[b.name]] = False
+            cm = np.full(b.size, -1, dtype=np.int64)
+            cm[free] = np.arange(n, n + free.sum())
+            n += int(free.sum())
+            self.colmap[b.name] = cm
+        for (name, i), (tname, j) in ties.items():
+            self.colmap[name][i] = self.colmap[tname][j]  # (-1: the target is fixed)
+        #: blocks with a tied entry or a tie target: their Jacobians are not kept factored,
+        #: and rows with two entries in one column are merged (see _merge_tied_columns)
+        self.tie_blocks = {name for name, _ in ties} | {name for name, _ in ties.values()}
+        self.n_c = n
+        self.labels_c = params.free_labels([b.name for b in self.cblocks])
+        pb = params.points_block
+        self.pblock = pb
+        if pb is not None:
+            self.n_pts, self.p = pb.shape
+            self.pfree = pb.free.copy()
+        else:
+            self.n_pts, self.p = 0, 0
+            self.pfree = np.zeros((0, 0), dtype=bool)
+        #: the point of each row of residual block i (from its Jacobian), for _reject
+        self.row_point: dict[int, np.ndarray] = {}
+
+    @property
+    def n_unknowns(self) -> int:
+        return self.n_c + int(self.pfree.sum())
+
+    def apply(self, dc: np.ndarray, dp: np.ndarray | None) -> None:
+        for b in self.cblocks:
+            cm = self.colmap[b.name]
+            sel = cm >= 0
+            if sel.any():
+                v = b.value.ravel().copy()
+                v[sel] += dc[cm[sel]]
+                b.value = v.reshape(b.shape)
+        if self.pblock is not None and dp is not None:
+            self.pblock.value = self.pblock.value + np.where(self.pfree, dp, 0.0)
+
+    def get_state(self):
+        return [b.value.copy() for b in self.params.blocks()]
+
+    def set_state(self, state):
+        for b, v in zip(self.params.blocks(), state, strict=True):
+            b.value = v.copy()
+
+
+class _RowJac:
+    """A row-compressed sparse matrix: row ``i`` has entries ``vals[i, s]`` at ``cols[i, s]``.
+
+    ``cols = -1`` marks an empty slot. Optionally each row also has one *factored* group
+    (from an :class:`~hsgeo.adjust.Indexed` Jacobian with ``weights``): entries
+    ``fw[i, a] * fd[i, j]`` at columns ``fcol[i, a] + j`` (``fcol = -1``: none). See
+    :mod:`hsgeo.adjust._fast`.
+    """
+
+    def __init__(self, cols: np.ndarray, vals: np.ndarray, n_cols: int, fcol=None, fw=None,
+                 fd=None):
+        self.cols, self.vals, self.n_cols = cols, vals, n_cols
+        M = cols.shape[0]
+        if fcol is None:
+            fcol = np.full((M, 0), -1, dtype=cols.dtype)
+            fw = np.zeros((M, 0))
+            fd = np.zeros((M, 0))
+        self.fcol, self.fw, self.fd = fcol, fw, fd
+
+    @property
+    def arrays(self):
+        """``(cols, vals, fcol, fw, fd)`` for the compiled kernels."""
+        return self.cols, self.vals, self.fcol, self.fw, self.fd
+
+    @property
+    def shape(self):
+        return (self.cols.shape[0], self.n_cols)
+
+    def _safe_cols(self):
+        # index n_cols (an appended zero) for the empty slots
+        return np.where(self.cols >= 0, self.cols, self.n_cols)
+
+    def matvec(self, x: np.ndarray) -> np.ndarray:
+        from hsgeo.adjust._fast import matvec
+
+        return matvec(*self.arrays, np.ascontiguousarray(x, dtype=np.float64))
+
+    def rmatvec(self, y: np.ndarray, diag: bool = False):
+        """``Jᵀ y`` (and ``diag(JᵀJ)`` with ``diag=True``)."""
+        from hsgeo.adjust._fast import rmatvec_diag
+
+        g, d = rmatvec_diag(*self.arrays, np.ascontiguousarray(y, dtype=np.float64),
+                            self.n_cols, diag)
+        return (g, d) if diag else g
+
+    def tocsr(self) -> sp.csr_matrix:
+        M = self.cols.shape[0]
+        keep = self.cols >= 0
+        rows = np.broadcast_to(np.arange(M)[:, None], self.cols.shape)
+        r, c, v = [rows[keep]], [self.cols[keep]], [self.vals[keep]]
+        kf = self.fd.shape[1]
+        if self.fcol.shape[1] and kf:
+            fc = self.fcol[:, :, None] + np.arange(kf)  # (M, q, kf)
+            fv = self.fw[:, :, None] * self.fd[:, None, :]
+            fk = np.broadcast_to((self.fcol >= 0)[:, :, None], fc.shape)
+            r.append(np.broadcast_to(np.arange(M)[:, None, None], fc.shape)[fk])
+            c.append(fc[fk])
+            v.append(fv[fk])
+        return sp.csr_matrix((np.concatenate(v), (np.concatenate(r), np.concatenate(c))),
+                             shape=self.shape)
+
+
+#: Use the compiled row-compressed path (True) or the generic scipy.sparse path (False).
+@dataclass
+class _System:
+    """The whitened, linearised problem at one point x."""
+
+    r: np.ndarray  # (M,) whitened residuals, observation rows then prior rows
+    Jrc: _RowJac | None  # (M, n_c) row-compressed
+    pidx: np.ndarray | None  # (M,) point touched by each row (-1: none)
+    Jp: np.ndarray | None  # (M, p)
+    n_obs_rows: int  # rows that are observations (the rest are priors)
+
+    @property
+    def cost(self) -> float:
+        return 0.5 * float(self.r @ self.r)
+
+    @property
+    def Jc(self) -> sp.csr_matrix:
+        """The Jacobian of the non-point unknowns as scipy.sparse (generic path)."""
+        return self.Jrc.tocsr()
+
+
+class _Slots:
+    """One block Jacobian's share of the row-compressed matrix, written on request.
+
+    Writing straight into the final ``(M, K)`` arrays avoids intermediate copies of what can be
+    tens of millions of entries (GUIDE §9).
+    """
+
+    def __init__(self, J, m: int, size: int, name: str, colmap: np.ndarray, rows, w,
+                 factored_k: int | None = None, compiled: bool = True):
+        self.colmap, self.rows, self.w = colmap, rows, w  # rows: kept rows, or None for all
+        self.factored = False
+        if isinstance(J, Indexed) and J.factored:
+            m_j, q = J.index.shape
+            k = J.k
+            contiguous = colmap.size and colmap[0] >= 0 and np.all(np.diff(colmap) == 1)
+            if (compiled and factored_k in (None, k) and contiguous and m_j == m and size % k == 0
+                    and not (J.index.size and int(J.index.max()) >= size // k)):
+                # kept factored: one group of q items × k columns per row (see _RowJac)
+                self.kind, self.J, self.width, self.qk = "factored", J, 0, (q, k)
+                self.factored = True
+                return
+            J = J.expanded()  # generic path, fixed entries, or a second factored Jacobian
+        if isinstance(J, Indexed):
+            m_j, q, k = J.d.shape
+            if m_j != m:
+                raise InputError(f"Jacobian w.r.t. {name!r} has {m_j} rows, residuals have {m}")
+            if size % k:
+                raise InputError(
+                    f"Jacobian w.r.t. {name!r}: item width {k} does not divide {size}")
+            if J.index.size and int(J.index.max()) >= size // k:
+                raise InputError(f"Jacobian w.r.t. {name!r} indexes past the block's items")
+            self.kind, self.J, self.width, self.qk = "indexed", J, q * k, (q, k)
+        elif sp.issparse(J):
+            c = J.tocsr()
+            if c.shape != (m, size):
+                raise InputError(
+                    f"Jacobian w.r.t. {name!r} has shape {c.shape}, expected {(m, size)}")
+            nnz = np.diff(c.indptr)
+            K = int(nnz.max()) if m else 0
+            slot = np.arange(c.indices.size) - np.repeat(c.indptr[:-1], nnz)
+            rr = np.repeat(np.arange(m), nnz)
+            cols = np.full((m, K), -1, dtype=np.int64)
+            vals = np.zeros((m, K))
+            cols[rr, slot] = colmap[c.indices]
+            vals[rr, slot] = c.data
+            self.kind, self.J, self.width = "dense_slots", (cols, vals), K
+        else:
+            arr = np.asarray(J, dtype=np.float64)
+            if arr.shape != (m, size):
+                raise InputError(
+                    f"Jacobian w.r.t. {name!r} has shape {arr.shape}, expected {(m, size)}")
+            self.kind, self.J, self.width = "dense", arr, size
+
+    def _rows(self) -> np.ndarray:
+        return np.arange(self.w.size, dtype=np.int64) if self.rows is None else self.rows
+
+    def fill_factored(self, fcol_dst, fw_dst, fd_dst) -> None:
+        from hsgeo.adjust._fast import fill_factored
+
+        q, k = self.qk
+        fill_factored(self.J.index, self.J.weights, self.J.d, self._rows(), self.w,
+                      int(self.colmap[0]), fcol_dst[:, :q], fw_dst[:, :q], fd_dst[:, :k])
+
+    def fill(self, cols_dst: np.ndarray, vals_dst: np.ndarray) -> None:
+        from hsgeo.adjust._fast import fill_dense, fill_indexed
+
+        cm = self.colmap
+        if self.kind == "indexed":
+            fill_indexed(self.J.index, self.J.d, self._rows(), self.w, cm, cols_dst, vals_dst)
+        elif self.kind == "dense":
+            fill_dense(self.J, self._rows(), self.w, cm, cols_dst, vals_dst)
+        else:
+            cols, vals = self.J
+            rows = self._rows()
+            cols_dst[:] = cols[rows]
+            np.multiply(vals[rows], self.w[rows, None], out=vals_dst)
+            vals_dst[cols_dst < 0] = 0.0
+
+
+class _PriorSlots:
+    width = 1
+    factored = False
+
+    def __init__(self, cols, vals):
+        self.cols, self.vals = cols, vals
+
+    def fill(self, cols_dst, vals_dst):
+        cols_dst[:, 0] = self.cols
+        vals_dst[:, 0] = self.vals
+
+
+def _evaluate(layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian: bool,
+              compiled: bool = True) -> _System:
+    """Whitened residuals (and with ``jacobian`` the row-compressed Jacobian) at the current
+    values of ``layout.params``; rows of ``masks[i] == False`` are left out. ``compiled``
+    keeps factored Jacobians factored (the compiled kernels' form).
+    """
+    values = layout.params.values()
+    r_parts, slot_parts, pidx_parts, jp_parts = [], [], [], []
+    factored_k = None  # width k of the factored Jacobians (one per row, one k for all)
+    offset = 0
+    pname = layout.pblock.name if layout.pblock is not None else None
+    for ib, (blk, keep) in enumerate(zip(blocks, masks, strict=True)):
+        r, jac = blk.evaluate(values, jacobian)
+        r = np.asarray(r, dtype=np.float64)
+        if r.shape != (blk.m,):
+            raise InputError(
+                f"residual block {blk.name!r} returned {r.shape} residuals, expected ({blk.m},)"
+            )
+        if not np.all(np.isfinite(r)):
+            bad = np.flatnonzero(~np.isfinite(r))[:5].tolist()
+            raise InputError(
+                f"residual block {blk.name!r} produced non-finite residuals at rows {bad}: "
+                "check the observations for NaN, or the initial values (a point behind the "
+                "camera, a zero depth)"
+            )
+        w = 1.0 / blk.sigma
+        rows_kept = np.flatnonzero(keep)
+        all_kept = rows_kept.size == blk.m
+        r_parts.append(r * w if all_kept else r.take(rows_kept) * w.take(rows_kept))
+        if jacobian:
+            pidx = np.full(rows_kept.size, -1, dtype=np.int64)
+            jp = np.zeros((rows_kept.size, layout.p))
+            blk_slots = []
+            for name, J in jac.items():
+                b = layout.params[name]
+                if name == pname:
+                    if isinstance(J, Indexed):
+                        J = J.expanded()
+                    if not isinstance(J, Indexed) or J.index.shape[1] != 1 or J.k != layout.p:
+                        raise InputError(
+                            f"the Jacobian w.r.t. the points block {name!r} must be "
+                            f"Indexed((m,), (m, {layout.p})): each row touches one point"
+                        )
+                    pidx, jp = J.index[:, 0], J.d[:, 0, :]
+                    layout.row_point[ib] = pidx
+                    if all_kept:
+                        jp = jp * w[:, None]
+                    else:
+                        pidx = pidx.take(rows_kept)
+                        jp = jp.take(rows_kept, axis=0) * w.take(rows_kept)[:, None]
+                    if not layout.pfree.all():
+                        jp = jp * layout.pfree[np.maximum(pidx, 0)]
+                    if (pidx < 0).any():
+                        jp = np.where(pidx[:, None] >= 0, jp, 0.0)
+                    continue
+                if name in layout.tie_blocks and isinstance(J, Indexed):
+                    J = J.expanded()
+                has_f = any(sl.factored for sl in blk_slots)
+                sl = _Slots(J, blk.m, b.size, name, layout.colmap[name],
+                            None if all_kept else rows_kept, w,
+                            factored_k=-1 if has_f else factored_k, compiled=compiled)
+                if sl.factored:
+                    factored_k = sl.qk[1]
+                blk_slots.append(sl)
+            slot_parts.append(blk_slots)
+            pidx_parts.append(pidx)
+            jp_parts.append(jp)
+        offset += rows_kept.size
+    n_obs_rows = offset
+
+    # priors as pseudo-observations (x - μ) / σ
+    for b in layout.params.blocks():
+        hp = b.has_prior
+        if not hp.any():
+            continue
+        idx = np.flatnonzero(hp.ravel())
+        s = b.prior_sigma.ravel()[idx]
+        r_parts.append((b.value.ravel()[idx] - b.prior_mean.ravel()[idx]) / s)
+        if jacobian:
+            if b.points:
+                pt, comp = np.divmod(idx, layout.p)
+                jp = np.zeros((idx.size, layout.p))
+                jp[np.arange(idx.size), comp] = 1.0 / s
+                slot_parts.append([])
+                pidx_parts.append(pt)
+                jp_parts.append(jp)
+            else:
+                slot_parts.append([_PriorSlots(layout.colmap[b.name][idx], 1.0 / s)])
+                pidx_parts.append(np.full(idx.size, -1, dtype=np.int64))
+                jp_parts.append(np.zeros((idx.size, layout.p)))
+        offset += idx.size
+
+    r_all = np.concatenate(r_parts) if r_parts else np.zeros(0)
+    if not jacobian:
+        return _System(r_all, None, None, None, n_obs_rows)
+    M = offset
+    # one (M, K) row-compressed matrix: each part's slots side by side, padded to the widest
+    K = max([sum(sl.width for sl in part) for part in slot_parts] + [1])
+    itype = np.int32 if layout.n_c < 2**31 else np.int64
+    cols_all = np.empty((M, K), dtype=itype)
+    vals_all = np.empty((M, K))
+    Q = max([sl.qk[0] for part in slot_parts for sl in part if sl.factored] + [0])
+    Kf = factored_k if Q else 0
+    fcol = np.full((M, Q), -1, dtype=itype)
+    fw = np.zeros((M, Q))
+    fd = np.zeros((M, Kf))
+    row0 = 0
+    for part, pi in zip(slot_parts, pidx_parts, strict=True):
+        n = pi.size
+        k0 = 0
+        for sl in part:
+            if sl.factored:
+                sl.fill_factored(fcol[row0 : row0 + n], fw[row0 : row0 + n], fd[row0 : row0 + n])
+                continue
+            sl.fill(cols_all[row0 : row0 + n, k0 : k0 + sl.width],
+                    vals_all[row0 : row0 + n, k0 : k0 + sl.width])
+            k0 += sl.width
+        if k0 < K:  # padding
+            cols_all[row0 : row0 + n, k0:] = -1
+            vals_all[row0 : row0 + n, k0:] = 0.0
+        row0 += n
+    if layout.tie_blocks:
+        _merge_tied_columns(cols_all, vals_all)
+    pidx = np.concatenate(pidx_parts) if pidx_parts else np.full(M, -1)
+    Jp = np.concatenate(jp_parts) if jp_parts else np.zeros((M, layout.p))
+    Jrc = _RowJac(cols_all, vals_all, layout.n_c, *((fcol, fw, fd) if Q else ()))
+    return _System(r_all, Jrc, pidx, Jp, n_obs_rows)
+
+
+def _merge_tied_columns(cols: np.ndarray, vals: np.ndarray) -> None:
+    """Sum the entries of a row that fall in one column (tied parameters) into its first slot.
+
+    In place; the other slots become empty (``-1``, 0). Each row then has each column once, as
+    the compiled kernels expect.
+    """
+    K = cols.shape[1]
+    for s in range(K):
+        for t in range(s + 1, K):
+            dup = (cols[:, t] == cols[:, s]) & (cols[:, s] >= 0)
+            if dup.any():
+                vals[dup, s] += vals[dup, t]
+                cols[dup, t] = -1
+                vals[dup, t] = 0.0
