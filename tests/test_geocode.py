@@ -20,9 +20,10 @@ from hsgeo.geocode import (
     read_sensor_toml,
     write_lines,
 )
-from hsgeo.navigation import Navigation
+from hsgeo.io.navigation import write_trajectory
 from hsgeo.simulate.pula_flight import observe_gcps, simulate_flight
 from hsgeo.simulate.scenarios import load_scenario
+from hsgeo.trajectory import Trajectory
 from hsgeo.workflows.geocoding import geocode_files
 
 CAL = CalibratedLine(486.8, 3539.0, (1.459, -0.1636, 0.00526))  # 000 Table 1
@@ -33,7 +34,7 @@ def straight_nav(heading_deg=30.0, H=500.0, T=20.0, v=20.0):
     h = np.deg2rad(heading_deg)
     EN = np.outer(v * t, [np.sin(h), np.cos(h)])
     rpy = np.column_stack([0.01 * np.sin(t), 0.005 * np.cos(t), np.full(t.size, h)])
-    return Navigation(t, np.column_stack([EN, np.full(t.size, H)]), rpy)
+    return Trajectory(t, np.column_stack([EN, np.full(t.size, H)]), rpy)
 
 
 def test_intersect_plane_and_dem_round_trip():
@@ -145,7 +146,7 @@ def test_geocode_command_end_to_end(tmp_path):
     from hsgeo.io import read_envi
 
     nav = straight_nav(heading_deg=0.0, T=10.0)
-    nav.write_csv(tmp_path / "nav.csv")
+    write_trajectory(tmp_path / "nav.csv", nav)
     zeta = np.arange(200.0, 800.0, 2.0)
     g = geocode_image(nav, CAL, 80, zeta, t0_s=0.0, line_rate_hz=8.0, terrain=PlaneTerrain(3.0))
     write_lines(tmp_path / "lines.nc", g[..., 0], zeta, t0_s=0.0, line_rate_hz=8.0)
