@@ -4,7 +4,9 @@ import numpy as np
 import pandas as pd
 
 from hsgeo.cli import main
+from hsgeo.io.navigation import write_trajectory
 from hsgeo.simulate.pushbroom_campaign import CampaignConfig, simulate
+from hsgeo.trajectory import Trajectory, rph_from_platform_rpy
 
 
 def _write(tmp_path, obs):
@@ -12,11 +14,11 @@ def _write(tmp_path, obs):
     pd.DataFrame({"point_id": o.point + 1000, "band": o.band, "t_s": o.t_s,
                   "x_px": o.xy_px[:, 0], "y_px": o.xy_px[:, 1]}).to_parquet(
         tmp_path / "obs.parquet")
-    # navigation at the line times (the simulator's solution), sorted and unique
+    # navigation at the line times (the simulator's solution), sorted and unique; the
+    # simulator's platform angles become the GNSS/INS roll, pitch, heading of the file
     t, i = np.unique(o.t_s, return_index=True)
-    nav = np.column_stack([t, o.xyz_nav_m[i], o.rpy_nav_rad[i]])
-    pd.DataFrame(nav, columns=["t_s", "E_m", "N_m", "H_m", "roll_rad", "pitch_rad",
-                               "yaw_rad"]).to_csv(tmp_path / "nav.csv", index=False)
+    write_trajectory(tmp_path / "nav.csv", Trajectory(t, o.xyz_nav_m[i],
+                                                      rph_from_platform_rpy(o.rpy_nav_rad[i])))
     g = obs.gcp_xyz_m
     pd.DataFrame({"point_id": obs.gcp_index + 1000, "E_m": g[:, 0], "N_m": g[:, 1],
                   "H_m": g[:, 2]}).to_csv(tmp_path / "gcp.csv", index=False)
@@ -43,11 +45,20 @@ def test_adjust_pushbroom_cli(tmp_path, capsys):
 def test_adjust_pushbroom_cli_bad_input(tmp_path, capsys):
     obs, _ = simulate(0.001, rng=4)
     _write(tmp_path, obs)
-    pd.read_csv(tmp_path / "nav.csv").drop(columns="yaw_rad").to_csv(tmp_path / "bad.csv")
+    pd.read_csv(tmp_path / "nav.csv").drop(columns="heading_deg").to_csv(tmp_path / "bad.csv")
     rc = main(["adjust-pushbroom", str(tmp_path / "obs.parquet"), "--trajectory",
                str(tmp_path / "bad.csv"), "--camera", str(tmp_path / "cam.toml")])
     assert rc == 2
-    assert "yaw_rad" in capsys.readouterr().err
+    assert "heading_deg" in capsys.readouterr().err
+    # the former adjust-pushbroom format: the message says how to convert
+    o = obs.lines
+    pd.DataFrame(np.column_stack([o.t_s, o.xyz_nav_m, o.rpy_nav_rad]),
+                 columns=["t_s", "E_m", "N_m", "H_m", "roll_rad", "pitch_rad", "yaw_rad"]).to_csv(
+        tmp_path / "old.csv", index=False)
+    rc = main(["adjust-pushbroom", str(tmp_path / "obs.parquet"), "--trajectory",
+               str(tmp_path / "old.csv"), "--camera", str(tmp_path / "cam.toml")])
+    assert rc == 2
+    assert "heading_deg = 90 - degrees(yaw_rad)" in capsys.readouterr().err
     rc = main(["adjust-pushbroom", str(tmp_path / "nope.csv"), "--trajectory",
                str(tmp_path / "nav.csv"), "--camera", str(tmp_path / "cam.toml")])
     assert rc == 2

@@ -22,9 +22,10 @@ from hsgeo.geocode import (
     read_sensor_toml,
     write_lines,
 )
-from hsgeo.navigation import Navigation
+from hsgeo.io.navigation import write_trajectory
 from hsgeo.simulate.pula_flight import observe_gcps, simulate_flight
 from hsgeo.simulate.scenarios import load_scenario
+from hsgeo.trajectory import Trajectory
 from hsgeo.workflows.geocoding import gcp_deviations, geocode_files
 
 CAL = CalibratedLine(486.8, 3539.0, (1.459, -0.1636, 0.00526))  # 000 Table 1
@@ -35,7 +36,7 @@ def straight_nav(heading_deg=30.0, H=500.0, T=20.0, v=20.0):
     h = np.deg2rad(heading_deg)
     EN = np.outer(v * t, [np.sin(h), np.cos(h)])
     rpy = np.column_stack([0.01 * np.sin(t), 0.005 * np.cos(t), np.full(t.size, h)])
-    return Navigation(t, np.column_stack([EN, np.full(t.size, H)]), rpy)
+    return Trajectory(t, np.column_stack([EN, np.full(t.size, H)]), rpy)
 
 
 def test_intersect_plane_and_dem_round_trip():
@@ -122,7 +123,7 @@ def test_flight_observations_are_frozen_and_truth_free():
     assert not names & {"true_nav", "sensor", "boresight_rad"}, names
     assert {"recorded_nav", "line", "zeta_px", "gcp_enu_m", "sensor_nominal"} <= names
     assert isinstance(fl.sensor_nominal, LinearIFOV) and fl.recorded_nav is not truth.true_nav
-    assert not np.allclose(fl.recorded_nav.enu_m, truth.true_nav.enu_m, atol=0.1)
+    assert not np.allclose(fl.recorded_nav.xyz_m, truth.true_nav.xyz_m, atol=0.1)
     with pytest.raises(dataclasses.FrozenInstanceError):
         fl.line = fl.line + 1
 
@@ -182,7 +183,7 @@ def test_geocode_command_end_to_end(tmp_path):
     from hsgeo.io import read_envi
 
     nav = straight_nav(heading_deg=0.0, T=10.0)
-    nav.write_csv(tmp_path / "nav.csv")
+    write_trajectory(tmp_path / "nav.csv", nav)
     zeta = np.arange(200.0, 800.0, 2.0)
     g = geocode_image(nav, CAL, 80, zeta, t0_s=0.0, line_rate_hz=8.0, terrain=PlaneTerrain(3.0))
     write_lines(tmp_path / "lines.nc", g[..., 0], zeta, t0_s=0.0, line_rate_hz=8.0)

@@ -4,24 +4,6 @@ import pytest
 from hsgeo import InputError, ObservationError
 from hsgeo.gcp import deviation_table, recompute_printed_table
 from hsgeo.io import read_envi, write_envi
-from hsgeo.navigation import Navigation
-
-
-def test_navigation_csv_round_trip_and_interpolation(tmp_path):
-    t = np.linspace(0, 10, 11)
-    nav = Navigation(t, np.column_stack([t, 2 * t, np.full(11, 100.0)]),
-                     np.column_stack([0.01 * t, -0.02 * t, np.full(11, 3.1)]))
-    back = Navigation.read_csv(nav.write_csv(tmp_path / "nav.csv"))
-    np.testing.assert_allclose(back.enu_m, nav.enu_m, rtol=0, atol=1e-12)
-    np.testing.assert_allclose(back.rpy_rad, nav.rpy_rad, rtol=0, atol=1e-12)
-    pos, att = nav.at([2.5])
-    np.testing.assert_allclose(pos, [[2.5, 5.0, 100.0]])
-    with pytest.raises(InputError, match="outside"):
-        nav.at([11.0])
-    with pytest.raises(InputError, match="increase"):
-        Navigation(t[::-1], nav.enu_m, nav.rpy_rad)
-    with pytest.raises(InputError, match="NaN"):
-        Navigation(t, nav.enu_m * np.nan, nav.rpy_rad)
 
 
 def test_deviation_table_by_hand():

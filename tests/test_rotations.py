@@ -4,6 +4,7 @@ import pytest
 
 from hsgeo.errors import InputError
 from hsgeo.rotations import (
+    R_ENU_FROM_NED,
     R_from_opk,
     R_from_rotvec,
     R_from_rpy,
@@ -87,6 +88,16 @@ def test_rpy_round_trip_and_orthonormality():
     R = R_from_rpy(r, p, y)
     _assert_rotation(R)
     np.testing.assert_allclose(rpy_from_R(R), np.stack([r, p, y], -1), atol=1e-12)
+
+
+def test_R_ENU_FROM_NED_maps_the_axes_and_is_its_own_inverse():
+    _assert_rotation(R_ENU_FROM_NED)
+    np.testing.assert_array_equal(R_ENU_FROM_NED @ R_ENU_FROM_NED, np.eye(3))
+    np.testing.assert_array_equal(R_ENU_FROM_NED @ [1.0, 0, 0], [0, 1.0, 0])  # north
+    np.testing.assert_array_equal(R_ENU_FROM_NED @ [0, 1.0, 0], [1.0, 0, 0])  # east
+    np.testing.assert_array_equal(R_ENU_FROM_NED @ [0, 0, 1.0], [0, 0, -1.0])  # down
+    with pytest.raises(ValueError):  # a constant: read-only
+        R_ENU_FROM_NED[0, 0] = 1.0
 
 
 @pytest.mark.parametrize("sign", [1.0, -1.0])

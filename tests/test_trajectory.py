@@ -2,7 +2,16 @@ import numpy as np
 import pytest
 
 from hsgeo import InputError
-from hsgeo.trajectory import SplineNodes, Trajectory, bspline_basis
+from hsgeo.rotations import R_ENU_FROM_NED, R_from_rpy
+from hsgeo.trajectory import (
+    R_BODY_FROM_PLATFORM,
+    SplineNodes,
+    Trajectory,
+    bspline_basis,
+    platform_rpy_from_rph,
+    platform_rpy_rate_from_rph_rate,
+    rph_from_platform_rpy,
+)
 
 
 def test_basis_partition_of_unity_and_continuity():
@@ -49,18 +58,79 @@ def test_spline_errors():
 def test_trajectory_interpolation_and_errors():
     t = np.array([0.0, 1.0, 2.0])
     xyz = np.array([[0, 0, 100], [10, 0, 100], [20, 0, 100]], float)
-    rpy = np.array([[0, 0, 3.1], [0, 0, -3.1], [0, 0, -3.0]])  # yaw wraps through ±π
-    tr = Trajectory(t, xyz, rpy)
+    rph = np.array([[0, 0, 3.1], [0, 0, -3.1], [0, 0, -3.0]])  # heading wraps through ±π
+    tr = Trajectory(t, xyz, rph)
     p, a = tr.pose([0.5])
     np.testing.assert_allclose(p, [[5, 0, 100]])
     assert abs(abs(a[0, 2]) - np.pi) < 0.05  # interpolated across the wrap, not through 0
-    assert tr.R_map_from_platform([1.5]).shape == (1, 3, 3)
+    # roll and pitch are unwrapped too (a roll record passing ±π)
+    tr2 = Trajectory(t, xyz, np.array([[3.1, 0, 0], [-3.1, 0, 0], [-3.0, 0, 0]]))
+    assert abs(abs(tr2.pose(0.5)[1][0, 0]) - np.pi) < 0.05
+    p, a = tr.pose(1.5)  # a scalar time gives one row
+    assert p.shape == (1, 3) and a.shape == (1, 3)
     with pytest.raises(InputError, match="outside"):
         tr.pose([3.0])
-    with pytest.raises(InputError, match="increasing"):
-        Trajectory([0, 0, 1], xyz, rpy)
+    with pytest.raises(InputError, match="increase strictly"):
+        Trajectory([0, 0, 1], xyz, rph)
     with pytest.raises(InputError, match="expected"):
-        Trajectory(t, xyz[:2], rpy)
+        Trajectory(t, xyz[:2], rph)
+    with pytest.raises(InputError, match="NaN"):
+        Trajectory(t, xyz * np.nan, rph)
+    with pytest.raises(InputError, match="at least 2"):
+        Trajectory(t[:1], xyz[:1], rph[:1])
+    with pytest.raises(AttributeError):  # frozen
+        tr.t_s = t
+
+
+def test_R_map_from_body_axes():
+    """Level, heading 30°: body x points 30° east of north, body z down, in ENU."""
+    h = np.deg2rad(30.0)
+    tr = Trajectory([0.0, 1.0], np.zeros((2, 3)), [[0, 0, h], [0, 0, h]])
+    R = tr.R_map_from_body([0.5])[0]
+    np.testing.assert_allclose(R @ [1, 0, 0], [np.sin(h), np.cos(h), 0], atol=1e-15)
+    np.testing.assert_allclose(R @ [0, 1, 0], [np.cos(h), -np.sin(h), 0], atol=1e-15)  # right
+    np.testing.assert_allclose(R @ [0, 0, 1], [0, 0, -1], atol=1e-15)
+    # positive pitch raises the nose: body x gets a positive up component
+    tr = Trajectory([0.0, 1.0], np.zeros((2, 3)), [[0, 0.1, 0], [0, 0.1, 0]])
+    assert tr.R_map_from_body(0.0)[0, 2, 0] == pytest.approx(np.sin(0.1), abs=1e-15)
+
+
+def test_platform_angles_give_the_same_rotation_and_rays():
+    """R_ENU_FROM_NED R_from_rpy(r, p, h) diag(1, -1, -1) = R_from_rpy(r, -p, pi/2 - h)."""
+    rng = np.random.default_rng(3)
+    n = 500
+    rph = np.column_stack([rng.uniform(-np.pi, np.pi, n), rng.uniform(-1.5, 1.5, n),
+                           rng.uniform(-4 * np.pi, 4 * np.pi, n)])
+    rpy = platform_rpy_from_rph(rph)
+    R_map_from_body = R_ENU_FROM_NED @ R_from_rpy(rph[:, 0], rph[:, 1], rph[:, 2])
+    R_map_from_platform = R_from_rpy(rpy[:, 0], rpy[:, 1], rpy[:, 2])
+    np.testing.assert_allclose(R_map_from_platform @ R_BODY_FROM_PLATFORM, R_map_from_body,
+                               rtol=0, atol=2e-15)
+    # the same ray: a view direction given in the platform frame and in the body frame
+    v_platform = rng.standard_normal((n, 3))
+    v_body = v_platform @ R_BODY_FROM_PLATFORM.T
+    np.testing.assert_allclose(np.einsum("nij,nj->ni", R_map_from_platform, v_platform),
+                               np.einsum("nij,nj->ni", R_map_from_body, v_body),
+                               rtol=0, atol=1e-14)
+    # the platform frame is x forward, y left, z up: level flight north is yaw = 90°
+    assert platform_rpy_from_rph([0.0, 0.0, 0.0]).tolist() == [0.0, 0.0, np.pi / 2]
+    # round trips (the map is its own inverse)
+    np.testing.assert_allclose(rph_from_platform_rpy(rpy), rph, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(platform_rpy_from_rph(rph_from_platform_rpy(rpy)), rpy,
+                               rtol=0, atol=1e-14)
+    with pytest.raises(InputError, match="shape"):
+        platform_rpy_from_rph([1.0, 2.0])
+
+
+def test_platform_rates_are_the_derivative_of_the_conversion():
+    t = np.linspace(0, 10, 101)
+    rph = np.column_stack([0.1 * np.sin(t), 0.05 * np.cos(t), 1.0 + 0.02 * t])
+    tr = Trajectory(t, np.zeros((t.size, 3)), rph)
+    tq = np.array([1.23, 4.56, 7.89])
+    _, w = tr.rates(tq)
+    h = 1e-6
+    num = (platform_rpy_from_rph(tr.pose(tq + h)[1]) - platform_rpy_from_rph(tr.pose(tq - h)[1]))
+    np.testing.assert_allclose(platform_rpy_rate_from_rph_rate(w), num / (2 * h), atol=1e-8)
 
 
 def test_spline_rate_against_differences():
@@ -90,6 +160,6 @@ def test_trajectory_rates():
     t = np.linspace(0, 10, 11)
     tr = Trajectory(t, np.column_stack([2 * t, -t, 0 * t + 5]),
                     np.column_stack([0.1 * t, 0 * t, 0.02 * t]))
-    v, w = tr.rates(np.array([0.0, 3.3, 10.0]))
+    v, w = tr.rates(np.array([0.0, 3.3, 10.0]))  # one-sided at the ends
     np.testing.assert_allclose(v, [[2, -1, 0]] * 3, atol=1e-9)
     np.testing.assert_allclose(w, [[0.1, 0, 0.02]] * 3, atol=1e-9)

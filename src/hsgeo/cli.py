@@ -159,11 +159,15 @@ def build_parser() -> argparse.ArgumentParser:
         description="Geocode every pixel of a flight line (ray from the recorded navigation and "
         "the sensor model, intersected with a DEM or a plane) and resample it onto a north-up "
         "grid by nearest neighbour. LINES: NetCDF with radiance(line, pixel) or (band, line, "
-        "pixel), coordinate pixel (ζ, px), attributes t0_s and line_rate_hz. NAV: CSV "
-        "t_s,E_m,N_m,U_m,roll_deg,pitch_deg,heading_deg. SENSOR: TOML, see "
-        "hsgeo.geocode.read_sensor_toml. DEM: NetCDF with height(N, E) in metres.")
+        "pixel), coordinate pixel (ζ, px), attributes t0_s and line_rate_hz. "
+        "NAV: the navigation file of every command, CSV or Parquet with t_s, E_m, N_m, U_m, "
+        "roll_deg, pitch_deg, heading_deg (positions east-north-up in m; attitude of the body, "
+        "x forward, y right, z down, in north-east-down, in degrees; see hsgeo.io.navigation). "
+        "SENSOR: TOML, see hsgeo.geocode.read_sensor_toml. DEM: NetCDF with height(N, E) in "
+        "metres.")
     p.add_argument("lines", metavar="LINES")
-    p.add_argument("--trajectory", required=True, metavar="NAV")
+    p.add_argument("--trajectory", required=True, metavar="NAV",
+                   help="navigation file (GNSS/INS solution, CSV or Parquet; see above)")
     p.add_argument("--sensor", required=True, metavar="SENSOR.toml")
     g = p.add_mutually_exclusive_group(required=True)
     g.add_argument("--dem", metavar="DEM.nc")
@@ -177,11 +181,17 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser(
         "adjust-pushbroom",
         help="bundle-adjust LP lines with spline trajectory corrections (002 eq. 2-4)",
-        description="Observation table: point_id, band, t_s, x_px, y_px; trajectory: t_s, E_m, "
-        "N_m, H_m, roll_rad, pitch_rad, yaw_rad; GCPs: point_id, E_m, N_m, H_m (CSV or "
-        "Parquet); camera TOML: see hsgeo.workflows.pushbroom_ba.adjust_files.")
+        description="Observation table: point_id, band, t_s, x_px, y_px; GCPs: point_id, E_m, "
+        "N_m, H_m (CSV or Parquet); camera TOML: see hsgeo.workflows.pushbroom_ba.adjust_files. "
+        "NAV: the navigation file of every command, CSV or Parquet with t_s, E_m, N_m, U_m, "
+        "roll_deg, pitch_deg, heading_deg (positions east-north-up in m; attitude of the body, "
+        "x forward, y right, z down, in north-east-down, in degrees; see hsgeo.io.navigation). "
+        "The former format (H_m, roll_rad, pitch_rad, yaw_rad in ENU platform angles) converts "
+        "as U_m = H_m, roll_deg = deg(roll_rad), pitch_deg = -deg(pitch_rad), heading_deg = "
+        "90 - deg(yaw_rad).")
     p.add_argument("observations", help="observation table (CSV or Parquet)")
-    p.add_argument("--trajectory", required=True, help="GNSS/INS trajectory table")
+    p.add_argument("--trajectory", required=True, metavar="NAV",
+                   help="navigation file (GNSS/INS solution, CSV or Parquet; see above)")
     p.add_argument("--camera", required=True, help="camera and prior σ (TOML)")
     p.add_argument("--gcp", help="ground control points table (optional)")
     p.add_argument("--node-interval", type=float, default=10.0,

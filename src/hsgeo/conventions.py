@@ -17,14 +17,27 @@ Photogrammetric image frame
 Rotations
     Named for what they do: ``R_world_from_cam`` maps camera-frame vectors to world-frame ones.
     ω-φ-κ: ``R_world_from_cam = Rx(ω) Ry(φ) Rz(κ)`` (:func:`hsgeo.rotations.R_from_opk`).
-    Roll-pitch-yaw (aircraft, NED): ``R_ned_from_body = Rz(yaw) Ry(pitch) Rx(roll)``
-    (:func:`hsgeo.rotations.R_from_rpy`). OpenCV's ``rvec`` is ``R_cam_from_world`` as a
-    rotation vector (:func:`hsgeo.rotations.R_from_rotvec`).
+    Roll-pitch-yaw: ``R = Rz(yaw) Ry(pitch) Rx(roll)`` (:func:`hsgeo.rotations.R_from_rpy`),
+    ``R_nav_from_body``; the angles mean different things in NED and ENU (below). OpenCV's
+    ``rvec`` is ``R_cam_from_world`` as a rotation vector (:func:`hsgeo.rotations.R_from_rotvec`).
 
 Map frames
     A local east-north-up frame in metres (E, N, U). Paper 000 uses the Croatian y (east),
-    x (north) convention: its Δy is our ΔE and its Δx our ΔN. The navigation's attitude refers to
-    north-east-down; ``hsgeo.geocode.R_ENU_FROM_NED`` converts.
+    x (north) convention: its Δy is our ΔE and its Δx our ΔN. ``R_ENU_FROM_NED``
+    (:data:`hsgeo.rotations.R_ENU_FROM_NED`) takes north-east-down vectors to east-north-up.
+
+Trajectories and navigation files
+    One class for every timed pose, :class:`hsgeo.trajectory.Trajectory`: positions ``xyz_m``
+    (E, N, U) and ``roll_pitch_heading_rad``, the attitude as a GNSS/INS gives it, of the body
+    (x forward, y right, z down) relative to north-east-down:
+    ``R_map_from_body = R_ENU_FROM_NED @ R_from_rpy(roll, pitch, heading)``. One file format for
+    every command (:mod:`hsgeo.io.navigation`):
+    ``t_s, E_m, N_m, U_m, roll_deg, pitch_deg, heading_deg``. The pushbroom model of 002 keeps its
+    own angles, roll, pitch, yaw of the platform (x forward, y left, z up) relative to
+    east-north-up, ``R_map_from_platform = R_from_rpy(roll, pitch, yaw)``; exactly
+    ``(roll, pitch, yaw) = (roll, −pitch, π/2 − heading)``
+    (:func:`hsgeo.trajectory.platform_rpy_from_rph`), because
+    ``R_ENU_FROM_NED R_from_rpy(r, p, h) diag(1, −1, −1) = R_from_rpy(r, −p, π/2 − h)``.
 
 Units
     SI and radians inside; degrees only at the edges (files, tables, command line). Names carry
@@ -45,7 +58,7 @@ Randomness
     Sub-streams are derived with ``numpy.random.SeedSequence([seed, i])``.
 """
 
-from hsgeo.geocode import R_ENU_FROM_NED
+from hsgeo.rotations import R_ENU_FROM_NED
 
 __all__ = ["R_ENU_FROM_NED", "PIXEL_ORIGIN"]
 

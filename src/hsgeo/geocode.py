@@ -25,11 +25,10 @@ import numpy as np
 
 from hsgeo.adjust import Parameters, ResidualBlock, adjust
 from hsgeo.errors import ConvergenceError, InputError, ObservationError
-from hsgeo.rotations import R_from_rpy, dR_drpy
+from hsgeo.rotations import R_ENU_FROM_NED, R_from_rpy, dR_drpy
 from hsgeo.sensors import line1d
 
 __all__ = [
-    "R_ENU_FROM_NED",
     "LineGeometry",
     "LinearIFOV",
     "CalibratedLine",
@@ -47,10 +46,6 @@ __all__ = [
     "read_lines",
     "write_lines",
 ]
-
-#: the fixed rotation between the north-east-down and east-north-up frames (its own inverse)
-R_ENU_FROM_NED = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
-
 
 class LineGeometry:
     """The inner geometry of a line scanner: pixel ζ ↔ tangent of the across-track view angle."""
@@ -232,7 +227,7 @@ def geocode_observations(nav, sensor: LineGeometry, line, zeta_px, *, t0_s: floa
 
     Parameters
     ----------
-    nav : hsgeo.navigation.Navigation
+    nav : hsgeo.trajectory.Trajectory
         Recorded navigation of the projection centre.
     sensor : LineGeometry
         The assumed inner geometry (calibrated or not).
@@ -248,7 +243,7 @@ def geocode_observations(nav, sensor: LineGeometry, line, zeta_px, *, t0_s: floa
     (n, 3) ndarray of (E, N, U)
     """
     line = np.asarray(line, dtype=float)
-    pos, rpy = nav.at(t0_s + line / line_rate_hz)
+    pos, rpy = nav.pose(t0_s + line / line_rate_hz)
     d = ray_directions(rpy, sensor.tan_angle(zeta_px), R_from_rpy(*boresight_rad))
     return intersect(pos, d, terrain)
 
@@ -271,9 +266,9 @@ class BoresightGCP(ResidualBlock):
                  blocks: Mapping[str, str] | None = None):
         gcp = np.asarray(gcp_enu_m, dtype=float)
         super().__init__(np.full(2 * gcp.shape[0], sigma_m), blocks=blocks)
-        pos, rpy = nav.at(t0_s + np.asarray(line, float) / line_rate_hz)
-        self.pos = pos
-        self.R_mb = R_ENU_FROM_NED @ R_from_rpy(rpy[:, 0], rpy[:, 1], rpy[:, 2])
+        t_s = t0_s + np.asarray(line, float) / line_rate_hz
+        self.pos, _ = nav.pose(t_s)
+        self.R_mb = nav.R_map_from_body(t_s)
         t = sensor.tan_angle(zeta_px)
         self.d_s = np.stack([np.zeros_like(t), t, np.ones_like(t)], axis=1)
         self.gcp_en = gcp[:, :2]
@@ -333,7 +328,7 @@ def geocode_image(nav, sensor: LineGeometry, n_lines: int, zeta_px, *, t0_s: flo
     out = np.empty((n_lines, zeta.size, 3))
     for a in range(0, n_lines, chunk_lines):
         b = min(n_lines, a + chunk_lines)
-        pos, rpy = nav.at(t0_s + np.arange(a, b) / line_rate_hz)
+        pos, rpy = nav.pose(t0_s + np.arange(a, b) / line_rate_hz)
         m = b - a
         d = ray_directions(np.repeat(rpy, zeta.size, axis=0), np.tile(tan, m), R_bs)
         out[a:b] = intersect(np.repeat(pos, zeta.size, axis=0), d, terrain).reshape(m, -1, 3)

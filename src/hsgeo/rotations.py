@@ -11,6 +11,9 @@ Conventions
 * **Aerospace roll-pitch-yaw** (:func:`R_from_rpy`): ``R = Rz(yaw) @ Ry(pitch) @ Rx(roll)``,
   which is ``R_nav_from_body``. Whether the navigation frame is north-east-down or
   east-north-up is the caller's business; the algebra is the same.
+* **North-east-down to east-north-up** (:data:`R_ENU_FROM_NED`): the fixed swap of the first
+  two axes and sign change of the third; a GNSS/INS attitude ``R_ned_from_body`` becomes
+  ``R_map_from_body = R_ENU_FROM_NED @ R_ned_from_body`` in the east-north-up map frame.
 * **Rotation vector** (:func:`R_from_rotvec`): axis times angle, Rodrigues' formula, identical
   to OpenCV's ``cv2.Rodrigues``.
 
@@ -30,6 +33,7 @@ from hsgeo.errors import InputError
 from hsgeo.validate import finite_array
 
 __all__ = [
+    "R_ENU_FROM_NED",
     "R_from_opk",
     "opk_from_R",
     "dR_dopk",
@@ -41,6 +45,11 @@ __all__ = [
     "skew",
     "R_small",
 ]
+
+#: The fixed rotation from north-east-down to east-north-up (E = N_ned[1], N = N_ned[0],
+#: U = −D); a proper rotation (det +1) and its own inverse.
+R_ENU_FROM_NED = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
+R_ENU_FROM_NED.setflags(write=False)
 
 #: Tolerance on max |RᵀR − I| accepted by the ``*_from_R`` functions.
 ORTHONORMALITY_TOL = 1e-6

@@ -1,11 +1,40 @@
-"""Timed platform poses and local cubic B-spline corrections at nodes (002 §3.3).
+"""Timed poses of a GNSS/INS solution, and local cubic B-spline corrections at nodes (002 §3.3).
 
-A GNSS/INS solution gives the platform pose at any time: position ``xyz_m`` in the map frame
-(east, north, up) and attitude ``rpy_rad`` (roll, pitch, yaw) with
-``R_map_from_platform = R_from_rpy(roll, pitch, yaw)`` (see :mod:`hsgeo.rotations`). Its
-high-frequency motion is right; what remains wrong is smooth and low-frequency. The bundle
-adjustment therefore estimates *corrections* ``δ(t) = (δE, δN, δH, δroll, δpitch, δyaw)`` at
-nodes every ``Δt`` seconds and interpolates them to each line's exposure time (002 Fig. 4).
+The one timed pose
+------------------
+:class:`Trajectory` holds a GNSS/INS solution as the instrument gives it: at each time ``t_s``
+the position ``xyz_m`` = (E, N, U) in a local **east-north-up** map frame (metres), and the
+attitude ``roll_pitch_heading_rad`` = (roll, pitch, heading) of the **body** (x forward, y right,
+z down) relative to **north-east-down**::
+
+    R_ned_from_body = R_from_rpy(roll, pitch, heading)            (hsgeo.rotations)
+    R_map_from_body = R_ENU_FROM_NED @ R_ned_from_body            (Trajectory.R_map_from_body)
+
+Positions and the three (unwrapped) angles are interpolated linearly in time
+(:meth:`Trajectory.pose`); the velocity and angle rates are the slopes of that interpolation
+(:meth:`Trajectory.rates`). Files: :mod:`hsgeo.io.navigation`.
+
+The pushbroom model's angles (002)
+----------------------------------
+The pushbroom model of 002 (:mod:`hsgeo.sensors.pushbroom`) parametrises the attitude with its
+own angles: roll, pitch, yaw of the **platform** frame (x forward, y left, z up) relative to
+east-north-up, ``R_map_from_platform = R_from_rpy(roll, pitch, yaw)``; its node corrections
+δroll, δpitch, δyaw are corrections of those angles. With
+``R_body_from_platform = diag(1, −1, −1)`` the two are related exactly by::
+
+    R_ENU_FROM_NED @ R_from_rpy(r, p, h) @ diag(1, −1, −1) = R_from_rpy(r, −p, π/2 − h)
+
+so the platform angles are ``(roll, −pitch, π/2 − heading)`` (:func:`platform_rpy_from_rph`),
+and back the same map (:func:`rph_from_platform_rpy`; it is its own inverse). The map is linear,
+so interpolating either set of angles gives the same poses, and the rates convert as
+``(ṙ, −ṗ, −ḣ)`` (:func:`platform_rpy_rate_from_rph_rate`).
+
+Spline corrections
+------------------
+A GNSS/INS solution's high-frequency motion is right; what remains wrong is smooth and
+low-frequency. The bundle adjustment therefore estimates *corrections*
+``δ(t) = (δE, δN, δH, δroll, δpitch, δyaw)`` (platform angles) at nodes every ``Δt`` seconds
+and interpolates them to each line's exposure time (002 Fig. 4).
 
 Which spline, and why
 ---------------------
@@ -38,11 +67,20 @@ from dataclasses import dataclass
 import numpy as np
 
 from hsgeo.errors import InputError
-from hsgeo.rotations import R_from_rpy
+from hsgeo.rotations import R_ENU_FROM_NED, R_from_rpy
 
-__all__ = ["Trajectory", "SplineNodes", "bspline_basis", "bspline_basis_derivative"]
+__all__ = [
+    "Trajectory",
+    "R_BODY_FROM_PLATFORM",
+    "platform_rpy_from_rph",
+    "rph_from_platform_rpy",
+    "platform_rpy_rate_from_rph_rate",
+    "SplineNodes",
+    "bspline_basis",
+    "bspline_basis_derivative",
+]
 
-#: Names of the six corrections per node, in order.
+#: Names of the six corrections per node, in order (positions E, N, U; platform angles).
 CORRECTION_COLUMNS = ("dE_m", "dN_m", "dH_m", "droll_rad", "dpitch_rad", "dyaw_rad")
 
 
@@ -159,64 +197,112 @@ class SplineNodes:
         return np.einsum("ma,mak->mk", w, nodes[idx])
 
 
-@dataclass
+
+# ----------------------------------------------------------------------------------------------
+# The one timed pose
+# ----------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
 class Trajectory:
-    """Timed platform poses (a GNSS/INS solution), linearly interpolated in time.
+    """Timed poses of a GNSS/INS solution, linearly interpolated in time.
 
     Parameters
     ----------
-    t_s : (n,) ndarray
-        Strictly increasing times.
-    xyz_m : (n, 3) ndarray
-        Platform position (E, N, U) in the map frame.
-    rpy_rad : (n, 3) ndarray
-        Roll, pitch, yaw with ``R_map_from_platform = R_from_rpy(roll, pitch, yaw)``. Yaw is
-        unwrapped before interpolation.
+    t_s : (n,) array_like, s
+        Strictly increasing times, n ≥ 2.
+    xyz_m : (n, 3) array_like, m
+        Position (E, N, U) in the local east-north-up map frame.
+    roll_pitch_heading_rad : (n, 3) array_like, rad
+        Roll, pitch, heading of the body (x forward, y right, z down) relative to
+        north-east-down: ``R_ned_from_body = R_from_rpy(roll, pitch, heading)``. All three are
+        unwrapped along time (``numpy.unwrap``) before they are stored, so that interpolation
+        never passes the long way round ±180°.
+
+    Raises
+    ------
+    InputError
+        On wrong shapes, fewer than two records, NaN or inf, or times that do not increase
+        strictly.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> tr = Trajectory([0.0, 1.0], [[0, 0, 100], [10, 0, 100]], [[0, 0, 0], [0, 0, 0.2]])
+    >>> xyz, rph = tr.pose(0.5)
+    >>> xyz.tolist(), rph.round(6).tolist()
+    ([[5.0, 0.0, 100.0]], [[0.0, 0.0, 0.1]])
     """
 
     t_s: np.ndarray
     xyz_m: np.ndarray
-    rpy_rad: np.ndarray
+    roll_pitch_heading_rad: np.ndarray
 
     def __post_init__(self):
-        self.t_s = np.asarray(self.t_s, dtype=np.float64).ravel()
-        self.xyz_m = np.asarray(self.xyz_m, dtype=np.float64)
-        self.rpy_rad = np.asarray(self.rpy_rad, dtype=np.float64)
-        n = self.t_s.size
-        if n < 2:
-            raise InputError("a trajectory needs at least two epochs")
-        if self.xyz_m.shape != (n, 3) or self.rpy_rad.shape != (n, 3):
+        t = np.asarray(self.t_s, dtype=np.float64)
+        p = np.asarray(self.xyz_m, dtype=np.float64)
+        a = np.asarray(self.roll_pitch_heading_rad, dtype=np.float64)
+        if t.ndim != 1 or p.shape != (t.size, 3) or a.shape != (t.size, 3):
             raise InputError(
-                f"trajectory: {n} times but positions {self.xyz_m.shape} and attitudes "
-                f"{self.rpy_rad.shape}; expected ({n}, 3) each"
+                f"trajectory: times (n,), positions (n, 3) and attitudes (n, 3) expected, got "
+                f"{t.shape}, {p.shape}, {a.shape}"
             )
-        if not (np.all(np.isfinite(self.xyz_m)) and np.all(np.isfinite(self.rpy_rad))
-                and np.all(np.isfinite(self.t_s))):
-            raise InputError("trajectory contains NaN or inf")
-        if np.any(np.diff(self.t_s) <= 0):
-            raise InputError("trajectory times must be strictly increasing (sort the file)")
-        self.rpy_rad = self.rpy_rad.copy()
-        self.rpy_rad[:, 2] = np.unwrap(self.rpy_rad[:, 2])
+        if t.size < 2:
+            raise InputError("a trajectory needs at least 2 records")
+        if not (np.all(np.isfinite(t)) and np.all(np.isfinite(p)) and np.all(np.isfinite(a))):
+            raise InputError("trajectory records contain NaN or inf")
+        if np.any(np.diff(t) <= 0):
+            i = int(np.flatnonzero(np.diff(t) <= 0)[0])
+            raise InputError(
+                f"trajectory times must increase strictly (records {i}, {i + 1}): sort the "
+                "records and drop duplicates"
+            )
+        object.__setattr__(self, "t_s", t)
+        object.__setattr__(self, "xyz_m", p)
+        object.__setattr__(self, "roll_pitch_heading_rad", np.unwrap(a, axis=0))
 
-    def pose(self, t_s):
-        """Position ``(m, 3)`` and attitude angles ``(m, 3)`` at ``t_s`` (linear interpolation)."""
-        t = np.asarray(t_s, dtype=np.float64).ravel()
+    def pose(self, t_s) -> tuple[np.ndarray, np.ndarray]:
+        """Position and attitude angles at the given times (linear interpolation).
+
+        Parameters
+        ----------
+        t_s : float or (m,) array_like, s
+            Times within the record.
+
+        Returns
+        -------
+        xyz_m : (m, 3) ndarray, m
+            Position (E, N, U).
+        roll_pitch_heading_rad : (m, 3) ndarray, rad
+            Roll, pitch, heading (NED), interpolated on the unwrapped angles.
+
+        Raises
+        ------
+        InputError
+            If a time falls outside the record.
+        """
+        t = np.atleast_1d(np.asarray(t_s, dtype=np.float64)).ravel()
         if np.any(t < self.t_s[0]) or np.any(t > self.t_s[-1]):
             raise InputError(
-                f"times outside the trajectory [{self.t_s[0]}, {self.t_s[-1]}] s: the navigation "
-                "file does not cover the observations"
+                f"times {t.min():.3f}…{t.max():.3f} s fall outside the trajectory "
+                f"{self.t_s[0]:.3f}…{self.t_s[-1]:.3f} s: the navigation does not cover them"
             )
-        xyz = np.column_stack([np.interp(t, self.t_s, self.xyz_m[:, i]) for i in range(3)])
-        rpy = np.column_stack([np.interp(t, self.t_s, self.rpy_rad[:, i]) for i in range(3)])
-        return xyz, rpy
+        a = self.roll_pitch_heading_rad
+        pos = np.stack([np.interp(t, self.t_s, self.xyz_m[:, k]) for k in range(3)], axis=1)
+        att = np.stack([np.interp(t, self.t_s, a[:, k]) for k in range(3)], axis=1)
+        return pos, att
 
-    def rates(self, t_s, step_s: float = 1e-3):
-        """Velocity ``(m, 3)`` m/s and attitude-angle rates ``(m, 3)`` rad/s at ``t_s``.
+    def rates(self, t_s, step_s: float = 1e-3) -> tuple[np.ndarray, np.ndarray]:
+        """Velocity and attitude-angle rates at the given times.
 
         Central differences of :meth:`pose` over ``± step_s`` (one-sided at the ends of the
-        trajectory): the slope of the linear interpolation, averaged at the epochs.
+        record): the slope of the linear interpolation, averaged at the records.
+
+        Returns
+        -------
+        velocity_m_s : (m, 3) ndarray, m/s
+            (Ė, Ṅ, U̇).
+        roll_pitch_heading_rate_rad_s : (m, 3) ndarray, rad/s
         """
-        t = np.asarray(t_s, dtype=np.float64).ravel()
+        t = np.atleast_1d(np.asarray(t_s, dtype=np.float64)).ravel()
         self.pose(t)  # span check
         ta = np.maximum(t - step_s, self.t_s[0])
         tb = np.minimum(t + step_s, self.t_s[-1])
@@ -225,6 +311,86 @@ class Trajectory:
         dt = (tb - ta)[:, None]
         return (xb - xa) / dt, (rb - ra) / dt
 
-    def R_map_from_platform(self, t_s) -> np.ndarray:
-        _, rpy = self.pose(t_s)
-        return R_from_rpy(rpy[:, 0], rpy[:, 1], rpy[:, 2])
+    def R_map_from_body(self, t_s) -> np.ndarray:
+        """``R_map_from_body = R_ENU_FROM_NED @ R_from_rpy(roll, pitch, heading)``, ``(m, 3, 3)``.
+
+        Takes body vectors (x forward, y right, z down) to the east-north-up map frame.
+        """
+        _, a = self.pose(t_s)
+        return R_ENU_FROM_NED @ R_from_rpy(a[:, 0], a[:, 1], a[:, 2])
+
+
+# ----------------------------------------------------------------------------------------------
+# The pushbroom model's platform angles (002) <-> the GNSS/INS angles
+# ----------------------------------------------------------------------------------------------
+#: Body (x forward, y right, z down) from the pushbroom model's platform frame (x forward,
+#: y left, z up): ``xyz_body = R_BODY_FROM_PLATFORM @ xyz_platform`` (its own inverse).
+R_BODY_FROM_PLATFORM = np.diag([1.0, -1.0, -1.0])
+R_BODY_FROM_PLATFORM.setflags(write=False)
+
+
+def _angles3(a, name: str) -> np.ndarray:
+    a = np.array(a, dtype=np.float64)
+    if a.ndim < 1 or a.shape[-1] != 3:
+        raise InputError(f"{name} must have shape (..., 3), got {a.shape}")
+    return a
+
+
+def platform_rpy_from_rph(roll_pitch_heading_rad) -> np.ndarray:
+    """The pushbroom model's platform angles from GNSS/INS roll, pitch, heading.
+
+    ``(roll, pitch, yaw) = (roll, −pitch, π/2 − heading)``, exact because
+    ``R_ENU_FROM_NED @ R_from_rpy(r, p, h) @ R_BODY_FROM_PLATFORM = R_from_rpy(r, −p, π/2 − h)``
+    (see the module docstring).
+
+    Parameters
+    ----------
+    roll_pitch_heading_rad : (..., 3) array_like, rad
+        Attitude of the body (x forward, y right, z down) relative to north-east-down.
+
+    Returns
+    -------
+    rpy_rad : (..., 3) ndarray, rad
+        Attitude of the platform (x forward, y left, z up) relative to east-north-up,
+        ``R_map_from_platform = R_from_rpy(roll, pitch, yaw)``.
+    """
+    a = _angles3(roll_pitch_heading_rad, "roll_pitch_heading_rad")
+    return np.stack([a[..., 0], -a[..., 1], np.pi / 2 - a[..., 2]], axis=-1)
+
+
+def rph_from_platform_rpy(rpy_rad) -> np.ndarray:
+    """GNSS/INS roll, pitch, heading from the pushbroom model's platform angles.
+
+    ``(roll, pitch, heading) = (roll, −pitch, π/2 − yaw)``: the inverse of
+    :func:`platform_rpy_from_rph` (the map is its own inverse).
+
+    Parameters
+    ----------
+    rpy_rad : (..., 3) array_like, rad
+        ``R_map_from_platform = R_from_rpy(roll, pitch, yaw)`` (platform x forward, y left, z up;
+        map east-north-up).
+
+    Returns
+    -------
+    roll_pitch_heading_rad : (..., 3) ndarray, rad
+        ``R_ned_from_body = R_from_rpy(roll, pitch, heading)`` (body x forward, y right, z down).
+    """
+    a = _angles3(rpy_rad, "rpy_rad")
+    return np.stack([a[..., 0], -a[..., 1], np.pi / 2 - a[..., 2]], axis=-1)
+
+
+def platform_rpy_rate_from_rph_rate(roll_pitch_heading_rate_rad_s) -> np.ndarray:
+    """Rates of the platform angles from rates of roll, pitch, heading: ``(ṙ, −ṗ, −ḣ)``.
+
+    The derivative of :func:`platform_rpy_from_rph` (a linear map); also its own inverse.
+
+    Parameters
+    ----------
+    roll_pitch_heading_rate_rad_s : (..., 3) array_like, rad/s
+
+    Returns
+    -------
+    rpy_rate_rad_s : (..., 3) ndarray, rad/s
+    """
+    a = _angles3(roll_pitch_heading_rate_rad_s, "roll_pitch_heading_rate_rad_s")
+    return np.stack([a[..., 0], -a[..., 1], -a[..., 2]], axis=-1)

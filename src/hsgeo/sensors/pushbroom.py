@@ -48,6 +48,12 @@ the factored form ``B_a(t*) ∂r/∂δ``. Evaluating x at ``t*`` rather than ``t
 The nominal mount ``β₀`` maps the platform frame (x forward, y left, z up) to the camera frame
 (x along the line to the right, y backward, z down the viewing direction).
 
+The attitude angles ``rpy_nav`` and their corrections are the model's own: roll, pitch, yaw of
+the platform frame relative to east-north-up, ``R_map_from_platform = R_from_rpy(roll, pitch,
+yaw)``. A GNSS/INS attitude (:class:`hsgeo.trajectory.Trajectory`: roll, pitch, heading of the
+body x forward, y right, z down in north-east-down) converts exactly by
+:func:`hsgeo.trajectory.platform_rpy_from_rph`, ``(roll, −pitch, π/2 − heading)``.
+
 References
 ----------
 Jonassen et al. (2024), 002 eq. (2)–(4), §3.3–3.5.

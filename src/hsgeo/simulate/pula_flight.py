@@ -22,15 +22,15 @@ from pathlib import Path
 import numpy as np
 
 from hsgeo.geocode import (
-    R_ENU_FROM_NED,
     CalibratedLine,
     LinearIFOV,
     LineGeometry,
     PlaneTerrain,
 )
-from hsgeo.navigation import Navigation
+from hsgeo.io.navigation import write_trajectory
 from hsgeo.rotations import R_from_rpy
 from hsgeo.simulate import as_rng
+from hsgeo.trajectory import Trajectory
 
 __all__ = ["FlightObservations", "FlightTruth", "simulate_flight", "gcp_field", "observe_gcps",
            "generate", "airfield_scene", "render_line_image", "true_sensor", "nominal_sensor"]
@@ -42,7 +42,7 @@ class FlightObservations:
 
     Attributes
     ----------
-    recorded_nav : Navigation
+    recorded_nav : Trajectory
         The recorded GNSS/IMU navigation (with its errors).
     t0_s : float
         Time of line 0, s.
@@ -62,7 +62,7 @@ class FlightObservations:
         The uncalibrated sensor model the operator starts from (Jakšić 2009).
     """
 
-    recorded_nav: Navigation
+    recorded_nav: Trajectory
     t0_s: float
     line_rate_hz: float
     gcp_id: np.ndarray
@@ -79,7 +79,7 @@ class FlightTruth:
 
     Attributes
     ----------
-    true_nav : Navigation
+    true_nav : Trajectory
         The true trajectory.
     sensor : CalibratedLine
         The true sensor (000 Table 1).
@@ -93,7 +93,7 @@ class FlightTruth:
         Time of line 0 (s) and line rate (Hz) of the scanner.
     """
 
-    true_nav: Navigation
+    true_nav: Trajectory
     sensor: CalibratedLine
     boresight_rad: np.ndarray
     gcp_enu_m: np.ndarray
@@ -114,7 +114,7 @@ def gcp_field(cfg: dict) -> tuple[np.ndarray, np.ndarray]:
     return ids, np.column_stack([EN, np.full(len(ids), f["height_m"])])
 
 
-def _true_trajectory(cfg: dict, rng) -> tuple[Navigation, float, float]:
+def _true_trajectory(cfg: dict, rng) -> tuple[Trajectory, float, float]:
     fl = cfg["flight"]
     v, H = fl["speed_m_s"], fl["height_agl_m"] + cfg["field"]["height_m"]
     heading = np.deg2rad(fl["heading_deg"])
@@ -127,16 +127,16 @@ def _true_trajectory(cfg: dict, rng) -> tuple[Navigation, float, float]:
     amp = np.deg2rad(np.array(fl["attitude_motion_deg"]))
     per = np.array(fl["attitude_period_s"])
     ph = rng.uniform(0, 2 * np.pi, 3)
-    rpy = np.stack([amp[k] * np.sin(2 * np.pi * t / per[k] + ph[k]) for k in range(3)], axis=1)
-    rpy[:, 2] += heading
+    rph = np.stack([amp[k] * np.sin(2 * np.pi * t / per[k] + ph[k]) for k in range(3)], axis=1)
+    rph[:, 2] += heading  # roll, pitch, heading (NED)
     s = v * t
     lateral = fl["lateral_wander_m"] * np.sin(2 * np.pi * t / (2.5 * per[0]) + ph[1])
     EN = start + s[:, None] * u + lateral[:, None] * np.array([u[1], -u[0]])
     U = H + fl["height_wander_m"] * np.sin(2 * np.pi * t / (3 * per[1]) + ph[2])
-    return Navigation(t, np.column_stack([EN, U]), rpy), T, H
+    return Trajectory(t, np.column_stack([EN, U]), rph), T, H
 
 
-def _recorded(nav: Navigation, cfg: dict, rng) -> Navigation:
+def _recorded(nav: Trajectory, cfg: dict, rng) -> Trajectory:
     """Add GNSS and IMU errors (001 §2.1: iVRU-RSSC attitude resolution < 0.01°)."""
     g, imu = cfg["gnss"], cfg["imu"]
     n = nav.t_s.size
@@ -144,14 +144,15 @@ def _recorded(nav: Navigation, cfg: dict, rng) -> Navigation:
     pos_bias = rng.normal(0, g["bias_m"], 3)
     steps = rng.normal(0, 1, (n, 3)) * np.sqrt(dt)[:, None]
     walk = np.cumsum(steps, axis=0) * g["random_walk_m_per_sqrt_s"]
-    pos = nav.enu_m + pos_bias + walk + rng.normal(0, g["white_m"], (n, 3))
+    pos = nav.xyz_m + pos_bias + walk + rng.normal(0, g["white_m"], (n, 3))
     att_bias = rng.normal(0, np.deg2rad(imu["attitude_bias_deg"]), 3)
-    att = (nav.rpy_rad + att_bias + rng.normal(0, np.deg2rad(imu["attitude_noise_deg"]), (n, 3))
+    att = (nav.roll_pitch_heading_rad + att_bias
+           + rng.normal(0, np.deg2rad(imu["attitude_noise_deg"]), (n, 3))
            + np.deg2rad(imu["heading_drift_deg_per_s"]) * nav.t_s[:, None] * np.array([0, 0, 1]))
-    return Navigation(nav.t_s, pos, att)
+    return Trajectory(nav.t_s, pos, att)
 
 
-def observe_gcps(nav: Navigation, sensor: LineGeometry, boresight_rad, t0_s, line_rate_hz,
+def observe_gcps(nav: Trajectory, sensor: LineGeometry, boresight_rad, t0_s, line_rate_hz,
                  gcp_enu_m, rng, sigma_line: float, sigma_px: float):
     """Where the true sensor sees each GCP: (fractional line, ζ), with measurement noise.
 
@@ -161,8 +162,8 @@ def observe_gcps(nav: Navigation, sensor: LineGeometry, boresight_rad, t0_s, lin
     R_bs = R_from_rpy(*boresight_rad)
 
     def sensor_coords(t, X):
-        pos, rpy = nav.at(t)
-        R = R_ENU_FROM_NED @ R_from_rpy(rpy[:, 0], rpy[:, 1], rpy[:, 2]) @ R_bs  # map<-sensor
+        pos, _ = nav.pose(t)
+        R = nav.R_map_from_body(t) @ R_bs  # map<-sensor
         return np.einsum("nji,nj->ni", R, X - pos)
 
     lo = np.full(len(gcp_enu_m), nav.t_s[0])
@@ -216,7 +217,7 @@ def simulate_flight(cfg: dict, rng) -> tuple[FlightObservations, FlightTruth]:
 def generate(cfg: dict, outdir: Path) -> list[Path]:
     """``make data``: the recorded navigation and GCP observations of the scenario's seed."""
     fl, _ = simulate_flight(cfg, cfg["scenario"]["seed"])
-    nav = fl.recorded_nav.write_csv(outdir / "pula_flight_navigation.csv")
+    nav = write_trajectory(outdir / "pula_flight_navigation.csv", fl.recorded_nav)
     obs = outdir / "pula_flight_gcp_observations.csv"
     np.savetxt(obs, np.column_stack([fl.gcp_id, fl.line, fl.zeta_px, fl.gcp_enu_m]),
                delimiter=",", fmt=["%d"] + ["%.17g"] * 5,

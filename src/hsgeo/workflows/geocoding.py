@@ -32,12 +32,12 @@ def geocode_files(lines, trajectory, sensor, *, output, dem=None, height_m=None,
     """Orthorectify a recorded flight line from files (see ``hsgeo geocode --help``)."""
     import xarray as xr
 
-    from hsgeo.navigation import Navigation
+    from hsgeo.io.navigation import read_trajectory
 
     if (dem is None) == (height_m is None):
         raise InputError("give exactly one of --dem DEM.nc or --height H (a plane)")
     da, t0, rate = read_lines(lines)
-    nav = Navigation.read_csv(trajectory)
+    nav = read_trajectory(trajectory)
     geom, bs = read_sensor_toml(sensor)
     if dem is not None:
         ds = xr.open_dataset(dem)

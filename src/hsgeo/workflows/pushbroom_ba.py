@@ -123,8 +123,10 @@ def build_problem(obs: PushbroomObservations, n_points: int, cam: CameraPrior, *
     Parameters
     ----------
     obs : PushbroomObservations
-        The observations and the GNSS/INS pose at their line times; with ``y_as_time`` also
-        the GNSS/INS velocity and attitude rates there.
+        The observations and the GNSS/INS pose at their line times, the attitude as the
+        model's platform angles (``R_map_from_platform = R_from_rpy``, ENU;
+        :func:`hsgeo.trajectory.platform_rpy_from_rph` converts a GNSS/INS attitude); with
+        ``y_as_time`` also the GNSS/INS velocity and platform-angle rates there.
     n_points : int
     cam : CameraPrior
     node_interval_s : float
@@ -184,8 +186,8 @@ def build_problem(obs: PushbroomObservations, n_points: int, cam: CameraPrior, *
         if not obs.has_rates:
             raise InputError(
                 "y_as_time needs the GNSS/INS rates at the line times (xyz_rate_nav_m_s, "
-                "rpy_rate_nav_rad_s): give them (e.g. hsgeo.trajectory.Trajectory.rates) or use "
-                "y_as_time=False")
+                "rpy_rate_nav_rad_s): give them (hsgeo.trajectory.Trajectory.rates, converted by "
+                "hsgeo.trajectory.platform_rpy_rate_from_rph_rate) or use y_as_time=False")
         z_ref = float(np.median(obs.xyz_nav_m[:, 2] - P0[obs.point, 2]))
         v_ref = float(np.median(np.linalg.norm(obs.xyz_rate_nav_m_s, axis=1)))
         timed = {"xyz_rate_m_s": obs.xyz_rate_nav_m_s,
@@ -202,7 +204,6 @@ def build_problem(obs: PushbroomObservations, n_points: int, cam: CameraPrior, *
 # ----------------------------------------------------------------------------------------------
 #: Required columns of the input tables (CSV or Parquet).
 OBS_COLUMNS = ("point_id", "band", "t_s", "x_px", "y_px")
-NAV_COLUMNS = ("t_s", "E_m", "N_m", "H_m", "roll_rad", "pitch_rad", "yaw_rad")
 GCP_COLUMNS = ("point_id", "E_m", "N_m", "H_m")
 
 
@@ -267,10 +268,13 @@ def adjust_files(observations, trajectory, camera, gcp=None, *, node_interval_s:
         (0-based), exposure time of the line (s, the navigation's time scale), image
         coordinates in pixels from the line centre (x along the line, y across it; 0 = the line).
     trajectory : path
-        CSV or Parquet with ``t_s, E_m, N_m, H_m, roll_rad, pitch_rad, yaw_rad``: the GNSS/INS
-        solution (map frame east-north-up, ``R_map_from_platform = R_from_rpy``), interpolated
-        linearly to the line times; its velocity and angular rates (for the time residual,
-        ``y_as_time``) are central differences of that interpolation.
+        The navigation file of every command (:mod:`hsgeo.io.navigation`): CSV or Parquet with
+        ``t_s, E_m, N_m, U_m, roll_deg, pitch_deg, heading_deg``, the GNSS/INS solution
+        (positions of the platform reference point east-north-up; attitude of the body, x
+        forward, y right, z down, in north-east-down). It is interpolated linearly to the line
+        times and converted to the model's platform angles
+        (:func:`hsgeo.trajectory.platform_rpy_from_rph`); its velocity and angular rates (for
+        the time residual, ``y_as_time``) are central differences of that interpolation.
     camera : path
         TOML: ``[camera] n_bands, pixel_mm, c_mm, x0_mm, y0_mm, lever_arm_m, sigma_lever_m``,
         ``[gnss_ins] sigma_pos_m = [E, N, H], sigma_att_deg = [roll, pitch, yaw]``,
@@ -284,17 +288,18 @@ def adjust_files(observations, trajectory, camera, gcp=None, *, node_interval_s:
         Summary, the camera parameters with σ̂, the node corrections and the adjusted points.
     """
     from hsgeo.adjust import adjust
-    from hsgeo.trajectory import Trajectory
+    from hsgeo.io.navigation import read_trajectory
+    from hsgeo.trajectory import platform_rpy_from_rph, platform_rpy_rate_from_rph_rate
 
     obs_df = read_table(observations, OBS_COLUMNS, "observation")
-    nav_df = read_table(trajectory, NAV_COLUMNS, "trajectory")
+    traj = read_trajectory(trajectory)
     cam = read_camera(camera)
     ids, point = np.unique(obs_df["point_id"].to_numpy(), return_inverse=True)
-    traj = Trajectory(nav_df["t_s"].to_numpy(), nav_df[["E_m", "N_m", "H_m"]].to_numpy(),
-                      nav_df[["roll_rad", "pitch_rad", "yaw_rad"]].to_numpy())
     t = obs_df["t_s"].to_numpy(dtype=float)
-    xyz, rpy = traj.pose(t)
-    vel, rate = traj.rates(t)
+    xyz, rph = traj.pose(t)
+    vel, rph_rate = traj.rates(t)
+    rpy = platform_rpy_from_rph(rph)  # the model's ENU platform angles (002)
+    rate = platform_rpy_rate_from_rph_rate(rph_rate)
     obs = PushbroomObservations(
         point=point.astype(np.int64), band=obs_df["band"].to_numpy().astype(np.int64), t_s=t,
         xy_px=obs_df[["x_px", "y_px"]].to_numpy(dtype=float), xyz_nav_m=xyz, rpy_nav_rad=rpy,
