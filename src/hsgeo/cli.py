@@ -134,7 +134,7 @@ def build_parser() -> argparse.ArgumentParser:
                        "jointly, 003) from images of an ArUco / ChArUco board")
     p.add_argument("images", nargs="+", metavar="IMAGES", help="image files")
     p.add_argument("--board", required=True, help="board description (TOML, see "
-                   "hsgeo.measure.boards)")
+                   "hsgeo.io.boards)")
     g = p.add_mutually_exclusive_group()
     g.add_argument("--per-band", action="store_false", dest="joint",
                    help="one calibration per band (default)")
@@ -161,7 +161,7 @@ def build_parser() -> argparse.ArgumentParser:
         "grid by nearest neighbour. LINES: NetCDF with radiance(line, pixel) or (band, line, "
         "pixel), coordinate pixel (ζ, px), attributes t0_s and line_rate_hz. NAV: CSV "
         "t_s,E_m,N_m,U_m,roll_deg,pitch_deg,heading_deg. SENSOR: TOML, see "
-        "hsgeo.geocode.read_sensor_toml. DEM: NetCDF with height(N, E) in metres.")
+        "hsgeo.io.read_sensor_toml. DEM: NetCDF with height(N, E) in metres.")
     p.add_argument("lines", metavar="LINES")
     p.add_argument("--trajectory", required=True, metavar="NAV")
     p.add_argument("--sensor", required=True, metavar="SENSOR.toml")
