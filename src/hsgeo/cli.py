@@ -179,7 +179,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="bundle-adjust LP lines with spline trajectory corrections (002 eq. 2-4)",
         description="Observation table: point_id, band, t_s, x_px, y_px; trajectory: t_s, E_m, "
         "N_m, H_m, roll_rad, pitch_rad, yaw_rad; GCPs: point_id, E_m, N_m, H_m (CSV or "
-        "Parquet); camera TOML: see hsgeo.workflows.pushbroom_ba.adjust_files.")
+        "Parquet); camera TOML: see hsgeo.io.read_camera_toml.")
     p.add_argument("observations", help="observation table (CSV or Parquet)")
     p.add_argument("--trajectory", required=True, help="GNSS/INS trajectory table")
     p.add_argument("--camera", required=True, help="camera and prior σ (TOML)")
