@@ -19,9 +19,8 @@ from hsgeo.geocode import (
     geocode_observations,
     intersect,
     orthorectify,
-    read_sensor_toml,
-    write_lines,
 )
+from hsgeo.io import write_lines
 from hsgeo.io.navigation import write_trajectory
 from hsgeo.simulate.pula_flight import observe_gcps, simulate_flight
 from hsgeo.simulate.scenarios import load_scenario
@@ -163,19 +162,6 @@ def test_orthorectify_places_pixels_where_they_belong():
     # nearest neighbour: within half the largest pixel spacing (along track 2 m here)
     assert np.max(np.abs(da.values[0][ok] - E[ok])) < 1.5
     assert np.max(np.abs(da.values[1][ok] - N[ok])) < 1.5
-
-
-def test_sensor_toml_errors(tmp_path):
-    p = tmp_path / "s.toml"
-    p.write_text("[sensor]\nmodel = 'pinhole'\nzeta0_px = 1\nc_px = 2\n")
-    with pytest.raises(InputError, match="model must be"):
-        read_sensor_toml(p)
-    p.write_text("[sensor]\nmodel = 'calibrated'\nzeta0_px = 1\n")
-    with pytest.raises(InputError, match="c_px"):
-        read_sensor_toml(p)
-    p.write_text("[sensor\n")
-    with pytest.raises(InputError, match="malformed"):
-        read_sensor_toml(p)
 
 
 def test_geocode_command_end_to_end(tmp_path):

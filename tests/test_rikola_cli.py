@@ -10,7 +10,7 @@ import pytest
 
 from hsgeo.cli import main
 from hsgeo.errors import InputError
-from hsgeo.measure.boards import load_board
+from hsgeo.io import read_board
 
 ROOT = Path(__file__).resolve().parents[1]
 CHARUCO = ROOT / "src/hsgeo/data/reference/opencv-charuco/images"
@@ -59,17 +59,17 @@ def test_rendered_aruco_grid_recovers_truth(tmp_path, capsys):
 
 def test_bad_board_files(tmp_path, capsys):
     with pytest.raises(InputError, match="not found"):
-        load_board(tmp_path / "none.toml")
+        read_board(tmp_path / "none.toml")
     p = tmp_path / "b.toml"
     p.write_text('[board]\ntype = "charuco"\ndictionary = "DICT_6X6_250"\nsquares_x = 5\n')
     with pytest.raises(InputError, match="missing"):
-        load_board(p)
+        read_board(p)
     p.write_text('[board]\ntype = "hexagons"\n')
     with pytest.raises(InputError, match="type"):
-        load_board(p)
+        read_board(p)
     p.write_text("[board\n")
     with pytest.raises(InputError, match="malformed"):
-        load_board(p)
+        read_board(p)
     assert main(["calibrate-frame", str(CHARUCO / "img_00.jpg"), "--board", str(BOARD),
                  "--joint"]) == 2
     assert "--band-regex" in capsys.readouterr().err

@@ -134,7 +134,7 @@ def build_parser() -> argparse.ArgumentParser:
                        "jointly, 003) from images of an ArUco / ChArUco board")
     p.add_argument("images", nargs="+", metavar="IMAGES", help="image files")
     p.add_argument("--board", required=True, help="board description (TOML, see "
-                   "hsgeo.measure.boards)")
+                   "hsgeo.io.boards)")
     g = p.add_mutually_exclusive_group()
     g.add_argument("--per-band", action="store_false", dest="joint",
                    help="one calibration per band (default)")
@@ -163,7 +163,7 @@ def build_parser() -> argparse.ArgumentParser:
         "NAV: the navigation file of every command, CSV or Parquet with t_s, E_m, N_m, U_m, "
         "roll_deg, pitch_deg, heading_deg (positions east-north-up in m; attitude of the body, "
         "x forward, y right, z down, in north-east-down, in degrees; see hsgeo.io.navigation). "
-        "SENSOR: TOML, see hsgeo.geocode.read_sensor_toml. DEM: NetCDF with height(N, E) in "
+        "SENSOR: TOML, see hsgeo.io.read_sensor_toml. DEM: NetCDF with height(N, E) in "
         "metres.")
     p.add_argument("lines", metavar="LINES")
     p.add_argument("--trajectory", required=True, metavar="NAV",
@@ -182,7 +182,7 @@ def build_parser() -> argparse.ArgumentParser:
         "adjust-pushbroom",
         help="bundle-adjust LP lines with spline trajectory corrections (002 eq. 2-4)",
         description="Observation table: point_id, band, t_s, x_px, y_px; GCPs: point_id, E_m, "
-        "N_m, H_m (CSV or Parquet); camera TOML: see hsgeo.workflows.pushbroom_ba.adjust_files. "
+        "N_m, H_m (CSV or Parquet); camera TOML: see hsgeo.io.read_camera_toml. "
         "NAV: the navigation file of every command, CSV or Parquet with t_s, E_m, N_m, U_m, "
         "roll_deg, pitch_deg, heading_deg (positions east-north-up in m; attitude of the body, "
         "x forward, y right, z down, in north-east-down, in degrees; see hsgeo.io.navigation). "

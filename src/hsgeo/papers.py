@@ -9,6 +9,8 @@ References
 bundle block adjusting method. Geodetski list 2017/2.
 001: Krtalić, Miljković, Gajski, Racetin (2019). Spatial distortion assessments of a low-cost
 laboratory and field hyperspectral imaging system. Sensors 19(19), 4267.
+002: the LP (line-pair) bundle adjustment of a HySpex VNIR-1800 pushbroom camera with spline
+trajectory corrections (see ``/work/shared/papers/002_*.txt``).
 """
 
 from __future__ import annotations
@@ -263,3 +265,31 @@ RIKOLA_FIG8_MAX_DIFF_PX = 1.0
 RIKOLA_FIG9_MAX_DECENTERING_PX = (1 / 5, 1 / 3)
 
 __all__ += ["RIKOLA_ROP_TEST_PX", "RIKOLA_FIG8_MAX_DIFF_PX", "RIKOLA_FIG9_MAX_DECENTERING_PX"]
+
+
+# ---- 002 (pushbroom bundle adjustment of LP image lines)
+#: Column order of 002 Tables 1-3: Min, Max, Median, Mean, STD, NMAD.
+P002_STATS = ("min", "max", "median", "mean", "std", "nmad")
+
+#: 002 Tables 1-3 (Table 1 in px, Tables 2-3 in m, columns :data:`P002_STATS`), the Fig. 8
+#: caption, §4 and §5, as printed.
+P002 = {
+    # 002 Table 1: reprojection errors of the 113758 tie points, with the four GCPs (px)
+    "002 Table 1": {"x": (-1.87, 1.82, 0.00, 0.00, 0.37, 0.32),  # 002 Table 1, row x
+                    "y": (-2.64, 2.62, 0.02, 0.00, 0.48, 0.42)},  # 002 Table 1, row y
+    # 002 Table 2: errors of the 13 check points, with the four GCPs (m)
+    "002 Table 2": {"e": (-0.13, 0.14, 0.04, 0.03, 0.07, 0.08),  # 002 Table 2, row E
+                    "n": (-0.05, 0.12, 0.03, 0.03, 0.04, 0.03),  # 002 Table 2, row N
+                    "h": (-1.61, 0.41, -0.78, -0.78, 0.66, 0.99)},  # 002 Table 2, row H
+    # 002 Table 3: errors of the 13 check points, without GCPs (m)
+    "002 Table 3": {"e": (-0.13, 0.14, 0.05, 0.04, 0.07, 0.08),  # 002 Table 3, row E
+                    "n": (-0.04, 0.13, 0.04, 0.04, 0.04, 0.03),  # 002 Table 3, row N
+                    "h": (-1.93, 0.04, -1.18, -1.13, 0.66, 0.95)},  # 002 Table 3, row H
+    "fig8_max_abs_diff_um": 11.8,  # 002 Fig. 8 caption: "differences are ≤ 11.8 µm"
+    "fig8_sigma_um": (1.2, 2.4),  # 002 Fig. 8 caption: "precision estimates of 1.2–2.4 µm"
+    "chromatic_shift_px": 0.27,  # 002 §5: "maximum absolute shift ≤ 0.27 pixels"
+    "n_unknowns": 342407,  # 002 §4: "A total of 342407 unknowns"
+    "n_observations_2d": 441587,  # 002 §4: "441 587 2D observations"
+}
+
+__all__ += ["P002_STATS", "P002"]

@@ -1,208 +1,57 @@
-"""Reading and writing: OpenCV calibration files, observation tables, scenario outputs."""
+"""Every file hsgeo reads or writes, in one place, checked at the boundary.
+
+One module per format:
+
+* :mod:`hsgeo.io.tables` — CSV / Parquet tables with required columns (units in the names);
+* :mod:`hsgeo.io.config` — TOML with a schema (unknown keys are errors with a suggestion);
+* :mod:`hsgeo.io.sensors` — the sensor TOML of ``hsgeo geocode``, the camera TOML of
+  ``hsgeo adjust-pushbroom``;
+* :mod:`hsgeo.io.boards` — the calibration-board description (:class:`Board`, mm) and the
+  board TOML of ``hsgeo calibrate-frame``;
+* :mod:`hsgeo.io.navigation` — the one navigation file of every command (GNSS/INS
+  trajectory, :class:`~hsgeo.trajectory.Trajectory`);
+* :mod:`hsgeo.io.lines` — recorded flight lines (NetCDF);
+* :mod:`hsgeo.io.raster` — orthoimages (NetCDF and ENVI) and DEMs (NetCDF);
+* :mod:`hsgeo.io.envi` — ENVI BSQ + ``.hdr``;
+* :mod:`hsgeo.io.opencv` — OpenCV FileStorage YAML/XML.
+
+Writers replace their file atomically (temporary file, then :func:`os.replace`) and, given the
+command's input files, refuse to write over one of them. Errors are
+:class:`~hsgeo.InputError` naming the file, the line / column / key, and the remedy.
+"""
 
 from __future__ import annotations
 
-from pathlib import Path
+from hsgeo.io._files import atomic_path, refuse_inputs
+from hsgeo.io.boards import Board, read_board
+from hsgeo.io.config import Key, read_config, read_toml
+from hsgeo.io.envi import read_envi, write_envi
+from hsgeo.io.lines import read_lines, write_lines
+from hsgeo.io.navigation import NAV_COLUMNS, read_trajectory, write_trajectory
+from hsgeo.io.opencv import read_opencv_storage
+from hsgeo.io.raster import read_dem, to_map_files
+from hsgeo.io.sensors import read_camera_toml, read_sensor_toml
+from hsgeo.io.tables import read_table
 
-import numpy as np
-
-from hsgeo.errors import InputError
-
-__all__ = ["read_opencv_storage", "read_csv_table"]
-
-
-def read_opencv_storage(path, required: tuple[str, ...] = ()) -> dict:
-    """Read an OpenCV FileStorage YAML/XML file (camera calibration output) into a dict.
-
-    Matrices (``!!opencv-matrix``) become float64 arrays, numbers floats, strings str.
-
-    Parameters
-    ----------
-    path : str or Path
-    required : tuple of str
-        Keys that must be present; a missing one raises :class:`~hsgeo.InputError`.
-    """
-    import cv2
-
-    path = Path(path)
-    if not path.is_file():
-        raise InputError(f"{path}: no such file")
-    try:
-        fs = cv2.FileStorage(str(path), cv2.FILE_STORAGE_READ)
-    except (cv2.error, SystemError) as exc:  # cv2 wraps parse errors in SystemError
-        cause = exc.__cause__ or exc
-        raise InputError(
-            f"{path}: not a readable OpenCV FileStorage file (YAML/XML): "
-            f"{str(cause).strip().splitlines()[-1]}"
-        ) from None
-    if not fs.isOpened():
-        raise InputError(f"{path}: OpenCV could not open it as FileStorage YAML/XML")
-    out = {}
-    root = fs.root()
-    for key in root.keys():
-        node = fs.getNode(key)
-        if node.isMap() and not node.empty() and node.mat() is not None:
-            out[key] = np.asarray(node.mat(), dtype=np.float64)
-        elif node.isReal() or node.isInt():
-            out[key] = float(node.real())
-        elif node.isString():
-            out[key] = node.string()
-        else:
-            m = node.mat()
-            if m is not None:
-                out[key] = np.asarray(m, dtype=np.float64)
-    fs.release()
-    missing = [k for k in required if k not in out]
-    if missing:
-        raise InputError(f"{path}: missing entries {missing} (found: {sorted(out)})")
-    return out
-
-
-def read_csv_table(path, columns: tuple[str, ...]):
-    """Read a CSV observation table with required columns; NaN and missing columns are errors.
-
-    Returns
-    -------
-    pandas.DataFrame
-    """
-    import pandas as pd
-
-    path = Path(path)
-    if not path.is_file():
-        raise InputError(f"{path}: no such file")
-    try:
-        df = pd.read_csv(path, comment="#")
-    except (pd.errors.ParserError, UnicodeDecodeError, pd.errors.EmptyDataError) as exc:
-        raise InputError(f"{path}: not a readable CSV table: {exc}") from None
-    df.columns = [c.strip() for c in df.columns]
-    missing = [c for c in columns if c not in df.columns]
-    if missing:
-        raise InputError(
-            f"{path}: missing columns {missing}; the file has {list(df.columns)} and needs "
-            f"{list(columns)}"
-        )
-    sub = df[list(columns)]
-    bad = sub.isna().any(axis=1)
-    if bad.any():
-        rows = (np.flatnonzero(bad.to_numpy())[:5] + 2).tolist()
-        raise InputError(f"{path}: empty or NaN values in lines {rows} (1 = header)")
-    return df
-
-
-# ----------------------------------------------------------------------------------------------
-# ENVI BSQ with a .hdr (map rasters and cubes)
-# ----------------------------------------------------------------------------------------------
-_ENVI_TYPES = {np.dtype("uint8"): 1, np.dtype("int16"): 2, np.dtype("int32"): 3,
-               np.dtype("float32"): 4, np.dtype("float64"): 5, np.dtype("uint16"): 12}
-
-
-def write_envi(path, data, *, map_info=None, band_names=None, wavelength_nm=None,
-               description: str = "hsgeo") -> tuple[Path, Path]:
-    """Write a band-sequential ENVI file ``path`` and its header ``path.hdr``.
-
-    Parameters
-    ----------
-    path : str or Path
-        The binary file (conventionally without extension or ``.bsq``).
-    data : (bands, lines, samples) or (lines, samples) ndarray
-        Any of uint8, int16, int32, uint16, float32, float64; written little-endian.
-    map_info : (E_ul, N_ul, dE, dN), optional
-        Map coordinates of the upper-left corner of the upper-left pixel and the cell sizes,
-        written as an ENVI ``map info`` in an arbitrary metric frame.
-    """
-    path = Path(path)
-    arr = np.asarray(data)
-    if arr.ndim == 2:
-        arr = arr[None]
-    if arr.ndim != 3:
-        raise InputError(f"ENVI data must be (bands, lines, samples), got {np.shape(data)}")
-    if arr.dtype not in _ENVI_TYPES:
-        raise InputError(f"ENVI cannot store dtype {arr.dtype}; use one of "
-                         f"{sorted(str(t) for t in _ENVI_TYPES)}")
-    arr.astype(arr.dtype.newbyteorder("<"), copy=False).tofile(path)
-    b, lines, samples = arr.shape
-    hdr = ["ENVI", f"description = {{{description}}}", f"samples = {samples}",
-           f"lines = {lines}", f"bands = {b}", "header offset = 0", "file type = ENVI Standard",
-           f"data type = {_ENVI_TYPES[arr.dtype]}", "interleave = bsq", "byte order = 0"]
-    if map_info is not None:
-        e, n, de, dn = map_info
-        hdr.append(f"map info = {{Arbitrary, 1, 1, {e!r}, {n!r}, {de!r}, {dn!r}, 0, "
-                   "units=Meters}")
-    if band_names is not None:
-        hdr.append("band names = {" + ", ".join(str(x) for x in band_names) + "}")
-    if wavelength_nm is not None:
-        hdr.append("wavelength units = Nanometers")
-        hdr.append("wavelength = {" + ", ".join(repr(float(x)) for x in wavelength_nm) + "}")
-    hpath = path.with_name(path.name + ".hdr")
-    hpath.write_text("\n".join(hdr) + "\n")
-    return path, hpath
-
-
-def read_envi(path) -> tuple[np.ndarray, dict]:
-    """Read a BSQ/BIL/BIP ENVI file written by :func:`write_envi` (or ENVI itself).
-
-    Returns
-    -------
-    data : (bands, lines, samples) ndarray
-    header : dict
-        Header entries (strings; ``map info`` parsed to floats under ``map_info``).
-    """
-    path = Path(path)
-    hpath = path.with_name(path.name + ".hdr")
-    if not hpath.is_file():
-        raise InputError(f"{hpath}: ENVI header not found next to {path}")
-    text = hpath.read_text()
-    if not text.startswith("ENVI"):
-        raise InputError(f"{hpath}: not an ENVI header (first line must be 'ENVI')")
-    hdr: dict = {}
-    key, buf = None, ""
-    for line in text.splitlines()[1:]:
-        if key is not None:
-            buf += " " + line.strip()
-            if "}" in line:
-                hdr[key], key = buf.strip(), None
-            continue
-        if "=" not in line:
-            continue
-        k, v = (s.strip() for s in line.split("=", 1))
-        if v.startswith("{") and "}" not in v:
-            key, buf = k.lower(), v
-        else:
-            hdr[k.lower()] = v
-    try:
-        b, lines, samples = int(hdr["bands"]), int(hdr["lines"]), int(hdr["samples"])
-        dtype = {v: k for k, v in _ENVI_TYPES.items()}[int(hdr["data type"])]
-    except (KeyError, ValueError) as exc:
-        raise InputError(f"{hpath}: missing or bad entry ({exc}); need samples, lines, bands, "
-                         "data type") from None
-    if hdr.get("byte order", "0") == "1":
-        dtype = dtype.newbyteorder(">")
-    raw = np.fromfile(path, dtype=dtype, offset=int(hdr.get("header offset", 0)))
-    if raw.size != b * lines * samples:
-        raise InputError(f"{path}: {raw.size} values, the header says {b}×{lines}×{samples}")
-    inter = hdr.get("interleave", "bsq").lower()
-    shape = {"bsq": (b, lines, samples), "bil": (lines, b, samples), "bip": (lines, samples, b)}
-    if inter not in shape:
-        raise InputError(f"{hpath}: unknown interleave {inter!r}")
-    data = raw.reshape(shape[inter])
-    data = {"bsq": data, "bil": data.transpose(1, 0, 2), "bip": data.transpose(2, 0, 1)}[inter]
-    if "map info" in hdr:
-        parts = [p.strip() for p in hdr["map info"].strip("{}").split(",")]
-        hdr["map_info"] = tuple(float(x) for x in parts[3:7])
-    return data, hdr
-
-
-def read_toml(path, what: str = "file") -> dict:
-    """Read a TOML file; a missing or malformed file raises :class:`~hsgeo.InputError`.
-
-    ``what`` names the file's role in the message (``"sensor file"``, ``"board file"``).
-    """
-    import tomllib
-
-    path = Path(path)
-    if not path.is_file():
-        raise InputError(f"{what} {path} not found")
-    try:
-        return tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{path}: malformed TOML: {exc}") from None
+__all__ = [
+    "atomic_path",
+    "refuse_inputs",
+    "read_table",
+    "NAV_COLUMNS",
+    "read_trajectory",
+    "write_trajectory",
+    "Key",
+    "read_config",
+    "read_toml",
+    "read_sensor_toml",
+    "read_camera_toml",
+    "Board",
+    "read_board",
+    "read_lines",
+    "write_lines",
+    "to_map_files",
+    "read_dem",
+    "read_envi",
+    "write_envi",
+    "read_opencv_storage",
+]

@@ -1,6 +1,7 @@
-"""Calibration boards described in TOML, and their observations from image files.
+"""Observations of calibration boards (ChArUco or ArUco grid) from image files.
 
-A board file (``--board BOARD.toml`` of ``hsgeo calibrate-frame``) has one ``[board]`` table::
+The board is a :class:`hsgeo.io.boards.Board` (lengths in mm), usually read from the board file
+(``--board BOARD.toml`` of ``hsgeo calibrate-frame``, :func:`hsgeo.io.read_board`)::
 
     [board]
     type = "charuco"          # or "aruco_grid"
@@ -23,66 +24,16 @@ are averaged into one virtual point, as in 003 §3.2.
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from hsgeo.errors import InputError, ObservationError
+from hsgeo.io.boards import Board
 
-__all__ = ["Board", "load_board", "observe_files", "NOMINAL_PIXEL_MM"]
+__all__ = ["observe_files", "NOMINAL_PIXEL_MM"]
 
 NOMINAL_PIXEL_MM = 0.005
-
-
-@dataclass(frozen=True)
-class Board:
-    """A board description (see the module docstring)."""
-
-    type: str
-    dictionary: str
-    nx: int
-    ny: int
-    a_mm: float  # square (charuco) or marker (aruco_grid)
-    b_mm: float  # marker (charuco) or separation (aruco_grid)
-    pixel_mm: float | None = None
-
-    def cv_board(self):
-        import cv2
-
-        d = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, self.dictionary))
-        if self.type == "charuco":
-            return cv2.aruco.CharucoBoard((self.nx, self.ny), self.a_mm, self.b_mm, d)
-        return cv2.aruco.GridBoard((self.nx, self.ny), self.a_mm, self.b_mm, d)
-
-
-def load_board(path) -> Board:
-    """Read a board TOML file (module docstring); errors name the missing key."""
-    import cv2
-
-    from hsgeo.io import read_toml
-
-    path = Path(path)
-    cfg = read_toml(path, "board file")
-    b = cfg.get("board")
-    if not isinstance(b, dict):
-        raise InputError(f"{path}: needs a [board] table (see hsgeo.measure.boards)")
-    kind = b.get("type")
-    keys = {"charuco": ("squares_x", "squares_y", "square_mm", "marker_mm"),
-            "aruco_grid": ("markers_x", "markers_y", "marker_mm", "separation_mm")}
-    if kind not in keys:
-        raise InputError(f"{path}: board type must be 'charuco' or 'aruco_grid', got {kind!r}")
-    missing = [k for k in (*keys[kind], "dictionary") if k not in b]
-    if missing:
-        raise InputError(f"{path}: [board] of type {kind} is missing {', '.join(missing)}")
-    if not hasattr(cv2.aruco, str(b["dictionary"])):
-        raise InputError(f"{path}: unknown ArUco dictionary {b['dictionary']!r}")
-    k = keys[kind]
-    pixel = cfg.get("camera", {}).get("pixel_mm")
-    if pixel is not None and not float(pixel) > 0:
-        raise InputError(f"{path}: camera.pixel_mm must be positive, got {pixel}")
-    return Board(kind, str(b["dictionary"]), int(b[k[0]]), int(b[k[1]]), float(b[k[2]]),
-                 float(b[k[3]]), None if pixel is None else float(pixel))
 
 
 def _number(pattern: str | None, name: str, default: int) -> int:
@@ -96,7 +47,7 @@ def _number(pattern: str | None, name: str, default: int) -> int:
 
 def observe_files(paths, board: Board, *, band_regex: str | None = None,
                   cube_regex: str | None = None, refine: str = "subpix"):
-    """Detect the board in image files and return :class:`hsgeo.workflows.rikola.Observations`.
+    """Detect the board in image files and return :class:`hsgeo.measure.targets.Observations`.
 
     Parameters
     ----------

@@ -2,49 +2,30 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from hsgeo.errors import InputError, ObservationError
+from hsgeo.io.boards import Board
 
-__all__ = ["CharucoBoardSpec", "detect_charuco"]
-
-
-@dataclass(frozen=True)
-class CharucoBoardSpec:
-    """A ChArUco board: squares_x × squares_y squares, sizes in metres, an ArUco dictionary name.
-
-    The corners' object coordinates are OpenCV's (``board.getChessboardCorners()``), Z = 0.
-    """
-
-    squares_x: int = 5
-    squares_y: int = 7
-    square_m: float = 0.04
-    marker_m: float = 0.02
-    dictionary: str = "DICT_6X6_250"
-
-    def board(self):
-        """The ``cv2.aruco.CharucoBoard``."""
-        import cv2
-
-        if not hasattr(cv2.aruco, self.dictionary):
-            raise InputError(f"unknown ArUco dictionary {self.dictionary!r} (e.g. DICT_6X6_250)")
-        d = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, self.dictionary))
-        return cv2.aruco.CharucoBoard((self.squares_x, self.squares_y), self.square_m,
-                                      self.marker_m, d)
+__all__ = ["detect_charuco"]
 
 
-def detect_charuco(image, spec: CharucoBoardSpec, min_corners: int = 6):
+def detect_charuco(image, board: Board, min_corners: int = 6, *, length_unit: str = "mm"):
     """Detect the ChArUco corners of one image.
 
     Parameters
     ----------
     image : str, Path or (H, W[, 3]) uint8 ndarray
-    spec : CharucoBoardSpec
+    board : Board
+        A ChArUco board (``Board.charuco``), lengths in mm.
     min_corners : int
         Fewer detected corners raise :class:`~hsgeo.ObservationError`.
+    length_unit : {"mm", "m"}
+        Unit of the returned object coordinates and of the board given to OpenCV (which
+        interpolates the corners in float32, so the unit moves them by ~3e-5 px: use the unit of
+        the reference you compare with).
 
     Returns
     -------
@@ -52,11 +33,14 @@ def detect_charuco(image, spec: CharucoBoardSpec, min_corners: int = 6):
         Corner ids.
     uv_px : (n, 2) ndarray
         Sub-pixel corner positions (OpenCV convention).
-    X_m : (n, 3) ndarray
-        The corners' board coordinates.
+    X : (n, 3) ndarray
+        The corners' board coordinates (OpenCV's ``getChessboardCorners``, Z = 0), in
+        ``length_unit``.
     """
     import cv2
 
+    if board.type != "charuco":
+        raise InputError(f"detect_charuco needs a ChArUco board, got type {board.type!r}")
     if isinstance(image, (str, Path)):
         img = cv2.imread(str(image), cv2.IMREAD_GRAYSCALE)
         if img is None:
@@ -65,15 +49,15 @@ def detect_charuco(image, spec: CharucoBoardSpec, min_corners: int = 6):
         img = np.asarray(image)
         if img.ndim == 3:
             img = cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)
-    board = spec.board()
-    det = cv2.aruco.CharucoDetector(board)
+    cvb = board.cv_board(length_unit)
+    det = cv2.aruco.CharucoDetector(cvb)
     corners, ids, _, _ = det.detectBoard(img)
     n = 0 if ids is None else len(ids)
     if n < min_corners:
         raise ObservationError(
             f"only {n} ChArUco corners detected (need {min_corners}): is the board "
-            f"{spec.squares_x}x{spec.squares_y} {spec.dictionary} in the image?"
+            f"{board.nx}x{board.ny} {board.dictionary} in the image?"
         )
     ids = ids.ravel().astype(int)
-    X = np.asarray(board.getChessboardCorners(), dtype=np.float64)[ids]
+    X = np.asarray(cvb.getChessboardCorners(), dtype=np.float64)[ids]
     return ids, corners.reshape(-1, 2).astype(np.float64), X

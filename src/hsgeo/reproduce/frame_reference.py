@@ -17,7 +17,8 @@ from importlib import resources
 import numpy as np
 
 from hsgeo.io import read_opencv_storage
-from hsgeo.measure.charuco import CharucoBoardSpec, detect_charuco
+from hsgeo.io.boards import OPENCV_TUTORIAL_CHARUCO, Board
+from hsgeo.measure.charuco import detect_charuco
 from hsgeo.report import Reproduction, Row
 from hsgeo.workflows.frame_calibration import View, calibrate_opencv, calibrate_photogrammetric
 
@@ -59,14 +60,22 @@ def chessboard_views():
     return views, (int(d["image_Width"]), int(d["image_Height"])), ref
 
 
-def charuco_views(spec: CharucoBoardSpec | None = None):
-    """ChArUco corners detected in the four tutorial photographs, and the 2021 reference file."""
-    spec = spec or CharucoBoardSpec()
+def charuco_views(board: Board | None = None):
+    """ChArUco corners detected in the four tutorial photographs, and the 2021 reference file.
+
+    The board (default: :data:`~hsgeo.io.boards.OPENCV_TUTORIAL_CHARUCO`, lengths in mm) is
+    given to OpenCV in metres, as in OpenCV's tutorial: OpenCV interpolates the corners in
+    float32, and the unit moves them by ~3e-5 px, which moves the four-image calibration by
+    ~1e-4 relative. The views' object coordinates are therefore in metres (the tutorial's
+    extrinsic translations too); the intrinsics do not depend on the unit.
+    """
+    board = board or OPENCV_TUTORIAL_CHARUCO
     folder = reference_dir() / "opencv-charuco"
     views = []
     for i in range(4):
-        ids, uv, X = detect_charuco(folder / "images" / f"img_{i:02d}.jpg", spec)
-        views.append(View(X, uv, ids))
+        ids, uv_px, X_m = detect_charuco(folder / "images" / f"img_{i:02d}.jpg", board,
+                                         length_unit="m")
+        views.append(View(X_m, uv_px, ids))
     ref = read_opencv_storage(folder / "tutorial_camera_charuco.yml",
                               required=("camera_matrix", "distortion_coefficients"))
     return views, (int(ref["image_width"]), int(ref["image_height"])), ref

@@ -15,6 +15,7 @@ import time
 import numpy as np
 
 from hsgeo.adjust import adjust, identifiability
+from hsgeo.papers import P002, P002_STATS
 from hsgeo.report import Reproduction, Row
 from hsgeo.simulate.pushbroom_campaign import (
     CampaignConfig,
@@ -26,28 +27,9 @@ from hsgeo.stats import describe
 from hsgeo.workflows.pushbroom_ba import CameraPrior, build_problem
 
 __all__ = ["run", "adjust_campaign", "camera_prior", "cp_errors", "outlier_detection",
-           "node_interval_study", "y_model_comparison", "PAPER"]
+           "node_interval_study", "y_model_comparison"]
 
 RAD2DEG = 180 / np.pi
-STATS = ("min", "max", "median", "mean", "std", "nmad")
-
-#: 002 Tables 1–3 (Table 1 in px, Tables 2–3 in m) and the Fig. 8 caption.
-PAPER = {
-    "002 Table 1": {"x": (-1.87, 1.82, 0.00, 0.00, 0.37, 0.32),
-                    "y": (-2.64, 2.62, 0.02, 0.00, 0.48, 0.42)},
-    "002 Table 2": {"e": (-0.13, 0.14, 0.04, 0.03, 0.07, 0.08),
-                    "n": (-0.05, 0.12, 0.03, 0.03, 0.04, 0.03),
-                    "h": (-1.61, 0.41, -0.78, -0.78, 0.66, 0.99)},
-    "002 Table 3": {"e": (-0.13, 0.14, 0.05, 0.04, 0.07, 0.08),
-                    "n": (-0.04, 0.13, 0.04, 0.04, 0.04, 0.03),
-                    "h": (-1.93, 0.04, -1.18, -1.13, 0.66, 0.95)},
-    "fig8_max_abs_diff_um": 11.8,  # 002 Fig. 8 caption
-    "fig8_sigma_um": (1.2, 2.4),  # 002 Fig. 8 caption
-    "chromatic_shift_px": 0.27,  # 002 §5
-    "n_unknowns": 342407,  # 002 §4
-    "n_observations_2d": 441587,  # 002 §4
-}
-
 #: The reject threshold, in robust σ of the standardised residuals (ours: about the largest
 #: residual / NMAD ratio of 002 Table 1, ≈ 6, with a margin).
 REJECT_K = 5.0
@@ -111,7 +93,7 @@ def _stats_rows(table, names, data, unit, paper):
     rows = []
     for nm, col in zip(names, data.T, strict=True):
         d = describe(col)
-        for k, st in enumerate(STATS):
+        for k, st in enumerate(P002_STATS):
             rows.append(Row(table, f"{st}_{nm}_{unit}", unit, paper=paper[nm][k],
                             reproduced=d[st]))
     return rows
@@ -173,24 +155,24 @@ def run(seed: int = 0, scale: float = 1.0, progress=None) -> Reproduction:
     # -- 002 Table 1: reprojection errors of the tie points (with GCPs), px
     keep = ~res.outliers(0)
     r_px = res.residuals(0).reshape(-1, 2)[keep]
-    rows += _stats_rows("002 Table 1", ("x", "y"), r_px, "px", PAPER["002 Table 1"])
+    rows += _stats_rows("002 Table 1", ("x", "y"), r_px, "px", P002["002 Table 1"])
     # -- 002 Tables 2 and 3: check points, m
     E_gcp, E_nogcp = cp_errors(res, truth), cp_errors(res0, truth)
-    rows += _stats_rows("002 Table 2", ("e", "n", "h"), E_gcp, "m", PAPER["002 Table 2"])
-    rows += _stats_rows("002 Table 3", ("e", "n", "h"), E_nogcp, "m", PAPER["002 Table 3"])
+    rows += _stats_rows("002 Table 2", ("e", "n", "h"), E_gcp, "m", P002["002 Table 2"])
+    rows += _stats_rows("002 Table 3", ("e", "n", "h"), E_nogcp, "m", P002["002 Table 3"])
     # -- 002 Fig. 8: principal distance per band minus the mean
     d_um, s_um, t_um = c_minus_mean(res, truth.values["c_mm"])
     for b, wl in enumerate(cfg.wavelengths_nm):
         rows.append(Row("002 Fig. 8", f"c_minus_mean_band{b}_{wl:.0f}nm_um", "um",
                         reproduced=d_um[b], sigma=s_um[b], truth=t_um[b]))
     rows.append(Row("002 Fig. 8", "max_abs_c_minus_mean_um", "um",
-                    paper=PAPER["fig8_max_abs_diff_um"], reproduced=np.max(np.abs(d_um)),
+                    paper=P002["fig8_max_abs_diff_um"], reproduced=np.max(np.abs(d_um)),
                     truth=np.max(np.abs(t_um))))
     c_mean = res.value("c_mm").mean()
     half_px = cfg.pixels_per_line / 2
     shift = np.max(np.abs(d_um)) * 1e-3 / c_mean * half_px  # chromatic shift at the line's end
     rows.append(Row("002 Fig. 8", "chromatic_shift_at_edge_px", "px",
-                    paper=PAPER["chromatic_shift_px"], reproduced=shift,
+                    paper=P002["chromatic_shift_px"], reproduced=shift,
                     truth=np.max(np.abs(t_um)) * 1e-3 / truth.values["c_mm"].mean() * half_px))
     # -- parameters: boresight, lever arm, distortion, c, nodes (with GCPs)
     par = []
@@ -219,8 +201,8 @@ def run(seed: int = 0, scale: float = 1.0, progress=None) -> Reproduction:
         "n_unknowns": int(res.n_unknowns),
         "n_nonpoint_unknowns": int(info["n_nonpoint_unknowns"]),
         "rank_at_truth": int(info["rank_at_truth"]),
-        "paper_n_unknowns": PAPER["n_unknowns"],
-        "paper_n_observations_2d": PAPER["n_observations_2d"],
+        "paper_n_unknowns": P002["n_unknowns"],
+        "paper_n_observations_2d": P002["n_observations_2d"],
         "n_lines": n_lines,
         "eo_unknowns_per_line": 6 * n_lines,
         "node_unknowns": int(res.params["nodes"].size),

@@ -19,31 +19,31 @@ from hsgeo.geocode import (
     geocode_image,
     geocode_observations,
     orthorectify,
-    read_lines,
-    read_sensor_toml,
-    to_map_files,
 )
+from hsgeo.io import read_dem, read_lines, read_sensor_toml, refuse_inputs, to_map_files
 
 __all__ = ["geocode_files", "gcp_deviations"]
 
 
 def geocode_files(lines, trajectory, sensor, *, output, dem=None, height_m=None,
                   resolution_m=0.5, envi=None, progress=True):
-    """Orthorectify a recorded flight line from files (see ``hsgeo geocode --help``)."""
-    import xarray as xr
+    """Orthorectify a recorded flight line from files (see ``hsgeo geocode --help``).
 
+    The outputs are written atomically and never over one of the input files.
+    """
     from hsgeo.io.navigation import read_trajectory
 
     if (dem is None) == (height_m is None):
         raise InputError("give exactly one of --dem DEM.nc or --height H (a plane)")
+    inputs = (lines, trajectory, sensor, dem)
+    for out in (output, envi):  # before the work, not after it
+        if out is not None:
+            refuse_inputs(out, inputs)
     da, t0, rate = read_lines(lines)
     nav = read_trajectory(trajectory)
     geom, bs = read_sensor_toml(sensor)
     if dem is not None:
-        ds = xr.open_dataset(dem)
-        if "height" not in ds:
-            raise InputError(f"{dem}: no variable 'height' (dimensions N, E in metres)")
-        terrain = DemTerrain(ds["height"])
+        terrain = DemTerrain(read_dem(dem))
     else:
         terrain = PlaneTerrain(float(height_m))
     ground = geocode_image(nav, geom, da.sizes["line"], da["pixel"].values, t0_s=t0,
@@ -52,7 +52,7 @@ def geocode_files(lines, trajectory, sensor, *, output, dem=None, height_m=None,
     ortho = orthorectify(da.values, ground, resolution_m=resolution_m,
                          band_names=da["band"].values,
                          attrs={"source": str(lines), "sensor": str(sensor)})
-    return ortho, to_map_files(ortho, output, envi)
+    return ortho, to_map_files(ortho, output, envi, inputs=inputs)
 
 
 def gcp_deviations(nav, sensor: LineGeometry, line, zeta_px, gcp_enu_m, *, height_m: float,
@@ -65,7 +65,7 @@ def gcp_deviations(nav, sensor: LineGeometry, line, zeta_px, gcp_enu_m, *, heigh
 
     Parameters
     ----------
-    nav : Navigation
+    nav : Trajectory
         The recorded navigation.
     sensor : LineGeometry
         The assumed sensor model (nominal or calibrated).

@@ -12,6 +12,7 @@ import numpy as np
 
 from hsgeo.adjust import Parameters, adjust
 from hsgeo.errors import InputError
+from hsgeo.io import read_table
 from hsgeo.measure.line_minima import associate_by_order, find_minima
 from hsgeo.sensors.line1d import (
     LineObservations,
@@ -100,24 +101,6 @@ def calibrate(params: Parameters, block: LineObservations, *, stages: bool = Tru
     return adjust(p, block, **kw)
 
 
-def _read_csv(path, columns, what):
-    import csv
-    from pathlib import Path
-
-    p = Path(path)
-    if not p.is_file():
-        raise InputError(f"{what} file {str(p)!r} not found")
-    with p.open(newline="") as fh:
-        rd = csv.DictReader(fh)
-        if rd.fieldnames is None or not set(columns) <= {c.strip() for c in rd.fieldnames}:
-            raise InputError(f"{what} file {str(p)!r} must have a header with columns "
-                             f"{', '.join(columns)}; found {rd.fieldnames}")
-        rows = [{k.strip(): (v or "").strip() for k, v in r.items()} for r in rd]
-    if not rows:
-        raise InputError(f"{what} file {str(p)!r} has no data rows")
-    return rows
-
-
 def calibrate_files(observations, control, *, zeta0_px: float = 485.0, c_px: float = 3600.0,
                     sigma_px: float = 0.1, reject_k: float | None = None) -> dict:
     """Calibrate one spectral line from a user's files (``hsgeo calibrate-line``).
@@ -141,24 +124,23 @@ def calibrate_files(observations, control, *, zeta0_px: float = 485.0, c_px: flo
     -------
     dict with ``result`` (AdjustmentResult), ``image_ids``, ``point_ids``, ``residuals_px``.
     """
-    obs = _read_csv(observations, ("image", "point", "zeta_px"), "observations")
-    ctl = _read_csv(control, ("point", "x_m", "y_m"), "control")
-    try:
-        pid = [r["point"] for r in ctl]
-        xy = np.array([[float(r["x_m"]), float(r["y_m"])] for r in ctl])
-        z = np.array([float(r["zeta_px"]) for r in obs])
-    except ValueError as exc:
-        raise InputError(f"non-numeric value in the input files: {exc}") from exc
+    obs = read_table(observations, ("image", "point", "zeta_px"), "observations",
+                     text_columns=("image", "point"))
+    ctl = read_table(control, ("point", "x_m", "y_m"), "control", text_columns=("point",))
+    pid = ctl["point"].tolist()
+    xy = ctl[["x_m", "y_m"]].to_numpy(dtype=float)
+    z = obs["zeta_px"].to_numpy(dtype=float)
     if len(set(pid)) != len(pid):
-        raise InputError("control file lists a point id twice")
+        raise InputError(f"control file {str(control)!r} lists a point id twice; keep one row "
+                         "per point")
     index = {p: i for i, p in enumerate(pid)}
-    missing = sorted({r["point"] for r in obs} - set(index))
+    missing = sorted(set(obs["point"]) - set(index))
     if missing:
         raise InputError(f"observed points without control coordinates: {missing[:10]}; add them "
-                         "to the control file")
-    image_ids = list(dict.fromkeys(r["image"] for r in obs))
-    img = np.array([image_ids.index(r["image"]) for r in obs])
-    pt = np.array([index[r["point"]] for r in obs])
+                         f"to the control file {str(control)!r}")
+    image_ids = list(dict.fromkeys(obs["image"]))
+    img = np.array([image_ids.index(i) for i in obs["image"]])
+    pt = np.array([index[p] for p in obs["point"]])
     blk = LineObservations(img, pt, z, sigma_px)  # NaN check
     check_minimum_observations(img, pt, np.ones(len(pid), bool), len(image_ids))
     eop = np.array([resect(xy[pt[img == i]], z[img == i], zeta0_px, c_px).eop

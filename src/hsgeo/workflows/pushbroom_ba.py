@@ -20,6 +20,7 @@ import numpy as np
 
 from hsgeo.adjust import Parameters
 from hsgeo.errors import InputError
+from hsgeo.io import read_camera_toml, read_table
 from hsgeo.rotations import R_from_opk, R_from_rpy
 from hsgeo.sensors.pushbroom import (
     BETA0_CAM_FROM_PLATFORM,
@@ -207,54 +208,23 @@ OBS_COLUMNS = ("point_id", "band", "t_s", "x_px", "y_px")
 GCP_COLUMNS = ("point_id", "E_m", "N_m", "H_m")
 
 
-def read_table(path, columns, what: str):
-    """A CSV or Parquet table with the required ``columns`` (extra columns are ignored)."""
-    from pathlib import Path
-
-    import pandas as pd
-
-    path = Path(path)
-    if not path.is_file():
-        raise InputError(f"{what} file {str(path)!r} does not exist")
-    try:
-        if path.suffix.lower() in (".parquet", ".pq"):
-            df = pd.read_parquet(path)
-        else:
-            df = pd.read_csv(path)
-    except Exception as exc:  # noqa: BLE001 - any parser error becomes an InputError
-        raise InputError(f"{what} file {str(path)!r} cannot be read: {exc}") from exc
-    missing = [c for c in columns if c not in df.columns]
-    if missing:
-        raise InputError(
-            f"{what} file {str(path)!r} lacks the column(s) {missing}; required: "
-            f"{list(columns)} (see `hsgeo adjust-pushbroom --help`)"
-        )
-    if df[list(columns)].isna().any().any():
-        raise InputError(f"{what} file {str(path)!r} has empty or NaN values in {list(columns)}")
-    return df
-
-
 def read_camera(path) -> CameraPrior:
-    """Camera and GNSS/INS priors from a TOML file (see :func:`adjust_files`)."""
-    from hsgeo.io import read_toml
-
-    cfg = read_toml(path, "camera file")
-    cam = cfg.get("camera", {})
-    nav = cfg.get("gnss_ins", {})
-    if "n_bands" not in cam or "pixel_mm" not in cam or "c_mm" not in cam:
-        raise InputError(
-            f"camera file {str(path)!r} needs a [camera] table with n_bands, pixel_mm and c_mm"
-        )
-    return CameraPrior(
-        n_bands=int(cam["n_bands"]), pixel_mm=float(cam["pixel_mm"]), c_mm=float(cam["c_mm"]),
-        x0_mm=float(cam.get("x0_mm", 0.0)), y0_mm=float(cam.get("y0_mm", 0.0)),
-        lever_arm_m=tuple(cam.get("lever_arm_m", (0.0, 0.0, 0.0))),
-        sigma_lever_m=float(cam.get("sigma_lever_m", 0.02)),
-        sigma_pos_m=tuple(nav.get("sigma_pos_m", (0.013, 0.013, 0.020))),
-        sigma_att_rad=tuple(np.deg2rad(nav.get("sigma_att_deg", (0.005, 0.005, 0.008)))),
-        sigma_obs_px=float(cfg.get("observations", {}).get("sigma_px", 0.5)),
-        sigma_gcp_m=float(cfg.get("gcp", {}).get("sigma_m", 0.01)),
-    )
+    """Camera and GNSS/INS priors from a TOML file (:func:`hsgeo.io.read_camera_toml`); keys
+    the file does not give keep the defaults of :class:`CameraPrior`.
+    """
+    cfg = read_camera_toml(path)
+    cam, nav = cfg["camera"], cfg["gnss_ins"]
+    kw = {k: cam[k] for k in ("n_bands", "pixel_mm", "c_mm", "x0_mm", "y0_mm", "lever_arm_m",
+                              "sigma_lever_m") if k in cam}
+    if "sigma_pos_m" in nav:
+        kw["sigma_pos_m"] = nav["sigma_pos_m"]
+    if "sigma_att_deg" in nav:
+        kw["sigma_att_rad"] = tuple(np.deg2rad(nav["sigma_att_deg"]))
+    if "sigma_px" in cfg["observations"]:
+        kw["sigma_obs_px"] = cfg["observations"]["sigma_px"]
+    if "sigma_m" in cfg["gcp"]:
+        kw["sigma_gcp_m"] = cfg["gcp"]["sigma_m"]
+    return CameraPrior(**kw)
 
 
 def adjust_files(observations, trajectory, camera, gcp=None, *, node_interval_s: float = 10.0,

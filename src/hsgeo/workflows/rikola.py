@@ -527,10 +527,11 @@ def calibrate_frame_files(images, board_path, *, joint: bool = False, band_regex
         ``camera.pixel_mm`` in the board file — px) or ``joint model``; ``meta`` has σ0, the
         RMS residual and the number of points per band.
     """
-    from hsgeo.measure.boards import load_board, observe_files
+    from hsgeo.io import read_board
+    from hsgeo.measure.boards import observe_files
     from hsgeo.report import Reproduction, Row
 
-    board = load_board(board_path)
+    board = read_board(board_path)
     obs = observe_files(images, board, band_regex=band_regex, cube_regex=cube_regex)
     unit = "mm" if board.pixel_mm is not None else "px"
     rows, meta = [], {"images": len(list(images)), "points": int(len(obs.cube)),

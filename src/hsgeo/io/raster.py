@@ -1,0 +1,81 @@
+"""Map rasters: an orthoimage as NetCDF and/or ENVI with map info."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from hsgeo.errors import InputError
+from hsgeo.io._files import atomic_path, refuse_inputs
+from hsgeo.io.envi import write_envi
+
+__all__ = ["to_map_files", "read_dem"]
+
+
+def to_map_files(da, path_nc=None, path_envi=None, *, inputs=()) -> list:
+    """Write an orthorectified raster as NetCDF 3 and/or ENVI BSQ with map info.
+
+    NetCDF is written with xarray's scipy engine (no further dependency).
+
+    Parameters
+    ----------
+    da : xarray.DataArray
+        ``(band, N, E)`` from :func:`hsgeo.geocode.orthorectify` (attribute ``resolution_m``,
+        cell-centre coordinates ``E``, ``N`` in m).
+    path_nc, path_envi : str or Path, optional
+        The NetCDF file and the ENVI data file (its header is ``path_envi + ".hdr"``).
+    inputs : iterable of path, optional
+        The files the command read: none of them is overwritten (:class:`~hsgeo.InputError`
+        before anything is written).
+
+    Returns
+    -------
+    list of path
+        The paths written, each atomically (temporary file, then :func:`os.replace`).
+    """
+    inputs = [p for p in inputs if p is not None]
+    for p in (path_nc, path_envi):
+        if p is not None:
+            refuse_inputs(p, inputs)
+    if path_envi is not None:
+        refuse_inputs(Path(str(path_envi) + ".hdr"), inputs)
+    out = []
+    if path_nc is not None:
+        with atomic_path(path_nc, inputs) as tmp:
+            da.to_dataset(name=da.name or "radiance").to_netcdf(tmp, engine="scipy")
+        out.append(path_nc)
+    if path_envi is not None:
+        res = float(da.attrs["resolution_m"])
+        E0 = float(da["E"].values[0]) - res / 2
+        N0 = float(da["N"].values[0]) + res / 2
+        out += list(write_envi(path_envi, da.values.astype(np.float32),
+                               map_info=(E0, N0, res, res),
+                               band_names=[str(b) for b in da["band"].values],
+                               description="hsgeo orthorectified line-scanner image",
+                               inputs=inputs))
+    return out
+
+
+def read_dem(path):
+    """A DEM for :class:`hsgeo.geocode.DemTerrain`: NetCDF with ``height(N, E)`` in metres.
+
+    Returns
+    -------
+    xarray.DataArray
+        The variable ``height``, loaded into memory.
+    """
+    import xarray as xr
+
+    if not Path(path).is_file():
+        raise InputError(f"DEM {path} not found; check the path")
+    try:
+        ds = xr.open_dataset(path)
+    except (OSError, ValueError, ImportError) as exc:
+        raise InputError(f"DEM {path}: not a readable NetCDF file: {exc}") from None
+    if "height" not in ds:
+        raise InputError(f"DEM {path}: no variable 'height' (found {list(ds.data_vars)}); it "
+                         "needs height(N, E) in metres")
+    h = ds["height"].load()
+    ds.close()
+    return h

@@ -1,0 +1,109 @@
+"""Sensor and camera descriptions in TOML: ``hsgeo geocode --sensor`` and ``hsgeo
+adjust-pushbroom --camera``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hsgeo.io.config import Key, read_config
+
+__all__ = ["SENSOR_SCHEMA", "CAMERA_SCHEMA", "read_sensor_toml", "read_camera_toml"]
+
+#: ``hsgeo geocode --sensor``: a line scanner (000 eq. (2)) and its boresight.
+SENSOR_SCHEMA = {
+    "sensor": {
+        "model": Key("str", default="calibrated", choices=("calibrated", "linear-ifov"),
+                     doc="'calibrated' (000 eq. (2)) or 'linear-ifov' (no distortion)"),
+        "zeta0_px": Key("float", required=True, doc="principal point ζ0, px"),
+        "c_px": Key("float", required=True, positive=True, doc="principal distance, px"),
+        "K": Key("floats", length=3, default=(0.0, 0.0, 0.0),
+                 doc="K1..K3 of 000 eq. (2), px per (100 px)^(3, 5, 7); calibrated only"),
+        "boresight_deg": Key("floats", length=3, default=(0.0, 0.0, 0.0),
+                             doc="roll, pitch, heading of R_body_from_sensor, degrees"),
+    },
+}
+
+#: ``hsgeo adjust-pushbroom --camera``: camera and GNSS/INS priors (002 §4). Absent optional
+#: keys are left out of :func:`read_camera_toml`'s result (the workflow's defaults apply).
+CAMERA_SCHEMA = {
+    "camera": {
+        "n_bands": Key("int", required=True, positive=True, doc="number of bands"),
+        "pixel_mm": Key("float", required=True, positive=True, doc="pixel pitch, mm"),
+        "c_mm": Key("float", required=True, positive=True, doc="principal distance, mm"),
+        "x0_mm": Key("float", doc="principal point x, mm"),
+        "y0_mm": Key("float", doc="principal point y, mm"),
+        "lever_arm_m": Key("floats", length=3, doc="lever arm (platform frame), m"),
+        "sigma_lever_m": Key("float", positive=True, doc="σ of the measured lever arm, m"),
+    },
+    "gnss_ins": {
+        "sigma_pos_m": Key("floats", length=3, positive=True, doc="σ of E, N, H, m"),
+        "sigma_att_deg": Key("floats", length=3, positive=True,
+                             doc="σ of roll, pitch, yaw, degrees"),
+    },
+    "observations": {"sigma_px": Key("float", positive=True, doc="σ of an image coordinate, px")},
+    "gcp": {"sigma_m": Key("float", positive=True, doc="σ of a GCP coordinate, m")},
+}
+
+
+def read_sensor_toml(path):
+    """A line-scanner description: ``(LineGeometry, boresight_rad)``.
+
+    Format::
+
+        [sensor]
+        model = "calibrated"          # 000 eq. (2); or "linear-ifov" (no distortion)
+        zeta0_px = 486.8
+        c_px = 3539.0
+        K = [1.459, -0.1636, 0.00526] # calibrated only; δ in px, (ζ − ζ0) in units of 100 px
+        boresight_deg = [0.0, 0.0, 0.0]   # roll, pitch, heading of R_body_from_sensor
+
+    Returns
+    -------
+    geometry : hsgeo.geocode.CalibratedLine or hsgeo.geocode.LinearIFOV
+    boresight_rad : (3,) ndarray
+        Roll, pitch, heading (rad).
+
+    Raises
+    ------
+    InputError
+        Missing file, malformed TOML, unknown or misspelled keys, missing ``zeta0_px`` /
+        ``c_px``, values of the wrong type (:func:`~hsgeo.io.config.read_config`).
+    """
+    from hsgeo.geocode import CalibratedLine, LinearIFOV
+
+    s = read_config(path, SENSOR_SCHEMA, "sensor file", required_tables=("sensor",))["sensor"]
+    if s["model"] == "calibrated":
+        geom = CalibratedLine(s["zeta0_px"], s["c_px"], tuple(s["K"]))
+    else:
+        geom = LinearIFOV(s["zeta0_px"], s["c_px"])
+    return geom, np.deg2rad(np.asarray(s["boresight_deg"], dtype=float))
+
+
+def read_camera_toml(path) -> dict:
+    """The camera file of ``hsgeo adjust-pushbroom`` (:data:`CAMERA_SCHEMA`), checked.
+
+    Format::
+
+        [camera]
+        n_bands = 4
+        pixel_mm = 0.0065
+        c_mm = 40.0
+        x0_mm = 0.0                      # optional, as all below
+        y0_mm = 0.0
+        lever_arm_m = [0.1, 0.0, -0.2]
+        sigma_lever_m = 0.02
+        [gnss_ins]
+        sigma_pos_m = [0.013, 0.013, 0.020]
+        sigma_att_deg = [0.005, 0.005, 0.008]
+        [observations]
+        sigma_px = 0.5
+        [gcp]
+        sigma_m = 0.01
+
+    Returns
+    -------
+    dict of dict
+        The tables with the keys the file gives (angles still in degrees, as named).
+    """
+    return read_config(path, CAMERA_SCHEMA, "camera file", required_tables=("camera",))
