@@ -25,7 +25,7 @@ import numpy as np
 from hsgeo.adjust import AdjustmentResult, Parameters, adjust
 from hsgeo.errors import InputError, ObservationError
 from hsgeo.papers import RIKOLA_BANDS
-from hsgeo.rotations import R_from_opk, R_from_rotvec, opk_from_R
+from hsgeo.rotations import R_from_opk, opk_from_R
 from hsgeo.sensors.frame import (
     PHOTOGRAMMETRIC_DISTORTION,
     PHOTOGRAMMETRIC_INTERIOR,
@@ -38,6 +38,7 @@ from hsgeo.sensors.rikola import (
     JointCentroids,
     TargetCentroids,
 )
+from hsgeo.workflows._initial import pose_from_pnp
 
 __all__ = [
     "Observations",
@@ -54,8 +55,6 @@ __all__ = [
     "design_effect",
     "predict_band",
 ]
-
-_FLIP = np.diag([1.0, -1.0, -1.0])  # OpenCV camera frame <-> photogrammetric camera frame
 
 
 from hsgeo.measure.targets import Observations  # noqa: E402  (re-exported)
@@ -120,8 +119,6 @@ def initial_poses(obs: Observations, f_mm: float) -> dict[int, np.ndarray]:
     """Photogrammetric pose of each cube from ``cv2.solvePnP`` on the centroids (no distortion,
     principal point at the centre), for the initial values of an adjustment.
     """
-    import cv2
-
     w, h = obs.image_size
     fpx = f_mm / obs.pixel_mm
     K = np.array([[fpx, 0, (w - 1) / 2], [0, fpx, (h - 1) / 2], [0, 0, 1.0]])
@@ -130,13 +127,8 @@ def initial_poses(obs: Observations, f_mm: float) -> dict[int, np.ndarray]:
         m = obs.cube == c
         if m.sum() < 4:
             raise ObservationError(f"cube {c}: {m.sum()} targets; a pose needs at least 4")
-        ok, rvec, tvec = cv2.solvePnP(obs.corners_obj[m].mean(axis=1), obs.centroids_px[m], K,
-                                      np.zeros(5), flags=cv2.SOLVEPNP_ITERATIVE)
-        if not ok:
-            raise ObservationError(f"cube {c}: no initial pose from solvePnP")
-        Rcw = R_from_rotvec(rvec.ravel())
-        X0 = -Rcw.T @ tvec.ravel()
-        out[int(c)] = np.concatenate([opk_from_R(Rcw.T @ _FLIP), X0])
+        out[int(c)] = pose_from_pnp(obs.corners_obj[m].mean(axis=1), obs.centroids_px[m], K,
+                                    frame="photogrammetric", what=f"cube {c}")
     return out
 
 
