@@ -45,6 +45,12 @@ are evaluated at ``t*``, so they do not contain the time error, and the node der
 the factored form ``B_a(t*) ∂r/∂δ``. Evaluating x at ``t*`` rather than ``t_e`` adds
 ``ẋ (t* − t_e)`` (≈ 0.1 px at the mount's angular rates) to the x residual, zero-mean.
 
+002 eq. (3)–(4) and the spline weights are the scalar cores of :mod:`hsgeo._kernels`
+(:func:`~hsgeo._kernels.pushbroom_camera_point`, :func:`~hsgeo._kernels.pushbroom_image_mm`,
+:func:`~hsgeo._kernels.bspline_weights`): the compiled kernel calls them per observation, the
+numpy reference path (:func:`project`, :meth:`PushbroomLines.evaluate_numpy`) through
+:func:`~hsgeo._kernels.pushbroom_image_rows`.
+
 The nominal mount ``β₀`` maps the platform frame (x forward, y left, z up) to the camera frame
 (x along the line to the right, y backward, z down the viewing direction).
 
