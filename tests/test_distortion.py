@@ -248,3 +248,89 @@ def test_bad_newton_settings_raise():
         undistort_opencv([[0.1, 0.1]], DIST, tol=0.0)
     with pytest.raises(InputError, match="max_iter"):
         measured_from_ideal_mm([[0.1, 0.1]], K_003, P_003, max_iter=0)
+
+
+# ------------------------------------------------------------------ 1D: norm, distort/undistort
+
+
+K_000 = np.array([1.459, -0.1636, 0.00526])  # 000 Table 1, px at u = d / 100 px
+
+
+def test_odd_radial_1d_norm_is_the_line_scanner_polynomial():
+    d = np.linspace(-450, 450, 91)
+    u = d / 100.0
+    expected = K_000[0] * u**3 + K_000[1] * u**5 + K_000[2] * u**7  # 000 eq. (2)
+    np.testing.assert_allclose(odd_radial_1d(d, K_000, norm=100.0), expected, rtol=1e-14,
+                               atol=1e-13)
+    # the Horner core to the last bits of the formula the line-scanner solver used
+    u2 = u * u
+    np.testing.assert_array_equal(odd_radial_1d(d, K_000, norm=100.0),
+                                  u * u2 * (K_000[0] + u2 * (K_000[1] + u2 * K_000[2])))
+
+
+@pytest.mark.parametrize("norm", [1.0, 100.0])
+def test_odd_radial_1d_jacobian_with_norm_finite_differences(norm):
+    d = np.linspace(-4.4, 4.4, 37) * norm
+    K = K_000 if norm == 100.0 else K_000 * 1e-2
+    dd, dK = odd_radial_1d_jacobian(d, K, norm)
+    h = 1e-5 * norm
+    num = (odd_radial_1d(d + h, K, norm) - odd_radial_1d(d - h, K, norm)) / (2 * h)
+    np.testing.assert_allclose(dd, num, rtol=1e-8, atol=1e-10)
+    num_dK = _central_diff(lambda k: odd_radial_1d(d, k, norm)[..., None], K, 1e-6)[:, 0, :]
+    np.testing.assert_allclose(dK, num_dK, rtol=1e-8, atol=1e-8)
+
+
+def test_1d_distort_undistort_round_trip():
+    from hsgeo.distortion import ideal_from_measured_1d, measured_from_ideal_1d
+
+    d = np.linspace(-440, 440, 177)
+    t = ideal_from_measured_1d(d, K_000, 100.0)
+    np.testing.assert_allclose(t, d - odd_radial_1d(d, K_000, 100.0), rtol=0, atol=1e-12)
+    back, Fp = measured_from_ideal_1d(t, K_000, 100.0)
+    np.testing.assert_allclose(back, d, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(Fp, 1 - odd_radial_1d_jacobian(d, K_000, 100.0)[0], atol=1e-9)
+    # beyond the fold the inverse is not the physical one
+    with pytest.raises(ConvergenceError, match="folded"):
+        measured_from_ideal_1d(2000.0, K_000, 100.0)  # d − δ(d) never reaches it
+    with pytest.raises(InputError, match="norm"):
+        odd_radial_1d(1.0, K_000, norm=0.0)
+
+
+# ------------------------------------------------------------------ 002 line form
+
+
+DIST_002 = np.array([-4e-5, 3e-7, 2.5e-5, -3e-5])  # K1 mm^-2, K2 mm^-4, P1, P2 mm^-1
+
+
+def test_pushbroom_line_values_and_jacobian():
+    from hsgeo.distortion import distort_pushbroom_line, distort_pushbroom_line_jacobian
+
+    xy = np.random.default_rng(3).uniform(-8, 8, (4, 25, 2))
+    x, y = xy[..., 0], xy[..., 1]
+    K1, K2, P1, P2 = DIST_002
+    out = distort_pushbroom_line(xy, DIST_002)
+    assert out.shape == xy.shape
+    # 002 eq. (3)
+    np.testing.assert_allclose(out[..., 0], x + K1 * x**3 + K2 * x**5 + 3 * P1 * x**2,
+                               rtol=1e-15, atol=1e-15)
+    np.testing.assert_allclose(out[..., 1], y + P2 * x**2, rtol=1e-15, atol=1e-15)
+    J_xy, J_d = distort_pushbroom_line_jacobian(xy, DIST_002)
+    assert J_xy.shape == (4, 25, 2, 2) and J_d.shape == (4, 25, 2, 4)
+    num = _central_diff(lambda v: distort_pushbroom_line(v, DIST_002), xy, 1e-6)
+    np.testing.assert_allclose(J_xy, num, atol=1e-8)
+    num_d = _central_diff(lambda k: distort_pushbroom_line(xy, k), DIST_002, 1e-8)
+    np.testing.assert_allclose(J_d, num_d, rtol=1e-6, atol=1e-6)
+
+
+def test_pushbroom_line_round_trip_and_errors():
+    from hsgeo.distortion import distort_pushbroom_line, undistort_pushbroom_line
+
+    xy = np.random.default_rng(4).uniform(-8, 8, (300, 2))
+    back = undistort_pushbroom_line(distort_pushbroom_line(xy, DIST_002), DIST_002)
+    np.testing.assert_allclose(back, xy, rtol=0, atol=1e-11)
+    with pytest.raises(InputError, match="K1, K2, P1, P2"):
+        distort_pushbroom_line(xy, DIST_002[:3])
+    with pytest.raises(InputError):
+        distort_pushbroom_line([[np.nan, 0.0]], DIST_002)
+    with pytest.raises(ConvergenceError):  # far on the folded part of a strong polynomial
+        undistort_pushbroom_line([[-60.0, 0.0]], [1e-2, 0.0, 0.0, 0.0], max_iter=5)

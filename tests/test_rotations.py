@@ -233,3 +233,16 @@ def test_bad_rotation_raises(fun):
         fun(np.diag([1.0, 1.0, -1.0]))
     with pytest.raises(InputError, match="float"):
         fun([["a", "b", "c"]] * 3)
+
+
+def test_R_photogrammetric_from_opencv_cam():
+    from hsgeo.rotations import R_photogrammetric_from_opencv_cam
+
+    F = R_photogrammetric_from_opencv_cam()
+    np.testing.assert_array_equal(F @ F, np.eye(3))  # its own inverse
+    assert np.linalg.det(F) == 1.0  # a rotation, not a reflection
+    # OpenCV's view direction (+z) is the photogrammetric −z; y down is y up
+    np.testing.assert_array_equal(F @ [0, 0, 1], [0, 0, -1])
+    np.testing.assert_array_equal(F @ [0, 1, 0], [0, -1, 0])
+    F[0, 0] = 5.0  # a fresh array each call
+    assert R_photogrammetric_from_opencv_cam()[0, 0] == 1.0

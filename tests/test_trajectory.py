@@ -145,15 +145,33 @@ def test_spline_rate_against_differences():
 
 
 def test_compiled_spline_weights_equal_the_basis():
-    """The pushbroom kernel's own copy of the B-spline weights (numba) against the basis."""
-    from hsgeo.sensors.pushbroom import _spline_weights
+    """The kernel's scalar core is what the numpy basis returns (one implementation)."""
+    from hsgeo._kernels import bspline_weights
     from hsgeo.trajectory import bspline_basis_derivative
 
     w, dw = np.empty(4), np.empty(4)
     for u in (-0.01, 0.0, 0.3, 0.999, 1.02):  # the kernel also continues a piece a little
-        _spline_weights(u, 0.1, w, dw)
-        np.testing.assert_allclose(w, bspline_basis(u), rtol=0, atol=1e-15)
+        bspline_weights(u, 1.0, w, dw)
+        np.testing.assert_array_equal(w, bspline_basis(u))
+        np.testing.assert_array_equal(dw, bspline_basis_derivative(u))
+        bspline_weights(u, 0.1, w, dw)
         np.testing.assert_allclose(dw, 0.1 * bspline_basis_derivative(u), rtol=0, atol=1e-15)
+
+
+def test_spline_basis_against_the_polynomials():
+    """The shared core against the previous numpy formulas (002 §3.3), to the last bits."""
+    from hsgeo.trajectory import bspline_basis_derivative
+
+    u = np.r_[np.linspace(-0.05, 1.05, 221), 0.0, 1.0]
+    u2, u3 = u * u, u * u * u
+    B = np.stack([(1 - u) ** 3 / 6, (3 * u3 - 6 * u2 + 4) / 6,
+                  (-3 * u3 + 3 * u2 + 3 * u + 1) / 6, u3 / 6], axis=-1)
+    dB = np.stack([-((1 - u) ** 2) / 2, (3 * u2 - 4 * u) / 2, (-3 * u2 + 2 * u + 1) / 2,
+                   u2 / 2], axis=-1)
+    np.testing.assert_allclose(bspline_basis(u), B, rtol=0, atol=4e-16)
+    np.testing.assert_allclose(bspline_basis_derivative(u), dB, rtol=0, atol=4e-16)
+    assert bspline_basis(u[:221].reshape(13, 17)).shape == (13, 17, 4)
+    assert bspline_basis(0.5).shape == (4,)
 
 
 def test_trajectory_rates():

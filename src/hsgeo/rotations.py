@@ -16,6 +16,9 @@ Conventions
   ``R_map_from_body = R_ENU_FROM_NED @ R_ned_from_body`` in the east-north-up map frame.
 * **Rotation vector** (:func:`R_from_rotvec`): axis times angle, Rodrigues' formula, identical
   to OpenCV's ``cv2.Rodrigues``.
+* **Camera frames** (:func:`R_photogrammetric_from_opencv_cam`): OpenCV's camera frame
+  (x right, y down, z forward along the view) and the photogrammetric one (x right, y up,
+  z backward) differ by ``diag(1, −1, −1)``.
 
 The elementary active rotations are::
 
@@ -44,6 +47,7 @@ __all__ = [
     "rotvec_from_R",
     "skew",
     "R_small",
+    "R_photogrammetric_from_opencv_cam",
 ]
 
 #: The fixed rotation from north-east-down to east-north-up (E = N_ned[1], N = N_ned[0],
@@ -383,6 +387,29 @@ def R_small(dtheta_rad: ArrayLike) -> NDArray:
         If ``dtheta_rad`` is not (..., 3) or contains NaN/inf.
     """
     return np.eye(3) + skew(dtheta_rad)
+
+
+def R_photogrammetric_from_opencv_cam() -> NDArray:
+    """The rotation from OpenCV's camera frame to the photogrammetric camera frame.
+
+    OpenCV: x right, y down, z forward (along the view). Photogrammetric: x right, y up,
+    z backward (the camera looks along −z). The rotation is ``diag(1, −1, −1)`` (half a turn
+    about x); it is its own inverse, so it is also ``R_opencv_from_photogrammetric_cam``.
+
+    Returns
+    -------
+    R : (3, 3) ndarray
+        A new array each call (safe to modify).
+
+    Examples
+    --------
+    A world-from-camera rotation in OpenCV's frame becomes the photogrammetric one with
+    ``R_world_from_photo = R_world_from_opencv @ R_photogrammetric_from_opencv_cam().T``:
+
+    >>> R_photogrammetric_from_opencv_cam() @ [0.0, 0.0, 1.0]  # the view direction
+    array([ 0.,  0., -1.])
+    """
+    return np.diag([1.0, -1.0, -1.0])
 
 
 def R_from_rotvec(rotvec: ArrayLike) -> NDArray:

@@ -66,6 +66,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from hsgeo._kernels import bspline_weights_rows
 from hsgeo.errors import InputError
 from hsgeo.rotations import R_ENU_FROM_NED, R_from_rpy
 
@@ -87,26 +88,24 @@ CORRECTION_COLUMNS = ("dE_m", "dN_m", "dH_m", "droll_rad", "dpitch_rad", "dyaw_r
 def bspline_basis(u):
     """Uniform cubic B-spline weights at local coordinate ``u`` in [0, 1).
 
+    The compiled core :func:`hsgeo._kernels.bspline_weights` (002 §3.3), which the pushbroom
+    kernel evaluates too.
+
     Returns
     -------
     B : (..., 4) ndarray
         Weights of the nodes ``k-1, k, k+1, k+2``; they sum to one.
     """
     u = np.asarray(u, dtype=np.float64)
-    u2, u3 = u * u, u * u * u
-    return np.stack(
-        [(1 - u) ** 3 / 6, (3 * u3 - 6 * u2 + 4) / 6, (-3 * u3 + 3 * u2 + 3 * u + 1) / 6, u3 / 6],
-        axis=-1,
-    )
+    w, _ = bspline_weights_rows(np.ascontiguousarray(u.ravel()), 1.0)
+    return w.reshape(u.shape + (4,))
 
 
 def bspline_basis_derivative(u):
     """Derivatives ``dB_a/du`` of :func:`bspline_basis` (divide by Δt for a rate per second)."""
     u = np.asarray(u, dtype=np.float64)
-    u2 = u * u
-    return np.stack(
-        [-((1 - u) ** 2) / 2, (3 * u2 - 4 * u) / 2, (-3 * u2 + 2 * u + 1) / 2, u2 / 2], axis=-1
-    )
+    _, dw = bspline_weights_rows(np.ascontiguousarray(u.ravel()), 1.0)
+    return dw.reshape(u.shape + (4,))
 
 
 @dataclass(frozen=True)

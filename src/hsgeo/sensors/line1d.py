@@ -69,6 +69,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from hsgeo.adjust import Indexed, Parameters, ResidualBlock
+from hsgeo.distortion import _measured_from_ideal_1d, odd_radial_1d, odd_radial_1d_jacobian
 from hsgeo.errors import ConvergenceError, InputError, ObservationError
 from hsgeo.validate import finite_array
 
@@ -92,7 +93,6 @@ __all__ = [
 DISTORTION_NORM_PX = 100.0
 #: Columns of the per-image exterior orientation block.
 EOP_COLUMNS = ("x0_m", "y0_m", "alpha_rad")
-_EXPONENTS = np.array([3, 5, 7])
 
 
 _finite = finite_array  # the boundary check shared by every module
@@ -127,17 +127,15 @@ def distortion_px(zeta_px: ArrayLike, zeta0_px: float, K: ArrayLike,
     >>> round(float(distortion_px(486.8 + 450, 486.8, [1.459, -0.164, 0.0053])), 2)
     28.37
     """
-    u = (_finite(zeta_px, "zeta_px") - float(zeta0_px)) / norm_px
-    K = _K3(K)
-    return u**3 * (K[0] + u**2 * (K[1] + u**2 * K[2]))
+    d = _finite(zeta_px, "zeta_px") - float(zeta0_px)
+    return odd_radial_1d(d, _K3(K), norm_px)  # 000 eq. (2)
 
 
 def distortion_derivative(zeta_px: ArrayLike, zeta0_px: float, K: ArrayLike,
                           norm_px: float = DISTORTION_NORM_PX) -> NDArray:
     """dδ/dζ (dimensionless) of :func:`distortion_px`."""
-    u = (_finite(zeta_px, "zeta_px") - float(zeta0_px)) / norm_px
-    K = _K3(K)
-    return u**2 * (3 * K[0] + u**2 * (5 * K[1] + 7 * K[2] * u**2)) / norm_px
+    d = _finite(zeta_px, "zeta_px") - float(zeta0_px)
+    return odd_radial_1d_jacobian(d, _K3(K), norm_px)[0]  # 000 eq. (2)
 
 
 def distortion_extremes(K: ArrayLike, r_max_px: float = 450.0, n: int = 4501,
@@ -180,24 +178,15 @@ def tan_from_zeta(zeta_px: ArrayLike, zeta0_px: float, c_px: float, K: ArrayLike
     return -(z - distortion_px(z, zeta0_px, K, norm_px) - zeta0_px) / c_px
 
 
-def _solve_zeta(ideal_px, zeta0_px, K, norm_px, max_iter=50, tol=1e-10):
-    """Solve ζ − δ(ζ − ζ0) = ideal for ζ by Newton (ζ0-reduced); returns ζ and F' = 1 − δ'."""
-    K = np.asarray(K, dtype=float)
+def _solve_zeta(ideal_px, zeta0_px, K, norm_px):
+    """Solve ζ − δ(ζ − ζ0) = ideal for ζ (000 eq. (2)); returns ζ and F' = 1 − δ'.
+
+    :func:`hsgeo.distortion.measured_from_ideal_1d` without its checks (trial steps of an
+    adjustment may leave the model's domain; the caller decides).
+    """
     t = np.asarray(ideal_px, dtype=float) - zeta0_px  # target of d − δ(d)
-    d = t.copy()
-    for _ in range(max_iter):
-        u = d / norm_px
-        u2 = u * u
-        delta = u * u2 * (K[0] + u2 * (K[1] + u2 * K[2]))
-        Fp = 1.0 - u2 * (3 * K[0] + u2 * (5 * K[1] + 7 * K[2] * u2)) / norm_px
-        Fp = np.where(np.abs(Fp) < 1e-6, 1e-6, Fp)
-        step = (d - delta - t) / Fp
-        d = d - np.clip(step, -200.0, 200.0)
-        if np.all(np.abs(step) < tol):
-            break
-    u = d / norm_px
-    u2 = u * u
-    Fp = 1.0 - u2 * (3 * K[0] + u2 * (5 * K[1] + 7 * K[2] * u2)) / norm_px
+    d, Fp = _measured_from_ideal_1d(t, np.asarray(K, dtype=float), float(norm_px),
+                                    max_iter=50, tol=1e-10, max_step=200.0)
     return d + zeta0_px, Fp
 
 
@@ -357,7 +346,8 @@ class LineObservations(ResidualBlock):
         Y = np.where(np.abs(Y) < 1e-9, 1e-9, Y)  # keep trial steps finite
         q = X / Y
         zeta, Fp = _solve_zeta(z0 - c * q, z0, K, self.norm_px)
-        return zeta, {"q": q, "X": X, "Y": Y, "ca": ca, "sa": sa, "Fp": Fp, "z0": z0, "c": c}
+        return zeta, {"q": q, "X": X, "Y": Y, "ca": ca, "sa": sa, "Fp": Fp, "z0": z0, "c": c,
+                      "K": K}
 
     def evaluate(self, values, jacobian):
         zeta, w = self.predict(values)
@@ -366,7 +356,7 @@ class LineObservations(ResidualBlock):
             return r, None
         n = self.blocks
         q, X, Y, ca, sa, Fp, c = w["q"], w["X"], w["Y"], w["ca"], w["sa"], w["Fp"], w["c"]
-        u = (zeta - w["z0"]) / self.norm_px
+        dK = odd_radial_1d_jacobian(zeta - w["z0"], w["K"], self.norm_px)[1]  # ∂δ/∂K, 000 eq. (2)
         # ∂q/∂x, ∂q/∂y of the object point; ∂q/∂α = 1 + q²
         dq_dx = (Y * ca + X * sa) / Y**2
         dq_dy = (Y * sa - X * ca) / Y**2
@@ -377,7 +367,7 @@ class LineObservations(ResidualBlock):
             n["eop"]: Indexed(self.image, J_eop),
             n["zeta0"]: np.ones((m, 1)),  # ζ − ζ0 depends on c·q and K only
             n["c"]: (-q / Fp)[:, None],
-            n["K"]: (u[:, None] ** _EXPONENTS) / Fp[:, None],
+            n["K"]: dK / Fp[:, None],
             n["xy"]: Indexed(self.point, np.stack([g * dq_dx, g * dq_dy], axis=1)),
         }
         return r, J

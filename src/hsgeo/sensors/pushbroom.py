@@ -45,6 +45,12 @@ are evaluated at ``t*``, so they do not contain the time error, and the node der
 the factored form ``B_a(t*) ∂r/∂δ``. Evaluating x at ``t*`` rather than ``t_e`` adds
 ``ẋ (t* − t_e)`` (≈ 0.1 px at the mount's angular rates) to the x residual, zero-mean.
 
+002 eq. (3)–(4) and the spline weights are the scalar cores of :mod:`hsgeo._kernels`
+(:func:`~hsgeo._kernels.pushbroom_camera_point`, :func:`~hsgeo._kernels.pushbroom_image_mm`,
+:func:`~hsgeo._kernels.bspline_weights`): the compiled kernel calls them per observation, the
+numpy reference path (:func:`project`, :meth:`PushbroomLines.evaluate_numpy`) through
+:func:`~hsgeo._kernels.pushbroom_image_rows`.
+
 The nominal mount ``β₀`` maps the platform frame (x forward, y left, z up) to the camera frame
 (x along the line to the right, y backward, z down the viewing direction).
 
@@ -68,6 +74,13 @@ from types import MappingProxyType
 import numpy as np
 from numba import njit, prange
 
+from hsgeo._kernels import (
+    bspline_weights,
+    pushbroom_camera_point,
+    pushbroom_image_mm,
+    pushbroom_image_rows,
+    rpy_rotation,
+)
 from hsgeo.adjust import Indexed, ResidualBlock
 from hsgeo.errors import InputError
 from hsgeo.rotations import R_from_opk, R_from_rpy, dR_dopk, dR_drpy
@@ -92,8 +105,12 @@ BLOCK_NAMES = MappingProxyType({
 
 
 def _camera_geometry(values, names, nodes: SplineNodes, t_s, xyz_nav, rpy_nav, pidx, band,
-                     beta0, jacobian):
-    """p^c and intermediate quantities for every observation (002 eq. 4)."""
+                     beta0, x0_mm, y0_mm):
+    """Image coordinates, p^c and intermediate quantities for every observation (002 eq. 3–4).
+
+    The numpy path: the pose is corrected here, 002 eq. (3)–(4) are the compiled cores of
+    :mod:`hsgeo._kernels` that :func:`_lines_kernel` calls too.
+    """
     P = values[names["points"]][pidx]
     idx, w = nodes.basis(t_s)
     node_vals = values[names["nodes"]]
@@ -103,70 +120,22 @@ def _camera_geometry(values, names, nodes: SplineNodes, t_s, xyz_nav, rpy_nav, p
     R = R_from_rpy(rpy[:, 0], rpy[:, 1], rpy[:, 2])
     bore = values[names["boresight"]]
     beta = R_from_opk(bore[0], bore[1], bore[2]) @ beta0
-    lever = values[names["lever_arm"]]
-    d = P - x
-    q = np.einsum("mji,mj->mi", R, d) - lever  # Rᵀ d − l
-    p = q @ beta.T
-    out = {"p": p, "q": q, "d": d, "R": R, "beta": beta, "idx": idx, "w": w, "rpy": rpy}
-    return out
+    lever = np.asarray(values[names["lever_arm"]], dtype=np.float64)
+    d = np.ascontiguousarray(P - x, dtype=np.float64)
+    c = np.ascontiguousarray(values[names["c"]][band], dtype=np.float64)
+    dist = np.asarray(values[names["distortion"]], dtype=np.float64)
+    q, p, xy, xb, yb, iz, gx, gy = pushbroom_image_rows(  # 002 eq. (3)–(4)
+        np.ascontiguousarray(R), d, lever, np.ascontiguousarray(beta), c, dist,
+        float(x0_mm), float(y0_mm))
+    return {"xy": xy, "p": p, "q": q, "d": d, "R": R, "beta": beta, "idx": idx, "w": w,
+            "rpy": rpy, "c": c, "xb": xb, "yb": yb, "iz": iz, "gx": gx, "gy": gy}
 
 
 def project(values, names, nodes, t_s, xyz_nav, rpy_nav, pidx, band, beta0, x0_mm, y0_mm):
     """Image coordinates (mm) of every observation (002 eq. 2–4), without derivatives."""
-    g = _camera_geometry(values, names, nodes, t_s, xyz_nav, rpy_nav, pidx, band, beta0, False)
-    p = g["p"]
-    c = values[names["c"]][band]
-    K1, K2, P1, P2 = values[names["distortion"]]
-    xb = c * p[:, 0] / p[:, 2]
-    yb = c * p[:, 1] / p[:, 2]
-    x = xb + K1 * xb**3 + K2 * xb**5 + 3 * P1 * xb**2 + x0_mm  # 002 eq. (3)
-    y = yb + P2 * xb**2 + y0_mm
-    return np.column_stack([x, y]), p
-
-
-@njit(cache=True, inline="always")
-def _rot_rpy(ro, pi, ya, R, dR):  # pragma: no cover - compiled
-    """R = Rz(yaw) Ry(pitch) Rx(roll) and its derivatives (same as hsgeo.rotations)."""
-    cr, sr, cp, sp, cy, sy = np.cos(ro), np.sin(ro), np.cos(pi), np.sin(pi), np.cos(ya), np.sin(ya)
-    R[0, 0] = cy * cp
-    R[0, 1] = cy * sp * sr - sy * cr
-    R[0, 2] = cy * sp * cr + sy * sr
-    R[1, 0] = sy * cp
-    R[1, 1] = sy * sp * sr + cy * cr
-    R[1, 2] = sy * sp * cr - cy * sr
-    R[2, 0] = -sp
-    R[2, 1] = cp * sr
-    R[2, 2] = cp * cr
-    # roll
-    dR[0, 0, 0] = 0.0
-    dR[0, 0, 1] = cy * sp * cr + sy * sr
-    dR[0, 0, 2] = -cy * sp * sr + sy * cr
-    dR[0, 1, 0] = 0.0
-    dR[0, 1, 1] = sy * sp * cr - cy * sr
-    dR[0, 1, 2] = -sy * sp * sr - cy * cr
-    dR[0, 2, 0] = 0.0
-    dR[0, 2, 1] = cp * cr
-    dR[0, 2, 2] = -cp * sr
-    # pitch
-    dR[1, 0, 0] = -cy * sp
-    dR[1, 0, 1] = cy * cp * sr
-    dR[1, 0, 2] = cy * cp * cr
-    dR[1, 1, 0] = -sy * sp
-    dR[1, 1, 1] = sy * cp * sr
-    dR[1, 1, 2] = sy * cp * cr
-    dR[1, 2, 0] = -cp
-    dR[1, 2, 1] = -sp * sr
-    dR[1, 2, 2] = -sp * cr
-    # yaw
-    dR[2, 0, 0] = -sy * cp
-    dR[2, 0, 1] = -sy * sp * sr - cy * cr
-    dR[2, 0, 2] = -sy * sp * cr + cy * sr
-    dR[2, 1, 0] = cy * cp
-    dR[2, 1, 1] = cy * sp * sr - sy * cr
-    dR[2, 1, 2] = cy * sp * cr + sy * sr
-    dR[2, 2, 0] = 0.0
-    dR[2, 2, 1] = 0.0
-    dR[2, 2, 2] = 0.0
+    g = _camera_geometry(values, names, nodes, t_s, xyz_nav, rpy_nav, pidx, band, beta0,
+                         x0_mm, y0_mm)
+    return g["xy"], g["p"]
 
 
 #: The crossing time is sought within ± this of the line time (s): 0.25 s is ~55 px of image
@@ -174,20 +143,6 @@ def _rot_rpy(ro, pi, ya, R, dR):  # pragma: no cover - compiled
 #: intersected point far off is held there (without the bound the time of such a point runs
 #: off with the spline extrapolated, and the first iterations are damped to a crawl).
 T_MAX = 0.25
-
-
-@njit(cache=True, inline="always")
-def _spline_weights(u, inv_dt, w, dw):  # pragma: no cover - compiled
-    """Uniform cubic B-spline weights at local coordinate u and their time derivatives."""
-    v = 1.0 - u
-    w[0] = v * v * v / 6.0
-    w[1] = (3.0 * u * u * u - 6.0 * u * u + 4.0) / 6.0
-    w[2] = (-3.0 * u * u * u + 3.0 * u * u + 3.0 * u + 1.0) / 6.0
-    w[3] = u * u * u / 6.0
-    dw[0] = -v * v / 2.0 * inv_dt
-    dw[1] = (3.0 * u * u - 4.0 * u) / 2.0 * inv_dt
-    dw[2] = (-3.0 * u * u + 2.0 * u + 1.0) / 2.0 * inv_dt
-    dw[3] = u * u / 2.0 * inv_dt
 
 
 @njit(cache=True, parallel=True)
@@ -226,7 +181,7 @@ def _lines_kernel(P, pidx, idx, u0, inv_dt, nodes, xyz_nav, rpy_nav, xyz_rate, r
             ey = 0.0
             n_it = n_newton if timed else 0
             for it in range(n_it + 1):
-                _spline_weights(u0[j] + dt * inv_dt, inv_dt, w, dw)
+                bspline_weights(u0[j] + dt * inv_dt, inv_dt, w, dw)
                 for a in range(6):
                     acc = 0.0
                     acc_r = 0.0
@@ -235,24 +190,18 @@ def _lines_kernel(P, pidx, idx, u0, inv_dt, nodes, xyz_nav, rpy_nav, xyz_rate, r
                         acc_r += dw[b] * nodes[idx[j, b], a]
                     dl[a] = acc
                     rate[a] = acc_r + (xyz_rate[j, a] if a < 3 else rpy_rate[j, a - 3])
-                _rot_rpy(rpy_nav[j, 0] + dt * rpy_rate[j, 0] + dl[3],
+                rpy_rotation(rpy_nav[j, 0] + dt * rpy_rate[j, 0] + dl[3],
                          rpy_nav[j, 1] + dt * rpy_rate[j, 1] + dl[4],
                          rpy_nav[j, 2] + dt * rpy_rate[j, 2] + dl[5], R, dR)
                 pt = pidx[j]
                 for a in range(3):
                     d[a] = P[pt, a] - xyz_nav[j, a] - dt * xyz_rate[j, a] - dl[a]
-                for a in range(3):  # q = Rᵀ d − l
-                    q[a] = R[0, a] * d[0] + R[1, a] * d[1] + R[2, a] * d[2] - lever[a]
-                for a in range(3):  # p = β q
-                    p[a] = beta[a, 0] * q[0] + beta[a, 1] * q[1] + beta[a, 2] * q[2]
+                pushbroom_camera_point(R, d, lever, beta, q, p)  # 002 eq. (4)
                 c = c_b[band[j]]
-                iz = 1.0 / p[2]
-                xb = c * p[0] * iz
-                yb = c * p[1] * iz
-                x = xb + K1 * xb**3 + K2 * xb**5 + 3 * P1 * xb**2 + x0  # 002 eq. (3)
-                y = yb + P2 * xb**2 + y0
-                gx = 1.0 + 3 * K1 * xb**2 + 5 * K2 * xb**4 + 6 * P1 * xb
-                gy = 2 * P2 * xb
+                x, y, xb, yb, iz, gx, gy = pushbroom_image_mm(p[0], p[1], p[2], c,
+                                                              K1, K2, P1, P2)  # 002 eq. (3)
+                x = x + x0
+                y = y + y0
                 a_ = c * iz
                 Jp[0, 0] = gx * a_ * k_px
                 Jp[0, 1] = 0.0
@@ -539,25 +488,18 @@ class PushbroomLines(ResidualBlock):
             raise NotImplementedError("the numpy reference covers the image-y residual only")
         nm = self.blocks
         g = _camera_geometry(values, nm, self.nodes, self.t_s, self.xyz_nav, self.rpy_nav,
-                             self.point, self.band, self.beta0, jacobian)
-        p, q, d, R, beta = g["p"], g["q"], g["d"], g["R"], g["beta"]
-        c = values[nm["c"]][self.band]
-        K1, K2, P1, P2 = values[nm["distortion"]]
-        iz = 1.0 / p[:, 2]
-        xb = c * p[:, 0] * iz
-        yb = c * p[:, 1] * iz
-        x = xb + K1 * xb**3 + K2 * xb**5 + 3 * P1 * xb**2 + self.x0_mm  # 002 eq. (3)
-        y = yb + P2 * xb**2 + self.y0_mm
+                             self.point, self.band, self.beta0, self.x0_mm, self.y0_mm)
+        q, d, R, beta = g["q"], g["d"], g["R"], g["beta"]
+        c, xb, yb, iz = g["c"], g["xb"], g["yb"], g["iz"]
         k = 1.0 / self.pixel_mm
         m = self.point.size
         r = np.empty(2 * m)
-        r[0::2] = x * k - self.xy_px[:, 0]
-        r[1::2] = y * k - self.xy_px[:, 1]
+        r[0::2] = g["xy"][:, 0] * k - self.xy_px[:, 0]
+        r[1::2] = g["xy"][:, 1] * k - self.xy_px[:, 1]
         if not jacobian:
             return r, None
         # d(x, y)/d p^c  (2 × 3 per observation), in px
-        gx = 1.0 + 3 * K1 * xb**2 + 5 * K2 * xb**4 + 6 * P1 * xb  # dx/dx̄
-        gy = 2 * P2 * xb  # dy/dx̄
+        gx, gy = g["gx"], g["gy"]  # dx/dx̄, dy/dx̄ of 002 eq. (3)
         a = c * iz
         dxb = np.stack([a, np.zeros(m), -xb * iz], axis=1)
         dyb = np.stack([np.zeros(m), a, -yb * iz], axis=1)

@@ -14,7 +14,7 @@ import numpy as np
 
 from hsgeo.adjust import AdjustmentResult, Parameters, adjust
 from hsgeo.errors import InputError, ObservationError
-from hsgeo.rotations import R_from_rotvec, opk_from_R
+from hsgeo.rotations import R_from_opk, R_photogrammetric_from_opencv_cam, opk_from_R
 from hsgeo.sensors.frame import (
     OPENCV_DISTORTION,
     OPENCV_INTRINSICS,
@@ -25,11 +25,11 @@ from hsgeo.sensors.frame import (
     FramePhotogrammetric,
     pixel_to_mm,
 )
+from hsgeo.workflows._initial import pose_from_pnp
 
 __all__ = ["View", "FrameCalibration", "calibrate_opencv", "calibrate_photogrammetric",
            "initial_poses"]
 
-_FLIP = np.diag([1.0, -1.0, -1.0])  # OpenCV camera frame (y down, z forward) <-> photogrammetric
 
 
 @dataclass(frozen=True)
@@ -77,24 +77,14 @@ def _check_views(views: Sequence[View], image_size) -> list[View]:
 
 
 def initial_poses(views: Sequence[View], K: np.ndarray) -> np.ndarray:
-    """Per-view OpenCV pose (``R_cam_from_world`` as a rotation vector, t) from ``cv2.solvePnP``.
+    """Per-view pose from ``cv2.solvePnP`` (:func:`hsgeo.workflows._initial.pose_from_pnp`).
 
     Returns
     -------
     (n_views, 6) ndarray of ``(ω, φ, κ, X0, Y0, Z0)`` for the OpenCV camera frame.
     """
-    import cv2
-
-    out = []
-    for i, v in enumerate(views):
-        ok, rvec, tvec = cv2.solvePnP(v.X.astype(np.float64), v.uv_px.astype(np.float64), K,
-                                      np.zeros(5), flags=cv2.SOLVEPNP_ITERATIVE)
-        if not ok:
-            raise ObservationError(f"view {i}: no initial pose found (degenerate points?)")
-        R_cam_from_world = R_from_rotvec(rvec.ravel())
-        X0 = -R_cam_from_world.T @ tvec.ravel()
-        out.append(np.concatenate([opk_from_R(R_cam_from_world.T), X0]))
-    return np.array(out)
+    return np.array([pose_from_pnp(v.X, v.uv_px, K, frame="opencv", what=f"view {i}")
+                     for i, v in enumerate(views)])
 
 
 def _initial_K(views, image_size) -> np.ndarray:
@@ -261,9 +251,8 @@ def calibrate_photogrammetric(
     f0 = float(np.sqrt(K[0, 0] * K[1, 1]))
     K = np.array([[f0, 0, (w - 1) / 2], [0, f0, (h - 1) / 2], [0, 0, 1.0]])
     poses = initial_poses(views, K)
-    from hsgeo.rotations import R_from_opk
-
-    R = R_from_opk(poses[:, 0], poses[:, 1], poses[:, 2]) @ _FLIP
+    # OpenCV camera frame -> photogrammetric camera frame
+    R = R_from_opk(poses[:, 0], poses[:, 1], poses[:, 2]) @ R_photogrammetric_from_opencv_cam().T
     poses[:, :3] = opk_from_R(R)
     p = Parameters()
     p.add("interior", [f0 * pixel_pitch_mm, 0.0, 0.0], columns=PHOTOGRAMMETRIC_INTERIOR)

@@ -27,7 +27,7 @@ from hsgeo.distortion import ideal_from_measured_mm
 from hsgeo.errors import InputError, ObservationError
 from hsgeo.measure.targets import Observations
 from hsgeo.papers import RIKOLA_BANDS
-from hsgeo.rotations import R_from_opk, R_from_rotvec, opk_from_R
+from hsgeo.rotations import R_from_opk, opk_from_R
 from hsgeo.sensors.frame import (
     PHOTOGRAMMETRIC_DISTORTION,
     PHOTOGRAMMETRIC_INTERIOR,
@@ -42,6 +42,7 @@ from hsgeo.sensors.rikola import (
     TargetCentroids,
     project_measured_mm,
 )
+from hsgeo.workflows._initial import pose_from_pnp
 
 __all__ = [
     "Observations",
@@ -63,8 +64,6 @@ __all__ = [
     "rop_transformation_test",
     "cluster_keys",
 ]
-
-_FLIP = np.diag([1.0, -1.0, -1.0])  # OpenCV camera frame <-> photogrammetric camera frame
 
 
 def detect_targets_in_images(images, corners_obj, target_ids, image_size, pixel_mm: float, *,
@@ -126,8 +125,6 @@ def initial_poses(obs: Observations, f_mm: float) -> dict[int, np.ndarray]:
     """Photogrammetric pose of each cube from ``cv2.solvePnP`` on the centroids (no distortion,
     principal point at the centre), for the initial values of an adjustment.
     """
-    import cv2
-
     w, h = obs.image_size
     fpx = f_mm / obs.pixel_mm
     K = np.array([[fpx, 0, (w - 1) / 2], [0, fpx, (h - 1) / 2], [0, 0, 1.0]])
@@ -136,13 +133,8 @@ def initial_poses(obs: Observations, f_mm: float) -> dict[int, np.ndarray]:
         m = obs.cube == c
         if m.sum() < 4:
             raise ObservationError(f"cube {c}: {m.sum()} targets; a pose needs at least 4")
-        ok, rvec, tvec = cv2.solvePnP(obs.corners_obj[m].mean(axis=1), obs.centroids_px[m], K,
-                                      np.zeros(5), flags=cv2.SOLVEPNP_ITERATIVE)
-        if not ok:
-            raise ObservationError(f"cube {c}: no initial pose from solvePnP")
-        Rcw = R_from_rotvec(rvec.ravel())
-        X0 = -Rcw.T @ tvec.ravel()
-        out[int(c)] = np.concatenate([opk_from_R(Rcw.T @ _FLIP), X0])
+        out[int(c)] = pose_from_pnp(obs.corners_obj[m].mean(axis=1), obs.centroids_px[m], K,
+                                    frame="photogrammetric", what=f"cube {c}")
     return out
 
 
