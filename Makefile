@@ -57,6 +57,7 @@ bench: $(STAMP) ## run the benchmarks, results as JSON in bench/results/
 
 lint: $(STAMP) ## ruff check and format check, and the import contracts of the layout (GUIDE §2)
 	$(VENV)/bin/ruff check src tests bench
+	$(VENV)/bin/ruff format --check src tests bench
 	$(VENV)/bin/lint-imports --no-cache
 
 lock: ## re-resolve the environment from pyproject.toml and rewrite requirements.lock

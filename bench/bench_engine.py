@@ -26,8 +26,9 @@ def make_problem(n_points, seed=0):
     gx, gy = np.meshgrid(np.arange(10), np.arange(8))
     C = np.column_stack([gx.ravel() * 60.0, gy.ravel() * 60.0, np.full(gx.size, -300.0)])
     poses = np.column_stack([rng.normal(0, 0.02, (C.shape[0], 3)), C])
-    X = np.column_stack([rng.uniform(0, 540, n_points), rng.uniform(0, 420, n_points),
-                         rng.normal(0, 5, n_points)])
+    X = np.column_stack(
+        [rng.uniform(0, 540, n_points), rng.uniform(0, 420, n_points), rng.normal(0, 5, n_points)]
+    )
     intr = np.array([1000.0, 1000.0, 500.0, 400.0])
     dist = np.array([-0.1, 0.05, 0.0, 0.0, 0.0])
     view, point = [], []
@@ -38,7 +39,8 @@ def make_problem(n_points, seed=0):
             point.append(j)
     view, point = np.array(view), np.array(point)
     uv = project_opencv(poses, view, X[point], intr, dist) + 0.5 * rng.standard_normal(
-        (view.size, 2))
+        (view.size, 2)
+    )
     p = Parameters()
     p.add("intrinsics", intr * [1.01, 1.01, 1, 1], columns=("fx", "fy", "cx", "cy"))
     p.add("distortion", np.zeros(5))
@@ -84,8 +86,18 @@ def run_scipy(p, blk):
         return sp.hstack([s.Jc, Jp[:, np.flatnonzero(pfree)]]).tocsr()
 
     t = time.perf_counter()
-    res = least_squares(fun, x0, jac=jac, method="trf", tr_solver="lsmr", x_scale="jac",
-                        ftol=1e-10, xtol=1e-12, gtol=1e-12, max_nfev=200)
+    res = least_squares(
+        fun,
+        x0,
+        jac=jac,
+        method="trf",
+        tr_solver="lsmr",
+        x_scale="jac",
+        ftol=1e-10,
+        xtol=1e-12,
+        gtol=1e-12,
+        max_nfev=200,
+    )
     return time.perf_counter() - t, 0.5 * float(res.fun @ res.fun)
 
 
@@ -94,23 +106,36 @@ if __name__ == "__main__":
     p, blk = make_problem(40000)
     t = time.perf_counter()
     res = adjust(p, blk)
-    out.update(n_observations=int(blk.m), n_unknowns=int(res.n_unknowns),
-               seconds=time.perf_counter() - t, iterations=res.iterations, sigma0=res.sigma0,
-               peak_rss_mb=peak_rss_mb())
-    print(f"hsgeo: {blk.m} observations, {res.n_unknowns} unknowns, {out['seconds']:.2f} s, "
-          f"{res.iterations} iterations")
+    out.update(
+        n_observations=int(blk.m),
+        n_unknowns=int(res.n_unknowns),
+        seconds=time.perf_counter() - t,
+        iterations=res.iterations,
+        sigma0=res.sigma0,
+        peak_rss_mb=peak_rss_mb(),
+    )
+    print(
+        f"hsgeo: {blk.m} observations, {res.n_unknowns} unknowns, {out['seconds']:.2f} s, "
+        f"{res.iterations} iterations"
+    )
     pb, bb = make_problem(5000)
     t = time.perf_counter()
     rb = adjust(pb, bb)
     ours_small = time.perf_counter() - t
     base_s, base_cost = run_scipy(pb, bb)
     ours_cost = 0.5 * (rb.sigma0**2) * rb.dof
-    out.update(baseline="scipy.optimize.least_squares trf/lsmr x_scale=jac, same Jacobian",
-               baseline_n_observations=int(bb.m), baseline_seconds=base_s,
-               ours_seconds_at_baseline_size=ours_small, final_cost_ratio=base_cost / ours_cost,
-               speedup=base_s / ours_small)
-    print(f"at {bb.m} observations: hsgeo {ours_small:.2f} s, scipy {base_s:.2f} s, "
-          f"cost ratio scipy/hsgeo {base_cost / ours_cost:.6f}")
+    out.update(
+        baseline="scipy.optimize.least_squares trf/lsmr x_scale=jac, same Jacobian",
+        baseline_n_observations=int(bb.m),
+        baseline_seconds=base_s,
+        ours_seconds_at_baseline_size=ours_small,
+        final_cost_ratio=base_cost / ours_cost,
+        speedup=base_s / ours_small,
+    )
+    print(
+        f"at {bb.m} observations: hsgeo {ours_small:.2f} s, scipy {base_s:.2f} s, "
+        f"cost ratio scipy/hsgeo {base_cost / ours_cost:.6f}"
+    )
     path = Path(__file__).parent / "results" / "engine_frame_ba.json"
     path.write_text(json.dumps(out, indent=1))
     print(f"wrote {path}")

@@ -39,9 +39,14 @@ def _problem(scale, seed, with_gcp=True):
     cfg = CampaignConfig()
     obs, _ = simulate(scale, rng=seed, cfg=cfg)
     p, blocks, _ = build_problem(
-        obs.lines, obs.n_points, camera_prior(cfg, obs), t_span_s=obs.t_span_s,
+        obs.lines,
+        obs.n_points,
+        camera_prior(cfg, obs),
+        t_span_s=obs.t_span_s,
         gcp_index=obs.gcp_index if with_gcp else None,
-        gcp_xyz_m=obs.gcp_xyz_m if with_gcp else None, y_as_time=Y_AS_TIME)
+        gcp_xyz_m=obs.gcp_xyz_m if with_gcp else None,
+        y_as_time=Y_AS_TIME,
+    )
     return obs, p, blocks
 
 
@@ -65,13 +70,20 @@ def case_ours(scale, seed, reject):
     obs, p, blocks = _problem(scale, seed)
     jit = _load_compiled_kernels(seed)
     t0 = time.perf_counter()
-    res = adjust(p, blocks, reject_k=REJECT_K if reject else None, ftol=FTOL,
-                 reject_every_iteration=True)
+    res = adjust(
+        p, blocks, reject_k=REJECT_K if reject else None, ftol=FTOL, reject_every_iteration=True
+    )
     wall = time.perf_counter() - t0
-    return {"n_observations": obs.lines.n, "n_unknowns": int(res.n_unknowns),
-            "solver_seconds": res.seconds, "wall_seconds": wall, "iterations": res.iterations,
-            "final_cost": float(res.cost_history[-1]), "sigma0": res.sigma0,
-            "jit_load_seconds": jit}
+    return {
+        "n_observations": obs.lines.n,
+        "n_unknowns": int(res.n_unknowns),
+        "solver_seconds": res.seconds,
+        "wall_seconds": wall,
+        "iterations": res.iterations,
+        "final_cost": float(res.cost_history[-1]),
+        "sigma0": res.sigma0,
+        "jit_load_seconds": jit,
+    }
 
 
 def case_scipy(scale, seed, max_seconds):
@@ -103,16 +115,35 @@ def case_scipy(scale, seed, max_seconds):
         sy = E._evaluate(lay, blocks, masks, True)
         rows = np.flatnonzero(sy.pidx >= 0)
         Jp = sp.csr_matrix(
-            (sy.Jp[rows].ravel(), (np.repeat(rows, lay.p),
-                                   (sy.pidx[rows, None] * lay.p + np.arange(lay.p)).ravel())),
-            shape=(sy.r.size, n_p))
+            (
+                sy.Jp[rows].ravel(),
+                (np.repeat(rows, lay.p), (sy.pidx[rows, None] * lay.p + np.arange(lay.p)).ravel()),
+            ),
+            shape=(sy.r.size, n_p),
+        )
         return sp.hstack([sy.Jrc.tocsr(), Jp]).tocsr()
 
     t0 = time.perf_counter()
-    res = least_squares(fun, x0, jac=jac, method="trf", tr_solver="lsmr", x_scale="jac",
-                        ftol=1e-10, xtol=1e-12, gtol=1e-10, max_nfev=200, verbose=0)
-    return {"baseline_seconds": time.perf_counter() - t0, "final_cost": float(res.cost),
-            "nfev": int(res.nfev), "status": int(res.status), "message": res.message}
+    res = least_squares(
+        fun,
+        x0,
+        jac=jac,
+        method="trf",
+        tr_solver="lsmr",
+        x_scale="jac",
+        ftol=1e-10,
+        xtol=1e-12,
+        gtol=1e-10,
+        max_nfev=200,
+        verbose=0,
+    )
+    return {
+        "baseline_seconds": time.perf_counter() - t0,
+        "final_cost": float(res.cost),
+        "nfev": int(res.nfev),
+        "status": int(res.status),
+        "message": res.message,
+    }
 
 
 def _child(args):
@@ -132,8 +163,9 @@ def _spawn(case, scale, seed, blas, reject=False, timeout=3600):
     cmd = [sys.executable, __file__, "--child", case, "--scale", str(scale), "--seed", str(seed)]
     if reject:
         cmd.append("--reject")
-    print(f"bench: {case} scale={scale} OPENBLAS_NUM_THREADS={blas} ...", file=sys.stderr,
-          flush=True)
+    print(
+        f"bench: {case} scale={scale} OPENBLAS_NUM_THREADS={blas} ...", file=sys.stderr, flush=True
+    )
     t0 = time.perf_counter()
     try:
         cp = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=timeout)
@@ -166,8 +198,9 @@ def main(argv=None):
     best = min(full, key=lambda b: full[b]["solver_seconds"])
     # this machine's speed varies from run to run (shared cores): repeat the best setting and
     # report the median, with every run
-    runs = [full[best]] + [_spawn("ours", args.scale, args.seed, best, reject=True)
-                           for _ in range(args.repeats - 1)]
+    runs = [full[best]] + [
+        _spawn("ours", args.scale, args.seed, best, reject=True) for _ in range(args.repeats - 1)
+    ]
     seconds = sorted(r["solver_seconds"] for r in runs)
     median = seconds[len(seconds) // 2]
     ours_b = _spawn("ours", args.baseline_scale, args.seed, best)
@@ -175,15 +208,15 @@ def main(argv=None):
     f = full[best]
     out = {
         "problem": "002 pushbroom bundle adjustment, spline nodes every 10 s, with 4 GCPs, "
-                   "residual across the line as a time (as in the chapter)",
+        "residual across the line as a time (as in the chapter)",
         "scale": args.scale,
         "n_observations": f["n_observations"],
         "n_unknowns": f["n_unknowns"],
         "solver_seconds": median,
         "solver_seconds_runs": seconds,
         "solver_seconds_note": "adjust() at full size, each run in a fresh process after the "
-                               "compiled kernels were loaded from numba's cache by a tiny "
-                               "adjustment (jit_load_seconds, a fixed cost per process)",
+        "compiled kernels were loaded from numba's cache by a tiny "
+        "adjustment (jit_load_seconds, a fixed cost per process)",
         "jit_load_seconds_runs": sorted(r["jit_load_seconds"] for r in runs),
         "iterations": f["iterations"],
         "peak_rss_mb": max(r["peak_rss_mb"] for r in runs),
@@ -195,15 +228,23 @@ def main(argv=None):
         "baseline_nfev": base.get("nfev"),
         "baseline_message": base.get("message"),
         "ours_seconds_at_baseline_scale": ours_b["solver_seconds"],
-        "final_cost_ratio": (base["final_cost"] / ours_b["final_cost"]
-                             if "final_cost" in base else None),
-        "speedup_at_baseline_scale": (base["baseline_seconds"] / ours_b["solver_seconds"]
-                                      if "baseline_seconds" in base else None),
+        "final_cost_ratio": (
+            base["final_cost"] / ours_b["final_cost"] if "final_cost" in base else None
+        ),
+        "speedup_at_baseline_scale": (
+            base["baseline_seconds"] / ours_b["solver_seconds"]
+            if "baseline_seconds" in base
+            else None
+        ),
         "goals": {"solver_seconds_max": 5.0, "peak_rss_mb_max": 1536, "speedup_min": 30},
-        "machine": {"cpus": os.cpu_count(), "loadavg_at_start": load0,
-                    "loadavg_at_end": os.getloadavg(), "python": platform.python_version(),
-                    "numba_threads": os.environ.get("NUMBA_NUM_THREADS", "default"),
-                    "glibc_tunables": os.environ.get("GLIBC_TUNABLES", "")},
+        "machine": {
+            "cpus": os.cpu_count(),
+            "loadavg_at_start": load0,
+            "loadavg_at_end": os.getloadavg(),
+            "python": platform.python_version(),
+            "numba_threads": os.environ.get("NUMBA_NUM_THREADS", "default"),
+            "glibc_tunables": os.environ.get("GLIBC_TUNABLES", ""),
+        },
         "seed": args.seed,
     }
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)

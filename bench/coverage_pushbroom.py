@@ -35,15 +35,19 @@ def one(scale: float, seed: int) -> dict:
     obs, truth = simulate(scale, rng=seed, cfg=cfg)
     res, _, _, _ = adjust_campaign(obs, cfg)
     zn = (res.value("nodes") - truth.values["nodes"]) / res.sigma("nodes")
-    zc = np.concatenate([(res.value(k) - truth.values[k]).ravel() / res.sigma(k).ravel()
-                         for k in CAMERA])
+    zc = np.concatenate(
+        [(res.value(k) - truth.values[k]).ravel() / res.sigma(k).ravel() for k in CAMERA]
+    )
     z = np.r_[zn.ravel(), zc]
     r = res.residuals(0).reshape(-1, 2)[~res.outliers(0)]
     E = cp_errors(res, truth)
     gsd = cfg.agl_low_m * cfg.pixel_mm / cfg.c_mean_mm
     return {
-        "scale": scale, "seed": seed, "n_observations_2d": obs.lines.n,
-        "sigma0": res.sigma0, "iterations": res.iterations,
+        "scale": scale,
+        "seed": seed,
+        "n_observations_2d": obs.lines.n,
+        "sigma0": res.sigma0,
+        "iterations": res.iterations,
         "share_within_3sigma": float(np.mean(np.abs(z) < 3)),
         "node_z_mean": np.mean(zn, axis=0).round(3).tolist(),
         "node_z_std": np.std(zn, axis=0).round(3).tolist(),
@@ -58,8 +62,9 @@ def one(scale: float, seed: int) -> dict:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cases", default="0.1:0,0.1:1,0.1:2,0.1:3,1.0:0,1.0:1")
-    ap.add_argument("--out", default=str(Path(__file__).parent / "results"
-                                          / "coverage_pushbroom.json"))
+    ap.add_argument(
+        "--out", default=str(Path(__file__).parent / "results" / "coverage_pushbroom.json")
+    )
     args = ap.parse_args(argv)
     out = []
     for case in args.cases.split(","):

@@ -18,7 +18,9 @@ only = sys.argv[1:]
 for script in sorted(here.glob("bench_*.py")):
     if only and script.stem.removeprefix("bench_") not in only:
         continue
-    print(f"== {script.name} (OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS')})",
-          flush=True)
+    print(
+        f"== {script.name} (OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS')})",
+        flush=True,
+    )
     sys.argv = [str(script)]  # each benchmark parses its own (default) arguments
     runpy.run_path(str(script), run_name="__main__")

@@ -23,6 +23,7 @@ def test_a_broken_contract_is_reported(tmp_path):
         'source_modules = ["hsgeo.reproduce"]\nforbidden_modules = ["hsgeo.workflows"]\n'
     )
     exe = Path(sys.executable).with_name("lint-imports")
-    out = subprocess.run([str(exe), "--no-cache", "--config", str(cfg)], cwd=ROOT,
-                         capture_output=True, text=True)
+    out = subprocess.run(
+        [str(exe), "--no-cache", "--config", str(cfg)], cwd=ROOT, capture_output=True, text=True
+    )
     assert out.returncode != 0 and "BROKEN" in out.stdout

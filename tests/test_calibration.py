@@ -22,8 +22,9 @@ def test_chessboard_matches_opencv_file(chessboard):
     # reference: OpenCV's out_camera_data.yml (flags 14): fx = 657.46697810243404 px,
     # k1 -0.41802327018241026, k2 0.50715243805833121, k3 -0.57843596847939704
     views, size, ref = chessboard
-    cal = calibrate_opencv(views, size, fix_principal_point=True, square_pixels=True,
-                           zero_tangent=True)
+    cal = calibrate_opencv(
+        views, size, fix_principal_point=True, square_pixels=True, zero_tangent=True
+    )
     v = cal.values()
     assert abs(v["fx_px"] - 657.46697810243404) < 0.01
     for k in ("k1", "k2", "k3"):
@@ -42,8 +43,9 @@ def test_sigma_equals_opencv_std_deviations(chessboard):
     out = cv2.calibrateCameraExtended(obj, img, size, None, None, criteria=crit)
     std_cv = out[5].ravel()[:9]  # fx fy cx cy k1 k2 p1 p2 k3
     s = cal.sigmas()
-    ours = np.array([s[k] for k in ("fx_px", "fy_px", "cx_px", "cy_px", "k1", "k2", "p1", "p2",
-                                    "k3")])
+    ours = np.array(
+        [s[k] for k in ("fx_px", "fy_px", "cx_px", "cy_px", "k1", "k2", "p1", "p2", "k3")]
+    )
     np.testing.assert_allclose(ours, std_cv, rtol=1e-3)
 
 
@@ -53,27 +55,35 @@ def test_charuco_within_0p2_percent_of_calibrate_camera():
     cal = calibrate_opencv(views, size)
     K, dist, rms = opencv_calibrate(views, size)
     v = cal.values()
-    for name, ref in [("fx_px", K[0, 0]), ("fy_px", K[1, 1]), ("cx_px", K[0, 2]),
-                      ("cy_px", K[1, 2])]:
+    for name, ref in [
+        ("fx_px", K[0, 0]),
+        ("fy_px", K[1, 1]),
+        ("cx_px", K[0, 2]),
+        ("cy_px", K[1, 2]),
+    ]:
         assert abs(v[name] / ref - 1) < 0.002, name
     assert cal.rms_px == pytest.approx(rms, rel=1e-4)
 
 
 def test_photogrammetric_form_differs_but_fits(chessboard):
     views, size, _ = chessboard
-    pg = calibrate_photogrammetric(views, size, 0.006, fix_principal_point=True,
-                                   zero_decentering=True)
+    pg = calibrate_photogrammetric(
+        views, size, 0.006, fix_principal_point=True, zero_decentering=True
+    )
     f_px = pg.values()["f_mm"] / 0.006
     assert 600 < f_px < 700 and pg.rms_px < 0.5
     # the pixel pitch only scales the mm units
-    pg2 = calibrate_photogrammetric(views, size, 0.01, fix_principal_point=True,
-                                    zero_decentering=True)
+    pg2 = calibrate_photogrammetric(
+        views, size, 0.01, fix_principal_point=True, zero_decentering=True
+    )
     assert pg2.values()["f_mm"] / 0.01 == pytest.approx(f_px, rel=1e-7)
 
 
 def _views(sim):
-    return [View(sim.X_mm[sim.point[sim.view == i]], sim.uv_px[sim.view == i])
-            for i in range(sim.n_views)]
+    return [
+        View(sim.X_mm[sim.point[sim.view == i]], sim.uv_px[sim.view == i])
+        for i in range(sim.n_views)
+    ]
 
 
 def test_simulated_bench_observations_are_frozen_and_truth_free():

@@ -38,8 +38,9 @@ def test_unknown_chapter_and_bad_seed(capsys):
 
 
 def test_console_script_runs():
-    out = subprocess.run([sys.executable, "-m", "hsgeo.cli", "--version"], capture_output=True,
-                         text=True, check=True)
+    out = subprocess.run(
+        [sys.executable, "-m", "hsgeo.cli", "--version"], capture_output=True, text=True, check=True
+    )
     assert out.stdout.startswith("hsgeo ")
 
 

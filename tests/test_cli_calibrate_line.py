@@ -14,12 +14,20 @@ def files(tmp_path_factory):
 
 
 def test_calibrate_line_json(files, capsys):
-    rc = main(["calibrate-line", str(files / "line_lab_observations.csv"), "--control",
-               str(files / "line_lab_control.csv"), "--json"])
+    rc = main(
+        [
+            "calibrate-line",
+            str(files / "line_lab_observations.csv"),
+            "--control",
+            str(files / "line_lab_control.csv"),
+            "--json",
+        ]
+    )
     assert rc == 0
     out = json.loads(capsys.readouterr().out)
-    truth = dict(line.split(",") for line in
-                 (files / "line_lab_truth.csv").read_text().splitlines()[1:])
+    truth = dict(
+        line.split(",") for line in (files / "line_lab_truth.csv").read_text().splitlines()[1:]
+    )
     for k in ("zeta0_px", "c_px", "K1"):
         p = out["parameters"][k]
         assert abs(p["value"] - float(truth[k])) < 3 * p["sigma"], k
@@ -33,8 +41,12 @@ def test_calibrate_line_errors(files, tmp_path, capsys):
     assert main(["calibrate-line", str(bad), "--control", str(files / "line_lab_control.csv")]) == 2
     assert "NaN" in capsys.readouterr().err
     few = tmp_path / "few.csv"
-    few.write_text("\n".join([ln for ln in lines if not ln.startswith("img1")][:] +
-                             [ln for ln in lines if ln.startswith("img1")][:2]))
+    few.write_text(
+        "\n".join(
+            [ln for ln in lines if not ln.startswith("img1")][:]
+            + [ln for ln in lines if ln.startswith("img1")][:2]
+        )
+    )
     assert main(["calibrate-line", str(few), "--control", str(files / "line_lab_control.csv")]) == 2
     assert "at least 3 per image" in capsys.readouterr().err
     assert main(["calibrate-line", str(tmp_path / "none.csv"), "--control", "x.csv"]) == 2

@@ -119,8 +119,9 @@ def test_distort_opencv_jacobian_finite_differences():
     assert J_xy.shape == (60, 2, 2)
     assert J_dist.shape == (60, 2, 5)
     h = 1e-6
-    np.testing.assert_allclose(J_xy, _central_diff(lambda u: distort_opencv(u, DIST), xy, h),
-                               atol=1e-9)
+    np.testing.assert_allclose(
+        J_xy, _central_diff(lambda u: distort_opencv(u, DIST), xy, h), atol=1e-9
+    )
     num = _central_diff(lambda c: distort_opencv(xy, c), DIST, h)
     np.testing.assert_allclose(J_dist, num, atol=1e-9)
 
@@ -132,8 +133,9 @@ def test_undistort_opencv_outside_monotonic_region_raises():
         undistort_opencv([[0.5, 0.0]], dist)
     assert info.value.result is not None
     # inside the region it works
-    np.testing.assert_allclose(distort_opencv(undistort_opencv([[0.3, 0.0]], dist), dist),
-                               [[0.3, 0.0]], atol=1e-14)
+    np.testing.assert_allclose(
+        distort_opencv(undistort_opencv([[0.3, 0.0]], dist), dist), [[0.3, 0.0]], atol=1e-14
+    )
 
 
 # ------------------------------------------------------------------ photogrammetric form
@@ -148,13 +150,15 @@ def test_brown_correction_formula_and_opencv_correspondence():
     radial = K1 * r2 + K2 * r2**2 + K3 * r2**3
     dx = x * radial + P1 * (r2 + 2 * x**2) + 2 * P2 * x * y
     dy = y * radial + 2 * P1 * x * y + P2 * (r2 + 2 * y**2)
-    np.testing.assert_allclose(brown_correction(xy, K_003, P_003), np.column_stack([dx, dy]),
-                               rtol=1e-13, atol=1e-18)
+    np.testing.assert_allclose(
+        brown_correction(xy, K_003, P_003), np.column_stack([dx, dy]), rtol=1e-13, atol=1e-18
+    )
     # P1 <-> p2, P2 <-> p1: the correction equals OpenCV's distortion minus identity with
     # (k1, k2, p1, p2, k3) = (K1, K2, P2, P1, K3) in the same units.
     dist_cv = np.array([K1, K2, P2, P1, K3])
-    np.testing.assert_allclose(brown_correction(xy, K_003, P_003),
-                               distort_opencv(xy, dist_cv) - xy, atol=1e-15)
+    np.testing.assert_allclose(
+        brown_correction(xy, K_003, P_003), distort_opencv(xy, dist_cv) - xy, atol=1e-15
+    )
 
 
 def test_brown_ideal_measured_round_trip():
@@ -179,8 +183,10 @@ def test_brown_correction_jacobian_finite_differences():
         J_K, _central_diff(lambda k: brown_correction(xy, k, P_003), K_003, 1e-7), rtol=1e-6
     )
     np.testing.assert_allclose(
-        J_P, _central_diff(lambda p: brown_correction(xy, K_003, p), P_003, 1e-7),
-        rtol=1e-6, atol=1e-9
+        J_P,
+        _central_diff(lambda p: brown_correction(xy, K_003, p), P_003, 1e-7),
+        rtol=1e-6,
+        atol=1e-9,
     )
 
 
@@ -260,12 +266,14 @@ def test_odd_radial_1d_norm_is_the_line_scanner_polynomial():
     d = np.linspace(-450, 450, 91)
     u = d / 100.0
     expected = K_000[0] * u**3 + K_000[1] * u**5 + K_000[2] * u**7  # 000 eq. (2)
-    np.testing.assert_allclose(odd_radial_1d(d, K_000, norm=100.0), expected, rtol=1e-14,
-                               atol=1e-13)
+    np.testing.assert_allclose(
+        odd_radial_1d(d, K_000, norm=100.0), expected, rtol=1e-14, atol=1e-13
+    )
     # the Horner core to the last bits of the formula the line-scanner solver used
     u2 = u * u
-    np.testing.assert_array_equal(odd_radial_1d(d, K_000, norm=100.0),
-                                  u * u2 * (K_000[0] + u2 * (K_000[1] + u2 * K_000[2])))
+    np.testing.assert_array_equal(
+        odd_radial_1d(d, K_000, norm=100.0), u * u2 * (K_000[0] + u2 * (K_000[1] + u2 * K_000[2]))
+    )
 
 
 @pytest.mark.parametrize("norm", [1.0, 100.0])
@@ -311,8 +319,9 @@ def test_pushbroom_line_values_and_jacobian():
     out = distort_pushbroom_line(xy, DIST_002)
     assert out.shape == xy.shape
     # 002 eq. (3)
-    np.testing.assert_allclose(out[..., 0], x + K1 * x**3 + K2 * x**5 + 3 * P1 * x**2,
-                               rtol=1e-15, atol=1e-15)
+    np.testing.assert_allclose(
+        out[..., 0], x + K1 * x**3 + K2 * x**5 + 3 * P1 * x**2, rtol=1e-15, atol=1e-15
+    )
     np.testing.assert_allclose(out[..., 1], y + P2 * x**2, rtol=1e-15, atol=1e-15)
     J_xy, J_d = distort_pushbroom_line_jacobian(xy, DIST_002)
     assert J_xy.shape == (4, 25, 2, 2) and J_d.shape == (4, 25, 2, 4)

@@ -36,16 +36,18 @@ def test_nonlinear_matches_scipy():
     p = Parameters()
     p.add("Ak", [1.0, 0.1])
     res = adjust(p, Exponential(t, y, 0.02))
-    ref = least_squares(lambda x: x[0] * np.exp(-x[1] * t) - y, [1.0, 0.1], xtol=1e-15,
-                        ftol=1e-15, gtol=1e-15)
+    ref = least_squares(
+        lambda x: x[0] * np.exp(-x[1] * t) - y, [1.0, 0.1], xtol=1e-15, ftol=1e-15, gtol=1e-15
+    )
     np.testing.assert_allclose(res.value("Ak"), ref.x, rtol=1e-8)
 
 
 def _bearing_params(S, P, st, pt, th, points=True, n_control=2, sigma_ctrl=1e-3, seed=0):
     rng = np.random.default_rng(seed)
     p = Parameters()
-    p.add("stations", S + rng.normal(0, [2, 2, 0.02], S.shape),
-          columns=("x_m", "y_m", "heading_rad"))
+    p.add(
+        "stations", S + rng.normal(0, [2, 2, 0.02], S.shape), columns=("x_m", "y_m", "heading_rad")
+    )
     p.add("points", P + rng.normal(0, 1.0, P.shape), points=points, columns=("x_m", "y_m"))
     for j in range(n_control):
         p.set_prior("points", sigma_ctrl, index=j, mean=P[j])
@@ -69,8 +71,9 @@ def test_schur_equals_plain_solution():
     r1 = adjust(p1, blk, ftol=1e-14, keep_jacobian=True)
     r2 = adjust(p2, blk, ftol=1e-14)
     for name in ("points", "stations"):
-        np.testing.assert_array_less(np.abs(r1.value(name) - r2.value(name)),
-                                     1e-4 * r2.sigma(name) + 1e-12)
+        np.testing.assert_array_less(
+            np.abs(r1.value(name) - r2.value(name)), 1e-4 * r2.sigma(name) + 1e-12
+        )
     np.testing.assert_allclose(r1.sigma("stations"), r2.sigma("stations"), rtol=1e-6)
     # point covariance from the Schur back-substitution equals the plain inverse
     np.testing.assert_allclose(r1.sigma("points"), r2.sigma("points"), rtol=1e-6)
@@ -230,11 +233,14 @@ def test_compiled_path_equals_generic_path(lam):
     r_slow = adjust(p, blk, ftol=1e-14, compiled=False, keep_jacobian=True)
     r_fast = adjust(p, blk, ftol=1e-14, compiled=True, keep_jacobian=True)
     # (the compiled path takes chord steps once settled: the same minimum by other steps)
-    np.testing.assert_array_less(np.abs(r_fast.value("points") - r_slow.value("points")),
-                                 1e-4 * np.nan_to_num(r_slow.sigma("points")) + 1e-12)
+    np.testing.assert_array_less(
+        np.abs(r_fast.value("points") - r_slow.value("points")),
+        1e-4 * np.nan_to_num(r_slow.sigma("points")) + 1e-12,
+    )
     # (covariances at points 1e-4 σ apart: equal to ~1e-6)
-    np.testing.assert_allclose(r_fast.covariance, r_slow.covariance, rtol=1e-6,
-                               atol=1e-6 * np.abs(r_slow.covariance).max())
+    np.testing.assert_allclose(
+        r_fast.covariance, r_slow.covariance, rtol=1e-6, atol=1e-6 * np.abs(r_slow.covariance).max()
+    )
     np.testing.assert_allclose(r_fast.sigma("points"), r_slow.sigma("points"), rtol=1e-6)
 
 
@@ -266,8 +272,9 @@ def test_outliers_rejected_every_iteration_like_rounds():
     assert set(np.flatnonzero(r_each.outliers(0))) == set(bad)
     np.testing.assert_array_equal(r_each.outliers(0), r_rounds.outliers(0))
     # both stop at the minimum to ftol (1e-10 of the cost): a difference ≪ σ, not to the last bit
-    np.testing.assert_allclose(r_each.value("ab"), r_rounds.value("ab"), rtol=0,
-                               atol=1e-3 * np.min(r_rounds.sigma("ab")))
+    np.testing.assert_allclose(
+        r_each.value("ab"), r_rounds.value("ab"), rtol=0, atol=1e-3 * np.min(r_rounds.sigma("ab"))
+    )
 
 
 @pytest.mark.parametrize("consecutive", [True, False])
@@ -289,8 +296,11 @@ def test_reduced_kernel_equals_dense_schur(consecutive):
     pidx = np.repeat(np.arange(n_pts), rows_per_pt)
     M = pidx.size
     first = rng.integers(0, item_start.size - q + 1, M)
-    items = first[:, None] + np.arange(q) if consecutive else np.stack(
-        [rng.choice(item_start.size, q, replace=False) for _ in range(M)])
+    items = (
+        first[:, None] + np.arange(q)
+        if consecutive
+        else np.stack([rng.choice(item_start.size, q, replace=False) for _ in range(M)])
+    )
     fcol = item_start[items].astype(np.int32)
     fw = rng.random((M, q))
     fd = rng.normal(size=(M, kf))
@@ -347,8 +357,12 @@ def test_chord_steps_end_with_the_covariance_of_the_final_point(monkeypatch):
     lay = _Layout(r.params)
     ne = schur._normal(lay, _evaluate(lay, [blk], [np.ones(blk.m, bool)], True), SolverOptions())
     S_final = schur._reduced(lay, ne, 0.0)[0]
-    np.testing.assert_allclose(r.covariance, r.sigma0**2 * np.linalg.inv(S_final), rtol=1e-9,
-                               atol=1e-12 * np.abs(r.covariance).max())
+    np.testing.assert_allclose(
+        r.covariance,
+        r.sigma0**2 * np.linalg.inv(S_final),
+        rtol=1e-9,
+        atol=1e-12 * np.abs(r.covariance).max(),
+    )
 
 
 def test_chord_steps_from_the_first_iterate_still_converge():
@@ -361,8 +375,9 @@ def test_chord_steps_from_the_first_iterate_still_converge():
     r = adjust(p, blk, ftol=1e-14, settled=np.inf)
     assert r.converged
     for name in ("points", "stations"):
-        np.testing.assert_array_less(np.abs(r.value(name) - ref.value(name)),
-                                     1e-4 * np.nan_to_num(ref.sigma(name)) + 1e-12)
+        np.testing.assert_array_less(
+            np.abs(r.value(name) - ref.value(name)), 1e-4 * np.nan_to_num(ref.sigma(name)) + 1e-12
+        )
 
 
 @pytest.mark.parametrize("each", [False, True])
@@ -373,8 +388,12 @@ def test_gross_errors_rejected_without_swamping_their_points(each):
     S, P, st, pt, th = bearing_scene(11, n_points=60, coverage=5)
     rng = np.random.default_rng(2)
     # one gross error on each of 6 points (not the control points)
-    gross = np.array([rng.choice(np.flatnonzero(pt == j)) for j in
-                      rng.choice(np.arange(2, 60), 6, replace=False)])
+    gross = np.array(
+        [
+            rng.choice(np.flatnonzero(pt == j))
+            for j in rng.choice(np.arange(2, 60), 6, replace=False)
+        ]
+    )
     th = th.copy()
     th[gross] += rng.choice([-1, 1], gross.size) * rng.uniform(0.02, 0.05, gross.size)
     p, blk = _bearing_params(S, P, st, pt, th, n_control=2, seed=11)
@@ -494,18 +513,27 @@ def test_sensor_blocks_declare_their_roles():
     assert set(FrameOpenCV.BLOCKS) == {"poses", "points", "intrinsics", "distortion"}
     assert FramePhotogrammetric.BLOCKS["distortion"] == "distortion_mm"
     assert PushbroomLines.BLOCKS == BLOCK_NAMES
-    assert set(JointCentroids.BLOCKS) == {"poses", "gap", "df", "pp", "distortion", "rotation",
-                                          "offset"}
+    assert set(JointCentroids.BLOCKS) == {
+        "poses",
+        "gap",
+        "df",
+        "pp",
+        "distortion",
+        "rotation",
+        "offset",
+    }
     assert TargetCentroids.BLOCKS["interior"] == "interior"
     assert LineObservations.BLOCKS["xy"] == "xy_m"
     assert BoresightGCP.BLOCKS == {"boresight": "boresight"}
     rng = np.random.default_rng(0)
     view = np.zeros(4, int)
     X = rng.normal(size=(4, 3)) + [0, 0, 5]
-    blk = FrameOpenCV(view, rng.normal(size=(4, 2)), 1.0, X=X,
-                      blocks={"intrinsics": "K_band2"})
-    vals = {"poses": np.zeros((1, 6)), "K_band2": np.array([500.0, 500.0, 10.0, 10.0]),
-            "distortion": np.zeros(5)}
+    blk = FrameOpenCV(view, rng.normal(size=(4, 2)), 1.0, X=X, blocks={"intrinsics": "K_band2"})
+    vals = {
+        "poses": np.zeros((1, 6)),
+        "K_band2": np.array([500.0, 500.0, 10.0, 10.0]),
+        "distortion": np.zeros(5),
+    }
     r, jac = blk.evaluate(vals, True)
     assert set(jac) == {"K_band2", "distortion", "poses"} and r.shape == (8,)
 
@@ -515,8 +543,13 @@ def _square_pixel_problem(seed=3, n=30, n_views=4):
 
     rng = np.random.default_rng(seed)
     X = np.column_stack([rng.uniform(-1, 1, n), rng.uniform(-1, 1, n), rng.uniform(-0.2, 0.2, n)])
-    poses = np.column_stack([rng.normal(0, 0.1, (n_views, 3)),
-                             rng.normal(0, 0.3, (n_views, 2)), rng.uniform(-5, -3, n_views)])
+    poses = np.column_stack(
+        [
+            rng.normal(0, 0.1, (n_views, 3)),
+            rng.normal(0, 0.3, (n_views, 2)),
+            rng.uniform(-5, -3, n_views),
+        ]
+    )
     view = np.repeat(np.arange(n_views), n)
     Xall = np.tile(X, (n_views, 1))
     intr = np.array([800.0, 800.0, 320.0, 240.0])
@@ -544,17 +577,20 @@ def test_tie_equals_square_pixel_model():
     r_tie = adjust(p, FrameOpenCV(view, uv, 0.3, X=X))
     fx, fy = r_tie.value("intrinsics")[:2]
     assert fx == fy
-    np.testing.assert_allclose(r_tie.value("intrinsics")[[0, 2, 3]],
-                               r_old.value("intrinsics")[[0, 2, 3]], rtol=1e-9)
+    np.testing.assert_allclose(
+        r_tie.value("intrinsics")[[0, 2, 3]], r_old.value("intrinsics")[[0, 2, 3]], rtol=1e-9
+    )
     for name in ("distortion", "poses"):
         np.testing.assert_allclose(r_tie.value(name), r_old.value(name), rtol=1e-9, atol=1e-12)
     s_tie, s_old = r_tie.sigma("intrinsics"), r_old.sigma("intrinsics")
     assert np.isnan(s_old[1]) and s_tie[1] == s_tie[0]
     np.testing.assert_allclose(s_tie[[0, 2, 3]], s_old[[0, 2, 3]], rtol=1e-9)
-    np.testing.assert_allclose(r_tie.covariance, r_old.covariance, rtol=1e-9,
-                               atol=1e-12 * np.abs(r_old.covariance).max())
-    assert r_tie.n_unknowns == r_old.n_unknowns and r_tie.sigma0 == pytest.approx(r_old.sigma0,
-                                                                                   rel=1e-12)
+    np.testing.assert_allclose(
+        r_tie.covariance, r_old.covariance, rtol=1e-9, atol=1e-12 * np.abs(r_old.covariance).max()
+    )
+    assert r_tie.n_unknowns == r_old.n_unknowns and r_tie.sigma0 == pytest.approx(
+        r_old.sigma0, rel=1e-12
+    )
     assert r_tie.labels == r_old.labels and "intrinsics[1]" not in r_tie.labels
     # the input is untouched apart from the tie itself
     assert p.ties == {("intrinsics", 1): ("intrinsics", 0)}
@@ -600,8 +636,9 @@ def test_adjust_modules_import_without_cycles():
                 mods = [a.name for a in node.names]
             else:
                 continue
-            deps |= {m.split(".")[2] for m in mods
-                     if m.startswith("hsgeo.adjust.") and m.count(".") >= 2}
+            deps |= {
+                m.split(".")[2] for m in mods if m.startswith("hsgeo.adjust.") and m.count(".") >= 2
+            }
         graph[f.stem] = deps - {f.stem}
     assert graph["result"] <= {"parameters"}, graph["result"]
     assert "engine" not in graph

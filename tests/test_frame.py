@@ -19,8 +19,13 @@ from hsgeo.sensors.frame import (
 def scene(seed=0, n=30, n_views=3):
     rng = np.random.default_rng(seed)
     X = np.column_stack([rng.uniform(-1, 1, n), rng.uniform(-1, 1, n), rng.uniform(-0.2, 0.2, n)])
-    poses = np.column_stack([rng.normal(0, 0.1, (n_views, 3)),
-                             rng.normal(0, 0.3, (n_views, 2)), rng.uniform(-5, -3, n_views)])
+    poses = np.column_stack(
+        [
+            rng.normal(0, 0.1, (n_views, 3)),
+            rng.normal(0, 0.3, (n_views, 2)),
+            rng.uniform(-5, -3, n_views),
+        ]
+    )
     view = np.repeat(np.arange(n_views), n)
     Xall = np.tile(X, (n_views, 1))
     return X, poses, view, Xall
@@ -60,9 +65,12 @@ def test_photogrammetric_jacobians():
     xy = rng.uniform(-3, 3, (Xall.shape[0], 2))
     point = np.tile(np.arange(X.shape[0]), poses.shape[0])
     blk = FramePhotogrammetric(view, xy, 0.003, point=point)
-    vals = {"interior": np.array([9.0, 0.05, -0.03]),
-            "distortion_mm": np.array([-3e-3, 2e-5, -1e-7, 1e-5, -2e-5]),
-            "poses": poses, "points": X}
+    vals = {
+        "interior": np.array([9.0, 0.05, -0.03]),
+        "distortion_mm": np.array([-3e-3, 2e-5, -1e-7, 1e-5, -2e-5]),
+        "poses": poses,
+        "points": X,
+    }
     for name, h in [("interior", 1e-6), ("distortion_mm", 1e-9), ("poses", 1e-7), ("points", 1e-7)]:
         assert check_jacobian(blk, vals, name, h) < 1e-6, name
 
@@ -80,8 +88,14 @@ def test_photogrammetric_noise_free_residual_is_zero():
     ideal = -f * Xc[:, :2] / Xc[:, 2:3]
     xy = measured_from_ideal_mm(ideal, K, P) + [x0, y0]
     blk = FramePhotogrammetric(view, xy, 0.003, X=Xall)
-    r, _ = blk.evaluate({"interior": np.array([f, x0, y0]),
-                         "distortion_mm": np.concatenate([K, P]), "poses": poses}, False)
+    r, _ = blk.evaluate(
+        {
+            "interior": np.array([f, x0, y0]),
+            "distortion_mm": np.concatenate([K, P]),
+            "poses": poses,
+        },
+        False,
+    )
     assert np.max(np.abs(r)) < 1e-12
 
 
@@ -111,5 +125,11 @@ def test_bad_input():
     poses_behind = poses.copy()
     poses_behind[:, 0] -= np.pi
     with pytest.raises(InputError, match="behind"):
-        blk.evaluate({"intrinsics": np.array([800.0, 800, 320, 240]),
-                      "distortion": np.zeros(5), "poses": poses_behind}, False)
+        blk.evaluate(
+            {
+                "intrinsics": np.array([800.0, 800, 320, 240]),
+                "distortion": np.zeros(5),
+                "poses": poses_behind,
+            },
+            False,
+        )

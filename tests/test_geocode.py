@@ -45,8 +45,9 @@ def test_intersect_plane_and_dem_round_trip():
     # tilted terrain as a DEM (bilinear interpolation of a plane is exact)
     E = np.linspace(-400, 400, 81)
     N = np.linspace(-400, 400, 81)
-    dem = xr.DataArray(10 + 0.05 * E[None, :] - 0.03 * N[:, None], dims=("N", "E"),
-                       coords={"N": N, "E": E})
+    dem = xr.DataArray(
+        10 + 0.05 * E[None, :] - 0.03 * N[:, None], dims=("N", "E"), coords={"N": N, "E": E}
+    )
     X[:, 2] = 10 + 0.05 * X[:, 0] - 0.03 * X[:, 1]
     got = intersect(O, 3.7 * (X - O), DemTerrain(dem), tol_m=1e-9)
     np.testing.assert_allclose(got, X, atol=1e-6)
@@ -78,8 +79,16 @@ def test_geocoding_a_known_point_returns_it():
     bs = np.deg2rad([0.3, -0.2, 0.5])
     X = np.array([[40.0, 150.0, 12.0], [10.0, 120.0, 12.0], [65.0, 180.0, 12.0]])
     line, zeta = observe_gcps(nav, CAL, bs, 0.0, 12.5, X, np.random.default_rng(0), 0.0, 0.0)
-    got = geocode_observations(nav, CAL, line, zeta, t0_s=0.0, line_rate_hz=12.5,
-                               terrain=PlaneTerrain(12.0), boresight_rad=bs)
+    got = geocode_observations(
+        nav,
+        CAL,
+        line,
+        zeta,
+        t0_s=0.0,
+        line_rate_hz=12.5,
+        terrain=PlaneTerrain(12.0),
+        boresight_rad=bs,
+    )
     np.testing.assert_allclose(got, X, atol=1e-6)
 
 
@@ -89,11 +98,17 @@ def test_boresight_jacobian_and_recovery():
     rng = np.random.default_rng(1)
     along, across = rng.uniform(60, 300, 12), rng.uniform(-50, 50, 12)  # within ±354 px
     h = np.deg2rad(30.0)
-    X = np.column_stack([along * np.sin(h) + across * np.cos(h),
-                         along * np.cos(h) - across * np.sin(h), np.full(12, 5.0)])
+    X = np.column_stack(
+        [
+            along * np.sin(h) + across * np.cos(h),
+            along * np.cos(h) - across * np.sin(h),
+            np.full(12, 5.0),
+        ]
+    )
     line, zeta = observe_gcps(nav, CAL, bs, 0.0, 12.5, X, rng, 0.0, 0.0)
-    blk = BoresightGCP(nav, CAL, line, zeta, X, t0_s=0.0, line_rate_hz=12.5, height_m=5.0,
-                       sigma_m=0.1)
+    blk = BoresightGCP(
+        nav, CAL, line, zeta, X, t0_s=0.0, line_rate_hz=12.5, height_m=5.0, sigma_m=0.1
+    )
     assert check_jacobian(blk, {"boresight": bs}, "boresight", 1e-7) < 1e-6
     res = calibrate_boresight(nav, CAL, line, zeta, X, t0_s=0.0, line_rate_hz=12.5, height_m=5.0)
     np.testing.assert_allclose(res.value("boresight"), bs, atol=1e-9)
@@ -108,9 +123,17 @@ def test_boresight_truth_within_3_sigma():
     for seed in range(8):
         fl, truth = simulate_flight(cfg, seed)
         # the true sensor as the assumed one: only the boresight is tested here
-        res = calibrate_boresight(fl.recorded_nav, truth.sensor, fl.line, fl.zeta_px,
-                                  fl.gcp_enu_m, t0_s=0.0, line_rate_hz=fl.line_rate_hz,
-                                  height_m=50.0, sigma_m=0.2)
+        res = calibrate_boresight(
+            fl.recorded_nav,
+            truth.sensor,
+            fl.line,
+            fl.zeta_px,
+            fl.gcp_enu_m,
+            t0_s=0.0,
+            line_rate_hz=fl.line_rate_hz,
+            height_m=50.0,
+            sigma_m=0.2,
+        )
         z.append((res.value("boresight") - truth.boresight_rad) / res.sigma("boresight"))
     assert np.max(np.abs(z)) < 4.0  # 24 deviates, family-wise
 
@@ -135,25 +158,29 @@ def test_gcp_deviations_vanish_with_exact_navigation_and_sensor():
     rng = np.random.default_rng(2)
     along, across = rng.uniform(60, 300, 10), rng.uniform(-50, 50, 10)
     h = np.deg2rad(30.0)
-    X = np.column_stack([along * np.sin(h) + across * np.cos(h),
-                         along * np.cos(h) - across * np.sin(h), np.full(10, 5.0)])
+    X = np.column_stack(
+        [
+            along * np.sin(h) + across * np.cos(h),
+            along * np.cos(h) - across * np.sin(h),
+            np.full(10, 5.0),
+        ]
+    )
     line, zeta = observe_gcps(nav, CAL, bs, 0.0, 12.5, X, rng, 0.0, 0.0)
-    dev, res = gcp_deviations(nav, CAL, line, zeta, X, height_m=5.0, t0_s=0.0,
-                              line_rate_hz=12.5)
+    dev, res = gcp_deviations(nav, CAL, line, zeta, X, height_m=5.0, t0_s=0.0, line_rate_hz=12.5)
     assert dev.shape == (10, 2)
     np.testing.assert_allclose(dev, 0.0, atol=1e-6)
     np.testing.assert_allclose(res.value("boresight"), bs, atol=1e-9)
     # a wrong sensor model shows up as deviations
-    dev_nom, _ = gcp_deviations(nav, LinearIFOV(485.0, 3600.0), line, zeta, X, height_m=5.0,
-                                t0_s=0.0, line_rate_hz=12.5)
+    dev_nom, _ = gcp_deviations(
+        nav, LinearIFOV(485.0, 3600.0), line, zeta, X, height_m=5.0, t0_s=0.0, line_rate_hz=12.5
+    )
     assert np.max(np.abs(dev_nom)) > 0.05
 
 
 def test_orthorectify_places_pixels_where_they_belong():
     nav = straight_nav(heading_deg=0.0, T=10.0)
     zeta = np.arange(100.0, 900.0)
-    g = geocode_image(nav, CAL, 100, zeta, t0_s=0.0, line_rate_hz=10.0,
-                      terrain=PlaneTerrain(0.0))
+    g = geocode_image(nav, CAL, 100, zeta, t0_s=0.0, line_rate_hz=10.0, terrain=PlaneTerrain(0.0))
     img = np.stack([g[..., 0], g[..., 1]])  # every pixel's value is its own E and N
     da = orthorectify(img, g, resolution_m=0.5)
     E, N = np.meshgrid(da["E"], da["N"])
@@ -175,10 +202,25 @@ def test_geocode_command_end_to_end(tmp_path):
     write_lines(tmp_path / "lines.nc", g[..., 0], zeta, t0_s=0.0, line_rate_hz=8.0)
     (tmp_path / "sensor.toml").write_text(
         "[sensor]\nmodel = 'calibrated'\nzeta0_px = 486.8\nc_px = 3539.0\n"
-        "K = [1.459, -0.1636, 0.00526]\n")
-    rc = main(["geocode", str(tmp_path / "lines.nc"), "--trajectory", str(tmp_path / "nav.csv"),
-               "--sensor", str(tmp_path / "sensor.toml"), "--height", "3", "-o",
-               str(tmp_path / "o.nc"), "--envi", str(tmp_path / "o_envi"), "--quiet"])
+        "K = [1.459, -0.1636, 0.00526]\n"
+    )
+    rc = main(
+        [
+            "geocode",
+            str(tmp_path / "lines.nc"),
+            "--trajectory",
+            str(tmp_path / "nav.csv"),
+            "--sensor",
+            str(tmp_path / "sensor.toml"),
+            "--height",
+            "3",
+            "-o",
+            str(tmp_path / "o.nc"),
+            "--envi",
+            str(tmp_path / "o_envi"),
+            "--quiet",
+        ]
+    )
     assert rc == 0
     ds = xr.open_dataset(tmp_path / "o.nc")
     E = np.broadcast_to(ds["E"].values, ds["radiance"].shape[1:])
@@ -191,12 +233,30 @@ def test_geocode_command_end_to_end(tmp_path):
     assert np.median(err) < 0.1
     data, hdr = read_envi(tmp_path / "o_envi")
     assert data.shape == ds["radiance"].shape and hdr["map_info"][2] == 0.5
-    assert main(["geocode", str(tmp_path / "lines.nc"), "--trajectory", str(tmp_path / "nav.csv"),
-                 "--sensor", str(tmp_path / "missing.toml"), "--height", "3", "-o",
-                 str(tmp_path / "x.nc")]) == 2
+    assert (
+        main(
+            [
+                "geocode",
+                str(tmp_path / "lines.nc"),
+                "--trajectory",
+                str(tmp_path / "nav.csv"),
+                "--sensor",
+                str(tmp_path / "missing.toml"),
+                "--height",
+                "3",
+                "-o",
+                str(tmp_path / "x.nc"),
+            ]
+        )
+        == 2
+    )
     with pytest.raises(InputError, match="exactly one"):
-        geocode_files(tmp_path / "lines.nc", tmp_path / "nav.csv", tmp_path / "sensor.toml",
-                      output=tmp_path / "y.nc")
+        geocode_files(
+            tmp_path / "lines.nc",
+            tmp_path / "nav.csv",
+            tmp_path / "sensor.toml",
+            output=tmp_path / "y.nc",
+        )
 
 
 def test_zeta_outside_the_model_raises():

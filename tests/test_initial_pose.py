@@ -33,8 +33,9 @@ def test_opencv_frame_differs_by_the_flip():
     X, uv, K, opk, X0 = _scene()
     pose = pose_from_pnp(X, uv, K, frame="opencv")
     R_world_from_cv = R_from_opk(*pose[:3])
-    np.testing.assert_allclose(R_world_from_cv @ R_photogrammetric_from_opencv_cam().T,
-                               R_from_opk(*opk), atol=1e-8)
+    np.testing.assert_allclose(
+        R_world_from_cv @ R_photogrammetric_from_opencv_cam().T, R_from_opk(*opk), atol=1e-8
+    )
     np.testing.assert_allclose(pose[3:], X0, atol=1e-8)
 
 

@@ -61,8 +61,14 @@ COLS = ("image", "point", "zeta_px")
 
 @pytest.mark.parametrize("suffix", [".csv", ".parquet"])
 def test_read_table_round_trip(tmp_path, suffix):
-    df = pd.DataFrame({"image": ["a", "a", "b"], "point": ["01", "2", "3"],
-                       "zeta_px": [3.5, -1.25, 1e3], "extra": [1, 2, 3]})
+    df = pd.DataFrame(
+        {
+            "image": ["a", "a", "b"],
+            "point": ["01", "2", "3"],
+            "zeta_px": [3.5, -1.25, 1e3],
+            "extra": [1, 2, 3],
+        }
+    )
     p = tmp_path / f"obs{suffix}"
     if suffix == ".csv":
         df.to_csv(p, index=False)
@@ -84,14 +90,20 @@ def test_read_table_comments_and_line_numbers(tmp_path):
     assert "fill it in or delete the row" in msg
 
 
-@pytest.mark.parametrize("text, needle", [
-    ("image,point,zeta\n1,2,3.5\n", ["missing column(s) zeta_px", "rename 'zeta' to 'zeta_px'"]),
-    ("image,point,zeta_px\n1,2,nan\n", ["line 2", "column zeta_px", "NaN"]),
-    ("image,point,zeta_px\n1,2,abc\n", ["line 2", "column zeta_px", "'abc' is not a number"]),
-    ("image,point,zeta_px\n1,,3\n", ["line 2", "column point", "empty"]),
-    ("", ["is empty", "header line"]),
-    ("image,point,zeta_px\n", ["no data rows"]),
-])
+@pytest.mark.parametrize(
+    "text, needle",
+    [
+        (
+            "image,point,zeta\n1,2,3.5\n",
+            ["missing column(s) zeta_px", "rename 'zeta' to 'zeta_px'"],
+        ),
+        ("image,point,zeta_px\n1,2,nan\n", ["line 2", "column zeta_px", "NaN"]),
+        ("image,point,zeta_px\n1,2,abc\n", ["line 2", "column zeta_px", "'abc' is not a number"]),
+        ("image,point,zeta_px\n1,,3\n", ["line 2", "column point", "empty"]),
+        ("", ["is empty", "header line"]),
+        ("image,point,zeta_px\n", ["no data rows"]),
+    ],
+)
 def test_read_table_bad_files(tmp_path, text, needle):
     p = tmp_path / "obs.csv"
     p.write_text(text)
@@ -117,8 +129,14 @@ def test_read_table_missing_and_unreadable(tmp_path):
 
 
 # ---- TOML with a schema
-SCHEMA = {"a": {"x_m": Key("float", required=True), "n": Key("int", default=3),
-                "v": Key("floats", length=2), "kind": Key("str", choices=("one", "two"))}}
+SCHEMA = {
+    "a": {
+        "x_m": Key("float", required=True),
+        "n": Key("int", default=3),
+        "v": Key("floats", length=2),
+        "kind": Key("str", choices=("one", "two")),
+    }
+}
 
 
 def test_read_config_round_trip_and_defaults(tmp_path):
@@ -129,17 +147,20 @@ def test_read_config_round_trip_and_defaults(tmp_path):
     assert isinstance(cfg["a"]["x_m"], float)
 
 
-@pytest.mark.parametrize("text, needle", [
-    ("[a]\nx_mm = 1\n", ["[a] x_mm: unknown key; did you mean 'x_m'?", "[a] x_m: missing"]),
-    ("[aa]\nx_m = 1\n", ["[aa]: unknown table; did you mean 'a'?", "[a]: missing table"]),
-    ("[a]\nx_m = nan\n", ["[a] x_m: must be a finite number"]),
-    ("[a]\nx_m = 'one'\n", ["[a] x_m: expected a number"]),
-    ("[a]\nx_m = 1\nn = 1.5\n", ["[a] n: expected a whole number"]),
-    ("[a]\nx_m = 1\nv = [1]\n", ["[a] v: needs 2 numbers"]),
-    ("[a]\nx_m = 1\nkind = 'tow'\n", ["[a] kind must be one of 'one', 'two'", "'two'?"]),
-    ("[a\n", ["malformed TOML"]),
-    ("", ["[a]: missing table"]),
-])
+@pytest.mark.parametrize(
+    "text, needle",
+    [
+        ("[a]\nx_mm = 1\n", ["[a] x_mm: unknown key; did you mean 'x_m'?", "[a] x_m: missing"]),
+        ("[aa]\nx_m = 1\n", ["[aa]: unknown table; did you mean 'a'?", "[a]: missing table"]),
+        ("[a]\nx_m = nan\n", ["[a] x_m: must be a finite number"]),
+        ("[a]\nx_m = 'one'\n", ["[a] x_m: expected a number"]),
+        ("[a]\nx_m = 1\nn = 1.5\n", ["[a] n: expected a whole number"]),
+        ("[a]\nx_m = 1\nv = [1]\n", ["[a] v: needs 2 numbers"]),
+        ("[a]\nx_m = 1\nkind = 'tow'\n", ["[a] kind must be one of 'one', 'two'", "'two'?"]),
+        ("[a\n", ["malformed TOML"]),
+        ("", ["[a]: missing table"]),
+    ],
+)
 def test_read_config_errors(tmp_path, text, needle):
     p = tmp_path / "c.toml"
     p.write_text(text)
@@ -153,8 +174,10 @@ def test_read_config_errors(tmp_path, text, needle):
 
 def test_sensor_toml(tmp_path):
     p = tmp_path / "s.toml"
-    p.write_text("[sensor]\nmodel = 'calibrated'\nzeta0_px = 486.8\nc_px = 3539\n"
-                 "K = [1.459, -0.1636, 0.00526]\nboresight_deg = [1.0, -2.0, 90]\n")
+    p.write_text(
+        "[sensor]\nmodel = 'calibrated'\nzeta0_px = 486.8\nc_px = 3539\n"
+        "K = [1.459, -0.1636, 0.00526]\nboresight_deg = [1.0, -2.0, 90]\n"
+    )
     geom, b = read_sensor_toml(p)
     assert geom == CalibratedLine(486.8, 3539.0, (1.459, -0.1636, 0.00526))
     np.testing.assert_allclose(b, np.deg2rad([1.0, -2.0, 90.0]), rtol=0, atol=0)
@@ -163,15 +186,20 @@ def test_sensor_toml(tmp_path):
     assert geom == LinearIFOV(485.0, 3600.0) and not b.any()
 
 
-@pytest.mark.parametrize("text, needle", [
-    ("[sensor]\nmodel = 'pinhole'\nzeta0_px = 1\nc_px = 2\n", "model must be one of"),
-    ("[sensor]\nzeta0_px = 1\n", "[sensor] c_px: missing"),
-    ("[sensor]\nzeta0_px = 1\nc_px = 2\nborsight_deg = [0, 0, 0]\n",
-     "[sensor] borsight_deg: unknown key; did you mean 'boresight_deg'?"),
-    ("[sensor]\nzeta0_px = 1\nc_px = 2\nboresight_deg = [0, 0]\n", "needs 3 numbers"),
-    ("[sensor]\nzeta0_px = nan\nc_px = 2\n", "[sensor] zeta0_px: must be a finite number"),
-    ("[sensor\n", "malformed"),
-])
+@pytest.mark.parametrize(
+    "text, needle",
+    [
+        ("[sensor]\nmodel = 'pinhole'\nzeta0_px = 1\nc_px = 2\n", "model must be one of"),
+        ("[sensor]\nzeta0_px = 1\n", "[sensor] c_px: missing"),
+        (
+            "[sensor]\nzeta0_px = 1\nc_px = 2\nborsight_deg = [0, 0, 0]\n",
+            "[sensor] borsight_deg: unknown key; did you mean 'boresight_deg'?",
+        ),
+        ("[sensor]\nzeta0_px = 1\nc_px = 2\nboresight_deg = [0, 0]\n", "needs 3 numbers"),
+        ("[sensor]\nzeta0_px = nan\nc_px = 2\n", "[sensor] zeta0_px: must be a finite number"),
+        ("[sensor\n", "malformed"),
+    ],
+)
 def test_sensor_toml_errors(tmp_path, text, needle):
     p = tmp_path / "s.toml"
     p.write_text(text)
@@ -184,8 +212,10 @@ def test_camera_toml(tmp_path):
     from hsgeo.workflows.pushbroom_ba import CameraPrior, read_camera
 
     p = tmp_path / "cam.toml"
-    p.write_text("[camera]\nn_bands = 7\npixel_mm = 0.0065\nc_mm = 40\n"
-                 "[gnss_ins]\nsigma_att_deg = [0.01, 0.01, 0.02]\n[gcp]\nsigma_m = 0.05\n")
+    p.write_text(
+        "[camera]\nn_bands = 7\npixel_mm = 0.0065\nc_mm = 40\n"
+        "[gnss_ins]\nsigma_att_deg = [0.01, 0.01, 0.02]\n[gcp]\nsigma_m = 0.05\n"
+    )
     assert read_camera_toml(p)["camera"] == {"n_bands": 7, "pixel_mm": 0.0065, "c_mm": 40.0}
     cam = read_camera(p)
     default = CameraPrior(n_bands=7)
@@ -204,29 +234,53 @@ def test_camera_toml(tmp_path):
 # ---- boards
 def test_read_board_round_trip(tmp_path):
     p = tmp_path / "b.toml"
-    p.write_text('[board]\ntype = "charuco"\ndictionary = "DICT_6X6_250"\nsquares_x = 5\n'
-                 "squares_y = 7\nsquare_mm = 40\nmarker_mm = 20\n")
+    p.write_text(
+        '[board]\ntype = "charuco"\ndictionary = "DICT_6X6_250"\nsquares_x = 5\n'
+        "squares_y = 7\nsquare_mm = 40\nmarker_mm = 20\n"
+    )
     assert read_board(p) == OPENCV_TUTORIAL_CHARUCO
-    p.write_text('[board]\ntype = "aruco_grid"\ndictionary = "DICT_4X4_100"\nmarkers_x = 9\n'
-                 "markers_y = 6\nmarker_mm = 60.0\nseparation_mm = 20.0\n"
-                 "[camera]\npixel_mm = 0.0055\n")
+    p.write_text(
+        '[board]\ntype = "aruco_grid"\ndictionary = "DICT_4X4_100"\nmarkers_x = 9\n'
+        "markers_y = 6\nmarker_mm = 60.0\nseparation_mm = 20.0\n"
+        "[camera]\npixel_mm = 0.0055\n"
+    )
     assert read_board(p) == Board.aruco_grid(9, 6, 60.0, 20.0, "DICT_4X4_100", 0.0055)
 
 
-@pytest.mark.parametrize("text, needle", [
-    ('[board]\ntype = "charuco"\ndictionary = "DICT_6X6_250"\nsquares_x = 5\n',
-     "is missing squares_y, square_mm, marker_mm"),
-    ('[board]\ntype = "hexagons"\ndictionary = "DICT_6X6_250"\n', "[board] type must be one of"),
-    ('[board]\ntype = "charuco"\ndictionary = "DICT_6X6_250"\nsquares_x = 5\nsquares_y = 7\n'
-     "square_mm = 40\nmarker_mm = 20\nseparation_mm = 3\n", "belong to the other board type"),
-    ('[board]\ntype = "charuco"\ndictionary = "DICT_6X6_250"\nsquares_x = 5\nsquares_y = 7\n'
-     "squre_mm = 40\nmarker_mm = 20\n", "did you mean 'square_mm'?"),
-    ('[board]\ntype = "charuco"\ndictionary = "DICT_6X6_999"\nsquares_x = 5\nsquares_y = 7\n'
-     "square_mm = 40\nmarker_mm = 20\n", "unknown ArUco dictionary"),
-    ('[board]\ntype = "charuco"\ndictionary = "DICT_6X6_250"\nsquares_x = 1\nsquares_y = 7\n'
-     "square_mm = 40\nmarker_mm = 20\n", "at least 2 x 2"),
-    ("[board\n", "malformed"),
-])
+@pytest.mark.parametrize(
+    "text, needle",
+    [
+        (
+            '[board]\ntype = "charuco"\ndictionary = "DICT_6X6_250"\nsquares_x = 5\n',
+            "is missing squares_y, square_mm, marker_mm",
+        ),
+        (
+            '[board]\ntype = "hexagons"\ndictionary = "DICT_6X6_250"\n',
+            "[board] type must be one of",
+        ),
+        (
+            '[board]\ntype = "charuco"\ndictionary = "DICT_6X6_250"\nsquares_x = 5\nsquares_y = 7\n'
+            "square_mm = 40\nmarker_mm = 20\nseparation_mm = 3\n",
+            "belong to the other board type",
+        ),
+        (
+            '[board]\ntype = "charuco"\ndictionary = "DICT_6X6_250"\nsquares_x = 5\nsquares_y = 7\n'
+            "squre_mm = 40\nmarker_mm = 20\n",
+            "did you mean 'square_mm'?",
+        ),
+        (
+            '[board]\ntype = "charuco"\ndictionary = "DICT_6X6_999"\nsquares_x = 5\nsquares_y = 7\n'
+            "square_mm = 40\nmarker_mm = 20\n",
+            "unknown ArUco dictionary",
+        ),
+        (
+            '[board]\ntype = "charuco"\ndictionary = "DICT_6X6_250"\nsquares_x = 1\nsquares_y = 7\n'
+            "square_mm = 40\nmarker_mm = 20\n",
+            "at least 2 x 2",
+        ),
+        ("[board\n", "malformed"),
+    ],
+)
 def test_read_board_errors(tmp_path, text, needle):
     p = tmp_path / "b.toml"
     p.write_text(text)
@@ -248,8 +302,14 @@ def test_board_units_reach_opencv():
 def test_lines_round_trip_and_errors(tmp_path):
     rng = np.random.default_rng(0)
     r = rng.random((2, 5, 4)).astype(np.float32)
-    write_lines(tmp_path / "l.nc", r, [10.0, 11, 12, 13], t0_s=1.5, line_rate_hz=8.0,
-                wavelength_nm=[500.0, 600.0])
+    write_lines(
+        tmp_path / "l.nc",
+        r,
+        [10.0, 11, 12, 13],
+        t0_s=1.5,
+        line_rate_hz=8.0,
+        wavelength_nm=[500.0, 600.0],
+    )
     da, t0, rate = read_lines(tmp_path / "l.nc")
     np.testing.assert_array_equal(da.values, r)
     assert (t0, rate) == (1.5, 8.0) and da["pixel"].values.tolist() == [10, 11, 12, 13]
@@ -258,8 +318,7 @@ def test_lines_round_trip_and_errors(tmp_path):
     xr.Dataset({"dn": (("line", "pixel"), r[0])}).to_netcdf(tmp_path / "b.nc", engine="scipy")
     with pytest.raises(InputError, match="no variable 'radiance'"):
         read_lines(tmp_path / "b.nc")
-    xr.Dataset({"radiance": (("line", "pixel"), r[0])}).to_netcdf(tmp_path / "c.nc",
-                                                                 engine="scipy")
+    xr.Dataset({"radiance": (("line", "pixel"), r[0])}).to_netcdf(tmp_path / "c.nc", engine="scipy")
     with pytest.raises(InputError, match="attribute 't0_s' missing"):
         read_lines(tmp_path / "c.nc")
     with pytest.raises(InputError, match="none.nc not found"):
@@ -274,9 +333,13 @@ def test_map_files_refuse_inputs_and_are_atomic(tmp_path):
 
     from hsgeo.io import read_envi
 
-    da = xr.DataArray(np.arange(6.0).reshape(1, 2, 3), dims=("band", "N", "E"),
-                      coords={"band": [0], "N": [10.0, 9.0], "E": [0.0, 1.0, 2.0]},
-                      name="radiance", attrs={"resolution_m": 1.0})
+    da = xr.DataArray(
+        np.arange(6.0).reshape(1, 2, 3),
+        dims=("band", "N", "E"),
+        coords={"band": [0], "N": [10.0, 9.0], "E": [0.0, 1.0, 2.0]},
+        name="radiance",
+        attrs={"resolution_m": 1.0},
+    )
     src = tmp_path / "input.nc"
     src.write_text("the input")
     with pytest.raises(InputError, match="input of the command"):
@@ -303,8 +366,10 @@ def test_atomic_path_keeps_the_old_file_on_failure(tmp_path):
     with atomic_path(p) as tmp:
         tmp.write_text("new")
     assert p.read_text() == "new" and os.listdir(tmp_path) == ["x.txt"]
-    with pytest.raises(InputError, match="does not exist; create it"), \
-            atomic_path(tmp_path / "no" / "x.txt"):
+    with (
+        pytest.raises(InputError, match="does not exist; create it"),
+        atomic_path(tmp_path / "no" / "x.txt"),
+    ):
         pass
 
 

@@ -12,9 +12,11 @@ from hsgeo.trajectory import Trajectory
 def _traj(n=11):
     t = np.linspace(0, 10, n)
     rng = np.random.default_rng(0)
-    return Trajectory(t, np.column_stack([t, 2 * t, np.full(n, 100.0)]) + rng.normal(0, 1, (n, 3)),
-                      np.column_stack([0.01 * t, -0.02 * t, np.full(n, 3.1)])
-                      + rng.normal(0, 0.1, (n, 3)))
+    return Trajectory(
+        t,
+        np.column_stack([t, 2 * t, np.full(n, 100.0)]) + rng.normal(0, 1, (n, 3)),
+        np.column_stack([0.01 * t, -0.02 * t, np.full(n, 3.1)]) + rng.normal(0, 0.1, (n, 3)),
+    )
 
 
 def test_round_trip_is_lossless_and_the_header_is_the_format(tmp_path):
@@ -25,8 +27,9 @@ def test_round_trip_is_lossless_and_the_header_is_the_format(tmp_path):
     np.testing.assert_array_equal(back.t_s, tr.t_s)
     np.testing.assert_array_equal(back.xyz_m, tr.xyz_m)
     # degrees at the edge: deg2rad(rad2deg(x)) is x to the last bit or one ulp
-    np.testing.assert_allclose(back.roll_pitch_heading_rad, tr.roll_pitch_heading_rad,
-                               rtol=2e-16, atol=0)
+    np.testing.assert_allclose(
+        back.roll_pitch_heading_rad, tr.roll_pitch_heading_rad, rtol=2e-16, atol=0
+    )
     # degrees in the file, to the last bit (%.17g)
     table = np.loadtxt(p, delimiter=",", skiprows=1)
     np.testing.assert_array_equal(table[:, 4:], np.rad2deg(tr.roll_pitch_heading_rad))
@@ -35,8 +38,10 @@ def test_round_trip_is_lossless_and_the_header_is_the_format(tmp_path):
 
 def test_parquet_and_extra_columns(tmp_path):
     tr = _traj()
-    df = pd.DataFrame(np.column_stack([tr.t_s, tr.xyz_m, np.rad2deg(tr.roll_pitch_heading_rad)]),
-                      columns=list(NAV_COLUMNS))
+    df = pd.DataFrame(
+        np.column_stack([tr.t_s, tr.xyz_m, np.rad2deg(tr.roll_pitch_heading_rad)]),
+        columns=list(NAV_COLUMNS),
+    )
     df["quality"] = 1
     df.to_parquet(tmp_path / "nav.parquet")
     back = read_trajectory(tmp_path / "nav.parquet")
@@ -55,9 +60,10 @@ def test_never_overwrites_an_input(tmp_path):
 
 
 def test_old_pushbroom_format_gets_the_conversion(tmp_path):
-    pd.DataFrame(np.zeros((3, 7)) + np.arange(3)[:, None],
-                 columns=["t_s", "E_m", "N_m", "H_m", "roll_rad", "pitch_rad", "yaw_rad"]).to_csv(
-        tmp_path / "old.csv", index=False)
+    pd.DataFrame(
+        np.zeros((3, 7)) + np.arange(3)[:, None],
+        columns=["t_s", "E_m", "N_m", "H_m", "roll_rad", "pitch_rad", "yaw_rad"],
+    ).to_csv(tmp_path / "old.csv", index=False)
     with pytest.raises(InputError) as e:
         read_trajectory(tmp_path / "old.csv")
     msg = str(e.value)

@@ -48,8 +48,9 @@ def test_pushbroom_rows_equal_the_previous_numpy_formulas():
     h = 1e-6
     fx = lambda t: t + K1 * t**3 + K2 * t**5 + 3 * P1 * t**2  # noqa: E731
     np.testing.assert_allclose(gx, (fx(xb + h) - fx(xb - h)) / (2 * h), rtol=1e-8)
-    np.testing.assert_allclose(gy, P2 * ((xb + h) ** 2 - (xb - h) ** 2) / (2 * h), rtol=1e-6,
-                               atol=1e-12)
+    np.testing.assert_allclose(
+        gy, P2 * ((xb + h) ** 2 - (xb - h) ** 2) / (2 * h), rtol=1e-6, atol=1e-12
+    )
 
 
 def test_scalar_cores_equal_their_rows():
@@ -59,8 +60,9 @@ def test_scalar_cores_equal_their_rows():
     lever, beta = np.zeros(3), np.eye(3)
     q, p = np.empty(3), np.empty(3)
     KN.pushbroom_camera_point(R, d[0], lever, beta, q, p)
-    rows = KN.pushbroom_image_rows(R[None], d, lever, beta, np.array([17.0]),
-                                   np.array([1e-4, 1e-6, 1e-5, 2e-5]), 0.0, 0.0)
+    rows = KN.pushbroom_image_rows(
+        R[None], d, lever, beta, np.array([17.0]), np.array([1e-4, 1e-6, 1e-5, 2e-5]), 0.0, 0.0
+    )
     np.testing.assert_array_equal(p, rows[1][0])
     x, y, xb, yb, iz, gx, gy = KN.pushbroom_image_mm(*p, 17.0, 1e-4, 1e-6, 1e-5, 2e-5)
     np.testing.assert_array_equal([x, y], rows[2][0])

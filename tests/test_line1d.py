@@ -59,13 +59,19 @@ def test_project_satisfies_eq2_and_matches_view_direction():
     np.testing.assert_allclose(L.tan_from_zeta(z, 486.8, 3539.0, K_NIR), X / Y, atol=1e-12)
 
 
-@pytest.mark.parametrize("name,step", [("eop", 1e-6), ("zeta0_px", 1e-4), ("c_px", 1e-2),
-                                       ("K", 1e-6), ("xy_m", 1e-6)])
+@pytest.mark.parametrize(
+    "name,step", [("eop", 1e-6), ("zeta0_px", 1e-4), ("c_px", 1e-2), ("K", 1e-6), ("xy_m", 1e-6)]
+)
 def test_jacobians(name, step):
     eop, pts, img, pt, z = bench(seed=1)
     blk = L.LineObservations(img, pt, z, 0.05)
-    vals = {"eop": eop + [0.01, -0.02, 0.003], "zeta0_px": np.array(488.0),
-            "c_px": np.array(3500.0), "K": K_NIR * 1.1, "xy_m": pts}
+    vals = {
+        "eop": eop + [0.01, -0.02, 0.003],
+        "zeta0_px": np.array(488.0),
+        "c_px": np.array(3500.0),
+        "K": K_NIR * 1.1,
+        "xy_m": pts,
+    }
     assert check_jacobian(blk, vals, name, step) < 1e-6
 
 
@@ -106,15 +112,17 @@ def test_offline_side_signals_or_station_priors_make_it_full_rank():
     assert identifiability(_params(eop, pts), L.LineObservations(img, pt, z, 0.05)).full_rank
     eop, pts, img, pt, z = bench(offset_m=0.0)
     ps = np.tile([0.01, 0.01, np.inf], (3, 1))
-    assert identifiability(_params(eop, pts, eop_prior_sigma=ps),
-                           L.LineObservations(img, pt, z, 0.05)).full_rank
+    assert identifiability(
+        _params(eop, pts, eop_prior_sigma=ps), L.LineObservations(img, pt, z, 0.05)
+    ).full_rank
 
 
 @pytest.mark.parametrize("seed", range(4))
 def test_truth_within_3_sigma(seed):
     eop, pts, img, pt, z = bench(seed=seed)
-    p = L.make_parameters(eop + [0.02, -0.03, 0.01], 485.0, 3600.0, [0, 0, 0], pts,
-                          np.ones(len(pts), bool))
+    p = L.make_parameters(
+        eop + [0.02, -0.03, 0.01], 485.0, 3600.0, [0, 0, 0], pts, np.ones(len(pts), bool)
+    )
     res = calibrate(p, L.LineObservations(img, pt, z, 0.05))
     for name, truth in [("zeta0_px", 486.8), ("c_px", 3539.0), ("K", K_NIR), ("eop", eop)]:
         assert np.all(np.abs(res.value(name) - truth) < 3.5 * res.sigma(name)), name

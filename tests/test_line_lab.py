@@ -52,8 +52,13 @@ def test_render_is_12bit_and_reproducible():
 def test_measured_minima_match_projection(row):
     sim = simulate_observations(LAB, row, 3)
     t = sim["iop_true"]
-    z = line1d.project(sim["xy_m"][sim["point"]], sim["eop_true"][sim["image"]],
-                       float(t["zeta0_px"]), float(t["c_px"]), t["K"])
+    z = line1d.project(
+        sim["xy_m"][sim["point"]],
+        sim["eop_true"][sim["image"]],
+        float(t["zeta0_px"]),
+        float(t["c_px"]),
+        t["K"],
+    )
     err = sim["zeta_px"] - z
     assert np.abs(err).max() < 0.5 and abs(err.mean()) < 0.03
 
@@ -75,8 +80,11 @@ def test_calibration_within_3_sigma_of_truth(seed, row):
 def test_generate_writes_cli_files(tmp_path):
     cfg = {"scenario": {"generator": "line_lab", "seed": 1}, "calibration": {"row": 1000}}
     paths = generate(cfg, tmp_path)
-    assert [p.name for p in paths] == ["line_lab_observations.csv", "line_lab_control.csv",
-                                       "line_lab_truth.csv"]
+    assert [p.name for p in paths] == [
+        "line_lab_observations.csv",
+        "line_lab_control.csv",
+        "line_lab_truth.csv",
+    ]
     assert paths[0].read_text().splitlines()[0] == "image,point,zeta_px"
     with pytest.raises(InputError, match="unknown line-lab settings"):
         LL.LineLab.from_config({"bogus": 1})

@@ -31,8 +31,9 @@ def test_000_tables_recomputed():
 
 def test_envi_round_trip_and_errors(tmp_path):
     data = np.arange(2 * 3 * 4, dtype=np.float32).reshape(2, 3, 4)
-    p, h = write_envi(tmp_path / "cube", data, map_info=(100.0, 200.0, 0.5, 0.5),
-                      wavelength_nm=[450.0, 870.0])
+    p, h = write_envi(
+        tmp_path / "cube", data, map_info=(100.0, 200.0, 0.5, 0.5), wavelength_nm=[450.0, 870.0]
+    )
     back, hdr = read_envi(p)
     np.testing.assert_array_equal(back, data)
     assert hdr["map_info"] == (100.0, 200.0, 0.5, 0.5)

@@ -15,13 +15,20 @@ CFG = CampaignConfig()
 
 
 def _problem(obs, with_gcp=True, node_interval_s=10.0, y_as_time=False):
-    cam = CameraPrior(n_bands=len(CFG.c_offsets_um), x0_mm=CFG.x0_mm,
-                      lever_arm_m=tuple(obs.lever_arm_m))
+    cam = CameraPrior(
+        n_bands=len(CFG.c_offsets_um), x0_mm=CFG.x0_mm, lever_arm_m=tuple(obs.lever_arm_m)
+    )
     return build_problem(
-        obs.lines, obs.n_points, cam, node_interval_s=node_interval_s,
-        t_span_s=obs.t_span_s, node_prior_mean=obs.node_prior_mean,
+        obs.lines,
+        obs.n_points,
+        cam,
+        node_interval_s=node_interval_s,
+        t_span_s=obs.t_span_s,
+        node_prior_mean=obs.node_prior_mean,
         gcp_index=obs.gcp_index if with_gcp else None,
-        gcp_xyz_m=obs.gcp_xyz_m if with_gcp else None, y_as_time=y_as_time)
+        gcp_xyz_m=obs.gcp_xyz_m if with_gcp else None,
+        y_as_time=y_as_time,
+    )
 
 
 @pytest.fixture(scope="module")
@@ -30,8 +37,19 @@ def tiny():
 
 
 #: What a simulation knows and an adjustment must not see.
-TRUTH_ONLY = {"outlier", "xy_true_px", "strip", "strips", "truth", "values", "nodes", "cp_index",
-              "node_err", "cfg", "scale"}
+TRUTH_ONLY = {
+    "outlier",
+    "xy_true_px",
+    "strip",
+    "strips",
+    "truth",
+    "values",
+    "nodes",
+    "cp_index",
+    "node_err",
+    "cfg",
+    "scale",
+}
 
 
 def test_observations_are_frozen_and_truth_free(tiny):
@@ -43,8 +61,15 @@ def test_observations_are_frozen_and_truth_free(tiny):
         with pytest.raises(dataclasses.FrozenInstanceError):
             o.n_points = 0
     assert {f.name for f in dataclasses.fields(obs.lines)} == {
-        "point", "band", "t_s", "xy_px", "xyz_nav_m", "rpy_nav_rad", "xyz_rate_nav_m_s",
-        "rpy_rate_nav_rad_s"}
+        "point",
+        "band",
+        "t_s",
+        "xy_px",
+        "xyz_nav_m",
+        "rpy_nav_rad",
+        "xyz_rate_nav_m_s",
+        "rpy_rate_nav_rad_s",
+    }
     # the truth-only quantities are on the truth side, and differ from what was observed
     assert truth.__dataclass_params__.frozen
     assert truth.outlier.shape == (obs.lines.n,) and truth.outlier.any()
@@ -73,9 +98,16 @@ def test_model_is_exact_at_truth_noise_free(y_as_time):
     assert np.max(np.abs(r)) < 1e-9
 
 
-@pytest.mark.parametrize("name,step", [
-    ("points_m", 1e-3), ("boresight_rad", 1e-7), ("lever_arm_m", 1e-4),
-    ("distortion", [1e-7, 1e-9, 1e-7, 1e-7]), ("c_mm", 1e-5)])
+@pytest.mark.parametrize(
+    "name,step",
+    [
+        ("points_m", 1e-3),
+        ("boresight_rad", 1e-7),
+        ("lever_arm_m", 1e-4),
+        ("distortion", [1e-7, 1e-9, 1e-7, 1e-7]),
+        ("c_mm", 1e-5),
+    ],
+)
 @pytest.mark.parametrize("y_as_time", [False, True])
 def test_jacobians_against_finite_differences(tiny, name, step, y_as_time):
     _, blocks, _ = _problem(tiny[0], y_as_time=y_as_time)
@@ -125,10 +157,15 @@ def _time_shifted(obs: CampaignObservations, a_s):
 
     vel, rate = two(o.xyz_rate_nav_m_s), two(o.rpy_rate_nav_rad_s)
     lines = PushbroomObservations(
-        point=two(o.point), band=two(o.band), t_s=two(o.t_s) + a_s * sgn, xy_px=two(o.xy_px),
+        point=two(o.point),
+        band=two(o.band),
+        t_s=two(o.t_s) + a_s * sgn,
+        xy_px=two(o.xy_px),
         xyz_nav_m=two(o.xyz_nav_m) + a_s * sgn[:, None] * vel,
         rpy_nav_rad=two(o.rpy_nav_rad) + a_s * sgn[:, None] * rate,
-        xyz_rate_nav_m_s=vel, rpy_rate_nav_rad_s=rate)
+        xyz_rate_nav_m_s=vel,
+        rpy_rate_nav_rad_s=rate,
+    )
     return dataclasses.replace(obs, lines=lines)
 
 
@@ -145,8 +182,12 @@ def test_symmetric_time_errors_do_not_bias(y_as_time):
     p, blocks, _ = _problem(_time_shifted(obs, 2.5e-3), y_as_time=y_as_time)
     res = adjust(p, blocks, ftol=1e-12)
     zn = (res.value("nodes") - truth.values["nodes"]) / res.sigma("nodes")
-    zc = np.concatenate([(res.value(k) - truth.values[k]) / res.sigma(k)
-                         for k in ["boresight_rad", "lever_arm_m", "distortion", "c_mm"]])
+    zc = np.concatenate(
+        [
+            (res.value(k) - truth.values[k]) / res.sigma(k)
+            for k in ["boresight_rad", "lever_arm_m", "distortion", "c_mm"]
+        ]
+    )
     if y_as_time:
         assert np.max(np.abs(zn)) < 0.01 and np.max(np.abs(zc)) < 0.01
     else:  # the probe is sensitive: the image form shows its bias
@@ -187,8 +228,9 @@ def test_bad_input(tiny):
     o = tiny[0].lines
     _, blocks, nodes = _problem(tiny[0])
     with pytest.raises(InputError, match="shape"):
-        PushbroomLines(o.point, o.band[:-1], o.t_s, o.xy_px, o.xyz_nav_m, o.rpy_nav_rad, nodes,
-                       0.0065)
+        PushbroomLines(
+            o.point, o.band[:-1], o.t_s, o.xy_px, o.xyz_nav_m, o.rpy_nav_rad, nodes, 0.0065
+        )
     with pytest.raises(InputError, match="pixel pitch"):
         PushbroomLines(o.point, o.band, o.t_s, o.xy_px, o.xyz_nav_m, o.rpy_nav_rad, nodes, 0.0)
     with pytest.raises(InputError, match="scale"):
@@ -196,8 +238,7 @@ def test_bad_input(tiny):
     point = o.point.copy()
     point[point == 5] = 6  # point 5 unobserved
     with pytest.raises(InputError, match="fewer than two"):
-        build_problem(dataclasses.replace(o, point=point), tiny[0].n_points,
-                      CameraPrior(n_bands=7))
+        build_problem(dataclasses.replace(o, point=point), tiny[0].n_points, CameraPrior(n_bands=7))
 
 
 def test_same_seed_same_bits():
@@ -249,8 +290,9 @@ def test_time_residual_is_the_crossing_time_by_bisection(tiny):
         t = o.t_s + dt
         xyz = o.xyz_nav_m + dt[:, None] * o.xyz_rate_nav_m_s
         rpy = o.rpy_nav_rad + dt[:, None] * o.rpy_rate_nav_rad_s
-        xy, _ = project(vals, b.blocks, nodes, t, xyz, rpy, b.point, b.band, b.beta0,
-                        b.x0_mm, b.y0_mm)
+        xy, _ = project(
+            vals, b.blocks, nodes, t, xyz, rpy, b.point, b.band, b.beta0, b.x0_mm, b.y0_mm
+        )
         return xy * k - b.xy_px
 
     lo, hi = np.full(b.point.size, -0.25), np.full(b.point.size, 0.25)
@@ -261,7 +303,7 @@ def test_time_residual_is_the_crossing_time_by_bisection(tiny):
         lo, hi = np.where(neg, mid, lo), np.where(neg, hi, mid)
     t_star = 0.5 * (lo + hi)
     # same spline piece as the line time (the model continues the piece of t_e)
-    same = (nodes.basis(o.t_s + t_star)[0][:, 0] == nodes.basis(o.t_s)[0][:, 0])
+    same = nodes.basis(o.t_s + t_star)[0][:, 0] == nodes.basis(o.t_s)[0][:, 0]
     assert same.mean() > 0.95
     np.testing.assert_allclose(r[1::2][same], -b.y_rate_ref_px_s * t_star[same], atol=1e-6)
     np.testing.assert_allclose(r[0::2][same], xy_at(t_star)[same, 0], atol=1e-6)
@@ -302,8 +344,7 @@ def test_factored_node_jacobian_compiled_equals_generic(tiny, lam, fix_node):
     lay = _Layout(p)
     out = {}
     for compiled in (True, False):
-        sy = _evaluate(lay, blocks, [np.ones(b.m, bool) for b in blocks], True,
-                       compiled=compiled)
+        sy = _evaluate(lay, blocks, [np.ones(b.m, bool) for b in blocks], True, compiled=compiled)
         assert (sy.Jrc.fcol.shape[1] == 4) == (compiled and not fix_node)
         ne = _normal(lay, sy, SolverOptions(compiled=compiled))
         S_, rhs, _, _ = _reduced(lay, ne, lam)
@@ -320,11 +361,14 @@ def test_time_residual_needs_rates_and_reference(tiny):
     with pytest.raises(InputError, match="both"):
         PushbroomLines(*args, xyz_rate_m_s=o.xyz_rate_nav_m_s)
     with pytest.raises(InputError, match="y_rate_ref_px_s"):
-        PushbroomLines(*args, xyz_rate_m_s=o.xyz_rate_nav_m_s,
-                       rpy_rate_rad_s=o.rpy_rate_nav_rad_s)
+        PushbroomLines(*args, xyz_rate_m_s=o.xyz_rate_nav_m_s, rpy_rate_rad_s=o.rpy_rate_nav_rad_s)
     with pytest.raises(InputError, match="shape"):
-        PushbroomLines(*args, xyz_rate_m_s=o.xyz_rate_nav_m_s[:-1],
-                       rpy_rate_rad_s=o.rpy_rate_nav_rad_s, y_rate_ref_px_s=220.0)
+        PushbroomLines(
+            *args,
+            xyz_rate_m_s=o.xyz_rate_nav_m_s[:-1],
+            rpy_rate_rad_s=o.rpy_rate_nav_rad_s,
+            y_rate_ref_px_s=220.0,
+        )
     no_rates = dataclasses.replace(o, xyz_rate_nav_m_s=None, rpy_rate_nav_rad_s=None)
     with pytest.raises(InputError, match="rates"):
         build_problem(no_rates, tiny[0].n_points, CameraPrior(n_bands=7), y_as_time=True)
@@ -339,11 +383,10 @@ def test_simulated_navigation_rates_are_the_derivative_of_the_poses():
     poses = []
     for dt in (h, -h):
         t = o.t_s + dt
-        xyz, rpy = pc._true_pose(truth.strips, truth.strip, t, cfg.mount_motion_rad,
-                                 cfg.speed_m_s)
+        xyz, rpy = pc._true_pose(truth.strips, truth.strip, t, cfg.mount_motion_rad, cfg.speed_m_s)
         d = truth.nodes.evaluate(truth.values["nodes"], t)
         poses.append((xyz - d[:, :3], rpy - d[:, 3:]))
-    np.testing.assert_allclose(o.xyz_rate_nav_m_s, (poses[0][0] - poses[1][0]) / (2 * h),
-                               atol=1e-6)
-    np.testing.assert_allclose(o.rpy_rate_nav_rad_s, (poses[0][1] - poses[1][1]) / (2 * h),
-                               atol=1e-9)
+    np.testing.assert_allclose(o.xyz_rate_nav_m_s, (poses[0][0] - poses[1][0]) / (2 * h), atol=1e-6)
+    np.testing.assert_allclose(
+        o.rpy_rate_nav_rad_s, (poses[0][1] - poses[1][1]) / (2 * h), atol=1e-9
+    )

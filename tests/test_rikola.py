@@ -47,13 +47,17 @@ def test_paper_tables():
     assert RIKOLA_BANDS.shape == (25,)
     assert np.all(RIKOLA_BANDS["sensor"][:10] == 2) and np.all(RIKOLA_BANDS["sensor"][10:] == 1)
     # the "Average" row of 003 Table 4 is the mean of its ten rows
-    np.testing.assert_allclose(RIKOLA_TABLE4_ROP_DEG.mean(axis=0), RIKOLA_TABLE4_ROP_MEAN_DEG,
-                               atol=2e-5)
+    np.testing.assert_allclose(
+        RIKOLA_TABLE4_ROP_DEG.mean(axis=0), RIKOLA_TABLE4_ROP_MEAN_DEG, atol=2e-5
+    )
 
 
 def _values(truth, band):
-    return {"interior": truth.interior(band), "distortion_mm": truth.KP,
-            "poses": truth.poses[:3].copy()}
+    return {
+        "interior": truth.interior(band),
+        "distortion_mm": truth.KP,
+        "poses": truth.poses[:3].copy(),
+    }
 
 
 def test_target_centroids_jacobian(truth):
@@ -64,8 +68,11 @@ def test_target_centroids_jacobian(truth):
     xy = np.zeros((9, 2))
     blk = TargetCentroids(view, corners, xy, 0.001)
     vals["distortion_mm"] = truth.KP + [1e-4, 1e-6, 1e-7, 1e-5, 1e-5]
-    for name, step in (("interior", 1e-6), ("distortion_mm", [1e-7, 1e-9, 1e-11, 1e-8, 1e-8]),
-                       ("poses", 1e-6)):
+    for name, step in (
+        ("interior", 1e-6),
+        ("distortion_mm", [1e-7, 1e-9, 1e-11, 1e-8, 1e-8]),
+        ("poses", 1e-6),
+    ):
         assert check_jacobian(blk, vals, name, step) < 1e-6, name
 
 
@@ -75,16 +82,33 @@ def test_joint_centroids_jacobian(truth):
     corners = plate.corners()[np.arange(n) * 4 % 54]
     cube = np.arange(n) % 3
     band_index = np.array([1, 4, 19, 14] * 3)  # bands 2, 5, 20, 15
-    blk = JointCentroids(cube, band_index, corners, np.zeros((n, 2)), 0.001,
-                         RIKOLA_BANDS["gap_nm"], RIKOLA_BANDS["sensor"])
-    vals = {"poses": truth.poses[:3].copy(), "gap_model": truth.gap_model.copy(),
-            "df_mm": np.full(25, 1e-3), "pp_mm": truth.pp_mm.copy(),
-            "distortion_mm": truth.KP + [1e-4, 1e-6, 1e-7, 1e-5, 1e-5],
-            "sensor2_rotation": truth.rotation_rad.copy(),
-            "sensor2_offset_mm": np.array([0.5, -0.3, 1.0])}
-    steps = {"gap_model": np.array([1e-8, 1e-6, 1e-8, 1e-6]), "df_mm": 1e-6,
-             "pp_mm": 1e-6, "distortion_mm": [1e-7, 1e-9, 1e-11, 1e-8, 1e-8], "poses": 1e-6,
-             "sensor2_rotation": 1e-7, "sensor2_offset_mm": 1e-4}
+    blk = JointCentroids(
+        cube,
+        band_index,
+        corners,
+        np.zeros((n, 2)),
+        0.001,
+        RIKOLA_BANDS["gap_nm"],
+        RIKOLA_BANDS["sensor"],
+    )
+    vals = {
+        "poses": truth.poses[:3].copy(),
+        "gap_model": truth.gap_model.copy(),
+        "df_mm": np.full(25, 1e-3),
+        "pp_mm": truth.pp_mm.copy(),
+        "distortion_mm": truth.KP + [1e-4, 1e-6, 1e-7, 1e-5, 1e-5],
+        "sensor2_rotation": truth.rotation_rad.copy(),
+        "sensor2_offset_mm": np.array([0.5, -0.3, 1.0]),
+    }
+    steps = {
+        "gap_model": np.array([1e-8, 1e-6, 1e-8, 1e-6]),
+        "df_mm": 1e-6,
+        "pp_mm": 1e-6,
+        "distortion_mm": [1e-7, 1e-9, 1e-11, 1e-8, 1e-8],
+        "poses": 1e-6,
+        "sensor2_rotation": 1e-7,
+        "sensor2_offset_mm": 1e-4,
+    }
     for name, step in steps.items():
         assert check_jacobian(blk, vals, name, step) < 1e-6, name
 
@@ -98,13 +122,28 @@ def test_joint_equals_per_band_at_truth(truth):
         vals["poses"] = np.array([truth.band_pose(0, band)])
         pb = TargetCentroids(np.zeros(10, int), corners, np.zeros((10, 2)), 1.0).predict(vals)
         s = truth.sensor(band) - 1
-        df = truth.f_mm - (truth.gap_model[RIKOLA_BANDS["sensor"] - 1, 0] * RIKOLA_BANDS["gap_nm"]
-                           + truth.gap_model[RIKOLA_BANDS["sensor"] - 1, 1])
-        jv = {"poses": truth.poses[:1], "gap_model": truth.gap_model, "df_mm": df,
-              "pp_mm": truth.pp_mm, "distortion_mm": truth.KP,
-              "sensor2_rotation": truth.rotation_rad, "sensor2_offset_mm": truth.offset_mm}
-        jb = JointCentroids(np.zeros(10, int), np.full(10, band - 1), corners, np.zeros((10, 2)),
-                            1.0, RIKOLA_BANDS["gap_nm"], RIKOLA_BANDS["sensor"]).predict(jv)
+        df = truth.f_mm - (
+            truth.gap_model[RIKOLA_BANDS["sensor"] - 1, 0] * RIKOLA_BANDS["gap_nm"]
+            + truth.gap_model[RIKOLA_BANDS["sensor"] - 1, 1]
+        )
+        jv = {
+            "poses": truth.poses[:1],
+            "gap_model": truth.gap_model,
+            "df_mm": df,
+            "pp_mm": truth.pp_mm,
+            "distortion_mm": truth.KP,
+            "sensor2_rotation": truth.rotation_rad,
+            "sensor2_offset_mm": truth.offset_mm,
+        }
+        jb = JointCentroids(
+            np.zeros(10, int),
+            np.full(10, band - 1),
+            corners,
+            np.zeros((10, 2)),
+            1.0,
+            RIKOLA_BANDS["gap_nm"],
+            RIKOLA_BANDS["sensor"],
+        ).predict(jv)
         np.testing.assert_allclose(jb, pb, atol=1e-12)
         assert s in (0, 1)
 
@@ -118,8 +157,9 @@ def test_projection_round_trip_with_frame_photogrammetric(truth):
     f, x0, y0 = truth.interior(20)
     xy = project_measured_mm(Xc, f, np.array([x0, y0]), truth.KP)
     blk = FramePhotogrammetric(np.zeros(20, int), xy, 0.001, X=X)
-    r, _ = blk.evaluate({"interior": truth.interior(20), "distortion_mm": truth.KP,
-                         "poses": pose[None]}, False)
+    r, _ = blk.evaluate(
+        {"interior": truth.interior(20), "distortion_mm": truth.KP, "poses": pose[None]}, False
+    )
     assert np.max(np.abs(r)) < 1e-10
 
 
@@ -129,8 +169,15 @@ def test_bad_inputs():
     with pytest.raises(InputError):
         TargetCentroids(np.zeros(3, int), np.zeros((3, 4, 3)), np.full((3, 2), np.nan), 1.0)
     with pytest.raises(InputError):
-        JointCentroids(np.zeros(2, int), np.array([0, 30]), np.zeros((2, 4, 3)),
-                       np.zeros((2, 2)), 1.0, RIKOLA_BANDS["gap_nm"], RIKOLA_BANDS["sensor"])
+        JointCentroids(
+            np.zeros(2, int),
+            np.array([0, 30]),
+            np.zeros((2, 4, 3)),
+            np.zeros((2, 2)),
+            1.0,
+            RIKOLA_BANDS["gap_nm"],
+            RIKOLA_BANDS["sensor"],
+        )
     with pytest.raises(InputError):
         make_detector("DICT_NOPE")
     with pytest.raises(InputError):
@@ -167,11 +214,16 @@ def test_rendered_image_is_measured_without_the_truth(cfg, truth):
     assert isinstance(img, np.ndarray) and img.dtype == np.uint16
     plate, cam = r.plate, cfg["camera"]
     size = (int(cam["width_px"]), int(cam["height_px"]))
-    obs, cmp_ = detect_targets_in_images([((0, 5), img)], plate.corners(), plate.ids, size,
-                                         float(cam["pixel_mm"]), dictionary=plate.dictionary)
+    obs, cmp_ = detect_targets_in_images(
+        [((0, 5), img)],
+        plate.corners(),
+        plate.ids,
+        size,
+        float(cam["pixel_mm"]),
+        dictionary=plate.dictionary,
+    )
     assert cmp_ is None and obs.expected == {} and len(obs.target) > 10
-    true_px = mm_to_pixel(truth.project(0, 5, plate.corners()[obs.target]), size,
-                          cam["pixel_mm"])
+    true_px = mm_to_pixel(truth.project(0, 5, plate.corners()[obs.target]), size, cam["pixel_mm"])
     assert np.median(np.abs(obs.corners_px - true_px)) < 0.5
 
 
@@ -200,8 +252,12 @@ def test_joint_model_recovers_truth(bench, truth):
     cals = {b: calibrate_band(obs, b) for b in bands}
     j = calibrate_joint(obs, init=cals, scatter_mm=tuple(truth.scatter_mm))
     R = j.result
-    for name, tr in (("gap_model", truth.gap_model), ("pp_mm", truth.pp_mm),
-                     ("distortion_mm", truth.KP), ("sensor2_rotation", truth.rotation_rad)):
+    for name, tr in (
+        ("gap_model", truth.gap_model),
+        ("pp_mm", truth.pp_mm),
+        ("distortion_mm", truth.KP),
+        ("sensor2_rotation", truth.rotation_rad),
+    ):
         z = (j.value(name) - tr) / j.sigma(name)
         assert np.all(np.abs(z) < 3.5), (name, z)
     np.testing.assert_array_equal(R.value("sensor2_offset_mm"), 0.0)  # held (one lens)

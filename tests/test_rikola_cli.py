@@ -20,8 +20,18 @@ BOARD = ROOT / "src/hsgeo/data/reference/opencv-charuco/board.toml"
 def test_charuco_photographs_match_opencv(capsys):
     """The four tutorial photographs: RMS and principal distance agree with OpenCV's own
     calibration of the same images (SOURCE.md: RMS 0.1878 px, fx, fy 457.3, 461.3 px)."""
-    assert main(["calibrate-frame", *map(str, sorted(CHARUCO.glob("*.jpg"))), "--board",
-                 str(BOARD), "--json"]) == 0
+    assert (
+        main(
+            [
+                "calibrate-frame",
+                *map(str, sorted(CHARUCO.glob("*.jpg"))),
+                "--board",
+                str(BOARD),
+                "--json",
+            ]
+        )
+        == 0
+    )
     out = json.loads(capsys.readouterr().out)
     rows = {r["quantity"]: r for r in out["rows"]}
     assert abs(out["meta"]["band 1"]["rms_px"] - 0.1878) < 0.01
@@ -46,11 +56,27 @@ def test_rendered_aruco_grid_recovers_truth(tmp_path, capsys):
         cv2.imwrite(str(p), to_uint8(r.render(c, 20, 5)))
         files.append(str(p))
     board = tmp_path / "plate.toml"
-    board.write_text('[board]\ntype = "aruco_grid"\ndictionary = "DICT_4X4_100"\n'
-                     "markers_x = 9\nmarkers_y = 6\nmarker_mm = 60.0\nseparation_mm = 20.0\n"
-                     "[camera]\npixel_mm = 0.0055\n")
-    assert main(["calibrate-frame", *files, "--board", str(board), "--band-regex",
-                 r"band(\d+)", "--sigma-px", "0.02", "--json"]) == 0
+    board.write_text(
+        '[board]\ntype = "aruco_grid"\ndictionary = "DICT_4X4_100"\n'
+        "markers_x = 9\nmarkers_y = 6\nmarker_mm = 60.0\nseparation_mm = 20.0\n"
+        "[camera]\npixel_mm = 0.0055\n"
+    )
+    assert (
+        main(
+            [
+                "calibrate-frame",
+                *files,
+                "--board",
+                str(board),
+                "--band-regex",
+                r"band(\d+)",
+                "--sigma-px",
+                "0.02",
+                "--json",
+            ]
+        )
+        == 0
+    )
     out = json.loads(capsys.readouterr().out)
     rows = {r["quantity"]: r for r in out["rows"]}
     for q, t in zip(("f", "x0", "y0"), truth.interior(20), strict=True):
@@ -70,6 +96,8 @@ def test_bad_board_files(tmp_path, capsys):
     p.write_text("[board\n")
     with pytest.raises(InputError, match="malformed"):
         read_board(p)
-    assert main(["calibrate-frame", str(CHARUCO / "img_00.jpg"), "--board", str(BOARD),
-                 "--joint"]) == 2
+    assert (
+        main(["calibrate-frame", str(CHARUCO / "img_00.jpg"), "--board", str(BOARD), "--joint"])
+        == 2
+    )
     assert "--band-regex" in capsys.readouterr().err

@@ -183,9 +183,7 @@ def _central_difference(fun, angles, h=1e-6):
     return np.stack(out, axis=-3)
 
 
-@pytest.mark.parametrize(
-    ("R_fun", "dR_fun"), [(R_from_opk, dR_dopk), (R_from_rpy, dR_drpy)]
-)
+@pytest.mark.parametrize(("R_fun", "dR_fun"), [(R_from_opk, dR_dopk), (R_from_rpy, dR_drpy)])
 def test_dR_against_finite_differences(R_fun, dR_fun):
     angles = [np.asarray(a) for a in _random_angles(n=50, seed=11)]
     np.testing.assert_allclose(dR_fun(*angles), _central_difference(R_fun, angles), atol=1e-9)

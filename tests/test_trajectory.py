@@ -99,25 +99,35 @@ def test_platform_angles_give_the_same_rotation_and_rays():
     """R_ENU_FROM_NED R_from_rpy(r, p, h) diag(1, -1, -1) = R_from_rpy(r, -p, pi/2 - h)."""
     rng = np.random.default_rng(3)
     n = 500
-    rph = np.column_stack([rng.uniform(-np.pi, np.pi, n), rng.uniform(-1.5, 1.5, n),
-                           rng.uniform(-4 * np.pi, 4 * np.pi, n)])
+    rph = np.column_stack(
+        [
+            rng.uniform(-np.pi, np.pi, n),
+            rng.uniform(-1.5, 1.5, n),
+            rng.uniform(-4 * np.pi, 4 * np.pi, n),
+        ]
+    )
     rpy = platform_rpy_from_rph(rph)
     R_map_from_body = R_ENU_FROM_NED @ R_from_rpy(rph[:, 0], rph[:, 1], rph[:, 2])
     R_map_from_platform = R_from_rpy(rpy[:, 0], rpy[:, 1], rpy[:, 2])
-    np.testing.assert_allclose(R_map_from_platform @ R_BODY_FROM_PLATFORM, R_map_from_body,
-                               rtol=0, atol=2e-15)
+    np.testing.assert_allclose(
+        R_map_from_platform @ R_BODY_FROM_PLATFORM, R_map_from_body, rtol=0, atol=2e-15
+    )
     # the same ray: a view direction given in the platform frame and in the body frame
     v_platform = rng.standard_normal((n, 3))
     v_body = v_platform @ R_BODY_FROM_PLATFORM.T
-    np.testing.assert_allclose(np.einsum("nij,nj->ni", R_map_from_platform, v_platform),
-                               np.einsum("nij,nj->ni", R_map_from_body, v_body),
-                               rtol=0, atol=1e-14)
+    np.testing.assert_allclose(
+        np.einsum("nij,nj->ni", R_map_from_platform, v_platform),
+        np.einsum("nij,nj->ni", R_map_from_body, v_body),
+        rtol=0,
+        atol=1e-14,
+    )
     # the platform frame is x forward, y left, z up: level flight north is yaw = 90°
     assert platform_rpy_from_rph([0.0, 0.0, 0.0]).tolist() == [0.0, 0.0, np.pi / 2]
     # round trips (the map is its own inverse)
     np.testing.assert_allclose(rph_from_platform_rpy(rpy), rph, rtol=0, atol=1e-14)
-    np.testing.assert_allclose(platform_rpy_from_rph(rph_from_platform_rpy(rpy)), rpy,
-                               rtol=0, atol=1e-14)
+    np.testing.assert_allclose(
+        platform_rpy_from_rph(rph_from_platform_rpy(rpy)), rpy, rtol=0, atol=1e-14
+    )
     with pytest.raises(InputError, match="shape"):
         platform_rpy_from_rph([1.0, 2.0])
 
@@ -129,7 +139,7 @@ def test_platform_rates_are_the_derivative_of_the_conversion():
     tq = np.array([1.23, 4.56, 7.89])
     _, w = tr.rates(tq)
     h = 1e-6
-    num = (platform_rpy_from_rph(tr.pose(tq + h)[1]) - platform_rpy_from_rph(tr.pose(tq - h)[1]))
+    num = platform_rpy_from_rph(tr.pose(tq + h)[1]) - platform_rpy_from_rph(tr.pose(tq - h)[1])
     np.testing.assert_allclose(platform_rpy_rate_from_rph_rate(w), num / (2 * h), atol=1e-8)
 
 
@@ -164,10 +174,13 @@ def test_spline_basis_against_the_polynomials():
 
     u = np.r_[np.linspace(-0.05, 1.05, 221), 0.0, 1.0]
     u2, u3 = u * u, u * u * u
-    B = np.stack([(1 - u) ** 3 / 6, (3 * u3 - 6 * u2 + 4) / 6,
-                  (-3 * u3 + 3 * u2 + 3 * u + 1) / 6, u3 / 6], axis=-1)
-    dB = np.stack([-((1 - u) ** 2) / 2, (3 * u2 - 4 * u) / 2, (-3 * u2 + 2 * u + 1) / 2,
-                   u2 / 2], axis=-1)
+    B = np.stack(
+        [(1 - u) ** 3 / 6, (3 * u3 - 6 * u2 + 4) / 6, (-3 * u3 + 3 * u2 + 3 * u + 1) / 6, u3 / 6],
+        axis=-1,
+    )
+    dB = np.stack(
+        [-((1 - u) ** 2) / 2, (3 * u2 - 4 * u) / 2, (-3 * u2 + 2 * u + 1) / 2, u2 / 2], axis=-1
+    )
     np.testing.assert_allclose(bspline_basis(u), B, rtol=0, atol=4e-16)
     np.testing.assert_allclose(bspline_basis_derivative(u), dB, rtol=0, atol=4e-16)
     assert bspline_basis(u[:221].reshape(13, 17)).shape == (13, 17, 4)
@@ -176,8 +189,9 @@ def test_spline_basis_against_the_polynomials():
 
 def test_trajectory_rates():
     t = np.linspace(0, 10, 11)
-    tr = Trajectory(t, np.column_stack([2 * t, -t, 0 * t + 5]),
-                    np.column_stack([0.1 * t, 0 * t, 0.02 * t]))
+    tr = Trajectory(
+        t, np.column_stack([2 * t, -t, 0 * t + 5]), np.column_stack([0.1 * t, 0 * t, 0.02 * t])
+    )
     v, w = tr.rates(np.array([0.0, 3.3, 10.0]))  # one-sided at the ends
     np.testing.assert_allclose(v, [[2, -1, 0]] * 3, atol=1e-9)
     np.testing.assert_allclose(w, [[0.1, 0, 0.02]] * 3, atol=1e-9)

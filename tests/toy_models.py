@@ -72,8 +72,10 @@ class Bearings(ResidualBlock):
         dth_dP = np.column_stack([-d[:, 1] / q, d[:, 0] / q])
         dth_dS = np.column_stack([-dth_dP, -np.ones(len(q))])
         nm = self.blocks
-        return r, {nm["stations"]: Indexed(self.station, dth_dS),
-                   nm["points"]: Indexed(self.point, dth_dP)}
+        return r, {
+            nm["stations"]: Indexed(self.station, dth_dS),
+            nm["points"]: Indexed(self.point, dth_dP),
+        }
 
 
 def bearing_scene(rng, n_stations=6, n_points=40, sigma_rad=1e-3, coverage=4):

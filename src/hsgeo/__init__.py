@@ -33,8 +33,16 @@ def show_versions() -> str:
     import platform
 
     lines = [f"hsgeo {__version__}", f"python {platform.python_version()} ({platform.platform()})"]
-    for dist in ("numpy", "scipy", "matplotlib", "pandas", "xarray", "opencv-python-headless",
-                 "numba", "jupyter-book"):
+    for dist in (
+        "numpy",
+        "scipy",
+        "matplotlib",
+        "pandas",
+        "xarray",
+        "opencv-python-headless",
+        "numba",
+        "jupyter-book",
+    ):
         try:
             lines.append(f"{dist} {md.version(dist)}")
         except md.PackageNotFoundError:

@@ -202,7 +202,8 @@ def pushbroom_line_distortion_rows(xb, yb, dist):  # pragma: no cover - compiled
     gy = np.empty(m)
     for j in range(m):
         x[j], y[j], gx[j], gy[j] = pushbroom_line_distortion(
-            xb[j], yb[j], dist[j, 0], dist[j, 1], dist[j, 2], dist[j, 3])
+            xb[j], yb[j], dist[j, 0], dist[j, 1], dist[j, 2], dist[j, 3]
+        )
     return x, y, gx, gy
 
 
@@ -282,7 +283,8 @@ def pushbroom_image_rows(R, d, lever, beta, c, dist, x0, y0):  # pragma: no cove
     for j in range(m):
         pushbroom_camera_point(R[j], d[j], lever, beta, q[j], p[j])
         x, y, xb[j], yb[j], iz[j], gx[j], gy[j] = pushbroom_image_mm(
-            p[j, 0], p[j, 1], p[j, 2], c[j], K1, K2, P1, P2)
+            p[j, 0], p[j, 1], p[j, 2], c[j], K1, K2, P1, P2
+        )
         xy[j, 0] = x + x0
         xy[j, 1] = y + y0
     return q, p, xy, xb, yb, iz, gx, gy

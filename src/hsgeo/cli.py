@@ -28,31 +28,62 @@ def _cmd_calibrate_line(args) -> int:
 
     from hsgeo.workflows.line_calibration import calibrate_files
 
-    out = calibrate_files(args.observations, args.control, zeta0_px=args.zeta0_px,
-                          c_px=args.c_px, sigma_px=args.sigma_px, reject_k=args.reject_k)
+    out = calibrate_files(
+        args.observations,
+        args.control,
+        zeta0_px=args.zeta0_px,
+        c_px=args.c_px,
+        sigma_px=args.sigma_px,
+        reject_k=args.reject_k,
+    )
     res, v = out["result"], out["residuals_px"]
     names = [("zeta0_px", res.value("zeta0_px"), res.sigma("zeta0_px"))]
     names += [("c_px", res.value("c_px"), res.sigma("c_px"))]
-    names += [(k, a, s) for k, a, s in zip(("K1", "K2", "K3"), res.value("K"), res.sigma("K"),
-                                                          strict=True)]
-    stats = {"sigma0": res.sigma0, "dof": res.dof, "rms_px": float(np.sqrt(np.mean(v**2))),
-             "max_abs_px": float(np.max(np.abs(v))), "n_observations": int(v.size)}
+    names += [
+        (k, a, s)
+        for k, a, s in zip(("K1", "K2", "K3"), res.value("K"), res.sigma("K"), strict=True)
+    ]
+    stats = {
+        "sigma0": res.sigma0,
+        "dof": res.dof,
+        "rms_px": float(np.sqrt(np.mean(v**2))),
+        "max_abs_px": float(np.max(np.abs(v))),
+        "n_observations": int(v.size),
+    }
     if args.json:
-        print(json.dumps({"parameters": {k: {"value": float(a), "sigma": float(s)}
-                                          for k, a, s in names},
-                          "residuals": stats}, indent=1))
+        print(
+            json.dumps(
+                {
+                    "parameters": {k: {"value": float(a), "sigma": float(s)} for k, a, s in names},
+                    "residuals": stats,
+                },
+                indent=1,
+            )
+        )
     else:
         print(res.report())
-        print(f"residuals: RMS {stats['rms_px']:.4f} px, max |v| {stats['max_abs_px']:.4f} px "
-              f"over {stats['n_observations']} observations")
+        print(
+            f"residuals: RMS {stats['rms_px']:.4f} px, max |v| {stats['max_abs_px']:.4f} px "
+            f"over {stats['n_observations']} observations"
+        )
+
+
 def _cmd_calibrate_frame(args) -> int:
     from hsgeo.workflows.rikola import calibrate_frame_files
 
-    out = calibrate_frame_files(args.images, args.board, joint=args.joint,
-                                band_regex=args.band_regex, cube_regex=args.cube_regex,
-                                sigma_px=args.sigma_px)
-    print(out.to_json() if args.json else out.to_text() + "\n\n" + "\n".join(
-        f"  {k}: {v}" for k, v in out.meta.items()))
+    out = calibrate_frame_files(
+        args.images,
+        args.board,
+        joint=args.joint,
+        band_regex=args.band_regex,
+        cube_regex=args.cube_regex,
+        sigma_px=args.sigma_px,
+    )
+    print(
+        out.to_json()
+        if args.json
+        else out.to_text() + "\n\n" + "\n".join(f"  {k}: {v}" for k, v in out.meta.items())
+    )
     return 0
 
 
@@ -67,9 +98,15 @@ def _cmd_adjust_pushbroom(args) -> int:
 
     from hsgeo.workflows.pushbroom_ba import adjust_files
 
-    out = adjust_files(args.observations, args.trajectory, args.camera, args.gcp,
-                       node_interval_s=args.node_interval, progress=True,
-                       y_as_time=not args.image_y)
+    out = adjust_files(
+        args.observations,
+        args.trajectory,
+        args.camera,
+        args.gcp,
+        node_interval_s=args.node_interval,
+        progress=True,
+        y_as_time=not args.image_y,
+    )
     res = out.pop("_result")
     print(json.dumps(out, indent=1) if args.json else res.report(max_block_size=20))
     return 0
@@ -85,11 +122,21 @@ def _cmd_versions(args) -> int:
 def _cmd_geocode(args) -> int:
     from hsgeo.workflows.geocoding import geocode_files
 
-    ortho, paths = geocode_files(args.lines, args.trajectory, args.sensor, output=args.output,
-                                 dem=args.dem, height_m=args.height, resolution_m=args.resolution,
-                                 envi=args.envi, progress=not args.quiet)
-    print(f"orthorectified {ortho.sizes['band']} band(s) onto {ortho.sizes['N']} x "
-          f"{ortho.sizes['E']} cells of {args.resolution} m: " + ", ".join(map(str, paths)))
+    ortho, paths = geocode_files(
+        args.lines,
+        args.trajectory,
+        args.sensor,
+        output=args.output,
+        dem=args.dem,
+        height_m=args.height,
+        resolution_m=args.resolution,
+        envi=args.envi,
+        progress=not args.quiet,
+    )
+    print(
+        f"orthorectified {ortho.sizes['band']} band(s) onto {ortho.sizes['N']} x "
+        f"{ortho.sizes['E']} cells of {args.resolution} m: " + ", ".join(map(str, paths))
+    )
     return 0
 
 
@@ -106,11 +153,19 @@ def build_parser() -> argparse.ArgumentParser:
     sub = ap.add_subparsers(dest="command", required=True)
 
     p = sub.add_parser("reproduce", help="print a chapter's tables (paper | reproduced | truth)")
-    p.add_argument("chapter", choices=chapter_names(), metavar="CHAPTER",
-                   help="one of: " + ", ".join(chapter_names()))
+    p.add_argument(
+        "chapter",
+        choices=chapter_names(),
+        metavar="CHAPTER",
+        help="one of: " + ", ".join(chapter_names()),
+    )
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0); any works")
-    p.add_argument("--scale", type=float, default=1.0,
-                   help="problem size in (0, 1] for chapters that have a size knob (default 1)")
+    p.add_argument(
+        "--scale",
+        type=float,
+        default=1.0,
+        help="problem size in (0, 1] for chapters that have a size knob (default 1)",
+    )
     p.add_argument("--json", action="store_true", help="one JSON object instead of text tables")
     p.set_defaults(func=_cmd_reproduce)
 
@@ -119,43 +174,65 @@ def build_parser() -> argparse.ArgumentParser:
         help="calibrate one spectral line of a 1D line scanner (000 eq. 2) from measured minima",
         description="OBSERVATIONS: CSV 'image,point,zeta_px' (ids, ζ in px, pixel-centre "
         "origin); CONTROL: CSV 'point,x_m,y_m' (coordinates in the scanner plane, m). Some "
-        "control points must lie off the pattern line, or the scale c is undetermined.")
+        "control points must lie off the pattern line, or the scale c is undetermined.",
+    )
     p.add_argument("observations", metavar="OBSERVATIONS")
     p.add_argument("--control", required=True, metavar="CONTROL")
     p.add_argument("--zeta0-px", type=float, default=485.0, help="initial ζ0 (000 Table 1: 485)")
     p.add_argument("--c-px", type=float, default=3600.0, help="initial c (000 Table 1: 3600)")
     p.add_argument("--sigma-px", type=float, default=0.1, help="a-priori σ of ζ (px)")
-    p.add_argument("--reject-k", type=float, default=None,
-                   help="reject observations whose standardised residual exceeds k robust σ "
-                        "(default: none)")
+    p.add_argument(
+        "--reject-k",
+        type=float,
+        default=None,
+        help="reject observations whose standardised residual exceeds k robust σ (default: none)",
+    )
     p.add_argument("--json", action="store_true", help="estimates and residual statistics as JSON")
     p.set_defaults(func=_cmd_calibrate_line)
-    p = sub.add_parser("calibrate-frame", help="self-calibrate a frame camera (per band or "
-                       "jointly, 003) from images of an ArUco / ChArUco board")
+    p = sub.add_parser(
+        "calibrate-frame",
+        help="self-calibrate a frame camera (per band or "
+        "jointly, 003) from images of an ArUco / ChArUco board",
+    )
     p.add_argument("images", nargs="+", metavar="IMAGES", help="image files")
-    p.add_argument("--board", required=True, help="board description (TOML, see "
-                   "hsgeo.io.boards)")
+    p.add_argument("--board", required=True, help="board description (TOML, see hsgeo.io.boards)")
     g = p.add_mutually_exclusive_group()
-    g.add_argument("--per-band", action="store_false", dest="joint",
-                   help="one calibration per band (default)")
-    g.add_argument("--joint", action="store_true", help="one joint adjustment of all bands "
-                   "(Rikola band numbering of 003 Table 2; needs --band-regex and --cube-regex)")
+    g.add_argument(
+        "--per-band", action="store_false", dest="joint", help="one calibration per band (default)"
+    )
+    g.add_argument(
+        "--joint",
+        action="store_true",
+        help="one joint adjustment of all bands "
+        "(Rikola band numbering of 003 Table 2; needs --band-regex and --cube-regex)",
+    )
     p.add_argument("--band-regex", help="regex with one group: band number from the file name")
     p.add_argument("--cube-regex", help="regex with one group: cube (view) from the file name")
-    p.add_argument("--sigma-px", type=float, default=0.1,
-                   help="a-priori σ of an image point in px (default 0.1)")
+    p.add_argument(
+        "--sigma-px",
+        type=float,
+        default=0.1,
+        help="a-priori σ of an image point in px (default 0.1)",
+    )
     p.add_argument("--json", action="store_true", help="one JSON object instead of text")
     p.set_defaults(func=_cmd_calibrate_frame, joint=False)
 
     p = sub.add_parser("data", help="generate data_synthetic/generated from the scenario TOMLs")
-    p.add_argument("--verify", action="store_true",
-                   help="fail if a generated file differs from data_synthetic/MANIFEST.sha256")
-    p.add_argument("--update-manifest", action="store_true",
-                   help="rewrite the manifest from what was generated (after a deliberate change)")
+    p.add_argument(
+        "--verify",
+        action="store_true",
+        help="fail if a generated file differs from data_synthetic/MANIFEST.sha256",
+    )
+    p.add_argument(
+        "--update-manifest",
+        action="store_true",
+        help="rewrite the manifest from what was generated (after a deliberate change)",
+    )
     p.set_defaults(func=_cmd_data)
 
     p = sub.add_parser(
-        "geocode", help="orthorectify a line-scanner flight line onto a map grid",
+        "geocode",
+        help="orthorectify a line-scanner flight line onto a map grid",
         description="Geocode every pixel of a flight line (ray from the recorded navigation and "
         "the sensor model, intersected with a DEM or a plane) and resample it onto a north-up "
         "grid by nearest neighbour. LINES: NetCDF with radiance(line, pixel) or (band, line, "
@@ -164,10 +241,15 @@ def build_parser() -> argparse.ArgumentParser:
         "roll_deg, pitch_deg, heading_deg (positions east-north-up in m; attitude of the body, "
         "x forward, y right, z down, in north-east-down, in degrees; see hsgeo.io.navigation). "
         "SENSOR: TOML, see hsgeo.io.read_sensor_toml. DEM: NetCDF with height(N, E) in "
-        "metres.")
+        "metres.",
+    )
     p.add_argument("lines", metavar="LINES")
-    p.add_argument("--trajectory", required=True, metavar="NAV",
-                   help="navigation file (GNSS/INS solution, CSV or Parquet; see above)")
+    p.add_argument(
+        "--trajectory",
+        required=True,
+        metavar="NAV",
+        help="navigation file (GNSS/INS solution, CSV or Parquet; see above)",
+    )
     p.add_argument("--sensor", required=True, metavar="SENSOR.toml")
     g = p.add_mutually_exclusive_group(required=True)
     g.add_argument("--dem", metavar="DEM.nc")
@@ -188,19 +270,31 @@ def build_parser() -> argparse.ArgumentParser:
         "x forward, y right, z down, in north-east-down, in degrees; see hsgeo.io.navigation). "
         "The former format (H_m, roll_rad, pitch_rad, yaw_rad in ENU platform angles) converts "
         "as U_m = H_m, roll_deg = deg(roll_rad), pitch_deg = -deg(pitch_rad), heading_deg = "
-        "90 - deg(yaw_rad).")
+        "90 - deg(yaw_rad).",
+    )
     p.add_argument("observations", help="observation table (CSV or Parquet)")
-    p.add_argument("--trajectory", required=True, metavar="NAV",
-                   help="navigation file (GNSS/INS solution, CSV or Parquet; see above)")
+    p.add_argument(
+        "--trajectory",
+        required=True,
+        metavar="NAV",
+        help="navigation file (GNSS/INS solution, CSV or Parquet; see above)",
+    )
     p.add_argument("--camera", required=True, help="camera and prior σ (TOML)")
     p.add_argument("--gcp", help="ground control points table (optional)")
-    p.add_argument("--node-interval", type=float, default=10.0,
-                   help="spline node interval in s (default 10, 002 §4)")
-    p.add_argument("--image-y", action="store_true",
-                   help="residual across the line as the image y of 002 eq. 2 (default: as a "
-                   "time, the image y over its rate from the trajectory's velocity and angular "
-                   "rate, which avoids a bias of the principal distance and the pitch "
-                   "corrections)")
+    p.add_argument(
+        "--node-interval",
+        type=float,
+        default=10.0,
+        help="spline node interval in s (default 10, 002 §4)",
+    )
+    p.add_argument(
+        "--image-y",
+        action="store_true",
+        help="residual across the line as the image y of 002 eq. 2 (default: as a "
+        "time, the image y over its rate from the trajectory's velocity and angular "
+        "rate, which avoids a bias of the principal distance and the pitch "
+        "corrections)",
+    )
     p.add_argument("--json", action="store_true", help="JSON instead of the text report")
     p.set_defaults(func=_cmd_adjust_pushbroom)
 

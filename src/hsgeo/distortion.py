@@ -86,15 +86,13 @@ def _as_last(a: ArrayLike, name: str, n: int, what: str) -> NDArray[np.float64]:
 def _broadcast(*arrays: tuple[NDArray[np.float64], int, str]) -> list[NDArray[np.float64]]:
     """Broadcast the batch dimensions of (array, n_trailing, name) triples."""
     try:
-        batch = np.broadcast_shapes(
-            *(a.shape[: a.ndim - k] for a, k, _ in arrays)
-        )
+        batch = np.broadcast_shapes(*(a.shape[: a.ndim - k] for a, k, _ in arrays))
     except ValueError as exc:
         shapes = ", ".join(f"{nm}{a.shape}" for a, _, nm in arrays)
         raise InputError(
             f"batch dimensions do not broadcast: {shapes}; give them compatible leading shapes."
         ) from exc
-    return [np.broadcast_to(a, batch + a.shape[a.ndim - k:]) for a, k, _ in arrays]
+    return [np.broadcast_to(a, batch + a.shape[a.ndim - k :]) for a, k, _ in arrays]
 
 
 def _stack22(a, b, c, d) -> NDArray[np.float64]:
@@ -160,8 +158,9 @@ def _newton_invert(
 # --------------------------------------------------------------------------- 1D odd radial
 
 
-def _check_K_1d(d: ArrayLike, K: ArrayLike, norm: float = 1.0,
-                d_name: str = "d") -> tuple[NDArray, NDArray, NDArray]:
+def _check_K_1d(
+    d: ArrayLike, K: ArrayLike, norm: float = 1.0, d_name: str = "d"
+) -> tuple[NDArray, NDArray, NDArray]:
     d = _as_float(d, d_name)
     K = _as_float(K, "K")
     if K.ndim < 1 or K.shape[-1] < 1:
@@ -245,8 +244,9 @@ def odd_radial_1d(d: ArrayLike, K: ArrayLike, norm: float = 1.0) -> NDArray:
     return _odd_series(d / norm, K)
 
 
-def odd_radial_1d_jacobian(d: ArrayLike, K: ArrayLike,
-                           norm: float = 1.0) -> tuple[NDArray, NDArray]:
+def odd_radial_1d_jacobian(
+    d: ArrayLike, K: ArrayLike, norm: float = 1.0
+) -> tuple[NDArray, NDArray]:
     """Jacobian of :func:`odd_radial_1d` with respect to d and K.
 
     Parameters
@@ -304,8 +304,9 @@ def ideal_from_measured_1d(d: ArrayLike, K: ArrayLike, norm: float = 1.0) -> NDA
     return d - _odd_series(d / norm, K)
 
 
-def _measured_from_ideal_1d(t: NDArray, K: NDArray, norm: float, max_iter: int, tol: float,
-                            max_step: float) -> tuple[NDArray, NDArray]:
+def _measured_from_ideal_1d(
+    t: NDArray, K: NDArray, norm: float, max_iter: int, tol: float, max_step: float
+) -> tuple[NDArray, NDArray]:
     """Newton for ``d − δ(d) = t`` (no checks, no convergence test); returns d and 1 − δ'(d)."""
     d = np.array(t, dtype=np.float64, copy=True)
     for _ in range(max_iter):
@@ -744,8 +745,7 @@ def _line_002_terms(xy: NDArray, dist: NDArray):
     flat = xy.reshape(-1, 2)
     xb = np.ascontiguousarray(flat[:, 0])
     yb = np.ascontiguousarray(flat[:, 1])
-    x, y, gx, gy = pushbroom_line_distortion_rows(
-        xb, yb, np.ascontiguousarray(dist.reshape(-1, 4)))
+    x, y, gx, gy = pushbroom_line_distortion_rows(xb, yb, np.ascontiguousarray(dist.reshape(-1, 4)))
     return tuple(a.reshape(shape) for a in (x, y, gx, gy, xb))
 
 
@@ -784,8 +784,7 @@ def distort_pushbroom_line(xy_mm: ArrayLike, dist: ArrayLike) -> NDArray:
     return np.stack([x, y], axis=-1)
 
 
-def distort_pushbroom_line_jacobian(xy_mm: ArrayLike,
-                                    dist: ArrayLike) -> tuple[NDArray, NDArray]:
+def distort_pushbroom_line_jacobian(xy_mm: ArrayLike, dist: ArrayLike) -> tuple[NDArray, NDArray]:
     """Jacobian of :func:`distort_pushbroom_line`.
 
     Parameters
@@ -817,15 +816,18 @@ def _line_002_jacobian(xy: NDArray, dist: NDArray) -> tuple[NDArray, NDArray]:
     J_xy = _stack22(gx, zero, gy, one)
     x2 = xb**2
     J_dist = np.stack(
-        [np.stack([xb**3, xb**5, 3.0 * x2, zero], axis=-1),
-         np.stack([zero, zero, zero, x2], axis=-1)],
+        [
+            np.stack([xb**3, xb**5, 3.0 * x2, zero], axis=-1),
+            np.stack([zero, zero, zero, x2], axis=-1),
+        ],
         axis=-2,
     )
     return J_xy, J_dist
 
 
-def undistort_pushbroom_line(xy_d_mm: ArrayLike, dist: ArrayLike, tol: float = 1e-12,
-                             max_iter: int = 50) -> NDArray:
+def undistort_pushbroom_line(
+    xy_d_mm: ArrayLike, dist: ArrayLike, tol: float = 1e-12, max_iter: int = 50
+) -> NDArray:
     """Invert :func:`distort_pushbroom_line` by Newton iteration (2×2, analytic Jacobian).
 
     Parameters

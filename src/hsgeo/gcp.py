@@ -26,6 +26,7 @@ __all__ = [
     "Flag",
 ]
 
+
 def deviation_table(dy_m, dx_m, ids=None) -> tuple[pd.DataFrame, dict[str, float]]:
     """The 000 Table 2/3 layout computed from coordinate differences.
 
@@ -55,15 +56,25 @@ def deviation_table(dy_m, dx_m, ids=None) -> tuple[pd.DataFrame, dict[str, float
     ny, nx = dy.mean(), dx.mean()
     vy, vx = dy - ny, dx - nx
     table = pd.DataFrame(
-        {"dy_m": dy, "dx_m": dx, "dy_minus_n_m": vy, "vyvy_m2": vy**2, "dx_minus_n_m": vx,
-         "vxvx_m2": vx**2},
+        {
+            "dy_m": dy,
+            "dx_m": dx,
+            "dy_minus_n_m": vy,
+            "vyvy_m2": vy**2,
+            "dx_minus_n_m": vx,
+            "vxvx_m2": vx**2,
+        },
         index=pd.Index(ids if ids is not None else np.arange(1, n + 1), name="gcp"),
     )
     summary = {
-        "n": n, "bias_y_m": ny, "bias_x_m": nx,
+        "n": n,
+        "bias_y_m": ny,
+        "bias_x_m": nx,
         "sigma_y_m": float(np.sqrt((vy**2).sum() / (n - 1))),
         "sigma_x_m": float(np.sqrt((vx**2).sum() / (n - 1))),
-        "sum_dy_m": dy.sum(), "sum_dx_m": dx.sum(), "sum_vyvy_m2": (vy**2).sum(),
+        "sum_dy_m": dy.sum(),
+        "sum_dx_m": dx.sum(),
+        "sum_vyvy_m2": (vy**2).sum(),
         "sum_vxvx_m2": (vx**2).sum(),
     }
     return table, summary
@@ -90,8 +101,10 @@ class Flag:
     note: str
 
     def __str__(self) -> str:
-        return (f"{self.where}: printed {self.printed:.{self.decimals}f}, recomputed "
-                f"{self.recomputed:.4f} ({self.note})")
+        return (
+            f"{self.where}: printed {self.printed:.{self.decimals}f}, recomputed "
+            f"{self.recomputed:.4f} ({self.note})"
+        )
 
 
 def _follows(printed: float, value: float, decimals: int) -> bool:

@@ -43,6 +43,7 @@ __all__ = [
     "orthorectify",
 ]
 
+
 class LineGeometry:
     """The inner geometry of a line scanner: pixel ζ ↔ tangent of the across-track view angle."""
 
@@ -124,11 +125,20 @@ class DemTerrain:
             raise InputError("the DEM has NaN cells: fill them before geocoding")
         from scipy.interpolate import RegularGridInterpolator
 
-        self._f = RegularGridInterpolator((d["N"].values, d["E"].values), z, method="linear",
-                                          bounds_error=False, fill_value=np.nan)
+        self._f = RegularGridInterpolator(
+            (d["N"].values, d["E"].values),
+            z,
+            method="linear",
+            bounds_error=False,
+            fill_value=np.nan,
+        )
         self.mean_height_m = float(z.mean())
-        self.extent = (float(d["E"].min()), float(d["E"].max()), float(d["N"].min()),
-                       float(d["N"].max()))
+        self.extent = (
+            float(d["E"].min()),
+            float(d["E"].max()),
+            float(d["N"].min()),
+            float(d["N"].max()),
+        )
 
     def height(self, E, N):
         E, N = np.broadcast_arrays(np.asarray(E, float), np.asarray(N, float))
@@ -213,12 +223,20 @@ def ray_directions(rpy_rad, tan_angle, R_body_from_sensor=None) -> np.ndarray:
     return np.einsum("nij,nj->ni", R, d_s)
 
 
-
 # ----------------------------------------------------------------------------------------------
 # Geocoding of point observations and the GCP calibration of the boresight (PARGE-style)
 # ----------------------------------------------------------------------------------------------
-def geocode_observations(nav, sensor: LineGeometry, line, zeta_px, *, t0_s: float,
-                         line_rate_hz: float, terrain, boresight_rad=(0.0, 0.0, 0.0)):
+def geocode_observations(
+    nav,
+    sensor: LineGeometry,
+    line,
+    zeta_px,
+    *,
+    t0_s: float,
+    line_rate_hz: float,
+    terrain,
+    boresight_rad=(0.0, 0.0, 0.0),
+):
     """Ground coordinates of observations (fractional line, ζ) of a line scanner.
 
     Parameters
@@ -257,9 +275,20 @@ class BoresightGCP(ResidualBlock):
     group_size = 2
     BLOCKS = MappingProxyType({"boresight": "boresight"})
 
-    def __init__(self, nav, sensor: LineGeometry, line, zeta_px, gcp_enu_m, *, t0_s: float,
-                 line_rate_hz: float, height_m: float, sigma_m: float,
-                 blocks: Mapping[str, str] | None = None):
+    def __init__(
+        self,
+        nav,
+        sensor: LineGeometry,
+        line,
+        zeta_px,
+        gcp_enu_m,
+        *,
+        t0_s: float,
+        line_rate_hz: float,
+        height_m: float,
+        sigma_m: float,
+        blocks: Mapping[str, str] | None = None,
+    ):
         gcp = np.asarray(gcp_enu_m, dtype=float)
         super().__init__(np.full(2 * gcp.shape[0], sigma_m), blocks=blocks)
         t_s = t0_s + np.asarray(line, float) / line_rate_hz
@@ -286,8 +315,18 @@ class BoresightGCP(ResidualBlock):
         return r, {self.blocks["boresight"]: np.transpose(dX[:, :, :2], (0, 2, 1)).reshape(-1, 3)}
 
 
-def calibrate_boresight(nav, sensor: LineGeometry, line, zeta_px, gcp_enu_m, *, t0_s,
-                        line_rate_hz, height_m, sigma_m=0.3):
+def calibrate_boresight(
+    nav,
+    sensor: LineGeometry,
+    line,
+    zeta_px,
+    gcp_enu_m,
+    *,
+    t0_s,
+    line_rate_hz,
+    height_m,
+    sigma_m=0.3,
+):
     """Estimate the boresight angles from GCPs (as PARGE does with GCP-calibrated data).
 
     The rank of the design is checked first: with one straight line over a flat field, the three
@@ -301,17 +340,36 @@ def calibrate_boresight(nav, sensor: LineGeometry, line, zeta_px, gcp_enu_m, *, 
     """
     p = Parameters()
     p.add("boresight", np.zeros(3), columns=("roll_rad", "pitch_rad", "heading_rad"))
-    blk = BoresightGCP(nav, sensor, line, zeta_px, gcp_enu_m, t0_s=t0_s,
-                       line_rate_hz=line_rate_hz, height_m=height_m, sigma_m=sigma_m)
+    blk = BoresightGCP(
+        nav,
+        sensor,
+        line,
+        zeta_px,
+        gcp_enu_m,
+        t0_s=t0_s,
+        line_rate_hz=line_rate_hz,
+        height_m=height_m,
+        sigma_m=sigma_m,
+    )
     return adjust(p, blk)
 
 
 # ----------------------------------------------------------------------------------------------
 # Orthorectification of whole flight lines
 # ----------------------------------------------------------------------------------------------
-def geocode_image(nav, sensor: LineGeometry, n_lines: int, zeta_px, *, t0_s: float,
-                  line_rate_hz: float, terrain, boresight_rad=(0.0, 0.0, 0.0),
-                  chunk_lines: int = 2000, progress=None) -> np.ndarray:
+def geocode_image(
+    nav,
+    sensor: LineGeometry,
+    n_lines: int,
+    zeta_px,
+    *,
+    t0_s: float,
+    line_rate_hz: float,
+    terrain,
+    boresight_rad=(0.0, 0.0, 0.0),
+    chunk_lines: int = 2000,
+    progress=None,
+) -> np.ndarray:
     """Ground coordinates of every pixel of a flight line: ``(n_lines, n_px, 3)`` (E, N, U).
 
     ``progress``: True prints the share done to stderr; a callable gets ``(done, total)``.
@@ -329,15 +387,27 @@ def geocode_image(nav, sensor: LineGeometry, n_lines: int, zeta_px, *, t0_s: flo
         d = ray_directions(np.repeat(rpy, zeta.size, axis=0), np.tile(tan, m), R_bs)
         out[a:b] = intersect(np.repeat(pos, zeta.size, axis=0), d, terrain).reshape(m, -1, 3)
         if progress is True:
-            print(f"\r  geocoded {b}/{n_lines} lines", end="" if b < n_lines else "\n",
-                  file=sys.stderr, flush=True)
+            print(
+                f"\r  geocoded {b}/{n_lines} lines",
+                end="" if b < n_lines else "\n",
+                file=sys.stderr,
+                flush=True,
+            )
         elif callable(progress):
             progress(b, n_lines)
     return out
 
 
-def orthorectify(image, ground_enu_m, *, resolution_m: float, bounds=None, band_names=None,
-                 max_distance_m: float | None = None, attrs=None):
+def orthorectify(
+    image,
+    ground_enu_m,
+    *,
+    resolution_m: float,
+    bounds=None,
+    band_names=None,
+    max_distance_m: float | None = None,
+    attrs=None,
+):
     """Resample a line-scanner image onto a north-up map grid by nearest neighbour.
 
     Nearest neighbour keeps every spectrum as it was measured (no mixing of pixels), as is usual
@@ -383,13 +453,12 @@ def orthorectify(image, ground_enu_m, *, resolution_m: float, bounds=None, band_
         across = np.linalg.norm(np.diff(g, axis=1), axis=-1).max() if g.shape[1] > 1 else 0.0
         max_distance_m = 0.55 * np.hypot(along, across) + 0.5 * resolution_m
     e0, e1, n0, n1 = bounds
-    E = np.arange(np.floor(e0 / resolution_m) * resolution_m + resolution_m / 2, e1,
-                  resolution_m)
-    N = np.arange(np.ceil(n1 / resolution_m) * resolution_m - resolution_m / 2, n0,
-                  -resolution_m)
+    E = np.arange(np.floor(e0 / resolution_m) * resolution_m + resolution_m / 2, e1, resolution_m)
+    N = np.arange(np.ceil(n1 / resolution_m) * resolution_m - resolution_m / 2, n0, -resolution_m)
     gE, gN = np.meshgrid(E, N)
-    dist, idx = cKDTree(EN).query(np.column_stack([gE.ravel(), gN.ravel()]),
-                                  distance_upper_bound=max_distance_m)
+    dist, idx = cKDTree(EN).query(
+        np.column_stack([gE.ravel(), gN.ravel()]), distance_upper_bound=max_distance_m
+    )
     ok = np.isfinite(dist)
     flat = img.reshape(img.shape[0], -1).astype(np.float64)
     out = np.full((img.shape[0], gE.size), np.nan)
@@ -397,12 +466,19 @@ def orthorectify(image, ground_enu_m, *, resolution_m: float, bounds=None, band_
     da = xr.DataArray(
         out.reshape(img.shape[0], N.size, E.size),
         dims=("band", "N", "E"),
-        coords={"band": band_names if band_names is not None else np.arange(img.shape[0]),
-                "N": N, "E": E},
+        coords={
+            "band": band_names if band_names is not None else np.arange(img.shape[0]),
+            "N": N,
+            "E": E,
+        },
         name="radiance",
-        attrs={"crs": "local east-north-up frame (metres)", "resolution_m": resolution_m,
-               "resampling": "nearest neighbour", "max_distance_m": float(max_distance_m),
-               **(attrs or {})},
+        attrs={
+            "crs": "local east-north-up frame (metres)",
+            "resolution_m": resolution_m,
+            "resampling": "nearest neighbour",
+            "max_distance_m": float(max_distance_m),
+            **(attrs or {}),
+        },
     )
     da["E"].attrs.update(units="m", long_name="easting")
     da["N"].attrs.update(units="m", long_name="northing")

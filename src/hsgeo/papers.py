@@ -62,12 +62,28 @@ class LineIOP:
 
 #: 000 Table 1, row "calibrated": λ = 870 nm (000 §4.1, "calibration was performed for 870 nm").
 P000_TABLE1_CALIBRATED = LineIOP(
-    None, 870.0, 486.8, 0.1, 3539.0, 14.0, 1.459, -0.1636, 0.00526,
+    None,
+    870.0,
+    486.8,
+    0.1,
+    3539.0,
+    14.0,
+    1.459,
+    -0.1636,
+    0.00526,
     "000 Table 1, row 'calibrated'",
 )
 #: 000 Table 1, row "uncalibrated": the nominal values (x0 = 485 px, c = 3600 px).
 P000_TABLE1_UNCALIBRATED = LineIOP(
-    None, 870.0, 485.0, None, 3600.0, None, None, None, None,
+    None,
+    870.0,
+    485.0,
+    None,
+    3600.0,
+    None,
+    None,
+    None,
+    None,
     "000 Table 1, row 'uncalibrated'",
 )
 
@@ -76,8 +92,7 @@ P001_TABLE2 = (
     LineIOP(100, None, 499.9, 0.1, 3614.0, 14.0, 0.660, -0.080, 0.0024, "001 Table 2, line 100"),
     LineIOP(300, None, 497.5, 0.1, 3605.0, 14.0, 0.695, -0.085, 0.0027, "001 Table 2, line 300"),
     LineIOP(500, None, 494.7, 0.1, 3569.0, 14.0, 0.710, -0.084, 0.0027, "001 Table 2, line 500"),
-    LineIOP(1000, None, 486.8, 0.1, 3539.0, 14.0, 1.459, -0.164, 0.0053,
-            "001 Table 2, line 1000"),
+    LineIOP(1000, None, 486.8, 0.1, 3539.0, 14.0, 1.459, -0.164, 0.0053, "001 Table 2, line 1000"),
 )
 
 #: ImSpector V9 + PixelFly (001 Table 1 and §2.1).
@@ -99,8 +114,11 @@ P001_SENSOR = {
 P001_DISTORTION_STATEMENTS = {
     "max_distortion_line100_px": (4.0, "001 §4: 'ranges from 4 px for the blue-indigo'"),
     "max_distortion_visible_px": (11.0, "001 §3.1: 'within a range of 0 to 11 for the visible'"),
-    "distortion_450px_line1000_px": (25.0, "001 §3.1: 'rises drastically ... above 25' (NIR, at "
-                                           "the line's edge, 450 px from the centre)"),
+    "distortion_450px_line1000_px": (
+        25.0,
+        "001 §3.1: 'rises drastically ... above 25' (NIR, at "
+        "the line's edge, 450 px from the centre)",
+    ),
 }
 
 
@@ -135,14 +153,24 @@ P000_TABLE3_ROWS = (
 #: The footers as printed: value and printed decimals. Table 2 prints the y bias as "n_x".
 P000_GCP_FOOTERS = {
     "000 Table 2": {
-        "sum_dy_m": (-1.95, 2), "sum_dx_m": (0.25, 2), "sum_vyvy_m2": (6.98, 2),
-        "sum_vxvx_m2": (3.84, 2), "bias_y_m": (-0.2, 1), "bias_x_m": (0.0, 1),
-        "sigma_y_m": (0.88, 2), "sigma_x_m": (0.65, 2),
+        "sum_dy_m": (-1.95, 2),
+        "sum_dx_m": (0.25, 2),
+        "sum_vyvy_m2": (6.98, 2),
+        "sum_vxvx_m2": (3.84, 2),
+        "bias_y_m": (-0.2, 1),
+        "bias_x_m": (0.0, 1),
+        "sigma_y_m": (0.88, 2),
+        "sigma_x_m": (0.65, 2),
     },
     "000 Table 3": {
-        "sum_dy_m": (-0.20, 2), "sum_dx_m": (0.34, 2), "sum_vyvy_m2": (1.49, 2),
-        "sum_vxvx_m2": (0.75, 2), "bias_y_m": (-0.02, 2), "bias_x_m": (0.03, 2),
-        "sigma_y_m": (0.40, 2), "sigma_x_m": (0.29, 2),
+        "sum_dy_m": (-0.20, 2),
+        "sum_dx_m": (0.34, 2),
+        "sum_vyvy_m2": (1.49, 2),
+        "sum_vxvx_m2": (0.75, 2),
+        "bias_y_m": (-0.02, 2),
+        "bias_x_m": (0.03, 2),
+        "sigma_y_m": (0.40, 2),
+        "sigma_x_m": (0.29, 2),
     },
 }
 
@@ -188,8 +216,13 @@ RIKOLA_BANDS = np.array(
         (24, 1, 635, 790.302, 17.38),
         (25, 1, 666, 819.655, 17.84),
     ],
-    dtype=[("band", "i4"), ("sensor", "i4"), ("gap_nm", "f8"), ("wavelength_nm", "f8"),
-           ("fwhm_nm", "f8")],
+    dtype=[
+        ("band", "i4"),
+        ("sensor", "i4"),
+        ("gap_nm", "f8"),
+        ("wavelength_nm", "f8"),
+        ("fwhm_nm", "f8"),
+    ],
 )
 
 #: 003 Table 3: IOP of band 5 (sensor II) and band 20 (sensor I), value and σ, with the
@@ -255,6 +288,7 @@ def band_table():
 
     return pd.DataFrame(RIKOLA_BANDS).set_index("band")
 
+
 #: 003 §3.4, transformation test: mean discrepancy (columns, rows) in px between the sensor-II
 #: and sensor-I coordinates before the transformation, and after it with the best ROP set.
 RIKOLA_ROP_TEST_PX = {"before": (-6.8, 5.4), "after_best": (0.99, 0.91)}
@@ -275,16 +309,22 @@ P002_STATS = ("min", "max", "median", "mean", "std", "nmad")
 #: caption, §4 and §5, as printed.
 P002 = {
     # 002 Table 1: reprojection errors of the 113758 tie points, with the four GCPs (px)
-    "002 Table 1": {"x": (-1.87, 1.82, 0.00, 0.00, 0.37, 0.32),  # 002 Table 1, row x
-                    "y": (-2.64, 2.62, 0.02, 0.00, 0.48, 0.42)},  # 002 Table 1, row y
+    "002 Table 1": {
+        "x": (-1.87, 1.82, 0.00, 0.00, 0.37, 0.32),  # 002 Table 1, row x
+        "y": (-2.64, 2.62, 0.02, 0.00, 0.48, 0.42),
+    },  # 002 Table 1, row y
     # 002 Table 2: errors of the 13 check points, with the four GCPs (m)
-    "002 Table 2": {"e": (-0.13, 0.14, 0.04, 0.03, 0.07, 0.08),  # 002 Table 2, row E
-                    "n": (-0.05, 0.12, 0.03, 0.03, 0.04, 0.03),  # 002 Table 2, row N
-                    "h": (-1.61, 0.41, -0.78, -0.78, 0.66, 0.99)},  # 002 Table 2, row H
+    "002 Table 2": {
+        "e": (-0.13, 0.14, 0.04, 0.03, 0.07, 0.08),  # 002 Table 2, row E
+        "n": (-0.05, 0.12, 0.03, 0.03, 0.04, 0.03),  # 002 Table 2, row N
+        "h": (-1.61, 0.41, -0.78, -0.78, 0.66, 0.99),
+    },  # 002 Table 2, row H
     # 002 Table 3: errors of the 13 check points, without GCPs (m)
-    "002 Table 3": {"e": (-0.13, 0.14, 0.05, 0.04, 0.07, 0.08),  # 002 Table 3, row E
-                    "n": (-0.04, 0.13, 0.04, 0.04, 0.04, 0.03),  # 002 Table 3, row N
-                    "h": (-1.93, 0.04, -1.18, -1.13, 0.66, 0.95)},  # 002 Table 3, row H
+    "002 Table 3": {
+        "e": (-0.13, 0.14, 0.05, 0.04, 0.07, 0.08),  # 002 Table 3, row E
+        "n": (-0.04, 0.13, 0.04, 0.04, 0.04, 0.03),  # 002 Table 3, row N
+        "h": (-1.93, 0.04, -1.18, -1.13, 0.66, 0.95),
+    },  # 002 Table 3, row H
     "fig8_max_abs_diff_um": 11.8,  # 002 Fig. 8 caption: "differences are ≤ 11.8 µm"
     "fig8_sigma_um": (1.2, 2.4),  # 002 Fig. 8 caption: "precision estimates of 1.2–2.4 µm"
     "chromatic_shift_px": 0.27,  # 002 §5: "maximum absolute shift ≤ 0.27 pixels"

@@ -6,14 +6,24 @@ import numpy as np
 
 from hsgeo.papers import RIKOLA_BANDS
 
-__all__ = ["residual_quiver", "radial_displacement", "z_scores", "image_with_points",
-"plot_band_image", "plot_corner_bias", "plot_tracks", "plot_band_eops",
-           "plot_gap_model", "plot_principal_points", "plot_distortion_effects"
+__all__ = [
+    "residual_quiver",
+    "radial_displacement",
+    "z_scores",
+    "image_with_points",
+    "plot_band_image",
+    "plot_corner_bias",
+    "plot_tracks",
+    "plot_band_eops",
+    "plot_gap_model",
+    "plot_principal_points",
+    "plot_distortion_effects",
 ]
 
 
-def residual_quiver(ax, uv_px, residuals_px, *, scale_px: float = 100.0, image_size=None,
-                    color="C3", label=None):
+def residual_quiver(
+    ax, uv_px, residuals_px, *, scale_px: float = 100.0, image_size=None, color="C3", label=None
+):
     """Residual vectors drawn at their points, magnified ``scale_px`` times; y axis downwards.
 
     Parameters
@@ -26,9 +36,18 @@ def residual_quiver(ax, uv_px, residuals_px, *, scale_px: float = 100.0, image_s
         Magnification of the vectors (stated in the legend).
     """
     uv, r = np.asarray(uv_px), np.asarray(residuals_px)
-    ax.quiver(uv[:, 0], uv[:, 1], r[:, 0] * scale_px, r[:, 1] * scale_px, angles="xy",
-              scale_units="xy", scale=1, color=color, width=0.003,
-              label=(label or "residual") + f" (×{scale_px:g})")
+    ax.quiver(
+        uv[:, 0],
+        uv[:, 1],
+        r[:, 0] * scale_px,
+        r[:, 1] * scale_px,
+        angles="xy",
+        scale_units="xy",
+        scale=1,
+        color=color,
+        width=0.003,
+        label=(label or "residual") + f" (×{scale_px:g})",
+    )
     ax.plot(uv[:, 0], uv[:, 1], ".", color="0.4", ms=2)
     if image_size is not None:
         ax.set_xlim(0, image_size[0])
@@ -41,8 +60,9 @@ def residual_quiver(ax, uv_px, residuals_px, *, scale_px: float = 100.0, image_s
     return ax
 
 
-def radial_displacement(ax, *, f_px, k=None, K_per_mm=None, pixel_pitch_mm=None, r_max_px=400.0,
-                        label=None, **style):
+def radial_displacement(
+    ax, *, f_px, k=None, K_per_mm=None, pixel_pitch_mm=None, r_max_px=400.0, label=None, **style
+):
     """Radial displacement measured − ideal (px) against the measured radius (px).
 
     Give ``k = (k1, k2, k3)`` for OpenCV's form (distortion of normalised ideal coordinates), or
@@ -87,8 +107,9 @@ def image_with_points(ax, image, uv_px, *, labels=None, color="C1"):
     ax.plot(uv[:, 0], uv[:, 1], "+", color=color, ms=8, mew=1.5)
     if labels is not None:
         for (u, v), t in zip(uv, labels, strict=True):
-            ax.annotate(str(t), (u, v), xytext=(3, 3), textcoords="offset points", fontsize=6,
-                        color=color)
+            ax.annotate(
+                str(t), (u, v), xytext=(3, 3), textcoords="offset points", fontsize=6, color=color
+            )
     ax.set_axis_off()
     return ax
 
@@ -161,8 +182,9 @@ def plot_band_eops(axes, cals, cube):
 def plot_gap_model(ax, gaps, f_hat, f_sig, regression, sensor, truth_ab=None):
     """Per-band focal length against air gap with the fitted line (003 Fig. 6)."""
     c = _SENSOR_COLOR[sensor]
-    ax.errorbar(gaps, f_hat, yerr=f_sig, fmt="o", color=c,
-                label=f"sensor {'I' if sensor == 1 else 'II'}")
+    ax.errorbar(
+        gaps, f_hat, yerr=f_sig, fmt="o", color=c, label=f"sensor {'I' if sensor == 1 else 'II'}"
+    )
     g = np.linspace(min(gaps) - 10, max(gaps) + 10, 2)
     ax.plot(g, regression["a"] * g + regression["b"], "-", color=c)
     if truth_ab is not None:

@@ -61,8 +61,12 @@ class Reproduction:
 
     def to_json(self) -> str:
         return json.dumps(
-            {"chapter": self.chapter, "seed": self.seed,
-             "rows": [r.as_dict() for r in self.rows], "meta": self.meta},
+            {
+                "chapter": self.chapter,
+                "seed": self.seed,
+                "rows": [r.as_dict() for r in self.rows],
+                "meta": self.meta,
+            },
             indent=1,
         )
 
@@ -82,13 +86,17 @@ class Reproduction:
         out = [f"{self.chapter} (seed {self.seed})"]
         for t in dict.fromkeys(r.table for r in self.rows):
             out.append(f"\n{t}")
-            out.append(f"  {'quantity':<28s}{'unit':>8s}{'paper':>14s}{'reproduced':>14s}"
-                       f"{'sigma':>12s}{'truth':>14s}")
+            out.append(
+                f"  {'quantity':<28s}{'unit':>8s}{'paper':>14s}{'reproduced':>14s}"
+                f"{'sigma':>12s}{'truth':>14s}"
+            )
             for r in self.rows:
                 if r.table != t:
                     continue
                 d = r.as_dict()
                 f = lambda x, w: f"{x:{w}.6g}" if x is not None else " " * (w - 1) + "–"  # noqa: E731
-                out.append(f"  {r.quantity:<28s}{r.unit:>8s}{f(d['paper'], 14)}"
-                           f"{f(d['reproduced'], 14)}{f(d['sigma'], 12)}{f(d['truth'], 14)}")
+                out.append(
+                    f"  {r.quantity:<28s}{r.unit:>8s}{f(d['paper'], 14)}"
+                    f"{f(d['reproduced'], 14)}{f(d['sigma'], 12)}{f(d['truth'], 14)}"
+                )
         return "\n".join(out)

@@ -179,8 +179,9 @@ def R_from_opk(omega_rad: ArrayLike, phi_rad: ArrayLike, kappa_rad: ArrayLike) -
     >>> np.round(R @ [1.0, 0.0, 0.0], 12)
     array([0., 1., 0.])
     """
-    om, ph, ka = _as_angles(omega_rad, phi_rad, kappa_rad,
-                            names=("omega_rad", "phi_rad", "kappa_rad"))
+    om, ph, ka = _as_angles(
+        omega_rad, phi_rad, kappa_rad, names=("omega_rad", "phi_rad", "kappa_rad")
+    )
     return _Rx(om) @ _Ry(ph) @ _Rz(ka)
 
 
@@ -237,8 +238,9 @@ def dR_dopk(omega_rad: ArrayLike, phi_rad: ArrayLike, kappa_rad: ArrayLike) -> N
     InputError
         If an angle is NaN/inf or the angle arrays do not broadcast.
     """
-    om, ph, ka = _as_angles(omega_rad, phi_rad, kappa_rad,
-                            names=("omega_rad", "phi_rad", "kappa_rad"))
+    om, ph, ka = _as_angles(
+        omega_rad, phi_rad, kappa_rad, names=("omega_rad", "phi_rad", "kappa_rad")
+    )
     Rx, Ry, Rz = _Rx(om), _Ry(ph), _Rz(ka)
     d_omega = _dRx(om) @ Ry @ Rz
     d_phi = Rx @ _dRy(ph) @ Rz
@@ -272,8 +274,9 @@ def R_from_rpy(roll_rad: ArrayLike, pitch_rad: ArrayLike, yaw_rad: ArrayLike) ->
     InputError
         If an angle is NaN/inf or the angle arrays do not broadcast.
     """
-    ro, pi, ya = _as_angles(roll_rad, pitch_rad, yaw_rad,
-                            names=("roll_rad", "pitch_rad", "yaw_rad"))
+    ro, pi, ya = _as_angles(
+        roll_rad, pitch_rad, yaw_rad, names=("roll_rad", "pitch_rad", "yaw_rad")
+    )
     return _Rz(ya) @ _Ry(pi) @ _Rx(ro)
 
 
@@ -330,8 +333,9 @@ def dR_drpy(roll_rad: ArrayLike, pitch_rad: ArrayLike, yaw_rad: ArrayLike) -> ND
     InputError
         If an angle is NaN/inf or the angle arrays do not broadcast.
     """
-    ro, pi, ya = _as_angles(roll_rad, pitch_rad, yaw_rad,
-                            names=("roll_rad", "pitch_rad", "yaw_rad"))
+    ro, pi, ya = _as_angles(
+        roll_rad, pitch_rad, yaw_rad, names=("roll_rad", "pitch_rad", "yaw_rad")
+    )
     Rx, Ry, Rz = _Rx(ro), _Ry(pi), _Rz(ya)
     d_roll = Rz @ Ry @ _dRx(ro)
     d_pitch = Rz @ _dRy(pi) @ Rx

@@ -189,12 +189,9 @@ class SplineNodes:
         """Correction at ``t_s`` from node values ``nodes`` ``(n_nodes, k)`` -> ``(m, k)``."""
         nodes = np.asarray(nodes, dtype=np.float64)
         if nodes.ndim != 2 or nodes.shape[0] != self.n_nodes:
-            raise InputError(
-                f"node values must be ({self.n_nodes}, k), got {nodes.shape}"
-            )
+            raise InputError(f"node values must be ({self.n_nodes}, k), got {nodes.shape}")
         idx, w = self.basis(t_s)
         return np.einsum("ma,mak->mk", w, nodes[idx])
-
 
 
 # ----------------------------------------------------------------------------------------------

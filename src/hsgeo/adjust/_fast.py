@@ -23,8 +23,14 @@ import numba
 import numpy as np
 from numba import njit, prange
 
-__all__ = ["normal_cc", "reduced_points", "factored_tiles", "point_covariance", "locality_orders",
-           "n_threads"]
+__all__ = [
+    "normal_cc",
+    "reduced_points",
+    "factored_tiles",
+    "point_covariance",
+    "locality_orders",
+    "n_threads",
+]
 
 
 def n_threads() -> int:
@@ -71,8 +77,9 @@ def _expand_row(i, cols, vals, fcol, fw, fd, cl, v):  # pragma: no cover - compi
 
 
 @njit(cache=True, parallel=True)
-def _normal_cc_kernel(cols, vals, fcol, fw, fd, row_order, n_c,
-                      n_chunks):  # pragma: no cover - compiled
+def _normal_cc_kernel(
+    cols, vals, fcol, fw, fd, row_order, n_c, n_chunks
+):  # pragma: no cover - compiled
     K = cols.shape[1] + fcol.shape[1] * fd.shape[1]
     M = row_order.size
     out = np.zeros((n_chunks, n_c, n_c))
@@ -104,8 +111,24 @@ def _normal_cc_kernel(cols, vals, fcol, fw, fd, row_order, n_c,
 
 
 @njit(cache=True, parallel=True, fastmath=True)
-def _reduced_kernel(cols, vals, fcol, fw, fd, jp, order, ptr, pt_order, Vinv, n_c, capg, capc,
-                    tile_of, n_tiles, n_chunks):  # pragma: no cover - compiled
+def _reduced_kernel(
+    cols,
+    vals,
+    fcol,
+    fw,
+    fd,
+    jp,
+    order,
+    ptr,
+    pt_order,
+    Vinv,
+    n_c,
+    capg,
+    capc,
+    tile_of,
+    n_tiles,
+    n_chunks,
+):  # pragma: no cover - compiled
     """A with ``A + Aᵀ = Σ_i (J_c,iᵀ J_c,i − W_i V_i⁻¹ W_iᵀ)`` over the points.
 
     Rows of point i are ``order[ptr[i]:ptr[i+1]]``; points are visited in ``pt_order``.
@@ -297,8 +320,9 @@ def _symmetrise_upper(U: np.ndarray) -> np.ndarray:
     return S
 
 
-def locality_orders(J, n_c: int, order: np.ndarray | None, ptr: np.ndarray | None,
-                    rows: np.ndarray | None = None):
+def locality_orders(
+    J, n_c: int, order: np.ndarray | None, ptr: np.ndarray | None, rows: np.ndarray | None = None
+):
     """Row and point processing orders that keep consecutive updates in nearby rows of S.
 
     ``rows`` (default all) are sorted by their smallest column (``J`` a row-compressed
@@ -348,8 +372,7 @@ def factored_tiles(fcol: np.ndarray, kf: int, n_c: int):
     return tile_of, starts
 
 
-def reduced_points(arrays, jp, order, ptr, Vinv, n_c: int, pt_order=None, tiles=None
-                   ) -> np.ndarray:
+def reduced_points(arrays, jp, order, ptr, Vinv, n_c: int, pt_order=None, tiles=None) -> np.ndarray:
     """``Σ_i (J_c,iᵀ J_c,i − W_i V_i⁻¹ W_iᵀ)`` (dense ``n_c × n_c``) over the points' rows.
 
     ``tiles`` is :func:`factored_tiles` of the factored columns (computed when not given).
@@ -366,8 +389,9 @@ def reduced_points(arrays, jp, order, ptr, Vinv, n_c: int, pt_order=None, tiles=
     capg = max_rows if fcol.shape[1] else 0
     capc = int(min(n_c, max(1, max_rows * cols.shape[1])))
     nch = max(1, min(n_threads(), n_pts // 2000 + 1))
-    parts, tparts = _reduced_kernel(*arrays, jp, order, ptr, pt_order, Vinv, n_c, capg, capc,
-                                    tile_of, starts.size, nch)
+    parts, tparts = _reduced_kernel(
+        *arrays, jp, order, ptr, pt_order, Vinv, n_c, capg, capc, tile_of, starts.size, nch
+    )
     A = parts.sum(axis=0) if nch > 1 else parts[0]
     if starts.size:
         # the tiles T[t, u] (kf × kf, row-major in each tile) into the columns of their items
@@ -383,8 +407,9 @@ def reduced_points(arrays, jp, order, ptr, Vinv, n_c: int, pt_order=None, tiles=
 
 
 @njit(cache=True, parallel=True)
-def _point_cov_kernel(cols, vals, fcol, fw, fd, jp, order, ptr, points, Vinv, S_inv,
-                      cap):  # pragma: no cover
+def _point_cov_kernel(
+    cols, vals, fcol, fw, fd, jp, order, ptr, points, Vinv, S_inv, cap
+):  # pragma: no cover
     """V_i⁻¹ + V_i⁻¹ W_iᵀ S⁻¹ W_i V_i⁻¹ for the listed points, on each point's local columns."""
     K = cols.shape[1] + fcol.shape[1] * fd.shape[1]
     p = jp.shape[1]
@@ -459,8 +484,19 @@ def rmatvec_diag(cols, vals, fcol, fw, fd, y, n_c, want_diag):  # pragma: no cov
     ds = np.zeros((n_chunks, n_c))
     step = (M + n_chunks - 1) // n_chunks
     for ch in prange(n_chunks):
-        _rmatvec_rows(cols, vals, fcol, fw, fd, y, want_diag, ch * step, min(M, (ch + 1) * step),
-                      gs[ch], ds[ch])
+        _rmatvec_rows(
+            cols,
+            vals,
+            fcol,
+            fw,
+            fd,
+            y,
+            want_diag,
+            ch * step,
+            min(M, (ch + 1) * step),
+            gs[ch],
+            ds[ch],
+        )
     g = gs[0].copy()
     d = ds[0].copy()
     for ch in range(1, n_chunks):  # fixed order: the same bits for any thread count
@@ -597,8 +633,9 @@ def fill_dense(J, rows, w, cm, cols_dst, vals_dst):  # pragma: no cover - compil
 
 
 @njit(cache=True, parallel=True)
-def fill_factored(index, weights, d, rows, w, c0, fcol_dst, fw_dst,
-                  fd_dst):  # pragma: no cover - compiled
+def fill_factored(
+    index, weights, d, rows, w, c0, fcol_dst, fw_dst, fd_dst
+):  # pragma: no cover - compiled
     """The factored group of ``Indexed(index (m, q), d (m, k), weights (m, q))``."""
     q = index.shape[1]
     k = d.shape[1]

@@ -51,9 +51,7 @@ class Identifiability:
 
     @property
     def full_rank(self) -> bool:
-        return (
-            self.rank == self.n_unknowns and not self.undetermined_points and not self.unobserved
-        )
+        return self.rank == self.n_unknowns and not self.undetermined_points and not self.unobserved
 
     def deficient_parameters(self) -> list[str]:
         """Names involved in any deficiency, each once, in order of appearance."""
@@ -68,7 +66,8 @@ class Identifiability:
         parts = []
         if self.unobserved:
             parts.append(
-                "no observation depends on " + ", ".join(self.unobserved[:10])
+                "no observation depends on "
+                + ", ".join(self.unobserved[:10])
                 + (" …" if len(self.unobserved) > 10 else "")
             )
         if self.undetermined_points:

@@ -108,11 +108,16 @@ class SolverOptions:
         for name in ("max_iter", "max_reject_rounds"):
             v = getattr(self, name)
             if isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers.Integral) or v < 0:
-                raise InputError(
-                    f"SolverOptions.{name} must be a non-negative integer, got {v!r}"
-                )
-        positive = ("ftol", "lambda0", "lambda_points_min", "lambda_max", "reject_round_ftol",
-                    "chord_end", "rank_rtol")
+                raise InputError(f"SolverOptions.{name} must be a non-negative integer, got {v!r}")
+        positive = (
+            "ftol",
+            "lambda0",
+            "lambda_points_min",
+            "lambda_max",
+            "reject_round_ftol",
+            "chord_end",
+            "rank_rtol",
+        )
         for name in positive:
             v = getattr(self, name)
             if not _is_real(v) or not (0.0 < v < math.inf):
@@ -135,8 +140,13 @@ class SolverOptions:
                 f"SolverOptions.reject_k must be None (no rejection) or a finite positive "
                 f"number of robust σ, e.g. 5.0; got {self.reject_k!r}"
             )
-        for name in ("reject_every_iteration", "check_datum", "raise_on_failure", "compiled",
-                     "keep_jacobian"):
+        for name in (
+            "reject_every_iteration",
+            "check_datum",
+            "raise_on_failure",
+            "compiled",
+            "keep_jacobian",
+        ):
             v = getattr(self, name)
             if not isinstance(v, (bool, np.bool_)):
                 raise InputError(f"SolverOptions.{name} must be True or False, got {v!r}")

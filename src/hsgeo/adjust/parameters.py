@@ -196,8 +196,10 @@ class Parameters:
                     "coordinates into one (n_points, p) block"
                 )
         fr = _broadcast(name, "free", free, val.shape, bool)
-        pm = val.copy() if prior_mean is None else _broadcast(
-            name, "prior_mean", prior_mean, val.shape, np.float64
+        pm = (
+            val.copy()
+            if prior_mean is None
+            else _broadcast(name, "prior_mean", prior_mean, val.shape, np.float64)
         )
         ps = (
             np.full(val.shape, np.inf)

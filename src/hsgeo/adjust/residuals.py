@@ -175,8 +175,13 @@ class ResidualBlock:
     #: The roles of the parameter blocks the residuals depend on, with their default names.
     BLOCKS: ClassVar[Mapping[str, str]] = MappingProxyType({})
 
-    def __init__(self, sigma, name: str | None = None, group_size: int | None = None,
-                 blocks: Mapping[str, str] | None = None):
+    def __init__(
+        self,
+        sigma,
+        name: str | None = None,
+        group_size: int | None = None,
+        blocks: Mapping[str, str] | None = None,
+    ):
         if name is not None:
             self.name = name
         self.blocks = self._block_names(blocks)

@@ -184,10 +184,18 @@ class AdjustmentResult:
             if b.points or (max_block_size is not None and b.size > max_block_size):
                 continue
             sig = self.sigma(b.name).ravel()
-            for lab, v, s, f, ps in zip(b.labels(), b.value.ravel(), sig, b.free.ravel(),
-                                        b.prior_sigma.ravel(), strict=True):
-                rows.append({"parameter": lab, "value": v, "sigma": s, "free": bool(f),
-                             "prior_sigma": ps if np.isfinite(ps) else np.nan})
+            for lab, v, s, f, ps in zip(
+                b.labels(), b.value.ravel(), sig, b.free.ravel(), b.prior_sigma.ravel(), strict=True
+            ):
+                rows.append(
+                    {
+                        "parameter": lab,
+                        "value": v,
+                        "sigma": s,
+                        "free": bool(f),
+                        "prior_sigma": ps if np.isfinite(ps) else np.nan,
+                    }
+                )
         return pd.DataFrame(rows).set_index("parameter")
 
     def _summary_lines(self) -> list[str]:
@@ -212,8 +220,7 @@ class AdjustmentResult:
                 skipped.append(f"{b.name} {b.shape}")
                 continue
             sig = self.sigma(b.name).ravel()
-            for lab, v, s, f in zip(b.labels(), b.value.ravel(), sig, b.free.ravel(),
-                                    strict=True):
+            for lab, v, s, f in zip(b.labels(), b.value.ravel(), sig, b.free.ravel(), strict=True):
                 s_txt = f"{s:12.4g}" if f else "       fixed"
                 lines.append(f"{lab:<36s} {v:16.8g} {s_txt}")
         if skipped:
@@ -225,6 +232,8 @@ class AdjustmentResult:
 
     def _repr_html_(self) -> str:
         head = "<br>".join(html.escape(s) for s in self._summary_lines())
-        return (f"<div><b>Adjustment result</b><br>{head}"
-                f"{self.to_frame(max_block_size=60).to_html(float_format=lambda x: f'{x:.6g}')}"
-                "</div>")
+        return (
+            f"<div><b>Adjustment result</b><br>{head}"
+            f"{self.to_frame(max_block_size=60).to_html(float_format=lambda x: f'{x:.6g}')}"
+            "</div>"
+        )

@@ -31,8 +31,7 @@ def _leverage(ne: _Normal, sy: _System) -> np.ndarray | None:
     return point_leverage(sy.Jp, sy.pidx, np.ascontiguousarray(Vinv))
 
 
-def _reject(blocks, masks, sy: _System, reject_k: float, row_point=None,
-            leverage=None) -> bool:
+def _reject(blocks, masks, sy: _System, reject_k: float, row_point=None, leverage=None) -> bool:
     """Reject the kept groups whose residual in ``sy`` exceeds ``reject_k`` robust σ.
 
     With ``leverage`` (of each row of ``sy`` on its point, see :func:`_leverage`) the residuals

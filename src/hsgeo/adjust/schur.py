@@ -88,8 +88,9 @@ class _Normal:
             return self.W @ y.ravel()
         from hsgeo.adjust._fast import point_rows_dot
 
-        return self.sy.Jrc.rmatvec(point_rows_dot(self.sy.Jp, self.sy.pidx,
-                                                  np.ascontiguousarray(y)))
+        return self.sy.Jrc.rmatvec(
+            point_rows_dot(self.sy.Jp, self.sy.pidx, np.ascontiguousarray(y))
+        )
 
 
 def _W_sparse(sy: _System, n_pts: int) -> sp.csr_matrix:
@@ -120,8 +121,13 @@ class _OrderCache:
         from hsgeo.adjust._fast import locality_orders
 
         key = self.key
-        if (key is not None and key[0] == layout.n_c and key[1] == layout.n_pts
-                and key[3] == sy.Jrc.cols.shape and np.array_equal(key[2], sy.pidx)):
+        if (
+            key is not None
+            and key[0] == layout.n_c
+            and key[1] == layout.n_pts
+            and key[3] == sy.Jrc.cols.shape
+            and np.array_equal(key[2], sy.pidx)
+        ):
             # same rows and points as the previous iteration: reuse the processing orders
             # (order and ptr depend only on pidx; row_order is a permutation of the rows that
             # only affects speed, so a changed column pattern cannot make it wrong)
@@ -143,8 +149,9 @@ class _OrderCache:
         return self.value
 
 
-def _normal(layout: _Layout, sy: _System, options: SolverOptions,
-            orders: _OrderCache | None = None) -> _Normal:
+def _normal(
+    layout: _Layout, sy: _System, options: SolverOptions, orders: _OrderCache | None = None
+) -> _Normal:
     """The normal equations at ``sy`` (compiled or generic path, see ``options.compiled``).
 
     ``orders`` carries the processing orders from one call to the next (a new cache if None).
@@ -178,10 +185,10 @@ def _normal(layout: _Layout, sy: _System, options: SolverOptions,
         pi = sy.pidx[rows]
         jp = sy.Jp[rows]
         # V_i = Σ_rows jpᵀ jp, g_p,i = Σ jpᵀ r  (sparse aggregation instead of a Python loop)
-        agg = sp.csr_matrix((np.ones(rows.size), (pi, np.arange(rows.size))),
-                            shape=(n_pts, rows.size))
-        V = (agg @ (jp[:, :, None] * jp[:, None, :]).reshape(rows.size, p * p)).reshape(
-            n_pts, p, p)
+        agg = sp.csr_matrix(
+            (np.ones(rows.size), (pi, np.arange(rows.size))), shape=(n_pts, rows.size)
+        )
+        V = (agg @ (jp[:, :, None] * jp[:, None, :]).reshape(rows.size, p * p)).reshape(n_pts, p, p)
         gp = agg @ (jp * sy.r[rows, None])
     # fixed point entries: unit diagonal, zero gradient -> zero update
     # (their Jacobian columns were zeroed in _evaluate, so V has zero rows/columns there)
@@ -191,8 +198,9 @@ def _normal(layout: _Layout, sy: _System, options: SolverOptions,
     gp[fixed] = 0.0
     if not compiled:
         return _Normal(Ncc, gc, V, gp, _W_sparse(sy, n_pts), n_pts=n_pts, options=options)
-    return _Normal(Ncc, gc, V, gp, None, sy, order, ptr, n_pts, pt_order, Ncc_free, diag_cc,
-                   options=options)
+    return _Normal(
+        Ncc, gc, V, gp, None, sy, order, ptr, n_pts, pt_order, Ncc_free, diag_cc, options=options
+    )
 
 
 def _damped(A: np.ndarray, lam: float) -> np.ndarray:
@@ -263,8 +271,9 @@ def _reduced(layout: _Layout, ne: _Normal, lam: float):
             if ne.S_chord is not None and lam_p == 0.0:
                 S0 = ne.S_chord  # a chord step: the matrix of an earlier point (see adjust)
             else:
-                S0 = ne.Ncc_free + reduced_points(sy.Jrc.arrays, sy.Jp, ne.order, ne.ptr,
-                                                  Vinv, layout.n_c, ne.pt_order)
+                S0 = ne.Ncc_free + reduced_points(
+                    sy.Jrc.arrays, sy.Jp, ne.order, ne.ptr, Vinv, layout.n_c, ne.pt_order
+                )
             r0 = rhs - ne.W_dot(np.einsum("nij,nj->ni", Vinv, ne.gp)) if layout.n_c else rhs
             if lam_p == 0.0:  # keep the undamped one (datum check, steps, covariance)
                 ne.reduced0 = (S0, r0, Vinv)
@@ -318,7 +327,6 @@ def _predicted_decrease(layout, ne: _Normal, lam, dc, dp) -> float:
     return pred
 
 
-
 # ----------------------------------------------------------------------------------------------
 # Covariances at the solution
 # ----------------------------------------------------------------------------------------------
@@ -348,8 +356,9 @@ def _reduced_inverse(layout: _Layout, ne: _Normal) -> np.ndarray:
     return _spd_inverse(S)
 
 
-def _point_cofactors(ne: _Normal, S_inv: np.ndarray, pts: np.ndarray,
-                     chunk: int = 20000) -> np.ndarray:
+def _point_cofactors(
+    ne: _Normal, S_inv: np.ndarray, pts: np.ndarray, chunk: int = 20000
+) -> np.ndarray:
     """``V⁻¹ + V⁻¹ Wᵀ S⁻¹ W V⁻¹`` of the points ``pts``: ``(len(pts), p, p)``, NaN for a point
     whose ``V`` is singular (e.g. too few rays left after outlier rejection).
 
@@ -384,8 +393,9 @@ def _point_cofactors(ne: _Normal, S_inv: np.ndarray, pts: np.ndarray,
     return out
 
 
-def _point_cofactor_function(ne: _Normal,
-                             S_inv: np.ndarray) -> Callable[[np.ndarray, int], np.ndarray]:
+def _point_cofactor_function(
+    ne: _Normal, S_inv: np.ndarray
+) -> Callable[[np.ndarray, int], np.ndarray]:
     """``f(pts, chunk)`` → the points' cofactor blocks (see :func:`_point_cofactors`).
 
     The function holds the Jacobian of the solution; the result keeps it only on request

@@ -181,8 +181,9 @@ class _Trial:
 class _Solve:
     """The state of one adjustment: layout, masks, processing orders, history, counters."""
 
-    def __init__(self, params: Parameters, blocks: list[ResidualBlock], options: SolverOptions,
-                 progress):
+    def __init__(
+        self, params: Parameters, blocks: list[ResidualBlock], options: SolverOptions, progress
+    ):
         self.options = options
         self.blocks = blocks
         params._sync_ties()  # a tied entry starts at its target's value
@@ -204,8 +205,9 @@ class _Solve:
     def linearise(self, check_redundancy: bool = False) -> tuple[_System, _Normal]:
         """The whitened system and its normal equations at the current values."""
         layout = self.layout
-        sy = _evaluate(layout, self.blocks, self.masks, jacobian=True,
-                       compiled=self.options.compiled)
+        sy = _evaluate(
+            layout, self.blocks, self.masks, jacobian=True, compiled=self.options.compiled
+        )
         if check_redundancy:
             dof = sy.r.size - layout.n_unknowns
             if dof < 0 or (dof == 0 and sy.n_obs_rows < layout.n_unknowns):
@@ -218,8 +220,14 @@ class _Solve:
 
     def reject(self, residuals: _System, sy: _System, ne: _Normal) -> bool:
         """Test the residuals of ``residuals`` (leverages from ``sy``, ``ne``); see robust."""
-        return _reject(self.blocks, self.masks, residuals, self.options.reject_k,
-                       self.layout.row_point, _leverage(ne, sy))
+        return _reject(
+            self.blocks,
+            self.masks,
+            residuals,
+            self.options.reject_k,
+            self.layout.row_point,
+            _leverage(ne, sy),
+        )
 
     # -- one pass of the Levenberg–Marquardt loop -------------------------------------------
     def minimise(self, tol: float, check_datum: bool = False):
@@ -251,8 +259,11 @@ class _Solve:
                 # minimum, and the reduced system just formed gives its covariance
                 return _Outcome(True, "predicted decrease of the cost below ftol"), sy, ne
             if n_iter >= opts.max_iter:
-                return _Outcome(False, f"not converged within max_iter={opts.max_iter} "
-                                       "iterations"), sy, ne
+                return (
+                    _Outcome(False, f"not converged within max_iter={opts.max_iter} iterations"),
+                    sy,
+                    ne,
+                )
             n_iter += 1
             self.total_iter += 1
             step = self._damped_step(ne, cost, lam, nu, dc, dp, pred)
@@ -260,8 +271,16 @@ class _Solve:
             if lam > opts.lambda_max:
                 # no step decreases the cost: we are at the minimum to machine precision
                 ok = step.pred <= 1e3 * tol * max(cost, 1e-300) or cost <= opts.atol * sy.r.size
-                return _Outcome(ok, "no further decrease possible" if ok else (
-                    "the damping grew without bound: the cost could not be decreased")), sy, ne
+                return (
+                    _Outcome(
+                        ok,
+                        "no further decrease possible"
+                        if ok
+                        else ("the damping grew without bound: the cost could not be decreased"),
+                    ),
+                    sy,
+                    ne,
+                )
             new_cost = step.system.cost
             self.history.append(new_cost)
             tested = False
@@ -277,8 +296,11 @@ class _Solve:
             # barely changes, so the next steps reuse the last one formed (the gradient and
             # the points' blocks are always those of the current point); it is formed again
             # where the convergence test passes, or when a chord step fails
-            chord = (ne.reduced0[0] if settled and ne.compiled_schur and ne.reduced0 is not None
-                     else None)
+            chord = (
+                ne.reduced0[0]
+                if settled and ne.compiled_schur and ne.reduced0 is not None
+                else None
+            )
             sy = ne = step = None  # free the old Jacobian before forming the new one
             sy, ne = self.linearise()
             if chord is not None and ne.compiled_schur:
@@ -305,11 +327,11 @@ class _Solve:
         """The undamped Gauss–Newton step with this point's own matrix predicts a decrease
         below ``tol`` times the cost.
         """
-        return (lam <= self.options.lambda_points_min and pred <= tol * cost
-                and ne.S_chord is None)
+        return lam <= self.options.lambda_points_min and pred <= tol * cost and ne.S_chord is None
 
-    def _damped_step(self, ne: _Normal, cost: float, lam: float, nu: float, dc, dp,
-                     pred: float) -> _Trial:
+    def _damped_step(
+        self, ne: _Normal, cost: float, lam: float, nu: float, dc, dp, pred: float
+    ) -> _Trial:
         """Take the step, or retry with more damping (Nielsen) until the cost decreases.
 
         A failed chord step is first retried with the matrix of this point. The parameters
@@ -319,8 +341,9 @@ class _Solve:
         state = layout.get_state()
         while True:
             layout.apply(dc, dp)
-            trial = _evaluate(layout, self.blocks, self.masks, jacobian=False,
-                              compiled=self.options.compiled)
+            trial = _evaluate(
+                layout, self.blocks, self.masks, jacobian=False, compiled=self.options.compiled
+            )
             actual = cost - trial.cost
             rho = actual / pred if pred > 0 else (1.0 if actual >= 0 else -1.0)
             if rho > 0 and np.isfinite(trial.cost):
@@ -351,8 +374,7 @@ class _Solve:
             )
 
     # -- the result -------------------------------------------------------------------------
-    def result(self, sy: _System, ne: _Normal, outcome: _Outcome,
-               rounds: int) -> AdjustmentResult:
+    def result(self, sy: _System, ne: _Normal, outcome: _Outcome, rounds: int) -> AdjustmentResult:
         """σ0, covariance and residuals at the final iterate, as an :class:`AdjustmentResult`."""
         layout, blocks = self.layout, self.blocks
         seconds = time.perf_counter() - self.t0
@@ -419,8 +441,8 @@ def _progress_printer(progress):
     def show(info):
         print(
             f"  iter {info['iteration']:3d}  cost {info['cost']:.6e}  λ {info['lambda']:.1e}"
-            f"  {info['seconds']:.2f} s" + (f"  rejected {info['rejected']}" if info.get(
-                "rejected") else ""),
+            f"  {info['seconds']:.2f} s"
+            + (f"  rejected {info['rejected']}" if info.get("rejected") else ""),
             file=sys.stderr,
             flush=True,
         )

@@ -41,7 +41,8 @@ class _Layout:
                 raise InputError(f"{b.labels()[i]} is tied and fixed: fix its target instead")
             if np.isfinite(b.prior_sigma.ravel()[i]):
                 raise InputError(
-                    f"{b.labels()[i]} is tied and has a prior: put the prior on its target")
+                    f"{b.labels()[i]} is tied and has a prior: put the prior on its target"
+                )
             tied.setdefault(name, []).append(i)
         n = 0
         for b in self.cblocks:
@@ -103,8 +104,9 @@ class _RowJac:
     :mod:`hsgeo.adjust._fast`.
     """
 
-    def __init__(self, cols: np.ndarray, vals: np.ndarray, n_cols: int, fcol=None, fw=None,
-                 fd=None):
+    def __init__(
+        self, cols: np.ndarray, vals: np.ndarray, n_cols: int, fcol=None, fw=None, fd=None
+    ):
         self.cols, self.vals, self.n_cols = cols, vals, n_cols
         M = cols.shape[0]
         if fcol is None:
@@ -135,8 +137,9 @@ class _RowJac:
         """``Jᵀ y`` (and ``diag(JᵀJ)`` with ``diag=True``)."""
         from hsgeo.adjust._fast import rmatvec_diag
 
-        g, d = rmatvec_diag(*self.arrays, np.ascontiguousarray(y, dtype=np.float64),
-                            self.n_cols, diag)
+        g, d = rmatvec_diag(
+            *self.arrays, np.ascontiguousarray(y, dtype=np.float64), self.n_cols, diag
+        )
         return (g, d) if diag else g
 
     def tocsr(self) -> sp.csr_matrix:
@@ -152,8 +155,9 @@ class _RowJac:
             r.append(np.broadcast_to(np.arange(M)[:, None, None], fc.shape)[fk])
             c.append(fc[fk])
             v.append(fv[fk])
-        return sp.csr_matrix((np.concatenate(v), (np.concatenate(r), np.concatenate(c))),
-                             shape=self.shape)
+        return sp.csr_matrix(
+            (np.concatenate(v), (np.concatenate(r), np.concatenate(c))), shape=self.shape
+        )
 
 
 #: Use the compiled row-compressed path (True) or the generic scipy.sparse path (False).
@@ -184,16 +188,32 @@ class _Slots:
     tens of millions of entries (GUIDE §9).
     """
 
-    def __init__(self, J, m: int, size: int, name: str, colmap: np.ndarray, rows, w,
-                 factored_k: int | None = None, compiled: bool = True):
+    def __init__(
+        self,
+        J,
+        m: int,
+        size: int,
+        name: str,
+        colmap: np.ndarray,
+        rows,
+        w,
+        factored_k: int | None = None,
+        compiled: bool = True,
+    ):
         self.colmap, self.rows, self.w = colmap, rows, w  # rows: kept rows, or None for all
         self.factored = False
         if isinstance(J, Indexed) and J.factored:
             m_j, q = J.index.shape
             k = J.k
             contiguous = colmap.size and colmap[0] >= 0 and np.all(np.diff(colmap) == 1)
-            if (compiled and factored_k in (None, k) and contiguous and m_j == m and size % k == 0
-                    and not (J.index.size and int(J.index.max()) >= size // k)):
+            if (
+                compiled
+                and factored_k in (None, k)
+                and contiguous
+                and m_j == m
+                and size % k == 0
+                and not (J.index.size and int(J.index.max()) >= size // k)
+            ):
                 # kept factored: one group of q items × k columns per row (see _RowJac)
                 self.kind, self.J, self.width, self.qk = "factored", J, 0, (q, k)
                 self.factored = True
@@ -204,8 +224,7 @@ class _Slots:
             if m_j != m:
                 raise InputError(f"Jacobian w.r.t. {name!r} has {m_j} rows, residuals have {m}")
             if size % k:
-                raise InputError(
-                    f"Jacobian w.r.t. {name!r}: item width {k} does not divide {size}")
+                raise InputError(f"Jacobian w.r.t. {name!r}: item width {k} does not divide {size}")
             if J.index.size and int(J.index.max()) >= size // k:
                 raise InputError(f"Jacobian w.r.t. {name!r} indexes past the block's items")
             self.kind, self.J, self.width, self.qk = "indexed", J, q * k, (q, k)
@@ -213,7 +232,8 @@ class _Slots:
             c = J.tocsr()
             if c.shape != (m, size):
                 raise InputError(
-                    f"Jacobian w.r.t. {name!r} has shape {c.shape}, expected {(m, size)}")
+                    f"Jacobian w.r.t. {name!r} has shape {c.shape}, expected {(m, size)}"
+                )
             nnz = np.diff(c.indptr)
             K = int(nnz.max()) if m else 0
             slot = np.arange(c.indices.size) - np.repeat(c.indptr[:-1], nnz)
@@ -227,7 +247,8 @@ class _Slots:
             arr = np.asarray(J, dtype=np.float64)
             if arr.shape != (m, size):
                 raise InputError(
-                    f"Jacobian w.r.t. {name!r} has shape {arr.shape}, expected {(m, size)}")
+                    f"Jacobian w.r.t. {name!r} has shape {arr.shape}, expected {(m, size)}"
+                )
             self.kind, self.J, self.width = "dense", arr, size
 
     def _rows(self) -> np.ndarray:
@@ -237,8 +258,17 @@ class _Slots:
         from hsgeo.adjust._fast import fill_factored
 
         q, k = self.qk
-        fill_factored(self.J.index, self.J.weights, self.J.d, self._rows(), self.w,
-                      int(self.colmap[0]), fcol_dst[:, :q], fw_dst[:, :q], fd_dst[:, :k])
+        fill_factored(
+            self.J.index,
+            self.J.weights,
+            self.J.d,
+            self._rows(),
+            self.w,
+            int(self.colmap[0]),
+            fcol_dst[:, :q],
+            fw_dst[:, :q],
+            fd_dst[:, :k],
+        )
 
     def fill(self, cols_dst: np.ndarray, vals_dst: np.ndarray) -> None:
         from hsgeo.adjust._fast import fill_dense, fill_indexed
@@ -268,8 +298,9 @@ class _PriorSlots:
         vals_dst[:, 0] = self.vals
 
 
-def _evaluate(layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian: bool,
-              compiled: bool = True) -> _System:
+def _evaluate(
+    layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian: bool, compiled: bool = True
+) -> _System:
     """Whitened residuals (and with ``jacobian`` the row-compressed Jacobian) at the current
     values of ``layout.params``; rows of ``masks[i] == False`` are left out. ``compiled``
     keeps factored Jacobians factored (the compiled kernels' form).
@@ -326,9 +357,17 @@ def _evaluate(layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian:
                 if name in layout.tie_blocks and isinstance(J, Indexed):
                     J = J.expanded()
                 has_f = any(sl.factored for sl in blk_slots)
-                sl = _Slots(J, blk.m, b.size, name, layout.colmap[name],
-                            None if all_kept else rows_kept, w,
-                            factored_k=-1 if has_f else factored_k, compiled=compiled)
+                sl = _Slots(
+                    J,
+                    blk.m,
+                    b.size,
+                    name,
+                    layout.colmap[name],
+                    None if all_kept else rows_kept,
+                    w,
+                    factored_k=-1 if has_f else factored_k,
+                    compiled=compiled,
+                )
                 if sl.factored:
                     factored_k = sl.qk[1]
                 blk_slots.append(sl)
@@ -382,8 +421,10 @@ def _evaluate(layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian:
             if sl.factored:
                 sl.fill_factored(fcol[row0 : row0 + n], fw[row0 : row0 + n], fd[row0 : row0 + n])
                 continue
-            sl.fill(cols_all[row0 : row0 + n, k0 : k0 + sl.width],
-                    vals_all[row0 : row0 + n, k0 : k0 + sl.width])
+            sl.fill(
+                cols_all[row0 : row0 + n, k0 : k0 + sl.width],
+                vals_all[row0 : row0 + n, k0 : k0 + sl.width],
+            )
             k0 += sl.width
         if k0 < K:  # padding
             cols_all[row0 : row0 + n, k0:] = -1

@@ -34,11 +34,12 @@ def refuse_inputs(output, inputs: Iterable = ()) -> Path:
         if p is None:
             continue
         p = Path(p)
-        same = (os.path.samefile(out, p) if out.exists() and p.exists()
-                else target == p.resolve())
+        same = os.path.samefile(out, p) if out.exists() and p.exists() else target == p.resolve()
         if same:
-            raise InputError(f"{out}: this is an input of the command and would be overwritten; "
-                             "write the output to another file name")
+            raise InputError(
+                f"{out}: this is an input of the command and would be overwritten; "
+                "write the output to another file name"
+            )
     return out
 
 

@@ -79,22 +79,51 @@ class Board:
             if v is not None and not v > 0:
                 raise InputError(f"board {name} must be positive, got {v}")
         if self.nx < 2 or self.ny < 2:
-            raise InputError(f"a board needs at least 2 x 2 squares or markers, got "
-                             f"{self.nx} x {self.ny}")
+            raise InputError(
+                f"a board needs at least 2 x 2 squares or markers, got {self.nx} x {self.ny}"
+            )
 
     @classmethod
-    def charuco(cls, squares_x: int, squares_y: int, square_mm: float, marker_mm: float,
-                dictionary: str, pixel_mm: float | None = None) -> Board:
+    def charuco(
+        cls,
+        squares_x: int,
+        squares_y: int,
+        square_mm: float,
+        marker_mm: float,
+        dictionary: str,
+        pixel_mm: float | None = None,
+    ) -> Board:
         """A ChArUco board of ``squares_x × squares_y`` squares."""
-        return cls("charuco", dictionary, int(squares_x), int(squares_y), float(marker_mm),
-                   square_mm=float(square_mm), pixel_mm=pixel_mm)
+        return cls(
+            "charuco",
+            dictionary,
+            int(squares_x),
+            int(squares_y),
+            float(marker_mm),
+            square_mm=float(square_mm),
+            pixel_mm=pixel_mm,
+        )
 
     @classmethod
-    def aruco_grid(cls, markers_x: int, markers_y: int, marker_mm: float, separation_mm: float,
-                   dictionary: str, pixel_mm: float | None = None) -> Board:
+    def aruco_grid(
+        cls,
+        markers_x: int,
+        markers_y: int,
+        marker_mm: float,
+        separation_mm: float,
+        dictionary: str,
+        pixel_mm: float | None = None,
+    ) -> Board:
         """A grid of ``markers_x × markers_y`` ArUco markers (first id 0)."""
-        return cls("aruco_grid", dictionary, int(markers_x), int(markers_y), float(marker_mm),
-                   separation_mm=float(separation_mm), pixel_mm=pixel_mm)
+        return cls(
+            "aruco_grid",
+            dictionary,
+            int(markers_x),
+            int(markers_y),
+            float(marker_mm),
+            separation_mm=float(separation_mm),
+            pixel_mm=pixel_mm,
+        )
 
     def cv_board(self, length_unit: str = "mm"):
         """The ``cv2.aruco.CharucoBoard`` or ``GridBoard``, lengths in ``length_unit``.
@@ -107,17 +136,20 @@ class Board:
         import cv2
 
         if length_unit not in LENGTH_UNITS_MM:
-            raise InputError(f"length_unit must be one of {list(LENGTH_UNITS_MM)}, got "
-                             f"{length_unit!r}")
+            raise InputError(
+                f"length_unit must be one of {list(LENGTH_UNITS_MM)}, got {length_unit!r}"
+            )
         if not hasattr(cv2.aruco, self.dictionary):
             raise InputError(f"unknown ArUco dictionary {self.dictionary!r} (e.g. DICT_6X6_250)")
         f = LENGTH_UNITS_MM[length_unit]
         d = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, self.dictionary))
         if self.type == "charuco":
-            return cv2.aruco.CharucoBoard((self.nx, self.ny), self.square_mm / f,
-                                          self.marker_mm / f, d)
-        return cv2.aruco.GridBoard((self.nx, self.ny), self.marker_mm / f,
-                                   self.separation_mm / f, d)
+            return cv2.aruco.CharucoBoard(
+                (self.nx, self.ny), self.square_mm / f, self.marker_mm / f, d
+            )
+        return cv2.aruco.GridBoard(
+            (self.nx, self.ny), self.marker_mm / f, self.separation_mm / f, d
+        )
 
 
 #: The ChArUco board of OpenCV's tutorial images (opencv_contrib aruco tutorial, img_00..03):
@@ -166,11 +198,13 @@ def read_board(path) -> Board:
     if missing:
         problems.append(f"[board] of type {b['type']} is missing {', '.join(missing)}; add them")
     if stray:
-        problems.append(f"[board] {', '.join(stray)} belong to the other board type; remove them "
-                        f"or change type")
+        problems.append(
+            f"[board] {', '.join(stray)} belong to the other board type; remove them or change type"
+        )
     if not hasattr(cv2.aruco, b["dictionary"]):
-        problems.append(f"[board] dictionary: unknown ArUco dictionary {b['dictionary']!r} "
-                        "(e.g. DICT_6X6_250)")
+        problems.append(
+            f"[board] dictionary: unknown ArUco dictionary {b['dictionary']!r} (e.g. DICT_6X6_250)"
+        )
     if problems:
         raise InputError(f"board file {path}: " + "; ".join(problems))
     pixel = cfg["camera"].get("pixel_mm")

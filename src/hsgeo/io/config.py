@@ -118,8 +118,9 @@ def _value(v, key: Key, where: str, problems: list):
             return None
         if key.choices and v not in key.choices:
             allowed = ", ".join(repr(c) for c in key.choices)
-            problems.append(f"{where} must be one of {allowed}, got {v!r}"
-                            f"{did_you_mean(v, key.choices)}")
+            problems.append(
+                f"{where} must be one of {allowed}, got {v!r}{did_you_mean(v, key.choices)}"
+            )
             return None
         return v
     # floats
@@ -133,8 +134,13 @@ def _value(v, key: Key, where: str, problems: list):
     return None if any(x is None for x in out) else tuple(out)
 
 
-def read_config(path, schema: Mapping[str, Mapping[str, Key]], what: str = "file", *,
-                required_tables: tuple[str, ...] = ()) -> dict[str, dict]:
+def read_config(
+    path,
+    schema: Mapping[str, Mapping[str, Key]],
+    what: str = "file",
+    *,
+    required_tables: tuple[str, ...] = (),
+) -> dict[str, dict]:
     """Read a TOML file and check it against ``schema``.
 
     Parameters
@@ -164,8 +170,10 @@ def read_config(path, schema: Mapping[str, Mapping[str, Key]], what: str = "file
     out: dict[str, dict] = {t: {} for t in schema}
     for t, table in cfg.items():
         if t not in schema:
-            problems.append(f"[{t}]: unknown table{did_you_mean(t, schema)} (known: "
-                            f"{', '.join(f'[{s}]' for s in schema)})")
+            problems.append(
+                f"[{t}]: unknown table{did_you_mean(t, schema)} (known: "
+                f"{', '.join(f'[{s}]' for s in schema)})"
+            )
         elif not isinstance(table, dict):
             problems.append(f"{t}: must be a table [{t}], got a value {table!r}")
     for t in required_tables:
@@ -177,8 +185,9 @@ def read_config(path, schema: Mapping[str, Mapping[str, Key]], what: str = "file
             table = {}
         for k in table:
             if k not in keys:
-                problems.append(f"[{t}] {k}: unknown key{did_you_mean(k, keys)} (known: "
-                                f"{', '.join(keys)})")
+                problems.append(
+                    f"[{t}] {k}: unknown key{did_you_mean(k, keys)} (known: {', '.join(keys)})"
+                )
         for k, key in keys.items():
             where = f"[{t}] {k}"
             if k in table:
@@ -187,8 +196,9 @@ def read_config(path, schema: Mapping[str, Mapping[str, Key]], what: str = "file
                     out[t][k] = v
             elif key.required:
                 if t in cfg or t not in required_tables:
-                    problems.append(f"{where}: missing; add `{k} = ...`"
-                                    + (f" ({key.doc})" if key.doc else ""))
+                    problems.append(
+                        f"{where}: missing; add `{k} = ...`" + (f" ({key.doc})" if key.doc else "")
+                    )
             elif key.default is not None:
                 out[t][k] = key.default
     if problems:

@@ -11,12 +11,26 @@ from hsgeo.io._files import atomic_path, refuse_inputs
 
 __all__ = ["write_envi", "read_envi"]
 
-_ENVI_TYPES = {np.dtype("uint8"): 1, np.dtype("int16"): 2, np.dtype("int32"): 3,
-               np.dtype("float32"): 4, np.dtype("float64"): 5, np.dtype("uint16"): 12}
+_ENVI_TYPES = {
+    np.dtype("uint8"): 1,
+    np.dtype("int16"): 2,
+    np.dtype("int32"): 3,
+    np.dtype("float32"): 4,
+    np.dtype("float64"): 5,
+    np.dtype("uint16"): 12,
+}
 
 
-def write_envi(path, data, *, map_info=None, band_names=None, wavelength_nm=None,
-               description: str = "hsgeo", inputs=()) -> tuple[Path, Path]:
+def write_envi(
+    path,
+    data,
+    *,
+    map_info=None,
+    band_names=None,
+    wavelength_nm=None,
+    description: str = "hsgeo",
+    inputs=(),
+) -> tuple[Path, Path]:
     """Write a band-sequential ENVI file ``path`` and its header ``path.hdr``.
 
     Parameters
@@ -47,20 +61,29 @@ def write_envi(path, data, *, map_info=None, band_names=None, wavelength_nm=None
     if arr.ndim != 3:
         raise InputError(f"ENVI data must be (bands, lines, samples), got {np.shape(data)}")
     if arr.dtype not in _ENVI_TYPES:
-        raise InputError(f"ENVI cannot store dtype {arr.dtype}; use one of "
-                         f"{sorted(str(t) for t in _ENVI_TYPES)}")
+        raise InputError(
+            f"ENVI cannot store dtype {arr.dtype}; use one of {sorted(str(t) for t in _ENVI_TYPES)}"
+        )
     hpath = path.with_name(path.name + ".hdr")
     refuse_inputs(hpath, inputs)
     with atomic_path(path, inputs) as tmp:
         arr.astype(arr.dtype.newbyteorder("<"), copy=False).tofile(tmp)
     b, lines, samples = arr.shape
-    hdr = ["ENVI", f"description = {{{description}}}", f"samples = {samples}",
-           f"lines = {lines}", f"bands = {b}", "header offset = 0", "file type = ENVI Standard",
-           f"data type = {_ENVI_TYPES[arr.dtype]}", "interleave = bsq", "byte order = 0"]
+    hdr = [
+        "ENVI",
+        f"description = {{{description}}}",
+        f"samples = {samples}",
+        f"lines = {lines}",
+        f"bands = {b}",
+        "header offset = 0",
+        "file type = ENVI Standard",
+        f"data type = {_ENVI_TYPES[arr.dtype]}",
+        "interleave = bsq",
+        "byte order = 0",
+    ]
     if map_info is not None:
         e, n, de, dn = map_info
-        hdr.append(f"map info = {{Arbitrary, 1, 1, {e!r}, {n!r}, {de!r}, {dn!r}, 0, "
-                   "units=Meters}")
+        hdr.append(f"map info = {{Arbitrary, 1, 1, {e!r}, {n!r}, {de!r}, {dn!r}, 0, units=Meters}}")
     if band_names is not None:
         hdr.append("band names = {" + ", ".join(str(x) for x in band_names) + "}")
     if wavelength_nm is not None:
@@ -106,8 +129,9 @@ def read_envi(path) -> tuple[np.ndarray, dict]:
         b, lines, samples = int(hdr["bands"]), int(hdr["lines"]), int(hdr["samples"])
         dtype = {v: k for k, v in _ENVI_TYPES.items()}[int(hdr["data type"])]
     except (KeyError, ValueError) as exc:
-        raise InputError(f"{hpath}: missing or bad entry ({exc}); need samples, lines, bands, "
-                         "data type") from None
+        raise InputError(
+            f"{hpath}: missing or bad entry ({exc}); need samples, lines, bands, data type"
+        ) from None
     if hdr.get("byte order", "0") == "1":
         dtype = dtype.newbyteorder(">")
     raw = np.fromfile(path, dtype=dtype, offset=int(hdr.get("header offset", 0)))

@@ -42,8 +42,10 @@ def read_lines(path):
     except (OSError, ValueError, ImportError) as exc:
         raise InputError(f"{path}: not a readable NetCDF file: {exc}") from None
     if "radiance" not in ds:
-        raise InputError(f"{path}: no variable 'radiance' (found {list(ds.data_vars)}); the "
-                         "recorded values must be called radiance")
+        raise InputError(
+            f"{path}: no variable 'radiance' (found {list(ds.data_vars)}); the "
+            "recorded values must be called radiance"
+        )
     da = ds["radiance"]
     if "band" not in da.dims:
         da = da.expand_dims("band")
@@ -53,17 +55,23 @@ def read_lines(path):
         )
     for a in ("t0_s", "line_rate_hz"):
         if a not in ds.attrs and a not in da.attrs:
-            raise InputError(f"{path}: attribute {a!r} missing (time of line 0, line rate); "
-                             "add it to the file's global attributes")
+            raise InputError(
+                f"{path}: attribute {a!r} missing (time of line 0, line rate); "
+                "add it to the file's global attributes"
+            )
     attrs = {**ds.attrs, **da.attrs}
-    out = (da.transpose("band", "line", "pixel").load(), float(attrs["t0_s"]),
-           float(attrs["line_rate_hz"]))
+    out = (
+        da.transpose("band", "line", "pixel").load(),
+        float(attrs["t0_s"]),
+        float(attrs["line_rate_hz"]),
+    )
     ds.close()
     return out
 
 
-def write_lines(path, radiance, zeta_px, *, t0_s: float, line_rate_hz: float,
-                wavelength_nm=None, inputs=()):
+def write_lines(
+    path, radiance, zeta_px, *, t0_s: float, line_rate_hz: float, wavelength_nm=None, inputs=()
+):
     """Write a recorded flight line in the format :func:`read_lines` reads (NetCDF 3).
 
     Parameters
@@ -89,8 +97,12 @@ def write_lines(path, radiance, zeta_px, *, t0_s: float, line_rate_hz: float,
     r = np.asarray(radiance, dtype=np.float32)
     if r.ndim == 2:
         r = r[None]
-    da = xr.DataArray(r, dims=("band", "line", "pixel"),
-                      coords={"pixel": np.asarray(zeta_px, float)}, name="radiance")
+    da = xr.DataArray(
+        r,
+        dims=("band", "line", "pixel"),
+        coords={"pixel": np.asarray(zeta_px, float)},
+        name="radiance",
+    )
     if wavelength_nm is not None:
         da = da.assign_coords(wavelength_nm=("band", np.asarray(wavelength_nm, float)))
     ds = da.to_dataset()

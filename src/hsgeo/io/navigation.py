@@ -159,8 +159,9 @@ def write_trajectory(path, traj: Trajectory, *, inputs: Iterable = ()) -> Path:
     try:
         os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; give the file a new file's mode
         with os.fdopen(fd, "wb") as fh:
-            np.savetxt(fh, table, delimiter=",", fmt="%.17g", header=",".join(NAV_COLUMNS),
-                       comments="")
+            np.savetxt(
+                fh, table, delimiter=",", fmt="%.17g", header=",".join(NAV_COLUMNS), comments=""
+            )
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)

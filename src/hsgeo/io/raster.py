@@ -49,11 +49,16 @@ def to_map_files(da, path_nc=None, path_envi=None, *, inputs=()) -> list:
         res = float(da.attrs["resolution_m"])
         E0 = float(da["E"].values[0]) - res / 2
         N0 = float(da["N"].values[0]) + res / 2
-        out += list(write_envi(path_envi, da.values.astype(np.float32),
-                               map_info=(E0, N0, res, res),
-                               band_names=[str(b) for b in da["band"].values],
-                               description="hsgeo orthorectified line-scanner image",
-                               inputs=inputs))
+        out += list(
+            write_envi(
+                path_envi,
+                da.values.astype(np.float32),
+                map_info=(E0, N0, res, res),
+                band_names=[str(b) for b in da["band"].values],
+                description="hsgeo orthorectified line-scanner image",
+                inputs=inputs,
+            )
+        )
     return out
 
 
@@ -74,8 +79,10 @@ def read_dem(path):
     except (OSError, ValueError, ImportError) as exc:
         raise InputError(f"DEM {path}: not a readable NetCDF file: {exc}") from None
     if "height" not in ds:
-        raise InputError(f"DEM {path}: no variable 'height' (found {list(ds.data_vars)}); it "
-                         "needs height(N, E) in metres")
+        raise InputError(
+            f"DEM {path}: no variable 'height' (found {list(ds.data_vars)}); it "
+            "needs height(N, E) in metres"
+        )
     h = ds["height"].load()
     ds.close()
     return h

@@ -13,14 +13,26 @@ __all__ = ["SENSOR_SCHEMA", "CAMERA_SCHEMA", "read_sensor_toml", "read_camera_to
 #: ``hsgeo geocode --sensor``: a line scanner (000 eq. (2)) and its boresight.
 SENSOR_SCHEMA = {
     "sensor": {
-        "model": Key("str", default="calibrated", choices=("calibrated", "linear-ifov"),
-                     doc="'calibrated' (000 eq. (2)) or 'linear-ifov' (no distortion)"),
+        "model": Key(
+            "str",
+            default="calibrated",
+            choices=("calibrated", "linear-ifov"),
+            doc="'calibrated' (000 eq. (2)) or 'linear-ifov' (no distortion)",
+        ),
         "zeta0_px": Key("float", required=True, doc="principal point ζ0, px"),
         "c_px": Key("float", required=True, positive=True, doc="principal distance, px"),
-        "K": Key("floats", length=3, default=(0.0, 0.0, 0.0),
-                 doc="K1..K3 of 000 eq. (2), px per (100 px)^(3, 5, 7); calibrated only"),
-        "boresight_deg": Key("floats", length=3, default=(0.0, 0.0, 0.0),
-                             doc="roll, pitch, heading of R_body_from_sensor, degrees"),
+        "K": Key(
+            "floats",
+            length=3,
+            default=(0.0, 0.0, 0.0),
+            doc="K1..K3 of 000 eq. (2), px per (100 px)^(3, 5, 7); calibrated only",
+        ),
+        "boresight_deg": Key(
+            "floats",
+            length=3,
+            default=(0.0, 0.0, 0.0),
+            doc="roll, pitch, heading of R_body_from_sensor, degrees",
+        ),
     },
 }
 
@@ -38,8 +50,9 @@ CAMERA_SCHEMA = {
     },
     "gnss_ins": {
         "sigma_pos_m": Key("floats", length=3, positive=True, doc="σ of E, N, H, m"),
-        "sigma_att_deg": Key("floats", length=3, positive=True,
-                             doc="σ of roll, pitch, yaw, degrees"),
+        "sigma_att_deg": Key(
+            "floats", length=3, positive=True, doc="σ of roll, pitch, yaw, degrees"
+        ),
     },
     "observations": {"sigma_px": Key("float", positive=True, doc="σ of an image coordinate, px")},
     "gcp": {"sigma_m": Key("float", positive=True, doc="σ of a GCP coordinate, m")},

@@ -18,8 +18,20 @@ from hsgeo.io.config import closest
 __all__ = ["read_table", "UNIT_SUFFIXES"]
 
 #: Column-name endings that mark a physical quantity (the column must be numeric and finite).
-UNIT_SUFFIXES = ("_px", "_m", "_mm", "_um", "_nm", "_s", "_rad", "_deg", "_hz", "_m_s",
-                 "_rad_s", "_dn")
+UNIT_SUFFIXES = (
+    "_px",
+    "_m",
+    "_mm",
+    "_um",
+    "_nm",
+    "_s",
+    "_rad",
+    "_deg",
+    "_hz",
+    "_m_s",
+    "_rad_s",
+    "_dn",
+)
 
 _PARQUET = (".parquet", ".pq")
 
@@ -84,11 +96,14 @@ def read_table(path, columns, what: str = "table", *, text_columns=()):
         if parquet:
             df = pd.read_parquet(path)
         else:
-            df = pd.read_csv(path, comment="#", skipinitialspace=True,
-                             dtype={c: str for c in text_columns})
+            df = pd.read_csv(
+                path, comment="#", skipinitialspace=True, dtype={c: str for c in text_columns}
+            )
     except pd.errors.EmptyDataError:
-        raise InputError(f"{name} is empty; it needs a header line with the columns "
-                         f"{', '.join(columns)} and one row per record") from None
+        raise InputError(
+            f"{name} is empty; it needs a header line with the columns "
+            f"{', '.join(columns)} and one row per record"
+        ) from None
     except Exception as exc:  # noqa: BLE001 - any parser error becomes an InputError
         kind = "Parquet" if parquet else "CSV"
         raise InputError(f"{name} is not a readable {kind} table: {exc}") from None
@@ -97,8 +112,10 @@ def read_table(path, columns, what: str = "table", *, text_columns=()):
     if missing:
         near = {c: closest(c, df.columns) for c in missing}
         hints = "".join(f"; rename {n!r} to {c!r}?" for c, n in near.items() if n)
-        raise InputError(f"{name}: missing column(s) {', '.join(missing)}; the header must "
-                         f"name {', '.join(columns)} (found: {', '.join(df.columns)}){hints}")
+        raise InputError(
+            f"{name}: missing column(s) {', '.join(missing)}; the header must "
+            f"name {', '.join(columns)} (found: {', '.join(df.columns)}){hints}"
+        )
     if len(df) == 0:
         raise InputError(f"{name} has a header but no data rows; add one row per record")
     lines = None if parquet else _data_lines(path)
@@ -119,8 +136,10 @@ def read_table(path, columns, what: str = "table", *, text_columns=()):
             text = col.notna() & num.isna()
             if text.any():
                 r = int(np.flatnonzero(text.to_numpy())[0])
-                raise InputError(f"{name}, {where(r)}, column {c}: {col.iloc[r]!r} is not a "
-                                 "number; correct the value")
+                raise InputError(
+                    f"{name}, {where(r)}, column {c}: {col.iloc[r]!r} is not a "
+                    "number; correct the value"
+                )
             df[c] = num
             bad = ~np.isfinite(num.to_numpy(dtype=float))
         else:

@@ -21,8 +21,12 @@ from hsgeo.errors import InputError
 
 __all__ = ["Detection", "make_detector", "detect_targets", "to_uint8", "detection_rate"]
 
-_REFINE = {"none": "CORNER_REFINE_NONE", "subpix": "CORNER_REFINE_SUBPIX",
-           "contour": "CORNER_REFINE_CONTOUR", "apriltag": "CORNER_REFINE_APRILTAG"}
+_REFINE = {
+    "none": "CORNER_REFINE_NONE",
+    "subpix": "CORNER_REFINE_SUBPIX",
+    "contour": "CORNER_REFINE_CONTOUR",
+    "apriltag": "CORNER_REFINE_APRILTAG",
+}
 
 
 @dataclass(frozen=True)
@@ -48,8 +52,7 @@ class Detection:
         return int(self.ids.size)
 
 
-def make_detector(dictionary: str = "DICT_4X4_100", refine: str = "subpix",
-                  win_size: int = 5):
+def make_detector(dictionary: str = "DICT_4X4_100", refine: str = "subpix", win_size: int = 5):
     """A ``cv2.aruco.ArucoDetector`` for a predefined dictionary.
 
     Parameters
@@ -64,8 +67,10 @@ def make_detector(dictionary: str = "DICT_4X4_100", refine: str = "subpix",
     import cv2
 
     if not hasattr(cv2.aruco, str(dictionary)):
-        raise InputError(f"unknown ArUco dictionary {dictionary!r}; use an OpenCV name such as "
-                         "DICT_4X4_100 or DICT_6X6_250")
+        raise InputError(
+            f"unknown ArUco dictionary {dictionary!r}; use an OpenCV name such as "
+            "DICT_4X4_100 or DICT_6X6_250"
+        )
     if refine not in _REFINE:
         raise InputError(f"refine must be one of {sorted(_REFINE)}, got {refine!r}")
     d = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, dictionary))
@@ -104,8 +109,10 @@ def detect_targets(image, detector=None, *, valid_ids=None) -> Detection:
     """
     img = np.asarray(image)
     if img.ndim != 2 or img.dtype != np.uint8:
-        raise InputError(f"detect_targets needs a (height, width) uint8 image, got {img.shape} "
-                         f"{img.dtype}; convert raw DN with to_uint8()")
+        raise InputError(
+            f"detect_targets needs a (height, width) uint8 image, got {img.shape} "
+            f"{img.dtype}; convert raw DN with to_uint8()"
+        )
     det = make_detector() if detector is None else detector
     corners, ids, _ = det.detectMarkers(img)
     if ids is None or len(ids) == 0:

@@ -45,8 +45,14 @@ def _number(pattern: str | None, name: str, default: int) -> int:
     return int(m.group(1))
 
 
-def observe_files(paths, board: Board, *, band_regex: str | None = None,
-                  cube_regex: str | None = None, refine: str = "subpix"):
+def observe_files(
+    paths,
+    board: Board,
+    *,
+    band_regex: str | None = None,
+    cube_regex: str | None = None,
+    refine: str = "subpix",
+):
     """Detect the board in image files and return :class:`hsgeo.measure.targets.Observations`.
 
     Parameters
@@ -105,5 +111,12 @@ def observe_files(paths, board: Board, *, band_regex: str | None = None,
     # results are converted to pixels by the caller)
     pixel = board.pixel_mm if board.pixel_mm is not None else NOMINAL_PIXEL_MM
     cat = {k: np.concatenate(v) for k, v in rows.items()}
-    return Observations(cat["cube"].astype(np.int64), cat["band"].astype(np.int64),
-                        cat["target"].astype(np.int64), cat["corners"], cat["obj"], size, pixel)
+    return Observations(
+        cat["cube"].astype(np.int64),
+        cat["band"].astype(np.int64),
+        cat["target"].astype(np.int64),
+        cat["corners"],
+        cat["obj"],
+        size,
+        pixel,
+    )

@@ -22,8 +22,14 @@ from hsgeo.errors import InputError, ObservationError
 __all__ = ["find_minima", "associate_by_order"]
 
 
-def find_minima(profile: ArrayLike, *, min_contrast: float = 0.12, half_window_px: int = 5,
-                centroid_half_px: int = 3, method: str = "parabola") -> tuple[NDArray, NDArray]:
+def find_minima(
+    profile: ArrayLike,
+    *,
+    min_contrast: float = 0.12,
+    half_window_px: int = 5,
+    centroid_half_px: int = 3,
+    method: str = "parabola",
+) -> tuple[NDArray, NDArray]:
     """Sub-pixel positions of the narrow dark features of a 1D profile.
 
     A candidate is a local minimum whose bright level on *both* sides (the maximum within
@@ -55,8 +61,10 @@ def find_minima(profile: ArrayLike, *, min_contrast: float = 0.12, half_window_p
     """
     p = np.asarray(profile, dtype=float)
     if p.ndim != 1 or p.size < 2 * half_window_px + 3:
-        raise InputError(f"profile must be 1-D with at least {2 * half_window_px + 3} pixels, "
-                         f"got shape {p.shape}")
+        raise InputError(
+            f"profile must be 1-D with at least {2 * half_window_px + 3} pixels, "
+            f"got shape {p.shape}"
+        )
     if not np.all(np.isfinite(p)):
         raise InputError("profile contains NaN/inf; mask bad pixels before measuring minima")
     if method not in ("centroid", "parabola", "pixel"):
@@ -65,7 +73,7 @@ def find_minima(profile: ArrayLike, *, min_contrast: float = 0.12, half_window_p
     pad = np.pad(p, h, mode="edge")
     win = np.lib.stride_tricks.sliding_window_view(pad, 2 * h + 1)  # (n, 2h+1), centred
     left = win[:, :h].max(axis=1)
-    right = win[:, h + 1:].max(axis=1)
+    right = win[:, h + 1 :].max(axis=1)
     bright = np.minimum(left, right)
     level = max(float(np.percentile(p, 95)), 1e-12)
     is_min = (p <= win.min(axis=1)) & (bright - p >= min_contrast * level)
@@ -99,8 +107,9 @@ def find_minima(profile: ArrayLike, *, min_contrast: float = 0.12, half_window_p
     return out, contrast
 
 
-def associate_by_order(zeta_px: ArrayLike, point_ids_in_order: ArrayLike,
-                       what: str = "profile") -> tuple[NDArray, NDArray]:
+def associate_by_order(
+    zeta_px: ArrayLike, point_ids_in_order: ArrayLike, what: str = "profile"
+) -> tuple[NDArray, NDArray]:
     """Pair measured minima with pattern points by their order along the line.
 
     The map from the pattern to the sensor line is monotonic, so the k-th minimum (ascending ζ)

@@ -53,8 +53,16 @@ class Observations:
 
     def select(self, mask) -> Observations:
         m = np.asarray(mask, bool)
-        return Observations(self.cube[m], self.band[m], self.target[m], self.corners_px[m],
-                            self.corners_obj[m], self.image_size, self.pixel_mm, self.expected)
+        return Observations(
+            self.cube[m],
+            self.band[m],
+            self.target[m],
+            self.corners_px[m],
+            self.corners_obj[m],
+            self.image_size,
+            self.pixel_mm,
+            self.expected,
+        )
 
     @property
     def detection_rate(self) -> float:

@@ -31,9 +31,7 @@ def chapter_names() -> list[str]:
 def run(chapter: str, seed: int = 0, scale: float = 1.0) -> Reproduction:
     """Run a chapter's computation and return its tables."""
     if chapter not in CHAPTERS:
-        raise InputError(
-            f"unknown chapter {chapter!r}; known chapters: {', '.join(CHAPTERS)}"
-        )
+        raise InputError(f"unknown chapter {chapter!r}; known chapters: {', '.join(CHAPTERS)}")
     if not (isinstance(seed, int) and seed >= 0):
         raise InputError(f"seed must be a non-negative integer, got {seed!r}")
     if not (0 < scale <= 1.0):

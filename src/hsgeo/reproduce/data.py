@@ -97,18 +97,30 @@ def generate_all(verify: bool = False, update: bool = False) -> int:
             continue
         name = Path(p).name
         old = previous.get(name)
-        if (old is not None and p in sums and p in expected
-                and hashlib.sha256(old.encode()).hexdigest() == expected[p]
-                and _same_numbers(old, (ddir / p).read_text(), VERIFY_RTOL)):
+        if (
+            old is not None
+            and p in sums
+            and p in expected
+            and hashlib.sha256(old.encode()).hexdigest() == expected[p]
+            and _same_numbers(old, (ddir / p).read_text(), VERIFY_RTOL)
+        ):
             close.append(p)
             (ddir / p).write_text(old)  # keep the committed bytes
             continue
         bad.append(p)
     if bad:
-        print("data_synthetic: generated files differ from MANIFEST.sha256: " + ", ".join(bad)
-              + "\n  (if the change is deliberate: hsgeo data --update-manifest)", file=sys.stderr)
+        print(
+            "data_synthetic: generated files differ from MANIFEST.sha256: "
+            + ", ".join(bad)
+            + "\n  (if the change is deliberate: hsgeo data --update-manifest)",
+            file=sys.stderr,
+        )
         return 1 if verify else 0
-    note = (f"; {len(close)} differ only in the last bits, every number within "
-            f"{VERIFY_RTOL:g} relative ({', '.join(close)})" if close else "")
+    note = (
+        f"; {len(close)} differ only in the last bits, every number within "
+        f"{VERIFY_RTOL:g} relative ({', '.join(close)})"
+        if close
+        else ""
+    )
     print(f"data_synthetic: {len(sums)} files match MANIFEST.sha256{note}", file=sys.stderr)
     return 0

@@ -46,8 +46,16 @@ def chessboard_views():
     """
     d = read_opencv_storage(
         reference_dir() / "opencv-chessboard" / "out_camera_data.yml",
-        required=("Image_points", "Camera_Matrix", "Distortion_Coefficients", "board_Width",
-                  "board_Height", "square_Size", "image_Width", "image_Height"),
+        required=(
+            "Image_points",
+            "Camera_Matrix",
+            "Distortion_Coefficients",
+            "board_Width",
+            "board_Height",
+            "square_Size",
+            "image_Width",
+            "image_Height",
+        ),
     )
     nx, ny, sq = int(d["board_Width"]), int(d["board_Height"]), d["square_Size"]
     uv = d["Image_points"].reshape(-1, nx * ny, 2)
@@ -55,8 +63,14 @@ def chessboard_views():
     X = np.column_stack([sq * (k % nx), sq * (k // nx), np.zeros(k.size)])
     views = [View(X, uv[i], k) for i in range(uv.shape[0])]
     dist = d["Distortion_Coefficients"].ravel()
-    ref = {"fx_px": d["Camera_Matrix"][0, 0], "k1": dist[0], "k2": dist[1], "k3": dist[4],
-           "rms_px": d["Avg_Reprojection_Error"], "file": d}
+    ref = {
+        "fx_px": d["Camera_Matrix"][0, 0],
+        "k1": dist[0],
+        "k2": dist[1],
+        "k3": dist[4],
+        "rms_px": d["Avg_Reprojection_Error"],
+        "file": d,
+    }
     return views, (int(d["image_Width"]), int(d["image_Height"])), ref
 
 
@@ -73,11 +87,14 @@ def charuco_views(board: Board | None = None):
     folder = reference_dir() / "opencv-charuco"
     views = []
     for i in range(4):
-        ids, uv_px, X_m = detect_charuco(folder / "images" / f"img_{i:02d}.jpg", board,
-                                         length_unit="m")
+        ids, uv_px, X_m = detect_charuco(
+            folder / "images" / f"img_{i:02d}.jpg", board, length_unit="m"
+        )
         views.append(View(X_m, uv_px, ids))
-    ref = read_opencv_storage(folder / "tutorial_camera_charuco.yml",
-                              required=("camera_matrix", "distortion_coefficients"))
+    ref = read_opencv_storage(
+        folder / "tutorial_camera_charuco.yml",
+        required=("camera_matrix", "distortion_coefficients"),
+    )
     return views, (int(ref["image_width"]), int(ref["image_height"])), ref
 
 
@@ -94,13 +111,23 @@ def opencv_calibrate(views, image_size, flags=0):
     obj = [v.X.astype(np.float32) for v in views]
     img = [v.uv_px.astype(np.float32).reshape(-1, 1, 2) for v in views]
     crit = (cv2.TERM_CRITERIA_COUNT + cv2.TERM_CRITERIA_EPS, 200, 1e-15)
-    rms, K, dist, _, _ = cv2.calibrateCamera(obj, img, image_size, None, None, flags=flags,
-                                             criteria=crit)
+    rms, K, dist, _, _ = cv2.calibrateCamera(
+        obj, img, image_size, None, None, flags=flags, criteria=crit
+    )
     return K, dist.ravel()[:5], float(rms)
 
 
-INTRINSIC_ROWS = (("fx_px", "px"), ("fy_px", "px"), ("cx_px", "px"), ("cy_px", "px"),
-                  ("k1", "1"), ("k2", "1"), ("p1", "1"), ("p2", "1"), ("k3", "1"))
+INTRINSIC_ROWS = (
+    ("fx_px", "px"),
+    ("fy_px", "px"),
+    ("cx_px", "px"),
+    ("cy_px", "px"),
+    ("k1", "1"),
+    ("k2", "1"),
+    ("p1", "1"),
+    ("p2", "1"),
+    ("k3", "1"),
+)
 
 
 def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
@@ -113,16 +140,19 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
 
     # 1. chessboard under OpenCV's constraints (flags 14)
     views, size, ref = chessboard_views()
-    cal = calibrate_opencv(views, size, fix_principal_point=True, square_pixels=True,
-                           zero_tangent=True)
+    cal = calibrate_opencv(
+        views, size, fix_principal_point=True, square_pixels=True, zero_tangent=True
+    )
     v, s = cal.values(), cal.sigmas()
     t = "OpenCV chessboard"
     for q in ("fx_px", "k1", "k2", "k3"):
-        rows.append(Row(t, q, "px" if q.endswith("px") else "1", paper=ref[q], reproduced=v[q],
-                        sigma=s[q]))
+        rows.append(
+            Row(t, q, "px" if q.endswith("px") else "1", paper=ref[q], reproduced=v[q], sigma=s[q])
+        )
     rows.append(Row(t, "rms_px", "px", paper=ref["rms_px"], reproduced=cal.rms_px))
-    pg = calibrate_photogrammetric(views, size, PIXEL_PITCH_MM, fix_principal_point=True,
-                                   zero_decentering=True)
+    pg = calibrate_photogrammetric(
+        views, size, PIXEL_PITCH_MM, fix_principal_point=True, zero_decentering=True
+    )
     t = "two forms of Brown's model (chessboard)"
     f_pg, sf_pg = pg.values()["f_mm"] / PIXEL_PITCH_MM, pg.sigmas()["f_mm"] / PIXEL_PITCH_MM
     rows += [
@@ -131,32 +161,60 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
         Row(t, "rms_px_opencv_form", "px", reproduced=cal.rms_px),
         Row(t, "rms_px_photogrammetric_form", "px", reproduced=pg.rms_px),
     ]
-    extras["chessboard"] = {"views": views, "opencv_form": cal, "photogrammetric_form": pg,
-                            "reference": ref}
+    extras["chessboard"] = {
+        "views": views,
+        "opencv_form": cal,
+        "photogrammetric_form": pg,
+        "reference": ref,
+    }
 
     # 2. ChArUco: hsgeo vs today's cv2.calibrateCamera on the same detected corners
     cviews, csize, cref = charuco_views()
     ccal = calibrate_opencv(cviews, csize)
     K, dist, rms_cv = opencv_calibrate(cviews, csize)
-    cv_vals = {"fx_px": K[0, 0], "fy_px": K[1, 1], "cx_px": K[0, 2], "cy_px": K[1, 2],
-               "k1": dist[0], "k2": dist[1], "p1": dist[2], "p2": dist[3], "k3": dist[4]}
+    cv_vals = {
+        "fx_px": K[0, 0],
+        "fy_px": K[1, 1],
+        "cx_px": K[0, 2],
+        "cy_px": K[1, 2],
+        "k1": dist[0],
+        "k2": dist[1],
+        "p1": dist[2],
+        "p2": dist[3],
+        "k3": dist[4],
+    }
     hv, hs = ccal.values(), ccal.sigmas()
     t = "OpenCV ChArUco"
     for q, unit in INTRINSIC_ROWS:
         rows.append(Row(t, q, unit, paper=cv_vals[q], reproduced=hv[q], sigma=hs[q]))
     rows.append(Row(t, "rms_px", "px", paper=rms_cv, reproduced=ccal.rms_px))
     cm, cd = cref["camera_matrix"], cref["distortion_coefficients"].ravel()
-    extras["charuco"] = {"views": cviews, "hsgeo": ccal, "opencv": cv_vals, "opencv_rms": rms_cv,
-                         "reference_2021": {"fx_px": cm[0, 0], "fy_px": cm[1, 1], "cx_px": cm[0, 2],
-                                            "cy_px": cm[1, 2], "k1": cd[0], "k2": cd[1],
-                                            "p1": cd[2], "p2": cd[3], "k3": cd[4],
-                                            "rms_px": cref["avg_reprojection_error"]}}
+    extras["charuco"] = {
+        "views": cviews,
+        "hsgeo": ccal,
+        "opencv": cv_vals,
+        "opencv_rms": rms_cv,
+        "reference_2021": {
+            "fx_px": cm[0, 0],
+            "fy_px": cm[1, 1],
+            "cx_px": cm[0, 2],
+            "cy_px": cm[1, 2],
+            "k1": cd[0],
+            "k2": cd[1],
+            "p1": cd[2],
+            "p2": cd[3],
+            "k3": cd[4],
+            "rms_px": cref["avg_reprojection_error"],
+        },
+    }
 
     # 3. simulated bench, truth known
     cfg = load_scenario("frame_bench")
     sim, sim_truth = simulate(cfg, seed)
-    sviews = [View(sim.X_mm[sim.point[sim.view == i]], sim.uv_px[sim.view == i])
-              for i in range(sim.n_views)]
+    sviews = [
+        View(sim.X_mm[sim.point[sim.view == i]], sim.uv_px[sim.view == i])
+        for i in range(sim.n_views)
+    ]
     scal = calibrate_opencv(sviews, sim.image_size_px, sigma_px=sim.sigma_px)
     truth = dict(zip(("fx_px", "fy_px", "cx_px", "cy_px"), sim_truth.intrinsics, strict=True))
     truth.update(zip(("k1", "k2", "p1", "p2", "k3"), sim_truth.distortion, strict=True))
@@ -165,14 +223,18 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
     for q, unit in INTRINSIC_ROWS:
         rows.append(Row(t, q, unit, reproduced=sv[q], sigma=ss[q], truth=truth[q]))
     rows.append(Row(t, "sigma0", "1", reproduced=scal.result.sigma0, truth=1.0))
-    extras["bench"] = {"calibration": scal, "truth": truth, "observations": sim,
-                       "simulation_truth": sim_truth}
+    extras["bench"] = {
+        "calibration": scal,
+        "truth": truth,
+        "observations": sim,
+        "simulation_truth": sim_truth,
+    }
 
     meta = {
         "chessboard_source": "opencv/opencv samples/cpp/tutorial_code/calib3d/camera_calibration/"
-                             "out_camera_data.yml (flags 14)",
+        "out_camera_data.yml (flags 14)",
         "charuco_source": "opencv_contrib aruco tutorial images img_00..03.jpg; board 5x7, "
-                          "0.04 m squares, 0.02 m markers, DICT_6X6_250",
+        "0.04 m squares, 0.02 m markers, DICT_6X6_250",
         "charuco_corners_per_image": [int(v.X.shape[0]) for v in cviews],
         "charuco_reference_2021": extras["charuco"]["reference_2021"],
         "pixel_pitch_mm_nominal": PIXEL_PITCH_MM,

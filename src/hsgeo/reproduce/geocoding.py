@@ -33,8 +33,9 @@ def calibrated_iop(seed: int):
     from hsgeo.reproduce.line_calibration import calibrate_simulated
     from hsgeo.simulate.line_lab import LineLab
 
-    res, _ = calibrate_simulated(LineLab(), 1000,
-                                 np.random.SeedSequence([seed, 1000]).generate_state(1)[0])
+    res, _ = calibrate_simulated(
+        LineLab(), 1000, np.random.SeedSequence([seed, 1000]).generate_state(1)[0]
+    )
     K = tuple(float(k) for k in res.value("K"))
     return CalibratedLine(float(res.value("zeta0_px")), float(res.value("c_px")), K), res
 
@@ -43,9 +44,17 @@ def flight_deviations(obs: FlightObservations, sensor, sigma_m: float = 0.3):
     """:func:`hsgeo.workflows.geocoding.gcp_deviations` on one simulated flight's observations:
     ``(dev_EN_m (n, 2), result)``.
     """
-    return gcp_deviations(obs.recorded_nav, sensor, obs.line, obs.zeta_px, obs.gcp_enu_m,
-                          height_m=obs.terrain_height_m, t0_s=obs.t0_s,
-                          line_rate_hz=obs.line_rate_hz, sigma_m=sigma_m)
+    return gcp_deviations(
+        obs.recorded_nav,
+        sensor,
+        obs.line,
+        obs.zeta_px,
+        obs.gcp_enu_m,
+        height_m=obs.terrain_height_m,
+        t0_s=obs.t0_s,
+        line_rate_hz=obs.line_rate_hz,
+        sigma_m=sigma_m,
+    )
 
 
 def monte_carlo(cfg: dict, sensors: dict, n_flights: int, seed: int) -> dict:
@@ -61,8 +70,7 @@ def monte_carlo(cfg: dict, sensors: dict, n_flights: int, seed: int) -> dict:
     out = {name: np.empty((n_flights, 4)) for name in sensors}
     first = {}
     for i in range(n_flights):
-        obs, truth = simulate_flight(cfg,
-                                     np.random.SeedSequence([seed, i]).generate_state(1)[0])
+        obs, truth = simulate_flight(cfg, np.random.SeedSequence([seed, i]).generate_state(1)[0])
         for name, sensor in sensors.items():
             dev, res = flight_deviations(obs, sensor)
             _, s = deviation_table(dev[:, 0], dev[:, 1], obs.gcp_id)
@@ -84,8 +92,9 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
         table = f"000 Table {which}"
         _, summary, flags = recompute_printed_table(which)
         for q in QUANTITIES:
-            rows.append(Row(table, q, "m", paper=P000_GCP_FOOTERS[table][q][0],
-                            reproduced=summary[q]))
+            rows.append(
+                Row(table, q, "m", paper=P000_GCP_FOOTERS[table][q][0], reproduced=summary[q])
+            )
         meta["flags"][table] = [str(f) for f in flags]
 
     # 2. the experiment
@@ -97,22 +106,38 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
     for name, paper_table in (("uncalibrated", "000 Table 2"), ("calibrated", "000 Table 3")):
         for k, q in enumerate(QUANTITIES):
             v = mc[name][:, k]
-            rows.append(Row(f"simulated, {name}", q, "m", paper=P000_GCP_FOOTERS[paper_table][q][0],
-                            reproduced=float(np.median(v)), sigma=float(nmad(v))))
+            rows.append(
+                Row(
+                    f"simulated, {name}",
+                    q,
+                    "m",
+                    paper=P000_GCP_FOOTERS[paper_table][q][0],
+                    reproduced=float(np.median(v)),
+                    sigma=float(nmad(v)),
+                )
+            )
     ratio = mc["uncalibrated"][:, 2:] / mc["calibrated"][:, 2:]
     p2, p3 = P000_GCP_FOOTERS["000 Table 2"], P000_GCP_FOOTERS["000 Table 3"]
     for k, (q, axis) in enumerate((("sigma_ratio_y", "y"), ("sigma_ratio_x", "x"))):
-        rows.append(Row("simulated, ratio", q, "1",
-                        paper=p2[f"sigma_{axis}_m"][0] / p3[f"sigma_{axis}_m"][0],
-                        reproduced=float(np.median(ratio[:, k])), sigma=float(nmad(ratio[:, k]))))
-    meta.update({
-        "n_flights": n,
-        "reproduced": "median over the simulated flights; sigma: NMAD of the per-flight values",
-        "fraction_ratio_above_2": [float(np.mean(ratio[:, k] > 2)) for k in range(2)],
-        "calibrated_iop": {"zeta0_px": cal.zeta0_px, "c_px": cal.c_px, "K": list(cal.K)},
-        "flight_height_agl_m": cfg["flight"]["height_agl_m"],
-        "gsd_across_m": cfg["flight"]["height_agl_m"] / cfg["sensor_truth"]["c_px"],
-    })
-    extras = {"cfg": cfg, "mc": mc, "ratio": ratio, "sensors": sensors,
-              "line_calibration": cal_res}
+        rows.append(
+            Row(
+                "simulated, ratio",
+                q,
+                "1",
+                paper=p2[f"sigma_{axis}_m"][0] / p3[f"sigma_{axis}_m"][0],
+                reproduced=float(np.median(ratio[:, k])),
+                sigma=float(nmad(ratio[:, k])),
+            )
+        )
+    meta.update(
+        {
+            "n_flights": n,
+            "reproduced": "median over the simulated flights; sigma: NMAD of the per-flight values",
+            "fraction_ratio_above_2": [float(np.mean(ratio[:, k] > 2)) for k in range(2)],
+            "calibrated_iop": {"zeta0_px": cal.zeta0_px, "c_px": cal.c_px, "K": list(cal.K)},
+            "flight_height_agl_m": cfg["flight"]["height_agl_m"],
+            "gsd_across_m": cfg["flight"]["height_agl_m"] / cfg["sensor_truth"]["c_px"],
+        }
+    )
+    extras = {"cfg": cfg, "mc": mc, "ratio": ratio, "sensors": sensors, "line_calibration": cal_res}
     return Reproduction("geocoding", seed, rows, meta, extras)

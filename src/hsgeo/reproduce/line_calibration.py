@@ -49,10 +49,24 @@ def simulate_observations(lab: LineLab, row: int, rng, eop_true=None, method: st
     (observations), ``xy_m`` (control points), ``point_ids``, ``frames`` (raw rows per image).
     """
     rec, truth = record(lab, row, rng, eop_true)
-    img, pt, z = observe_rows(rec.frames_dn, rec.xy_m, offset_dn=lab.offset_dn,
-                              n_columns=lab.n_reflected, method=method, row=row)
-    return {"eop_true": truth.eop, "iop_true": truth.iop, "image": img, "point": pt,
-            "zeta_px": z, "xy_m": rec.xy_m, "point_ids": rec.point_ids, "frames": rec.frames_dn}
+    img, pt, z = observe_rows(
+        rec.frames_dn,
+        rec.xy_m,
+        offset_dn=lab.offset_dn,
+        n_columns=lab.n_reflected,
+        method=method,
+        row=row,
+    )
+    return {
+        "eop_true": truth.eop,
+        "iop_true": truth.iop,
+        "image": img,
+        "point": pt,
+        "zeta_px": z,
+        "xy_m": rec.xy_m,
+        "point_ids": rec.point_ids,
+        "frames": rec.frames_dn,
+    }
 
 
 def calibrate_simulated(lab: LineLab, row: int, rng, method: str = "parabola"):
@@ -61,8 +75,15 @@ def calibrate_simulated(lab: LineLab, row: int, rng, method: str = "parabola"):
     xy = sim["xy_m"]
     line1d.check_minimum_observations(sim["image"], sim["point"], np.ones(len(xy), bool))
     u = P000_TABLE1_UNCALIBRATED
-    p = line1d.make_parameters(stations(lab), u.zeta0_px, u.c_px, [0.0, 0.0, 0.0], xy,
-                               np.ones(len(xy), bool), point_ids=sim["point_ids"])
+    p = line1d.make_parameters(
+        stations(lab),
+        u.zeta0_px,
+        u.c_px,
+        [0.0, 0.0, 0.0],
+        xy,
+        np.ones(len(xy), bool),
+        point_ids=sim["point_ids"],
+    )
     blk = line1d.LineObservations(sim["image"], sim["point"], sim["zeta_px"], lab.zeta_sigma_px)
     return calibrate(p, blk), sim
 
@@ -91,14 +112,27 @@ def monte_carlo(lab: LineLab, row: int, n: int, seed: int) -> dict:
         s0.append(res.sigma0)
     est, sig, tru = np.array(est), np.array(sig), np.array(tru)
     z = (est - tru) / sig
-    return {"est": est, "sigma": sig, "truth": tru, "sigma0": np.array(s0), "z": z,
-            "coverage": {k: np.mean(np.abs(z) <= k, axis=0) for k in (1, 2, 3)},
-            "bias": np.mean(est - tru, axis=0),
-            "bias_sigma": np.std(est - tru, axis=0) / np.sqrt(n)}
+    return {
+        "est": est,
+        "sigma": sig,
+        "truth": tru,
+        "sigma0": np.array(s0),
+        "z": z,
+        "coverage": {k: np.mean(np.abs(z) <= k, axis=0) for k in (1, 2, 3)},
+        "bias": np.mean(est - tru, axis=0),
+        "bias_sigma": np.std(est - tru, axis=0) / np.sqrt(n),
+    }
 
 
-def design_sigma_c(lab: LineLab, row: int = 1000, *, offsets_m=(0.0,), station_sigma_m=None,
-                   sigma_px: float = 0.1, seed: int = 0) -> np.ndarray:
+def design_sigma_c(
+    lab: LineLab,
+    row: int = 1000,
+    *,
+    offsets_m=(0.0,),
+    station_sigma_m=None,
+    sigma_px: float = 0.1,
+    seed: int = 0,
+) -> np.ndarray:
     """A-priori σ(c) [px] of a design, for side-signal offsets and/or station-position priors.
 
     Observations are projected exactly (no rendering) with ``sigma_px`` noise; σ(c) is the
@@ -125,9 +159,16 @@ def design_sigma_c(lab: LineLab, row: int = 1000, *, offsets_m=(0.0,), station_s
         blk = line1d.LineObservations(img, pt, z, sigma_px)
         for j, ss in enumerate(sig_st):
             ps = None if ss is None else np.tile([ss, ss, np.inf], (len(eop), 1))
-            p = line1d.make_parameters(eop, float(iop["zeta0_px"]), float(iop["c_px"]), iop["K"],
-                                       xy, np.ones(len(xy), bool), eop_prior_sigma=ps,
-                                       eop_prior_mean=eop)
+            p = line1d.make_parameters(
+                eop,
+                float(iop["zeta0_px"]),
+                float(iop["c_px"]),
+                iop["K"],
+                xy,
+                np.ones(len(xy), bool),
+                eop_prior_sigma=ps,
+                eop_prior_mean=eop,
+            )
             try:
                 res = adjust(p, blk)
             except DatumError:
@@ -151,8 +192,13 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
     rows.append(Row("000 Table 1", "c_px uncalibrated", "px", u.c_px, None, u.c_px))
     v, s = _iop(results[1000])
     t = _truth(sims[1000])
-    paper = [(c.zeta0_px, c.zeta0_sigma_px), (c.c_px, c.c_sigma_px), (c.K1, None), (c.K2, None),
-             (c.K3, None)]
+    paper = [
+        (c.zeta0_px, c.zeta0_sigma_px),
+        (c.c_px, c.c_sigma_px),
+        (c.K1, None),
+        (c.K2, None),
+        (c.K3, None),
+    ]
     units = ["px", "px", "px", "px", "px"]
     for q, un, (pv, ps), vi, si, ti in zip(IOP_NAMES, units, paper, v, s, t, strict=True):
         rows.append(Row("000 Table 1", q, un, pv, ps, vi, si, ti))
@@ -160,8 +206,13 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
     for pr in P001_TABLE2:
         v, s = _iop(results[pr.row_px])
         t = _truth(sims[pr.row_px])
-        paper = [(pr.zeta0_px, pr.zeta0_sigma_px), (pr.c_px, pr.c_sigma_px), (pr.K1, None),
-                 (pr.K2, None), (pr.K3, None)]
+        paper = [
+            (pr.zeta0_px, pr.zeta0_sigma_px),
+            (pr.c_px, pr.c_sigma_px),
+            (pr.K1, None),
+            (pr.K2, None),
+            (pr.K3, None),
+        ]
         for q, (pv, ps), vi, si, ti in zip(IOP_NAMES, paper, v, s, t, strict=True):
             rows.append(Row("001 Table 2", f"{q} line{pr.row_px}", "px", pv, ps, vi, si, ti))
     # distortion magnitudes from the published coefficients (100-px normalisation)
@@ -169,14 +220,36 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
     k1000 = [P001_TABLE2[3].K1, P001_TABLE2[3].K2, P001_TABLE2[3].K3]
     vis = max(line1d.distortion_extremes([p.K1, p.K2, p.K3])[0] for p in P001_TABLE2[:3])
     st = P001_DISTORTION_STATEMENTS
-    rows.append(Row("distortion magnitudes", "max_distortion_line100_px", "px",
-                    st["max_distortion_line100_px"][0], None,
-                    line1d.distortion_extremes(k100)[0]))
-    rows.append(Row("distortion magnitudes", "max_distortion_visible_px", "px",
-                    st["max_distortion_visible_px"][0], None, vis))
-    rows.append(Row("distortion magnitudes", "distortion_450px_line1000_px", "px",
-                    st["distortion_450px_line1000_px"][0], None,
-                    line1d.distortion_extremes(k1000)[2]))
+    rows.append(
+        Row(
+            "distortion magnitudes",
+            "max_distortion_line100_px",
+            "px",
+            st["max_distortion_line100_px"][0],
+            None,
+            line1d.distortion_extremes(k100)[0],
+        )
+    )
+    rows.append(
+        Row(
+            "distortion magnitudes",
+            "max_distortion_visible_px",
+            "px",
+            st["max_distortion_visible_px"][0],
+            None,
+            vis,
+        )
+    )
+    rows.append(
+        Row(
+            "distortion magnitudes",
+            "distortion_450px_line1000_px",
+            "px",
+            st["distortion_450px_line1000_px"][0],
+            None,
+            line1d.distortion_extremes(k1000)[2],
+        )
+    )
     # Monte Carlo
     n_mc = max(20, int(round(200 * scale)))
     mc = {r: monte_carlo(lab, r, n_mc, seed) for r in lab.rows}
@@ -184,14 +257,31 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
         for k in (1, 2, 3):
             cov = mc[r]["coverage"][k]
             for q, f in zip(IOP_NAMES, cov, strict=True):
-                rows.append(Row("Monte Carlo coverage", f"{q} line{r} in {k}sigma",
-                                "fraction", None, None, f,
-                                None, {1: 0.6827, 2: 0.9545, 3: 0.9973}[k]))
-    meta = {"n_monte_carlo": n_mc, "distortion_norm_px": line1d.DISTORTION_NORM_PX,
-            "side_offset_m": lab.side_offset_m,
-            "sigma0": {str(r): results[r].sigma0 for r in lab.rows}}
-    return Reproduction("line-calibration", seed, rows, meta,
-                        extras={"lab": lab, "results": results, "sims": sims, "mc": mc})
+                rows.append(
+                    Row(
+                        "Monte Carlo coverage",
+                        f"{q} line{r} in {k}sigma",
+                        "fraction",
+                        None,
+                        None,
+                        f,
+                        None,
+                        {1: 0.6827, 2: 0.9545, 3: 0.9973}[k],
+                    )
+                )
+    meta = {
+        "n_monte_carlo": n_mc,
+        "distortion_norm_px": line1d.DISTORTION_NORM_PX,
+        "side_offset_m": lab.side_offset_m,
+        "sigma0": {str(r): results[r].sigma0 for r in lab.rows},
+    }
+    return Reproduction(
+        "line-calibration",
+        seed,
+        rows,
+        meta,
+        extras={"lab": lab, "results": results, "sims": sims, "mc": mc},
+    )
 
 
 def generate(cfg: dict, outdir: Path) -> list[Path]:
@@ -217,8 +307,13 @@ def generate(cfg: dict, outdir: Path) -> list[Path]:
     with tru.open("w") as fh:
         fh.write("quantity,value\n")
         t = sim["iop_true"]
-        for k, v in [("zeta0_px", t["zeta0_px"]), ("c_px", t["c_px"]), ("K1", t["K"][0]),
-                     ("K2", t["K"][1]), ("K3", t["K"][2])]:
+        for k, v in [
+            ("zeta0_px", t["zeta0_px"]),
+            ("c_px", t["c_px"]),
+            ("K1", t["K"][0]),
+            ("K2", t["K"][1]),
+            ("K3", t["K"][2]),
+        ]:
             fh.write(f"{k},{float(v):.17g}\n")
         for i, e in enumerate(sim["eop_true"]):
             for k, v in zip(line1d.EOP_COLUMNS, e, strict=True):

@@ -42,8 +42,17 @@ TABLE3_BANDS = (5, 20)  # 003 Table 3
 ROP_CUBE = 0  # 003 Table 4 (first) uses the bands of one cube
 
 
-def observe(cfg: dict, truth, seed: int, cubes, bands, *, refine: str = "subpix",
-            compare_refine: str | None = None, keep_images=()):
+def observe(
+    cfg: dict,
+    truth,
+    seed: int,
+    cubes,
+    bands,
+    *,
+    refine: str = "subpix",
+    compare_refine: str | None = None,
+    keep_images=(),
+):
     """Render the bands of the cubes and measure them as a user would (the experiment of 003 §3.2).
 
     The images are rendered one at a time (:class:`hsgeo.simulate.rikola.Renderer`) and measured
@@ -79,8 +88,15 @@ def observe(cfg: dict, truth, seed: int, cubes, bands, *, refine: str = "subpix"
                 yield (c, b), img
 
     obs, obs_cmp = detect_targets_in_images(
-        rendered(), obj, plate.ids, size, float(cam["pixel_mm"]), dictionary=plate.dictionary,
-        refine=refine, compare_refine=compare_refine)
+        rendered(),
+        obj,
+        plate.ids,
+        size,
+        float(cam["pixel_mm"]),
+        dictionary=plate.dictionary,
+        refine=refine,
+        compare_refine=compare_refine,
+    )
     obs = replace(obs, expected=expected)
     if obs_cmp is not None:
         obs_cmp = replace(obs_cmp, expected=expected)
@@ -109,19 +125,24 @@ def corner_bias(obs: Observations, truth) -> dict[int, dict[str, float]]:
     out = {}
     for b in np.unique(obs.band):
         o = obs.select(obs.band == b)
-        true = np.stack([mm_to_pixel(truth.project(int(c), int(b), X), obs.image_size,
-                                     obs.pixel_mm) for c, X in zip(o.cube, o.corners_obj,
-                                                                   strict=True)])
+        true = np.stack(
+            [
+                mm_to_pixel(truth.project(int(c), int(b), X), obs.image_size, obs.pixel_mm)
+                for c, X in zip(o.cube, o.corners_obj, strict=True)
+            ]
+        )
         e = o.corners_px - true
         centre = true.mean(axis=1, keepdims=True)
         u = true - centre
         u /= np.linalg.norm(u, axis=-1, keepdims=True)
         side = lambda c: np.linalg.norm(np.roll(c, -1, axis=1) - c, axis=-1)  # noqa: E731
         ce = o.centroids_px - true.mean(axis=1)
-        out[int(b)] = {"outward_px": float(np.mean(np.sum(e * u, axis=-1))),
-                       "scale": float(np.mean(side(o.corners_px) / side(true))),
-                       "centroid_mean_px": ce.mean(axis=0).tolist(),
-                       "centroid_sd_px": ce.std(axis=0).tolist()}
+        out[int(b)] = {
+            "outward_px": float(np.mean(np.sum(e * u, axis=-1))),
+            "scale": float(np.mean(side(o.corners_px) / side(true))),
+            "centroid_mean_px": ce.mean(axis=0).tolist(),
+            "centroid_sd_px": ce.std(axis=0).tolist(),
+        }
     return out
 
 
@@ -146,8 +167,15 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
     cfg, truth, cubes, bands = setup(seed, scale)
     sigma_px = float(cfg["measure"]["sigma_px"])
     t0 = time.time()
-    obs, obs_contour, images = observe(cfg, truth, seed, cubes, bands, compare_refine="contour",
-                                       keep_images=[(ROP_CUBE, b) for b in (1, 5, 20)])
+    obs, obs_contour, images = observe(
+        cfg,
+        truth,
+        seed,
+        cubes,
+        bands,
+        compare_refine="contour",
+        keep_images=[(ROP_CUBE, b) for b in (1, 5, 20)],
+    )
     t_observe = time.time() - t0
     # 003 §3.3: every band its own camera
     t0 = time.time()
@@ -158,33 +186,86 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
     # --- 003 Table 3
     for b in TABLE3_BANDS:
         c = cals[b]
-        tr = dict(zip(("f_mm", "x0_mm", "y0_mm", "K1_per_mm2", "K2_per_mm4", "K3_per_mm6",
-                       "P1_per_mm", "P2_per_mm"), np.r_[truth.interior(b), truth.KP], strict=True))
+        tr = dict(
+            zip(
+                (
+                    "f_mm",
+                    "x0_mm",
+                    "y0_mm",
+                    "K1_per_mm2",
+                    "K2_per_mm4",
+                    "K3_per_mm6",
+                    "P1_per_mm",
+                    "P2_per_mm",
+                ),
+                np.r_[truth.interior(b), truth.KP],
+                strict=True,
+            )
+        )
         for q, (v, s) in c.iop.items():
             pv, ps = RIKOLA_TABLE3[b][q]
             unit = q.split("_", 1)[1] if "_" in q else ""
-            rows.append(Row("003 Table 3", f"{q.split('_')[0]}_band{b}", unit.replace("per_", "1/"),
-                            pv, ps, v, s, tr[q]))
-        rows.append(Row("003 Table 3", f"sigma0_sq_band{b}", "", RIKOLA_TABLE3_SIGMA0_SQ[b],
-                        None, c.result.sigma0 ** 2, None, 1.0))
+            rows.append(
+                Row(
+                    "003 Table 3",
+                    f"{q.split('_')[0]}_band{b}",
+                    unit.replace("per_", "1/"),
+                    pv,
+                    ps,
+                    v,
+                    s,
+                    tr[q],
+                )
+            )
+        rows.append(
+            Row(
+                "003 Table 3",
+                f"sigma0_sq_band{b}",
+                "",
+                RIKOLA_TABLE3_SIGMA0_SQ[b],
+                None,
+                c.result.sigma0**2,
+                None,
+                1.0,
+            )
+        )
     # --- 003 Table 4 (first): ROP from pairs (k, k+10). The paper uses one cube; the ROPs of
     # one cube share that cube's systematic centroid errors (their spread understates the
     # error), so every cube is used: rop_all[pair, cube], and σ̂ of the mean from the scatter
     # of the per-cube means between cubes.
     pairs = [(k, k + 10) for k in range(1, 11) if k in cals and k + 10 in cals]
-    rop_all = np.array([[relative_orientation(cals[k1].pose(c), cals[k2].pose(c))[0]
-                         for c in cubes] for k2, k1 in pairs])  # k2 sensor II, k1 sensor I
-    rop_cov = [relative_orientation(cals[k1].pose(ROP_CUBE), cals[k2].pose(ROP_CUBE),
-                                    cals[k1].pose_covariance(ROP_CUBE),
-                                    cals[k2].pose_covariance(ROP_CUBE))[1] for k2, k1 in pairs]
+    rop_all = np.array(
+        [
+            [relative_orientation(cals[k1].pose(c), cals[k2].pose(c))[0] for c in cubes]
+            for k2, k1 in pairs
+        ]
+    )  # k2 sensor II, k1 sensor I
+    rop_cov = [
+        relative_orientation(
+            cals[k1].pose(ROP_CUBE),
+            cals[k2].pose(ROP_CUBE),
+            cals[k1].pose_covariance(ROP_CUBE),
+            cals[k2].pose_covariance(ROP_CUBE),
+        )[1]
+        for k2, k1 in pairs
+    ]
     m = mean_relative_orientation(cals, obs, cubes, pairs, rop_all=rop_all)
     rop, rop_mean, rop_mean_sigma = m["rop_pairs"], m["rop_mean"], m["rop_mean_sigma"]
     pb_clusters, deff_pairs = m["band_clusters"], m["deff_pairs"]
     rop_cube0 = rop_all[:, cubes.index(ROP_CUBE)]
     for i, q in enumerate(("domega_deg", "dphi_deg", "dkappa_deg")):
-        rows.append(Row("003 Table 4 ROP", q, "deg", RIKOLA_TABLE4_ROP_MEAN_DEG[i], None,
-                        np.rad2deg(rop_mean[i]), np.rad2deg(rop_mean_sigma[i]),
-                        np.rad2deg(truth.rotation_rad[i])))
+        rows.append(
+            Row(
+                "003 Table 4 ROP",
+                q,
+                "deg",
+                RIKOLA_TABLE4_ROP_MEAN_DEG[i],
+                None,
+                np.rad2deg(rop_mean[i]),
+                np.rad2deg(rop_mean_sigma[i]),
+                np.rad2deg(truth.rotation_rad[i]),
+            )
+        )
     # transformation test (003 §3.4): discrepancies of the sensor-II centroids from the
     # sensor-I ones of the same cube and target, before and after applying the mean ROP
     disc = rop_transformation_test(obs, cals, pairs, rop_mean, ROP_CUBE)
@@ -201,52 +282,143 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
         reg_truth[s] = gap_regression(g, truth.f_mm[np.array(bs) - 1])
         pm = RIKOLA_TABLE4_GAP_MODEL[s]
         rows += [
-            Row("003 Table 4 gap model", f"a_sensor{s}_mm_per_nm", "mm/nm", pm["a_mm_per_nm"][0],
-                pm["a_mm_per_nm"][1], reg[s]["a"], reg[s]["sigma_a"], truth.gap_model[s - 1, 0]),
-            Row("003 Table 4 gap model", f"b_sensor{s}_mm", "mm", pm["b_mm"][0], pm["b_mm"][1],
-                reg[s]["b"], reg[s]["sigma_b"], truth.gap_model[s - 1, 1]),
-            Row("003 Table 4 gap model", f"r2_sensor{s}", "%", pm["r2_percent"], None,
-                100 * reg[s]["r2"], None, 100 * reg_truth[s]["r2"]),
+            Row(
+                "003 Table 4 gap model",
+                f"a_sensor{s}_mm_per_nm",
+                "mm/nm",
+                pm["a_mm_per_nm"][0],
+                pm["a_mm_per_nm"][1],
+                reg[s]["a"],
+                reg[s]["sigma_a"],
+                truth.gap_model[s - 1, 0],
+            ),
+            Row(
+                "003 Table 4 gap model",
+                f"b_sensor{s}_mm",
+                "mm",
+                pm["b_mm"][0],
+                pm["b_mm"][1],
+                reg[s]["b"],
+                reg[s]["sigma_b"],
+                truth.gap_model[s - 1, 1],
+            ),
+            Row(
+                "003 Table 4 gap model",
+                f"r2_sensor{s}",
+                "%",
+                pm["r2_percent"],
+                None,
+                100 * reg[s]["r2"],
+                None,
+                100 * reg_truth[s]["r2"],
+            ),
         ]
     # --- the joint model (003 §3.5 future work); σ of a centroid from the per-band σ0
-    sigma0_pool = float(np.sqrt(np.mean([c.result.sigma0 ** 2 for c in cals.values()])))
+    sigma0_pool = float(np.sqrt(np.mean([c.result.sigma0**2 for c in cals.values()])))
     sigma_joint = sigma_px * sigma0_pool
     f_sd = np.sqrt(np.mean(np.concatenate(list(f_sig.values())) ** 2))
-    scatter = tuple(float(np.sqrt(max(reg[s]["s"] ** 2 - f_sd ** 2, (0.5 * f_sd) ** 2)))
-                    for s in (1, 2))
+    scatter = tuple(
+        float(np.sqrt(max(reg[s]["s"] ** 2 - f_sd**2, (0.5 * f_sd) ** 2))) for s in (1, 2)
+    )
     t0 = time.time()
     joint = calibrate_joint(obs, sigma_px=sigma_joint, scatter_mm=scatter, init=cals)
     t_joint = time.time() - t0
     R = joint  # value() and sigma() with the design effect of the target clusters
-    jrows = [("a_sensor1_mm_per_nm", "mm/nm", R.value("gap_model")[0, 0],
-              R.sigma("gap_model")[0, 0], truth.gap_model[0, 0], RIKOLA_TABLE4_GAP_MODEL[1]),
-             ("b_sensor1_mm", "mm", R.value("gap_model")[0, 1], R.sigma("gap_model")[0, 1],
-              truth.gap_model[0, 1], None),
-             ("a_sensor2_mm_per_nm", "mm/nm", R.value("gap_model")[1, 0],
-              R.sigma("gap_model")[1, 0], truth.gap_model[1, 0], None),
-             ("b_sensor2_mm", "mm", R.value("gap_model")[1, 1], R.sigma("gap_model")[1, 1],
-              truth.gap_model[1, 1], None)]
-    paper_gap = {"a_sensor1_mm_per_nm": RIKOLA_TABLE4_GAP_MODEL[1]["a_mm_per_nm"],
-                 "b_sensor1_mm": RIKOLA_TABLE4_GAP_MODEL[1]["b_mm"],
-                 "a_sensor2_mm_per_nm": RIKOLA_TABLE4_GAP_MODEL[2]["a_mm_per_nm"],
-                 "b_sensor2_mm": RIKOLA_TABLE4_GAP_MODEL[2]["b_mm"]}
+    jrows = [
+        (
+            "a_sensor1_mm_per_nm",
+            "mm/nm",
+            R.value("gap_model")[0, 0],
+            R.sigma("gap_model")[0, 0],
+            truth.gap_model[0, 0],
+            RIKOLA_TABLE4_GAP_MODEL[1],
+        ),
+        (
+            "b_sensor1_mm",
+            "mm",
+            R.value("gap_model")[0, 1],
+            R.sigma("gap_model")[0, 1],
+            truth.gap_model[0, 1],
+            None,
+        ),
+        (
+            "a_sensor2_mm_per_nm",
+            "mm/nm",
+            R.value("gap_model")[1, 0],
+            R.sigma("gap_model")[1, 0],
+            truth.gap_model[1, 0],
+            None,
+        ),
+        (
+            "b_sensor2_mm",
+            "mm",
+            R.value("gap_model")[1, 1],
+            R.sigma("gap_model")[1, 1],
+            truth.gap_model[1, 1],
+            None,
+        ),
+    ]
+    paper_gap = {
+        "a_sensor1_mm_per_nm": RIKOLA_TABLE4_GAP_MODEL[1]["a_mm_per_nm"],
+        "b_sensor1_mm": RIKOLA_TABLE4_GAP_MODEL[1]["b_mm"],
+        "a_sensor2_mm_per_nm": RIKOLA_TABLE4_GAP_MODEL[2]["a_mm_per_nm"],
+        "b_sensor2_mm": RIKOLA_TABLE4_GAP_MODEL[2]["b_mm"],
+    }
     for q, u, v, s, t, _ in jrows:
         rows.append(Row("joint model", q, u, paper_gap[q][0], paper_gap[q][1], v, s, t))
     for i, q in enumerate(("x0_sensor1_mm", "y0_sensor1_mm", "x0_sensor2_mm", "y0_sensor2_mm")):
         paper = RIKOLA_TABLE3[20 if i < 2 else 5]["x0_mm" if i % 2 == 0 else "y0_mm"]
-        rows.append(Row("joint model", q, "mm", paper[0], paper[1], R.value("pp_mm").ravel()[i],
-                        R.sigma("pp_mm").ravel()[i], truth.pp_mm.ravel()[i]))
+        rows.append(
+            Row(
+                "joint model",
+                q,
+                "mm",
+                paper[0],
+                paper[1],
+                R.value("pp_mm").ravel()[i],
+                R.sigma("pp_mm").ravel()[i],
+                truth.pp_mm.ravel()[i],
+            )
+        )
     for i, q in enumerate(("K1_per_mm2", "K2_per_mm4", "K3_per_mm6", "P1_per_mm", "P2_per_mm")):
-        rows.append(Row("joint model", q, q.split("_", 1)[1].replace("per_", "1/"), None, None,
-                        R.value("distortion_mm")[i], R.sigma("distortion_mm")[i], truth.KP[i]))
+        rows.append(
+            Row(
+                "joint model",
+                q,
+                q.split("_", 1)[1].replace("per_", "1/"),
+                None,
+                None,
+                R.value("distortion_mm")[i],
+                R.sigma("distortion_mm")[i],
+                truth.KP[i],
+            )
+        )
     for i, q in enumerate(("domega_deg", "dphi_deg", "dkappa_deg")):
-        rows.append(Row("joint model", q, "deg", RIKOLA_TABLE4_ROP_MEAN_DEG[i], None,
-                        np.rad2deg(R.value("sensor2_rotation")[i]),
-                        np.rad2deg(R.sigma("sensor2_rotation")[i]),
-                        np.rad2deg(truth.rotation_rad[i])))
+        rows.append(
+            Row(
+                "joint model",
+                q,
+                "deg",
+                RIKOLA_TABLE4_ROP_MEAN_DEG[i],
+                None,
+                np.rad2deg(R.value("sensor2_rotation")[i]),
+                np.rad2deg(R.sigma("sensor2_rotation")[i]),
+                np.rad2deg(truth.rotation_rad[i]),
+            )
+        )
     for i, q in enumerate(("tx_mm", "ty_mm", "tz_mm")):
-        rows.append(Row("joint model", q, "mm", None, None, R.value("sensor2_offset_mm")[i],
-                        R.sigma("sensor2_offset_mm")[i], truth.offset_mm[i]))
+        rows.append(
+            Row(
+                "joint model",
+                q,
+                "mm",
+                None,
+                None,
+                R.value("sensor2_offset_mm")[i],
+                R.sigma("sensor2_offset_mm")[i],
+                truth.offset_mm[i],
+            )
+        )
     rows.append(Row("joint model", "sigma0", "", None, None, R.result.sigma0, None, 1.0))
     # --- held-out bands: joint model vs the per-band route
     t0 = time.time()
@@ -254,8 +426,13 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
     for h in HELD_OUT:
         if h not in bands:
             continue
-        jh = calibrate_joint(obs, exclude_bands=[h], sigma_px=sigma_joint, scatter_mm=scatter,
-                             init={b: c for b, c in cals.items() if b != h})
+        jh = calibrate_joint(
+            obs,
+            exclude_bands=[h],
+            sigma_px=sigma_joint,
+            scatter_mm=scatter,
+            init={b: c for b, c in cals.items() if b != h},
+        )
         r_joint = predict_band(jh, obs, h)
         # the same prediction with the band's true focal length (an oracle): what is left is
         # the error of everything but f
@@ -264,27 +441,36 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
         line = vals["gap_model"][s_row, 0] * RIKOLA_BANDS["gap_nm"] + vals["gap_model"][s_row, 1]
         r_oracle = _predict_with(jh, obs, h, vals, df=truth.f_mm - line)
         r_perband = predict_per_band(cals, obs, h, bands)
-        held[h] = {"joint": _rms(r_joint), "joint_true_f": _rms(r_oracle),
-                   "per_band": _rms(r_perband),
-                   "calibrated": _rms(cals[h].residuals_px)}
+        held[h] = {
+            "joint": _rms(r_joint),
+            "joint_true_f": _rms(r_oracle),
+            "per_band": _rms(r_perband),
+            "calibrated": _rms(cals[h].residuals_px),
+        }
         for k, v in held[h].items():
-            rows.append(Row("held-out band", f"rms_band{h}_{k}", "px", None, None, v, None,
-                            None))
+            rows.append(Row("held-out band", f"rms_band{h}_{k}", "px", None, None, v, None, None))
     t_held = time.time() - t0
     meta = {
-        "scale": scale, "n_cubes": len(cubes), "bands": bands,
-        "images": len(cubes) * len(bands), "targets": int(len(obs.cube)),
+        "scale": scale,
+        "n_cubes": len(cubes),
+        "bands": bands,
+        "images": len(cubes) * len(bands),
+        "targets": int(len(obs.cube)),
         "detection_rate": obs.detection_rate,
         "detection_rate_contour": obs_contour.detection_rate,
-        "sigma_px_apriori": sigma_px, "sigma0_pooled_bands": sigma0_pool,
-        "sigma_px_joint": sigma_joint, "df_prior_mm": list(scatter),
+        "sigma_px_apriori": sigma_px,
+        "sigma0_pooled_bands": sigma0_pool,
+        "sigma_px_joint": sigma_joint,
+        "df_prior_mm": list(scatter),
         "rop_pairs": [list(p) for p in pairs],
-        "band_clusters": pb_clusters, "rop_deff_pairs": deff_pairs,
+        "band_clusters": pb_clusters,
+        "rop_deff_pairs": deff_pairs,
         "rop_pairs_deg": np.rad2deg(rop).tolist(),
         "rop_pairs_cube0_deg": np.rad2deg(rop_cube0).tolist(),
         "rop_cube0_mean_deg": np.rad2deg(rop_cube0.mean(axis=0)).tolist(),
-        "rop_cube0_mean_sigma_deg": np.rad2deg(np.sqrt(np.diag(np.sum(rop_cov, axis=0)))
-                                               / len(pairs)).tolist(),
+        "rop_cube0_mean_sigma_deg": np.rad2deg(
+            np.sqrt(np.diag(np.sum(rop_cov, axis=0))) / len(pairs)
+        ).tolist(),
         "rop_discrepancy_px": disc,
         "held_out": {str(k): v for k, v in held.items()},
         "rms_px_per_band": _rms(np.concatenate([c.residuals_px for c in cals.values()])),
@@ -293,12 +479,31 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
         "joint_clusters": joint.clusters,
     }
     # wall times vary from run to run: they stay out of the (bit-reproducible) JSON
-    extras = {"cfg": cfg, "truth": truth, "obs": obs, "obs_contour": obs_contour,
-              "images": images, "cals": cals, "joint": joint, "rop": rop, "rop_cube0": rop_cube0,
-              "rop_all": rop_all, "pairs": pairs, "regression": reg,
-              "regression_truth": reg_truth, "gaps": gaps, "f_hat": f_hat, "f_sigma": f_sig,
-              "seconds": {"observe": t_observe, "per_band": t_bands, "joint": t_joint,
-                          "held_out": t_held, "total": time.time() - t_start}}
+    extras = {
+        "cfg": cfg,
+        "truth": truth,
+        "obs": obs,
+        "obs_contour": obs_contour,
+        "images": images,
+        "cals": cals,
+        "joint": joint,
+        "rop": rop,
+        "rop_cube0": rop_cube0,
+        "rop_all": rop_all,
+        "pairs": pairs,
+        "regression": reg,
+        "regression_truth": reg_truth,
+        "gaps": gaps,
+        "f_hat": f_hat,
+        "f_sigma": f_sig,
+        "seconds": {
+            "observe": t_observe,
+            "per_band": t_bands,
+            "joint": t_joint,
+            "held_out": t_held,
+            "total": time.time() - t_start,
+        },
+    }
     return Reproduction("rikola", seed, rows, meta, extras)
 
 
@@ -311,11 +516,15 @@ def _predict_with(joint, obs, band, values, df):
 
     sel = (obs.band == band) & np.isin(obs.cube, joint.cubes)
     o = obs.select(sel)
-    blk = JointCentroids(np.searchsorted(joint.cubes, o.cube),
-                         np.searchsorted(RIKOLA_BANDS["band"], o.band), o.corners_obj,
-                         o.centroids_mm, 1.0, RIKOLA_BANDS["gap_nm"], RIKOLA_BANDS["sensor"])
+    blk = JointCentroids(
+        np.searchsorted(joint.cubes, o.cube),
+        np.searchsorted(RIKOLA_BANDS["band"], o.band),
+        o.corners_obj,
+        o.centroids_mm,
+        1.0,
+        RIKOLA_BANDS["gap_nm"],
+        RIKOLA_BANDS["sensor"],
+    )
     values = dict(values)
     values["df_mm"] = np.asarray(df, float)
     return blk.evaluate(values, False)[0].reshape(-1, 2) / obs.pixel_mm * np.array([1.0, -1.0])
-
-

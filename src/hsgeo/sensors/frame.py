@@ -117,10 +117,13 @@ class _FrameBase(ResidualBlock):
     def __init__(self, view, xy, sigma, X=None, point=None, *, blocks=None, name=None):
         view, xy, X = _check_views(type(self).__name__, view, xy, X)
         if (X is None) == (point is None):
-            raise InputError("give either known object points X (n, 3) or point indices into "
-                             "a points block, not both")
-        super().__init__(np.broadcast_to(np.asarray(sigma, float), xy.shape).ravel(), name=name,
-                         blocks=blocks)
+            raise InputError(
+                "give either known object points X (n, 3) or point indices into "
+                "a points block, not both"
+            )
+        super().__init__(
+            np.broadcast_to(np.asarray(sigma, float), xy.shape).ravel(), name=name, blocks=blocks
+        )
         self.view, self.xy, self.X = view, xy, X
         self.point = None if point is None else np.asarray(point, dtype=np.int64)
 
@@ -155,8 +158,9 @@ def project_opencv(poses, view, X, intrinsics, dist):
     -------
     uv_px : (n, 2) ndarray
     """
-    Xc, _, _ = camera_coordinates(np.asarray(poses, float), np.asarray(view), np.asarray(X, float),
-                                  False)
+    Xc, _, _ = camera_coordinates(
+        np.asarray(poses, float), np.asarray(view), np.asarray(X, float), False
+    )
     xd = distort_opencv(Xc[:, :2] / Xc[:, 2:3], dist)
     fx, fy, cx, cy = intrinsics
     return np.column_stack([fx * xd[:, 0] + cx, fy * xd[:, 1] + cy])
@@ -186,11 +190,11 @@ class FrameOpenCV(_FrameBase):
     """
 
     name = "image points (OpenCV form)"
-    BLOCKS = MappingProxyType({**_FrameBase.BLOCKS, "intrinsics": "intrinsics",
-                               "distortion": "distortion"})
+    BLOCKS = MappingProxyType(
+        {**_FrameBase.BLOCKS, "intrinsics": "intrinsics", "distortion": "distortion"}
+    )
 
-    def __init__(self, view, uv_px, sigma_px=1.0, X=None, point=None, *, square_pixels=False,
-                 **kw):
+    def __init__(self, view, uv_px, sigma_px=1.0, X=None, point=None, *, square_pixels=False, **kw):
         super().__init__(view, uv_px, sigma_px, X, point, **kw)
         self.square_pixels = square_pixels
 
@@ -227,8 +231,10 @@ class FrameOpenCV(_FrameBase):
         d_Xc = F[None, :, None] * np.einsum("nab,nbc->nac", J_xy, _dproj(Xc))
         dp = np.einsum("nac,nck->nak", d_Xc, d_pose)
         dX = np.einsum("nac,nck->nak", d_Xc, d_X)
-        extra = {self.blocks["intrinsics"]: d_intr.reshape(2 * n, 4),
-                 self.blocks["distortion"]: d_dist.reshape(2 * n, 5)}
+        extra = {
+            self.blocks["intrinsics"]: d_intr.reshape(2 * n, 4),
+            self.blocks["distortion"]: d_dist.reshape(2 * n, 5),
+        }
         return self._pack(r2, dp, dX, extra)
 
 
@@ -245,16 +251,20 @@ def pixel_to_mm(uv_px, image_size, pixel_pitch_mm):
     """
     uv = np.asarray(uv_px, dtype=np.float64)
     w, h = image_size
-    return np.stack([(uv[..., 0] - (w - 1) / 2) * pixel_pitch_mm,
-                     -(uv[..., 1] - (h - 1) / 2) * pixel_pitch_mm], axis=-1)
+    return np.stack(
+        [(uv[..., 0] - (w - 1) / 2) * pixel_pitch_mm, -(uv[..., 1] - (h - 1) / 2) * pixel_pitch_mm],
+        axis=-1,
+    )
 
 
 def mm_to_pixel(xy_mm, image_size, pixel_pitch_mm):
     """Inverse of :func:`pixel_to_mm`."""
     xy = np.asarray(xy_mm, dtype=np.float64)
     w, h = image_size
-    return np.stack([xy[..., 0] / pixel_pitch_mm + (w - 1) / 2,
-                     -xy[..., 1] / pixel_pitch_mm + (h - 1) / 2], axis=-1)
+    return np.stack(
+        [xy[..., 0] / pixel_pitch_mm + (w - 1) / 2, -xy[..., 1] / pixel_pitch_mm + (h - 1) / 2],
+        axis=-1,
+    )
 
 
 class FramePhotogrammetric(_FrameBase):
@@ -277,8 +287,9 @@ class FramePhotogrammetric(_FrameBase):
     """
 
     name = "image points (photogrammetric form)"
-    BLOCKS = MappingProxyType({**_FrameBase.BLOCKS, "interior": "interior",
-                               "distortion": "distortion_mm"})
+    BLOCKS = MappingProxyType(
+        {**_FrameBase.BLOCKS, "interior": "interior", "distortion": "distortion_mm"}
+    )
 
     def __init__(self, view, xy_mm, sigma_mm, X=None, point=None, **kw):
         super().__init__(view, xy_mm, sigma_mm, X, point, **kw)
@@ -308,6 +319,8 @@ class FramePhotogrammetric(_FrameBase):
         d_Xc = f * _dproj(Xc)
         dp = np.einsum("nac,nck->nak", d_Xc, d_pose)
         dX = np.einsum("nac,nck->nak", d_Xc, d_X)
-        extra = {self.blocks["interior"]: d_int.reshape(2 * n, 3),
-                 self.blocks["distortion"]: d_dist.reshape(2 * n, 5)}
+        extra = {
+            self.blocks["interior"]: d_int.reshape(2 * n, 3),
+            self.blocks["distortion"]: d_dist.reshape(2 * n, 5),
+        }
         return self._pack(r2, dp, dX, extra)

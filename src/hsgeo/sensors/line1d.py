@@ -106,8 +106,9 @@ def _K3(K: ArrayLike) -> NDArray[np.float64]:
 
 
 # ------------------------------------------------------------------------- distortion (000 eq. 2)
-def distortion_px(zeta_px: ArrayLike, zeta0_px: float, K: ArrayLike,
-                  norm_px: float = DISTORTION_NORM_PX) -> NDArray:
+def distortion_px(
+    zeta_px: ArrayLike, zeta0_px: float, K: ArrayLike, norm_px: float = DISTORTION_NORM_PX
+) -> NDArray:
     """Radial distortion δ [px] at the pixel coordinate ζ (000 eq. (2)).
 
     ``δ = K1 u³ + K2 u⁵ + K3 u⁷`` with ``u = (ζ − ζ0) / norm_px``.
@@ -131,15 +132,17 @@ def distortion_px(zeta_px: ArrayLike, zeta0_px: float, K: ArrayLike,
     return odd_radial_1d(d, _K3(K), norm_px)  # 000 eq. (2)
 
 
-def distortion_derivative(zeta_px: ArrayLike, zeta0_px: float, K: ArrayLike,
-                          norm_px: float = DISTORTION_NORM_PX) -> NDArray:
+def distortion_derivative(
+    zeta_px: ArrayLike, zeta0_px: float, K: ArrayLike, norm_px: float = DISTORTION_NORM_PX
+) -> NDArray:
     """dδ/dζ (dimensionless) of :func:`distortion_px`."""
     d = _finite(zeta_px, "zeta_px") - float(zeta0_px)
     return odd_radial_1d_jacobian(d, _K3(K), norm_px)[0]  # 000 eq. (2)
 
 
-def distortion_extremes(K: ArrayLike, r_max_px: float = 450.0, n: int = 4501,
-                        norm_px: float = DISTORTION_NORM_PX) -> tuple[float, float, float]:
+def distortion_extremes(
+    K: ArrayLike, r_max_px: float = 450.0, n: int = 4501, norm_px: float = DISTORTION_NORM_PX
+) -> tuple[float, float, float]:
     """Largest |δ| within ``|ζ − ζ0| ≤ r_max_px``, where it occurs, and δ at ``r_max_px``.
 
     Returns
@@ -153,8 +156,13 @@ def distortion_extremes(K: ArrayLike, r_max_px: float = 450.0, n: int = 4501,
 
 
 # ------------------------------------------------------------------- ζ  ↔  tangent of view angle
-def tan_from_zeta(zeta_px: ArrayLike, zeta0_px: float, c_px: float, K: ArrayLike,
-                  norm_px: float = DISTORTION_NORM_PX) -> NDArray:
+def tan_from_zeta(
+    zeta_px: ArrayLike,
+    zeta0_px: float,
+    c_px: float,
+    K: ArrayLike,
+    norm_px: float = DISTORTION_NORM_PX,
+) -> NDArray:
     """Tangent of the view angle in the scanner plane of the pixel coordinate ζ (distortion
     included).
 
@@ -185,13 +193,20 @@ def _solve_zeta(ideal_px, zeta0_px, K, norm_px):
     adjustment may leave the model's domain; the caller decides).
     """
     t = np.asarray(ideal_px, dtype=float) - zeta0_px  # target of d − δ(d)
-    d, Fp = _measured_from_ideal_1d(t, np.asarray(K, dtype=float), float(norm_px),
-                                    max_iter=50, tol=1e-10, max_step=200.0)
+    d, Fp = _measured_from_ideal_1d(
+        t, np.asarray(K, dtype=float), float(norm_px), max_iter=50, tol=1e-10, max_step=200.0
+    )
     return d + zeta0_px, Fp
 
 
-def zeta_from_tan(tan_theta: ArrayLike, zeta0_px: float, c_px: float, K: ArrayLike,
-                  norm_px: float = DISTORTION_NORM_PX, max_abs_px: float = 450.0) -> NDArray:
+def zeta_from_tan(
+    tan_theta: ArrayLike,
+    zeta0_px: float,
+    c_px: float,
+    K: ArrayLike,
+    norm_px: float = DISTORTION_NORM_PX,
+    max_abs_px: float = 450.0,
+) -> NDArray:
     """Pixel coordinate ζ of a view direction: the inverse of :func:`tan_from_zeta`.
 
     Solves ``ζ − δ(ζ − ζ0) = ζ0 − c tan θ`` by Newton's method.
@@ -244,8 +259,14 @@ def camera_xy(xy_m: ArrayLike, eop: ArrayLike) -> tuple[NDArray, NDArray]:
     return dx * ca + dy * sa, dy * ca - dx * sa
 
 
-def project(xy_m: ArrayLike, eop: ArrayLike, zeta0_px: float, c_px: float, K: ArrayLike,
-            norm_px: float = DISTORTION_NORM_PX) -> NDArray:
+def project(
+    xy_m: ArrayLike,
+    eop: ArrayLike,
+    zeta0_px: float,
+    c_px: float,
+    K: ArrayLike,
+    norm_px: float = DISTORTION_NORM_PX,
+) -> NDArray:
     """Pixel coordinates ζ of points seen from stations, eq. (2) solved implicitly.
 
     Parameters
@@ -305,11 +326,21 @@ class LineObservations(ResidualBlock):
     """
 
     name = "zeta"
-    BLOCKS = MappingProxyType({"eop": "eop", "zeta0": "zeta0_px", "c": "c_px", "K": "K",
-                               "xy": "xy_m"})
+    BLOCKS = MappingProxyType(
+        {"eop": "eop", "zeta0": "zeta0_px", "c": "c_px", "K": "K", "xy": "xy_m"}
+    )
 
-    def __init__(self, image, point, zeta_px, sigma_px, *, name: str | None = None,
-                 blocks: Mapping[str, str] | None = None, norm_px: float = DISTORTION_NORM_PX):
+    def __init__(
+        self,
+        image,
+        point,
+        zeta_px,
+        sigma_px,
+        *,
+        name: str | None = None,
+        blocks: Mapping[str, str] | None = None,
+        norm_px: float = DISTORTION_NORM_PX,
+    ):
         z = _finite(zeta_px, "zeta_px").ravel()
         img = np.asarray(image)
         pt = np.asarray(point)
@@ -324,8 +355,9 @@ class LineObservations(ResidualBlock):
             raise InputError("image and point must be integer indices")
         if img.min() < 0 or pt.min() < 0:
             raise InputError("image and point indices must be non-negative")
-        super().__init__(np.broadcast_to(np.asarray(sigma_px, dtype=float), z.shape),
-                         name=name, blocks=blocks)
+        super().__init__(
+            np.broadcast_to(np.asarray(sigma_px, dtype=float), z.shape), name=name, blocks=blocks
+        )
         self.image, self.point, self.zeta_px = img.astype(np.int64), pt.astype(np.int64), z
         self.norm_px = float(norm_px)
 
@@ -346,8 +378,17 @@ class LineObservations(ResidualBlock):
         Y = np.where(np.abs(Y) < 1e-9, 1e-9, Y)  # keep trial steps finite
         q = X / Y
         zeta, Fp = _solve_zeta(z0 - c * q, z0, K, self.norm_px)
-        return zeta, {"q": q, "X": X, "Y": Y, "ca": ca, "sa": sa, "Fp": Fp, "z0": z0, "c": c,
-                      "K": K}
+        return zeta, {
+            "q": q,
+            "X": X,
+            "Y": Y,
+            "ca": ca,
+            "sa": sa,
+            "Fp": Fp,
+            "z0": z0,
+            "c": c,
+            "K": K,
+        }
 
     def evaluate(self, values, jacobian):
         zeta, w = self.predict(values)
@@ -414,9 +455,20 @@ def check_minimum_observations(image, point, control, n_images: int | None = Non
         )
 
 
-def make_parameters(eop, zeta0_px: float, c_px: float, K, xy_m, control,
-                    *, xy_sigma_m=None, eop_prior_sigma=None, eop_prior_mean=None,
-                    image_ids=None, point_ids=None) -> Parameters:
+def make_parameters(
+    eop,
+    zeta0_px: float,
+    c_px: float,
+    K,
+    xy_m,
+    control,
+    *,
+    xy_sigma_m=None,
+    eop_prior_sigma=None,
+    eop_prior_mean=None,
+    image_ids=None,
+    point_ids=None,
+) -> Parameters:
     """The parameter blocks of a 1D calibration (names as :class:`LineObservations` expects).
 
     Parameters
@@ -441,8 +493,14 @@ def make_parameters(eop, zeta0_px: float, c_px: float, K, xy_m, control,
     xy = _finite(xy_m, "xy_m")
     ctrl = np.asarray(control, dtype=bool)
     p = Parameters()
-    p.add("eop", eop, columns=EOP_COLUMNS, rows=image_ids,
-          prior_sigma=eop_prior_sigma, prior_mean=eop_prior_mean)
+    p.add(
+        "eop",
+        eop,
+        columns=EOP_COLUMNS,
+        rows=image_ids,
+        prior_sigma=eop_prior_sigma,
+        prior_mean=eop_prior_mean,
+    )
     p.add("zeta0_px", float(zeta0_px))
     p.add("c_px", float(c_px))
     p.add("K", _K3(K), columns=("K1", "K2", "K3"))
@@ -452,8 +510,7 @@ def make_parameters(eop, zeta0_px: float, c_px: float, K, xy_m, control,
     else:
         s = np.broadcast_to(np.asarray(xy_sigma_m, dtype=float).reshape(len(xy), -1), xy.shape)
         s = np.where(ctrl[:, None], s, np.inf)
-        p.add("xy_m", xy, points=True, columns=("x_m", "y_m"), rows=point_ids,
-              prior_sigma=s)
+        p.add("xy_m", xy, points=True, columns=("x_m", "y_m"), rows=point_ids, prior_sigma=s)
     return p
 
 
@@ -465,8 +522,14 @@ class Resection:
     rms_px: float
 
 
-def resect(xy_m: ArrayLike, zeta_px: ArrayLike, zeta0_px: float, c_px: float,
-           K=(0.0, 0.0, 0.0), n_alpha: int = 720) -> Resection:
+def resect(
+    xy_m: ArrayLike,
+    zeta_px: ArrayLike,
+    zeta0_px: float,
+    c_px: float,
+    K=(0.0, 0.0, 0.0),
+    n_alpha: int = 720,
+) -> Resection:
     """Initial ``x0, y0, α`` of one image from ≥ 3 control points, for given inner orientation.
 
     For a trial α, each measured ray ``tan θ_j`` gives a condition linear in the station:

@@ -86,26 +86,34 @@ from hsgeo.errors import InputError
 from hsgeo.rotations import R_from_opk, R_from_rpy, dR_dopk, dR_drpy
 from hsgeo.trajectory import SplineNodes, bspline_basis
 
-__all__ = ["PushbroomLines", "PushbroomObservations", "BETA0_CAM_FROM_PLATFORM", "BLOCK_NAMES",
-           "project"]
+__all__ = [
+    "PushbroomLines",
+    "PushbroomObservations",
+    "BETA0_CAM_FROM_PLATFORM",
+    "BLOCK_NAMES",
+    "project",
+]
 
 #: Nominal camera-from-platform rotation (platform x forward, y left, z up → camera x right,
 #: y backward, z down).
 BETA0_CAM_FROM_PLATFORM = np.array([[0.0, -1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
 
 #: Default parameter-block names of :class:`PushbroomLines` by role (its ``BLOCKS``).
-BLOCK_NAMES = MappingProxyType({
-    "points": "points_m",
-    "nodes": "nodes",
-    "boresight": "boresight_rad",
-    "lever_arm": "lever_arm_m",
-    "distortion": "distortion",
-    "c": "c_mm",
-})
+BLOCK_NAMES = MappingProxyType(
+    {
+        "points": "points_m",
+        "nodes": "nodes",
+        "boresight": "boresight_rad",
+        "lever_arm": "lever_arm_m",
+        "distortion": "distortion",
+        "c": "c_mm",
+    }
+)
 
 
-def _camera_geometry(values, names, nodes: SplineNodes, t_s, xyz_nav, rpy_nav, pidx, band,
-                     beta0, x0_mm, y0_mm):
+def _camera_geometry(
+    values, names, nodes: SplineNodes, t_s, xyz_nav, rpy_nav, pidx, band, beta0, x0_mm, y0_mm
+):
     """Image coordinates, p^c and intermediate quantities for every observation (002 eq. 3–4).
 
     The numpy path: the pose is corrected here, 002 eq. (3)–(4) are the compiled cores of
@@ -125,16 +133,39 @@ def _camera_geometry(values, names, nodes: SplineNodes, t_s, xyz_nav, rpy_nav, p
     c = np.ascontiguousarray(values[names["c"]][band], dtype=np.float64)
     dist = np.asarray(values[names["distortion"]], dtype=np.float64)
     q, p, xy, xb, yb, iz, gx, gy = pushbroom_image_rows(  # 002 eq. (3)–(4)
-        np.ascontiguousarray(R), d, lever, np.ascontiguousarray(beta), c, dist,
-        float(x0_mm), float(y0_mm))
-    return {"xy": xy, "p": p, "q": q, "d": d, "R": R, "beta": beta, "idx": idx, "w": w,
-            "rpy": rpy, "c": c, "xb": xb, "yb": yb, "iz": iz, "gx": gx, "gy": gy}
+        np.ascontiguousarray(R),
+        d,
+        lever,
+        np.ascontiguousarray(beta),
+        c,
+        dist,
+        float(x0_mm),
+        float(y0_mm),
+    )
+    return {
+        "xy": xy,
+        "p": p,
+        "q": q,
+        "d": d,
+        "R": R,
+        "beta": beta,
+        "idx": idx,
+        "w": w,
+        "rpy": rpy,
+        "c": c,
+        "xb": xb,
+        "yb": yb,
+        "iz": iz,
+        "gx": gx,
+        "gy": gy,
+    }
 
 
 def project(values, names, nodes, t_s, xyz_nav, rpy_nav, pidx, band, beta0, x0_mm, y0_mm):
     """Image coordinates (mm) of every observation (002 eq. 2–4), without derivatives."""
-    g = _camera_geometry(values, names, nodes, t_s, xyz_nav, rpy_nav, pidx, band, beta0,
-                         x0_mm, y0_mm)
+    g = _camera_geometry(
+        values, names, nodes, t_s, xyz_nav, rpy_nav, pidx, band, beta0, x0_mm, y0_mm
+    )
     return g["xy"], g["p"]
 
 
@@ -146,9 +177,40 @@ T_MAX = 0.25
 
 
 @njit(cache=True, parallel=True)
-def _lines_kernel(P, pidx, idx, u0, inv_dt, nodes, xyz_nav, rpy_nav, xyz_rate, rpy_rate, band,
-                  c_b, dist, beta, dbeta, lever, x0, y0, k_px, xy_obs, timed, n_newton,
-                  y_rate_ref, jac, r, w_out, dP, dN, dB, dL, dD, dC):  # pragma: no cover
+def _lines_kernel(
+    P,
+    pidx,
+    idx,
+    u0,
+    inv_dt,
+    nodes,
+    xyz_nav,
+    rpy_nav,
+    xyz_rate,
+    rpy_rate,
+    band,
+    c_b,
+    dist,
+    beta,
+    dbeta,
+    lever,
+    x0,
+    y0,
+    k_px,
+    xy_obs,
+    timed,
+    n_newton,
+    y_rate_ref,
+    jac,
+    r,
+    w_out,
+    dP,
+    dN,
+    dB,
+    dL,
+    dD,
+    dC,
+):  # pragma: no cover
     """002 eq. (2)–(4) and their derivatives, one observation per iteration (rows 2j, 2j+1).
 
     ``timed``: the observation is evaluated at the model's crossing time ``t*`` of the line
@@ -190,16 +252,21 @@ def _lines_kernel(P, pidx, idx, u0, inv_dt, nodes, xyz_nav, rpy_nav, xyz_rate, r
                         acc_r += dw[b] * nodes[idx[j, b], a]
                     dl[a] = acc
                     rate[a] = acc_r + (xyz_rate[j, a] if a < 3 else rpy_rate[j, a - 3])
-                rpy_rotation(rpy_nav[j, 0] + dt * rpy_rate[j, 0] + dl[3],
-                         rpy_nav[j, 1] + dt * rpy_rate[j, 1] + dl[4],
-                         rpy_nav[j, 2] + dt * rpy_rate[j, 2] + dl[5], R, dR)
+                rpy_rotation(
+                    rpy_nav[j, 0] + dt * rpy_rate[j, 0] + dl[3],
+                    rpy_nav[j, 1] + dt * rpy_rate[j, 1] + dl[4],
+                    rpy_nav[j, 2] + dt * rpy_rate[j, 2] + dl[5],
+                    R,
+                    dR,
+                )
                 pt = pidx[j]
                 for a in range(3):
                     d[a] = P[pt, a] - xyz_nav[j, a] - dt * xyz_rate[j, a] - dl[a]
                 pushbroom_camera_point(R, d, lever, beta, q, p)  # 002 eq. (4)
                 c = c_b[band[j]]
-                x, y, xb, yb, iz, gx, gy = pushbroom_image_mm(p[0], p[1], p[2], c,
-                                                              K1, K2, P1, P2)  # 002 eq. (3)
+                x, y, xb, yb, iz, gx, gy = pushbroom_image_mm(
+                    p[0], p[1], p[2], c, K1, K2, P1, P2
+                )  # 002 eq. (3)
                 x = x + x0
                 y = y + y0
                 a_ = c * iz
@@ -211,13 +278,15 @@ def _lines_kernel(P, pidx, idx, u0, inv_dt, nodes, xyz_nav, rpy_nav, xyz_rate, r
                 Jp[1, 2] = (-yb * iz - gy * xb * iz) * k_px
                 for u in range(2):
                     for a in range(3):
-                        JpB[u, a] = (Jp[u, 0] * beta[0, a] + Jp[u, 1] * beta[1, a]
-                                     + Jp[u, 2] * beta[2, a])
+                        JpB[u, a] = (
+                            Jp[u, 0] * beta[0, a] + Jp[u, 1] * beta[1, a] + Jp[u, 2] * beta[2, a]
+                        )
                 # d6: derivatives w.r.t. the pose (position, attitude) of the platform
                 for u in range(2):
                     for a in range(3):
-                        d6[u, a] = -(JpB[u, 0] * R[a, 0] + JpB[u, 1] * R[a, 1]
-                                     + JpB[u, 2] * R[a, 2])
+                        d6[u, a] = -(
+                            JpB[u, 0] * R[a, 0] + JpB[u, 1] * R[a, 1] + JpB[u, 2] * R[a, 2]
+                        )
                     for kk in range(3):
                         v = 0.0
                         for i in range(3):
@@ -262,8 +331,9 @@ def _lines_kernel(P, pidx, idx, u0, inv_dt, nodes, xyz_nav, rpy_nav, xyz_rate, r
                     # boresight: dp/dbore_k = dβ_k q
                     v = 0.0
                     for i in range(3):
-                        v += Jp[u, i] * (dbeta[kk, i, 0] * q[0] + dbeta[kk, i, 1] * q[1]
-                                         + dbeta[kk, i, 2] * q[2])
+                        v += Jp[u, i] * (
+                            dbeta[kk, i, 0] * q[0] + dbeta[kk, i, 1] * q[1] + dbeta[kk, i, 2] * q[2]
+                        )
                     dB[row, kk] = v
             dC[2 * j, 0] = gx * xb / c * k_px
             dC[2 * j + 1, 0] = (yb / c + gy * xb / c) * k_px
@@ -333,24 +403,34 @@ class PushbroomObservations:
 
     def __post_init__(self):
         if (self.xyz_rate_nav_m_s is None) != (self.rpy_rate_nav_rad_s is None):
-            raise InputError("give both GNSS/INS rates (xyz_rate_nav_m_s and rpy_rate_nav_rad_s) "
-                             "or neither")
+            raise InputError(
+                "give both GNSS/INS rates (xyz_rate_nav_m_s and rpy_rate_nav_rad_s) or neither"
+            )
         point = np.asarray(self.point)
         band = np.asarray(self.band)
         for nm, arr in (("point", point), ("band", band)):
             if arr.size and (not np.issubdtype(arr.dtype, np.integer) or np.any(arr < 0)):
                 raise InputError(f"{nm} indices must be non-negative integers")
         m = point.size
-        shapes = {"point": (m,), "band": (m,), "t_s": (m,), "xy_px": (m, 2), "xyz_nav_m": (m, 3),
-                  "rpy_nav_rad": (m, 3), "xyz_rate_nav_m_s": (m, 3), "rpy_rate_nav_rad_s": (m, 3)}
+        shapes = {
+            "point": (m,),
+            "band": (m,),
+            "t_s": (m,),
+            "xy_px": (m, 2),
+            "xyz_nav_m": (m, 3),
+            "rpy_nav_rad": (m, 3),
+            "xyz_rate_nav_m_s": (m, 3),
+            "rpy_rate_nav_rad_s": (m, 3),
+        }
         for nm, shape in shapes.items():
             v = getattr(self, nm)
             if v is None:
                 continue
             v = np.asarray(v, dtype=np.int64 if nm in ("point", "band") else np.float64)
             if v.shape != shape:
-                raise InputError(f"observations: {nm} has shape {v.shape}, expected {shape} "
-                                 f"for {m} observations")
+                raise InputError(
+                    f"observations: {nm} has shape {v.shape}, expected {shape} for {m} observations"
+                )
             object.__setattr__(self, nm, v)
 
     @property
@@ -409,22 +489,44 @@ class PushbroomLines(ResidualBlock):
     group_size = 2
     BLOCKS = BLOCK_NAMES
 
-    def __init__(self, point, band, t_s, xy_px, xyz_nav_m, rpy_nav_rad, nodes: SplineNodes,
-                 pixel_mm: float, sigma_px: float = 0.5, x0_mm: float = 0.0,
-                 y0_mm: float = 0.0, blocks: Mapping[str, str] | None = None,
-                 beta0=BETA0_CAM_FROM_PLATFORM, xyz_rate_m_s=None, rpy_rate_rad_s=None,
-                 y_rate_ref_px_s: float | None = None, newton_iterations: int = 8):
+    def __init__(
+        self,
+        point,
+        band,
+        t_s,
+        xy_px,
+        xyz_nav_m,
+        rpy_nav_rad,
+        nodes: SplineNodes,
+        pixel_mm: float,
+        sigma_px: float = 0.5,
+        x0_mm: float = 0.0,
+        y0_mm: float = 0.0,
+        blocks: Mapping[str, str] | None = None,
+        beta0=BETA0_CAM_FROM_PLATFORM,
+        xyz_rate_m_s=None,
+        rpy_rate_rad_s=None,
+        y_rate_ref_px_s: float | None = None,
+        newton_iterations: int = 8,
+    ):
         point = np.asarray(point)
         m = point.size
         xy = np.asarray(xy_px, dtype=np.float64)
-        checks = [("band", band, (m,)), ("t_s", t_s, (m,)), ("xy_px", xy, (m, 2)),
-                  ("xyz_nav_m", xyz_nav_m, (m, 3)), ("rpy_nav_rad", rpy_nav_rad, (m, 3))]
+        checks = [
+            ("band", band, (m,)),
+            ("t_s", t_s, (m,)),
+            ("xy_px", xy, (m, 2)),
+            ("xyz_nav_m", xyz_nav_m, (m, 3)),
+            ("rpy_nav_rad", rpy_nav_rad, (m, 3)),
+        ]
         if (xyz_rate_m_s is None) != (rpy_rate_rad_s is None):
             raise InputError("PushbroomLines: give both xyz_rate_m_s and rpy_rate_rad_s, or none")
         timed = xyz_rate_m_s is not None
         if timed:
-            checks += [("xyz_rate_m_s", xyz_rate_m_s, (m, 3)),
-                       ("rpy_rate_rad_s", rpy_rate_rad_s, (m, 3))]
+            checks += [
+                ("xyz_rate_m_s", xyz_rate_m_s, (m, 3)),
+                ("rpy_rate_rad_s", rpy_rate_rad_s, (m, 3)),
+            ]
         for nm, arr, shape in checks:
             if np.shape(arr) != shape:
                 raise InputError(
@@ -454,15 +556,16 @@ class PushbroomLines(ResidualBlock):
         self.timed = timed
         zeros = np.zeros((m, 3))
         self.xyz_rate = np.ascontiguousarray(xyz_rate_m_s if timed else zeros, dtype=np.float64)
-        self.rpy_rate = np.ascontiguousarray(rpy_rate_rad_s if timed else zeros,
-                                             dtype=np.float64)
+        self.rpy_rate = np.ascontiguousarray(rpy_rate_rad_s if timed else zeros, dtype=np.float64)
         self.y_rate_ref_px_s = 1.0
         if timed:
-            if not (y_rate_ref_px_s is not None and np.isfinite(y_rate_ref_px_s)
-                    and y_rate_ref_px_s > 0):
+            if not (
+                y_rate_ref_px_s is not None and np.isfinite(y_rate_ref_px_s) and y_rate_ref_px_s > 0
+            ):
                 raise InputError(
                     "PushbroomLines: the time residual needs y_rate_ref_px_s > 0 (the image "
-                    f"rate across the line in px/s, c V / (Z pixel)), got {y_rate_ref_px_s!r}")
+                    f"rate across the line in px/s, c V / (Z pixel)), got {y_rate_ref_px_s!r}"
+                )
             self.y_rate_ref_px_s = float(y_rate_ref_px_s)
         if not (isinstance(newton_iterations, int | np.integer) and newton_iterations >= 1):
             raise InputError(f"newton_iterations must be an integer ≥ 1, got {newton_iterations!r}")
@@ -475,8 +578,19 @@ class PushbroomLines(ResidualBlock):
 
     def image_mm(self, values):
         """Modelled image coordinates in mm, ``(m, 2)``."""
-        xy, _ = project(values, self.blocks, self.nodes, self.t_s, self.xyz_nav, self.rpy_nav,
-                        self.point, self.band, self.beta0, self.x0_mm, self.y0_mm)
+        xy, _ = project(
+            values,
+            self.blocks,
+            self.nodes,
+            self.t_s,
+            self.xyz_nav,
+            self.rpy_nav,
+            self.point,
+            self.band,
+            self.beta0,
+            self.x0_mm,
+            self.y0_mm,
+        )
         return xy
 
     def evaluate_numpy(self, values, jacobian):
@@ -487,8 +601,19 @@ class PushbroomLines(ResidualBlock):
         if self.timed:
             raise NotImplementedError("the numpy reference covers the image-y residual only")
         nm = self.blocks
-        g = _camera_geometry(values, nm, self.nodes, self.t_s, self.xyz_nav, self.rpy_nav,
-                             self.point, self.band, self.beta0, self.x0_mm, self.y0_mm)
+        g = _camera_geometry(
+            values,
+            nm,
+            self.nodes,
+            self.t_s,
+            self.xyz_nav,
+            self.rpy_nav,
+            self.point,
+            self.band,
+            self.beta0,
+            self.x0_mm,
+            self.y0_mm,
+        )
         q, d, R, beta = g["q"], g["d"], g["R"], g["beta"]
         c, xb, yb, iz = g["c"], g["xb"], g["yb"], g["iz"]
         k = 1.0 / self.pixel_mm
@@ -555,16 +680,40 @@ class PushbroomLines(ResidualBlock):
         dL = np.empty(shp + (3,))
         dD = np.empty(shp + (4,))
         dC = np.empty(shp + (1,))
-        _lines_kernel(np.ascontiguousarray(values[nm["points"]], dtype=np.float64), self.point,
-                      idx, self._u0, 1.0 / self.nodes.interval_s,
-                      np.ascontiguousarray(values[nm["nodes"]], dtype=np.float64),
-                      self.xyz_nav, self.rpy_nav, self.xyz_rate, self.rpy_rate, self.band,
-                      np.asarray(values[nm["c"]], dtype=np.float64),
-                      np.asarray(values[nm["distortion"]], dtype=np.float64), beta, dbeta,
-                      np.asarray(values[nm["lever_arm"]], dtype=np.float64), self.x0_mm,
-                      self.y0_mm, 1.0 / self.pixel_mm, self.xy_px, self.timed,
-                      self.newton_iterations, self.y_rate_ref_px_s, bool(jacobian), r, w_out,
-                      dP, dN, dB, dL, dD, dC)
+        _lines_kernel(
+            np.ascontiguousarray(values[nm["points"]], dtype=np.float64),
+            self.point,
+            idx,
+            self._u0,
+            1.0 / self.nodes.interval_s,
+            np.ascontiguousarray(values[nm["nodes"]], dtype=np.float64),
+            self.xyz_nav,
+            self.rpy_nav,
+            self.xyz_rate,
+            self.rpy_rate,
+            self.band,
+            np.asarray(values[nm["c"]], dtype=np.float64),
+            np.asarray(values[nm["distortion"]], dtype=np.float64),
+            beta,
+            dbeta,
+            np.asarray(values[nm["lever_arm"]], dtype=np.float64),
+            self.x0_mm,
+            self.y0_mm,
+            1.0 / self.pixel_mm,
+            self.xy_px,
+            self.timed,
+            self.newton_iterations,
+            self.y_rate_ref_px_s,
+            bool(jacobian),
+            r,
+            w_out,
+            dP,
+            dN,
+            dB,
+            dL,
+            dD,
+            dC,
+        )
         if not jacobian:
             return r, None
         jac = {

@@ -137,8 +137,10 @@ def _check_obs(name, view, corners, xy):
     if xy.ndim != 2 or xy.shape[1] != 2:
         raise InputError(f"{name}: centroids must be (n, 2) in mm, got {xy.shape}")
     if corners.shape != (n, 4, 3):
-        raise InputError(f"{name}: target corners must be (n, 4, 3) object coordinates, got "
-                         f"{corners.shape} for {n} centroids")
+        raise InputError(
+            f"{name}: target corners must be (n, 4, 3) object coordinates, got "
+            f"{corners.shape} for {n} centroids"
+        )
     if view.shape != (n,) or not np.issubdtype(view.dtype, np.integer):
         raise InputError(f"{name}: view/cube indices must be (n,) integers")
     if not (np.all(np.isfinite(xy)) and np.all(np.isfinite(corners))):
@@ -168,13 +170,15 @@ class TargetCentroids(ResidualBlock):
 
     name = "target centroids"
     group_size = 2
-    BLOCKS = MappingProxyType({"interior": "interior", "distortion": "distortion_mm",
-                               "poses": "poses"})
+    BLOCKS = MappingProxyType(
+        {"interior": "interior", "distortion": "distortion_mm", "poses": "poses"}
+    )
 
     def __init__(self, view, corners, xy_mm, sigma_mm, *, blocks=None, name=None):
         view, corners, xy = _check_obs(type(self).__name__, view, corners, xy_mm)
-        super().__init__(np.broadcast_to(np.asarray(sigma_mm, float), xy.shape).ravel(),
-                         name=name, blocks=blocks)
+        super().__init__(
+            np.broadcast_to(np.asarray(sigma_mm, float), xy.shape).ravel(), name=name, blocks=blocks
+        )
         self.view, self.corners, self.xy = view, corners, xy
 
     def predict(self, values) -> np.ndarray:
@@ -184,10 +188,19 @@ class TargetCentroids(ResidualBlock):
     def _model(self, values, jacobian):
         f, x0, y0 = values[self.blocks["interior"]]
         n = self.xy.shape[0]
-        Xc, d_pose, _ = camera_coordinates(values[self.blocks["poses"]], np.repeat(self.view, 4),
-                                           self.corners.reshape(-1, 3), jacobian)
-        xy, J = centroid_model(Xc.reshape(n, 4, 3), np.full(n, f), np.array([x0, y0]),
-                               values[self.blocks["distortion"]], jacobian)
+        Xc, d_pose, _ = camera_coordinates(
+            values[self.blocks["poses"]],
+            np.repeat(self.view, 4),
+            self.corners.reshape(-1, 3),
+            jacobian,
+        )
+        xy, J = centroid_model(
+            Xc.reshape(n, 4, 3),
+            np.full(n, f),
+            np.array([x0, y0]),
+            values[self.blocks["distortion"]],
+            jacobian,
+        )
         return xy, J, d_pose
 
     def evaluate(self, values, jacobian):
@@ -202,9 +215,11 @@ class TargetCentroids(ResidualBlock):
         d_int[:, 1, 2] = 1.0
         dp = np.einsum("nkac,nkcj->naj", J["Xc"], d_pose.reshape(n, 4, 3, 6))
         nm = self.blocks
-        jac = {nm["interior"]: d_int.reshape(2 * n, 3),
-               nm["distortion"]: J["KP"].reshape(2 * n, 5),
-               nm["poses"]: Indexed(np.repeat(self.view, 2), dp.reshape(2 * n, 6))}
+        jac = {
+            nm["interior"]: d_int.reshape(2 * n, 3),
+            nm["distortion"]: J["KP"].reshape(2 * n, 5),
+            nm["poses"]: Indexed(np.repeat(self.view, 2), dp.reshape(2 * n, 6)),
+        }
         return r.ravel(), jac
 
 
@@ -244,12 +259,21 @@ class JointCentroids(ResidualBlock):
     name = "target centroids (joint model)"
     group_size = 2
 
-    BLOCKS = MappingProxyType({"poses": "poses", "gap": "gap_model", "df": "df_mm",
-                               "pp": "pp_mm", "distortion": "distortion_mm",
-                               "rotation": "sensor2_rotation", "offset": "sensor2_offset_mm"})
+    BLOCKS = MappingProxyType(
+        {
+            "poses": "poses",
+            "gap": "gap_model",
+            "df": "df_mm",
+            "pp": "pp_mm",
+            "distortion": "distortion_mm",
+            "rotation": "sensor2_rotation",
+            "offset": "sensor2_offset_mm",
+        }
+    )
 
-    def __init__(self, cube, band_index, corners, xy_mm, sigma_mm, gap_nm, sensor, *,
-                 blocks=None, name=None):
+    def __init__(
+        self, cube, band_index, corners, xy_mm, sigma_mm, gap_nm, sensor, *, blocks=None, name=None
+    ):
         cube, corners, xy = _check_obs(type(self).__name__, cube, corners, xy_mm)
         band_index = np.asarray(band_index)
         gap_nm = np.asarray(gap_nm, dtype=np.float64)
@@ -260,10 +284,10 @@ class JointCentroids(ResidualBlock):
             raise InputError("JointCentroids: gap_nm and sensor must be (n_bands,), sensor 1 or 2")
         if band_index.min() < 0 or band_index.max() >= gap_nm.size:
             raise InputError("JointCentroids: band_index outside the band table")
-        super().__init__(np.broadcast_to(np.asarray(sigma_mm, float), xy.shape).ravel(),
-                         name=name, blocks=blocks)
-        self.cube, self.band, self.corners, self.xy = cube, band_index.astype(np.int64), \
-            corners, xy
+        super().__init__(
+            np.broadcast_to(np.asarray(sigma_mm, float), xy.shape).ravel(), name=name, blocks=blocks
+        )
+        self.cube, self.band, self.corners, self.xy = cube, band_index.astype(np.int64), corners, xy
         self.gap = gap_nm[self.band]
         self.srow = sensor[self.band].astype(np.int64) - 1  # 0: sensor I, 1: sensor II
 
@@ -276,8 +300,9 @@ class JointCentroids(ResidualBlock):
         ab = values[nm["gap"]]
         f = ab[self.srow, 0] * self.gap + ab[self.srow, 1] + values[nm["df"]][self.band]
         pp = values[nm["pp"]][self.srow]
-        XcI, d_pose, _ = camera_coordinates(values[nm["poses"]], np.repeat(self.cube, 4),
-                                            self.corners.reshape(-1, 3), jacobian)
+        XcI, d_pose, _ = camera_coordinates(
+            values[nm["poses"]], np.repeat(self.cube, 4), self.corners.reshape(-1, 3), jacobian
+        )
         XcI = XcI.reshape(n, 4, 3)
         rot = values[nm["rotation"]]
         t = values[nm["offset"]]

@@ -107,8 +107,9 @@ def simulate(cfg: dict, rng) -> tuple[BenchObservations, BenchTruth]:
         dist_mm = rng.uniform(*geo["distance_mm"])
         tilt = np.deg2rad(rng.uniform(0, geo["max_tilt_deg"]))
         azi = rng.uniform(0, 2 * np.pi)
-        C = centre + dist_mm * np.array([np.sin(tilt) * np.cos(azi), np.sin(tilt) * np.sin(azi),
-                                         -np.cos(tilt)])
+        C = centre + dist_mm * np.array(
+            [np.sin(tilt) * np.cos(azi), np.sin(tilt) * np.sin(azi), -np.cos(tilt)]
+        )
         z = centre - C
         z /= np.linalg.norm(z)
         x = np.cross([0.0, 1.0, 0.0], z)
@@ -126,8 +127,14 @@ def simulate(cfg: dict, rng) -> tuple[BenchObservations, BenchTruth]:
             uv.append(p)
     uv_true = np.concatenate(uv)
     noisy = uv_true + cam["sigma_px"] * rng.standard_normal(uv_true.shape)
-    obs = BenchObservations(X, np.concatenate(views), np.concatenate(pts), noisy,
-                            (int(w), int(h)), float(cam["sigma_px"]))
+    obs = BenchObservations(
+        X,
+        np.concatenate(views),
+        np.concatenate(pts),
+        noisy,
+        (int(w), int(h)),
+        float(cam["sigma_px"]),
+    )
     return obs, BenchTruth(np.array(poses), intr, dist, uv_true)
 
 
@@ -137,9 +144,21 @@ def generate(cfg: dict, outdir: Path) -> list[Path]:
     obs = outdir / "frame_bench_observations.csv"
     X = sim.X_mm[sim.point]
     table = np.column_stack([sim.view, sim.point, X, sim.uv_px])
-    np.savetxt(obs, table, delimiter=",", fmt=["%d", "%d"] + ["%.17g"] * 5,
-               header="view,point,X_mm,Y_mm,Z_mm,u_px,v_px", comments="")
+    np.savetxt(
+        obs,
+        table,
+        delimiter=",",
+        fmt=["%d", "%d"] + ["%.17g"] * 5,
+        header="view,point,X_mm,Y_mm,Z_mm,u_px,v_px",
+        comments="",
+    )
     truth_csv = outdir / "frame_bench_truth.csv"
-    np.savetxt(truth_csv, truth.poses, delimiter=",", fmt="%.17g",
-               header="omega_rad,phi_rad,kappa_rad,X0_mm,Y0_mm,Z0_mm", comments="")
+    np.savetxt(
+        truth_csv,
+        truth.poses,
+        delimiter=",",
+        fmt="%.17g",
+        header="omega_rad,phi_rad,kappa_rad,X0_mm,Y0_mm,Z0_mm",
+        comments="",
+    )
     return [obs, truth_csv]

@@ -32,8 +32,18 @@ from hsgeo.papers import P000_TABLE1_CALIBRATED, P001_SENSOR, P001_TABLE2
 from hsgeo.sensors import line1d
 from hsgeo.simulate import as_rng
 
-__all__ = ["LineLab", "true_iop", "wavelength_nm", "stations", "pattern_points", "render_rows",
-           "render_frame", "LabRecording", "LabTruth", "record"]
+__all__ = [
+    "LineLab",
+    "true_iop",
+    "wavelength_nm",
+    "stations",
+    "pattern_points",
+    "render_rows",
+    "render_frame",
+    "LabRecording",
+    "LabTruth",
+    "record",
+]
 
 
 @dataclass(frozen=True)
@@ -118,8 +128,11 @@ def stations(lab: LineLab, rng=None) -> np.ndarray:
     e = np.column_stack([lab.distance_m * np.sin(a), -lab.distance_m * np.cos(a), a])
     if rng is not None:
         rng = as_rng(rng)
-        e = e + rng.normal(0.0, [lab.station_sigma_m, lab.station_sigma_m,
-                                 np.deg2rad(lab.alpha_sigma_deg)], e.shape)
+        e = e + rng.normal(
+            0.0,
+            [lab.station_sigma_m, lab.station_sigma_m, np.deg2rad(lab.alpha_sigma_deg)],
+            e.shape,
+        )
     return e
 
 

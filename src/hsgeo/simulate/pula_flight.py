@@ -32,8 +32,18 @@ from hsgeo.rotations import R_from_rpy
 from hsgeo.simulate import as_rng
 from hsgeo.trajectory import Trajectory
 
-__all__ = ["FlightObservations", "FlightTruth", "simulate_flight", "gcp_field", "observe_gcps",
-           "generate", "airfield_scene", "render_line_image", "true_sensor", "nominal_sensor"]
+__all__ = [
+    "FlightObservations",
+    "FlightTruth",
+    "simulate_flight",
+    "gcp_field",
+    "observe_gcps",
+    "generate",
+    "airfield_scene",
+    "render_line_image",
+    "true_sensor",
+    "nominal_sensor",
+]
 
 
 @dataclass(frozen=True)
@@ -146,14 +156,26 @@ def _recorded(nav: Trajectory, cfg: dict, rng) -> Trajectory:
     walk = np.cumsum(steps, axis=0) * g["random_walk_m_per_sqrt_s"]
     pos = nav.xyz_m + pos_bias + walk + rng.normal(0, g["white_m"], (n, 3))
     att_bias = rng.normal(0, np.deg2rad(imu["attitude_bias_deg"]), 3)
-    att = (nav.roll_pitch_heading_rad + att_bias
-           + rng.normal(0, np.deg2rad(imu["attitude_noise_deg"]), (n, 3))
-           + np.deg2rad(imu["heading_drift_deg_per_s"]) * nav.t_s[:, None] * np.array([0, 0, 1]))
+    att = (
+        nav.roll_pitch_heading_rad
+        + att_bias
+        + rng.normal(0, np.deg2rad(imu["attitude_noise_deg"]), (n, 3))
+        + np.deg2rad(imu["heading_drift_deg_per_s"]) * nav.t_s[:, None] * np.array([0, 0, 1])
+    )
     return Trajectory(nav.t_s, pos, att)
 
 
-def observe_gcps(nav: Trajectory, sensor: LineGeometry, boresight_rad, t0_s, line_rate_hz,
-                 gcp_enu_m, rng, sigma_line: float, sigma_px: float):
+def observe_gcps(
+    nav: Trajectory,
+    sensor: LineGeometry,
+    boresight_rad,
+    t0_s,
+    line_rate_hz,
+    gcp_enu_m,
+    rng,
+    sigma_line: float,
+    sigma_px: float,
+):
     """Where the true sensor sees each GCP: (fractional line, ζ), with measurement noise.
 
     The line time is where the GCP crosses the scan plane (sensor x = 0), found by bisection on
@@ -180,8 +202,7 @@ def observe_gcps(nav: Trajectory, sensor: LineGeometry, boresight_rad, t0_s, lin
     xs = sensor_coords(t, gcp_enu_m)
     zeta = sensor.zeta(xs[:, 1] / xs[:, 2])
     line = (t - t0_s) * line_rate_hz
-    return (line + rng.normal(0, sigma_line, line.size),
-            zeta + rng.normal(0, sigma_px, zeta.size))
+    return (line + rng.normal(0, sigma_line, line.size), zeta + rng.normal(0, sigma_px, zeta.size))
 
 
 def nominal_sensor(cfg: dict) -> LinearIFOV:
@@ -206,11 +227,9 @@ def simulate_flight(cfg: dict, rng) -> tuple[FlightObservations, FlightTruth]:
     sensor = true_sensor(cfg)
     rate = cfg["scanner"]["line_rate_hz"]
     m = cfg["measurement"]
-    line, zeta = observe_gcps(nav, sensor, bs, 0.0, rate, enu, rng, m["sigma_line"],
-                              m["sigma_px"])
+    line, zeta = observe_gcps(nav, sensor, bs, 0.0, rate, enu, rng, m["sigma_line"], m["sigma_px"])
     h = cfg["field"]["height_m"]
-    obs = FlightObservations(rec, 0.0, rate, ids, enu.copy(), line, zeta, h,
-                             nominal_sensor(cfg))
+    obs = FlightObservations(rec, 0.0, rate, ids, enu.copy(), line, zeta, h, nominal_sensor(cfg))
     return obs, FlightTruth(nav, sensor, bs, enu, h, 0.0, rate)
 
 
@@ -219,9 +238,14 @@ def generate(cfg: dict, outdir: Path) -> list[Path]:
     fl, _ = simulate_flight(cfg, cfg["scenario"]["seed"])
     nav = write_trajectory(outdir / "pula_flight_navigation.csv", fl.recorded_nav)
     obs = outdir / "pula_flight_gcp_observations.csv"
-    np.savetxt(obs, np.column_stack([fl.gcp_id, fl.line, fl.zeta_px, fl.gcp_enu_m]),
-               delimiter=",", fmt=["%d"] + ["%.17g"] * 5,
-               header="gcp,line,zeta_px,E_m,N_m,U_m", comments="")
+    np.savetxt(
+        obs,
+        np.column_stack([fl.gcp_id, fl.line, fl.zeta_px, fl.gcp_enu_m]),
+        delimiter=",",
+        fmt=["%d"] + ["%.17g"] * 5,
+        header="gcp,line,zeta_px,E_m,N_m,U_m",
+        comments="",
+    )
     return [nav, obs]
 
 
@@ -258,8 +282,15 @@ def render_line_image(truth: FlightTruth, cfg: dict, rng=None, *, noise: float =
     z0 = round(cfg["sensor_truth"]["zeta0_px"])
     zeta = np.arange(z0 - half, z0 + half + 1, dtype=float)
     n_lines = int((fl.true_nav.t_s[-1] - fl.t0_s) * fl.line_rate_hz)
-    ground = geocode_image(fl.true_nav, fl.sensor, n_lines, zeta, t0_s=fl.t0_s,
-                           line_rate_hz=fl.line_rate_hz, terrain=PlaneTerrain(fl.terrain_height_m),
-                           boresight_rad=fl.boresight_rad)
+    ground = geocode_image(
+        fl.true_nav,
+        fl.sensor,
+        n_lines,
+        zeta,
+        t0_s=fl.t0_s,
+        line_rate_hz=fl.line_rate_hz,
+        terrain=PlaneTerrain(fl.terrain_height_m),
+        boresight_rad=fl.boresight_rad,
+    )
     img = airfield_scene(ground[..., 0], ground[..., 1], fl.gcp_enu_m)
     return img + noise * rng.standard_normal(img.shape), zeta

@@ -212,8 +212,9 @@ def _true_pose(plan, strip, t, amp, speed_m_s):
     return xyz, rpy
 
 
-def simulate(scale: float = 1.0, rng=0, noise_free: bool = False,
-             cfg: CampaignConfig | None = None) -> tuple[CampaignObservations, CampaignTruth]:
+def simulate(
+    scale: float = 1.0, rng=0, noise_free: bool = False, cfg: CampaignConfig | None = None
+) -> tuple[CampaignObservations, CampaignTruth]:
     """Simulate the campaign at ``scale`` (the share of the paper's tie points).
 
     Parameters
@@ -252,19 +253,37 @@ def simulate(scale: float = 1.0, rng=0, noise_free: bool = False,
         names["boresight"]: np.array(cfg.boresight_deg) * DEG,
         names["lever_arm"]: lever,
         names["distortion"]: np.array(cfg.distortion),
-        names["c"]: cfg.c_mean_mm + (np.array(cfg.c_offsets_um)
-                                     - np.mean(cfg.c_offsets_um)) * 1e-3,
+        names["c"]: cfg.c_mean_mm + (np.array(cfg.c_offsets_um) - np.mean(cfg.c_offsets_um)) * 1e-3,
     }
     lever_measured = lever + (0.0 if noise_free else 1.0) * cfg.sigma_lever_m * (
-        rng.standard_normal(3))
+        rng.standard_normal(3)
+    )
 
     # -- points: reference squares first, then tie points
     half = cfg.area_m / 2
     n_tie = max(int(round(cfg.n_tie_points_full * scale)), 50)
-    ref_en = np.array([[-270, -270], [270, -270], [-270, 270], [270, 270],  # 4 GCPs (corners)
-                       [0, 0], [-150, 0], [150, 0], [0, -150], [0, 150], [-150, -150],
-                       [150, 150], [-150, 150], [150, -150], [-270, 0], [270, 0], [0, -270],
-                       [0, 270]], dtype=float)
+    ref_en = np.array(
+        [
+            [-270, -270],
+            [270, -270],
+            [-270, 270],
+            [270, 270],  # 4 GCPs (corners)
+            [0, 0],
+            [-150, 0],
+            [150, 0],
+            [0, -150],
+            [0, 150],
+            [-150, -150],
+            [150, 150],
+            [-150, 150],
+            [150, -150],
+            [-270, 0],
+            [270, 0],
+            [0, -270],
+            [0, 270],
+        ],
+        dtype=float,
+    )
     ref_en += rng.uniform(-20, 20, ref_en.shape)
     tie_en = rng.uniform(-half, half, (n_tie, 2))
     en = np.vstack([ref_en, tie_en])
@@ -283,7 +302,8 @@ def simulate(scale: float = 1.0, rng=0, noise_free: bool = False,
     agl = np.array([p[3] for p in plan])
     half_swath = 0.97 * half_line_mm / c_fov * (agl - 0)  # m on the ground
     covers = np.abs(en[:, 0:1] - east[None, :]) < half_swath[None, :] * (
-        1 - h[:, None] / agl[None, :])
+        1 - h[:, None] / agl[None, :]
+    )
     covers &= np.abs(en[:, 1:2]) < cfg.strip_half_length_m - 30
     ncov = covers.sum(axis=1)
     if np.any(ncov < 3):
@@ -314,8 +334,7 @@ def simulate(scale: float = 1.0, rng=0, noise_free: bool = False,
         # truth = nav + δ(t): project with the true pose, zero corrections
         vals = dict(truth)
         vals[names["nodes"]] = np.zeros_like(node_err)
-        xy, p = project(vals, names, nodes, tt, xyz, rpy, pidx, band, beta0,
-                        cfg.x0_mm, cfg.y0_mm)
+        xy, p = project(vals, names, nodes, tt, xyz, rpy, pidx, band, beta0, cfg.x0_mm, cfg.y0_mm)
         return xy, p
 
     for _ in range(6):
@@ -361,15 +380,34 @@ def simulate(scale: float = 1.0, rng=0, noise_free: bool = False,
         comp = rng.integers(0, 2, n_out)
         xy_obs[np.flatnonzero(outlier), comp] += mag
         gcp_xyz = P[:4] + cfg.sigma_gcp_m * rng.standard_normal((4, 3))
-    lines = PushbroomObservations(point=pidx, band=band, t_s=t_line, xy_px=xy_obs,
-                                  xyz_nav_m=xyz_nav, rpy_nav_rad=rpy_nav,
-                                  xyz_rate_nav_m_s=xyz_rate_nav, rpy_rate_nav_rad_s=rpy_rate_nav)
+    lines = PushbroomObservations(
+        point=pidx,
+        band=band,
+        t_s=t_line,
+        xy_px=xy_obs,
+        xyz_nav_m=xyz_nav,
+        rpy_nav_rad=rpy_nav,
+        xyz_rate_nav_m_s=xyz_rate_nav,
+        rpy_rate_nav_rad_s=rpy_rate_nav,
+    )
     observations = CampaignObservations(
-        lines=lines, n_points=n_pts, gcp_index=np.arange(4), gcp_xyz_m=gcp_xyz,
+        lines=lines,
+        n_points=n_pts,
+        gcp_index=np.arange(4),
+        gcp_xyz_m=gcp_xyz,
         lever_arm_m=lever_measured,
         node_prior_mean=node_err.copy() if noise_free else np.zeros_like(node_err),
-        t_span_s=(0.0, float(t_end)))
-    truth = CampaignTruth(cfg=cfg, scale=scale, values=MappingProxyType(truth), nodes=nodes,
-                          strips=plan, strip=strip, cp_index=np.arange(4, 17), outlier=outlier,
-                          xy_true_px=xy_true_px)
+        t_span_s=(0.0, float(t_end)),
+    )
+    truth = CampaignTruth(
+        cfg=cfg,
+        scale=scale,
+        values=MappingProxyType(truth),
+        nodes=nodes,
+        strips=plan,
+        strip=strip,
+        cp_index=np.arange(4, 17),
+        outlier=outlier,
+        xy_true_px=xy_true_px,
+    )
     return observations, truth

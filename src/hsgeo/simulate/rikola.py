@@ -31,8 +31,15 @@ from hsgeo.rotations import R_from_opk, opk_from_R
 from hsgeo.sensors.frame import pixel_to_mm
 from hsgeo.sensors.rikola import project_measured_mm
 
-__all__ = ["Plate", "RikolaTruth", "make_truth", "band_radiometry", "render_band",
-           "Renderer", "generate"]
+__all__ = [
+    "Plate",
+    "RikolaTruth",
+    "make_truth",
+    "band_radiometry",
+    "render_band",
+    "Renderer",
+    "generate",
+]
 
 
 @dataclass(frozen=True)
@@ -73,8 +80,10 @@ class Plate:
         import cv2
 
         if not hasattr(cv2.aruco, self.dictionary):
-            raise InputError(f"unknown ArUco dictionary {self.dictionary!r}; use an OpenCV name "
-                             "such as DICT_4X4_100")
+            raise InputError(
+                f"unknown ArUco dictionary {self.dictionary!r}; use an OpenCV name "
+                "such as DICT_4X4_100"
+            )
         return cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, self.dictionary))
 
     @property
@@ -116,8 +125,10 @@ class Plate:
         nbits = d.markerSize + 2
         module = self.marker_mm / nbits / self.texel_mm
         if abs(module - round(module)) > 1e-9:
-            raise InputError(f"marker module {self.marker_mm / nbits} mm is not a whole number "
-                             f"of texels of {self.texel_mm} mm")
+            raise InputError(
+                f"marker module {self.marker_mm / nbits} mm is not a whole number "
+                f"of texels of {self.texel_mm} mm"
+            )
         side = int(round(self.marker_mm / self.texel_mm))
         x_min, x_max, y_min, y_max = self.extent_mm
         W = int(round((x_max - x_min) / self.texel_mm))
@@ -127,7 +138,7 @@ class Plate:
             img = cv2.aruco.generateImageMarker(d, int(k), side, borderBits=1)
             c = int(round(((k % self.nx) * self.pitch_mm - x_min) / self.texel_mm))
             r = int(round((y_max + (k // self.nx) * self.pitch_mm) / self.texel_mm))
-            tex[r:r + side, c:c + side] = np.where(img > 127, self.white, self.black)
+            tex[r : r + side, c : c + side] = np.where(img > 127, self.white, self.black)
         return tex
 
 
@@ -222,18 +233,30 @@ def make_truth(cfg: dict, rng, n_cubes: int | None = None) -> RikolaTruth:
     rng = as_rng(rng)
     cam, gm, mis, geo = cfg["camera"], cfg["gap_model"], cfg["misalignment"], cfg["geometry"]
     bands = RIKOLA_BANDS.copy()
-    ab = np.array([[gm["a_sensor1_mm_per_nm"], gm["b_sensor1_mm"]],
-                   [gm["a_sensor2_mm_per_nm"], gm["b_sensor2_mm"]]])
+    ab = np.array(
+        [
+            [gm["a_sensor1_mm_per_nm"], gm["b_sensor1_mm"]],
+            [gm["a_sensor2_mm_per_nm"], gm["b_sensor2_mm"]],
+        ]
+    )
     scatter = np.array([gm["scatter_sensor1_mm"], gm["scatter_sensor2_mm"]])
     s = bands["sensor"] - 1
     f = ab[s, 0] * bands["gap_nm"] + ab[s, 1] + scatter[s] * rng.standard_normal(len(bands))
     pp = np.array([cam["pp_sensor1_mm"], cam["pp_sensor2_mm"]], dtype=float)
-    KP = np.array([cam["K1_per_mm2"], cam["K2_per_mm4"], cam["K3_per_mm6"], cam["P1_per_mm"],
-                   cam["P2_per_mm"]])
+    KP = np.array(
+        [
+            cam["K1_per_mm2"],
+            cam["K2_per_mm4"],
+            cam["K3_per_mm6"],
+            cam["P1_per_mm"],
+            cam["P2_per_mm"],
+        ]
+    )
     rot = np.deg2rad([mis["domega_deg"], mis["dphi_deg"], mis["dkappa_deg"]])
     plate = Plate.from_config(cfg["plate"])
-    truth = RikolaTruth(bands, f, pp, KP, rot, np.asarray(mis["offset_mm"], float),
-                        np.zeros((0, 6)), ab, scatter)
+    truth = RikolaTruth(
+        bands, f, pp, KP, rot, np.asarray(mis["offset_mm"], float), np.zeros((0, 6)), ab, scatter
+    )
     n = geo["n_cubes"] if n_cubes is None else int(n_cubes)
     if n < 1:
         raise InputError(f"n_cubes must be at least 1, got {n}")
@@ -251,8 +274,9 @@ def make_truth(cfg: dict, rng, n_cubes: int | None = None) -> RikolaTruth:
         tilt = np.deg2rad(rng.uniform(*geo["tilt_deg"]))
         azi = rng.uniform(0, 2 * np.pi)
         aim = centre + np.r_[rng.uniform(-1, 1, 2) * geo["aim_offset_mm"], 0.0]
-        C = aim + D * np.array([np.sin(tilt) * np.cos(azi), np.sin(tilt) * np.sin(azi),
-                                np.cos(tilt)])
+        C = aim + D * np.array(
+            [np.sin(tilt) * np.cos(azi), np.sin(tilt) * np.sin(azi), np.cos(tilt)]
+        )
         roll = np.deg2rad(90.0 * (len(poses) % 4) + rng.uniform(-1, 1) * geo["roll_jitter_deg"])
         R = _look_at(C, aim, roll)
         Xc = (X - C) @ R
@@ -271,12 +295,17 @@ def band_radiometry(cfg: dict, band: int) -> dict:
     if r.size != 1:
         raise InputError(f"no band {band}; the Rikola bands are 1–25 (003 Table 2)")
     b = RIKOLA_BANDS[r[0]]
-    resp = np.exp(-0.5 * ((b["wavelength_nm"] - rad["response_peak_nm"])
-                          / rad["response_width_nm"]) ** 2)
+    resp = np.exp(
+        -0.5 * ((b["wavelength_nm"] - rad["response_peak_nm"]) / rad["response_width_nm"]) ** 2
+    )
     scale = rad["full_dn"] * b["fwhm_nm"] / RIKOLA_BANDS["fwhm_nm"].max() * resp
     psf = rad["psf0_px"] + rad["psf1_px"] * ((b["wavelength_nm"] - 680.0) / 160.0) ** 2
-    return {"scale_dn": float(scale), "white_dn": float(scale * plate["white"] + rad["dark_dn"]),
-            "black_dn": float(scale * plate["black"] + rad["dark_dn"]), "psf_px": float(psf)}
+    return {
+        "scale_dn": float(scale),
+        "white_dn": float(scale * plate["white"] + rad["dark_dn"]),
+        "black_dn": float(scale * plate["black"] + rad["dark_dn"]),
+        "psf_px": float(psf),
+    }
 
 
 class Renderer:
@@ -331,8 +360,14 @@ class Renderer:
         bad = ~(tt > 0)
         col[bad] = -1e6
         row[bad] = -1e6
-        fine = cv2.remap(pl.texture, col, row, cv2.INTER_LINEAR,
-                         borderMode=cv2.BORDER_CONSTANT, borderValue=float(pl.background))
+        fine = cv2.remap(
+            pl.texture,
+            col,
+            row,
+            cv2.INTER_LINEAR,
+            borderMode=cv2.BORDER_CONSTANT,
+            borderValue=float(pl.background),
+        )
         s = int(self.cfg["radiometry"]["supersample"])
         psf = band_radiometry(self.cfg, band)["psf_px"]
         fine = cv2.GaussianBlur(fine, (0, 0), sigmaX=psf * s, sigmaY=psf * s)
@@ -363,11 +398,24 @@ def generate(cfg: dict, outdir: Path) -> list[Path]:
     truth = make_truth(cfg, np.random.default_rng([cfg["scenario"]["seed"], 0]))
     bands = outdir / "rikola_bench_truth_bands.csv"
     pp = truth.pp_mm[truth.bands["sensor"] - 1]
-    table = np.column_stack([truth.bands["band"], truth.bands["sensor"], truth.bands["gap_nm"],
-                             truth.f_mm, pp])
-    np.savetxt(bands, table, delimiter=",", fmt=["%d", "%d", "%.17g", "%.17g", "%.17g", "%.17g"],
-               header="band,sensor,gap_nm,f_mm,x0_mm,y0_mm", comments="")
+    table = np.column_stack(
+        [truth.bands["band"], truth.bands["sensor"], truth.bands["gap_nm"], truth.f_mm, pp]
+    )
+    np.savetxt(
+        bands,
+        table,
+        delimiter=",",
+        fmt=["%d", "%d", "%.17g", "%.17g", "%.17g", "%.17g"],
+        header="band,sensor,gap_nm,f_mm,x0_mm,y0_mm",
+        comments="",
+    )
     cubes = outdir / "rikola_bench_truth_cubes.csv"
-    np.savetxt(cubes, truth.poses, delimiter=",", fmt="%.17g",
-               header="omega_rad,phi_rad,kappa_rad,X0_mm,Y0_mm,Z0_mm", comments="")
+    np.savetxt(
+        cubes,
+        truth.poses,
+        delimiter=",",
+        fmt="%.17g",
+        header="omega_rad,phi_rad,kappa_rad,X0_mm,Y0_mm,Z0_mm",
+        comments="",
+    )
     return [bands, cubes]

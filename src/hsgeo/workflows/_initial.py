@@ -16,8 +16,14 @@ from hsgeo.rotations import R_from_rotvec, R_photogrammetric_from_opencv_cam, op
 __all__ = ["pose_from_pnp"]
 
 
-def pose_from_pnp(X_m: ArrayLike, uv_px: ArrayLike, K_px: ArrayLike, *,
-                  frame: str = "photogrammetric", what: str = "view") -> NDArray:
+def pose_from_pnp(
+    X_m: ArrayLike,
+    uv_px: ArrayLike,
+    K_px: ArrayLike,
+    *,
+    frame: str = "photogrammetric",
+    what: str = "view",
+) -> NDArray:
     """Pose of a camera from ≥ 4 object points and their pixels (``cv2.solvePnP``, no distortion).
 
     Parameters
@@ -57,8 +63,9 @@ def pose_from_pnp(X_m: ArrayLike, uv_px: ArrayLike, K_px: ArrayLike, *,
     uv = np.asarray(uv_px, dtype=np.float64)
     if len(X) < 4:
         raise ObservationError(f"{what}: {len(X)} points; a pose needs at least 4")
-    ok, rvec, tvec = cv2.solvePnP(X, uv, np.asarray(K_px, dtype=np.float64), np.zeros(5),
-                                  flags=cv2.SOLVEPNP_ITERATIVE)
+    ok, rvec, tvec = cv2.solvePnP(
+        X, uv, np.asarray(K_px, dtype=np.float64), np.zeros(5), flags=cv2.SOLVEPNP_ITERATIVE
+    )
     if not ok:
         raise ObservationError(f"{what}: no initial pose from solvePnP (degenerate points?)")
     R_opencv_cam_from_world = R_from_rotvec(rvec.ravel())

@@ -27,9 +27,13 @@ from hsgeo.sensors.frame import (
 )
 from hsgeo.workflows._initial import pose_from_pnp
 
-__all__ = ["View", "FrameCalibration", "calibrate_opencv", "calibrate_photogrammetric",
-           "initial_poses"]
-
+__all__ = [
+    "View",
+    "FrameCalibration",
+    "calibrate_opencv",
+    "calibrate_photogrammetric",
+    "initial_poses",
+]
 
 
 @dataclass(frozen=True)
@@ -63,8 +67,9 @@ def _check_views(views: Sequence[View], image_size) -> list[View]:
         X = np.asarray(v.X, dtype=np.float64)
         uv = np.asarray(v.uv_px, dtype=np.float64)
         if X.ndim != 2 or X.shape[1] != 3 or uv.shape != (X.shape[0], 2):
-            raise InputError(f"view {i}: X must be (n, 3) and uv_px (n, 2); got {X.shape}, "
-                             f"{uv.shape}")
+            raise InputError(
+                f"view {i}: X must be (n, 3) and uv_px (n, 2); got {X.shape}, {uv.shape}"
+            )
         if not (np.all(np.isfinite(X)) and np.all(np.isfinite(uv))):
             raise InputError(f"view {i}: NaN or inf in the object or image points")
         if X.shape[0] < 4:
@@ -83,8 +88,12 @@ def initial_poses(views: Sequence[View], K: np.ndarray) -> np.ndarray:
     -------
     (n_views, 6) ndarray of ``(ω, φ, κ, X0, Y0, Z0)`` for the OpenCV camera frame.
     """
-    return np.array([pose_from_pnp(v.X, v.uv_px, K, frame="opencv", what=f"view {i}")
-                     for i, v in enumerate(views)])
+    return np.array(
+        [
+            pose_from_pnp(v.X, v.uv_px, K, frame="opencv", what=f"view {i}")
+            for i, v in enumerate(views)
+        ]
+    )
 
 
 def _initial_K(views, image_size) -> np.ndarray:
@@ -137,8 +146,12 @@ class FrameCalibration:
         r = self.residuals_px
         counts = np.array([v.X.shape[0] for v in self.views])
         edges = np.concatenate([[0], np.cumsum(counts)])
-        return np.array([np.sqrt(np.mean(np.sum(r[a:b] ** 2, axis=1)))
-                         for a, b in zip(edges[:-1], edges[1:], strict=True)])
+        return np.array(
+            [
+                np.sqrt(np.mean(np.sum(r[a:b] ** 2, axis=1)))
+                for a, b in zip(edges[:-1], edges[1:], strict=True)
+            ]
+        )
 
     def values(self) -> dict[str, float]:
         """Interior orientation and distortion by name."""
@@ -265,8 +278,15 @@ def calibrate_photogrammetric(
     if fix_K3:
         p.fix("distortion_mm", index=2)
     view, X, uv = _stack(views)
-    blk = FramePhotogrammetric(view, pixel_to_mm(uv, image_size, pixel_pitch_mm),
-                               sigma_px * pixel_pitch_mm, X=X)
+    blk = FramePhotogrammetric(
+        view, pixel_to_mm(uv, image_size, pixel_pitch_mm), sigma_px * pixel_pitch_mm, X=X
+    )
     res = adjust(p, blk, reject_k=reject_k, progress=progress)
-    return FrameCalibration("photogrammetric", res, (int(w), int(h)), views, pixel_pitch_mm,
-                            _blocks=("interior", "distortion_mm"))
+    return FrameCalibration(
+        "photogrammetric",
+        res,
+        (int(w), int(h)),
+        views,
+        pixel_pitch_mm,
+        _blocks=("interior", "distortion_mm"),
+    )

@@ -25,8 +25,18 @@ from hsgeo.io import read_dem, read_lines, read_sensor_toml, refuse_inputs, to_m
 __all__ = ["geocode_files", "gcp_deviations"]
 
 
-def geocode_files(lines, trajectory, sensor, *, output, dem=None, height_m=None,
-                  resolution_m=0.5, envi=None, progress=True):
+def geocode_files(
+    lines,
+    trajectory,
+    sensor,
+    *,
+    output,
+    dem=None,
+    height_m=None,
+    resolution_m=0.5,
+    envi=None,
+    progress=True,
+):
     """Orthorectify a recorded flight line from files (see ``hsgeo geocode --help``).
 
     The outputs are written atomically and never over one of the input files.
@@ -46,17 +56,39 @@ def geocode_files(lines, trajectory, sensor, *, output, dem=None, height_m=None,
         terrain = DemTerrain(read_dem(dem))
     else:
         terrain = PlaneTerrain(float(height_m))
-    ground = geocode_image(nav, geom, da.sizes["line"], da["pixel"].values, t0_s=t0,
-                           line_rate_hz=rate, terrain=terrain, boresight_rad=bs,
-                           progress=progress)
-    ortho = orthorectify(da.values, ground, resolution_m=resolution_m,
-                         band_names=da["band"].values,
-                         attrs={"source": str(lines), "sensor": str(sensor)})
+    ground = geocode_image(
+        nav,
+        geom,
+        da.sizes["line"],
+        da["pixel"].values,
+        t0_s=t0,
+        line_rate_hz=rate,
+        terrain=terrain,
+        boresight_rad=bs,
+        progress=progress,
+    )
+    ortho = orthorectify(
+        da.values,
+        ground,
+        resolution_m=resolution_m,
+        band_names=da["band"].values,
+        attrs={"source": str(lines), "sensor": str(sensor)},
+    )
     return ortho, to_map_files(ortho, output, envi, inputs=inputs)
 
 
-def gcp_deviations(nav, sensor: LineGeometry, line, zeta_px, gcp_enu_m, *, height_m: float,
-                   t0_s: float, line_rate_hz: float, sigma_m: float = 0.3):
+def gcp_deviations(
+    nav,
+    sensor: LineGeometry,
+    line,
+    zeta_px,
+    gcp_enu_m,
+    *,
+    height_m: float,
+    t0_s: float,
+    line_rate_hz: float,
+    sigma_m: float = 0.3,
+):
     """GCP deviations (geocoded − surveyed) after a GCP calibration of the boresight.
 
     The boresight is calibrated on the GCPs (:func:`hsgeo.geocode.calibrate_boresight`, the
@@ -91,8 +123,16 @@ def gcp_deviations(nav, sensor: LineGeometry, line, zeta_px, gcp_enu_m, *, heigh
     """
     gcp_enu_m = np.asarray(gcp_enu_m, dtype=float)
     kw = {"t0_s": t0_s, "line_rate_hz": line_rate_hz}
-    res = calibrate_boresight(nav, sensor, line, zeta_px, gcp_enu_m, height_m=height_m,
-                              sigma_m=sigma_m, **kw)
-    X = geocode_observations(nav, sensor, line, zeta_px, terrain=PlaneTerrain(height_m),
-                             boresight_rad=res.value("boresight"), **kw)
+    res = calibrate_boresight(
+        nav, sensor, line, zeta_px, gcp_enu_m, height_m=height_m, sigma_m=sigma_m, **kw
+    )
+    X = geocode_observations(
+        nav,
+        sensor,
+        line,
+        zeta_px,
+        terrain=PlaneTerrain(height_m),
+        boresight_rad=res.value("boresight"),
+        **kw,
+    )
     return X[:, :2] - gcp_enu_m[:, :2], res

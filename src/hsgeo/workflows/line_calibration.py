@@ -24,8 +24,15 @@ from hsgeo.sensors.line1d import (
 __all__ = ["observe_rows", "calibrate", "calibrate_files"]
 
 
-def observe_rows(frames_dn, xy_m, *, offset_dn: float = 0.0, n_columns: int | None = None,
-                 method: str = "parabola", row: int | None = None):
+def observe_rows(
+    frames_dn,
+    xy_m,
+    *,
+    offset_dn: float = 0.0,
+    n_columns: int | None = None,
+    method: str = "parabola",
+    row: int | None = None,
+):
     """Measured ζ of the control points on raw rows, associated with the points by their order.
 
     The dark lines of the pattern are the minima of each row (:func:`~hsgeo.measure.line_minima.
@@ -101,8 +108,15 @@ def calibrate(params: Parameters, block: LineObservations, *, stages: bool = Tru
     return adjust(p, block, **kw)
 
 
-def calibrate_files(observations, control, *, zeta0_px: float = 485.0, c_px: float = 3600.0,
-                    sigma_px: float = 0.1, reject_k: float | None = None) -> dict:
+def calibrate_files(
+    observations,
+    control,
+    *,
+    zeta0_px: float = 485.0,
+    c_px: float = 3600.0,
+    sigma_px: float = 0.1,
+    reject_k: float | None = None,
+) -> dict:
     """Calibrate one spectral line from a user's files (``hsgeo calibrate-line``).
 
     Parameters
@@ -124,29 +138,46 @@ def calibrate_files(observations, control, *, zeta0_px: float = 485.0, c_px: flo
     -------
     dict with ``result`` (AdjustmentResult), ``image_ids``, ``point_ids``, ``residuals_px``.
     """
-    obs = read_table(observations, ("image", "point", "zeta_px"), "observations",
-                     text_columns=("image", "point"))
+    obs = read_table(
+        observations, ("image", "point", "zeta_px"), "observations", text_columns=("image", "point")
+    )
     ctl = read_table(control, ("point", "x_m", "y_m"), "control", text_columns=("point",))
     pid = ctl["point"].tolist()
     xy = ctl[["x_m", "y_m"]].to_numpy(dtype=float)
     z = obs["zeta_px"].to_numpy(dtype=float)
     if len(set(pid)) != len(pid):
-        raise InputError(f"control file {str(control)!r} lists a point id twice; keep one row "
-                         "per point")
+        raise InputError(
+            f"control file {str(control)!r} lists a point id twice; keep one row per point"
+        )
     index = {p: i for i, p in enumerate(pid)}
     missing = sorted(set(obs["point"]) - set(index))
     if missing:
-        raise InputError(f"observed points without control coordinates: {missing[:10]}; add them "
-                         f"to the control file {str(control)!r}")
+        raise InputError(
+            f"observed points without control coordinates: {missing[:10]}; add them "
+            f"to the control file {str(control)!r}"
+        )
     image_ids = list(dict.fromkeys(obs["image"]))
     img = np.array([image_ids.index(i) for i in obs["image"]])
     pt = np.array([index[p] for p in obs["point"]])
     blk = LineObservations(img, pt, z, sigma_px)  # NaN check
     check_minimum_observations(img, pt, np.ones(len(pid), bool), len(image_ids))
-    eop = np.array([resect(xy[pt[img == i]], z[img == i], zeta0_px, c_px).eop
-                    for i in range(len(image_ids))])
-    p = make_parameters(eop, zeta0_px, c_px, [0.0, 0.0, 0.0], xy, np.ones(len(pid), bool),
-                        image_ids=image_ids, point_ids=pid)
+    eop = np.array(
+        [resect(xy[pt[img == i]], z[img == i], zeta0_px, c_px).eop for i in range(len(image_ids))]
+    )
+    p = make_parameters(
+        eop,
+        zeta0_px,
+        c_px,
+        [0.0, 0.0, 0.0],
+        xy,
+        np.ones(len(pid), bool),
+        image_ids=image_ids,
+        point_ids=pid,
+    )
     res = calibrate(p, blk, reject_k=reject_k)
-    return {"result": res, "image_ids": image_ids, "point_ids": pid,
-            "residuals_px": res.residuals(blk.name)}
+    return {
+        "result": res,
+        "image_ids": image_ids,
+        "point_ids": pid,
+        "residuals_px": res.residuals(blk.name),
+    }

@@ -116,9 +116,18 @@ def intersect_two_rays(point, origin, direction, n_points, min_angle_deg: float 
     return xyz
 
 
-def build_problem(obs: PushbroomObservations, n_points: int, cam: CameraPrior, *,
-                  node_interval_s: float = 10.0, gcp_index=None, gcp_xyz_m=None,
-                  t_span_s=None, node_prior_mean=None, y_as_time: bool = False):
+def build_problem(
+    obs: PushbroomObservations,
+    n_points: int,
+    cam: CameraPrior,
+    *,
+    node_interval_s: float = 10.0,
+    gcp_index=None,
+    gcp_xyz_m=None,
+    t_span_s=None,
+    node_prior_mean=None,
+    y_as_time: bool = False,
+):
     """Parameters and residual blocks of the LP bundle adjustment.
 
     Parameters
@@ -157,7 +166,8 @@ def build_problem(obs: PushbroomObservations, n_points: int, cam: CameraPrior, *
     if not isinstance(obs, PushbroomObservations):
         raise InputError(
             f"build_problem takes a PushbroomObservations, got {type(obs).__name__}: wrap the "
-            "arrays with hsgeo.workflows.pushbroom_ba.PushbroomObservations(point=..., ...)")
+            "arrays with hsgeo.workflows.pushbroom_ba.PushbroomObservations(point=..., ...)"
+        )
     t = obs.t_s
     if t.size == 0:
         raise InputError("no observations")
@@ -170,12 +180,20 @@ def build_problem(obs: PushbroomObservations, n_points: int, cam: CameraPrior, *
     P0 = intersect_two_rays(obs.point, o, d, n_points)
     p = Parameters()
     p.add(names["points"], P0, points=True, columns=("E_m", "N_m", "H_m"))
-    p.add(names["nodes"], np.zeros((nodes.n_nodes, 6)), columns=CORRECTION_COLUMNS,
-          prior_mean=0.0 if node_prior_mean is None else node_prior_mean,
-          prior_sigma=np.r_[cam.sigma_pos_m, cam.sigma_att_rad][None, :])
+    p.add(
+        names["nodes"],
+        np.zeros((nodes.n_nodes, 6)),
+        columns=CORRECTION_COLUMNS,
+        prior_mean=0.0 if node_prior_mean is None else node_prior_mean,
+        prior_sigma=np.r_[cam.sigma_pos_m, cam.sigma_att_rad][None, :],
+    )
     p.add(names["boresight"], np.zeros(3), columns=("omega_rad", "phi_rad", "kappa_rad"))
-    p.add(names["lever_arm"], np.asarray(cam.lever_arm_m, float), columns=("x_m", "y_m", "z_m"),
-          prior_sigma=cam.sigma_lever_m)
+    p.add(
+        names["lever_arm"],
+        np.asarray(cam.lever_arm_m, float),
+        columns=("x_m", "y_m", "z_m"),
+        prior_sigma=cam.sigma_lever_m,
+    )
     p.add(names["distortion"], np.zeros(4), columns=("K1", "K2", "P1", "P2"))
     p.add(names["c"], np.full(cam.n_bands, cam.c_mm))
     if gcp_index is not None:
@@ -188,15 +206,29 @@ def build_problem(obs: PushbroomObservations, n_points: int, cam: CameraPrior, *
             raise InputError(
                 "y_as_time needs the GNSS/INS rates at the line times (xyz_rate_nav_m_s, "
                 "rpy_rate_nav_rad_s): give them (hsgeo.trajectory.Trajectory.rates, converted by "
-                "hsgeo.trajectory.platform_rpy_rate_from_rph_rate) or use y_as_time=False")
+                "hsgeo.trajectory.platform_rpy_rate_from_rph_rate) or use y_as_time=False"
+            )
         z_ref = float(np.median(obs.xyz_nav_m[:, 2] - P0[obs.point, 2]))
         v_ref = float(np.median(np.linalg.norm(obs.xyz_rate_nav_m_s, axis=1)))
-        timed = {"xyz_rate_m_s": obs.xyz_rate_nav_m_s,
-                 "rpy_rate_rad_s": obs.rpy_rate_nav_rad_s,
-                 "y_rate_ref_px_s": cam.c_mm * v_ref / (z_ref * cam.pixel_mm)}
-    blk = PushbroomLines(obs.point, obs.band, t, obs.xy_px, obs.xyz_nav_m,
-                         obs.rpy_nav_rad, nodes, cam.pixel_mm, cam.sigma_obs_px,
-                         cam.x0_mm, cam.y0_mm, **timed)
+        timed = {
+            "xyz_rate_m_s": obs.xyz_rate_nav_m_s,
+            "rpy_rate_rad_s": obs.rpy_rate_nav_rad_s,
+            "y_rate_ref_px_s": cam.c_mm * v_ref / (z_ref * cam.pixel_mm),
+        }
+    blk = PushbroomLines(
+        obs.point,
+        obs.band,
+        t,
+        obs.xy_px,
+        obs.xyz_nav_m,
+        obs.rpy_nav_rad,
+        nodes,
+        cam.pixel_mm,
+        cam.sigma_obs_px,
+        cam.x0_mm,
+        cam.y0_mm,
+        **timed,
+    )
     return p, [blk], nodes
 
 
@@ -214,8 +246,11 @@ def read_camera(path) -> CameraPrior:
     """
     cfg = read_camera_toml(path)
     cam, nav = cfg["camera"], cfg["gnss_ins"]
-    kw = {k: cam[k] for k in ("n_bands", "pixel_mm", "c_mm", "x0_mm", "y0_mm", "lever_arm_m",
-                              "sigma_lever_m") if k in cam}
+    kw = {
+        k: cam[k]
+        for k in ("n_bands", "pixel_mm", "c_mm", "x0_mm", "y0_mm", "lever_arm_m", "sigma_lever_m")
+        if k in cam
+    }
     if "sigma_pos_m" in nav:
         kw["sigma_pos_m"] = nav["sigma_pos_m"]
     if "sigma_att_deg" in nav:
@@ -227,8 +262,17 @@ def read_camera(path) -> CameraPrior:
     return CameraPrior(**kw)
 
 
-def adjust_files(observations, trajectory, camera, gcp=None, *, node_interval_s: float = 10.0,
-                 reject_k: float | None = 5.0, progress=None, y_as_time: bool = True) -> dict:
+def adjust_files(
+    observations,
+    trajectory,
+    camera,
+    gcp=None,
+    *,
+    node_interval_s: float = 10.0,
+    reject_k: float | None = 5.0,
+    progress=None,
+    y_as_time: bool = True,
+) -> dict:
     """Adjust a user's pushbroom observations (``hsgeo adjust-pushbroom``).
 
     Parameters
@@ -271,9 +315,15 @@ def adjust_files(observations, trajectory, camera, gcp=None, *, node_interval_s:
     rpy = platform_rpy_from_rph(rph)  # the model's ENU platform angles (002)
     rate = platform_rpy_rate_from_rph_rate(rph_rate)
     obs = PushbroomObservations(
-        point=point.astype(np.int64), band=obs_df["band"].to_numpy().astype(np.int64), t_s=t,
-        xy_px=obs_df[["x_px", "y_px"]].to_numpy(dtype=float), xyz_nav_m=xyz, rpy_nav_rad=rpy,
-        xyz_rate_nav_m_s=vel, rpy_rate_nav_rad_s=rate)
+        point=point.astype(np.int64),
+        band=obs_df["band"].to_numpy().astype(np.int64),
+        t_s=t,
+        xy_px=obs_df[["x_px", "y_px"]].to_numpy(dtype=float),
+        xyz_nav_m=xyz,
+        rpy_nav_rad=rpy,
+        xyz_rate_nav_m_s=vel,
+        rpy_rate_nav_rad_s=rate,
+    )
     gi = gx = None
     if gcp is not None:
         g = read_table(gcp, GCP_COLUMNS, "GCP")
@@ -283,25 +333,47 @@ def adjust_files(observations, trajectory, camera, gcp=None, *, node_interval_s:
             raise InputError(f"GCP point_id(s) {unknown[:5]} are not in the observation table")
         gi = np.array([pos[v] for v in g["point_id"]])
         gx = g[["E_m", "N_m", "H_m"]].to_numpy(dtype=float)
-    p, blocks, nodes = build_problem(obs, ids.size, cam, node_interval_s=node_interval_s,
-                                     gcp_index=gi, gcp_xyz_m=gx, y_as_time=y_as_time)
-    res = adjust(p, blocks, reject_k=reject_k, ftol=1e-6, progress=progress,
-                 reject_every_iteration=True)  # 002 §3.4
+    p, blocks, nodes = build_problem(
+        obs,
+        ids.size,
+        cam,
+        node_interval_s=node_interval_s,
+        gcp_index=gi,
+        gcp_xyz_m=gx,
+        y_as_time=y_as_time,
+    )
+    res = adjust(
+        p, blocks, reject_k=reject_k, ftol=1e-6, progress=progress, reject_every_iteration=True
+    )  # 002 §3.4
     out = {
-        "converged": res.converged, "iterations": res.iterations, "sigma0": res.sigma0,
-        "n_observations_2d": int(len(obs_df)), "n_points": int(ids.size),
-        "n_unknowns": int(res.n_unknowns), "rejected": int(res.outliers(0).sum()),
-        "solver_seconds": res.seconds, "node_interval_s": node_interval_s,
+        "converged": res.converged,
+        "iterations": res.iterations,
+        "sigma0": res.sigma0,
+        "n_observations_2d": int(len(obs_df)),
+        "n_points": int(ids.size),
+        "n_unknowns": int(res.n_unknowns),
+        "rejected": int(res.outliers(0).sum()),
+        "solver_seconds": res.seconds,
+        "node_interval_s": node_interval_s,
         "parameters": {},
     }
-    for name, f in [("boresight_rad", 180 / np.pi), ("lever_arm_m", 1.0), ("distortion", 1.0),
-                    ("c_mm", 1.0)]:
+    for name, f in [
+        ("boresight_rad", 180 / np.pi),
+        ("lever_arm_m", 1.0),
+        ("distortion", 1.0),
+        ("c_mm", 1.0),
+    ]:
         key = name.replace("_rad", "_deg")
-        out["parameters"][key] = {"value": (res.value(name) * f).tolist(),
-                                  "sigma": (res.sigma(name) * f).tolist()}
-    out["nodes"] = {"t_s": nodes.t_nodes_s.tolist(), "value": res.value("nodes").tolist(),
-                    "sigma": res.sigma("nodes").tolist(),
-                    "columns": list(res.params["nodes"].columns)}
+        out["parameters"][key] = {
+            "value": (res.value(name) * f).tolist(),
+            "sigma": (res.sigma(name) * f).tolist(),
+        }
+    out["nodes"] = {
+        "t_s": nodes.t_nodes_s.tolist(),
+        "value": res.value("nodes").tolist(),
+        "sigma": res.sigma("nodes").tolist(),
+        "columns": list(res.params["nodes"].columns),
+    }
     out["points"] = {"point_id": ids.tolist(), "xyz_m": res.value("points_m").tolist()}
     out["_result"] = res
     return out

@@ -66,9 +66,17 @@ __all__ = [
 ]
 
 
-def detect_targets_in_images(images, corners_obj, target_ids, image_size, pixel_mm: float, *,
-                             dictionary: str = "DICT_4X4_100", refine: str = "subpix",
-                             compare_refine: str | None = None):
+def detect_targets_in_images(
+    images,
+    corners_obj,
+    target_ids,
+    image_size,
+    pixel_mm: float,
+    *,
+    dictionary: str = "DICT_4X4_100",
+    refine: str = "subpix",
+    compare_refine: str | None = None,
+):
     """Detect the ArUco targets of a plate in a sequence of images (003 §3.2).
 
     Each target keeps its four corners and their centroid (the virtual point of 003 §3.2).
@@ -114,10 +122,17 @@ def detect_targets_in_images(images, corners_obj, target_ids, image_size, pixel_
     out = []
     for rw in rows:
         target = np.concatenate(rw["target"]).astype(np.int64)
-        out.append(Observations(np.concatenate(rw["cube"]).astype(np.int64),
-                                np.concatenate(rw["band"]).astype(np.int64), target,
-                                np.concatenate(rw["corners"]), corners_obj[target], size,
-                                float(pixel_mm)))
+        out.append(
+            Observations(
+                np.concatenate(rw["cube"]).astype(np.int64),
+                np.concatenate(rw["band"]).astype(np.int64),
+                target,
+                np.concatenate(rw["corners"]),
+                corners_obj[target],
+                size,
+                float(pixel_mm),
+            )
+        )
     return out[0], (out[1] if len(out) > 1 else None)
 
 
@@ -133,8 +148,13 @@ def initial_poses(obs: Observations, f_mm: float) -> dict[int, np.ndarray]:
         m = obs.cube == c
         if m.sum() < 4:
             raise ObservationError(f"cube {c}: {m.sum()} targets; a pose needs at least 4")
-        out[int(c)] = pose_from_pnp(obs.corners_obj[m].mean(axis=1), obs.centroids_px[m], K,
-                                    frame="photogrammetric", what=f"cube {c}")
+        out[int(c)] = pose_from_pnp(
+            obs.corners_obj[m].mean(axis=1),
+            obs.centroids_px[m],
+            K,
+            frame="photogrammetric",
+            what=f"cube {c}",
+        )
     return out
 
 
@@ -173,8 +193,10 @@ class BandCalibration:
     def iop(self) -> dict[str, tuple[float, float]]:
         """Table-3 style: name -> (value, σ̂)."""
         out = {}
-        for blk, cols in (("interior", PHOTOGRAMMETRIC_INTERIOR),
-                          ("distortion_mm", PHOTOGRAMMETRIC_DISTORTION)):
+        for blk, cols in (
+            ("interior", PHOTOGRAMMETRIC_INTERIOR),
+            ("distortion_mm", PHOTOGRAMMETRIC_DISTORTION),
+        ):
             v, s = self.result.value(blk), self.result.sigma(blk)
             out.update({c: (float(v[i]), float(s[i])) for i, c in enumerate(cols)})
         return out
@@ -186,7 +208,7 @@ class BandCalibration:
         """(6, 6) covariance of a cube's pose."""
         cov, labels = self.result.covariance_of("poses")
         i = int(np.flatnonzero(self.cubes == cube)[0])
-        return cov[6 * i:6 * i + 6, 6 * i:6 * i + 6]
+        return cov[6 * i : 6 * i + 6, 6 * i : 6 * i + 6]
 
     @property
     def residuals_px(self) -> np.ndarray:
@@ -215,14 +237,24 @@ def band_problem(obs: Observations, band: int, f0_mm: float, sigma_px: float):
     p = Parameters()
     p.add("interior", [f0_mm, 0.0, 0.0], columns=PHOTOGRAMMETRIC_INTERIOR)
     p.add("distortion_mm", np.zeros(5), columns=PHOTOGRAMMETRIC_DISTORTION)
-    p.add("poses", np.array([poses[int(c)] for c in cubes]), columns=POSE_COLUMNS,
-          rows=[f"cube {c}" for c in cubes])
+    p.add(
+        "poses",
+        np.array([poses[int(c)] for c in cubes]),
+        columns=POSE_COLUMNS,
+        rows=[f"cube {c}" for c in cubes],
+    )
     blk = TargetCentroids(view, o.corners_obj, o.centroids_mm, sigma_px * obs.pixel_mm)
     return p, blk, cubes
 
 
-def calibrate_band(obs: Observations, band: int, *, f0_mm: float | None = 9.0,
-                   sigma_px: float = 0.02, reject_k: float | None = 5.0) -> BandCalibration:
+def calibrate_band(
+    obs: Observations,
+    band: int,
+    *,
+    f0_mm: float | None = 9.0,
+    sigma_px: float = 0.02,
+    reject_k: float | None = 5.0,
+) -> BandCalibration:
     """Self-calibrating bundle adjustment of one band (003 §3.3: each band a camera).
 
     The datum is the plate: the target coordinates are known (fixed), as on the paper's bench
@@ -256,6 +288,7 @@ def relative_orientation(pose_1, pose_2, cov_1=None, cov_2=None, step: float = 1
     opk_rad : (3,) ndarray
     cov : (3, 3) ndarray or None
     """
+
     def f(a1, a2):
         R = R_from_opk(*a1).T @ R_from_opk(*a2)
         return opk_from_R(R)
@@ -294,8 +327,14 @@ def gap_regression(gap_nm, f_mm) -> dict[str, float]:
     s2 = float(res @ res / dof)
     cov = s2 * np.linalg.inv(A.T @ A)
     r2 = 1.0 - float(res @ res) / float(np.sum((f - f.mean()) ** 2))
-    return {"a": float(coef[0]), "b": float(coef[1]), "sigma_a": float(np.sqrt(cov[0, 0])),
-            "sigma_b": float(np.sqrt(cov[1, 1])), "r2": r2, "s": float(np.sqrt(s2))}
+    return {
+        "a": float(coef[0]),
+        "b": float(coef[1]),
+        "sigma_a": float(np.sqrt(cov[0, 0])),
+        "sigma_b": float(np.sqrt(cov[1, 1])),
+        "r2": r2,
+        "s": float(np.sqrt(s2)),
+    }
 
 
 def design_effect(residuals_px, cluster) -> dict[str, float]:
@@ -323,8 +362,13 @@ def design_effect(residuals_px, cluster) -> dict[str, float]:
     r = np.asarray(residuals_px, float)
     u, inv, cnt = np.unique(np.asarray(cluster), return_inverse=True, return_counts=True)
     if u.size < 2 or u.size == r.shape[0]:
-        return {"sigma_within_px": float("nan"), "sigma_between_px": 0.0, "rho": 0.0,
-                "m": 1.0, "deff": 1.0}
+        return {
+            "sigma_within_px": float("nan"),
+            "sigma_between_px": 0.0,
+            "rho": 0.0,
+            "m": 1.0,
+            "deff": 1.0,
+        }
     m = float(cnt.mean())
     out = []
     for k in range(r.shape[1]):
@@ -335,8 +379,13 @@ def design_effect(residuals_px, cluster) -> dict[str, float]:
         out.append((s2w, s2b))
     s2w, s2b = np.mean(out, axis=0)
     rho = s2b / (s2b + s2w)
-    return {"sigma_within_px": float(np.sqrt(s2w)), "sigma_between_px": float(np.sqrt(s2b)),
-            "rho": float(rho), "m": m, "deff": float(1.0 + (m - 1.0) * rho)}
+    return {
+        "sigma_within_px": float(np.sqrt(s2w)),
+        "sigma_between_px": float(np.sqrt(s2b)),
+        "rho": float(rho),
+        "m": m,
+        "deff": float(1.0 + (m - 1.0) * rho),
+    }
 
 
 @dataclass
@@ -368,9 +417,17 @@ class JointCalibration:
 _OFF_LINE = (1, 11)  # bands whose gaps are off the linear trend (003 §3.5)
 
 
-def calibrate_joint(obs: Observations, *, exclude_bands=(), scatter_mm=(0.0035, 0.0028),
-                    f0_mm: float = 9.0, sigma_px: float = 0.02, estimate_offset: bool = False,
-                    reject_k: float | None = 5.0, init=None) -> JointCalibration:
+def calibrate_joint(
+    obs: Observations,
+    *,
+    exclude_bands=(),
+    scatter_mm=(0.0035, 0.0028),
+    f0_mm: float = 9.0,
+    sigma_px: float = 0.02,
+    estimate_offset: bool = False,
+    reject_k: float | None = 5.0,
+    init=None,
+) -> JointCalibration:
     """One adjustment of all bands (003 §3.5, the paper's future work).
 
     Parameters
@@ -398,21 +455,36 @@ def calibrate_joint(obs: Observations, *, exclude_bands=(), scatter_mm=(0.0035, 
     for s in (1, 2):
         on = [b for b in bands if table["sensor"][b - 1] == s and b not in _OFF_LINE]
         if len(on) < 2:
-            raise ObservationError(f"the joint model needs at least 2 on-line bands of sensor "
-                                   f"{'I' if s == 1 else 'II'}, got {on}")
+            raise ObservationError(
+                f"the joint model needs at least 2 on-line bands of sensor "
+                f"{'I' if s == 1 else 'II'}, got {on}"
+            )
     s1 = o.band >= 11
     poses0 = initial_poses(o.select(s1), f0_mm)
     p = Parameters()
-    p.add("poses", np.array([poses0[int(c)] for c in cubes]), columns=POSE_COLUMNS,
-          rows=[f"cube {c}" for c in cubes])
-    p.add("gap_model", [[0.0, f0_mm], [0.0, f0_mm]], columns=GAP_MODEL_COLUMNS,
-          rows=["sensor I", "sensor II"])
+    p.add(
+        "poses",
+        np.array([poses0[int(c)] for c in cubes]),
+        columns=POSE_COLUMNS,
+        rows=[f"cube {c}" for c in cubes],
+    )
+    p.add(
+        "gap_model",
+        [[0.0, f0_mm], [0.0, f0_mm]],
+        columns=GAP_MODEL_COLUMNS,
+        rows=["sensor I", "sensor II"],
+    )
     sigma_df = np.array([scatter_mm[table["sensor"][i] - 1] for i in range(len(table))], float)
     present = np.isin(table["band"], bands)
     free_df = present.copy()
     sigma_df[np.isin(table["band"], _OFF_LINE)] = np.inf
-    p.add("df_mm", np.zeros(len(table)), free=free_df, prior_sigma=np.where(present, sigma_df,
-          np.inf), rows=[f"band {b}" for b in table["band"]])
+    p.add(
+        "df_mm",
+        np.zeros(len(table)),
+        free=free_df,
+        prior_sigma=np.where(present, sigma_df, np.inf),
+        rows=[f"band {b}" for b in table["band"]],
+    )
     p.add("pp_mm", np.zeros((2, 2)), columns=("x0_mm", "y0_mm"), rows=["sensor I", "sensor II"])
     p.add("distortion_mm", np.zeros(5), columns=PHOTOGRAMMETRIC_DISTORTION)
     p.add("sensor2_rotation", np.zeros(3), columns=ROTATION_COLUMNS)
@@ -421,8 +493,15 @@ def calibrate_joint(obs: Observations, *, exclude_bands=(), scatter_mm=(0.0035, 
         p.fix("sensor2_offset_mm")
     if init is not None:
         _init_from_bands(p, init, cubes)
-    blk = JointCentroids(np.searchsorted(cubes, o.cube), brow, o.corners_obj, o.centroids_mm,
-                         sigma_px * obs.pixel_mm, table["gap_nm"], table["sensor"])
+    blk = JointCentroids(
+        np.searchsorted(cubes, o.cube),
+        brow,
+        o.corners_obj,
+        o.centroids_mm,
+        sigma_px * obs.pixel_mm,
+        table["gap_nm"],
+        table["sensor"],
+    )
     res = adjust(p, blk, reject_k=reject_k)
     j = JointCalibration(res, blk, cubes, bands, obs.pixel_mm)
     ok = ~res.outliers(0)  # one entry per centroid
@@ -436,8 +515,15 @@ def _init_from_bands(p: Parameters, cals: dict, cubes) -> None:
     s1 = [b for b in cals if b >= 11]
     if s1:
         c = cals[s1[0]]
-        p.set("poses", np.array([c.pose(int(k)) if k in c.cubes else p.value("poses")[i]
-                                 for i, k in enumerate(cubes)]))
+        p.set(
+            "poses",
+            np.array(
+                [
+                    c.pose(int(k)) if k in c.cubes else p.value("poses")[i]
+                    for i, k in enumerate(cubes)
+                ]
+            ),
+        )
     p.set("distortion_mm", np.mean([c.value("distortion_mm") for c in cals.values()], axis=0))
     for s, rng in ((0, range(11, 26)), (1, range(1, 11))):
         fs = [cals[b].value("interior") for b in rng if b in cals]
@@ -457,9 +543,15 @@ def predict_band(joint: JointCalibration, obs: Observations, band: int) -> np.nd
         raise ObservationError(f"no observations of band {band} in the joint model's cubes")
     o = obs.select(sel)
     table = RIKOLA_BANDS
-    blk = JointCentroids(np.searchsorted(joint.cubes, o.cube),
-                         np.searchsorted(table["band"], o.band), o.corners_obj, o.centroids_mm,
-                         1.0, table["gap_nm"], table["sensor"])
+    blk = JointCentroids(
+        np.searchsorted(joint.cubes, o.cube),
+        np.searchsorted(table["band"], o.band),
+        o.corners_obj,
+        o.centroids_mm,
+        1.0,
+        table["gap_nm"],
+        table["sensor"],
+    )
     values = {k: v.copy() for k, v in joint.result.params.values().items()}
     values["df_mm"] = np.zeros_like(values["df_mm"])
     r = blk.evaluate(values, False)[0].reshape(-1, 2)
@@ -478,8 +570,13 @@ def track_targets(obs: Observations, cube: int, ref_band: int) -> dict[str, tupl
     ref = obs.select((obs.cube == cube) & (obs.band == ref_band))
     if len(ref.cube) < 5:
         raise ObservationError(f"cube {cube}, band {ref_band}: fewer than 5 targets")
-    spots = {"ULC": (0, 0), "URC": (w - 1, 0), "BLC": (0, h - 1), "BRC": (w - 1, h - 1),
-             "IC": ((w - 1) / 2, (h - 1) / 2)}
+    spots = {
+        "ULC": (0, 0),
+        "URC": (w - 1, 0),
+        "BLC": (0, h - 1),
+        "BRC": (w - 1, h - 1),
+        "IC": ((w - 1) / 2, (h - 1) / 2),
+    }
     out = {}
     for lab, p in spots.items():
         t = int(ref.target[np.argmin(np.linalg.norm(ref.centroids_px - p, axis=1))])
@@ -496,7 +593,7 @@ def radial_effect_px(KP, r_mm, pixel_mm: float) -> np.ndarray:
     """Magnitude of the symmetric radial correction ``r (K1 r² + K2 r⁴ + K3 r⁶)`` in px."""
     r = np.asarray(r_mm, float)
     K = np.asarray(KP, float)[:3]
-    return r * (K[0] * r ** 2 + K[1] * r ** 4 + K[2] * r ** 6) / pixel_mm
+    return r * (K[0] * r**2 + K[1] * r**4 + K[2] * r**6) / pixel_mm
 
 
 def decentering_effect_px(KP, xy_mm, pixel_mm: float) -> np.ndarray:
@@ -507,8 +604,15 @@ def decentering_effect_px(KP, xy_mm, pixel_mm: float) -> np.ndarray:
     return brown_correction(np.asarray(xy_mm, float), np.zeros(3), KP[3:]) / pixel_mm
 
 
-def calibrate_frame_files(images, board_path, *, joint: bool = False, band_regex=None,
-                          cube_regex=None, sigma_px: float = 0.1):
+def calibrate_frame_files(
+    images,
+    board_path,
+    *,
+    joint: bool = False,
+    band_regex=None,
+    cube_regex=None,
+    sigma_px: float = 0.1,
+):
     """``hsgeo calibrate-frame``: detect a board in image files and self-calibrate, per band
     (:func:`calibrate_band`) or jointly (:func:`calibrate_joint`, Rikola band numbering).
 
@@ -526,35 +630,57 @@ def calibrate_frame_files(images, board_path, *, joint: bool = False, band_regex
     board = read_board(board_path)
     obs = observe_files(images, board, band_regex=band_regex, cube_regex=cube_regex)
     unit = "mm" if board.pixel_mm is not None else "px"
-    rows, meta = [], {"images": len(list(images)), "points": int(len(obs.cube)),
-                      "length_unit": unit, "board": board.type}
+    rows, meta = (
+        [],
+        {
+            "images": len(list(images)),
+            "points": int(len(obs.cube)),
+            "length_unit": unit,
+            "board": board.type,
+        },
+    )
     if joint:
         if band_regex is None or cube_regex is None:
-            raise InputError("--joint needs --band-regex and --cube-regex (which band and cube "
-                             "each file is)")
+            raise InputError(
+                "--joint needs --band-regex and --cube-regex (which band and cube each file is)"
+            )
         j = calibrate_joint(obs, f0_mm=initial_focal_mm(obs), sigma_px=sigma_px)
         R = j.result
         for blk in ("gap_model", "pp_mm", "distortion_mm", "sensor2_rotation"):
             b = R.params[blk]
-            for lab, v, s in zip(b.labels(), b.value.ravel(), R.sigma(blk).ravel(),
-                                 strict=True):
+            for lab, v, s in zip(b.labels(), b.value.ravel(), R.sigma(blk).ravel(), strict=True):
                 rows.append(Row("joint model", lab, "", None, None, v, s, None))
-        meta.update(sigma0=R.sigma0, rms_px=float(np.sqrt(np.mean(np.sum(
-            j.residuals_px ** 2, axis=1)))))
+        meta.update(
+            sigma0=R.sigma0, rms_px=float(np.sqrt(np.mean(np.sum(j.residuals_px**2, axis=1))))
+        )
         return Reproduction("calibrate-frame", 0, rows, meta)
     for band in np.unique(obs.band):
         c = calibrate_band(obs, int(band), f0_mm=None, sigma_px=sigma_px)
         for q, (v, s) in c.iop.items():
             u = q.split("_", 1)[1].replace("per_", "1/") if "_" in q else ""
             if board.pixel_mm is None:  # nominal pitch -> px: lengths /p, K_i ·p^(2i), P ·p
-                power = {"f": -1, "x0": -1, "y0": -1, "K1": 2, "K2": 4, "K3": 6, "P1": 1,
-                         "P2": 1}[q.split("_")[0]]
-                v, s = v * obs.pixel_mm ** power, s * obs.pixel_mm ** power
-            rows.append(Row(f"interior band {band}", q.split("_")[0],
-                            u.replace("mm", unit), None, None, v, s, None))
-        meta[f"band {band}"] = {"sigma0": c.result.sigma0, "points": int(np.sum(obs.band == band)),
-                                "rms_px": float(np.sqrt(np.mean(np.sum(c.residuals_px ** 2, 1)))),
-                                "views": int(len(c.cubes))}
+                power = {"f": -1, "x0": -1, "y0": -1, "K1": 2, "K2": 4, "K3": 6, "P1": 1, "P2": 1}[
+                    q.split("_")[0]
+                ]
+                v, s = v * obs.pixel_mm**power, s * obs.pixel_mm**power
+            rows.append(
+                Row(
+                    f"interior band {band}",
+                    q.split("_")[0],
+                    u.replace("mm", unit),
+                    None,
+                    None,
+                    v,
+                    s,
+                    None,
+                )
+            )
+        meta[f"band {band}"] = {
+            "sigma0": c.result.sigma0,
+            "points": int(np.sum(obs.band == band)),
+            "rms_px": float(np.sqrt(np.mean(np.sum(c.residuals_px**2, 1)))),
+            "views": int(len(c.cubes)),
+        }
     return Reproduction("calibrate-frame", 0, rows, meta)
 
 
@@ -578,17 +704,18 @@ def rop_mean_covariance(cal1, cal2, cubes, step: float = 1e-7) -> np.ndarray:
         for a in range(3):
             d = np.zeros(6)
             d[a] = step
-            J1[:, 6 * i1 + a] = (relative_orientation(p1 + d, p2)[0]
-                                 - relative_orientation(p1 - d, p2)[0]) / (2 * step)
-            J2[:, 6 * i2 + a] = (relative_orientation(p1, p2 + d)[0]
-                                 - relative_orientation(p1, p2 - d)[0]) / (2 * step)
+            J1[:, 6 * i1 + a] = (
+                relative_orientation(p1 + d, p2)[0] - relative_orientation(p1 - d, p2)[0]
+            ) / (2 * step)
+            J2[:, 6 * i2 + a] = (
+                relative_orientation(p1, p2 + d)[0] - relative_orientation(p1, p2 - d)[0]
+            ) / (2 * step)
     C1, _ = cal1.result.covariance_of("poses")
     C2, _ = cal2.result.covariance_of("poses")
     return (J1 @ C1 @ J1.T + J2 @ C2 @ J2.T) / len(cubes) ** 2
 
 
-def mean_relative_orientation(cals: dict, obs: Observations, cubes, pairs, *,
-                              rop_all=None) -> dict:
+def mean_relative_orientation(cals: dict, obs: Observations, cubes, pairs, *, rop_all=None) -> dict:
     """The mean relative orientation of sensor II to sensor I over band pairs and cubes, with σ̂
     (003 eq. (1), Table 4 first).
 
@@ -616,8 +743,12 @@ def mean_relative_orientation(cals: dict, obs: Observations, cubes, pairs, *,
     :func:`design_effect` summary) and ``deff_pairs``.
     """
     if rop_all is None:
-        rop_all = np.array([[relative_orientation(cals[k1].pose(c), cals[k2].pose(c))[0]
-                             for c in cubes] for k2, k1 in pairs])  # k2 sensor II, k1 sensor I
+        rop_all = np.array(
+            [
+                [relative_orientation(cals[k1].pose(c), cals[k2].pose(c))[0] for c in cubes]
+                for k2, k1 in pairs
+            ]
+        )  # k2 sensor II, k1 sensor I
     rop = rop_all.mean(axis=1)  # per pair, mean over cubes
     rop_mean = rop.mean(axis=0)
     # σ̂ of the mean: the poses of all cubes of a band are correlated through the band's
@@ -635,9 +766,14 @@ def mean_relative_orientation(cals: dict, obs: Observations, cubes, pairs, *,
     pb_clusters = design_effect(res_pb, keys)
     deff_pairs = 1.0 + (len(pairs) - 1) * pb_clusters["rho"]
     rop_mean_sigma = rop_mean_sigma * np.sqrt(deff_pairs)
-    return {"rop_all": rop_all, "rop_pairs": rop, "rop_mean": rop_mean,
-            "rop_mean_sigma": rop_mean_sigma, "band_clusters": pb_clusters,
-            "deff_pairs": deff_pairs}
+    return {
+        "rop_all": rop_all,
+        "rop_pairs": rop,
+        "rop_mean": rop_mean,
+        "rop_mean_sigma": rop_mean_sigma,
+        "band_clusters": pb_clusters,
+        "deff_pairs": deff_pairs,
+    }
 
 
 def predict_per_band(cals, obs, band, bands):
@@ -646,10 +782,12 @@ def predict_per_band(cals, obs, band, bands):
     mean distortion, and per cube the mean exterior orientation of the sensor's other bands.
     """
     s = RIKOLA_BANDS["sensor"][band - 1]
-    others = [b for b in bands if b != band and RIKOLA_BANDS["sensor"][b - 1] == s
-              and b not in (1, 11)]
-    reg = gap_regression(RIKOLA_BANDS["gap_nm"][np.array(others) - 1],
-                         [cals[b].value("interior")[0] for b in others])
+    others = [
+        b for b in bands if b != band and RIKOLA_BANDS["sensor"][b - 1] == s and b not in (1, 11)
+    ]
+    reg = gap_regression(
+        RIKOLA_BANDS["gap_nm"][np.array(others) - 1], [cals[b].value("interior")[0] for b in others]
+    )
     f = reg["a"] * RIKOLA_BANDS["gap_nm"][band - 1] + reg["b"]
     pp = np.mean([cals[b].value("interior")[1:] for b in others], axis=0)
     KP = np.mean([cals[b].value("distortion_mm") for b in cals if b != band], axis=0)
@@ -690,9 +828,11 @@ def rop_transformation_test(obs, cals, pairs, rop_mean, cube: int):
         x2_in_1 = project_measured_mm(ray1, f1, np.array([x01, y01]), K1)
         px = obs.pixel_mm
         before.append(mm_to_pixel(x2, obs.image_size, px) - mm_to_pixel(x1, obs.image_size, px))
-        after.append(mm_to_pixel(x2_in_1, obs.image_size, px)
-                     - mm_to_pixel(x1, obs.image_size, px))
+        after.append(mm_to_pixel(x2_in_1, obs.image_size, px) - mm_to_pixel(x1, obs.image_size, px))
     b, a = np.concatenate(before), np.concatenate(after)
-    return {"before_mean_px": b.mean(axis=0).tolist(), "after_mean_px": a.mean(axis=0).tolist(),
-            "before_rms_px": float(np.sqrt(np.mean(np.sum(b ** 2, 1)))),
-            "after_rms_px": float(np.sqrt(np.mean(np.sum(a ** 2, 1))))}
+    return {
+        "before_mean_px": b.mean(axis=0).tolist(),
+        "after_mean_px": a.mean(axis=0).tolist(),
+        "before_rms_px": float(np.sqrt(np.mean(np.sum(b**2, 1)))),
+        "after_rms_px": float(np.sqrt(np.mean(np.sum(a**2, 1)))),
+    }
