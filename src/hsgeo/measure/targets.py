@@ -7,7 +7,7 @@ of rendered images both return :class:`Observations`; the calibrations of
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -30,8 +30,6 @@ class Observations:
         Object coordinates of the corners.
     image_size : (int, int)
     pixel_mm : float
-    expected : dict
-        ``(cube, band) -> number of targets fully in view`` (for the detection rate), if known.
     """
 
     cube: np.ndarray
@@ -41,7 +39,6 @@ class Observations:
     corners_obj: np.ndarray
     image_size: tuple[int, int]
     pixel_mm: float
-    expected: dict = field(default_factory=dict)
 
     @property
     def centroids_px(self) -> np.ndarray:
@@ -61,11 +58,4 @@ class Observations:
             self.corners_obj[m],
             self.image_size,
             self.pixel_mm,
-            self.expected,
         )
-
-    @property
-    def detection_rate(self) -> float:
-        if not self.expected:
-            return float("nan")
-        return len(self.cube) / max(1, sum(self.expected.values()))

@@ -11,6 +11,7 @@ import time
 import numpy as np
 
 from hsgeo.adjust import identifiability
+from hsgeo.measure.aruco import detection_rate
 from hsgeo.measure.targets import Observations
 from hsgeo.papers import (
     RIKOLA_BANDS,
@@ -61,11 +62,15 @@ def observe(
 
     Returns
     -------
-    Observations (with ``expected``), Observations or None (``compare_refine``), and a dict
-    ``(cube, band) -> image`` of ``keep_images``.
+    obs : Observations
+    obs_compare : Observations or None
+        With the ``compare_refine`` refinement.
+    images : dict
+        ``(cube, band) -> image`` of ``keep_images``.
+    expected : dict
+        ``(cube, band) -> number of targets fully in view`` (from the truth), for the detection
+        rate (:func:`hsgeo.measure.aruco.detection_rate`).
     """
-    from dataclasses import replace
-
     from hsgeo.simulate.rikola import Renderer
 
     r = Renderer(cfg, truth)
@@ -97,10 +102,7 @@ def observe(
         refine=refine,
         compare_refine=compare_refine,
     )
-    obs = replace(obs, expected=expected)
-    if obs_cmp is not None:
-        obs_cmp = replace(obs_cmp, expected=expected)
-    return obs, obs_cmp, images
+    return obs, obs_cmp, images, expected
 
 
 def band_identifiability(obs: Observations, band: int, truth) -> object:
@@ -167,7 +169,7 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
     cfg, truth, cubes, bands = setup(seed, scale)
     sigma_px = float(cfg["measure"]["sigma_px"])
     t0 = time.time()
-    obs, obs_contour, images = observe(
+    obs, obs_contour, images, expected = observe(
         cfg,
         truth,
         seed,
@@ -456,8 +458,8 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
         "bands": bands,
         "images": len(cubes) * len(bands),
         "targets": int(len(obs.cube)),
-        "detection_rate": obs.detection_rate,
-        "detection_rate_contour": obs_contour.detection_rate,
+        "detection_rate": detection_rate(len(obs.cube), sum(expected.values())),
+        "detection_rate_contour": detection_rate(len(obs_contour.cube), sum(expected.values())),
         "sigma_px_apriori": sigma_px,
         "sigma0_pooled_bands": sigma0_pool,
         "sigma_px_joint": sigma_joint,
