@@ -356,6 +356,18 @@ def test_map_files_refuse_inputs_and_are_atomic(tmp_path):
     assert sorted(os.listdir(tmp_path)) == ["input.nc", "o.nc", "o_envi", "o_envi.hdr"]
 
 
+def test_atomic_path_gives_a_new_file_s_mode(tmp_path):
+    import os
+
+    umask = os.umask(0o022)
+    try:
+        with atomic_path(tmp_path / "x.txt") as tmp:
+            tmp.write_text("x")
+        assert (tmp_path / "x.txt").stat().st_mode & 0o777 == 0o644
+    finally:
+        os.umask(umask)
+
+
 def test_atomic_path_keeps_the_old_file_on_failure(tmp_path):
     p = tmp_path / "x.txt"
     p.write_text("old")

@@ -54,7 +54,7 @@ def test_never_overwrites_an_input(tmp_path):
     tr = _traj()
     src = write_trajectory(tmp_path / "in.csv", tr)
     before = src.read_bytes()
-    with pytest.raises(InputError, match="overwrite the input"):
+    with pytest.raises(InputError, match="is an input of the command and would be overwritten"):
         write_trajectory(tmp_path / "in.csv", tr, inputs=[src])
     assert src.read_bytes() == before
 

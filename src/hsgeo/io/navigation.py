@@ -24,14 +24,13 @@ yaw_rad`` with ENU platform angles) is recognised and rejected with the conversi
 
 from __future__ import annotations
 
-import os
-import tempfile
 from collections.abc import Iterable
 from pathlib import Path
 
 import numpy as np
 
 from hsgeo.errors import InputError
+from hsgeo.io._files import atomic_path
 from hsgeo.trajectory import Trajectory
 
 __all__ = ["NAV_COLUMNS", "read_trajectory", "write_trajectory"]
@@ -145,25 +144,9 @@ def write_trajectory(path, traj: Trajectory, *, inputs: Iterable = ()) -> Path:
         If ``path`` is one of ``inputs``.
     """
     path = Path(path)
-    target = path.resolve()
-    for p in inputs:
-        if Path(p).resolve() == target:
-            raise InputError(
-                f"refusing to overwrite the input {str(p)!r} with the navigation output: "
-                "choose another output path"
-            )
     table = np.column_stack([traj.t_s, traj.xyz_m, np.rad2deg(traj.roll_pitch_heading_rad)])
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    umask = os.umask(0)
-    os.umask(umask)
-    try:
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; give the file a new file's mode
-        with os.fdopen(fd, "wb") as fh:
-            np.savetxt(
-                fh, table, delimiter=",", fmt="%.17g", header=",".join(NAV_COLUMNS), comments=""
-            )
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    with atomic_path(path, inputs) as tmp:
+        np.savetxt(
+            tmp, table, delimiter=",", fmt="%.17g", header=",".join(NAV_COLUMNS), comments=""
+        )
     return path
