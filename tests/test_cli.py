@@ -48,3 +48,35 @@ def test_data_manifest_verifies():
     from hsgeo.reproduce.data import generate_all
 
     assert generate_all(verify=True) == 0
+
+
+def test_ctrl_c_is_one_line_and_status_130(monkeypatch, capsys):
+    from hsgeo import cli
+
+    def interrupted(args):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli, "_cmd_versions", interrupted)
+    assert cli.main(["versions"]) == cli.EXIT_INTERRUPTED == 130
+    err = capsys.readouterr().err
+    assert err.strip() == "hsgeo versions: interrupted"
+
+
+def test_closed_pipe_ends_silently():
+    """`hsgeo ... | head -c 1`: the reader goes away; no traceback, no 'Exception ignored'."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys\nfrom hsgeo import cli\n"
+        "def loud(args):\n    for _ in range(20000):\n        print('x' * 100)\n    return 0\n"
+        "cli._cmd_versions = loud\nsys.exit(cli.main(['versions']))\n"
+    )
+    p = subprocess.Popen(
+        [sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE
+    )
+    p.stdout.read(1)
+    p.stdout.close()  # the reader goes away with 2 MB still to come
+    err = p.stderr.read().decode()
+    assert p.wait(timeout=60) == 141
+    assert err == ""

@@ -1,16 +1,25 @@
 """The ``hsgeo`` command: ``hsgeo reproduce``, ``hsgeo data``, ``hsgeo versions``, ...
 
-Every subcommand turns an :class:`hsgeo.HsgeoError` into a one-line message and exit status 2.
+Every subcommand turns an :class:`hsgeo.HsgeoError` into a one-line message and exit status 2,
+Ctrl-C into one line and status 130, and a closed output pipe into a silent exit (status 141).
 """
 
 from __future__ import annotations
 
 import argparse
+import io
+import os
 import sys
 
 from hsgeo.errors import HsgeoError
 
-__all__ = ["main"]
+__all__ = ["main", "EXIT_INTERRUPTED", "EXIT_BROKEN_PIPE"]
+
+#: Exit status after Ctrl-C (128 + SIGINT, as a shell reports it).
+EXIT_INTERRUPTED = 130
+#: Exit status when the reader of the output closed the pipe (128 + SIGPIPE, as git and
+#: coreutils end), silently.
+EXIT_BROKEN_PIPE = 141
 
 
 def _cmd_reproduce(args) -> int:
@@ -311,6 +320,19 @@ def main(argv: list[str] | None = None) -> int:
     except HsgeoError as exc:
         print(f"hsgeo {args.command}: error: {exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print(f"hsgeo {args.command}: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except BrokenPipeError:
+        # the reader of our output went away (`hsgeo reproduce ... --json | head -1`): stop
+        # without a word; stdout goes to /dev/null so that flushing it at exit cannot fail again
+        # (the recipe of the Python docs, "Note on SIGPIPE")
+        try:
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, sys.stdout.fileno())
+        except (OSError, ValueError, io.UnsupportedOperation):
+            pass
+        return EXIT_BROKEN_PIPE
 
 
 if __name__ == "__main__":
