@@ -106,3 +106,32 @@ def test_adjust_pushbroom_cli_bad_input(tmp_path, capsys):
         ]
     )
     assert rc == 2
+
+
+def test_adjust_pushbroom_cli_refuses_an_implausible_fit(tmp_path, capsys):
+    """Navigation angles in radians under the *_deg columns (a units mistake): the fit is
+    reported, the error names σ0 and the likely cause, and the exit status is 2 unless
+    --accept-poor-fit."""
+    obs, _ = simulate(0.002, rng=4)
+    _write(tmp_path, obs)
+    nav = pd.read_csv(tmp_path / "nav.csv")
+    for c in ("roll_deg", "pitch_deg", "heading_deg"):
+        nav[c] = np.deg2rad(nav[c])
+    nav.to_csv(tmp_path / "nav_rad.csv", index=False)
+    args = [
+        "adjust-pushbroom",
+        str(tmp_path / "obs.parquet"),
+        "--trajectory",
+        str(tmp_path / "nav_rad.csv"),
+        "--camera",
+        str(tmp_path / "cam.toml"),
+        "--json",
+    ]
+    assert main(args) == 2
+    cap = capsys.readouterr()
+    out = json.loads(cap.out)
+    assert out["fit"]["verdict"] == "poor" and out["fit"]["sigma0"] > 3
+    err = [line for line in cap.err.splitlines() if "error:" in line]
+    assert len(err) == 1 and "σ0 = " in err[0] and "roll_deg" in err[0]
+    assert main([*args, "--accept-poor-fit"]) == 0
+    assert json.loads(capsys.readouterr().out)["fit"]["verdict"] == "poor"

@@ -118,6 +118,14 @@ def _cmd_adjust_pushbroom(args) -> int:
     )
     res = out.pop("_result")
     print(json.dumps(out, indent=1) if args.json else res.report(max_block_size=20))
+    fit = out["fit"]
+    if fit["verdict"] == "poor" and not args.accept_poor_fit:
+        print(
+            f"hsgeo {args.command}: error: implausible fit: {'; '.join(fit['reasons'])} "
+            "(the result is printed above; --accept-poor-fit keeps it with exit status 0)",
+            file=sys.stderr,
+        )
+        return 2
     return 0
 
 
@@ -303,6 +311,12 @@ def build_parser() -> argparse.ArgumentParser:
         "time, the image y over its rate from the trajectory's velocity and angular "
         "rate, which avoids a bias of the principal distance and the pitch "
         "corrections)",
+    )
+    p.add_argument(
+        "--accept-poor-fit",
+        action="store_true",
+        help="exit 0 even when the fit is implausible (σ0 off by more than a factor of 3, more "
+        "than 5 %% of the observations rejected, or no convergence; the JSON's 'fit' says why)",
     )
     p.add_argument("--json", action="store_true", help="JSON instead of the text report")
     p.set_defaults(func=_cmd_adjust_pushbroom)

@@ -30,7 +30,14 @@ from hsgeo.sensors.pushbroom import (
 )
 from hsgeo.trajectory import CORRECTION_COLUMNS, SplineNodes
 
-__all__ = ["CameraPrior", "PushbroomObservations", "build_problem", "intersect_two_rays"]
+__all__ = [
+    "CameraPrior",
+    "PushbroomObservations",
+    "build_problem",
+    "intersect_two_rays",
+    "adjust_files",
+    "fit_verdict",
+]
 
 
 @dataclass(frozen=True)
@@ -299,7 +306,9 @@ def adjust_files(
     Returns
     -------
     dict
-        Summary, the camera parameters with σ̂, the node corrections and the adjusted points.
+        Summary, the camera parameters with σ̂, the node corrections, the adjusted points and
+        ``fit``, the plausibility verdict of :func:`fit_verdict` (``hsgeo adjust-pushbroom`` exits
+        2 on a poor fit unless ``--accept-poor-fit``).
     """
     from hsgeo.adjust import adjust
     from hsgeo.io.navigation import read_trajectory
@@ -343,8 +352,14 @@ def adjust_files(
         y_as_time=y_as_time,
     )
     res = adjust(
-        p, blocks, reject_k=reject_k, ftol=1e-6, progress=progress, reject_every_iteration=True
-    )  # 002 §3.4
+        p,
+        blocks,
+        reject_k=reject_k,
+        ftol=1e-6,
+        progress=progress,
+        reject_every_iteration=True,  # 002 §3.4
+        raise_on_failure=False,  # no convergence is a verdict of the fit (fit_verdict)
+    )
     out = {
         "converged": res.converged,
         "iterations": res.iterations,
@@ -375,5 +390,57 @@ def adjust_files(
         "columns": list(res.params["nodes"].columns),
     }
     out["points"] = {"point_id": ids.tolist(), "xyz_m": res.value("points_m").tolist()}
+    out["fit"] = fit_verdict(res, int(len(obs_df)))
     out["_result"] = res
     return out
+
+
+#: A fit is implausible when σ0 is off by more than this factor (either way): the a-priori σ,
+#: the units or the model are wrong, far beyond the χ² spread of σ0 at these sizes.
+POOR_FIT_SIGMA0_FACTOR = 3.0
+#: ... or when more than this share of the observations was rejected as outliers.
+POOR_FIT_REJECTED_SHARE = 0.05
+
+
+def fit_verdict(res, n_observations_2d: int) -> dict:
+    """Is the adjustment plausible? σ0, its χ² interval, the rejected share and a verdict.
+
+    Parameters
+    ----------
+    res : AdjustmentResult
+    n_observations_2d : int
+        Image observations (rows of the observation table).
+
+    Returns
+    -------
+    dict
+        ``sigma0``, ``sigma0_interval_99`` (two-sided 99 % interval under the model),
+        ``rejected_share``, ``verdict`` (``"ok"`` or ``"poor"``) and ``reasons``: one sentence
+        per problem, in the terms of the input files.
+    """
+    s0 = float(res.sigma0)
+    share = float(res.outliers(0).sum()) / max(1, n_observations_2d)
+    reasons = []
+    if not res.converged:
+        reasons.append(f"the adjustment did not converge in {res.iterations} iterations")
+    if not np.isfinite(s0):
+        reasons.append("σ0 is not finite: the observations do not determine the unknowns")
+    elif s0 > POOR_FIT_SIGMA0_FACTOR or s0 < 1 / POOR_FIT_SIGMA0_FACTOR:
+        reasons.append(
+            f"σ0 = {s0:.3g}: the model does not fit the data by a factor of {max(s0, 1 / s0):.3g}"
+            " — are the navigation angles in degrees (roll_deg, pitch_deg, heading_deg), the"
+            " camera's c_mm and pixel_mm right, and the a-priori σ of the camera file realistic?"
+        )
+    if share > POOR_FIT_REJECTED_SHARE:
+        reasons.append(
+            f"{100 * share:.1f} % of the observations were rejected as outliers (more than "
+            f"{100 * POOR_FIT_REJECTED_SHARE:.0f} %): look for a GCP or a point_id that is wrong"
+            " in the input tables"
+        )
+    return {
+        "sigma0": s0,
+        "sigma0_interval_99": list(res.chi2_interval(0.01)) if res.dof > 0 else None,
+        "rejected_share": share,
+        "verdict": "poor" if reasons else "ok",
+        "reasons": reasons,
+    }
