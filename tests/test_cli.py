@@ -80,3 +80,12 @@ def test_closed_pipe_ends_silently():
     err = p.stderr.read().decode()
     assert p.wait(timeout=60) == 141
     assert err == ""
+
+
+def test_data_verify_and_update_manifest_exclude_each_other(capsys):
+    from hsgeo.cli import main
+
+    with pytest.raises(SystemExit) as exc:
+        main(["data", "--verify", "--update-manifest"])
+    assert exc.value.code == 2
+    assert "not allowed with argument" in capsys.readouterr().err

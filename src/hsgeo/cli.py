@@ -235,12 +235,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_calibrate_frame, joint=False)
 
     p = sub.add_parser("data", help="generate data_synthetic/generated from the scenario TOMLs")
-    p.add_argument(
+    mode = p.add_mutually_exclusive_group()  # verifying and rewriting the manifest exclude
+    mode.add_argument(
         "--verify",
         action="store_true",
         help="fail if a generated file differs from data_synthetic/MANIFEST.sha256",
     )
-    p.add_argument(
+    mode.add_argument(
         "--update-manifest",
         action="store_true",
         help="rewrite the manifest from what was generated (after a deliberate change)",
