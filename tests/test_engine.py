@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 from scipy.optimize import least_squares
-from toy_models import Bearings, Exponential, Line, bearing_scene
+from toy_models import Bearings, Exponential, Line, bearing_scene, frame_scene
 
 from hsgeo import ConvergenceError, DatumError, InputError, ObservationError
 from hsgeo.adjust import Parameters, SolverOptions, adjust, identifiability
@@ -542,16 +542,7 @@ def _square_pixel_problem(seed=3, n=30, n_views=4):
     from hsgeo.sensors.frame import project_opencv
 
     rng = np.random.default_rng(seed)
-    X = np.column_stack([rng.uniform(-1, 1, n), rng.uniform(-1, 1, n), rng.uniform(-0.2, 0.2, n)])
-    poses = np.column_stack(
-        [
-            rng.normal(0, 0.1, (n_views, 3)),
-            rng.normal(0, 0.3, (n_views, 2)),
-            rng.uniform(-5, -3, n_views),
-        ]
-    )
-    view = np.repeat(np.arange(n_views), n)
-    Xall = np.tile(X, (n_views, 1))
+    X, poses, view, Xall = frame_scene(rng, n, n_views)
     intr = np.array([800.0, 800.0, 320.0, 240.0])
     dist = np.array([-0.2, 0.1, 0.0, 0.0, 0.0])
     uv = project_opencv(poses, view, Xall, intr, dist) + 0.3 * rng.standard_normal((view.size, 2))

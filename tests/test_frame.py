@@ -3,6 +3,7 @@
 import cv2
 import numpy as np
 import pytest
+from toy_models import frame_scene
 
 from hsgeo import InputError
 from hsgeo.adjust.checks import check_jacobian
@@ -17,18 +18,7 @@ from hsgeo.sensors.frame import (
 
 
 def scene(seed=0, n=30, n_views=3):
-    rng = np.random.default_rng(seed)
-    X = np.column_stack([rng.uniform(-1, 1, n), rng.uniform(-1, 1, n), rng.uniform(-0.2, 0.2, n)])
-    poses = np.column_stack(
-        [
-            rng.normal(0, 0.1, (n_views, 3)),
-            rng.normal(0, 0.3, (n_views, 2)),
-            rng.uniform(-5, -3, n_views),
-        ]
-    )
-    view = np.repeat(np.arange(n_views), n)
-    Xall = np.tile(X, (n_views, 1))
-    return X, poses, view, Xall
+    return frame_scene(np.random.default_rng(seed), n, n_views)
 
 
 def test_project_opencv_matches_cv2():

@@ -94,3 +94,22 @@ def bearing_scene(rng, n_stations=6, n_points=40, sigma_rad=1e-3, coverage=4):
     th, _ = Bearings.model(S, P, st, pt)
     th = th + sigma_rad * rng.standard_normal(th.size)
     return S, P, st, pt, th
+
+
+def frame_scene(rng, n=30, n_views=3):
+    """Object points and camera poses of a small frame-camera bench, drawn from ``rng``.
+
+    Returns ``X (n, 3)``, ``poses (n_views, 6)`` (ω, φ, κ, X0, Y0, Z0), ``view`` and ``Xall``
+    (one row per observation).
+    """
+    X = np.column_stack([rng.uniform(-1, 1, n), rng.uniform(-1, 1, n), rng.uniform(-0.2, 0.2, n)])
+    poses = np.column_stack(
+        [
+            rng.normal(0, 0.1, (n_views, 3)),
+            rng.normal(0, 0.3, (n_views, 2)),
+            rng.uniform(-5, -3, n_views),
+        ]
+    )
+    view = np.repeat(np.arange(n_views), n)
+    Xall = np.tile(X, (n_views, 1))
+    return X, poses, view, Xall

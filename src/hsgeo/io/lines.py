@@ -18,6 +18,38 @@ from hsgeo.io._files import atomic_path
 __all__ = ["read_lines", "write_lines"]
 
 
+def open_netcdf(path, variable: str, what: str, remedy: str):
+    """Open a NetCDF file that must hold ``variable``; one InputError otherwise.
+
+    Parameters
+    ----------
+    path : str or Path
+    variable : str
+        The variable the format requires.
+    what : str
+        How the file is named in messages (``"DEM "``, or ``""``).
+    remedy : str
+        What the user should do when the variable is missing.
+
+    Returns
+    -------
+    xarray.Dataset
+    """
+    import xarray as xr
+
+    if not Path(path).is_file():
+        raise InputError(f"{what}{path} not found; check the path")
+    try:
+        ds = xr.open_dataset(path)
+    except (OSError, ValueError, ImportError) as exc:
+        raise InputError(f"{what}{path}: not a readable NetCDF file: {exc}") from None
+    if variable not in ds:
+        raise InputError(
+            f"{what}{path}: no variable {variable!r} (found {list(ds.data_vars)}); {remedy}"
+        )
+    return ds
+
+
 def read_lines(path):
     """Read a recorded flight line (module docstring).
 
@@ -33,19 +65,7 @@ def read_lines(path):
         Time of line 0 (s).
     line_rate_hz : float
     """
-    import xarray as xr
-
-    if not Path(path).is_file():
-        raise InputError(f"{path} not found; check the path")
-    try:
-        ds = xr.open_dataset(path)
-    except (OSError, ValueError, ImportError) as exc:
-        raise InputError(f"{path}: not a readable NetCDF file: {exc}") from None
-    if "radiance" not in ds:
-        raise InputError(
-            f"{path}: no variable 'radiance' (found {list(ds.data_vars)}); the "
-            "recorded values must be called radiance"
-        )
+    ds = open_netcdf(path, "radiance", "", "the recorded values must be called radiance")
     da = ds["radiance"]
     if "band" not in da.dims:
         da = da.expand_dims("band")

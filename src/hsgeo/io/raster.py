@@ -6,9 +6,9 @@ from pathlib import Path
 
 import numpy as np
 
-from hsgeo.errors import InputError
 from hsgeo.io._files import atomic_path, refuse_inputs
 from hsgeo.io.envi import write_envi
+from hsgeo.io.lines import open_netcdf
 
 __all__ = ["to_map_files", "read_dem"]
 
@@ -70,19 +70,7 @@ def read_dem(path):
     xarray.DataArray
         The variable ``height``, loaded into memory.
     """
-    import xarray as xr
-
-    if not Path(path).is_file():
-        raise InputError(f"DEM {path} not found; check the path")
-    try:
-        ds = xr.open_dataset(path)
-    except (OSError, ValueError, ImportError) as exc:
-        raise InputError(f"DEM {path}: not a readable NetCDF file: {exc}") from None
-    if "height" not in ds:
-        raise InputError(
-            f"DEM {path}: no variable 'height' (found {list(ds.data_vars)}); it "
-            "needs height(N, E) in metres"
-        )
+    ds = open_netcdf(path, "height", "DEM ", "it needs height(N, E) in metres")
     h = ds["height"].load()
     ds.close()
     return h
