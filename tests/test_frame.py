@@ -35,14 +35,13 @@ def test_project_opencv_matches_cv2():
         np.testing.assert_allclose(uv[view == i], ref.reshape(-1, 2), atol=1e-9)
 
 
-@pytest.mark.parametrize("square", [False, True])
-def test_opencv_jacobians(square):
+def test_opencv_jacobians():
     X, poses, view, Xall = scene(1)
     intr = np.array([800.0, 790.0, 320.0, 240.0])
     dist = np.array([-0.2, 0.1, 1e-3, -2e-3, 0.05])
     uv = project_opencv(poses, view, Xall, intr, dist) + 0.3
     point = np.tile(np.arange(X.shape[0]), poses.shape[0])
-    blk = FrameOpenCV(view, uv, 0.5, point=point, square_pixels=square)
+    blk = FrameOpenCV(view, uv, 0.5, point=point)
     vals = {"intrinsics": intr, "distortion": dist, "poses": poses, "points": X}
     for name, h in [("intrinsics", 1e-4), ("distortion", 1e-7), ("poses", 1e-7), ("points", 1e-7)]:
         assert check_jacobian(blk, vals, name, h) < 1e-6, name

@@ -181,9 +181,6 @@ class FrameOpenCV(_FrameBase):
     sigma_px : float or (n, 2) ndarray
     X : (n, 3) ndarray, optional
         Known object points; or ``point`` indices into the points block.
-    square_pixels : bool
-        Use fx for both axes (OpenCV's FIX_ASPECT_RATIO with aspect 1); ``fy`` is then unused
-        and should be fixed.
     blocks : mapping, optional
         Parameter-block names by role (``poses``, ``points``, ``intrinsics``, ``distortion``;
         the defaults are the role names), see :class:`~hsgeo.adjust.ResidualBlock`.
@@ -194,15 +191,12 @@ class FrameOpenCV(_FrameBase):
         {**_FrameBase.BLOCKS, "intrinsics": "intrinsics", "distortion": "distortion"}
     )
 
-    def __init__(self, view, uv_px, sigma_px=1.0, X=None, point=None, *, square_pixels=False, **kw):
+    def __init__(self, view, uv_px, sigma_px=1.0, X=None, point=None, **kw):
         super().__init__(view, uv_px, sigma_px, X, point, **kw)
-        self.square_pixels = square_pixels
 
     def evaluate(self, values, jacobian):
         poses = values[self.blocks["poses"]]
         fx, fy, cx, cy = values[self.blocks["intrinsics"]]
-        if self.square_pixels:
-            fy = fx
         dist = values[self.blocks["distortion"]]
         Xc, d_pose, d_X = camera_coordinates(poses, self.view, self._world(values), jacobian)
         if np.any(Xc[:, 2] <= 0):
@@ -221,10 +215,7 @@ class FrameOpenCV(_FrameBase):
         F = np.array([fx, fy])
         d_intr = np.zeros((n, 2, 4))
         d_intr[:, 0, 0] = xd[:, 0]
-        if self.square_pixels:
-            d_intr[:, 1, 0] = xd[:, 1]
-        else:
-            d_intr[:, 1, 1] = xd[:, 1]
+        d_intr[:, 1, 1] = xd[:, 1]
         d_intr[:, 0, 2] = 1.0
         d_intr[:, 1, 3] = 1.0
         d_dist = F[None, :, None] * J_dist
