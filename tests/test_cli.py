@@ -10,6 +10,7 @@ from hsgeo.cli import main
 from hsgeo.reproduce import chapter_names, run
 
 KEYS = {"table", "quantity", "unit", "paper", "paper_sigma", "reproduced", "sigma", "truth"}
+KEYS |= {"z", "n_runs", "verdict", "reason"}  # GUIDE §5: rows may carry z and a verdict
 
 
 def test_reproduce_json_contract(capsys):

@@ -1,9 +1,20 @@
-"""Tables of results: paper | reproduced | σ̂ | truth (GUIDE §4–§5).
+"""Tables of results: paper | reproduced | σ̂ | truth | z | verdict (GUIDE §4–§5).
 
 :class:`Row` is one quantity of a table and :class:`Reproduction` a set of tables with metadata;
 ``hsgeo reproduce`` and the workflows that print tables (``hsgeo calibrate-frame``) return them,
 as text (:meth:`Reproduction.to_text`), strict JSON (:meth:`Reproduction.to_json`, ``null`` for
-absent or non-finite values) or a pandas DataFrame (:meth:`Reproduction.table`).
+absent or non-finite values), a pandas DataFrame of numbers (:meth:`Reproduction.table`) or the
+formatted table a chapter shows (:meth:`Reproduction.show`). Every chapter and the command line
+format their tables here, in one way:
+
+* ``z`` is ``(reproduced − truth) / σ̂``: how far the estimate lies from the simulation's truth,
+  in units of its own standard deviation (σ̂ from the adjustment, or the spread over ``n_runs``
+  repeated simulations for statistics such as an NMAD that have no σ̂ of their own);
+* the **verdict** says whether the paper's value was reproduced (:data:`VERDICTS`), with its
+  reason; it is computed from the numbers (:meth:`Row.judge`) unless the chapter states it, e.g.
+  ``"planned"``;
+* words about agreement in a chapter's prose come from :func:`agreement` and :func:`summarize`,
+  never typed.
 """
 
 from __future__ import annotations
@@ -14,12 +25,59 @@ from dataclasses import dataclass, field
 
 from hsgeo.errors import InputError
 
-__all__ = ["Row", "Reproduction"]
+__all__ = [
+    "Row",
+    "Reproduction",
+    "VERDICTS",
+    "Z_LIMIT",
+    "agreement",
+    "summarize",
+    "format_value",
+    "format_rows",
+]
+
+#: The verdicts of a claim (ReScience style). ``tuned``: the simulation took the paper's value as
+#: its truth, so agreement with the paper is by construction and only ``z`` is an outcome.
+VERDICTS = ("reproduced", "differs", "tuned", "not testable", "planned")
+
+#: |z| up to which a value counts as agreeing (3σ, GUIDE §6).
+Z_LIMIT = 3.0
+
+_MINUS = "\u2212"
+_SUPERSCRIPT = str.maketrans(
+    "-0123456789", "\u207b\u2070\u00b9\u00b2\u00b3\u2074\u2075\u2076\u2077\u2078\u2079"
+)
+
+
+def _clean(x) -> float | None:
+    if x is None:
+        return None
+    x = float(x)
+    return x if math.isfinite(x) else None
 
 
 @dataclass
 class Row:
-    """One quantity of a table: paper | reproduced | truth, with σ̂ (GUIDE §5)."""
+    """One quantity of a table: paper | reproduced | σ̂ | truth, with z and a verdict (GUIDE §5).
+
+    Parameters
+    ----------
+    table, quantity, unit : str
+        The table's name (``"000 Table 1"``), the quantity (``"c"``) and its unit (``"px"``;
+        ``""`` or ``"1"`` for a number).
+    paper, paper_sigma : float, optional
+        The paper's value and the standard deviation it gives.
+    reproduced, sigma : float, optional
+        Our value and its standard deviation: σ̂ of the adjustment, or the spread over
+        ``n_runs`` repeated simulations.
+    truth : float, optional
+        The simulation's true value.
+    n_runs : int, optional
+        Set when ``sigma`` is the spread over this many simulations (not an adjustment's σ̂).
+    verdict, reason : str, optional
+        A verdict stated by the chapter (one of :data:`VERDICTS`) and its reason; computed by
+        :meth:`judge` when absent.
+    """
 
     table: str
     quantity: str
@@ -29,24 +87,225 @@ class Row:
     reproduced: float | None = None
     sigma: float | None = None
     truth: float | None = None
+    n_runs: int | None = None
+    verdict: str | None = None
+    reason: str = ""
+
+    def __post_init__(self):
+        if self.verdict is not None and self.verdict not in VERDICTS:
+            raise InputError(f"verdict {self.verdict!r} of {self.quantity}: use one of {VERDICTS}")
+
+    @property
+    def z(self) -> float | None:
+        """``(reproduced − truth) / σ``, or None when any of them is absent or σ = 0."""
+        r, t, s = _clean(self.reproduced), _clean(self.truth), _clean(self.sigma)
+        if r is None or t is None or not s:
+            return None
+        return (r - t) / s
+
+    @property
+    def z_paper(self) -> float | None:
+        """``(reproduced − paper) / hypot(σ, paper σ)``, or None without a spread to judge by."""
+        r, p = _clean(self.reproduced), _clean(self.paper)
+        s = math.hypot(_clean(self.sigma) or 0.0, _clean(self.paper_sigma) or 0.0)
+        if r is None or p is None or s == 0.0:
+            return None
+        return (r - p) / s
+
+    def truth_is_paper(self) -> bool:
+        """True when the simulation took the paper's value as its truth."""
+        p, t = _clean(self.paper), _clean(self.truth)
+        if p is None or t is None:
+            return False
+        return abs(p - t) <= 1e-9 * max(abs(p), abs(t)) or (p == 0.0 == t)
+
+    def judge(self) -> tuple[str | None, str]:
+        """The verdict on the paper's value and its reason (None for a row without a paper value).
+
+        In this order: the verdict the chapter stated; ``not testable`` without a reproduced
+        value; ``tuned`` when the truth is the paper's value (agreement by construction: the
+        reason gives the recovery z); ``reproduced`` / ``differs`` by |z_paper| ≤ 3, where
+        z_paper combines our σ (σ̂ or the spread over runs) with the paper's σ; ``not testable``
+        when neither side has a σ.
+        """
+        if self.verdict is not None:
+            return self.verdict, self.reason
+        if _clean(self.paper) is None:
+            return None, ""
+        if _clean(self.reproduced) is None:
+            return "not testable", self.reason or "no reproduced value"
+        if self.truth_is_paper():
+            z = self.z
+            how = f"recovered {agreement(z)} of it" if z is not None else "no σ̂ to judge recovery"
+            return "tuned", f"simulated with the paper's value as truth; {how}"
+        zp = self.z_paper
+        if zp is None:
+            return "not testable", self.reason or "neither the paper nor the reproduction has a σ"
+        spread = f"spread over {self.n_runs} runs" if self.n_runs else "σ̂"
+        if abs(zp) <= Z_LIMIT:
+            return "reproduced", f"{agreement(zp)} of the paper (our {spread} and the paper's σ)"
+        return "differs", self.reason or f"{abs(zp):.1f}σ from the paper ({spread})"
 
     def as_dict(self) -> dict:
-        def clean(x):
-            if x is None:
-                return None
-            x = float(x)
-            return None if not math.isfinite(x) else x
-
+        """Strict-JSON-ready dict: absent or non-finite numbers are None."""
+        verdict, reason = self.judge()
+        z = self.z
         return {
             "table": self.table,
             "quantity": self.quantity,
             "unit": self.unit,
-            "paper": clean(self.paper),
-            "paper_sigma": clean(self.paper_sigma),
-            "reproduced": clean(self.reproduced),
-            "sigma": clean(self.sigma),
-            "truth": clean(self.truth),
+            "paper": _clean(self.paper),
+            "paper_sigma": _clean(self.paper_sigma),
+            "reproduced": _clean(self.reproduced),
+            "sigma": _clean(self.sigma),
+            "truth": _clean(self.truth),
+            "z": _clean(z),
+            "n_runs": self.n_runs,
+            "verdict": verdict,
+            "reason": reason,
         }
+
+
+def _strict(obj):
+    """``obj`` with every non-finite float replaced by None (strict JSON, GUIDE §5)."""
+    if isinstance(obj, dict):
+        return {k: _strict(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_strict(v) for v in obj]
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    return obj
+
+
+def agreement(z: float | None) -> str:
+    """Words for a z-score: ``"within 1σ"`` … ``"within 3σ"``, else ``"4.2σ off"``.
+
+    >>> agreement(0.4), agreement(-2.56), agreement(3.3)
+    ('within 1σ', 'within 3σ', '3.3σ off')
+    """
+    if z is None or not math.isfinite(z):
+        return "without a σ to judge"
+    a = abs(z)
+    for k in (1, 2, 3):
+        if a <= k:
+            return f"within {k}σ"
+    return f"{a:.1f}σ off"
+
+
+def summarize(rows: list[Row], what: str = "parameters") -> dict:
+    """Computed words about the z-scores of ``rows`` (those with a z), for a chapter's prose.
+
+    Returns a dict with ``n``, ``n_within_1``, ``n_within_3``, ``max_abs_z``, ``worst`` (the
+    quantity with the largest |z|), ``n_negative``, ``n_positive``, ``sign_p`` (two-sided sign
+    test probability of a sign balance at least this lopsided under zero-mean errors) and
+    ``sentence``, e.g. "7 of 8 parameters lie within 3σ̂ of the truth; the largest deviation is
+    c_line100 at 1.8σ̂."
+    """
+    zs = [(r.quantity, r.z) for r in rows if r.z is not None]
+    n = len(zs)
+    if n == 0:
+        return {"n": 0, "sentence": f"No {what} have a σ̂ to judge them by."}
+    within1 = sum(abs(z) <= 1 for _, z in zs)
+    within3 = sum(abs(z) <= Z_LIMIT for _, z in zs)
+    worst, zw = max(zs, key=lambda qz: abs(qz[1]))
+    neg = sum(z < 0 for _, z in zs)
+    pos = n - neg
+    k = min(neg, pos)
+    sign_p = min(1.0, 2 * sum(math.comb(n, i) for i in range(k + 1)) / 2**n)
+    if within3 == n:
+        head = (
+            f"all {n} {what} lie within 3σ̂ of the truth"
+            if n > 1
+            else f"the {what[:-1]} lies within 3σ̂ of the truth"
+        )
+    else:
+        head = f"{within3} of {n} {what} lie within 3σ̂ of the truth"
+    sentence = f"{head[0].upper()}{head[1:]}; the largest deviation is {worst} at {abs(zw):.1f}σ̂"
+    if n >= 4 and k == 0:
+        side = "below" if neg else "above"
+        sentence += f"; all {n} lie {side} the truth (sign test p = {sign_p:.2g})"
+    return {
+        "n": n,
+        "n_within_1": within1,
+        "n_within_3": within3,
+        "max_abs_z": abs(zw),
+        "worst": worst,
+        "n_negative": neg,
+        "n_positive": pos,
+        "sign_p": sign_p,
+        "sentence": sentence + ".",
+    }
+
+
+def _sci(x: float, digits: int) -> str:
+    mant, exp = f"{x:.{digits}e}".split("e")
+    return f"{mant} × 10{str(int(exp)).translate(_SUPERSCRIPT)}".replace("-", _MINUS)
+
+
+def format_value(x, sigma=None, sig: int = 4) -> str:
+    """A number for a table: rounded to σ's second significant digit when σ is given, else to
+    ``sig`` significant digits; scientific notation (× 10ⁿ) below 1e-3 and from 1e6; ``—`` when
+    absent or not finite; a true minus sign.
+
+    >>> format_value(3539.123, 14.2), format_value(-0.00414), format_value(None)
+    ('3539', '−0.004140', '—')
+    """
+    x = _clean(x)
+    if x is None:
+        return "—"
+    s = _clean(sigma)
+    mag = math.floor(math.log10(abs(x))) if x != 0 else 0
+    place = math.floor(math.log10(s)) - 1 if s else mag - (sig - 1)
+    tiny = place < -6 if s else (x != 0 and mag < -3)
+    if tiny or mag >= 6:
+        return _sci(x, max(0, mag - place))
+    return f"{x:.{max(0, -place)}f}".replace("-", _MINUS)
+
+
+def _format_paper(x) -> str:
+    """The paper's value as printed: the shortest repr of the stored float."""
+    x = _clean(x)
+    if x is None:
+        return "—"
+    text = repr(x)
+    if "e" in text:
+        mant, exp = text.split("e")
+        text = f"{mant} × 10{str(int(exp)).translate(_SUPERSCRIPT)}"
+    elif text.endswith(".0"):
+        text = text[:-2]
+    return text.replace("-", _MINUS)
+
+
+def format_rows(rows: list[Row]):
+    """The rows as a DataFrame of display strings: quantity | unit | paper | reproduced | σ̂ |
+    truth | z | verdict (no index; σ is marked ``(n runs)`` when it is a spread over runs).
+    """
+    import pandas as pd
+
+    out = []
+    for r in rows:
+        verdict, _ = r.judge()
+        paper = _format_paper(r.paper)
+        if _clean(r.paper_sigma) is not None:
+            paper += f" ± {_format_paper(r.paper_sigma)}"
+        sig = format_value(r.sigma, r.sigma, sig=2) if _clean(r.sigma) else "—"
+        if r.n_runs and sig != "—":
+            sig += f" ({r.n_runs} runs)"
+        z = r.z
+        out.append(
+            {
+                "quantity": r.quantity,
+                "unit": r.unit if r.unit not in ("", "1") else "—",
+                "paper": paper,
+                "reproduced": format_value(r.reproduced, r.sigma),
+                "σ̂": sig,
+                "truth": format_value(r.truth, r.sigma),
+                "z": "—" if z is None else f"{z:+.1f}".replace("-", _MINUS),
+                "verdict": verdict or "—",
+            }
+        )
+    cols = ["quantity", "unit", "paper", "reproduced", "σ̂", "truth", "z", "verdict"]
+    return pd.DataFrame(out, columns=cols)
 
 
 @dataclass
@@ -65,38 +324,75 @@ class Reproduction:
                 "chapter": self.chapter,
                 "seed": self.seed,
                 "rows": [r.as_dict() for r in self.rows],
-                "meta": self.meta,
+                "meta": _strict(self.meta),
             },
             indent=1,
+            allow_nan=False,
         )
 
+    def tables(self) -> list[str]:
+        """The table names, in order."""
+        return list(dict.fromkeys(r.table for r in self.rows))
+
+    def rows_of(self, name: str) -> list[Row]:
+        """The rows of one table (an error naming the known tables if there is none)."""
+        rows = [r for r in self.rows if r.table == name]
+        if not rows:
+            raise InputError(f"no table {name!r} in {self.chapter}; tables: {self.tables()}")
+        return rows
+
     def table(self, name: str | None = None):
-        """The rows as a pandas DataFrame (one table, or all with a ``table`` column)."""
+        """The rows as a pandas DataFrame of numbers (one table, or all with a ``table`` column)."""
         import pandas as pd
 
-        df = pd.DataFrame([r.as_dict() for r in self.rows])
+        rows = self.rows if name is None else self.rows_of(name)
+        df = pd.DataFrame([r.as_dict() for r in rows])
         if name is not None:
-            df = df[df["table"] == name].drop(columns="table")
-            if df.empty:
-                known = sorted({r.table for r in self.rows})
-                raise InputError(f"no table {name!r} in {self.chapter}; tables: {known}")
+            df = df.drop(columns="table")
         return df.reset_index(drop=True)
 
+    def show(self, name: str, columns: list[str] | None = None):
+        """One table as the book shows it (a pandas Styler without index; see :func:`format_rows`).
+
+        ``columns`` selects and orders columns, e.g.
+        ``["quantity", "unit", "paper", "reproduced"]``.
+        """
+        df = format_rows(self.rows_of(name))
+        if columns is not None:
+            df = df[columns]
+        return (
+            df.style.hide(axis="index")
+            .set_table_attributes('class="hsgeo-table"')
+            .set_properties(**{"text-align": "right"})
+            .set_properties(subset=["quantity"], **{"text-align": "left"})
+        )
+
+    def summarize(self, name: str, what: str = "parameters") -> dict:
+        """:func:`summarize` over one table's rows."""
+        return summarize(self.rows_of(name), what)
+
     def to_text(self) -> str:
+        """All tables as aligned plain text (the same strings as :meth:`show`)."""
         out = [f"{self.chapter} (seed {self.seed})"]
-        for t in dict.fromkeys(r.table for r in self.rows):
+        for t in self.tables():
+            df = format_rows(self.rows_of(t))
+            widths = {c: max(len(c), *(len(v) for v in df[c])) for c in df.columns}
             out.append(f"\n{t}")
             out.append(
-                f"  {'quantity':<28s}{'unit':>8s}{'paper':>14s}{'reproduced':>14s}"
-                f"{'sigma':>12s}{'truth':>14s}"
+                "  "
+                + "  ".join(
+                    c.ljust(widths[c]) if c == "quantity" else c.rjust(widths[c])
+                    for c in df.columns
+                )
             )
-            for r in self.rows:
-                if r.table != t:
-                    continue
-                d = r.as_dict()
-                f = lambda x, w: f"{x:{w}.6g}" if x is not None else " " * (w - 1) + "–"  # noqa: E731
+            for _, rec in df.iterrows():
                 out.append(
-                    f"  {r.quantity:<28s}{r.unit:>8s}{f(d['paper'], 14)}"
-                    f"{f(d['reproduced'], 14)}{f(d['sigma'], 12)}{f(d['truth'], 14)}"
+                    "  "
+                    + "  ".join(
+                        rec[c].ljust(widths[c])
+                        if c in ("quantity", "verdict")
+                        else rec[c].rjust(widths[c])
+                        for c in df.columns
+                    ).rstrip()
                 )
         return "\n".join(out)

@@ -1,0 +1,99 @@
+"""hsgeo.report: z, verdicts, agreement words, number formatting and strict JSON."""
+
+import json
+import math
+
+import pytest
+
+from hsgeo.errors import InputError
+from hsgeo.report import Reproduction, Row, agreement, format_rows, format_value, summarize
+
+
+def test_z_is_deviation_from_truth_in_sigmas():
+    r = Row("t", "c", "px", reproduced=10.5, sigma=0.25, truth=10.0)
+    assert r.z == pytest.approx(2.0)
+    assert Row("t", "c", "px", reproduced=1.0, truth=1.0).z is None  # no σ: no z
+
+
+def test_verdicts_follow_the_numbers():
+    # truth = paper: agreement with the paper is by construction, the reason gives the recovery
+    v, why = Row("t", "c", "px", paper=3539, reproduced=3541, sigma=1.0, truth=3539).judge()
+    assert v == "tuned" and "within 2σ" in why
+    # independent outcome: judged by the combined σ of ours and the paper's
+    assert Row("t", "q", "m", paper=1.0, paper_sigma=0.3, reproduced=1.5, sigma=0.4).judge()[0] == (
+        "reproduced"
+    )  # |z| = 0.5 / 0.5 = 1
+    v, why = Row("t", "q", "m", paper=1.0, reproduced=3.0, sigma=0.5, n_runs=20).judge()
+    assert v == "differs" and "4.0σ" in why and "20 runs" in why
+    assert Row("t", "q", "m", paper=1.0, reproduced=1.1).judge()[0] == "not testable"
+    assert Row("t", "q", "m", paper=1.0).judge()[0] == "not testable"
+    assert Row("t", "q", "m", reproduced=1.0).judge() == (None, "")
+    assert Row("t", "q", "m", paper=1.0, verdict="planned", reason="004").judge() == (
+        "planned",
+        "004",
+    )
+    with pytest.raises(InputError, match="use one of"):
+        Row("t", "q", "m", verdict="fine")
+
+
+def test_agreement_words():
+    assert [agreement(z) for z in (0.99, -1.5, 3.0, -3.04, None)] == [
+        "within 1σ",
+        "within 2σ",
+        "within 3σ",
+        "3.0σ off",
+        "without a σ to judge",
+    ]
+
+
+def test_summarize_counts_and_sign_test():
+    rows = [
+        Row("t", f"c{i}", "mm", reproduced=-z, sigma=1.0, truth=0.0)
+        for i, z in enumerate([0.5, 1.2, 2.0, 3.3, 0.1, 0.7, 1.9])
+    ]
+    s = summarize(rows)
+    assert (s["n"], s["n_within_1"], s["n_within_3"], s["worst"]) == (7, 3, 6, "c3")
+    assert s["max_abs_z"] == pytest.approx(3.3)
+    # all seven below the truth: two-sided sign test p = 2 / 2**7
+    assert s["sign_p"] == pytest.approx(2 / 128)
+    assert "6 of 7 parameters" in s["sentence"] and "all 7 lie below" in s["sentence"]
+
+
+def test_format_value_rounds_to_sigma_and_marks_absent():
+    assert format_value(3539.123, 14.2) == "3539"
+    assert format_value(8.664199622, 0.00066) == "8.66420"
+    assert format_value(-7.78e-7, 4.6e-7) == "−7.8 × 10⁻⁷"
+    assert format_value(1234567.0) == "1.235 × 10⁶"
+    assert format_value(float("nan")) == format_value(None) == "—"
+
+
+def test_table_has_no_nan_and_fixed_columns():
+    rows = [Row("t", "c", "px", paper=3539, paper_sigma=14, reproduced=float("nan"))]
+    df = format_rows(rows)
+    assert list(df.columns) == [
+        "quantity",
+        "unit",
+        "paper",
+        "reproduced",
+        "σ̂",
+        "truth",
+        "z",
+        "verdict",
+    ]
+    assert df.iloc[0]["paper"] == "3539 ± 14" and df.iloc[0]["reproduced"] == "—"
+    assert not df.apply(lambda c: c.str.contains("nan", case=False)).any().any()
+
+
+def test_json_is_strict_and_carries_the_verdict():
+    rep = Reproduction(
+        "x",
+        0,
+        [Row("t", "c", "px", paper=1.0, reproduced=math.inf)],
+        meta={"a": float("nan"), "b": [1.0, float("inf")]},
+    )
+    d = json.loads(rep.to_json())  # strict: would fail on NaN with parse_constant
+    assert d["rows"][0]["reproduced"] is None and d["rows"][0]["verdict"] == "not testable"
+    assert d["meta"] == {"a": None, "b": [1.0, None]}
+    with pytest.raises(InputError, match="tables"):
+        rep.show("nope")
+    assert "3539" not in rep.to_text() and "not testable" in rep.to_text()
