@@ -44,8 +44,11 @@ test-fast: $(STAMP) ## the test suite without the chapter executions and slow Mo
 # The execution cache is keyed on each chapter's code only: when the library or the scenarios
 # change, the cached outputs would be stale, so the cache is dropped then.
 book/_build/.library-stamp: $(shell find src/hsgeo data_synthetic -name '*.py' -o -name '*.toml') requirements.lock
-	rm -rf book/_build/.jupyter_cache
+	rm -rf book/_build/.jupyter_cache book/_build/reproduce
 	mkdir -p book/_build && touch $@
+
+# The chapters record their `hsgeo reproduce` results here; the scoreboard page reads them.
+book: export HSGEO_RECORD_DIR := $(CURDIR)/book/_build/reproduce
 
 book: $(STAMP) book/_build/.library-stamp ## execute every chapter and render the HTML book to book/_build/html (offline; ~15 min on 2 cores from an empty cache)
 	$(PY) -m hsgeo.cli data --verify

@@ -71,12 +71,16 @@ CHAPTERS = _chapters()
 
 
 @pytest.mark.parametrize("path", CHAPTERS, ids=[p.stem for p in CHAPTERS])
-def test_chapter_executes(path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_chapter_executes(
+    path: Path, monkeypatch: pytest.MonkeyPatch, tmp_path_factory: pytest.TempPathFactory
+) -> None:
     if not _has_code_cells(path):
         pytest.skip(f"{path.relative_to(BOOK)} has no code cells")
     # The kernel inherits this process's environment: reduced size, headless plotting,
     # one BLAS thread (as in the Makefile).
     monkeypatch.setenv("HSGEO_SCALE", "small")
+    # as in `make book`: chapters record their results, the scoreboard (last in the toc) reads them
+    monkeypatch.setenv("HSGEO_RECORD_DIR", str(tmp_path_factory.getbasetemp() / "reproduce"))
     monkeypatch.setenv("MPLBACKEND", "Agg")
     monkeypatch.setenv("PYDEVD_DISABLE_FILE_VALIDATION", "1")
     for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"):

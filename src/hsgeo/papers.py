@@ -333,3 +333,21 @@ P002 = {
 }
 
 __all__ += ["P002_STATS", "P002"]
+
+
+# ---- claims of the chapters still to be written (the scoreboard lists them as planned) ----
+
+#: 001 Table 3: GSD along the line sensor (GSDv), mm: the theoretical value for binning factor 1
+#: ((1.7 m × 0.333)/1170, 001 §3) and the values determined from the bar-target profiles at the
+#: spectral lines 100, 500, 700 and 1000 px.
+GSD_001_TABLE3_MM = {"theoretical": 0.48, "actual": {100: 0.58, 500: 0.58, 700: 0.51, 1000: 0.51}}
+
+#: 004 (abstract and text): the DAEDALUS AADS 1268's numbers: (value, unit).
+ASF_004 = {
+    "ASF variation, largest channel": (15.0, "%"),  # abstract: "variations up to 15 %"
+    "lab ASF max-min, channels 2-9": (5.0, "%"),  # 1994 integrating sphere, "about 5 %"
+    "lab ASF max-min, channel 1": (20.0, "%"),  # "almost 20 % for channel 1"
+    "angular pixel size": (0.12, "deg"),  # 2 · 43° / 716
+    "nadir GSD at 300 m": (0.7, "m"),  # "about 0.7 m for nadir"
+    "runway width": (50.0, "px"),  # "about 50 pixels"
+}

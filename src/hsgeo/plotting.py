@@ -229,3 +229,32 @@ def plot_distortion_effects(axes, bands, own, ref, diff, dec):
     for ax in axes:
         ax.set_xlabel("band")
     return axes
+
+
+# ---- scoreboard ----
+
+
+def verdict_bars(ax, per_paper):
+    """Horizontal stacked bars: claims per paper (rows of ``per_paper``) by verdict (columns).
+
+    ``per_paper`` is a pandas DataFrame of counts, one column per verdict in
+    :data:`hsgeo.report.VERDICTS` order. Returns ``ax``.
+    """
+    colours = {
+        "reproduced": "#1b9e77",
+        "differs": "#d95f02",
+        "tuned": "#7570b3",
+        "not testable": "#999999",
+        "planned": "#e6ab02",
+    }
+    left = None
+    papers_ = [str(p) for p in per_paper.index]
+    for verdict in per_paper.columns:
+        n = per_paper[verdict].to_numpy()
+        ax.barh(papers_, n, left=left, color=colours.get(verdict), label=verdict)
+        left = n if left is None else left + n
+    ax.set_xlabel("claims")
+    ax.set_ylabel("paper")
+    ax.invert_yaxis()
+    ax.legend(loc="lower right", fontsize=9, frameon=False)
+    return ax

@@ -330,6 +330,23 @@ class Reproduction:
             allow_nan=False,
         )
 
+    @classmethod
+    def from_json(cls, text: str) -> Reproduction:
+        """The inverse of :meth:`to_json` (rows and meta; ``extras`` are not serialized)."""
+        d = json.loads(text)
+        fields = ("table", "quantity", "unit", "paper", "paper_sigma", "reproduced", "sigma")
+        rows = [
+            Row(
+                *(r[k] for k in fields),
+                truth=r["truth"],
+                n_runs=r.get("n_runs"),
+                verdict=r.get("verdict"),  # as judged when written: the same numbers
+                reason=r.get("reason") or "",
+            )
+            for r in d["rows"]
+        ]
+        return cls(d["chapter"], d["seed"], rows, d.get("meta") or {})
+
     def tables(self) -> list[str]:
         """The table names, in order."""
         return list(dict.fromkeys(r.table for r in self.rows))

@@ -7,11 +7,18 @@ chapter calls the same function, so the chapter and the command print the same n
 from __future__ import annotations
 
 import importlib
+import os
+from pathlib import Path
 
 from hsgeo.errors import InputError
 from hsgeo.report import Reproduction, Row
 
-__all__ = ["Row", "Reproduction", "CHAPTERS", "run", "chapter_names"]
+__all__ = ["Row", "Reproduction", "CHAPTERS", "RECORD_ENV", "run", "recorded", "chapter_names"]
+
+#: When this environment variable names a directory, :func:`run` writes each chapter's result
+#: there as ``<chapter>.json`` (the book build sets it, so that the scoreboard page reads the
+#: chapters' results instead of computing them again).
+RECORD_ENV = "HSGEO_RECORD_DIR"
 
 #: chapter name -> module (relative to this package) with a ``run(seed, scale)`` function.
 CHAPTERS: dict[str, str] = {
@@ -20,6 +27,7 @@ CHAPTERS: dict[str, str] = {
     "geocoding": "geocoding",
     "rikola": "rikola",
     "pushbroom-ba": "pushbroom_ba",
+    "scoreboard": "scoreboard",
 }
 
 
@@ -37,4 +45,22 @@ def run(chapter: str, seed: int = 0, scale: float = 1.0) -> Reproduction:
     if not (0 < scale <= 1.0):
         raise InputError(f"scale must be in (0, 1], got {scale!r}")
     mod = importlib.import_module(f"hsgeo.reproduce.{CHAPTERS[chapter]}")
-    return mod.run(seed=seed, scale=scale)
+    rep = mod.run(seed=seed, scale=scale)
+    rep.meta.setdefault("scale", scale)
+    directory = os.environ.get(RECORD_ENV)
+    if directory and chapter != "scoreboard":
+        from hsgeo.io._files import atomic_path
+
+        Path(directory).mkdir(parents=True, exist_ok=True)
+        with atomic_path(Path(directory) / f"{chapter}.json") as tmp:
+            Path(tmp).write_text(rep.to_json(), encoding="utf-8")
+    return rep
+
+
+def recorded(chapter: str) -> Reproduction | None:
+    """The result :func:`run` last recorded for ``chapter`` under ``$HSGEO_RECORD_DIR``, or None."""
+    directory = os.environ.get(RECORD_ENV)
+    path = Path(directory) / f"{chapter}.json" if directory else None
+    if path is None or not path.is_file():
+        return None
+    return Reproduction.from_json(path.read_text(encoding="utf-8"))

@@ -1,0 +1,49 @@
+"""The claims scoreboard (issue 13) and the record of chapter results it reads."""
+
+import json
+
+from hsgeo.report import Reproduction, Row
+from hsgeo.reproduce import RECORD_ENV, recorded, run
+from hsgeo.reproduce.scoreboard import PAPER_CHAPTERS, claims, counts, planned_claims
+
+
+def test_claims_are_the_paper_tables_plus_planned():
+    rep = Reproduction(
+        "line-calibration",
+        0,
+        [
+            Row(
+                "000 Table 1",
+                "c",
+                "px",
+                paper=3539,
+                paper_sigma=14,
+                reproduced=3541,
+                sigma=12,
+                truth=3539,
+            ),
+            Row("000 Table 1", "unpublished", "px", reproduced=1.0),  # no paper value
+            Row("distortion magnitudes", "d", "px", paper=1.0, reproduced=1.0),  # not a paper
+            Row("002 Table 2", "nmad_h_m", "m", paper=0.99, reproduced=0.3, sigma=0.05, n_runs=10),
+        ],
+    )
+    rows = claims({"line-calibration": rep})
+    assert [r.quantity for r in rows[:2]] == ["c", "nmad_h_m"]
+    assert rows[2:] == planned_claims() and all(r.verdict == "planned" for r in rows[2:])
+    c = counts(rows)
+    assert c["tuned"] == 1 and c["differs"] == 1 and c["planned"] == len(planned_claims())
+    assert set(PAPER_CHAPTERS) >= {"line-calibration", "geocoding", "pushbroom-ba", "rikola"}
+
+
+def test_run_records_and_recorded_round_trips(tmp_path, monkeypatch):
+    assert recorded("frame-reference") is None or RECORD_ENV in __import__("os").environ
+    monkeypatch.setenv(RECORD_ENV, str(tmp_path / "rec"))
+    rep = run("frame-reference", seed=1)
+    back = recorded("frame-reference")
+    assert back is not None and back.seed == 1 and back.meta["scale"] == 1.0
+    assert [r.as_dict() for r in back.rows] == [r.as_dict() for r in rep.rows]
+    assert json.loads((tmp_path / "rec" / "frame-reference.json").read_text())["chapter"] == (
+        "frame-reference"
+    )
+    monkeypatch.delenv(RECORD_ENV)
+    assert recorded("frame-reference") is None
