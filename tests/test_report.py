@@ -65,6 +65,7 @@ def test_format_value_rounds_to_sigma_and_marks_absent():
     assert format_value(-7.78e-7, 4.6e-7) == "−7.8 × 10⁻⁷"
     assert format_value(1234567.0) == "1.235 × 10⁶"
     assert format_value(float("nan")) == format_value(None) == "—"
+    assert format_value(0.0, 4.6e-7) == "0"  # not "0.0000000 × 10⁰"
 
 
 def test_table_has_no_nan_and_fixed_columns():
@@ -97,3 +98,12 @@ def test_json_is_strict_and_carries_the_verdict():
     with pytest.raises(InputError, match="tables"):
         rep.show("nope")
     assert "3539" not in rep.to_text() and "not testable" in rep.to_text()
+
+
+def test_paper_values_print_at_most_six_digits_and_verdict_list():
+    rows = [Row("OpenCV", "fx_px", "px", paper=657.466978102434, reproduced=657.47, sigma=19.9)]
+    assert format_rows(rows).iloc[0]["paper"] == "657.467"
+    assert format_rows([Row("t", "K1", "1/mm2", paper=-0.00414)]).iloc[0]["paper"] == "−0.00414"
+    rep = Reproduction("x", 0, rows + [Row("t", "q", "m", reproduced=1.0)])
+    v = rep.verdicts().data
+    assert list(v["quantity"]) == ["fx_px"] and v.iloc[0]["verdict"] == "not testable"

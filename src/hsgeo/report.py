@@ -253,6 +253,8 @@ def format_value(x, sigma=None, sig: int = 4) -> str:
     x = _clean(x)
     if x is None:
         return "—"
+    if x == 0.0:
+        return "0"
     s = _clean(sigma)
     mag = math.floor(math.log10(abs(x))) if x != 0 else 0
     place = math.floor(math.log10(s)) - 1 if s else mag - (sig - 1)
@@ -263,11 +265,11 @@ def format_value(x, sigma=None, sig: int = 4) -> str:
 
 
 def _format_paper(x) -> str:
-    """The paper's value as printed: the shortest repr of the stored float."""
+    """The paper's value as printed: the shortest repr of the stored float (at most 6 digits)."""
     x = _clean(x)
     if x is None:
         return "—"
-    text = repr(x)
+    text = repr(x) if len(repr(x).lstrip("-0.").replace(".", "")) <= 6 else f"{x:.6g}"
     if "e" in text:
         mant, exp = text.split("e")
         text = f"{mant} × 10{str(int(exp)).translate(_SUPERSCRIPT)}"
@@ -383,6 +385,22 @@ class Reproduction:
             .set_properties(**{"text-align": "right"})
             .set_properties(subset=["quantity"], **{"text-align": "left"})
         )
+
+    def verdicts(self, tables: list[str] | None = None):
+        """The chapter's "What reproduced, what did not, and why": one line per claim (rows with
+        a paper value) of ``tables`` (default: all), with its verdict and reason (a Styler).
+        """
+        import pandas as pd
+
+        rows = [r for r in self.rows if tables is None or r.table in tables]
+        recs = [
+            {"table": r.table, "quantity": r.quantity, "verdict": v, "why": why}
+            for r in rows
+            for v, why in [r.judge()]
+            if v is not None
+        ]
+        df = pd.DataFrame(recs, columns=["table", "quantity", "verdict", "why"])
+        return df.style.hide(axis="index").set_table_attributes('class="hsgeo-table"')
 
     def summarize(self, name: str, what: str = "parameters") -> dict:
         """:func:`summarize` over one table's rows."""
