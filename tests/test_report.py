@@ -106,4 +106,4 @@ def test_paper_values_print_at_most_six_digits_and_verdict_list():
     assert format_rows([Row("t", "K1", "1/mm2", paper=-0.00414)]).iloc[0]["paper"] == "−0.00414"
     rep = Reproduction("x", 0, rows + [Row("t", "q", "m", reproduced=1.0)])
     v = rep.verdicts().data
-    assert list(v["quantity"]) == ["fx_px"] and v.iloc[0]["verdict"] == "not testable"
+    assert list(v["quantity"]) == ["fx_px"] and v.iloc[0]["verdict"] == "reproduced"
