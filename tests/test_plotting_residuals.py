@@ -39,7 +39,7 @@ def test_binned_residuals_draws_one_arrow_per_filled_cell():
     plotting.binned_residuals(ax, uv, r, (640, 480), bins=(8, 6), min_count=3)
     (q,) = [c for c in ax.collections if isinstance(c, matplotlib.quiver.Quiver)]
     assert q.N == 1  # the cell with a single residual is left out
-    assert ax.get_ylim() == (480, 0)
+    assert ax.get_ylim()[0] == 480 and ax.get_ylim()[1] < 0  # v down, a band for the key
     plt.close(fig)
 
 

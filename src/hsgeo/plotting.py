@@ -307,10 +307,12 @@ def binned_residuals(
         width=0.006,
         pivot="middle",
     )
+    # the key sits in a band above the image (v < 0), inside the axes
+    ax.axhline(0, color="0.5", lw=0.8, zorder=0)
     ax.quiverkey(
         q,
-        0.82,
-        1.04,
+        0.78,
+        1 - 0.07 / 1.14,
         key_px * scale,
         f"{key_px:g} px",
         labelpos="E",
@@ -318,7 +320,7 @@ def binned_residuals(
         fontproperties={"size": 9},
     )
     ax.set_xlim(0, w)
-    ax.set_ylim(h, 0)
+    ax.set_ylim(h, -0.14 * h)
     ax.set_aspect("equal")
     ax.set_xlabel("column u (px)")
     ax.set_ylabel("row v (px)")
