@@ -376,6 +376,8 @@ def residuals_by_band(ax, wavelength_nm, value, sigma=None, sensor=None, *, mark
     cols = [_SENSOR_COLOR[int(s)] for s in sensor] if sensor is not None else ["C0"] * len(wl)
     if sigma is not None:
         ax.errorbar(wl, v, yerr=sigma, fmt="none", ecolor="0.6", capsize=2)
-    ax.scatter(wl, v, c=cols, marker=marker, s=22, label=label, zorder=3)
+    ax.scatter(wl, v, c=cols, marker=marker, s=22, zorder=3)
+    if label:  # a grey proxy: the colours stand for the sensors, the marker for the series
+        ax.scatter([], [], color="0.35", marker=marker, s=22, label=label)
     ax.set_xlabel("central wavelength of the band (nm)")
     return ax
