@@ -286,3 +286,43 @@ def test_gap_regression_exact_line():
     assert abs(out["a"] - 8.4e-5) < 1e-12 and 0 < out["r2"] < 1
     R = R_from_opk(0.1, -0.2, 0.3)
     assert np.allclose(opk_from_R(R), [0.1, -0.2, 0.3])
+
+
+def test_chapter_parameters_are_the_scenario_and_the_paper(cfg):
+    """The rikola chapter's first cell (parameters only) states the values the simulation
+    reads from rikola_bench.toml, and those are the paper's (003 Tables 1, 3, 4)."""
+    from pathlib import Path
+
+    jupytext = pytest.importorskip("jupytext")
+    from hsgeo.papers import RIKOLA_TABLE3, RIKOLA_TABLE4_GAP_MODEL
+
+    md = Path(__file__).resolve().parents[1] / "book" / "chapters" / "rikola.md"
+    cell = next(c for c in jupytext.read(md, fmt="md:myst").cells if c.cell_type == "code")
+    p: dict = {}
+    exec(compile(cell.source, "rikola.md parameters", "exec"), p)  # noqa: S102
+    cam, gm = cfg["camera"], cfg["gap_model"]
+    assert (cam["width_px"], cam["height_px"], cam["pixel_mm"]) == (
+        p["width_px"],
+        p["height_px"],
+        p["pixel_mm"],
+    )
+    for s in (1, 2):
+        a, b = gm[f"a_sensor{s}_mm_per_nm"], gm[f"b_sensor{s}_mm"]
+        assert (a, b) == (p[f"a_sensor{s}_mm_per_nm"], p[f"b_sensor{s}_mm"])
+        assert (a, b) == (
+            RIKOLA_TABLE4_GAP_MODEL[s]["a_mm_per_nm"][0],
+            RIKOLA_TABLE4_GAP_MODEL[s]["b_mm"][0],
+        )
+    assert tuple(cam["pp_sensor1_mm"]) == p["pp_sensor1_mm"]
+    assert tuple(cam["pp_sensor2_mm"]) == p["pp_sensor2_mm"]
+    assert p["pp_sensor1_mm"] == tuple(RIKOLA_TABLE3[20][k][0] for k in ("x0_mm", "y0_mm"))
+    assert p["pp_sensor2_mm"] == tuple(RIKOLA_TABLE3[5][k][0] for k in ("x0_mm", "y0_mm"))
+    k1 = np.mean([RIKOLA_TABLE3[b]["K1_per_mm2"][0] for b in (5, 20)])
+    assert cam["K1_per_mm2"] == p["K1_per_mm2"] == pytest.approx(k1, rel=1e-12)
+    assert (cam["P1_per_mm"], cam["P2_per_mm"]) == (p["P1_per_mm"], p["P2_per_mm"])
+    mis = cfg["misalignment"]
+    rop = tuple(mis[k] for k in ("domega_deg", "dphi_deg", "dkappa_deg"))
+    assert rop == p["rop_deg"] == tuple(RIKOLA_TABLE4_ROP_MEAN_DEG)
+    assert cfg["geometry"]["n_cubes"] == p["n_cubes_paper"] == 20
+    assert cfg["measure"]["sigma_px"] == p["sigma_px"]
+    assert p["scale"] == 1.0 and isinstance(p["SEED"], int)

@@ -22,7 +22,14 @@ from hsgeo.measure.charuco import detect_charuco
 from hsgeo.report import Reproduction, Row
 from hsgeo.workflows.frame_calibration import View, calibrate_opencv, calibrate_photogrammetric
 
-__all__ = ["run", "chessboard_views", "charuco_views", "reference_dir", "PIXEL_PITCH_MM"]
+__all__ = [
+    "run",
+    "chessboard_views",
+    "charuco_views",
+    "reference_dir",
+    "opencv_sigmas",
+    "PIXEL_PITCH_MM",
+]
 
 #: nominal pixel pitch of the tutorial webcam (unknown; it only scales the mm units: f/pitch,
 #: the residuals in px and the fit do not depend on it)
@@ -117,6 +124,32 @@ def opencv_calibrate(views, image_size, flags=0):
     return K, dist.ravel()[:5], float(rms)
 
 
+def opencv_sigmas(views, image_size) -> np.ndarray:
+    """``cv2.calibrateCameraExtended``'s standard deviations of the 9 intrinsics
+    (fx, fy, cx, cy, k1, k2, p1, p2, k3), all free, on the same views (single-threaded).
+    """
+    import cv2
+
+    cv2.setNumThreads(1)
+    obj = [v.X.astype(np.float32) for v in views]
+    img = [v.uv_px.astype(np.float32) for v in views]
+    crit = (cv2.TERM_CRITERIA_COUNT + cv2.TERM_CRITERIA_EPS, 200, 1e-15)
+    out = cv2.calibrateCameraExtended(obj, img, image_size, None, None, criteria=crit)
+    return out[5].ravel()[:9].astype(float)
+
+
+#: relative difference up to which two numbers without a σ (an RMS, a σ̂) count as the same
+#: result of two implementations (the tolerance of tests/test_calibration.py)
+SAME_REL = 1e-3
+
+
+def _same(ours: float, theirs: float, what: str) -> tuple[str, str]:
+    """Verdict for a number without a σ: reproduced when within :data:`SAME_REL` relative."""
+    rel = abs(ours - theirs) / abs(theirs)
+    words = f"{what} differ by {rel:.1e} relative (no σ; tolerance {SAME_REL:g})"
+    return ("reproduced" if rel <= SAME_REL else "differs"), words
+
+
 INTRINSIC_ROWS = (
     ("fx_px", "px"),
     ("fy_px", "px"),
@@ -149,7 +182,27 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
         rows.append(
             Row(t, q, "px" if q.endswith("px") else "1", paper=ref[q], reproduced=v[q], sigma=s[q])
         )
-    rows.append(Row(t, "rms_px", "px", paper=ref["rms_px"], reproduced=cal.rms_px))
+    verdict, why = _same(cal.rms_px, ref["rms_px"], "the RMS residuals")
+    rows.append(
+        Row(
+            t,
+            "rms_px",
+            "px",
+            paper=ref["rms_px"],
+            reproduced=cal.rms_px,
+            verdict=verdict,
+            reason=why,
+        )
+    )
+    # σ̂ of all nine intrinsics (free) against OpenCV's stdDeviationsIntrinsics, same corners
+    full = calibrate_opencv(views, size)
+    sd_cv, sd_hs = opencv_sigmas(views, size), full.sigmas()
+    t = "σ̂ against OpenCV (chessboard, 9 intrinsics free)"
+    for (q, unit), s_cv in zip(INTRINSIC_ROWS, sd_cv, strict=True):
+        verdict, why = _same(sd_hs[q], s_cv, "the σ̂")
+        rows.append(
+            Row(t, f"σ({q})", unit, paper=s_cv, reproduced=sd_hs[q], verdict=verdict, reason=why)
+        )
     pg = calibrate_photogrammetric(
         views, size, PIXEL_PITCH_MM, fix_principal_point=True, zero_decentering=True
     )
@@ -164,6 +217,7 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
     extras["chessboard"] = {
         "views": views,
         "opencv_form": cal,
+        "all_free": full,
         "photogrammetric_form": pg,
         "reference": ref,
     }
@@ -187,7 +241,10 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
     t = "OpenCV ChArUco"
     for q, unit in INTRINSIC_ROWS:
         rows.append(Row(t, q, unit, paper=cv_vals[q], reproduced=hv[q], sigma=hs[q]))
-    rows.append(Row(t, "rms_px", "px", paper=rms_cv, reproduced=ccal.rms_px))
+    verdict, why = _same(ccal.rms_px, rms_cv, "the RMS residuals")
+    rows.append(
+        Row(t, "rms_px", "px", paper=rms_cv, reproduced=ccal.rms_px, verdict=verdict, reason=why)
+    )
     cm, cd = cref["camera_matrix"], cref["distortion_coefficients"].ravel()
     extras["charuco"] = {
         "views": cviews,
@@ -207,6 +264,23 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
             "rms_px": cref["avg_reprojection_error"],
         },
     }
+
+    # OpenCV's reference file of 2021 (an older corner detector) against hsgeo today
+    t = "OpenCV ChArUco 2021 file"
+    r21 = extras["charuco"]["reference_2021"]
+    for q, unit in INTRINSIC_ROWS:
+        rows.append(Row(t, q, unit, paper=r21[q], reproduced=hv[q], sigma=hs[q]))
+    rows.append(
+        Row(
+            t,
+            "rms_px",
+            "px",
+            paper=r21["rms_px"],
+            reproduced=ccal.rms_px,
+            verdict="differs" if abs(ccal.rms_px / r21["rms_px"] - 1) > SAME_REL else "reproduced",
+            reason="other corners (the 2021 file used an older detector); no σ for an RMS",
+        )
+    )
 
     # 3. simulated bench, truth known
     cfg = load_scenario("frame_bench")
