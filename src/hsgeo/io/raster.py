@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 from pathlib import Path
 
 import numpy as np
@@ -41,10 +42,18 @@ def to_map_files(da, path_nc=None, path_envi=None, *, inputs=()) -> list:
     if path_envi is not None:
         refuse_inputs(Path(str(path_envi) + ".hdr"), inputs)
     out = []
-    if path_nc is not None:
-        with atomic_path(path_nc, inputs) as tmp:
+    with contextlib.ExitStack() as stack:  # all files or none: a failing ENVI removes the .nc
+        if path_nc is not None:
+            tmp = stack.enter_context(atomic_path(path_nc, inputs))
             da.to_dataset(name=da.name or "radiance").to_netcdf(tmp, engine="scipy")
-        out.append(path_nc)
+            out.append(path_nc)
+        if path_envi is not None:
+            out += _write_map_envi(da, path_envi, inputs)
+    return out
+
+
+def _write_map_envi(da, path_envi, inputs) -> list:
+    out = []
     if path_envi is not None:
         res = float(da.attrs["resolution_m"])
         E0 = float(da["E"].values[0]) - res / 2

@@ -41,7 +41,9 @@ SENSOR_SCHEMA = {
 CAMERA_SCHEMA = {
     "camera": {
         "n_bands": Key("int", required=True, positive=True, doc="number of bands"),
-        "pixel_mm": Key("float", required=True, positive=True, doc="pixel pitch, mm"),
+        "pixel_mm": Key(
+            "float", required=True, positive=True, limit=1.0, doc="pixel pitch, mm (at most 1)"
+        ),
         "c_mm": Key("float", required=True, positive=True, doc="principal distance, mm"),
         "x0_mm": Key("float", doc="principal point x, mm"),
         "y0_mm": Key("float", doc="principal point y, mm"),
