@@ -482,6 +482,13 @@ case(C, "degenerate", "nav-gap", "--max-nav-gap-s", [("nav.csv", delete_rows(20,
 case(C, "degenerate", "nav-one-row", "navigation", [("nav.csv", keep_rows(1))])
 case(C, "degenerate", "nav-not-covering", "t_s", [("nav.csv", keep_rows(20))])
 case(C, "mistyped", "gcp-unknown-id", "999999", [("gcp.csv", set_cell("point_id", "999999"))])
+case(
+    C,
+    "degenerate",
+    "point-observed-once",
+    "999999",
+    [("obs.csv", set_cell("point_id", "999999", 0))],
+)
 case(C, "range", "band-negative", "band", [("obs.csv", set_cell("band", "-1"))])
 case(C, "range", "band-too-large", "n_bands", [("obs.csv", set_cell("band", "7"))])
 case(C, "type", "band-fraction", "band", [("obs.csv", set_cell("band", "1.5"))])
@@ -758,6 +765,22 @@ case(C, "missing", "dem-missing", "dem.nc", [("dem.nc", remove)], argv=_dem)
 case(C, "empty", "dem-empty", "dem.nc", [("dem.nc", text(""))], argv=_dem)
 case(C, "mistyped", "dem-is-lines", "height", [("dem.nc", copy_from("lines.nc"))], argv=_dem)
 case(C, "nonfinite", "dem-nan", "DEM", [("dem.nc", nc_edit(lambda ds: ds * np.nan))], argv=_dem)
+case(
+    C,
+    "mistyped",
+    "dem-x-y-dimensions",
+    "dimensions N, E",
+    [("dem.nc", nc_edit(lambda ds: ds.rename(N="y", E="x")))],
+    argv=_dem,
+)
+case(
+    C,
+    "degenerate",
+    "dem-one-cell",
+    "2 x 2 cells",
+    [("dem.nc", nc_edit(lambda ds: ds.isel(N=[0], E=[0])))],
+    argv=_dem,
+)
 case(
     C,
     "degenerate",

@@ -54,6 +54,11 @@ def open_netcdf(path, variable: str, what: str, remedy: str):
         )
     try:
         ds = xr.open_dataset(path, engine=engine)
+    except ImportError:
+        raise InputError(
+            f"{role} {str(path)!r} is NetCDF-4 (HDF5): reading it needs the h5py package (pip "
+            "install h5py), or save the file as NetCDF 3 classic"
+        ) from None
     except Exception as exc:  # noqa: BLE001 - any reader error becomes an InputError
         msg = " ".join(str(exc).split())[:200]
         raise InputError(

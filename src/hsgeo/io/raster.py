@@ -79,7 +79,21 @@ def read_dem(path):
     xarray.DataArray
         The variable ``height``, loaded into memory.
     """
+    from hsgeo.errors import InputError
+
     ds = open_netcdf(path, "height", "DEM ", "it needs height(N, E) in metres")
     h = ds["height"].load()
     ds.close()
+    if set(h.dims) != {"N", "E"} or "N" not in h.coords or "E" not in h.coords:
+        raise InputError(
+            f"DEM file {str(path)!r}: height must have dimensions N, E with coordinates in "
+            f"metres, got dimensions {h.dims}; rename them (northing N, easting E)"
+        )
+    if h.sizes["N"] < 2 or h.sizes["E"] < 2:
+        raise InputError(f"DEM file {str(path)!r}: needs at least 2 x 2 cells, got {h.shape}")
+    if not np.all(np.isfinite(h.values)):
+        raise InputError(
+            f"DEM file {str(path)!r}: height has {int(np.sum(~np.isfinite(h.values)))} NaN or "
+            "infinite cell(s); fill them before geocoding"
+        )
     return h

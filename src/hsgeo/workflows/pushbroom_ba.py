@@ -336,6 +336,14 @@ def adjust_files(
         remedy=f"bands are numbered 0 to n_bands - 1 (n_bands = {cam.n_bands} in the camera file)",
     )
     ids, point = np.unique(obs_df["point_id"].to_numpy(), return_inverse=True)
+    once = ids[np.bincount(point, minlength=ids.size) < 2]
+    if once.size:
+        raise InputError(
+            f"observation file {str(observations)!r}: point_id(s) {', '.join(once[:5])}"
+            + (f" (and {once.size - 5} more)" if once.size > 5 else "")
+            + " observed in one row only; a tie point needs two rays: add its other "
+            "observations or delete the row"
+        )
     t = obs_df["t_s"].to_numpy(dtype=float)
     check_navigation_covers(
         traj.t_s,
