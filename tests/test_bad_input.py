@@ -455,6 +455,14 @@ case(C, "mistyped", "obs-unknown-point", "999999", [("obs.csv", set_cell("point"
 case(C, "degenerate", "obs-three-rows", "at least", [("obs.csv", keep_rows(3))])
 case(C, "range", "zeta-negative-huge", "zeta_px", [("obs.csv", set_cell("zeta_px", "-5e7"))])
 case(C, "units", "control-in-mm", "control", [("control.csv", scale_column("x_m", 1e6))])
+case(C, "degenerate", "control-collinear", "collinear", [("control.csv", scale_column("y_m", 0.0))])
+case(
+    C,
+    "degenerate",
+    "image-all-zeta-equal",
+    "image img0",
+    [("obs.csv", lambda p: _set_image_zeta(p, "img0", "100.0"))],
+)
 for o, vals in {
     "--sigma-px": ["0", "-1", "nan", "inf", "abc"],
     "--zeta0-px": ["nan", "inf", "abc", "1e300"],
@@ -850,6 +858,11 @@ case(C, "output", "output-is-directory", "directory", argv=lambda a, d: opt("-o"
 case(C, "output", "output-exists", "--overwrite", argv=lambda a, d: _touch_output(a, d))
 case(C, "output", "envi-exists", "--overwrite", argv=lambda a, d: _touch_envi(a, d))
 case(C, "output", "output-dir-readonly", "writ", argv=lambda a, d: _readonly_output(a, d))
+
+
+def _set_image_zeta(p, image, value):
+    h, rows = read_csv(p)
+    write_csv(p, h, [[r[0], r[1], value] if r[0] == image else r for r in rows])
 
 
 def _drop_attr(ds, a):

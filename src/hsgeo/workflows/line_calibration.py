@@ -13,7 +13,7 @@ import re
 import numpy as np
 
 from hsgeo.adjust import Parameters, adjust
-from hsgeo.errors import InputError, ObservationError
+from hsgeo.errors import HsgeoError, InputError, ObservationError
 from hsgeo.io import read_table
 from hsgeo.measure.line_minima import associate_by_order, find_minima
 from hsgeo.sensors.line1d import (
@@ -174,9 +174,25 @@ def calibrate_files(
     except ObservationError as exc:  # the user's image id instead of its index
         msg = re.sub(r"^image (\d+)", lambda m: f"image {image_ids[int(m.group(1))]}", str(exc))
         raise ObservationError(f"observation file {str(observations)!r}: {msg}") from None
-    eop = np.array(
-        [resect(xy[pt[img == i]], z[img == i], zeta0_px, c_px).eop for i in range(len(image_ids))]
-    )
+    seen = xy[np.unique(pt)]
+    if np.linalg.svd(seen - seen.mean(axis=0), compute_uv=False)[-1] <= 1e-9 * max(
+        1.0, float(np.abs(seen).max())
+    ):
+        raise InputError(
+            f"control file {str(control)!r}: the observed points all lie on one line (x_m, y_m "
+            "collinear): the scale c is undetermined; add control points off the pattern line "
+            "(e.g. side signals in front of it)"
+        )
+    eop = []
+    for i, name in enumerate(image_ids):
+        try:
+            eop.append(resect(xy[pt[img == i]], z[img == i], zeta0_px, c_px).eop)
+        except HsgeoError as exc:
+            raise InputError(
+                f"observation file {str(observations)!r}, image {name}: {exc}; check its zeta_px "
+                "values and point ids, and --zeta0-px / --c-px"
+            ) from None
+    eop = np.array(eop)
     p = make_parameters(
         eop,
         zeta0_px,
