@@ -740,6 +740,13 @@ case(
     "[sensr]",
     [("sensor.toml", toml_append("[sensr]\nc = 1\n"))],
 )
+case(
+    C,
+    "mistyped",
+    "sensor-ifov-with-K",
+    "model = 'calibrated'",
+    [("sensor.toml", toml_set("sensor", "model", "'linear-ifov'"))],
+)
 case(C, "missing", "sensor-missing", "sensor.toml", [("sensor.toml", remove)])
 case(C, "empty", "sensor-empty", "[sensor]", [("sensor.toml", text(""))])
 case(C, "binary", "sensor-binary", "sensor.toml", [("sensor.toml", text(BINARY))])

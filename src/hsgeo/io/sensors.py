@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from hsgeo.errors import InputError
 from hsgeo.io.config import Key, read_config
 
 __all__ = ["SENSOR_SCHEMA", "CAMERA_SCHEMA", "read_sensor_toml", "read_camera_toml"]
@@ -88,6 +89,11 @@ def read_sensor_toml(path):
     from hsgeo.geocode import CalibratedLine, LinearIFOV
 
     s = read_config(path, SENSOR_SCHEMA, "sensor file", required_tables=("sensor",))["sensor"]
+    if s["model"] == "linear-ifov" and any(s["K"]):
+        raise InputError(
+            f"sensor file {path}: [sensor] K is the distortion of model 'calibrated'; remove it "
+            "or set model = 'calibrated' (model 'linear-ifov' has no distortion)"
+        )
     if s["model"] == "calibrated":
         geom = CalibratedLine(s["zeta0_px"], s["c_px"], tuple(s["K"]))
     else:
