@@ -319,12 +319,17 @@ def test_lines_round_trip_and_errors(tmp_path):
     with pytest.raises(InputError, match="no variable 'radiance'"):
         read_lines(tmp_path / "b.nc")
     xr.Dataset({"radiance": (("line", "pixel"), r[0])}).to_netcdf(tmp_path / "c.nc", engine="scipy")
+    with pytest.raises(InputError, match="no coordinate 'pixel'"):
+        read_lines(tmp_path / "c.nc")
+    xr.Dataset(
+        {"radiance": (("line", "pixel"), r[0])}, coords={"pixel": [10.0, 11, 12, 13]}
+    ).to_netcdf(tmp_path / "c.nc", engine="scipy")
     with pytest.raises(InputError, match="attribute 't0_s' missing"):
         read_lines(tmp_path / "c.nc")
-    with pytest.raises(InputError, match="none.nc not found"):
+    with pytest.raises(InputError, match="none.nc' not found"):
         read_lines(tmp_path / "none.nc")
     (tmp_path / "t.nc").write_text("text")
-    with pytest.raises(InputError, match="not a readable NetCDF"):
+    with pytest.raises(InputError, match="t.nc' is not a NetCDF file"):
         read_lines(tmp_path / "t.nc")
 
 

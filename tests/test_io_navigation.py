@@ -83,7 +83,7 @@ def test_errors_name_the_file_and_the_remedy(tmp_path):
     d = df.copy()
     d.loc[3, "E_m"] = np.nan
     d.to_csv(tmp_path / "b.csv", index=False)
-    with pytest.raises(InputError, match=r"line\(s\) \[5\]"):
+    with pytest.raises(InputError, match=r"line 5, column E_m"):
         read_trajectory(tmp_path / "b.csv")
     df.iloc[::-1].to_csv(tmp_path / "c.csv", index=False)
     with pytest.raises(InputError, match="c.csv.*increase strictly"):
@@ -91,9 +91,9 @@ def test_errors_name_the_file_and_the_remedy(tmp_path):
     d = df.astype({"U_m": object})
     d.loc[2, "U_m"] = "high"
     d.to_csv(tmp_path / "d.csv", index=False)
-    with pytest.raises(InputError, match="non-numeric"):
+    with pytest.raises(InputError, match="column U_m: 'high' is not a number"):
         read_trajectory(tmp_path / "d.csv")
-    with pytest.raises(InputError, match="does not exist"):
+    with pytest.raises(InputError, match="missing.csv' not found"):
         read_trajectory(tmp_path / "missing.csv")
     (tmp_path / "e.parquet").write_text("not parquet")
     with pytest.raises(InputError, match="not a readable"):

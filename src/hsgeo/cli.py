@@ -11,7 +11,8 @@ import io
 import os
 import sys
 
-from hsgeo.errors import HsgeoError
+from hsgeo.errors import ConvergenceError, HsgeoError
+from hsgeo.validate import option_number
 
 __all__ = ["main", "EXIT_INTERRUPTED", "EXIT_BROKEN_PIPE"]
 
@@ -99,7 +100,9 @@ def _cmd_calibrate_frame(args) -> int:
 def _cmd_data(args) -> int:
     from hsgeo.reproduce.data import generate_all
 
-    return generate_all(verify=args.verify, update=args.update_manifest)
+    return generate_all(
+        verify=args.verify, update=args.update_manifest, out=args.out, overwrite=args.overwrite
+    )
 
 
 def _cmd_adjust_pushbroom(args) -> int:
@@ -115,6 +118,7 @@ def _cmd_adjust_pushbroom(args) -> int:
         node_interval_s=args.node_interval,
         progress=True,
         y_as_time=not args.image_y,
+        max_nav_gap_s=args.max_nav_gap_s,
     )
     res = out.pop("_result")
     print(json.dumps(out, indent=1) if args.json else res.report(max_block_size=20))
@@ -149,6 +153,9 @@ def _cmd_geocode(args) -> int:
         resolution_m=args.resolution,
         envi=args.envi,
         progress=not args.quiet,
+        overwrite=args.overwrite,
+        max_grid_gib=args.max_grid_gib,
+        max_nav_gap_s=args.max_nav_gap_s,
     )
     print(
         f"orthorectified {ortho.sizes['band']} band(s) onto {ortho.sizes['N']} x "
@@ -157,11 +164,24 @@ def _cmd_geocode(args) -> int:
     return 0
 
 
+_POSITIVE = option_number(positive=True)
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors: ``hsgeo geocode: error: ... (see hsgeo geocode --help)``
+    and exit status 2 (the usage, which wraps over many lines, is left to ``--help``).
+    """
+
+    def error(self, message: str):
+        msg = " ".join(message.split())
+        self.exit(2, f"{self.prog}: error: {msg} (see {self.prog} --help)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
     from hsgeo import __version__
     from hsgeo.reproduce import chapter_names
 
-    ap = argparse.ArgumentParser(
+    ap = _Parser(
         prog="hsgeo",
         description="Geometry of hyperspectral sensors: reproduce the book's tables, calibrate, "
         "geocode.",
@@ -176,10 +196,15 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="CHAPTER",
         help="one of: " + ", ".join(chapter_names()),
     )
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0); any works")
+    p.add_argument(
+        "--seed",
+        type=option_number(integer=True, lo=0),
+        default=0,
+        help="random seed (default 0); any works",
+    )
     p.add_argument(
         "--scale",
-        type=float,
+        type=option_number(positive=True, hi=1.0),
         default=1.0,
         help="problem size in (0, 1] for chapters that have a size knob (default 1)",
     )
@@ -195,12 +220,22 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("observations", metavar="OBSERVATIONS")
     p.add_argument("--control", required=True, metavar="CONTROL")
-    p.add_argument("--zeta0-px", type=float, default=485.0, help="initial ζ0 (000 Table 1: 485)")
-    p.add_argument("--c-px", type=float, default=3600.0, help="initial c (000 Table 1: 3600)")
-    p.add_argument("--sigma-px", type=float, default=0.1, help="a-priori σ of ζ (px)")
+    p.add_argument(
+        "--zeta0-px",
+        type=option_number(lo=-1e6, hi=1e6),
+        default=485.0,
+        help="initial ζ0 (000 Table 1: 485)",
+    )
+    p.add_argument(
+        "--c-px",
+        type=option_number(positive=True, hi=1e6),
+        default=3600.0,
+        help="initial c (000 Table 1: 3600)",
+    )
+    p.add_argument("--sigma-px", type=_POSITIVE, default=0.1, help="a-priori σ of ζ (px, positive)")
     p.add_argument(
         "--reject-k",
-        type=float,
+        type=_POSITIVE,
         default=None,
         help="reject observations whose standardised residual exceeds k robust σ (default: none)",
     )
@@ -227,7 +262,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--cube-regex", help="regex with one group: cube (view) from the file name")
     p.add_argument(
         "--sigma-px",
-        type=float,
+        type=_POSITIVE,
         default=0.1,
         help="a-priori σ of an image point in px (default 0.1)",
     )
@@ -246,6 +281,14 @@ def build_parser() -> argparse.ArgumentParser:
         action="store_true",
         help="rewrite the manifest from what was generated (after a deliberate change)",
     )
+    p.add_argument(
+        "--out",
+        metavar="DIR",
+        help="folder for the generated files (default: data_synthetic/generated of the "
+        "repository the working directory is in, else ./data_synthetic/generated); never the "
+        "installed package",
+    )
+    p.add_argument("--overwrite", action="store_true", help="replace existing files in --out DIR")
     p.set_defaults(func=_cmd_data)
 
     p = sub.add_parser(
@@ -271,10 +314,30 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--sensor", required=True, metavar="SENSOR.toml")
     g = p.add_mutually_exclusive_group(required=True)
     g.add_argument("--dem", metavar="DEM.nc")
-    g.add_argument("--height", type=float, metavar="H", help="terrain height of a plane (m)")
+    g.add_argument(
+        "--height",
+        type=option_number(lo=-1e5, hi=1e5),
+        metavar="H",
+        help="terrain height of a plane (m)",
+    )
     p.add_argument("-o", "--output", required=True, metavar="ORTHO.nc")
     p.add_argument("--envi", metavar="PATH", help="also write ENVI BSQ + .hdr with map info")
-    p.add_argument("--resolution", type=float, default=0.5, help="cell size in m (default 0.5)")
+    p.add_argument(
+        "--overwrite", action="store_true", help="replace existing output files (default: refuse)"
+    )
+    p.add_argument("--resolution", type=_POSITIVE, default=0.5, help="cell size in m (default 0.5)")
+    p.add_argument(
+        "--max-grid-gib",
+        type=_POSITIVE,
+        default=2.0,
+        help="largest memory of the map grid, GiB (default 2); checked before the work",
+    )
+    p.add_argument(
+        "--max-nav-gap-s",
+        type=_POSITIVE,
+        default=1.0,
+        help="longest gap between navigation records interpolated across, s (default 1)",
+    )
     p.add_argument("--quiet", action="store_true", help="no progress display")
     p.set_defaults(func=_cmd_geocode)
 
@@ -300,8 +363,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--camera", required=True, help="camera and prior σ (TOML)")
     p.add_argument("--gcp", help="ground control points table (optional)")
     p.add_argument(
+        "--max-nav-gap-s",
+        type=_POSITIVE,
+        default=1.0,
+        help="longest gap between navigation records interpolated across, s (default 1)",
+    )
+    p.add_argument(
         "--node-interval",
-        type=float,
+        type=_POSITIVE,
         default=10.0,
         help="spline node interval in s (default 10, 002 §4)",
     )
@@ -332,8 +401,17 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
         return int(args.func(args) or 0)
+    except ConvergenceError:
+        print(
+            f"hsgeo {args.command}: error: the adjustment did not converge; look for gross "
+            "errors in the input files (a wrong unit, id or coordinate) and check the initial "
+            "values given as options",
+            file=sys.stderr,
+        )
+        return 2
     except HsgeoError as exc:
-        print(f"hsgeo {args.command}: error: {exc}", file=sys.stderr)
+        msg = " ".join(str(exc).split())  # one line, whatever the message
+        print(f"hsgeo {args.command}: error: {msg}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print(f"hsgeo {args.command}: interrupted", file=sys.stderr)

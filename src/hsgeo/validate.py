@@ -1,13 +1,66 @@
-"""Validation at the boundary: one place for the checks every public function makes."""
+"""Validation at the boundary: one place for the checks every reader, workflow and command makes.
+
+* :func:`finite_array` — numbers, all finite;
+* :func:`check_range` — values inside the range physics allows for their unit;
+* :func:`check_unique` — no id or row given twice (the lines and ids named);
+* :func:`check_navigation_covers` — a navigation solution covers the times it is used at,
+  without gaps longer than a tolerance;
+* :func:`option_number` — command-line numbers (finite, positive, in a range), as argparse
+  types whose errors name the option.
+
+Every failure is an :class:`~hsgeo.InputError` with a one-line message that names the file, the
+line / column / id or the option, and the remedy.
+"""
 
 from __future__ import annotations
+
+import argparse
+import math
+from collections.abc import Callable, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from hsgeo.errors import InputError
 
-__all__ = ["finite_array"]
+__all__ = [
+    "finite_array",
+    "check_range",
+    "check_unique",
+    "check_navigation_covers",
+    "option_number",
+    "UNIT_LIMITS",
+    "unit_limits",
+]
+
+#: The largest magnitude a value of a unit can plausibly have, by column-name ending: beyond it
+#: the value is a typo, a unit mistake or an uninitialised field (1e300). Pixels: no sensor has a
+#: million pixels across; metres: 1e8 m holds any projected or local coordinate; seconds: 1e10 s
+#: holds GPS and Unix time; angles: one turn either way (angles in other ranges are checked per
+#: column, e.g. pitch).
+UNIT_LIMITS = {
+    "_px": 1e6,
+    "_m": 1e8,
+    "_mm": 1e5,
+    "_um": 1e8,
+    "_nm": 1e6,
+    "_s": 1e10,
+    "_deg": 360.0,
+    "_rad": 2 * math.pi,
+    "_hz": 1e7,
+    "_m_s": 1e4,
+    "_rad_s": 1e3,
+    "_dn": 1e12,
+}
+
+
+def unit_limits(name: str) -> tuple[float, float] | None:
+    """``(lo, hi)`` for a column or key named with a unit suffix (:data:`UNIT_LIMITS`)."""
+    for suffix in sorted(UNIT_LIMITS, key=len, reverse=True):
+        if name.endswith(suffix):
+            m = UNIT_LIMITS[suffix]
+            return -m, m
+    return None
 
 
 def finite_array(a: ArrayLike, name: str) -> NDArray[np.float64]:
@@ -25,3 +78,157 @@ def finite_array(a: ArrayLike, name: str) -> NDArray[np.float64]:
             "remove or replace them before calling."
         )
     return arr
+
+
+def _where(where: Callable[[int], str] | None, i: int) -> str:
+    return where(i) if where is not None else f"row {i + 1}"
+
+
+def check_range(
+    values: ArrayLike,
+    lo: float,
+    hi: float,
+    what: str,
+    *,
+    where: Callable[[int], str] | None = None,
+    remedy: str = "correct the value (is the unit the one the name says?)",
+) -> None:
+    """Raise :class:`~hsgeo.InputError` if a value lies outside ``[lo, hi]``.
+
+    Parameters
+    ----------
+    values : array_like
+        Finite numbers.
+    lo, hi : float
+        The allowed range, inclusive.
+    what : str
+        Where the values come from, for the message (``"observation file 'o.csv', column t_s"``).
+    where : callable, optional
+        Index -> location (``"line 12"``) of a value.
+    remedy : str
+        What to do.
+    """
+    v = np.asarray(values, dtype=float).ravel()
+    bad = ~((v >= lo) & (v <= hi))
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        more = int(bad.sum()) - 1
+        raise InputError(
+            f"{what}, {_where(where, i)}: {v[i]:.6g} is outside [{lo:g}, {hi:g}]"
+            + (f" (and {more} more)" if more else "")
+            + f"; {remedy}"
+        )
+
+
+def check_unique(
+    keys: Sequence, what: str, label: str, *, where: Callable[[int], str] | None = None
+) -> None:
+    """Raise :class:`~hsgeo.InputError` if a key occurs twice (ids or whole rows).
+
+    Parameters
+    ----------
+    keys : sequence of hashable
+        One key per row (an id, or a tuple of the row's values).
+    what : str
+        The file, for the message.
+    label : str
+        What the key is (``"point"``, ``"row"``, ``"point_id"``).
+    where : callable, optional
+        Index -> location (``"line 12"``).
+    """
+    first: dict = {}
+    for i, k in enumerate(keys):
+        if k in first:
+            shown = k if not isinstance(k, tuple) else ", ".join(map(str, k))
+            raise InputError(
+                f"{what}: {label} {shown} is given twice ({_where(where, first[k])} and "
+                f"{_where(where, i)}); keep one row per {label.split(' ')[0]}"
+            )
+        first[k] = i
+
+
+def check_navigation_covers(
+    nav_t_s: ArrayLike,
+    t_s: ArrayLike,
+    *,
+    nav: str,
+    used: str,
+    max_gap_s: float,
+    gap_option: str = "--max-nav-gap-s",
+) -> None:
+    """The navigation covers the times ``t_s`` it is interpolated to, without long gaps.
+
+    Parameters
+    ----------
+    nav_t_s : (n,) array_like
+        Record times of the navigation, strictly increasing (s).
+    t_s : array_like
+        Times the navigation is used at (s).
+    nav : str
+        The navigation file, for the message.
+    used : str
+        What the times are (``"the lines of 'l.nc' (t0_s + line / line_rate_hz)"``).
+    max_gap_s : float
+        The longest interval between records that is interpolated across (s).
+    gap_option : str
+        The option that sets ``max_gap_s``, named in the message.
+    """
+    tn = np.asarray(nav_t_s, dtype=float)
+    t = np.asarray(t_s, dtype=float).ravel()
+    lo, hi = float(t.min()), float(t.max())
+    if lo < tn[0] or hi > tn[-1]:
+        raise InputError(
+            f"navigation file {nav} covers t_s {tn[0]:.6g} to {tn[-1]:.6g} s but "
+            f"{used} run from {lo:.6g} to {hi:.6g} s; give the navigation of the whole "
+            "acquisition, on the same time scale"
+        )
+    # a gap matters where the navigation is interpolated across it: a time strictly between
+    # two records farther apart than max_gap_s (times on a record use it as it is)
+    k = np.clip(np.searchsorted(tn, t, side="right") - 1, 0, tn.size - 2)
+    on_record = np.isclose(t, tn[k], rtol=0, atol=1e-9) | np.isclose(
+        t, tn[k + 1], rtol=0, atol=1e-9
+    )
+    gap = tn[k + 1] - tn[k]
+    bad = (gap > max_gap_s) & ~on_record
+    if bad.any():
+        j = int(k[np.flatnonzero(bad)[np.argmax(gap[bad])]])
+        raise InputError(
+            f"navigation file {nav}: a gap of {tn[j + 1] - tn[j]:.6g} s between the records at "
+            f"t_s = {tn[j]:.6g} and {tn[j + 1]:.6g} s (data rows {j + 1} and {j + 2}) is "
+            f"interpolated across for {used}, longer than {gap_option} {max_gap_s:g}; fill the "
+            f"gap, or allow it with {gap_option}"
+        )
+
+
+def option_number(
+    *,
+    positive: bool = False,
+    lo: float | None = None,
+    hi: float | None = None,
+    integer: bool = False,
+) -> Callable[[str], float]:
+    """An argparse ``type`` for a number option: finite, and optionally positive / in a range.
+
+    The error (argparse prints ``argument --sigma-px: must be a positive number, got '0'``)
+    names the option and the value.
+    """
+    if integer:
+        need = "a whole number"
+    else:
+        need = "a positive number" if positive else "a finite number"
+    if lo is not None or hi is not None:
+        need += f" in [{'-inf' if lo is None else f'{lo:g}'}, {'inf' if hi is None else f'{hi:g}'}]"
+
+    def parse(text: str):
+        try:
+            v = int(text) if integer else float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"must be {need}, got {text!r}") from None
+        ok = math.isfinite(v) and (not positive or v > 0)
+        ok = ok and (lo is None or v >= lo) and (hi is None or v <= hi)
+        if not ok:
+            raise argparse.ArgumentTypeError(f"must be {need}, got {text!r}")
+        return v
+
+    parse.__name__ = "number"
+    return parse

@@ -10,7 +10,7 @@ from pathlib import Path
 
 from hsgeo.errors import InputError
 
-__all__ = ["atomic_path", "refuse_inputs"]
+__all__ = ["atomic_path", "refuse_inputs", "check_outputs", "check_input_file", "read_text"]
 
 
 def refuse_inputs(output, inputs: Iterable = ()) -> Path:
@@ -40,6 +40,88 @@ def refuse_inputs(output, inputs: Iterable = ()) -> Path:
                 f"{out}: this is an input of the command and would be overwritten; "
                 "write the output to another file name"
             )
+    return out
+
+
+def check_input_file(path, what: str) -> Path:
+    """The input file ``path`` exists and is a file; :class:`~hsgeo.InputError` otherwise.
+
+    ``what`` names its role (``"observation file"``, ``"LINES file"``).
+    """
+    path = Path(path)
+    if path.is_dir():
+        raise InputError(f"{what} {str(path)!r} is a directory, not a file; give the file")
+    if not path.is_file():
+        raise InputError(f"{what} {str(path)!r} not found; check the path")
+    return path
+
+
+def read_text(path, what: str, kind: str) -> str:
+    """The text of a UTF-8 input file (a leading byte-order mark dropped, CRLF kept).
+
+    A binary file (NUL bytes, or bytes that are not UTF-8) raises :class:`~hsgeo.InputError`
+    naming the file and the ``kind`` of text expected (``"CSV table"``, ``"TOML"``).
+    """
+    path = check_input_file(path, what)
+    data = path.read_bytes()
+    try:
+        if b"\0" in data:
+            raise UnicodeDecodeError("utf-8", data, data.index(b"\0"), len(data), "NUL byte")
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise InputError(
+            f"{what} {str(path)!r} is not a {kind} text file (binary or not UTF-8 at byte "
+            f"{exc.start}); give the {kind} file, saved as UTF-8"
+        ) from None
+    return text
+
+
+def check_outputs(outputs, inputs: Iterable = (), *, overwrite: bool = False) -> list[Path]:
+    """Check the files a command will write, before it does any work.
+
+    Each output's folder must exist and be writable, the output must not be a folder, not one
+    of the ``inputs``, not given twice, and an existing file is replaced only with
+    ``overwrite``.
+
+    Parameters
+    ----------
+    outputs : iterable of (path or None, str)
+        Each output with the option that names it (``(ortho, "-o")``); ``None`` paths skipped.
+    inputs : iterable of path
+        The files the command reads.
+    overwrite : bool
+        The command's ``--overwrite``.
+
+    Returns
+    -------
+    list of Path
+    """
+    inputs = [p for p in inputs if p is not None]
+    seen: dict[Path, str] = {}
+    out = []
+    for p, option in outputs:
+        if p is None:
+            continue
+        p = Path(p)
+        refuse_inputs(p, inputs)
+        key = p.resolve()
+        if key in seen:
+            raise InputError(
+                f"{option} {p}: the same file as {seen[key]}; give each output its own name"
+            )
+        seen[key] = option
+        if p.is_dir():
+            raise InputError(f"{option} {p}: is a directory; give a file name in it")
+        folder = p.parent
+        if not folder.is_dir():
+            raise InputError(f"{option} {p}: the folder {folder} does not exist; create it first")
+        if not os.access(folder, os.W_OK | os.X_OK):
+            raise InputError(
+                f"{option} {p}: the folder {folder} is not writable; choose another folder"
+            )
+        if p.exists() and not overwrite:
+            raise InputError(f"{option} {p}: the file exists; use --overwrite to replace it")
+        out.append(p)
     return out
 
 

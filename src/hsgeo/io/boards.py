@@ -78,9 +78,15 @@ class Board:
             v = getattr(self, name)
             if v is not None and not v > 0:
                 raise InputError(f"board {name} must be positive, got {v}")
+        if self.type == "charuco" and not self.marker_mm < self.square_mm:
+            raise InputError(
+                f"marker_mm ({self.marker_mm:g}) must be smaller than square_mm "
+                f"({self.square_mm:g}): the marker is printed inside a white square"
+            )
         if self.nx < 2 or self.ny < 2:
             raise InputError(
-                f"a board needs at least 2 x 2 squares or markers, got {self.nx} x {self.ny}"
+                f"a board needs at least 2 x 2 squares or markers, got {self.nx} x {self.ny} "
+                "(squares_x/y or markers_x/y)"
             )
 
     @classmethod
@@ -173,7 +179,7 @@ BOARD_SCHEMA = {
         "separation_mm": Key("float", positive=True, doc="aruco_grid: gap between markers, mm"),
         "marker_mm": Key("float", positive=True, doc="marker side, mm"),
     },
-    "camera": {"pixel_mm": Key("float", positive=True, doc="pixel pitch, mm")},
+    "camera": {"pixel_mm": Key("float", positive=True, limit=1.0, doc="pixel pitch, mm")},
 }
 
 

@@ -15,10 +15,11 @@ from __future__ import annotations
 import difflib
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from hsgeo.errors import InputError
+from hsgeo.validate import unit_limits
 
 __all__ = ["Key", "read_toml", "read_config", "closest", "did_you_mean"]
 
@@ -45,6 +46,9 @@ class Key:
         Number of entries of a ``"floats"`` key.
     positive : bool
         Numbers must be > 0.
+    limit : float, optional
+        Numbers must not exceed this in magnitude (default: the plausible range of the unit
+        the key's name ends in, :data:`hsgeo.validate.UNIT_LIMITS`).
     """
 
     kind: str
@@ -54,6 +58,7 @@ class Key:
     choices: tuple = ()
     length: int | None = None
     positive: bool = False
+    limit: float | None = None
 
     def __post_init__(self):
         if self.kind not in _KINDS:
@@ -79,13 +84,14 @@ def read_toml(path, what: str = "file") -> dict:
     """
     import tomllib
 
+    from hsgeo.io._files import read_text
+
     path = Path(path)
-    if not path.is_file():
-        raise InputError(f"{what} {path} not found")
+    text = read_text(path, what, "TOML")
     try:
-        return tomllib.loads(path.read_text())
+        return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{path}: malformed TOML: {exc}") from None
+        raise InputError(f"{what} {path}: malformed TOML: {exc}; correct the file") from None
 
 
 def _number(v, key: Key, where: str, problems: list) -> float | None:
@@ -97,6 +103,9 @@ def _number(v, key: Key, where: str, problems: list) -> float | None:
         return None
     if key.positive and not v > 0:
         problems.append(f"{where}: must be positive, got {v!r}")
+        return None
+    if key.limit is not None and abs(v) > key.limit:
+        problems.append(f"{where}: {v!r} is outside [-{key.limit:g}, {key.limit:g}]")
         return None
     return float(v)
 
@@ -190,6 +199,10 @@ def read_config(
                 )
         for k, key in keys.items():
             where = f"[{t}] {k}"
+            if key.limit is None and key.kind in ("float", "floats"):
+                lim = unit_limits(k)
+                if lim is not None:
+                    key = replace(key, limit=lim[1])
             if k in table:
                 v = _value(table[k], key, where, problems)
                 if v is not None:

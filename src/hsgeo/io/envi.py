@@ -66,8 +66,6 @@ def write_envi(
         )
     hpath = path.with_name(path.name + ".hdr")
     refuse_inputs(hpath, inputs)
-    with atomic_path(path, inputs) as tmp:
-        arr.astype(arr.dtype.newbyteorder("<"), copy=False).tofile(tmp)
     b, lines, samples = arr.shape
     hdr = [
         "ENVI",
@@ -89,8 +87,11 @@ def write_envi(
     if wavelength_nm is not None:
         hdr.append("wavelength units = Nanometers")
         hdr.append("wavelength = {" + ", ".join(repr(float(x)) for x in wavelength_nm) + "}")
-    with atomic_path(hpath, inputs) as tmp:
-        tmp.write_text("\n".join(hdr) + "\n")
+    # both files or neither: the data and the header are renamed into place only after both
+    # were written
+    with atomic_path(path, inputs) as tmp, atomic_path(hpath, inputs) as htmp:
+        arr.astype(arr.dtype.newbyteorder("<"), copy=False).tofile(tmp)
+        htmp.write_text("\n".join(hdr) + "\n")
     return path, hpath
 
 

@@ -8,8 +8,6 @@ scale) and ``line_rate_hz``.
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
 from hsgeo.errors import InputError
@@ -37,12 +35,35 @@ def open_netcdf(path, variable: str, what: str, remedy: str):
     """
     import xarray as xr
 
-    if not Path(path).is_file():
-        raise InputError(f"{what}{path} not found; check the path")
+    from hsgeo.io._files import check_input_file
+
+    role = f"{what.strip() or 'LINES'} file"
+    path = check_input_file(path, role)
+    with open(path, "rb") as fh:
+        magic = fh.read(8)
+    # the engine from the file's signature, not xarray's guess (whose errors advise installing
+    # packages): classic NetCDF 'CDF\x01|2|5' -> scipy, NetCDF-4 (HDF5) -> h5netcdf
+    if magic[:3] == b"CDF":
+        engine = "scipy"
+    elif magic == b"\x89HDF\r\n\x1a\n":
+        engine = "h5netcdf"
+    else:
+        raise InputError(
+            f"{role} {str(path)!r} is not a NetCDF file (it does not start with a NetCDF or "
+            "HDF5 signature); give the NetCDF file"
+        )
     try:
-        ds = xr.open_dataset(path)
-    except (OSError, ValueError, ImportError) as exc:
-        raise InputError(f"{what}{path}: not a readable NetCDF file: {exc}") from None
+        ds = xr.open_dataset(path, engine=engine)
+    except ImportError:
+        raise InputError(
+            f"{role} {str(path)!r} is NetCDF-4 (HDF5): reading it needs the h5py package (pip "
+            "install h5py), or save the file as NetCDF 3 classic"
+        ) from None
+    except Exception as exc:  # noqa: BLE001 - any reader error becomes an InputError
+        msg = " ".join(str(exc).split())[:200]
+        raise InputError(
+            f"{role} {str(path)!r}: not a readable NetCDF file ({msg}); give an intact file"
+        ) from None
     if variable not in ds:
         raise InputError(
             f"{what}{path}: no variable {variable!r} (found {list(ds.data_vars)}); {remedy}"
@@ -65,27 +86,62 @@ def read_lines(path):
         Time of line 0 (s).
     line_rate_hz : float
     """
+    from hsgeo.validate import check_range
+
     ds = open_netcdf(path, "radiance", "", "the recorded values must be called radiance")
-    da = ds["radiance"]
-    if "band" not in da.dims:
-        da = da.expand_dims("band")
-    if set(da.dims) != {"band", "line", "pixel"}:
-        raise InputError(
-            f"{path}: radiance must have dimensions (band,) line, pixel; got {da.dims}"
-        )
-    for a in ("t0_s", "line_rate_hz"):
-        if a not in ds.attrs and a not in da.attrs:
+    name = f"LINES file {str(path)!r}"
+    try:
+        da = ds["radiance"]
+        if "band" not in da.dims:
+            da = da.expand_dims("band")
+        if set(da.dims) != {"band", "line", "pixel"}:
             raise InputError(
-                f"{path}: attribute {a!r} missing (time of line 0, line rate); "
-                "add it to the file's global attributes"
+                f"{name}: radiance must have dimensions (band,) line, pixel; got {da.dims}"
             )
-    attrs = {**ds.attrs, **da.attrs}
-    out = (
-        da.transpose("band", "line", "pixel").load(),
-        float(attrs["t0_s"]),
-        float(attrs["line_rate_hz"]),
-    )
-    ds.close()
+        if "pixel" not in da.coords:
+            raise InputError(
+                f"{name}: no coordinate 'pixel' (ζ of each column, px); add it: without it the "
+                "columns' positions in the image are unknown"
+            )
+        attrs = {**ds.attrs, **da.attrs}
+        values = {}
+        for a, doc in (("t0_s", "time of line 0, s"), ("line_rate_hz", "line rate, Hz")):
+            if a not in attrs:
+                raise InputError(
+                    f"{name}: attribute {a!r} missing ({doc}); add it to the file's global "
+                    "attributes"
+                )
+            try:
+                v = float(np.asarray(attrs[a]).item())
+            except (TypeError, ValueError):
+                v = None
+            if v is None or not np.isfinite(v) or (a == "line_rate_hz" and not v > 0):
+                need = "a positive number" if a == "line_rate_hz" else "a finite number"
+                raise InputError(
+                    f"{name}: attribute {a} = {attrs[a]!r} must be {need} ({doc}); correct it"
+                )
+            values[a] = v
+        check_range(values["t0_s"], -1e10, 1e10, f"{name}: attribute t0_s")
+        da = da.transpose("band", "line", "pixel")
+        if da.sizes["line"] < 2 or da.sizes["pixel"] < 2:
+            raise InputError(
+                f"{name}: radiance has {da.sizes['line']} line(s) of {da.sizes['pixel']} "
+                "pixel(s); an image needs at least 2 lines and 2 pixels"
+            )
+        zeta = np.asarray(da["pixel"].values, dtype=float)
+        if not np.all(np.isfinite(zeta)):
+            raise InputError(f"{name}: the coordinate pixel (ζ, px) has NaN or infinite values")
+        check_range(zeta, -1e6, 1e6, f"{name}: coordinate pixel (ζ, px)")
+        d = np.diff(zeta)
+        if not (np.all(d > 0) or np.all(d < 0)):
+            i = int(np.flatnonzero(~(d * np.sign(d[0]) > 0))[0])
+            raise InputError(
+                f"{name}: the coordinate pixel (ζ, px) must increase or decrease strictly; "
+                f"columns {i} and {i + 1} have {zeta[i]:g} and {zeta[i + 1]:g}"
+            )
+        out = (da.load(), values["t0_s"], values["line_rate_hz"])
+    finally:
+        ds.close()
     return out
 
 

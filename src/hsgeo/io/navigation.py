@@ -44,22 +44,21 @@ _OLD_PUSHBROOM_COLUMNS = ("H_m", "roll_rad", "pitch_rad", "yaw_rad")
 _FORMAT = ", ".join(NAV_COLUMNS)
 
 
-def _read_table(path: Path):
-    import pandas as pd
+#: Allowed ranges of the navigation's angles (degrees): roll one turn either way, pitch within
+#: ±90, heading 100 turns either way (an unwrapped heading passes 360 after each turn).
+NAV_LIMITS = {
+    "roll_deg": (-360.0, 360.0),
+    "pitch_deg": (-90.0, 90.0),
+    "heading_deg": (-36000.0, 36000.0),
+}
 
-    if not path.is_file():
-        raise InputError(f"navigation file {str(path)!r} does not exist")
-    try:
-        if path.suffix.lower() in (".parquet", ".pq"):
-            df = pd.read_parquet(path)
-        else:
-            df = pd.read_csv(path, comment="#")
-    except Exception as exc:  # noqa: BLE001 - any parser error becomes an InputError
-        raise InputError(
-            f"navigation file {str(path)!r} is not a readable CSV or Parquet table: {exc}"
-        ) from exc
-    df.columns = [str(c).strip() for c in df.columns]
-    return df
+#: The fastest plausible rotation (degrees per second) between two records, of each angle
+#: (differences taken modulo 360): beyond it a record is off or the angles are not in degrees.
+MAX_RATE_DEG_S = 360.0
+
+#: The fastest plausible platform (m/s) between two records: beyond it a record is off (a
+#: position jump, a wrong unit or time scale). Airborne platforms fly below 300 m/s.
+MAX_SPEED_M_S = 1000.0
 
 
 def read_trajectory(path) -> Trajectory:
@@ -80,45 +79,82 @@ def read_trajectory(path) -> Trajectory:
     ------
     InputError
         If the file is missing or unreadable, lacks a column (the former adjust-pushbroom
-        format gets the conversion to the new columns), has empty, NaN or non-numeric values,
-        or its times do not increase strictly.
+        format gets the conversion to the new columns), has empty, NaN, non-numeric or
+        out-of-range values (:data:`NAV_LIMITS`), has fewer than 2 records, times that do not
+        increase strictly, or a jump between records faster than :data:`MAX_SPEED_M_S`; the
+        message names the line and the column.
     """
+    from hsgeo.io.tables import read_table
+
     path = Path(path)
-    df = _read_table(path)
-    missing = [c for c in NAV_COLUMNS if c not in df.columns]
-    if missing:
-        if all(c in df.columns for c in _OLD_PUSHBROOM_COLUMNS):
-            raise InputError(
-                f"navigation file {str(path)!r} is in the former adjust-pushbroom format "
-                "(t_s, E_m, N_m, H_m, roll_rad, pitch_rad, yaw_rad: ENU platform angles). The "
-                f"navigation format of every command is now: {_FORMAT} (degrees; the GNSS/INS "
-                "attitude of the body x forward, y right, z down in north-east-down). Convert: "
-                "U_m = H_m, roll_deg = degrees(roll_rad), pitch_deg = -degrees(pitch_rad), "
-                "heading_deg = 90 - degrees(yaw_rad) (hsgeo.trajectory.rph_from_platform_rpy)"
-            )
-        raise InputError(
-            f"navigation file {str(path)!r} lacks the column(s) {missing}; it has "
-            f"{list(df.columns)} and needs {_FORMAT} (positions east-north-up in m, attitude "
-            "roll, pitch, heading of the body in north-east-down in degrees)"
-        )
-    sub = df[list(NAV_COLUMNS)]
+    name = f"navigation file {str(path)!r}"
     try:
-        table = sub.to_numpy(dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise InputError(
-            f"navigation file {str(path)!r} has non-numeric values in {_FORMAT}: {exc}"
-        ) from None
-    bad = ~np.all(np.isfinite(table), axis=1)
-    if bad.any():
-        rows = (np.flatnonzero(bad)[:5] + 2).tolist()
-        raise InputError(
-            f"navigation file {str(path)!r}: empty, NaN or infinite values in line(s) {rows} "
-            "(line 1 = the header)"
-        )
-    try:
-        return Trajectory(table[:, 0], table[:, 1:4], np.deg2rad(table[:, 4:7]))
+        df = read_table(path, NAV_COLUMNS, "navigation", limits=NAV_LIMITS, unique_rows=False)
     except InputError as exc:
-        raise InputError(f"navigation file {str(path)!r}: {exc}") from None
+        if "missing column" in str(exc):
+            _check_old_format(path)
+        raise
+    lines = _data_lines_of(path, len(df))
+    table = df[list(NAV_COLUMNS)].to_numpy(dtype=np.float64)
+    t = table[:, 0]
+    if t.size < 2:
+        raise InputError(f"{name} has {t.size} record; a navigation needs at least 2")
+    dt = np.diff(t)
+    if np.any(dt <= 0):
+        i = int(np.flatnonzero(dt <= 0)[0])
+        raise InputError(
+            f"{name}, {lines[i + 1]}, column t_s: {t[i + 1]:.17g} s does not come after "
+            f"{t[i]:.17g} s of {lines[i]}; times must increase strictly (sort the records, drop "
+            "duplicates)"
+        )
+    speed = np.linalg.norm(np.diff(table[:, 1:4], axis=0), axis=1) / dt
+    if np.any(speed > MAX_SPEED_M_S):
+        i = int(np.flatnonzero(speed > MAX_SPEED_M_S)[0])
+        raise InputError(
+            f"{name}: the position jumps by {speed[i] * dt[i]:.6g} m in {dt[i]:.6g} s between "
+            f"{lines[i]} and {lines[i + 1]} ({speed[i]:.3g} m/s, more than {MAX_SPEED_M_S:g}); "
+            "correct the record (positions E_m, N_m, U_m in metres, t_s in seconds)"
+        )
+    for j, c in enumerate(("roll_deg", "pitch_deg", "heading_deg")):
+        d = (np.diff(table[:, 4 + j]) + 180.0) % 360.0 - 180.0
+        rate = np.abs(d) / dt
+        if np.any(rate > MAX_RATE_DEG_S):
+            i = int(np.flatnonzero(rate > MAX_RATE_DEG_S)[0])
+            raise InputError(
+                f"{name}, column {c}: the angle turns by {d[i]:.6g}° in {dt[i]:.6g} s between "
+                f"{lines[i]} and {lines[i + 1]} ({rate[i]:.3g}°/s, more than "
+                f"{MAX_RATE_DEG_S:g}°/s); correct the record (angles in degrees, t_s in seconds)"
+            )
+    return Trajectory(t, table[:, 1:4], np.deg2rad(table[:, 4:7]))
+
+
+def _data_lines_of(path: Path, n: int) -> list[str]:
+    """``"line k"`` of each record of a CSV (``"row k"`` for Parquet)."""
+    from hsgeo.io._files import read_text
+    from hsgeo.io.tables import _PARQUET, _data_lines
+
+    if path.suffix.lower() in _PARQUET:
+        return [f"row {i + 1}" for i in range(n)]
+    return [f"line {k}" for k in _data_lines(read_text(path, "navigation file", "CSV table"))]
+
+
+def _check_old_format(path: Path) -> None:
+    """The former adjust-pushbroom format gets the conversion to the new columns."""
+    import pandas as pd
+
+    try:
+        cols = [str(c).strip() for c in pd.read_csv(path, nrows=0, comment="#").columns]
+    except Exception:  # noqa: BLE001 - the reader's own message stands
+        return
+    if all(c in cols for c in _OLD_PUSHBROOM_COLUMNS):
+        raise InputError(
+            f"navigation file {str(path)!r} is in the former adjust-pushbroom format "
+            "(t_s, E_m, N_m, H_m, roll_rad, pitch_rad, yaw_rad: ENU platform angles). The "
+            f"navigation format of every command is now: {_FORMAT} (degrees; the GNSS/INS "
+            "attitude of the body x forward, y right, z down in north-east-down). Convert: "
+            "U_m = H_m, roll_deg = degrees(roll_rad), pitch_deg = -degrees(pitch_rad), "
+            "heading_deg = 90 - degrees(yaw_rad) (hsgeo.trajectory.rph_from_platform_rpy)"
+        )
 
 
 def write_trajectory(path, traj: Trajectory, *, inputs: Iterable = ()) -> Path:

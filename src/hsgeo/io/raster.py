@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 from pathlib import Path
 
 import numpy as np
@@ -41,10 +42,18 @@ def to_map_files(da, path_nc=None, path_envi=None, *, inputs=()) -> list:
     if path_envi is not None:
         refuse_inputs(Path(str(path_envi) + ".hdr"), inputs)
     out = []
-    if path_nc is not None:
-        with atomic_path(path_nc, inputs) as tmp:
+    with contextlib.ExitStack() as stack:  # all files or none: a failing ENVI removes the .nc
+        if path_nc is not None:
+            tmp = stack.enter_context(atomic_path(path_nc, inputs))
             da.to_dataset(name=da.name or "radiance").to_netcdf(tmp, engine="scipy")
-        out.append(path_nc)
+            out.append(path_nc)
+        if path_envi is not None:
+            out += _write_map_envi(da, path_envi, inputs)
+    return out
+
+
+def _write_map_envi(da, path_envi, inputs) -> list:
+    out = []
     if path_envi is not None:
         res = float(da.attrs["resolution_m"])
         E0 = float(da["E"].values[0]) - res / 2
@@ -70,7 +79,21 @@ def read_dem(path):
     xarray.DataArray
         The variable ``height``, loaded into memory.
     """
+    from hsgeo.errors import InputError
+
     ds = open_netcdf(path, "height", "DEM ", "it needs height(N, E) in metres")
     h = ds["height"].load()
     ds.close()
+    if set(h.dims) != {"N", "E"} or "N" not in h.coords or "E" not in h.coords:
+        raise InputError(
+            f"DEM file {str(path)!r}: height must have dimensions N, E with coordinates in "
+            f"metres, got dimensions {h.dims}; rename them (northing N, easting E)"
+        )
+    if h.sizes["N"] < 2 or h.sizes["E"] < 2:
+        raise InputError(f"DEM file {str(path)!r}: needs at least 2 x 2 cells, got {h.shape}")
+    if not np.all(np.isfinite(h.values)):
+        raise InputError(
+            f"DEM file {str(path)!r}: height has {int(np.sum(~np.isfinite(h.values)))} NaN or "
+            "infinite cell(s); fill them before geocoding"
+        )
     return h

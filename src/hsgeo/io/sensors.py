@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from hsgeo.errors import InputError
 from hsgeo.io.config import Key, read_config
 
 __all__ = ["SENSOR_SCHEMA", "CAMERA_SCHEMA", "read_sensor_toml", "read_camera_toml"]
@@ -41,7 +42,9 @@ SENSOR_SCHEMA = {
 CAMERA_SCHEMA = {
     "camera": {
         "n_bands": Key("int", required=True, positive=True, doc="number of bands"),
-        "pixel_mm": Key("float", required=True, positive=True, doc="pixel pitch, mm"),
+        "pixel_mm": Key(
+            "float", required=True, positive=True, limit=1.0, doc="pixel pitch, mm (at most 1)"
+        ),
         "c_mm": Key("float", required=True, positive=True, doc="principal distance, mm"),
         "x0_mm": Key("float", doc="principal point x, mm"),
         "y0_mm": Key("float", doc="principal point y, mm"),
@@ -86,6 +89,11 @@ def read_sensor_toml(path):
     from hsgeo.geocode import CalibratedLine, LinearIFOV
 
     s = read_config(path, SENSOR_SCHEMA, "sensor file", required_tables=("sensor",))["sensor"]
+    if s["model"] == "linear-ifov" and any(s["K"]):
+        raise InputError(
+            f"sensor file {path}: [sensor] K is the distortion of model 'calibrated'; remove it "
+            "or set model = 'calibrated' (model 'linear-ifov' has no distortion)"
+        )
     if s["model"] == "calibrated":
         geom = CalibratedLine(s["zeta0_px"], s["c_px"], tuple(s["K"]))
     else:

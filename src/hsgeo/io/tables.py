@@ -8,11 +8,13 @@ text. Every error names the file, the line and the column, and what to do.
 
 from __future__ import annotations
 
+import io
 from pathlib import Path
 
 import numpy as np
 
 from hsgeo.errors import InputError
+from hsgeo.io._files import check_input_file, read_text
 from hsgeo.io.config import closest
 
 __all__ = ["read_table", "UNIT_SUFFIXES"]
@@ -40,37 +42,56 @@ def _has_unit(column: str) -> bool:
     return any(column.endswith(s) for s in UNIT_SUFFIXES)
 
 
-def _data_lines(path: Path) -> list[int]:
+def _data_lines(text: str) -> list[int]:
     """1-based file line numbers of the data rows of a CSV (after the header; no blank lines,
     no ``#`` comment lines), as pandas counts its rows.
     """
     lines = []
     header = False
-    with path.open(encoding="utf-8", errors="replace") as fh:
-        for i, line in enumerate(fh, 1):
-            s = line.strip()
-            if not s or s.startswith("#"):
-                continue
-            if header:
-                lines.append(i)
-            header = True
+    for i, line in enumerate(text.splitlines(), 1):
+        s = line.strip()
+        if not s or s.startswith("#"):
+            continue
+        if header:
+            lines.append(i)
+        header = True
     return lines
 
 
-def read_table(path, columns, what: str = "table", *, text_columns=()):
+def read_table(
+    path,
+    columns,
+    what: str = "table",
+    *,
+    text_columns=(),
+    integer_columns=(),
+    unique=(),
+    limits=None,
+    unique_rows: bool = True,
+):
     """Read a CSV (``#`` comments allowed) or Parquet table with the required ``columns``.
 
     Parameters
     ----------
     path : str or Path
-        ``.parquet`` / ``.pq``: Parquet; anything else: CSV with a header line.
+        ``.parquet`` / ``.pq``: Parquet; anything else: CSV with a header line (UTF-8, a
+        byte-order mark and CRLF line ends allowed).
     columns : sequence of str
-        Required columns (extra columns are kept and not checked). Those whose name ends in a
-        unit (:data:`UNIT_SUFFIXES`) must hold finite numbers.
+        Required columns (extra columns are kept and not checked; any order). Those whose name
+        ends in a unit (:data:`UNIT_SUFFIXES`) must hold finite numbers inside the unit's
+        plausible range (:data:`hsgeo.validate.UNIT_LIMITS`, or ``limits``).
     what : str
         The table's role in messages (``"observation"``, ``"control"``, ``"GCP"``).
     text_columns : sequence of str
         Columns read as text (stripped of blanks), e.g. ids that must not be parsed as numbers.
+    integer_columns : sequence of str
+        Columns that must hold whole numbers (read as int64).
+    unique : sequence of str or tuple of str
+        Columns (or combinations) whose values must not repeat, e.g. ``"point_id"``.
+    limits : dict of str to (lo, hi), optional
+        Allowed ranges of columns, instead of the unit's default.
+    unique_rows : bool
+        A row repeated exactly (in the required columns) is an error.
 
     Returns
     -------
@@ -80,24 +101,30 @@ def read_table(path, columns, what: str = "table", *, text_columns=()):
     Raises
     ------
     InputError
-        The file does not exist or cannot be parsed, is empty, lacks a required column (the
-        message suggests a close name), or has an empty, NaN or non-numeric value in a required
-        column (the message gives the line and column).
+        The file does not exist, is a folder, binary or cannot be parsed, is empty, lacks a
+        required column (the message suggests a close name), has an empty, NaN, non-numeric or
+        out-of-range value in a required column, or repeats an id or a row (the message gives
+        the lines and the column).
     """
     import pandas as pd
+
+    from hsgeo.validate import check_range, check_unique, unit_limits
 
     path = Path(path)
     columns = list(columns)
     name = f"{what} file {str(path)!r}"
-    if not path.is_file():
-        raise InputError(f"{name} not found; check the path")
+    check_input_file(path, f"{what} file")
     parquet = path.suffix.lower() in _PARQUET
+    text = None if parquet else read_text(path, f"{what} file", "CSV table")
     try:
         if parquet:
             df = pd.read_parquet(path)
         else:
             df = pd.read_csv(
-                path, comment="#", skipinitialspace=True, dtype={c: str for c in text_columns}
+                io.StringIO(text),
+                comment="#",
+                skipinitialspace=True,
+                dtype={c: str for c in text_columns},
             )
     except pd.errors.EmptyDataError:
         raise InputError(
@@ -106,36 +133,45 @@ def read_table(path, columns, what: str = "table", *, text_columns=()):
         ) from None
     except Exception as exc:  # noqa: BLE001 - any parser error becomes an InputError
         kind = "Parquet" if parquet else "CSV"
-        raise InputError(f"{name} is not a readable {kind} table: {exc}") from None
+        msg = " ".join(str(exc).split())
+        raise InputError(f"{name} is not a readable {kind} table: {msg}") from None
     df.columns = [str(c).strip() for c in df.columns]
+    dup = [c for c in columns if list(df.columns).count(c) > 1]
+    if dup:
+        raise InputError(f"{name}: the header names column {dup[0]} twice; keep one")
     missing = [c for c in columns if c not in df.columns]
     if missing:
         near = {c: closest(c, df.columns) for c in missing}
         hints = "".join(f"; rename {n!r} to {c!r}?" for c, n in near.items() if n)
+        found = ", ".join(df.columns)
+        if len(found) > 120:
+            found = found[:120] + "..."
         raise InputError(
             f"{name}: missing column(s) {', '.join(missing)}; the header must "
-            f"name {', '.join(columns)} (found: {', '.join(df.columns)}){hints}"
+            f"name {', '.join(columns)} (found: {found}){hints}"
         )
     if len(df) == 0:
         raise InputError(f"{name} has a header but no data rows; add one row per record")
-    lines = None if parquet else _data_lines(path)
+    lines = None if parquet else _data_lines(text)
 
     def where(row: int) -> str:
         if lines is not None and row < len(lines):
             return f"line {lines[row]}"
         return f"row {row + 1}"
 
+    limits = dict(limits or {})
     for c in columns:
         col = df[c]
         if c in text_columns:
-            col = col.str.strip()
+            na = col.isna()
+            col = col.astype(str).str.strip().where(~na, "")
             df[c] = col
-            bad = col.isna() | (col == "")
-        elif _has_unit(c):
+            bad = col == ""
+        elif _has_unit(c) or c in integer_columns:
             num = pd.to_numeric(col, errors="coerce")
-            text = col.notna() & num.isna()
-            if text.any():
-                r = int(np.flatnonzero(text.to_numpy())[0])
+            txt = col.notna() & num.isna()
+            if txt.any():
+                r = int(np.flatnonzero(txt.to_numpy())[0])
                 raise InputError(
                     f"{name}, {where(r)}, column {c}: {col.iloc[r]!r} is not a "
                     "number; correct the value"
@@ -153,4 +189,32 @@ def read_table(path, columns, what: str = "table", *, text_columns=()):
                 + (f" (and {more} more)" if more else "")
                 + "; fill it in or delete the row"
             )
+        if c in integer_columns:
+            v = df[c].to_numpy(dtype=float)
+            frac = v != np.round(v)
+            if frac.any():
+                r = int(np.flatnonzero(frac)[0])
+                raise InputError(
+                    f"{name}, {where(r)}, column {c}: {v[r]:g} is not a whole number; "
+                    "correct the value"
+                )
+            df[c] = v.astype(np.int64)
+        lim = limits.get(c) or (unit_limits(c) if c not in text_columns else None)
+        if lim is not None:
+            check_range(df[c].to_numpy(dtype=float), *lim, f"{name}, column {c}", where=where)
+    for u in unique:
+        cols = [u] if isinstance(u, str) else list(u)
+        keys = list(df[cols].itertuples(index=False, name=None))
+        if len(cols) == 1:
+            keys = [k[0] for k in keys]
+        check_unique(keys, name, " ".join(cols), where=where)
+    if unique_rows:
+        first: dict = {}
+        for i, k in enumerate(df[columns].itertuples(index=False, name=None)):
+            if k in first:
+                raise InputError(
+                    f"{name}: {where(i)} repeats {where(first[k])} exactly (a row given twice "
+                    "would count twice); delete one"
+                )
+            first[k] = i
     return df

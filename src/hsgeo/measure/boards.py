@@ -36,6 +36,16 @@ __all__ = ["observe_files", "NOMINAL_PIXEL_MM"]
 NOMINAL_PIXEL_MM = 0.005
 
 
+def _not_found(board: Board, what: str) -> str:
+    """The board/image mismatch, in the board file's terms."""
+    keys = "squares_x, squares_y" if board.type == "charuco" else "markers_x, markers_y"
+    return (
+        f"the board was not found ({what} of a {board.nx} x {board.ny} {board.type} board of "
+        f"{board.dictionary}): the board file does not match the board in the images (check "
+        f"its type, dictionary, {keys}), or the board is not visible in this image"
+    )
+
+
 def _number(pattern: str | None, name: str, default: int) -> int:
     if pattern is None:
         return default
@@ -93,14 +103,14 @@ def observe_files(
         if board.type == "charuco":
             cc, ids, _, _ = det.detectBoard(img)
             if ids is None or len(ids) < 6:
-                raise ObservationError(f"{p}: fewer than 6 ChArUco corners found")
+                raise ObservationError(f"{p}: {_not_found(board, 'fewer than 6 ChArUco corners')}")
             ids = np.asarray(ids).ravel().astype(np.int64)
             px = np.repeat(np.asarray(cc, float).reshape(-1, 1, 2), 4, axis=1)
             obj = np.repeat(obj_all[ids][:, None, :], 4, axis=1)
         else:
             d = detect_targets(img, det, valid_ids=np.arange(len(obj_all)))
             if len(d) < 4:
-                raise ObservationError(f"{p}: fewer than 4 ArUco targets found")
+                raise ObservationError(f"{p}: {_not_found(board, 'fewer than 4 ArUco targets')}")
             ids, px, obj = d.ids, d.corners_px, obj_all[d.ids]
         rows["cube"].append(np.full(len(ids), cube))
         rows["band"].append(np.full(len(ids), band))

@@ -62,11 +62,66 @@ def _same_numbers(a: str, b: str, rtol: float) -> bool:
     return bool(np.all(np.abs(na - nb) <= rtol * np.maximum(np.abs(na), np.abs(nb))))
 
 
-def generate_all(verify: bool = False, update: bool = False) -> int:
-    """Generate every scenario; compare with (or rewrite) the manifest. Returns an exit status."""
+def default_out(ddir: Path) -> Path:
+    """Where ``hsgeo data`` writes without ``--out``: the repository's
+    ``data_synthetic/generated`` when the working directory is inside that repository, else
+    ``./data_synthetic/generated`` under the working directory (never the installed package).
+    """
+    cwd = Path.cwd().resolve()
+    if ddir.resolve().parent in (cwd, *cwd.parents):
+        return ddir / "generated"
+    return cwd / "data_synthetic" / "generated"
+
+
+def _check_out(out: Path, *, repo: bool, overwrite: bool, default: bool) -> None:
+    """The output folder, checked before any work (``--out``)."""
+    import os
+
+    from hsgeo.errors import InputError
+
+    if out.exists() and not out.is_dir():
+        raise InputError(f"--out {out}: not a folder; give a folder")
+    if not out.exists():
+        if default:  # ./data_synthetic/generated is made with its parents
+            return
+        if not out.parent.is_dir():
+            raise InputError(f"--out {out}: the folder {out.parent} does not exist; create it")
+        if not os.access(out.parent, os.W_OK | os.X_OK):
+            raise InputError(f"--out {out}: the folder {out.parent} is not writable")
+        return
+    if not os.access(out, os.W_OK | os.X_OK):
+        raise InputError(f"--out {out}: the folder is not writable; choose another folder")
+    if not repo and not overwrite and any(out.iterdir()):
+        raise InputError(
+            f"--out {out}: the folder is not empty; use --overwrite to replace the generated "
+            "files in it, or choose an empty folder"
+        )
+
+
+def generate_all(
+    verify: bool = False, update: bool = False, out=None, overwrite: bool = False
+) -> int:
+    """Generate every scenario; compare with (or rewrite) the manifest. Returns an exit status.
+
+    Parameters
+    ----------
+    verify : bool
+        Exit status 1 if a file differs from ``data_synthetic/MANIFEST.sha256``.
+    update : bool
+        Rewrite the manifest (next to the generated folder).
+    out : path, optional
+        The folder for the generated files (:func:`default_out` if not given). A folder other
+        than the repository's own ``data_synthetic/generated`` must be empty, or ``overwrite``.
+    overwrite : bool
+        Replace files in a non-empty ``out``.
+    """
     ddir = data_dir()
-    out = ddir / "generated"
-    out.mkdir(exist_ok=True)
+    repo_out = ddir / "generated"
+    default = out is None
+    out = Path(out) if out is not None else default_out(ddir)
+    repo = out.resolve() == repo_out.resolve()
+    _check_out(out, repo=repo, overwrite=overwrite, default=default)  # before the work
+    out.mkdir(parents=default, exist_ok=True)
     sums: dict[str, str] = {}
     close: list[str] = []
     previous: dict[str, str] = {}
@@ -79,13 +134,14 @@ def generate_all(verify: bool = False, update: bool = False) -> int:
                 if dest.is_file():
                     previous[path.name] = dest.read_text()
                 shutil.copyfile(path, dest)
-                sums[str(dest.relative_to(ddir))] = _sha256(dest)
-                print(f"  generated {dest.relative_to(ddir.parent)}", file=sys.stderr)
+                sums[f"generated/{path.name}"] = _sha256(dest)
+                print(f"  generated {dest}", file=sys.stderr)
     manifest = ddir / "MANIFEST.sha256"
     text = "".join(f"{h}  {p}\n" for p, h in sorted(sums.items()))
     if update or not manifest.exists():
-        manifest.write_text(text)
-        print(f"wrote {manifest} ({len(sums)} files)", file=sys.stderr)
+        target = manifest if repo else out / "MANIFEST.sha256"
+        target.write_text(text)
+        print(f"wrote {target} ({len(sums)} files)", file=sys.stderr)
         return 0
     expected = {}
     for line in manifest.read_text().splitlines():
@@ -102,17 +158,17 @@ def generate_all(verify: bool = False, update: bool = False) -> int:
             and p in sums
             and p in expected
             and hashlib.sha256(old.encode()).hexdigest() == expected[p]
-            and _same_numbers(old, (ddir / p).read_text(), VERIFY_RTOL)
+            and _same_numbers(old, (out / name).read_text(), VERIFY_RTOL)
         ):
             close.append(p)
-            (ddir / p).write_text(old)  # keep the committed bytes
+            (out / name).write_text(old)  # keep the committed bytes
             continue
         bad.append(p)
     if bad:
         print(
             "data_synthetic: generated files differ from MANIFEST.sha256: "
             + ", ".join(bad)
-            + "\n  (if the change is deliberate: hsgeo data --update-manifest)",
+            + " (if the change is deliberate: hsgeo data --update-manifest)",
             file=sys.stderr,
         )
         return 1 if verify else 0

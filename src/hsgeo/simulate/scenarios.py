@@ -15,10 +15,13 @@ __all__ = ["data_dir", "load_scenario"]
 
 
 def data_dir() -> Path:
-    """The repository's ``data_synthetic/`` (found from the working directory or the package)."""
+    """The repository's ``data_synthetic/`` (found from the working directory or the package):
+    the first such folder that holds scenario TOMLs (a ``./data_synthetic/generated`` written by
+    ``hsgeo data`` outside the repository is not one).
+    """
     for base in [Path.cwd(), *Path.cwd().parents, Path(__file__).resolve().parents[3]]:
         d = base / "data_synthetic"
-        if d.is_dir():
+        if d.is_dir() and any(d.glob("*.toml")):
             return d
     raise InputError("data_synthetic/ not found: run from the hsgeo repository")
 

@@ -20,9 +20,23 @@ from hsgeo.geocode import (
     geocode_observations,
     orthorectify,
 )
-from hsgeo.io import read_dem, read_lines, read_sensor_toml, refuse_inputs, to_map_files
+from hsgeo.io import read_dem, read_lines, read_sensor_toml, to_map_files
 
 __all__ = ["geocode_files", "gcp_deviations"]
+
+
+#: Default memory limit of the map grid and the ground coordinates (GiB), ``--max-grid-gib``.
+MAX_GRID_GIB = 2.0
+#: Default longest navigation gap interpolated across (s), ``--max-nav-gap-s``.
+MAX_NAV_GAP_S = 1.0
+_GIB = 2.0**30
+
+
+def grid_bytes(n_cells: float, n_bands: int) -> float:
+    """Memory of an orthorectification onto ``n_cells`` cells: the raster (float64 per band)
+    and the nearest-neighbour query (cell coordinates, distances and indices, 5 × 8 bytes).
+    """
+    return float(n_cells) * (8.0 * n_bands + 40.0)
 
 
 def geocode_files(
@@ -36,37 +50,101 @@ def geocode_files(
     resolution_m=0.5,
     envi=None,
     progress=True,
+    overwrite: bool = False,
+    max_grid_gib: float = MAX_GRID_GIB,
+    max_nav_gap_s: float = MAX_NAV_GAP_S,
 ):
     """Orthorectify a recorded flight line from files (see ``hsgeo geocode --help``).
 
-    The outputs are written atomically and never over one of the input files.
+    Every check comes before the work: the outputs (folder exists and is writable, not an
+    input, an existing file replaced only with ``overwrite``), the inputs (:mod:`hsgeo.io`),
+    the geometry (navigation covering the lines without gaps over ``max_nav_gap_s``, terrain
+    below the aircraft, view angles of the sensor model) and the memory of the grid (at most
+    ``max_grid_gib``). The outputs are written atomically (all or nothing).
     """
+    from hsgeo.io._files import check_outputs
     from hsgeo.io.navigation import read_trajectory
+    from hsgeo.validate import check_navigation_covers
 
     if (dem is None) == (height_m is None):
         raise InputError("give exactly one of --dem DEM.nc or --height H (a plane)")
+    if not (np.isfinite(resolution_m) and resolution_m > 0):
+        raise InputError(f"--resolution must be a positive number of metres, got {resolution_m}")
     inputs = (lines, trajectory, sensor, dem)
-    for out in (output, envi):  # before the work, not after it
-        if out is not None:
-            refuse_inputs(out, inputs)
+    outs = [(output, "-o/--output")]
+    if envi is not None:
+        outs += [(envi, "--envi"), (str(envi) + ".hdr", "--envi (its .hdr)")]
+    check_outputs(outs, inputs, overwrite=overwrite)  # before the work, not after it
     da, t0, rate = read_lines(lines)
     nav = read_trajectory(trajectory)
     geom, bs = read_sensor_toml(sensor)
+    n_lines, n_px = da.sizes["line"], da.sizes["pixel"]
+    t_lines = t0 + np.arange(n_lines) / rate
+    check_navigation_covers(
+        nav.t_s,
+        t_lines,
+        nav=repr(str(trajectory)),
+        used=f"the lines of {str(lines)!r} (t0_s + line / line_rate_hz)",
+        max_gap_s=max_nav_gap_s,
+    )
+    zeta = np.asarray(da["pixel"].values, dtype=float)
+    with np.errstate(all="ignore"):
+        tan = np.asarray(geom.tan_angle(zeta), dtype=float)
+    ang = np.degrees(np.arctan(tan))
+    if not (np.all(np.isfinite(tan)) and np.all(np.abs(ang) < 80.0)):
+        raise InputError(
+            f"sensor file {str(sensor)!r}: the pixels ζ {zeta.min():g}…{zeta.max():g} px of the "
+            f"LINES file look {np.nanmin(ang):.3g}…{np.nanmax(ang):.3g}° off the axis with "
+            f"zeta0_px = {geom.zeta0_px:g}, c_px = {geom.c_px:g}; check zeta0_px and c_px "
+            "(px of this sensor) and the LINES pixel coordinate"
+        )
+    need = n_lines * n_px * 3 * 8.0
+    if need > max_grid_gib * _GIB:
+        raise InputError(
+            f"the ground coordinates of {n_lines} lines x {n_px} pixels need "
+            f"{need / _GIB:.3g} GiB, over --max-grid-gib {max_grid_gib:g}; split the LINES file "
+            "or raise --max-grid-gib"
+        )
+    U = nav.pose(t_lines)[0][:, 2]
     if dem is not None:
-        terrain = DemTerrain(read_dem(dem))
+        dem_da = read_dem(dem)
+        terrain = DemTerrain(dem_da)
+        top = float(np.max(dem_da.values))
+        if top >= U.min():
+            raise InputError(
+                f"DEM {str(dem)!r} reaches {top:.6g} m, not below the aircraft (U_m down to "
+                f"{U.min():.6g} m in the navigation): are the DEM and the navigation in the same "
+                "height system and unit?"
+            )
     else:
         terrain = PlaneTerrain(float(height_m))
+        if not height_m < U.min():
+            raise InputError(
+                f"--height {height_m:g} m is not below the aircraft (U_m down to {U.min():.6g} m "
+                "in the navigation); give the terrain height in the navigation's height system"
+            )
     ground = geocode_image(
         nav,
         geom,
-        da.sizes["line"],
-        da["pixel"].values,
+        n_lines,
+        zeta,
         t0_s=t0,
         line_rate_hz=rate,
         terrain=terrain,
         boresight_rad=bs,
         progress=progress,
     )
+    EN = ground[..., :2].reshape(-1, 2)
+    span = EN.max(axis=0) - EN.min(axis=0)
+    cells = float(np.prod(np.floor(span / resolution_m) + 2))
+    need = grid_bytes(cells, da.sizes["band"])
+    if need > max_grid_gib * _GIB:
+        raise InputError(
+            f"the map grid of the footprint ({span[0]:.6g} m x {span[1]:.6g} m) at --resolution "
+            f"{resolution_m:g} m has {cells:.3g} cells x {da.sizes['band']} band(s) and needs "
+            f"about {need / _GIB:.3g} GiB, over --max-grid-gib {max_grid_gib:g}; use a coarser "
+            "--resolution, or raise --max-grid-gib"
+        )
     ortho = orthorectify(
         da.values,
         ground,

@@ -8,10 +8,12 @@ every image for initial values, and adjust in stages (:func:`calibrate`).
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 
 from hsgeo.adjust import Parameters, adjust
-from hsgeo.errors import InputError
+from hsgeo.errors import HsgeoError, InputError, ObservationError
 from hsgeo.io import read_table
 from hsgeo.measure.line_minima import associate_by_order, find_minima
 from hsgeo.sensors.line1d import (
@@ -139,16 +141,23 @@ def calibrate_files(
     dict with ``result`` (AdjustmentResult), ``image_ids``, ``point_ids``, ``residuals_px``.
     """
     obs = read_table(
-        observations, ("image", "point", "zeta_px"), "observations", text_columns=("image", "point")
+        observations,
+        ("image", "point", "zeta_px"),
+        "observation",
+        text_columns=("image", "point"),
+        unique=(("image", "point"),),
     )
-    ctl = read_table(control, ("point", "x_m", "y_m"), "control", text_columns=("point",))
+    ctl = read_table(
+        control,
+        ("point", "x_m", "y_m"),
+        "control",
+        text_columns=("point",),
+        unique=("point",),
+        limits={"x_m": (-100.0, 100.0), "y_m": (-100.0, 100.0)},
+    )
     pid = ctl["point"].tolist()
     xy = ctl[["x_m", "y_m"]].to_numpy(dtype=float)
     z = obs["zeta_px"].to_numpy(dtype=float)
-    if len(set(pid)) != len(pid):
-        raise InputError(
-            f"control file {str(control)!r} lists a point id twice; keep one row per point"
-        )
     index = {p: i for i, p in enumerate(pid)}
     missing = sorted(set(obs["point"]) - set(index))
     if missing:
@@ -160,10 +169,30 @@ def calibrate_files(
     img = np.array([image_ids.index(i) for i in obs["image"]])
     pt = np.array([index[p] for p in obs["point"]])
     blk = LineObservations(img, pt, z, sigma_px)  # NaN check
-    check_minimum_observations(img, pt, np.ones(len(pid), bool), len(image_ids))
-    eop = np.array(
-        [resect(xy[pt[img == i]], z[img == i], zeta0_px, c_px).eop for i in range(len(image_ids))]
-    )
+    try:
+        check_minimum_observations(img, pt, np.ones(len(pid), bool), len(image_ids))
+    except ObservationError as exc:  # the user's image id instead of its index
+        msg = re.sub(r"^image (\d+)", lambda m: f"image {image_ids[int(m.group(1))]}", str(exc))
+        raise ObservationError(f"observation file {str(observations)!r}: {msg}") from None
+    seen = xy[np.unique(pt)]
+    if np.linalg.svd(seen - seen.mean(axis=0), compute_uv=False)[-1] <= 1e-9 * max(
+        1.0, float(np.abs(seen).max())
+    ):
+        raise InputError(
+            f"control file {str(control)!r}: the observed points all lie on one line (x_m, y_m "
+            "collinear): the scale c is undetermined; add control points off the pattern line "
+            "(e.g. side signals in front of it)"
+        )
+    eop = []
+    for i, name in enumerate(image_ids):
+        try:
+            eop.append(resect(xy[pt[img == i]], z[img == i], zeta0_px, c_px).eop)
+        except HsgeoError as exc:
+            raise InputError(
+                f"observation file {str(observations)!r}, image {name}: {exc}; check its zeta_px "
+                "values and point ids, and --zeta0-px / --c-px"
+            ) from None
+    eop = np.array(eop)
     p = make_parameters(
         eop,
         zeta0_px,

@@ -279,6 +279,7 @@ def adjust_files(
     reject_k: float | None = 5.0,
     progress=None,
     y_as_time: bool = True,
+    max_nav_gap_s: float = 1.0,
 ) -> dict:
     """Adjust a user's pushbroom observations (``hsgeo adjust-pushbroom``).
 
@@ -302,6 +303,8 @@ def adjust_files(
         ``[observations] sigma_px``, ``[gcp] sigma_m``.
     gcp : path, optional
         CSV or Parquet with ``point_id, E_m, N_m, H_m`` (points of the observation table).
+    max_nav_gap_s : float
+        The longest gap between navigation records interpolated across (s).
 
     Returns
     -------
@@ -313,12 +316,42 @@ def adjust_files(
     from hsgeo.adjust import adjust
     from hsgeo.io.navigation import read_trajectory
     from hsgeo.trajectory import platform_rpy_from_rph, platform_rpy_rate_from_rph_rate
+    from hsgeo.validate import check_navigation_covers, check_range
 
-    obs_df = read_table(observations, OBS_COLUMNS, "observation")
+    obs_df = read_table(
+        observations,
+        OBS_COLUMNS,
+        "observation",
+        text_columns=("point_id",),
+        integer_columns=("band",),
+    )
     traj = read_trajectory(trajectory)
     cam = read_camera(camera)
+    check_range(
+        obs_df["band"].to_numpy(),
+        0,
+        cam.n_bands - 1,
+        f"observation file {str(observations)!r}, column band",
+        where=lambda i: f"row {i + 1}",
+        remedy=f"bands are numbered 0 to n_bands - 1 (n_bands = {cam.n_bands} in the camera file)",
+    )
     ids, point = np.unique(obs_df["point_id"].to_numpy(), return_inverse=True)
+    once = ids[np.bincount(point, minlength=ids.size) < 2]
+    if once.size:
+        raise InputError(
+            f"observation file {str(observations)!r}: point_id(s) {', '.join(once[:5])}"
+            + (f" (and {once.size - 5} more)" if once.size > 5 else "")
+            + " observed in one row only; a tie point needs two rays: add its other "
+            "observations or delete the row"
+        )
     t = obs_df["t_s"].to_numpy(dtype=float)
+    check_navigation_covers(
+        traj.t_s,
+        t,
+        nav=repr(str(trajectory)),
+        used=f"the observations' t_s in {str(observations)!r}",
+        max_gap_s=max_nav_gap_s,
+    )
     xyz, rph = traj.pose(t)
     vel, rph_rate = traj.rates(t)
     rpy = platform_rpy_from_rph(rph)  # the model's ENU platform angles (002)
@@ -335,13 +368,24 @@ def adjust_files(
     )
     gi = gx = None
     if gcp is not None:
-        g = read_table(gcp, GCP_COLUMNS, "GCP")
+        g = read_table(gcp, GCP_COLUMNS, "GCP", text_columns=("point_id",), unique=("point_id",))
         pos = {v: i for i, v in enumerate(ids)}
         unknown = [v for v in g["point_id"] if v not in pos]
         if unknown:
-            raise InputError(f"GCP point_id(s) {unknown[:5]} are not in the observation table")
+            raise InputError(
+                f"GCP file {str(gcp)!r}: point_id(s) {', '.join(map(str, unknown[:5]))} are not "
+                f"in the observation file {str(observations)!r}; correct the id or delete the row"
+            )
         gi = np.array([pos[v] for v in g["point_id"]])
         gx = g[["E_m", "N_m", "H_m"]].to_numpy(dtype=float)
+        low = float(traj.xyz_m[:, 2].min())
+        high = int(np.argmax(gx[:, 2]))
+        if gx[high, 2] >= low:
+            raise InputError(
+                f"GCP file {str(gcp)!r}: point_id {g['point_id'].iloc[high]} at H_m = "
+                f"{gx[high, 2]:.6g} m is not below the aircraft (U_m down to {low:.6g} m in the "
+                f"navigation file {str(trajectory)!r}); are both heights in metres, in one system?"
+            )
     p, blocks, nodes = build_problem(
         obs,
         ids.size,

@@ -19,6 +19,7 @@ The road of the chapter ``rikola``:
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
@@ -604,6 +605,60 @@ def decentering_effect_px(KP, xy_mm, pixel_mm: float) -> np.ndarray:
     return brown_correction(np.asarray(xy_mm, float), np.zeros(3), KP[3:]) / pixel_mm
 
 
+#: Fewest views (images of the board) of a band for a self-calibration: a planar board gives
+#: two constraints on the interior orientation per view (Zhang 2000, §3.1).
+MIN_VIEWS = 3
+
+
+def _check_images(images) -> list:
+    """The image files exist, are files, and none is given twice (same path or same bytes)."""
+    import hashlib
+
+    from hsgeo.io._files import check_input_file
+
+    images = [Path(p) for p in images]
+    seen_path: dict = {}
+    seen_hash: dict = {}
+    for p in images:
+        check_input_file(p, "image file")
+        key = p.resolve()
+        if key in seen_path:
+            raise InputError(
+                f"image file {str(p)!r} is given twice (as {str(seen_path[key])!r}); give each "
+                "view once"
+            )
+        seen_path[key] = p
+        h = hashlib.sha256(p.read_bytes()).hexdigest()
+        if h in seen_hash:
+            raise InputError(
+                f"image files {str(seen_hash[h])!r} and {str(p)!r} are the same image (identical "
+                "bytes); give each view once"
+            )
+        seen_hash[h] = p
+    return images
+
+
+def _check_regex(option: str, rx: str, images) -> None:
+    """``rx`` compiles, has one group, and takes a whole number from every file name."""
+    import re
+
+    try:
+        pat = re.compile(rx)
+    except re.error as exc:
+        raise InputError(f"{option} {rx!r} is not a regular expression ({exc})") from None
+    if pat.groups != 1:
+        raise InputError(
+            f"{option} {rx!r} has {pat.groups} groups; it needs exactly one, e.g. 'band(\\d+)'"
+        )
+    for p in images:
+        m = pat.search(p.name)
+        if m is None or m.group(1) is None or not m.group(1).isdigit():
+            raise InputError(
+                f"{option} {rx!r} takes no number from the file name {p.name!r}; its group must "
+                "match the digits of the band or cube number"
+            )
+
+
 def calibrate_frame_files(
     images,
     board_path,
@@ -628,7 +683,22 @@ def calibrate_frame_files(
     from hsgeo.report import Reproduction, Row
 
     board = read_board(board_path)
+    images = _check_images(images)
+    for option, rx in (("--band-regex", band_regex), ("--cube-regex", cube_regex)):
+        if rx is not None:
+            _check_regex(option, rx, images)
+    if joint and (band_regex is None or cube_regex is None):
+        raise InputError(
+            "--joint needs --band-regex and --cube-regex (which band and cube each file is)"
+        )
     obs = observe_files(images, board, band_regex=band_regex, cube_regex=cube_regex)
+    for band in np.unique(obs.band):
+        views = np.unique(obs.cube[obs.band == band]).size
+        if views < MIN_VIEWS:
+            raise InputError(
+                f"band {band} has {views} image(s) of the board; a self-calibration needs at "
+                f"least {MIN_VIEWS} views from different directions (Zhang 2000): add images"
+            )
     unit = "mm" if board.pixel_mm is not None else "px"
     rows, meta = (
         [],

@@ -1,0 +1,1370 @@
+"""Every bad input gets one clear error, and nothing is ever lost (issue 12).
+
+The valid inputs of ``tests/test_cli*.py`` (a line-scanner calibration, a pushbroom campaign,
+a geocoding flight line, OpenCV's ChArUco photographs) are built once; each case copies the
+command's inputs, spoils one thing (a table of mutations: missing, empty, garbage, binary and
+mistyped files; NaN, inf, 1e300; wrong units and types; degenerate geometry; duplicates; bad
+options; output paths) and runs ``hsgeo.cli.main`` in-process. Each case must end with exit
+status 2, exactly one line on stderr (no traceback) naming the file / column / option / id in
+question (a per-case substring), and nothing on stdout. Benign variants (reordered and extra
+columns, CRLF, a UTF-8 BOM, 16-bit images, Parquet) must still work. The SHA-256 of every
+input file is the same before and after every command, failing or succeeding.
+
+``python tests/test_bad_input.py`` prints the count of cases by command and class.
+"""
+
+from __future__ import annotations
+
+import csv
+import hashlib
+import io
+import os
+import shutil
+from collections import Counter
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+CHARUCO = ROOT / "src/hsgeo/data/reference/opencv-charuco"
+
+# ---------------------------------------------------------------------------------------------
+# the valid inputs (as tests/test_cli*.py build them)
+
+
+def _line(d: Path) -> None:
+    from hsgeo.reproduce.line_calibration import generate
+
+    d.mkdir()
+    generate({"scenario": {"generator": "line_lab", "seed": 4}, "calibration": {"row": 1000}}, d)
+    (d / "line_lab_observations.csv").rename(d / "obs.csv")
+    (d / "line_lab_control.csv").rename(d / "control.csv")
+    (d / "line_lab_truth.csv").unlink()
+
+
+def _pushbroom(d: Path) -> None:
+    import pandas as pd
+
+    from hsgeo.io.navigation import write_trajectory
+    from hsgeo.simulate.pushbroom_campaign import CampaignConfig, simulate
+    from hsgeo.trajectory import Trajectory, rph_from_platform_rpy
+
+    d.mkdir()
+    obs, _ = simulate(0.001, rng=4)
+    o = obs.lines
+    pd.DataFrame(
+        {
+            "point_id": o.point + 1000,
+            "band": o.band,
+            "t_s": o.t_s,
+            "x_px": o.xy_px[:, 0],
+            "y_px": o.xy_px[:, 1],
+        }
+    ).to_csv(d / "obs.csv", index=False, float_format="%.17g")
+    t, i = np.unique(o.t_s, return_index=True)
+    write_trajectory(
+        d / "nav.csv", Trajectory(t, o.xyz_nav_m[i], rph_from_platform_rpy(o.rpy_nav_rad[i]))
+    )
+    g = obs.gcp_xyz_m
+    pd.DataFrame(
+        {"point_id": obs.gcp_index + 1000, "E_m": g[:, 0], "N_m": g[:, 1], "H_m": g[:, 2]}
+    ).to_csv(d / "gcp.csv", index=False, float_format="%.17g")
+    la = ", ".join(f"{v:.6f}" for v in obs.lever_arm_m)
+    (d / "cam.toml").write_text(
+        f"[camera]\nn_bands = 7\npixel_mm = 0.0065\nc_mm = 40.0\nx0_mm = {CampaignConfig().x0_mm}\n"
+        f"lever_arm_m = [{la}]\n"
+    )
+
+
+def _geocode(d: Path) -> None:
+    import xarray as xr
+
+    from hsgeo.geocode import CalibratedLine, PlaneTerrain, geocode_image
+    from hsgeo.io import write_lines
+    from hsgeo.io.navigation import write_trajectory
+    from hsgeo.trajectory import Trajectory
+
+    d.mkdir()
+    t = np.linspace(0, 10.0, 201)
+    EN = np.outer(20.0 * t, [0.0, 1.0])
+    rpy = np.column_stack([0.01 * np.sin(t), 0.005 * np.cos(t), np.zeros(t.size)])
+    nav = Trajectory(t, np.column_stack([EN, np.full(t.size, 500.0)]), rpy)
+    write_trajectory(d / "nav.csv", nav)
+    cal = CalibratedLine(486.8, 3539.0, (1.459, -0.1636, 0.00526))  # 000 Table 1
+    zeta = np.arange(200.0, 800.0, 4.0)
+    g = geocode_image(nav, cal, 40, zeta, t0_s=0.5, line_rate_hz=8.0, terrain=PlaneTerrain(3.0))
+    write_lines(d / "lines.nc", g[..., 0], zeta, t0_s=0.5, line_rate_hz=8.0)
+    (d / "sensor.toml").write_text(
+        "[sensor]\nmodel = 'calibrated'\nzeta0_px = 486.8\nc_px = 3539.0\n"
+        "K = [1.459, -0.1636, 0.00526]\nboresight_deg = [0.0, 0.0, 0.0]\n"
+    )
+    E = np.arange(-300.0, 301.0, 10.0)
+    N = np.arange(-300.0, 501.0, 10.0)
+    xr.Dataset(
+        {"height": (("N", "E"), np.full((N.size, E.size), 3.0))}, {"N": N, "E": E}
+    ).to_netcdf(d / "dem.nc", engine="scipy")
+
+
+def _frame(d: Path) -> None:
+    d.mkdir()
+    for p in sorted((CHARUCO / "images").glob("*.jpg"))[:3]:
+        shutil.copy(p, d / p.name)
+    shutil.copy(CHARUCO / "board.toml", d / "board.toml")
+
+
+def build_valid(root: Path) -> Path:
+    """Write the valid inputs of every command under ``root`` (one folder per command)."""
+    _line(root / "calibrate-line")
+    _pushbroom(root / "adjust-pushbroom")
+    _geocode(root / "geocode")
+    _frame(root / "calibrate-frame")
+    return root
+
+
+def base_argv(cmd: str, d: Path) -> list[str]:
+    """The command line that succeeds on the valid inputs in ``d``."""
+    s = str
+    if cmd == "calibrate-line":
+        return [cmd, s(d / "obs.csv"), "--control", s(d / "control.csv")]
+    if cmd == "adjust-pushbroom":
+        return [
+            cmd,
+            s(d / "obs.csv"),
+            "--trajectory",
+            s(d / "nav.csv"),
+            "--camera",
+            s(d / "cam.toml"),
+            "--gcp",
+            s(d / "gcp.csv"),
+        ]
+    if cmd == "geocode":
+        out = d.parent / "out"
+        out.mkdir(exist_ok=True)
+        return [
+            cmd,
+            s(d / "lines.nc"),
+            "--trajectory",
+            s(d / "nav.csv"),
+            "--sensor",
+            s(d / "sensor.toml"),
+            "--height",
+            "3",
+            "-o",
+            s(out / "ortho.nc"),
+            "--quiet",
+        ]
+    if cmd == "calibrate-frame":
+        return [cmd, *(s(d / f"img_0{i}.jpg") for i in range(3)), "--board", s(d / "board.toml")]
+    if cmd == "reproduce":
+        return [cmd, "frame-reference"]
+    if cmd == "data":
+        return [cmd]
+    return [cmd]
+
+
+# ---------------------------------------------------------------------------------------------
+# mutations of files
+
+
+def read_csv(p: Path) -> tuple[list[str], list[list[str]]]:
+    rows = list(csv.reader(io.StringIO(p.read_text())))
+    return rows[0], rows[1:]
+
+
+def write_csv(p: Path, header, rows) -> None:
+    p.write_text("\n".join(",".join(r) for r in [header, *rows]) + "\n")
+
+
+def set_cell(column: str, value: str, row: int = 3):
+    def edit(p: Path):
+        h, rows = read_csv(p)
+        rows[row][h.index(column)] = value
+        write_csv(p, h, rows)
+
+    return edit
+
+
+def scale_column(column: str, factor: float):
+    def edit(p: Path):
+        h, rows = read_csv(p)
+        j = h.index(column)
+        for r in rows:
+            r[j] = repr(float(r[j]) * factor)
+        write_csv(p, h, rows)
+
+    return edit
+
+
+def drop_column(column: str):
+    def edit(p: Path):
+        h, rows = read_csv(p)
+        j = h.index(column)
+        write_csv(p, h[:j] + h[j + 1 :], [r[:j] + r[j + 1 :] for r in rows])
+
+    return edit
+
+
+def rename_column(column: str, new: str):
+    def edit(p: Path):
+        h, rows = read_csv(p)
+        h[h.index(column)] = new
+        write_csv(p, h, rows)
+
+    return edit
+
+
+def duplicate_row(row: int = 2):
+    def edit(p: Path):
+        h, rows = read_csv(p)
+        write_csv(p, h, rows[: row + 1] + [rows[row]] + rows[row + 1 :])
+
+    return edit
+
+
+def keep_rows(n: int):
+    def edit(p: Path):
+        h, rows = read_csv(p)
+        write_csv(p, h, rows[:n])
+
+    return edit
+
+
+def swap_rows(a: int, b: int):
+    def edit(p: Path):
+        h, rows = read_csv(p)
+        rows[a], rows[b] = rows[b], rows[a]
+        write_csv(p, h, rows)
+
+    return edit
+
+
+def delete_rows(a: int, b: int):
+    def edit(p: Path):
+        h, rows = read_csv(p)
+        write_csv(p, h, rows[:a] + rows[b:])
+
+    return edit
+
+
+def text(content: str | bytes):
+    def edit(p: Path):
+        if isinstance(content, bytes):
+            p.write_bytes(content)
+        else:
+            p.write_text(content)
+
+    return edit
+
+
+def remove(p: Path):
+    p.unlink()
+
+
+def make_dir(p: Path):
+    p.unlink()
+    p.mkdir()
+
+
+def header_only(p: Path):
+    p.write_text(p.read_text().splitlines()[0] + "\n")
+
+
+def copy_from(other: str):
+    def edit(p: Path):
+        shutil.copy(p.parent / other, p)
+
+    return edit
+
+
+def toml_set(table: str, key: str, value: str | None):
+    """Set (or with ``None`` delete) ``key`` of ``[table]`` in a TOML file, as raw TOML text."""
+
+    def edit(p: Path):
+        out, cur, done = [], None, False
+        for ln in p.read_text().splitlines():
+            s = ln.strip()
+            if s.startswith("["):
+                if cur == table and not done and value is not None:
+                    out.append(f"{key} = {value}")
+                    done = True
+                cur = s.strip("[]")
+            elif cur == table and s.split("=")[0].strip() == key:
+                if value is not None:
+                    out.append(f"{key} = {value}")
+                done = True
+                continue
+            out.append(ln)
+        if not done and value is not None:
+            if cur != table:
+                out.append(f"[{table}]")
+            out.append(f"{key} = {value}")
+        p.write_text("\n".join(out) + "\n")
+
+    return edit
+
+
+def toml_append(extra: str):
+    def edit(p: Path):
+        p.write_text(p.read_text() + extra)
+
+    return edit
+
+
+def toml_rename(old: str, new: str):
+    def edit(p: Path):
+        p.write_text(
+            "\n".join(
+                new + ln.strip()[len(old) :] if ln.strip().startswith(old + " ") else ln
+                for ln in p.read_text().splitlines()
+            )
+            + "\n"
+        )
+
+    return edit
+
+
+def nc_edit(fn):
+    """Rewrite a NetCDF file through ``fn(Dataset) -> Dataset``."""
+
+    def edit(p: Path):
+        import xarray as xr
+
+        with xr.open_dataset(p, engine="scipy") as ds:
+            new = fn(ds.load())
+        p.unlink()
+        new.to_netcdf(p, engine="scipy")
+
+    return edit
+
+
+# ---------------------------------------------------------------------------------------------
+# the cases
+
+
+@dataclass(frozen=True)
+class Case:
+    """One bad input: the command, its class, a name, what to do to the valid inputs, the
+    substring the error must contain."""
+
+    cmd: str
+    kind: str
+    name: str
+    files: tuple  # ((file name, edit), ...)
+    argv: Callable | None  # (argv, d) -> argv
+    expect: str
+
+    @property
+    def id(self) -> str:
+        return f"{self.cmd}:{self.kind}:{self.name}"
+
+
+CASES: list[Case] = []
+
+
+def case(cmd, kind, name, expect, files=(), argv=None):
+    CASES.append(Case(cmd, kind, name, tuple(files), argv, expect))
+
+
+def opt(option: str, value: str | None = None):
+    """Replace the value of ``option`` (or append it) in the argv."""
+
+    def f(a, d):
+        a = list(a)
+        if option in a:
+            i = a.index(option)
+            if value is None:
+                del a[i : i + 2]
+            else:
+                a[i + 1] = value
+        elif value is not None:
+            a += [option, value]
+        else:
+            a.append(option)
+        return a
+
+    return f
+
+
+def flag(*extra):
+    return lambda a, d: list(a) + list(extra)
+
+
+def chain(*fs):
+    def f(a, d):
+        for g in fs:
+            a = g(a, d)
+        return a
+
+    return f
+
+
+def replace_arg(old: str, new):
+    """Replace the argument ending in ``old`` by ``new(d)`` (a path in the inputs' folder)."""
+
+    def f(a, d):
+        return [str(new(d)) if x.endswith(old) else x for x in a]
+
+    return f
+
+
+BAD_VALUES = [
+    ("nan", "nan", "nonfinite"),
+    ("inf", "inf", "nonfinite"),
+    ("-inf", "-inf", "nonfinite"),
+    ("1e300", "1e300", "range"),
+    ("text", "abc", "type"),
+    ("empty", "", "missing"),
+]
+
+BINARY = bytes(range(256)) * 8
+
+
+def table_file_cases(cmd: str, file: str, what: str, columns: list[str], other: str) -> None:
+    """File-level mutations of a CSV table and every bad value in each numeric column."""
+    case(cmd, "missing", f"{file}-missing", file, [(file, remove)])
+    case(cmd, "missing", f"{file}-directory", file, [(file, make_dir)])
+    case(cmd, "empty", f"{file}-empty", file, [(file, text(""))])
+    case(cmd, "empty", f"{file}-header-only", file, [(file, header_only)])
+    case(cmd, "empty", f"{file}-blank-lines", file, [(file, text("\n\n\n"))])
+    case(cmd, "garbage", f"{file}-garbage", file, [(file, text("hello world\x01\nfoo;bar\n"))])
+    case(cmd, "binary", f"{file}-binary", file, [(file, text(BINARY))])
+    case(cmd, "binary", f"{file}-gzip", file, [(file, text(b"\x1f\x8b\x08\x00" + BINARY))])
+    case(cmd, "mistyped", f"{file}-other-table", file, [(file, copy_from(other))])
+    case(cmd, "mistyped", f"{file}-toml", file, [(file, text("[camera]\nc_mm = 40.0\n"))])
+    for c in columns:
+        case(cmd, "mistyped", f"{file}-no-{c}", c, [(file, drop_column(c))])
+        case(cmd, "mistyped", f"{file}-{c}-misspelled", c, [(file, rename_column(c, c + "x"))])
+    for c in columns:
+        if c in ("point", "point_id", "image", "band"):
+            continue
+        for name, v, kind in BAD_VALUES:
+            case(cmd, kind, f"{file}-{c}-{name}", c, [(file, set_cell(c, v))])
+
+
+# --- calibrate-line ------------------------------------------------------------------------
+C = "calibrate-line"
+table_file_cases(C, "obs.csv", "observations", ["image", "point", "zeta_px"], "control.csv")
+table_file_cases(C, "control.csv", "control", ["point", "x_m", "y_m"], "obs.csv")
+case(C, "duplicates", "obs-duplicate-row", "line 4", [("obs.csv", duplicate_row(2))])
+case(C, "duplicates", "control-duplicate-id", "line 3", [("control.csv", set_cell("point", "", 1))])
+case(C, "duplicates", "control-same-id-twice", "P", [("control.csv", duplicate_row(0))])
+case(C, "mistyped", "obs-unknown-point", "999999", [("obs.csv", set_cell("point", "999999"))])
+case(C, "degenerate", "obs-three-rows", "at least", [("obs.csv", keep_rows(3))])
+case(C, "range", "zeta-negative-huge", "zeta_px", [("obs.csv", set_cell("zeta_px", "-5e7"))])
+case(C, "units", "control-in-mm", "control", [("control.csv", scale_column("x_m", 1e6))])
+case(C, "degenerate", "control-collinear", "collinear", [("control.csv", scale_column("y_m", 0.0))])
+case(
+    C,
+    "degenerate",
+    "image-all-zeta-equal",
+    "image img0",
+    [("obs.csv", lambda p: _set_image_zeta(p, "img0", "100.0"))],
+)
+for o, vals in {
+    "--sigma-px": ["0", "-1", "nan", "inf", "abc"],
+    "--zeta0-px": ["nan", "inf", "abc", "1e300"],
+    "--c-px": ["0", "-3600", "nan", "abc"],
+    "--reject-k": ["0", "-2", "nan"],
+}.items():
+    for v in vals:
+        case(C, "options", f"{o}={v}", o, argv=opt(o, v))
+case(C, "options", "no-control", "--control", argv=opt("--control"))
+case(C, "options", "unknown-option", "--sigmapx", argv=flag("--sigmapx", "1"))
+
+# --- adjust-pushbroom ----------------------------------------------------------------------
+C = "adjust-pushbroom"
+table_file_cases(
+    C, "obs.csv", "observation", ["point_id", "band", "t_s", "x_px", "y_px"], "gcp.csv"
+)
+table_file_cases(C, "gcp.csv", "GCP", ["point_id", "E_m", "N_m", "H_m"], "obs.csv")
+NAV = ["t_s", "E_m", "N_m", "U_m", "roll_deg", "pitch_deg", "heading_deg"]
+table_file_cases(C, "nav.csv", "navigation", NAV, "obs.csv")
+case(C, "duplicates", "obs-duplicate-row", "line 4", [("obs.csv", duplicate_row(2))])
+case(C, "duplicates", "gcp-duplicate-id", "1", [("gcp.csv", duplicate_row(1))])
+case(C, "duplicates", "nav-duplicate-time", "t_s", [("nav.csv", duplicate_row(5))])
+case(C, "degenerate", "nav-times-decreasing", "t_s", [("nav.csv", swap_rows(5, 6))])
+case(C, "degenerate", "nav-gap", "--max-nav-gap-s", [("nav.csv", delete_rows(20, 80))])
+case(C, "degenerate", "nav-one-row", "navigation", [("nav.csv", keep_rows(1))])
+case(C, "degenerate", "nav-not-covering", "t_s", [("nav.csv", keep_rows(20))])
+case(C, "mistyped", "gcp-unknown-id", "999999", [("gcp.csv", set_cell("point_id", "999999"))])
+case(
+    C,
+    "degenerate",
+    "point-observed-once",
+    "999999",
+    [("obs.csv", set_cell("point_id", "999999", 0))],
+)
+case(C, "range", "band-negative", "band", [("obs.csv", set_cell("band", "-1"))])
+case(C, "range", "band-too-large", "n_bands", [("obs.csv", set_cell("band", "7"))])
+case(C, "type", "band-fraction", "band", [("obs.csv", set_cell("band", "1.5"))])
+case(C, "range", "nav-jump-100km", "line 12", [("nav.csv", set_cell("E_m", "100000", 10))])
+case(C, "units", "roll-out-of-range", "roll_deg", [("nav.csv", set_cell("roll_deg", "400"))])
+case(C, "units", "pitch-out-of-range", "pitch_deg", [("nav.csv", set_cell("pitch_deg", "-95"))])
+case(C, "units", "nav-position-mm", "navigation", [("nav.csv", scale_column("E_m", 1e3))])
+for key, value, expect in [
+    ("n_bands", "0", "n_bands"),
+    ("n_bands", "'abc'", "n_bands"),
+    ("n_bands", "2.5", "n_bands"),
+    ("n_bands", None, "n_bands"),
+    ("pixel_mm", "0", "pixel_mm"),
+    ("pixel_mm", "'abc'", "pixel_mm"),
+    ("pixel_mm", "nan", "pixel_mm"),
+    ("pixel_mm", "6.5", "pixel_mm"),
+    ("c_mm", "-40.0", "c_mm"),
+    ("c_mm", "inf", "c_mm"),
+    ("c_mm", "1e300", "c_mm"),
+    ("c_mm", None, "c_mm"),
+    ("x0_mm", "'abc'", "x0_mm"),
+    ("x0_mm", "1e300", "x0_mm"),
+    ("lever_arm_m", "[1.0, 2.0]", "lever_arm_m"),
+    ("lever_arm_m", "[1.0, 'a', 2.0]", "lever_arm_m"),
+    ("lever_arm_m", "[1e300, 0.0, 0.0]", "lever_arm_m"),
+    ("sigma_lever_m", "0", "sigma_lever_m"),
+]:
+    kind = "missing" if value is None else ("range" if "1e300" in value else "type")
+    case(C, kind, f"cam-{key}={value}", expect, [("cam.toml", toml_set("camera", key, value))])
+for extra, expect in [
+    ("[gnss]\nsigma_pos_m = [0.01, 0.01, 0.02]\n", "gnss_ins"),
+    ("[observation]\nsigma_px = 0.5\n", "observations"),
+    ("[gnss_ins]\nsigma_pos_m = [0.01, 0.01]\n", "sigma_pos_m"),
+    ("[gnss_ins]\nsigma_att_deg = [0.0, 0.01, 0.01]\n", "sigma_att_deg"),
+    ("[observations]\nsigma_px = 0\n", "sigma_px"),
+    ("[gcp]\nsigma_m = -1.0\n", "sigma_m"),
+]:
+    case(
+        C, "mistyped", f"cam-{extra.split(chr(10))[0]}", expect, [("cam.toml", toml_append(extra))]
+    )
+case(
+    C,
+    "mistyped",
+    "cam-level_arm_m",
+    "lever_arm_m",
+    [("cam.toml", toml_rename("lever_arm_m", "level_arm_m"))],
+)
+case(C, "missing", "cam-missing", "cam.toml", [("cam.toml", remove)])
+case(C, "empty", "cam-empty", "[camera]", [("cam.toml", text(""))])
+case(C, "binary", "cam-binary", "cam.toml", [("cam.toml", text(BINARY))])
+case(C, "garbage", "cam-malformed", "cam.toml", [("cam.toml", text("[camera\nc_mm = \n"))])
+case(C, "mistyped", "cam-is-csv", "cam.toml", [("cam.toml", copy_from("gcp.csv"))])
+for o, vals in {"--node-interval": ["0", "-10", "nan", "inf", "abc"]}.items():
+    for v in vals:
+        case(C, "options", f"{o}={v}", o, argv=opt(o, v))
+case(C, "options", "--max-nav-gap-s=0", "--max-nav-gap-s", argv=opt("--max-nav-gap-s", "0"))
+case(C, "options", "no-camera", "--camera", argv=opt("--camera"))
+case(C, "options", "no-trajectory", "--trajectory", argv=opt("--trajectory"))
+
+# --- geocode -------------------------------------------------------------------------------
+C = "geocode"
+table_file_cases(C, "nav.csv", "navigation", NAV, "sensor.toml")
+case(C, "duplicates", "nav-duplicate-time", "t_s", [("nav.csv", duplicate_row(5))])
+case(C, "degenerate", "nav-times-decreasing", "t_s", [("nav.csv", swap_rows(5, 6))])
+case(C, "degenerate", "nav-gap-6s", "--max-nav-gap-s", [("nav.csv", delete_rows(40, 160))])
+case(C, "degenerate", "nav-not-covering", "navigation", [("nav.csv", keep_rows(60))])
+case(C, "range", "nav-record-100km-off", "line 12", [("nav.csv", set_cell("E_m", "100000", 10))])
+case(
+    C,
+    "units",
+    "nav-heading-out-of-range",
+    "heading_deg",
+    [("nav.csv", set_cell("heading_deg", "1000"))],
+)
+case(C, "units", "nav-attitude-in-mrad", "roll_deg", [("nav.csv", scale_column("roll_deg", 1e4))])
+case(C, "degenerate", "height-above-aircraft", "--height", argv=opt("--height", "600"))
+case(C, "degenerate", "height-at-aircraft", "--height", argv=opt("--height", "500"))
+for v in ("nan", "inf", "abc", "1e300"):
+    case(C, "options", f"--height={v}", "--height", argv=opt("--height", v))
+for v in ("0", "-1", "nan", "inf", "abc"):
+    case(C, "options", f"--resolution={v}", "--resolution", argv=opt("--resolution", v))
+case(C, "degenerate", "resolution-5mm", "--max-grid-gib", argv=opt("--resolution", "0.005"))
+case(C, "degenerate", "resolution-1e-9", "--max-grid-gib", argv=opt("--resolution", "1e-9"))
+case(C, "options", "max-grid-gib-0", "--max-grid-gib", argv=opt("--max-grid-gib", "0"))
+case(C, "options", "max-nav-gap-nan", "--max-nav-gap-s", argv=opt("--max-nav-gap-s", "nan"))
+case(C, "options", "dem-and-height", "--height", argv=flag("--dem", "x.nc"))
+case(C, "options", "no-output", "--output", argv=opt("-o"))
+# LINES
+case(C, "missing", "lines-missing", "lines.nc", [("lines.nc", remove)])
+case(C, "missing", "lines-directory", "lines.nc", [("lines.nc", make_dir)])
+case(C, "empty", "lines-empty", "lines.nc", [("lines.nc", text(""))])
+case(C, "mistyped", "lines-is-csv", "lines.nc", [("lines.nc", copy_from("nav.csv"))])
+case(C, "binary", "lines-binary", "lines.nc", [("lines.nc", text(BINARY))])
+case(
+    C,
+    "binary",
+    "lines-hdf5-garbage",
+    "lines.nc",
+    [("lines.nc", text(b"\x89HDF\r\n\x1a\n" + BINARY))],
+)
+case(
+    C,
+    "binary",
+    "lines-truncated",
+    "lines.nc",
+    [("lines.nc", lambda p: p.write_bytes(p.read_bytes()[:300]))],
+)
+case(
+    C,
+    "mistyped",
+    "lines-no-pixel",
+    "pixel",
+    [("lines.nc", nc_edit(lambda ds: ds.drop_vars("pixel")))],
+)
+case(
+    C,
+    "mistyped",
+    "lines-no-radiance",
+    "radiance",
+    [("lines.nc", nc_edit(lambda ds: ds.rename(radiance="L")))],
+)
+case(
+    C, "mistyped", "lines-no-t0", "t0_s", [("lines.nc", nc_edit(lambda ds: _drop_attr(ds, "t0_s")))]
+)
+case(
+    C,
+    "mistyped",
+    "lines-no-rate",
+    "line_rate_hz",
+    [("lines.nc", nc_edit(lambda ds: _drop_attr(ds, "line_rate_hz")))],
+)
+for attr, v, kind in [
+    ("line_rate_hz", np.nan, "nonfinite"),
+    ("line_rate_hz", 0.0, "range"),
+    ("line_rate_hz", -8.0, "range"),
+    ("line_rate_hz", "abc", "type"),
+    ("t0_s", np.nan, "nonfinite"),
+    ("t0_s", np.inf, "nonfinite"),
+    ("t0_s", "abc", "type"),
+]:
+    case(
+        C,
+        kind,
+        f"lines-{attr}={v}",
+        attr,
+        [("lines.nc", nc_edit(lambda ds, a=attr, v=v: _set_attr(ds, a, v)))],
+    )
+case(
+    C, "degenerate", "lines-one-line", "line", [("lines.nc", nc_edit(lambda ds: ds.isel(line=[0])))]
+)
+case(
+    C,
+    "degenerate",
+    "lines-one-pixel",
+    "pixel",
+    [("lines.nc", nc_edit(lambda ds: ds.isel(pixel=[0])))],
+)
+case(
+    C,
+    "nonfinite",
+    "lines-pixel-nan",
+    "pixel",
+    [("lines.nc", nc_edit(lambda ds: ds.assign_coords(pixel=ds["pixel"].values * np.nan)))],
+)
+case(
+    C,
+    "duplicates",
+    "lines-pixel-duplicated",
+    "pixel",
+    [
+        (
+            "lines.nc",
+            nc_edit(
+                lambda ds: ds.assign_coords(
+                    pixel=np.r_[ds["pixel"].values[:1], ds["pixel"].values[:-1]]
+                )
+            ),
+        )
+    ],
+)
+case(
+    C,
+    "range",
+    "lines-pixel-1e300",
+    "pixel",
+    [("lines.nc", nc_edit(lambda ds: ds.assign_coords(pixel=ds["pixel"].values + 1e300)))],
+)
+case(
+    C,
+    "mistyped",
+    "lines-wrong-dims",
+    "radiance",
+    [("lines.nc", nc_edit(lambda ds: ds.rename(line="row")))],
+)
+case(
+    C,
+    "degenerate",
+    "lines-after-navigation",
+    "navigation",
+    [("lines.nc", nc_edit(lambda ds: _set_attr(ds, "t0_s", 100.0)))],
+)
+case(
+    C,
+    "degenerate",
+    "lines-rate-too-low",
+    "navigation",
+    [("lines.nc", nc_edit(lambda ds: _set_attr(ds, "line_rate_hz", 1.0)))],
+)
+# SENSOR
+for key, value, kind in [
+    ("zeta0_px", "'abc'", "type"),
+    ("zeta0_px", "nan", "nonfinite"),
+    ("zeta0_px", "inf", "nonfinite"),
+    ("zeta0_px", "1e300", "range"),
+    ("zeta0_px", None, "missing"),
+    ("c_px", "0", "range"),
+    ("c_px", "-3539.0", "range"),
+    ("c_px", "'3539'", "type"),
+    ("c_px", "1e300", "range"),
+    ("K", "[1.0, 2.0]", "type"),
+    ("K", "1.0", "type"),
+    ("K", "[nan, 0.0, 0.0]", "nonfinite"),
+    ("boresight_deg", "[0.0, 0.0]", "type"),
+    ("boresight_deg", "[400.0, 0.0, 0.0]", "units"),
+    ("boresight_deg", "[1e300, 0.0, 0.0]", "range"),
+    ("model", "'pinhole'", "type"),
+    ("model", "3", "type"),
+]:
+    case(C, kind, f"sensor-{key}={value}", key, [("sensor.toml", toml_set("sensor", key, value))])
+case(
+    C,
+    "mistyped",
+    "sensor-borsight",
+    "boresight_deg",
+    [("sensor.toml", toml_rename("boresight_deg", "borsight_deg"))],
+)
+case(
+    C,
+    "mistyped",
+    "sensor-unknown-table",
+    "[sensr]",
+    [("sensor.toml", toml_append("[sensr]\nc = 1\n"))],
+)
+case(
+    C,
+    "mistyped",
+    "sensor-ifov-with-K",
+    "model = 'calibrated'",
+    [("sensor.toml", toml_set("sensor", "model", "'linear-ifov'"))],
+)
+case(C, "missing", "sensor-missing", "sensor.toml", [("sensor.toml", remove)])
+case(C, "empty", "sensor-empty", "[sensor]", [("sensor.toml", text(""))])
+case(C, "binary", "sensor-binary", "sensor.toml", [("sensor.toml", text(BINARY))])
+case(
+    C,
+    "binary",
+    "sensor-latin1",
+    "sensor.toml",
+    [("sensor.toml", text("[sensor]\n# \xe9t\xe9\n".encode("latin-1")))],
+)
+case(C, "garbage", "sensor-malformed", "sensor.toml", [("sensor.toml", text("[sensor\n"))])
+case(C, "mistyped", "sensor-is-csv", "sensor.toml", [("sensor.toml", copy_from("nav.csv"))])
+case(
+    C,
+    "degenerate",
+    "sensor-zeta0-outside",
+    "zeta0_px",
+    [("sensor.toml", toml_set("sensor", "zeta0_px", "5000.0"))],
+)
+# DEM
+
+
+def _dem(a, d):
+    a = [x for x in a]
+    i = a.index("--height")
+    a[i : i + 2] = ["--dem", str(d / "dem.nc")]
+    return a
+
+
+case(C, "missing", "dem-missing", "dem.nc", [("dem.nc", remove)], argv=_dem)
+case(C, "empty", "dem-empty", "dem.nc", [("dem.nc", text(""))], argv=_dem)
+case(C, "mistyped", "dem-is-lines", "height", [("dem.nc", copy_from("lines.nc"))], argv=_dem)
+case(C, "nonfinite", "dem-nan", "DEM", [("dem.nc", nc_edit(lambda ds: ds * np.nan))], argv=_dem)
+case(
+    C,
+    "mistyped",
+    "dem-x-y-dimensions",
+    "dimensions N, E",
+    [("dem.nc", nc_edit(lambda ds: ds.rename(N="y", E="x")))],
+    argv=_dem,
+)
+case(
+    C,
+    "degenerate",
+    "dem-one-cell",
+    "2 x 2 cells",
+    [("dem.nc", nc_edit(lambda ds: ds.isel(N=[0], E=[0])))],
+    argv=_dem,
+)
+case(
+    C,
+    "degenerate",
+    "dem-above-aircraft",
+    "DEM",
+    [("dem.nc", nc_edit(lambda ds: ds + 700.0))],
+    argv=_dem,
+)
+case(
+    C,
+    "degenerate",
+    "dem-not-covering",
+    "DEM",
+    [("dem.nc", nc_edit(lambda ds: ds.isel(N=slice(0, 5))))],
+    argv=_dem,
+)
+# outputs
+case(
+    C,
+    "output",
+    "output-is-lines",
+    "lines.nc",
+    argv=lambda a, d: opt("-o", str(d / "lines.nc"))(a, d),
+)
+case(C, "output", "output-is-nav", "nav.csv", argv=lambda a, d: opt("-o", str(d / "nav.csv"))(a, d))
+case(
+    C,
+    "output",
+    "output-is-sensor",
+    "sensor.toml",
+    argv=lambda a, d: opt("-o", str(d / "sensor.toml"))(a, d),
+)
+case(
+    C, "output", "envi-is-nav", "nav.csv", argv=lambda a, d: opt("--envi", str(d / "nav.csv"))(a, d)
+)
+case(
+    C,
+    "output",
+    "envi-hdr-is-input",
+    "s.hdr",
+    files=[("sensor.toml", lambda p: shutil.copy(p, p.parent / "s.hdr"))],
+    argv=lambda a, d: chain(opt("--sensor", str(d / "s.hdr")), opt("--envi", str(d / "s")))(a, d),
+)
+case(C, "output", "envi-hdr-is-output", "--envi", argv=lambda a, d: _envi_hdr_is_output(a, d))
+case(
+    C,
+    "output",
+    "envi-equals-output",
+    "--envi",
+    argv=lambda a, d: opt("--envi", a[a.index("-o") + 1])(a, d),
+)
+case(
+    C,
+    "output",
+    "output-dir-missing",
+    "does-not-exist",
+    argv=lambda a, d: opt("-o", str(d / "does-not-exist" / "o.nc"))(a, d),
+)
+case(
+    C,
+    "output",
+    "envi-dir-missing",
+    "does-not-exist",
+    argv=lambda a, d: opt("--envi", str(d / "does-not-exist" / "o"))(a, d),
+)
+case(C, "output", "output-is-directory", "directory", argv=lambda a, d: opt("-o", str(d))(a, d))
+case(C, "output", "output-exists", "--overwrite", argv=lambda a, d: _touch_output(a, d))
+case(C, "output", "envi-exists", "--overwrite", argv=lambda a, d: _touch_envi(a, d))
+case(C, "output", "output-dir-readonly", "writ", argv=lambda a, d: _readonly_output(a, d))
+
+
+def _set_image_zeta(p, image, value):
+    h, rows = read_csv(p)
+    write_csv(p, h, [[r[0], r[1], value] if r[0] == image else r for r in rows])
+
+
+def _drop_attr(ds, a):
+    ds.attrs.pop(a, None)
+    ds["radiance"].attrs.pop(a, None)
+    return ds
+
+
+def _set_attr(ds, a, v):
+    ds.attrs[a] = v
+    return ds
+
+
+def _envi_hdr_is_output(a, d):
+    out = Path(a[a.index("-o") + 1]).with_name("x")  # -o x.hdr --envi x: the header is -o
+    return chain(opt("-o", str(out) + ".hdr"), opt("--envi", str(out)))(a, d)
+
+
+def _touch_output(a, d):
+    out = Path(a[a.index("-o") + 1])
+    out.write_text("precious")
+    return a
+
+
+def _touch_envi(a, d):
+    envi = d.parent / "out" / "ortho_envi"
+    envi.with_name("ortho_envi.hdr").write_text("precious")
+    return opt("--envi", str(envi))(a, d)
+
+
+def _readonly_output(a, d):
+    ro = d.parent / "readonly"
+    ro.mkdir()
+    ro.chmod(0o555)
+    return opt("-o", str(ro / "o.nc"))(a, d)
+
+
+# --- calibrate-frame -----------------------------------------------------------------------
+C = "calibrate-frame"
+
+
+def add_image(path):
+    """Add the image ``path(d)`` to the command's images (before --board)."""
+    return lambda a, d: [a[0], str(path(d)), *a[1:]]
+
+
+def _first_image(d):
+    return sorted(d.glob("*.jpg"))[0]
+
+
+case(C, "duplicates", "same-image-twice", "given twice", argv=add_image(_first_image))
+case(
+    C,
+    "duplicates",
+    "same-image-two-names",
+    "same image",
+    files=[("img_00.jpg", lambda p: shutil.copy(p, p.parent / "copy.jpg"))],
+    argv=add_image(lambda d: d / "copy.jpg"),
+)
+case(
+    C,
+    "duplicates",
+    "same-image-relative",
+    "given twice",
+    argv=add_image(lambda d: d / ".." / d.name / "img_00.jpg"),
+)
+case(C, "missing", "image-missing", "img_01.jpg", [("img_01.jpg", remove)])
+case(C, "missing", "image-directory", "img_01.jpg", [("img_01.jpg", make_dir)])
+case(C, "empty", "image-empty", "img_01.jpg", [("img_01.jpg", text(b""))])
+case(C, "binary", "image-garbage", "img_01.jpg", [("img_01.jpg", text(BINARY))])
+case(C, "mistyped", "image-is-toml", "board.toml", argv=add_image(lambda d: d / "board.toml"))
+case(C, "degenerate", "image-other-size", "img_01.jpg", [("img_01.jpg", lambda p: _resize(p, 0.5))])
+case(C, "degenerate", "image-blank", "img_01.jpg", [("img_01.jpg", lambda p: _blank(p))])
+case(C, "degenerate", "one-image", "image", argv=lambda a, d: [a[0], a[1], *a[-2:]])
+case(
+    C,
+    "mismatch",
+    "board-other-dictionary",
+    "dictionary",
+    [("board.toml", toml_set("board", "dictionary", "'DICT_4X4_50'"))],
+)
+case(
+    C,
+    "mismatch",
+    "board-other-size",
+    "board",
+    [("board.toml", toml_set("board", "squares_x", "9"))],
+)
+case(
+    C,
+    "mismatch",
+    "board-aruco-grid",
+    "board",
+    [
+        (
+            "board.toml",
+            text(
+                "[board]\ntype = 'aruco_grid'\ndictionary = 'DICT_4X4_50'\nmarkers_x = 4\n"
+                "markers_y = 4\nmarker_mm = 20.0\nseparation_mm = 5.0\n"
+            ),
+        )
+    ],
+)
+for key, value, kind, expect in [
+    ("marker_mm", "50.0", "degenerate", "marker_mm"),
+    ("marker_mm", "40.0", "degenerate", "marker_mm"),
+    ("square_mm", "0", "range", "square_mm"),
+    ("square_mm", "'abc'", "type", "square_mm"),
+    ("square_mm", "nan", "nonfinite", "square_mm"),
+    ("square_mm", "1e300", "range", "square_mm"),
+    ("squares_x", "1", "degenerate", "squares"),
+    ("squares_x", "2.5", "type", "squares_x"),
+    ("squares_y", None, "missing", "squares_y"),
+    ("type", "'hexagons'", "type", "type"),
+    ("dictionary", "'DICT_NOPE'", "type", "dictionary"),
+    ("markers_x", "4", "mistyped", "markers_x"),
+    ("dictonary", "'DICT_6X6_250'", "mistyped", "dictionary"),
+]:
+    case(C, kind, f"board-{key}={value}", expect, [("board.toml", toml_set("board", key, value))])
+case(
+    C,
+    "type",
+    "board-pixel_mm-0",
+    "pixel_mm",
+    [("board.toml", toml_append("[camera]\npixel_mm = 0\n"))],
+)
+case(
+    C,
+    "mistyped",
+    "board-pixl_mm",
+    "pixel_mm",
+    [("board.toml", toml_append("[camera]\npixl_mm = 0.0055\n"))],
+)
+case(C, "missing", "board-missing", "board.toml", [("board.toml", remove)])
+case(C, "empty", "board-empty", "[board]", [("board.toml", text(""))])
+case(C, "binary", "board-binary", "board.toml", [("board.toml", text(BINARY))])
+case(
+    C,
+    "mistyped",
+    "board-is-image",
+    "board",
+    argv=lambda a, d: opt("--board", str(_first_image(d)))(a, d),
+)
+for v in ("0", "-1", "nan", "abc"):
+    case(C, "options", f"--sigma-px={v}", "--sigma-px", argv=opt("--sigma-px", v))
+case(C, "options", "band-regex-no-group", "--band-regex", argv=opt("--band-regex", "img"))
+case(C, "options", "band-regex-invalid", "--band-regex", argv=opt("--band-regex", "img(("))
+case(C, "options", "band-regex-no-match", "--band-regex", argv=opt("--band-regex", r"band(\d+)"))
+case(C, "options", "joint-without-regex", "--band-regex", argv=flag("--joint"))
+case(C, "options", "no-board", "--board", argv=opt("--board"))
+
+
+def _resize(p, f):
+    import cv2
+
+    img = cv2.imread(str(p))
+    cv2.imwrite(str(p), cv2.resize(img, None, fx=f, fy=f))
+
+
+def _blank(p):
+    import cv2
+
+    img = cv2.imread(str(p))
+    cv2.imwrite(str(p), np.full_like(img, 128))
+
+
+# --- reproduce, data, versions, the top level ----------------------------------------------
+C = "reproduce"
+case(
+    C,
+    "options",
+    "unknown-chapter",
+    "no-such-chapter",
+    argv=lambda a, d, C=C: [C, "no-such-chapter"],
+)
+case(
+    C, "options", "chapter-typo", "line-calibration", argv=lambda a, d, C=C: [C, "line-calibratio"]
+)
+for v in ("-1", "abc", "1.5", "1e300"):
+    case(C, "options", f"--seed={v}", "--seed", argv=opt("--seed", v))
+for v in ("0", "-1", "2", "nan", "inf", "abc"):
+    case(C, "options", f"--scale={v}", "--scale", argv=opt("--scale", v))
+C = "data"
+case(
+    C,
+    "output",
+    "out-missing-dir",
+    "--out",
+    argv=lambda a, d, C=C: [C, "--out", str(d / "no" / "such")],
+)
+case(C, "output", "out-is-file", "--out", argv=lambda a, d, C=C: [C, "--out", str(_a_file(d))])
+case(
+    C,
+    "output",
+    "out-exists",
+    "--overwrite",
+    argv=lambda a, d, C=C: [C, "--out", str(_filled_dir(d))],
+)
+case(
+    C, "output", "out-readonly", "writ", argv=lambda a, d, C=C: [C, "--out", str(_readonly_dir(d))]
+)
+case(C, "options", "verify-and-update", "--verify", argv=flag("--verify", "--update-manifest"))
+case(C, "options", "unknown-option", "--outt", argv=flag("--outt", "x"))
+C = "versions"
+case(C, "options", "extra-argument", "unrecognized", argv=flag("now"))
+C = "hsgeo"
+case(C, "options", "no-command", "command", argv=lambda a, d: [])
+case(C, "options", "unknown-command", "geocod", argv=lambda a, d: ["geocod"])
+
+
+def _a_file(d):
+    (d / "f.txt").write_text("x")
+    return d / "f.txt"
+
+
+def _filled_dir(d):
+    (d / "gen").mkdir()
+    (d / "gen" / "line_lab_control.csv").write_text("precious")
+    return d / "gen"
+
+
+def _readonly_dir(d):
+    (d / "ro").mkdir()
+    (d / "ro").chmod(0o555)
+    return d / "ro"
+
+
+# ---------------------------------------------------------------------------------------------
+# running
+
+
+@pytest.fixture(scope="session")
+def valid(tmp_path_factory) -> Path:
+    return build_valid(tmp_path_factory.mktemp("valid"))
+
+
+def _sha(root: Path) -> dict:
+    return {
+        p.relative_to(root): hashlib.sha256(p.read_bytes()).hexdigest()
+        for p in sorted(root.rglob("*"))
+        if p.is_file() and "__pycache__" not in p.parts
+    }
+
+
+@dataclass
+class Inputs:
+    dir: Path
+    before: dict
+
+
+@pytest.fixture
+def inputs(tmp_path, valid, request, monkeypatch):
+    """A copy of the command's valid inputs; their SHA-256 must be unchanged afterwards.
+
+    The working directory is a fresh folder (``hsgeo data`` writes under it).
+    """
+    cmd = request.node.callspec.params.get("cmd") if hasattr(request.node, "callspec") else None
+    c = request.node.callspec.params.get("case") if hasattr(request.node, "callspec") else None
+    cmd = c.cmd if c is not None else cmd
+    d = tmp_path / "in"
+    if cmd is not None and (valid / cmd).is_dir():
+        shutil.copytree(valid / cmd, d)
+    else:
+        d.mkdir()
+    cwd = tmp_path / "cwd"
+    cwd.mkdir()
+    monkeypatch.chdir(cwd)
+    holder = Inputs(d, {})
+    yield holder
+    for p in tmp_path.rglob("*"):  # readonly folders made by the cases
+        if p.is_dir():
+            p.chmod(0o755)
+    after = _sha(d)
+    changed = [str(p) for p, h in holder.before.items() if after.get(p) != h]
+    assert not changed, f"input files changed or removed: {changed}"
+    parts = [str(p) for p in tmp_path.rglob("*.part")]
+    assert not parts, f"partial files left: {parts}"
+
+
+def run_cli(argv, capsys) -> tuple[int, str, str]:
+    from hsgeo.cli import main
+
+    try:
+        rc = main([str(a) for a in argv])
+    except SystemExit as exc:  # argparse
+        rc = exc.code
+    cap = capsys.readouterr()
+    return rc, cap.out, cap.err
+
+
+@pytest.mark.parametrize("case", CASES, ids=[c.id for c in CASES])
+def test_bad_input(case: Case, inputs: Inputs, capsys):
+    if "readonly" in case.name and os.geteuid() == 0:
+        pytest.skip("root writes into read-only folders")
+    d = inputs.dir
+    for name, edit in case.files:
+        edit(d / name)
+    argv = base_argv(case.cmd, d) if case.cmd != "hsgeo" else []
+    if case.argv is not None:
+        argv = case.argv(argv, d)
+    inputs.before = _sha(d)
+    rc, out, err = run_cli(argv, capsys)
+    lines = err.splitlines()
+    assert rc == 2, f"exit {rc}; stderr: {err[-2000:]}"
+    assert len(lines) == 1, f"{len(lines)} lines on stderr:\n{err[-3000:]}"
+    assert "Traceback" not in err
+    assert case.expect.lower() in lines[0].lower(), lines[0]
+    # not a case that fails for a reason of the harness's making
+    assert "unrecognized arguments" not in err or case.kind == "options", err
+    assert out == "", f"stdout: {out[:500]}"
+
+
+# --- benign variants still work --------------------------------------------------------------
+
+
+def _crlf(p: Path):
+    p.write_bytes(p.read_bytes().replace(b"\n", b"\r\n"))
+
+
+def _bom(p: Path):
+    p.write_bytes(b"\xef\xbb\xbf" + p.read_bytes())
+
+
+def _reorder(p: Path):
+    h, rows = read_csv(p)
+    order = list(reversed(range(len(h))))
+    write_csv(p, [h[i] for i in order], [[r[i] for i in order] for r in rows])
+
+
+def _extra_column(p: Path):
+    h, rows = read_csv(p)
+    write_csv(p, [*h, "comment"], [[*r, "ok"] for r in rows])
+
+
+def _parquet(p: Path):
+    import pandas as pd
+
+    pd.read_csv(p).to_parquet(p.with_suffix(".parquet"))
+
+
+def _gray16(p: Path):
+    import cv2
+
+    img = cv2.imread(str(p), cv2.IMREAD_GRAYSCALE).astype(np.uint16) * 257
+    p.unlink()
+    cv2.imwrite(str(p.with_suffix(".png")), img)
+
+
+BENIGN = [
+    ("calibrate-line", "crlf", [("obs.csv", _crlf), ("control.csv", _crlf)], None),
+    ("calibrate-line", "bom", [("obs.csv", _bom), ("control.csv", _bom)], None),
+    ("calibrate-line", "reordered", [("obs.csv", _reorder), ("control.csv", _reorder)], None),
+    ("calibrate-line", "extra-column", [("obs.csv", _extra_column)], None),
+    ("calibrate-line", "options", [], flag("--sigma-px", "0.2", "--reject-k", "5", "--json")),
+    ("geocode", "crlf-nav", [("nav.csv", _crlf), ("sensor.toml", _crlf)], None),
+    ("geocode", "bom-nav", [("nav.csv", _bom), ("sensor.toml", _bom)], None),
+    ("geocode", "reordered-nav", [("nav.csv", _reorder)], None),
+    ("geocode", "extra-column-nav", [("nav.csv", _extra_column)], None),
+    ("geocode", "dem", [], _dem),
+    (
+        "geocode",
+        "envi-and-overwrite",
+        [],
+        lambda a, d: flag("--envi", str(d.parent / "out" / "o_envi"), "--overwrite")(a, d),
+    ),
+    ("geocode", "overwrite-existing", [], lambda a, d: flag("--overwrite")(_touch_output(a, d), d)),
+    (
+        "adjust-pushbroom",
+        "crlf-bom-reordered",
+        [("obs.csv", _reorder), ("nav.csv", _crlf), ("gcp.csv", _bom)],
+        flag("--json", "--accept-poor-fit"),
+    ),
+    (
+        "adjust-pushbroom",
+        "parquet-extra-columns",
+        [("obs.csv", _extra_column), ("obs.csv", _parquet), ("gcp.csv", _extra_column)],
+        lambda a, d: replace_arg("obs.csv", lambda d: d / "obs.parquet")(a, d) + ["--json"],
+    ),
+    ("calibrate-frame", "gray16-png", [(f"img_0{i}.jpg", _gray16) for i in range(3)], None),
+]
+
+
+@pytest.mark.parametrize("cmd,name,files,argv", BENIGN, ids=[f"{b[0]}:{b[1]}" for b in BENIGN])
+def test_benign_variant(cmd, name, files, argv, inputs: Inputs, capsys):
+    d = inputs.dir
+    for f, edit in files:
+        edit(d / f)
+    a = base_argv(cmd, d)
+    if cmd == "calibrate-frame":
+        a = [cmd, *map(str, sorted(d.glob("img_*"))), "--board", str(d / "board.toml")]
+    if argv is not None:
+        a = argv(a, d)
+    inputs.before = _sha(d)
+    rc, out, err = run_cli(a, capsys)
+    assert rc == 0, err[-3000:]
+    assert "Traceback" not in err
+
+
+@pytest.mark.parametrize("cmd", ["data"])
+def test_data_writes_under_the_working_directory(cmd, inputs: Inputs, capsys):
+    """``hsgeo data`` run outside the repository: the files go to --out, or without it to
+    ./data_synthetic/generated under the working directory; never into the package or the
+    repository (their files keep their SHA-256, no file is added)."""
+    import hsgeo
+    from hsgeo.simulate.scenarios import data_dir
+
+    watched = [Path(hsgeo.__file__).resolve().parent, data_dir()]
+    before = {w: _sha(w) for w in watched}
+    out = inputs.dir / "gen"
+    rc, _, err = run_cli(["data", "--out", str(out)], capsys)
+    assert rc == 0, err
+    assert (out / "line_lab_observations.csv").is_file()
+    rc, _, err = run_cli(["data"], capsys)  # the working directory is a fresh folder
+    assert rc == 0, err
+    assert (Path.cwd() / "data_synthetic/generated/line_lab_observations.csv").is_file()
+    for w in watched:
+        assert _sha(w) == before[w], w
+
+
+def counts() -> str:
+    """The table of cases by command and class."""
+    by = Counter((c.cmd, c.kind) for c in CASES)
+    cmds = sorted({c for c, _ in by})
+    kinds = sorted({k for _, k in by})
+    w = max(map(len, kinds)) + 2
+    lines = ["command".ljust(18) + "".join(k[: w - 1].rjust(w) for k in kinds) + "   total"]
+    for c in cmds:
+        row = [by[(c, k)] for k in kinds]
+        lines.append(c.ljust(18) + "".join(str(n or "").rjust(w) for n in row) + f"{sum(row):8d}")
+    lines.append(
+        "total".ljust(18)
+        + "".join(str(sum(by[(c, k)] for c in cmds)).rjust(w) for k in kinds)
+        + f"{len(CASES):8d}"
+    )
+    return "\n".join(lines)
+
+
+if __name__ == "__main__":
+    print(counts())
+
+
+@pytest.mark.parametrize("cmd", ["geocode"])
+def test_a_failing_envi_leaves_no_netcdf(cmd, inputs: Inputs, monkeypatch, capsys):
+    """-o x.nc --envi y: if writing the ENVI pair fails, the NetCDF is not left behind either
+    (all outputs or none), and no temporary file remains (the fixture checks *.part)."""
+    from hsgeo.errors import InputError
+    from hsgeo.io import raster
+
+    def fail(*args, **kwargs):
+        raise InputError("the ENVI writer failed")
+
+    monkeypatch.setattr(raster, "write_envi", fail)
+    d = inputs.dir
+    out = d.parent / "out"
+    a = base_argv("geocode", d) + ["--envi", str(out / "o_envi")]
+    inputs.before = _sha(d)
+    rc, _, err = run_cli(a, capsys)
+    assert rc == 2 and "ENVI writer failed" in err
+    assert sorted(p.name for p in out.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    "argv", [["--help"], *([c, "--help"] for c in sorted({c.cmd for c in CASES} - {"hsgeo"}))]
+)
+def test_help_still_works(argv, capsys):
+    from hsgeo.cli import main
+
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 0
+    assert capsys.readouterr().out.startswith("usage: hsgeo")
+
+
+@pytest.mark.parametrize(
+    "cmd,edit,expect",
+    [
+        ("calibrate-line", lambda a, d: opt("--zeta0-px", "nan")(a, d), "--zeta0-px"),
+        ("calibrate-line", lambda a, d: opt("--c-px", "0")(a, d), "--c-px"),
+        ("geocode", lambda a, d: opt("--resolution", "0.005")(a, d), "--max-grid-gib"),
+    ],
+    ids=["zeta0-nan", "c-px-0", "resolution-5mm"],
+)
+def test_end_to_end_in_a_subprocess(cmd, edit, expect, inputs: Inputs):
+    """The console command as a user runs it: file descriptors 1 and 2 as they are (a LAPACK
+    or C-library message would show here, where capsys cannot see it)."""
+    import subprocess
+    import sys
+
+    d = inputs.dir
+    argv = edit(base_argv(cmd, d), d)
+    inputs.before = _sha(d)
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src"), "OPENBLAS_NUM_THREADS": "1"}
+    p = subprocess.run(
+        [sys.executable, "-m", "hsgeo.cli", *argv], capture_output=True, text=True, env=env
+    )
+    assert p.returncode == 2
+    assert p.stdout == ""
+    assert len(p.stderr.splitlines()) == 1 and expect in p.stderr, p.stderr
