@@ -130,6 +130,13 @@ class CampaignConfig:
     sigma_gcp_m: float = 0.01  # 002 §4: RTK ≈ 1 cm
     terrain_relief_m: float = 15.0  # ours: tie points between 0 and 15 m above the datum
     mount_motion_rad: float = 0.02 * DEG  # ours: residual motion of the stabilised mount
+    # -- candidate explanations of 002's check-point errors (off by default; issue 15)
+    # the 17 reference squares (1.2 m, 002 §4) measured in the images by their centre: None as
+    # the tie points; a σ (px): the centre of a 3–4 px square picked with this error
+    sigma_ref_image_px: float | None = None
+    # atmospheric refraction in the images (standard photogrammetric model, see _refraction_k)
+    refraction: bool = False
+    terrain_asl_m: float = 90.0  # ours: Ås (002 §4: 59.665° N, 10.775° E) lies ≈ 90 m a.s.l.
 
 
 @dataclass(frozen=True)
@@ -316,6 +323,21 @@ def spline_fit(nodes: SplineNodes, t_s, values) -> np.ndarray:
     # basis functions touch, would otherwise wander (untouched nodes stay zero)
     N = (A.T @ A + RIDGE * sp.identity(nodes.n_nodes)).tocsc()
     return np.asarray(spla.spsolve(N, A.T @ v)).reshape(nodes.n_nodes, -1)
+
+
+def _refraction_k(flying_asl_m, ground_asl_m):
+    """Photogrammetric refraction constant K (rad) of the ARDC standard atmosphere.
+
+    ``K = 2410 H / (H² − 6 H + 250) − 2410 h² / ((h² − 6 h + 250) H)`` µrad with H, h the
+    flying and ground heights above sea level in km; the image point moves radially outward by
+    ``Δr = K (r + r³ / c²)``. As commonly quoted from Wolf, Dewitt & Wilkinson, *Elements of
+    Photogrammetry* (§ on atmospheric refraction; the book itself was not at hand to check).
+    At 1875 and 2500 m AGL over ground 90 m a.s.l., K ≈ 20 and 26 µrad.
+    """
+    H = np.asarray(flying_asl_m, dtype=np.float64) / 1e3
+    h = np.asarray(ground_asl_m, dtype=np.float64) / 1e3
+    k_urad = 2410 * H / (H**2 - 6 * H + 250) - 2410 * h**2 / ((h**2 - 6 * h + 250) * H)
+    return k_urad * 1e-6
 
 
 def _strip_plan(cfg: CampaignConfig):
@@ -539,11 +561,21 @@ def simulate(
     # key-point localisation error (ours, see CampaignConfig): x along the line, and in y an
     # error of the matched line, i.e. of the time
     loc = (0.0 if noise_free else cfg.sigma_keypoint_px) * rng.standard_normal((m, 2))
+    ref_loc = rng.standard_normal((m, 2))  # drawn always: the same stream with or without
+    if cfg.sigma_ref_image_px is not None and not noise_free:
+        on_ref = is_ref[pidx]
+        loc[on_ref] = cfg.sigma_ref_image_px * ref_loc[on_ref]
     t_loc = t - loc[:, 1] * cfg.pixel_mm / deriv
     t_line = np.round(t_loc / line_dt) * line_dt
     xy_true_mm, pc = true_xy(t_line)
     if np.any(pc[:, 2] <= 0):
         raise InputError("simulated points behind the camera: check the flight plan")
+    if cfg.refraction:  # the ray bends: the image point moves radially outward
+        agl_obs = np.array([p[3] for p in plan])[strip]
+        k = _refraction_k(agl_obs + cfg.terrain_asl_m, P[pidx, 2] + cfg.terrain_asl_m)
+        d = xy_true_mm - np.array([cfg.x0_mm, cfg.y0_mm])
+        r2 = np.sum(d**2, axis=1) / truth[names["c"]][band] ** 2
+        xy_true_mm = xy_true_mm + (k * (1 + r2))[:, None] * d
     xy_true_px = xy_true_mm / cfg.pixel_mm
     # navigation solution at the line times: truth minus the spline error
     xyz_true, rpy_true = _true_pose(plan, strip, t_line, cfg.mount_motion_rad, cfg.speed_m_s)
