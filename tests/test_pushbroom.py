@@ -220,9 +220,9 @@ def test_truth_within_3_sigma_small_scale(trajectory_error):
     else:
         # Gauss–Markov truth: no exact node values. The roll and pitch corrections of the nodes
         # that observations touch (the ones the images see) follow the best spline fit of the
-        # true error: measured at this size (seed 0) correlations 0.66 and 0.73, and |z| < 3
-        # for 97 % and 88 % (pitch: the part of the error the spline cannot represent is in
-        # the residuals, so σ̂ is optimistic)
+        # true error over the strips: measured at this size (seed 0) correlations 0.73 and 0.81,
+        # |z| < 3 for 97 % and 96 % (the part of the error the spline cannot represent is in
+        # the residuals, so σ̂ is somewhat optimistic)
         seen = np.unique(truth.nodes.basis(obs.lines.t_s)[0][:, 1:3])
         fit, est = truth.values["nodes"][seen, 3:5], res.value("nodes")[seen, 3:5]
         for j in range(2):

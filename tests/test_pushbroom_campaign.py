@@ -69,3 +69,43 @@ def test_error_model_options():
         simulate(0.001, rng=0, trajectory_error="random-walk")
     with pytest.raises(InputError, match="noise_free=True needs trajectory_error='spline'"):
         simulate(0.001, rng=0, noise_free=True)
+
+
+def test_refraction_moves_image_points_radially_by_the_standard_amount():
+    """K of the ARDC model at H = 1.965 km, h = 0.09 km, by hand from the formula:
+    2410·1.965/(1.965² − 6·1.965 + 250) − 2410·0.09²/((0.09² − 6·0.09 + 250)·1.965) = 19.52 µrad;
+    the image point moves outward by K(r + r³/c²): ≤ 0.02 px at the line's end (5.85 mm)."""
+    from dataclasses import replace
+
+    from hsgeo.simulate.pushbroom_campaign import CampaignConfig, _refraction_k
+
+    assert abs(_refraction_k(1965.0, 90.0) * 1e6 - 19.52) < 0.01
+    cfg = CampaignConfig()
+    (o0, t0), (o1, t1) = (
+        simulate(0.001, rng=3),
+        simulate(0.001, rng=3, cfg=replace(cfg, refraction=True)),
+    )
+    np.testing.assert_array_equal(o0.lines.t_s, o1.lines.t_s)  # same draws otherwise
+    dx = t1.xy_true_px[:, 0] - t0.xy_true_px[:, 0]
+    x = t0.xy_true_px[:, 0] - cfg.x0_mm / cfg.pixel_mm
+    assert np.all(np.sign(dx[np.abs(x) > 50]) == np.sign(x[np.abs(x) > 50]))  # outward
+    assert 0.01 < np.max(np.abs(dx)) < 0.03
+
+
+def test_reference_squares_measured_by_their_centre():
+    from dataclasses import replace
+
+    from hsgeo.simulate.pushbroom_campaign import CampaignConfig
+
+    cfg = CampaignConfig()
+    (o0, _), (o1, t1) = (
+        simulate(0.001, rng=4),
+        simulate(0.001, rng=4, cfg=replace(cfg, sigma_ref_image_px=0.5)),
+    )
+    ref = o1.lines.point < 17
+    np.testing.assert_array_equal(o0.lines.xy_px[~ref], o1.lines.xy_px[~ref])  # tie points
+    assert not np.array_equal(o0.lines.xy_px[ref], o1.lines.xy_px[ref])
+    good = ref & ~t1.outlier
+    err = o1.lines.xy_px[good, 0] - t1.xy_true_px[good, 0]
+    # N(0, 0.5²) then registered at the pixel centre: σ = √(0.25 + 1/12) ≈ 0.58 px
+    assert 0.4 < np.std(err) < 0.75, np.std(err)

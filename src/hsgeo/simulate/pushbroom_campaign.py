@@ -18,8 +18,9 @@ Truth and errors:
   10 Hz and interpolated by a cubic spline between the samples (the INS carries the solution
   smoothly between GNSS epochs), so the navigation rates are its derivative. This is *not* the
   estimator's model (a B-spline with nodes every 10 s): the node corrections have no exact
-  true value, and :attr:`CampaignTruth.values` holds the best least-squares spline fit of the
-  true error at the campaign's node interval (:func:`spline_fit`) in their place.
+  true value, and :attr:`CampaignTruth.values` holds in their place the best least-squares
+  spline fit (:func:`spline_fit`) of the true error at the campaign's node interval over the
+  imaged parts of the flight (the strips; the turns carry no observations).
   ``trajectory_error="spline"`` makes the error a local cubic B-spline with nodes every 10 s
   whose node values are drawn from the same σ (the estimator's own model, for the noise-free
   and identifiability tests: there the node corrections have an exact true value);
@@ -206,7 +207,8 @@ class CampaignTruth:
     -----
     With ``"spline"`` the node values in :attr:`values` are the exact error; with
     ``"gauss-markov"`` they are its best least-squares spline fit (:func:`spline_fit`) at the
-    campaign's node interval, which the adjustment can at best recover.
+    campaign's node interval over the strips (10 Hz samples while imaging), which the
+    adjustment can at best recover; nodes that no strip touches are zero (their prior).
     """
 
     cfg: CampaignConfig
@@ -244,7 +246,7 @@ class CampaignTruth:
         return (cs.derivative() if rate else cs)(np.asarray(t_s, dtype=np.float64))
 
     def node_fit(self, interval_s: float) -> tuple[SplineNodes, np.ndarray]:
-        """The best spline fit of the true error with nodes every ``interval_s`` over the flight.
+        """The best spline fit of the true error with nodes every ``interval_s`` over the strips.
 
         Returns ``(nodes, values (n_nodes, 6))``; with ``"spline"`` at the campaign's own
         interval this is the exact error.
@@ -252,10 +254,17 @@ class CampaignTruth:
         nodes = SplineNodes(self.nodes.t_start_s, self.nodes.t_end_s, float(interval_s))
         if self.error_samples is None and interval_s == self.nodes.interval_s:
             return nodes, np.array(self.values[BLOCK_NAMES["nodes"]])
-        if self.error_samples is None:
-            t = np.arange(self.nodes.t_start_s, self.nodes.t_end_s, 0.1)
-            return nodes, spline_fit(nodes, t, self.nav_error(t))
-        return nodes, spline_fit(nodes, self.error_t_s, self.error_samples)
+        t = _imaged(self.strips, np.arange(self.nodes.t_start_s, self.nodes.t_end_s, 0.1))
+        return nodes, spline_fit(nodes, t, self.nav_error(t))
+
+
+def _imaged(plan, t_s):
+    """The times of ``t_s`` that lie within a strip of ``plan``."""
+    t = np.asarray(t_s, dtype=np.float64)
+    inside = np.zeros(t.shape, bool)
+    for p in plan:
+        inside |= (t >= p[0]) & (t <= p[1])
+    return t[inside]
 
 
 def gauss_markov(n: int, dt_s: float, tau_s, sigma, rng) -> np.ndarray:
@@ -454,8 +463,9 @@ def simulate(
         err_x = gauss_markov(
             n_s, cfg.error_sample_s, np.r_[cfg.tau_pos_s, cfg.tau_att_s], sigma_nav, rng
         )
-        node_err = spline_fit(nodes, err_t[err_t <= t_end], err_x[err_t <= t_end])
         err_cs = CubicSpline(err_t, err_x, axis=0)
+        t_fit = _imaged(plan, np.arange(0.0, t_end, 0.1))
+        node_err = spline_fit(nodes, t_fit, err_cs(t_fit))
         err_rate_cs = err_cs.derivative()
 
         def nav_err(tt, rate=False):
