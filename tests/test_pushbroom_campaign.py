@@ -77,9 +77,9 @@ def test_refraction_moves_image_points_radially_by_the_standard_amount():
     the image point moves outward by K(r + r³/c²): ≤ 0.02 px at the line's end (5.85 mm)."""
     from dataclasses import replace
 
-    from hsgeo.simulate.pushbroom_campaign import CampaignConfig, _refraction_k
+    from hsgeo.simulate.pushbroom_campaign import CampaignConfig, refraction_k
 
-    assert abs(_refraction_k(1965.0, 90.0) * 1e6 - 19.52) < 0.01
+    assert abs(refraction_k(1965.0, 90.0) * 1e6 - 19.52) < 0.01
     cfg = CampaignConfig()
     (o0, t0), (o1, t1) = (
         simulate(0.001, rng=3),

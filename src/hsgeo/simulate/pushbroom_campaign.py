@@ -64,6 +64,7 @@ __all__ = [
     "CampaignTruth",
     "TRAJECTORY_ERRORS",
     "gauss_markov",
+    "refraction_k",
     "simulate",
     "spline_fit",
 ]
@@ -135,7 +136,7 @@ class CampaignConfig:
     # the 17 reference squares (1.2 m, 002 §4) measured in the images by their centre: None as
     # the tie points; a σ (px): the centre of a 3–4 px square picked with this error
     sigma_ref_image_px: float | None = None
-    # atmospheric refraction in the images (standard photogrammetric model, see _refraction_k)
+    # atmospheric refraction in the images (standard photogrammetric model, see refraction_k)
     refraction: bool = False
     terrain_asl_m: float = 90.0  # ours: Ås (002 §4: 59.665° N, 10.775° E) lies ≈ 90 m a.s.l.
 
@@ -334,7 +335,7 @@ def spline_fit(nodes: SplineNodes, t_s, values) -> np.ndarray:
     return np.asarray(spla.spsolve(N, A.T @ v)).reshape(nodes.n_nodes, -1)
 
 
-def _refraction_k(flying_asl_m, ground_asl_m):
+def refraction_k(flying_asl_m, ground_asl_m) -> np.ndarray:
     """Photogrammetric refraction constant K (rad) of the ARDC standard atmosphere.
 
     ``K = 2410 H / (H² − 6 H + 250) − 2410 h² / ((h² − 6 h + 250) H)`` µrad with H, h the
@@ -582,7 +583,7 @@ def simulate(
         raise InputError("simulated points behind the camera: check the flight plan")
     if cfg.refraction:  # the ray bends: the image point moves radially outward
         agl_obs = np.array([p[3] for p in plan])[strip]
-        k = _refraction_k(agl_obs + cfg.terrain_asl_m, P[pidx, 2] + cfg.terrain_asl_m)
+        k = refraction_k(agl_obs + cfg.terrain_asl_m, P[pidx, 2] + cfg.terrain_asl_m)
         d = xy_true_mm - np.array([cfg.x0_mm, cfg.y0_mm])
         r2 = np.sum(d**2, axis=1) / truth[names["c"]][band] ** 2
         xy_true_mm = xy_true_mm + (k * (1 + r2))[:, None] * d
