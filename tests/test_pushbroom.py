@@ -92,7 +92,7 @@ def test_observations_validate_shapes(tiny):
 
 @pytest.mark.parametrize("y_as_time", [False, True])
 def test_model_is_exact_at_truth_noise_free(y_as_time):
-    obs, truth = simulate(0.001, rng=5, noise_free=True)
+    obs, truth = simulate(0.001, rng=5, noise_free=True, trajectory_error="spline")
     _, blocks, _ = _problem(obs, y_as_time=y_as_time)
     r, _ = blocks[0].evaluate(truth.values, False)
     assert np.max(np.abs(r)) < 1e-9
@@ -178,7 +178,7 @@ def test_symmetric_time_errors_do_not_bias(y_as_time):
     depth-scaled y) is biased by a fixed amount, which at full size (σ̂ 10× smaller than here)
     is several σ̂.
     """
-    obs, truth = simulate(0.005, rng=2, noise_free=True)
+    obs, truth = simulate(0.005, rng=2, noise_free=True, trajectory_error="spline")
     p, blocks, _ = _problem(_time_shifted(obs, 2.5e-3), y_as_time=y_as_time)
     res = adjust(p, blocks, ftol=1e-12)
     zn = (res.value("nodes") - truth.values["nodes"]) / res.sigma("nodes")
@@ -195,7 +195,7 @@ def test_symmetric_time_errors_do_not_bias(y_as_time):
 
 
 def test_noise_free_recovers_truth():
-    obs, truth = simulate(0.001, rng=11, noise_free=True)
+    obs, truth = simulate(0.001, rng=11, noise_free=True, trajectory_error="spline")
     p, blocks, _ = _problem(obs, y_as_time=True)
     assert identifiability(p, blocks).full_rank
     res = adjust(p, blocks, ftol=1e-15)
@@ -203,19 +203,31 @@ def test_noise_free_recovers_truth():
         np.testing.assert_allclose(res.value(k), v, rtol=0, atol=1e-7, err_msg=k)
 
 
-@pytest.mark.parametrize("seed", [0])
-def test_truth_within_3_sigma_small_scale(seed):
-    obs, truth = simulate(0.01, rng=seed)
+@pytest.mark.parametrize("trajectory_error", ["spline", "gauss-markov"])
+def test_truth_within_3_sigma_small_scale(trajectory_error):
+    obs, truth = simulate(0.01, rng=0, trajectory_error=trajectory_error)
     p, blocks, _ = _problem(obs, y_as_time=True)
     res = adjust(p, blocks, reject_k=5.0, reject_every_iteration=True)
     for k in ["boresight_rad", "lever_arm_m", "distortion", "c_mm"]:
         z = (res.value(k) - truth.values[k]) / res.sigma(k)
         assert np.max(np.abs(z)) < 3.5, (k, z)  # 17 values: family-wise ≈ 1 % false alarms
-    # ~1,000 node corrections: a few |z| > 3 are expected (0.27 %), so assert the coverage and
-    # the spread of z rather than max |z| < 3
     z = (res.value("nodes") - truth.values["nodes"]) / res.sigma("nodes")
-    assert np.mean(np.abs(z) < 3) >= 0.99
-    assert 0.8 <= np.std(z) <= 1.2, np.std(z, axis=0)
+    if trajectory_error == "spline":
+        # the estimator's own model: ~1,000 node corrections with an exact truth; a few
+        # |z| > 3 are expected (0.27 %), so assert the coverage and the spread of z
+        assert np.mean(np.abs(z) < 3) >= 0.99
+        assert 0.8 <= np.std(z) <= 1.2, np.std(z, axis=0)
+    else:
+        # Gauss–Markov truth: no exact node values. The roll and pitch corrections of the nodes
+        # that observations touch (the ones the images see) follow the best spline fit of the
+        # true error over the strips: measured at this size (seed 0) correlations 0.73 and 0.81,
+        # |z| < 3 for 97 % and 96 % (the part of the error the spline cannot represent is in
+        # the residuals, so σ̂ is somewhat optimistic)
+        seen = np.unique(truth.nodes.basis(obs.lines.t_s)[0][:, 1:3])
+        fit, est = truth.values["nodes"][seen, 3:5], res.value("nodes")[seen, 3:5]
+        for j in range(2):
+            assert np.corrcoef(est[:, j], fit[:, j])[0, 1] > 0.5
+        assert np.mean(np.abs(z[seen, 3:5]) < 3) >= 0.85
     r = res.residuals(0).reshape(-1, 2)[~res.outliers(0)]
     assert np.all((nmad(r, axis=0) > 0.2) & (nmad(r, axis=0) < 0.5))
     cp = res.value("points_m")[truth.cp_index] - truth.values["points_m"][truth.cp_index]
@@ -374,17 +386,18 @@ def test_time_residual_needs_rates_and_reference(tiny):
         build_problem(no_rates, tiny[0].n_points, CameraPrior(n_bands=7), y_as_time=True)
 
 
-def test_simulated_navigation_rates_are_the_derivative_of_the_poses():
+@pytest.mark.parametrize("trajectory_error", ["spline", "gauss-markov"])
+def test_simulated_navigation_rates_are_the_derivative_of_the_poses(trajectory_error):
     """The simulator's GNSS/INS rates against central differences of its poses."""
     from hsgeo.simulate import pushbroom_campaign as pc
 
-    obs, truth = simulate(0.001, rng=1)
+    obs, truth = simulate(0.001, rng=1, trajectory_error=trajectory_error)
     o, cfg, h = obs.lines, truth.cfg, 1e-5
     poses = []
     for dt in (h, -h):
         t = o.t_s + dt
         xyz, rpy = pc._true_pose(truth.strips, truth.strip, t, cfg.mount_motion_rad, cfg.speed_m_s)
-        d = truth.nodes.evaluate(truth.values["nodes"], t)
+        d = truth.nav_error(t)
         poses.append((xyz - d[:, :3], rpy - d[:, 3:]))
     np.testing.assert_allclose(o.xyz_rate_nav_m_s, (poses[0][0] - poses[1][0]) / (2 * h), atol=1e-6)
     np.testing.assert_allclose(

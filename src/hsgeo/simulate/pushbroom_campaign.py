@@ -10,10 +10,20 @@ Truth and errors:
 
 * the platform attitude has high-frequency motion of a gyro-stabilised mount, which the INS
   records exactly (it is in both the truth and the navigation solution);
-* the navigation solution differs from the truth by a smooth low-frequency error: a local cubic
-  B-spline (:mod:`hsgeo.trajectory`) with nodes every 10 s (002 §4) whose node values are drawn
-  from the GNSS/INS σ (002 §4: < 1.3 cm E/N, < 2 cm H; attitude from the POS-AV 510 class,
-  heading worst). The adjustment's node corrections therefore have a true value;
+* the navigation solution differs from the truth by the error of a post-processed GNSS/INS
+  solution (``trajectory_error="gauss-markov"``, the default): one first-order Gauss–Markov
+  process per axis (E, N, H, roll, pitch, yaw), stationary, with the σ of 002 §4 for the
+  positions (< 1.3 cm E/N, < 2.0 cm H) and of the POS-AV 510 class for the attitude (heading
+  worst), and correlation times from seconds to minutes (:func:`gauss_markov`). It is sampled at
+  10 Hz and interpolated by a cubic spline between the samples (the INS carries the solution
+  smoothly between GNSS epochs), so the navigation rates are its derivative. This is *not* the
+  estimator's model (a B-spline with nodes every 10 s): the node corrections have no exact
+  true value, and :attr:`CampaignTruth.values` holds in their place the best least-squares
+  spline fit (:func:`spline_fit`) of the true error at the campaign's node interval over the
+  imaged parts of the flight (the strips; the turns carry no observations).
+  ``trajectory_error="spline"`` makes the error a local cubic B-spline with nodes every 10 s
+  whose node values are drawn from the same σ (the estimator's own model, for the noise-free
+  and identifiability tests: there the node corrections have an exact true value);
 * boresight of a few tenths of a degree, a lever arm measured to 2 cm, Brown K1, K2, P1, P2 of a
   few tenths of a pixel at the line's end, and one principal distance per band whose spread
   about the 40.3 mm mean is ≤ 11.8 µm (002 Fig. 8);
@@ -31,10 +41,13 @@ numerical precision.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 
 import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from scipy.interpolate import CubicSpline
 
 from hsgeo.errors import InputError
 from hsgeo.sensors.pushbroom import (
@@ -45,7 +58,21 @@ from hsgeo.sensors.pushbroom import (
 )
 from hsgeo.trajectory import SplineNodes
 
-__all__ = ["CampaignConfig", "CampaignObservations", "CampaignTruth", "simulate"]
+__all__ = [
+    "CampaignConfig",
+    "CampaignObservations",
+    "CampaignTruth",
+    "TRAJECTORY_ERRORS",
+    "gauss_markov",
+    "refraction_k",
+    "simulate",
+    "spline_fit",
+]
+
+#: The models of the GNSS/INS error the simulator knows (see the module docstring).
+TRAJECTORY_ERRORS = ("gauss-markov", "spline")
+#: Weight of the ridge of :func:`spline_fit`, in samples per node.
+RIDGE = 0.1
 
 DEG = np.pi / 180
 
@@ -74,9 +101,22 @@ class CampaignConfig:
     strip_half_length_m: float = 480.0  # ours: imaged length along each strip
     turn_s: float = 60.0  # ours: time between strips
     node_interval_s: float = 10.0  # 002 §4
-    sigma_pos_m: tuple = (0.013, 0.013, 0.020)  # 002 §4: GNSS/INS STD E, N, H
-    # POS-AV 510 post-processed attitude (Applanix spec: roll/pitch 0.005°, heading 0.008°)
+    # 002 §4: "a positional STD of < 1.3 cm in each of east and north, and < 2.0 cm in height"
+    # (the bounds are taken as the σ)
+    sigma_pos_m: tuple = (0.013, 0.013, 0.020)
+    # POS AV 510 post-processed attitude RMS, roll/pitch 0.005°, heading 0.008°, as commonly
+    # quoted from Applanix's specification sheet (002 §4 names the POS-AV 510 but gives no
+    # attitude σ; we could not check the sheet itself): heading worst
     sigma_att_rad: tuple = (0.005 * DEG, 0.005 * DEG, 0.008 * DEG)
+    # the GNSS/INS error model of the truth: "gauss-markov" (default) or "spline" (the
+    # estimator's own model; for the noise-free and identifiability tests)
+    trajectory_error: str = "gauss-markov"
+    # ours: correlation times of the first-order Gauss–Markov errors, s ("seconds to minutes":
+    # GNSS position errors of a smoothed solution wander over minutes, the INS attitude errors
+    # over tens of seconds, heading slowest)
+    tau_pos_s: tuple = (60.0, 60.0, 120.0)
+    tau_att_s: tuple = (20.0, 20.0, 60.0)
+    error_sample_s: float = 0.1  # ours: the error is sampled at 10 Hz (a GNSS epoch rate)
     boresight_deg: tuple = (0.25, -0.35, 0.15)  # ours: "a few tenths of a degree"
     lever_arm_m: tuple = (0.12, -0.05, -0.30)  # ours
     sigma_lever_m: float = 0.02  # ours: tape-measured lever arm
@@ -92,6 +132,13 @@ class CampaignConfig:
     sigma_gcp_m: float = 0.01  # 002 §4: RTK ≈ 1 cm
     terrain_relief_m: float = 15.0  # ours: tie points between 0 and 15 m above the datum
     mount_motion_rad: float = 0.02 * DEG  # ours: residual motion of the stabilised mount
+    # -- candidate explanations of 002's check-point errors (off by default; issue 15)
+    # the 17 reference squares (1.2 m, 002 §4) measured in the images by their centre: None as
+    # the tie points; a σ (px): the centre of a 3–4 px square picked with this error
+    sigma_ref_image_px: float | None = None
+    # atmospheric refraction in the images (standard photogrammetric model, see refraction_k)
+    refraction: bool = False
+    terrain_asl_m: float = 90.0  # ours: Ås (002 §4: 59.665° N, 10.775° E) lies ≈ 90 m a.s.l.
 
 
 @dataclass(frozen=True)
@@ -151,6 +198,18 @@ class CampaignTruth:
         Observations with a gross error.
     xy_true_px : (m, 2) ndarray
         Exact image coordinates of each observation in its line.
+    trajectory_error : str
+        The error model of the navigation solution (:data:`TRAJECTORY_ERRORS`).
+    error_t_s, error_samples : (k,) and (k, 6) ndarray or None
+        With ``"gauss-markov"``: the sample times and the sampled error (true minus navigation:
+        E, N, H in m, roll, pitch, yaw in rad). None with ``"spline"``.
+
+    Notes
+    -----
+    With ``"spline"`` the node values in :attr:`values` are the exact error; with
+    ``"gauss-markov"`` they are its best least-squares spline fit (:func:`spline_fit`) at the
+    campaign's node interval over the strips (10 Hz samples while imaging), which the
+    adjustment can at best recover; nodes that no strip touches are zero (their prior).
     """
 
     cfg: CampaignConfig
@@ -162,6 +221,133 @@ class CampaignTruth:
     cp_index: np.ndarray | None = None
     outlier: np.ndarray | None = None
     xy_true_px: np.ndarray | None = None
+    trajectory_error: str = "spline"
+    error_t_s: np.ndarray | None = None
+    error_samples: np.ndarray | None = None
+
+    def nav_error(self, t_s, rate: bool = False) -> np.ndarray:
+        """The true error of the navigation solution (truth minus navigation) at ``t_s``.
+
+        Parameters
+        ----------
+        t_s : (m,) array_like
+            Times, s, within the flight.
+        rate : bool
+            Return the time derivative (m/s, rad/s) instead.
+
+        Returns
+        -------
+        (m, 6) ndarray
+            E, N, H in m and roll, pitch, yaw in rad (or their rates).
+        """
+        if self.error_samples is None:
+            f = self.nodes.evaluate_rate if rate else self.nodes.evaluate
+            return f(self.values[BLOCK_NAMES["nodes"]], t_s)
+        cs = CubicSpline(self.error_t_s, self.error_samples, axis=0)
+        return (cs.derivative() if rate else cs)(np.asarray(t_s, dtype=np.float64))
+
+    def node_fit(self, interval_s: float) -> tuple[SplineNodes, np.ndarray]:
+        """The best spline fit of the true error with nodes every ``interval_s`` over the strips.
+
+        Returns ``(nodes, values (n_nodes, 6))``; with ``"spline"`` at the campaign's own
+        interval this is the exact error.
+        """
+        nodes = SplineNodes(self.nodes.t_start_s, self.nodes.t_end_s, float(interval_s))
+        if self.error_samples is None and interval_s == self.nodes.interval_s:
+            return nodes, np.array(self.values[BLOCK_NAMES["nodes"]])
+        t = _imaged(self.strips, np.arange(self.nodes.t_start_s, self.nodes.t_end_s, 0.1))
+        return nodes, spline_fit(nodes, t, self.nav_error(t))
+
+
+def _imaged(plan, t_s):
+    """The times of ``t_s`` that lie within a strip of ``plan``."""
+    t = np.asarray(t_s, dtype=np.float64)
+    inside = np.zeros(t.shape, bool)
+    for p in plan:
+        inside |= (t >= p[0]) & (t <= p[1])
+    return t[inside]
+
+
+def gauss_markov(n: int, dt_s: float, tau_s, sigma, rng) -> np.ndarray:
+    r"""Stationary first-order Gauss–Markov processes sampled every ``dt_s``.
+
+    The exact discrete recursion of the continuous process
+    :math:`\dot x = -x/\tau + w`: :math:`x_{k+1} = e^{-\Delta t/\tau} x_k +
+    \sigma\sqrt{1 - e^{-2\Delta t/\tau}}\, w_k`, :math:`w_k \sim N(0, 1)`, started from the
+    stationary distribution :math:`x_0 \sim N(0, \sigma^2)`; its autocorrelation is
+    :math:`\sigma^2 e^{-|\Delta t|/\tau}` at every lag.
+
+    Parameters
+    ----------
+    n : int
+        Number of samples.
+    dt_s : float
+        Sample interval, s.
+    tau_s, sigma : (k,) array_like
+        Correlation time (s) and stationary σ (any unit) of each of the ``k`` processes.
+    rng : int or numpy.random.Generator
+
+    Returns
+    -------
+    (n, k) ndarray
+    """
+    rng = np.random.default_rng(rng)
+    tau = np.atleast_1d(np.asarray(tau_s, dtype=np.float64))
+    sig = np.atleast_1d(np.asarray(sigma, dtype=np.float64)) * np.ones_like(tau)
+    if np.any(tau <= 0) or not dt_s > 0:
+        raise InputError("correlation times and the sample interval must be positive")
+    phi = np.exp(-dt_s / tau)
+    q = sig * np.sqrt(1.0 - phi**2)
+    w = rng.standard_normal((n, tau.size))
+    x = np.empty((n, tau.size))
+    x[0] = sig * w[0]
+    for k in range(1, n):  # a recursion: 18,000 steps of a 6-vector, negligible
+        x[k] = phi * x[k - 1] + q * w[k]
+    return x
+
+
+def spline_fit(nodes: SplineNodes, t_s, values) -> np.ndarray:
+    r"""Least-squares node values of the cubic B-spline ``nodes`` that best fit ``values``.
+
+    Parameters
+    ----------
+    nodes : SplineNodes
+    t_s : (m,) array_like
+        Sample times, s, within the span of ``nodes``.
+    values : (m, k) array_like
+        The samples.
+
+    Returns
+    -------
+    (n_nodes, k) ndarray
+        Minimises :math:`\sum_i \|\,\delta(t_i) - v_i\|^2` with :math:`\delta` the spline of
+        :meth:`SplineNodes.evaluate`, plus a ridge :math:`0.1 \sum_j \|c_j\|^2` (a tenth of a sample
+        per node) that holds nodes the samples barely touch near zero.
+    """
+    t = np.asarray(t_s, dtype=np.float64).ravel()
+    v = np.asarray(values, dtype=np.float64).reshape(t.size, -1)
+    idx, w = nodes.basis(t)
+    rows = np.repeat(np.arange(t.size), 4)
+    A = sp.csr_matrix((w.ravel(), (rows, idx.ravel())), shape=(t.size, nodes.n_nodes))
+    # a ridge of a tenth of a sample per node: the end nodes, which only the tails of their
+    # basis functions touch, would otherwise wander (untouched nodes stay zero)
+    N = (A.T @ A + RIDGE * sp.identity(nodes.n_nodes)).tocsc()
+    return np.asarray(spla.spsolve(N, A.T @ v)).reshape(nodes.n_nodes, -1)
+
+
+def refraction_k(flying_asl_m, ground_asl_m) -> np.ndarray:
+    """Photogrammetric refraction constant K (rad) of the ARDC standard atmosphere.
+
+    ``K = 2410 H / (H² − 6 H + 250) − 2410 h² / ((h² − 6 h + 250) H)`` µrad with H, h the
+    flying and ground heights above sea level in km; the image point moves radially outward by
+    ``Δr = K (r + r³ / c²)``. As commonly quoted from Wolf, Dewitt & Wilkinson, *Elements of
+    Photogrammetry* (§ on atmospheric refraction; the book itself was not at hand to check).
+    At 1875 and 2500 m AGL over ground 90 m a.s.l., K ≈ 20 and 26 µrad.
+    """
+    H = np.asarray(flying_asl_m, dtype=np.float64) / 1e3
+    h = np.asarray(ground_asl_m, dtype=np.float64) / 1e3
+    k_urad = 2410 * H / (H**2 - 6 * H + 250) - 2410 * h**2 / ((h**2 - 6 * h + 250) * H)
+    return k_urad * 1e-6
 
 
 def _strip_plan(cfg: CampaignConfig):
@@ -213,7 +399,11 @@ def _true_pose(plan, strip, t, amp, speed_m_s):
 
 
 def simulate(
-    scale: float = 1.0, rng=0, noise_free: bool = False, cfg: CampaignConfig | None = None
+    scale: float = 1.0,
+    rng=0,
+    noise_free: bool = False,
+    cfg: CampaignConfig | None = None,
+    trajectory_error: str | None = None,
 ) -> tuple[CampaignObservations, CampaignTruth]:
     """Simulate the campaign at ``scale`` (the share of the paper's tie points).
 
@@ -227,6 +417,9 @@ def simulate(
         Exact image coordinates, no outliers, exact GCPs (for the noise-free recovery test).
     cfg : CampaignConfig, optional
         Defaults to 002's values.
+    trajectory_error : {"gauss-markov", "spline"}, optional
+        Overrides ``cfg.trajectory_error``. The noise-free mode needs ``"spline"`` (only then
+        do the node corrections have an exact value).
 
     Returns
     -------
@@ -238,6 +431,17 @@ def simulate(
     if not (0 < scale <= 1.0):
         raise InputError(f"scale must be in (0, 1], got {scale!r}")
     cfg = cfg or CampaignConfig()
+    if trajectory_error is not None:
+        cfg = replace(cfg, trajectory_error=trajectory_error)
+    if cfg.trajectory_error not in TRAJECTORY_ERRORS:
+        raise InputError(
+            f"trajectory_error must be one of {TRAJECTORY_ERRORS}, got {cfg.trajectory_error!r}"
+        )
+    if noise_free and cfg.trajectory_error != "spline":
+        raise InputError(
+            "noise_free=True needs trajectory_error='spline' (only the estimator's own model "
+            "has exact node corrections)"
+        )
     rng = np.random.default_rng(rng)
     plan = _strip_plan(cfg)
     t_end = plan[-1][1]
@@ -245,8 +449,29 @@ def simulate(
     nb = len(cfg.c_offsets_um)
     names = BLOCK_NAMES
 
-    # -- truth of the camera and the trajectory errors
-    node_err = rng.standard_normal((nodes.n_nodes, 6)) * np.r_[cfg.sigma_pos_m, cfg.sigma_att_rad]
+    # -- truth of the camera and the trajectory errors (true minus navigation)
+    sigma_nav = np.r_[cfg.sigma_pos_m, cfg.sigma_att_rad]
+    if cfg.trajectory_error == "spline":
+        node_err = rng.standard_normal((nodes.n_nodes, 6)) * sigma_nav
+        err_t = err_x = None
+
+        def nav_err(tt, rate=False):
+            return (nodes.evaluate_rate if rate else nodes.evaluate)(node_err, tt)
+
+    else:  # post-processed GNSS/INS errors: first-order Gauss–Markov per axis (002 §4 σ)
+        n_s = int(np.ceil(t_end / cfg.error_sample_s)) + 2
+        err_t = np.arange(n_s) * cfg.error_sample_s
+        err_x = gauss_markov(
+            n_s, cfg.error_sample_s, np.r_[cfg.tau_pos_s, cfg.tau_att_s], sigma_nav, rng
+        )
+        err_cs = CubicSpline(err_t, err_x, axis=0)
+        t_fit = _imaged(plan, np.arange(0.0, t_end, 0.1))
+        node_err = spline_fit(nodes, t_fit, err_cs(t_fit))
+        err_rate_cs = err_cs.derivative()
+
+        def nav_err(tt, rate=False):
+            return (err_rate_cs if rate else err_cs)(tt)
+
     lever = np.array(cfg.lever_arm_m)
     truth = {
         names["nodes"]: node_err,
@@ -347,20 +572,30 @@ def simulate(
     # key-point localisation error (ours, see CampaignConfig): x along the line, and in y an
     # error of the matched line, i.e. of the time
     loc = (0.0 if noise_free else cfg.sigma_keypoint_px) * rng.standard_normal((m, 2))
+    ref_loc = rng.standard_normal((m, 2))  # drawn always: the same stream with or without
+    if cfg.sigma_ref_image_px is not None and not noise_free:
+        on_ref = is_ref[pidx]
+        loc[on_ref] = cfg.sigma_ref_image_px * ref_loc[on_ref]
     t_loc = t - loc[:, 1] * cfg.pixel_mm / deriv
     t_line = np.round(t_loc / line_dt) * line_dt
     xy_true_mm, pc = true_xy(t_line)
     if np.any(pc[:, 2] <= 0):
         raise InputError("simulated points behind the camera: check the flight plan")
+    if cfg.refraction:  # the ray bends: the image point moves radially outward
+        agl_obs = np.array([p[3] for p in plan])[strip]
+        k = refraction_k(agl_obs + cfg.terrain_asl_m, P[pidx, 2] + cfg.terrain_asl_m)
+        d = xy_true_mm - np.array([cfg.x0_mm, cfg.y0_mm])
+        r2 = np.sum(d**2, axis=1) / truth[names["c"]][band] ** 2
+        xy_true_mm = xy_true_mm + (k * (1 + r2))[:, None] * d
     xy_true_px = xy_true_mm / cfg.pixel_mm
     # navigation solution at the line times: truth minus the spline error
     xyz_true, rpy_true = _true_pose(plan, strip, t_line, cfg.mount_motion_rad, cfg.speed_m_s)
-    delta = nodes.evaluate(node_err, t_line)
+    delta = nav_err(t_line)
     xyz_nav = xyz_true - delta[:, :3]
     rpy_nav = rpy_true - delta[:, 3:]
     # and its rates (a GNSS/INS solution gives velocity and angular rate): the observation is
     # a time, and its residual needs the image motion across the line (see PushbroomLines)
-    ddelta = nodes.evaluate_rate(node_err, t_line)
+    ddelta = nav_err(t_line, rate=True)
     dirn_obs = np.array([p[4] for p in plan], float)[strip]
     xyz_rate_true = np.column_stack([np.zeros(m), dirn_obs * cfg.speed_m_s, np.zeros(m)])
     xyz_rate_nav = xyz_rate_true - ddelta[:, :3]
@@ -409,5 +644,8 @@ def simulate(
         cp_index=np.arange(4, 17),
         outlier=outlier,
         xy_true_px=xy_true_px,
+        trajectory_error=cfg.trajectory_error,
+        error_t_s=err_t,
+        error_samples=err_x,
     )
     return observations, truth

@@ -1,0 +1,111 @@
+"""The GNSS/INS error model of the 002 campaign simulator (hsgeo.simulate.pushbroom_campaign)."""
+
+import numpy as np
+import pytest
+
+from hsgeo import InputError
+from hsgeo.simulate.pushbroom_campaign import RIDGE, gauss_markov, simulate, spline_fit
+from hsgeo.trajectory import SplineNodes
+
+
+def test_gauss_markov_is_the_exact_first_order_recursion():
+    """Regressing x[k+1] on x[k] gives φ = exp(−Δt/τ) and the innovation σ√(1−φ²); the
+    stationary variance is σ² (the theory of the continuous process, sampled exactly)."""
+    dt, tau, sig = 0.1, np.array([0.5, 5.0]), np.array([2.0, 0.01])
+    x = gauss_markov(200_000, dt, tau, sig, rng=1)
+    phi = np.exp(-dt / tau)
+    for j in range(2):
+        a, b = x[:-1, j], x[1:, j]
+        slope = a @ b / (a @ a)
+        n_eff = x.shape[0] * (1 - phi[j]) / (1 + phi[j])  # independent samples for the variance
+        assert abs(slope - phi[j]) < 4 * np.sqrt((1 - phi[j] ** 2) / x.shape[0])
+        innov = np.std(b - phi[j] * a)
+        assert abs(innov / (sig[j] * np.sqrt(1 - phi[j] ** 2)) - 1) < 0.01
+        assert abs(np.var(x[:, j]) / sig[j] ** 2 - 1) < 4 * np.sqrt(2 / n_eff)
+    # stationary from the first sample: the first values have the same spread as the rest
+    starts = np.array([gauss_markov(1, dt, [30.0], [1.0], rng=s)[0, 0] for s in range(2000)])
+    assert abs(np.std(starts) - 1) < 0.05
+    with pytest.raises(InputError, match="positive"):
+        gauss_markov(10, dt, [0.0], [1.0], rng=0)
+
+
+def test_spline_fit_equals_a_dense_least_squares_solution():
+    """Against numpy's lstsq on the design matrix built column by column from
+    SplineNodes.evaluate (unit node values), with the documented ridge rows appended."""
+    nodes = SplineNodes(0.0, 95.0, 10.0)
+    t = np.arange(0.0, 95.0, 0.1)
+    rng = np.random.default_rng(0)
+    v = np.column_stack([np.sin(t / 7.0), rng.standard_normal(t.size)])
+    A = np.column_stack(
+        [nodes.evaluate(np.eye(nodes.n_nodes)[:, [j]], t)[:, 0] for j in range(nodes.n_nodes)]
+    )
+    Aa = np.vstack([A, np.sqrt(RIDGE) * np.eye(nodes.n_nodes)])
+    ref = np.linalg.lstsq(Aa, np.vstack([v, np.zeros((nodes.n_nodes, 2))]), rcond=None)[0]
+    np.testing.assert_allclose(spline_fit(nodes, t, v), ref, atol=1e-10)
+    # a spline is fitted by itself (up to the ridge)
+    c = rng.standard_normal((nodes.n_nodes, 1))
+    got = spline_fit(nodes, t, nodes.evaluate(c, t))
+    np.testing.assert_allclose(got[3:-3], c[3:-3], atol=0.05 * np.abs(c).max())
+
+
+def test_default_truth_is_gauss_markov_not_the_estimators_spline():
+    obs, truth = simulate(0.001, rng=3)
+    assert truth.trajectory_error == "gauss-markov"
+    t = obs.lines.t_s
+    err = truth.nav_error(t)
+    fit = truth.nodes.evaluate(truth.values["nodes"], t)
+    # the attitude error has structure the 10 s spline cannot follow (τ = 20 s roll, pitch)
+    resid = np.std(err[:, 3:5] - fit[:, 3:5], axis=0) / np.std(err[:, 3:5], axis=0)
+    assert np.all(resid > 0.1), resid
+    # while the spline truth is the spline exactly
+    obs_s, truth_s = simulate(0.001, rng=3, trajectory_error="spline")
+    e_s = truth_s.nav_error(obs_s.lines.t_s)
+    f_s = truth_s.nodes.evaluate(truth_s.values["nodes"], obs_s.lines.t_s)
+    np.testing.assert_allclose(e_s, f_s, atol=1e-15)
+
+
+def test_error_model_options():
+    with pytest.raises(InputError, match="trajectory_error must be one of"):
+        simulate(0.001, rng=0, trajectory_error="random-walk")
+    with pytest.raises(InputError, match="noise_free=True needs trajectory_error='spline'"):
+        simulate(0.001, rng=0, noise_free=True)
+
+
+def test_refraction_moves_image_points_radially_by_the_standard_amount():
+    """K of the ARDC model at H = 1.965 km, h = 0.09 km, by hand from the formula:
+    2410·1.965/(1.965² − 6·1.965 + 250) − 2410·0.09²/((0.09² − 6·0.09 + 250)·1.965) = 19.52 µrad;
+    the image point moves outward by K(r + r³/c²): ≤ 0.02 px at the line's end (5.85 mm)."""
+    from dataclasses import replace
+
+    from hsgeo.simulate.pushbroom_campaign import CampaignConfig, refraction_k
+
+    assert abs(refraction_k(1965.0, 90.0) * 1e6 - 19.52) < 0.01
+    cfg = CampaignConfig()
+    (o0, t0), (o1, t1) = (
+        simulate(0.001, rng=3),
+        simulate(0.001, rng=3, cfg=replace(cfg, refraction=True)),
+    )
+    np.testing.assert_array_equal(o0.lines.t_s, o1.lines.t_s)  # same draws otherwise
+    dx = t1.xy_true_px[:, 0] - t0.xy_true_px[:, 0]
+    x = t0.xy_true_px[:, 0] - cfg.x0_mm / cfg.pixel_mm
+    assert np.all(np.sign(dx[np.abs(x) > 50]) == np.sign(x[np.abs(x) > 50]))  # outward
+    assert 0.01 < np.max(np.abs(dx)) < 0.03
+
+
+def test_reference_squares_measured_by_their_centre():
+    from dataclasses import replace
+
+    from hsgeo.simulate.pushbroom_campaign import CampaignConfig
+
+    cfg = CampaignConfig()
+    (o0, _), (o1, t1) = (
+        simulate(0.001, rng=4),
+        simulate(0.001, rng=4, cfg=replace(cfg, sigma_ref_image_px=0.5)),
+    )
+    ref = o1.lines.point < 17
+    np.testing.assert_array_equal(o0.lines.xy_px[~ref], o1.lines.xy_px[~ref])  # tie points
+    assert not np.array_equal(o0.lines.xy_px[ref], o1.lines.xy_px[ref])
+    good = ref & ~t1.outlier
+    err = o1.lines.xy_px[good, 0] - t1.xy_true_px[good, 0]
+    # N(0, 0.5²) then registered at the pixel centre: σ = √(0.25 + 1/12) ≈ 0.58 px
+    assert 0.4 < np.std(err) < 0.75, np.std(err)
