@@ -21,6 +21,7 @@
 from __future__ import annotations
 
 import importlib.util
+import os
 import shutil
 from datetime import UTC, datetime
 from pathlib import Path
@@ -155,6 +156,12 @@ def _runtime_text(data: dict | None) -> str:
     return f"{data['runtime']:.0f} s"
 
 
+def _scale_text() -> str:
+    scale = os.environ.get("HSGEO_SCALE")
+    size = "at full size" if not scale else f"with HSGEO_SCALE={scale}"
+    return f"{size}, on the machine that built the book ({os.cpu_count()} CPU cores)"
+
+
 def _built_on(data: dict | None) -> str:
     if not data or not data.get("mtime"):
         return "—"
@@ -209,7 +216,7 @@ def _run_times_table(app: Sphinx, fromdocname: str) -> nodes.table:
     row = nodes.row()
     row += nodes.entry("", nodes.paragraph(text="all chapters"))
     row += nodes.entry("", nodes.paragraph(text=f"{total_s:.0f} s"))
-    row += nodes.entry("", nodes.paragraph(text=""))
+    row += nodes.entry("", nodes.paragraph(text="—"))
     tbody += row
     return table
 
@@ -235,13 +242,16 @@ def _run_box(app: Sphinx, docname: str) -> nodes.admonition:
     para += nodes.literal(text=f"{name}.ipynb")
     para += nodes.Text(" and as ")
     para += nodes.literal(text=f"{name}.md")
-    para += nodes.Text(". To rebuild the whole book, with every chapter executed, run from the "
-                       "repository's root:")
+    para += nodes.Text(
+        ". To rebuild the whole book, with every chapter executed, run from the repository's root:"
+    )
     box += para
     box += _literal("make book   # creates .venv from requirements.lock, then book/_build/html")
     para = nodes.paragraph()
-    para += nodes.Text("To run only this chapter, create the environment once and execute the "
-                       "downloaded notebook, or open it in Jupyter with the ")
+    para += nodes.Text(
+        "To run only this chapter, create the environment once and execute the "
+        "downloaded notebook, or open it in Jupyter with the "
+    )
     para += nodes.literal(text="python3")
     para += nodes.Text(" kernel of ")
     para += nodes.literal(text=".venv")
@@ -254,7 +264,7 @@ def _run_box(app: Sphinx, docname: str) -> nodes.admonition:
     para += nodes.Text("Run time measured when this book was built: ")
     para += nodes.strong(text=_runtime_text(data))
     if data and data.get("mtime"):
-        para += nodes.Text(f" (executed {_built_on(data)}, at full size, on the build machine).")
+        para += nodes.Text(f" (executed {_built_on(data)}, {_scale_text()}).")
     else:
         para += nodes.Text(".")
     box += para
