@@ -20,13 +20,17 @@
 
 from __future__ import annotations
 
+import importlib
 import importlib.util
+import inspect
 import os
+import re
 import shutil
 from datetime import UTC, datetime
 from pathlib import Path
 
 from docutils import nodes
+from docutils.parsers.rst import directives
 from sphinx.application import Sphinx
 from sphinx.errors import ExtensionError
 from sphinx.util import logging
@@ -283,6 +287,49 @@ def _insert_run_box(doctree: nodes.document, box: nodes.Node) -> None:
     section.insert(index, box)
 
 
+# --- a module docstring as part of a page ------------------------------------------------
+
+_PY_ROLE = re.compile(r":(?:py:)?(?:func|class|mod|data|meth|attr|obj|exc):`~?([^`]+)`")
+
+
+class DocstringDirective(SphinxDirective):
+    """``{hsgeo-docstring} module``: the module's docstring, parsed as reStructuredText.
+
+    One source for text that belongs to the code (e.g. ``hsgeo.conventions``): the page shows
+    the docstring rendered, not as printed source. Python cross-reference roles become literals
+    (the book has no API pages to link to). ``:skip-paragraphs: N`` drops the first N
+    paragraphs (the summary written for ``help()``).
+    """
+
+    required_arguments = 1
+    option_spec = {"skip-paragraphs": directives.nonnegative_int}
+
+    def run(self):
+        from docutils.core import publish_doctree
+
+        module = importlib.import_module(self.arguments[0])
+        if module.__file__:
+            self.env.note_dependency(module.__file__)
+        text = _PY_ROLE.sub(r"``\1``", inspect.getdoc(module) or "")
+        skip = self.options.get("skip-paragraphs", 0)
+        if skip:
+            text = "\n\n".join(text.split("\n\n")[skip:])
+        doctree = publish_doctree(
+            text,
+            source_path=f"{self.arguments[0]}.__doc__",
+            settings_overrides={"report_level": 5, "halt_level": 5, "file_insertion_enabled": 0},
+        )
+        problems = list(doctree.findall(nodes.system_message))
+        if problems:
+            raise self.error(
+                f"the docstring of {self.arguments[0]} is not valid reStructuredText: "
+                + problems[0].astext()
+            )
+        box = nodes.container(classes=["hsgeo-docstring"])
+        box.extend(child.deepcopy() for child in doctree.children)
+        return [box]
+
+
 def _resolve(app: Sphinx, doctree: nodes.document, docname: str) -> None:
     for node in list(doctree.findall(RunTimesNode)):
         node.replace_self(_run_times_table(app, docname))
@@ -300,6 +347,7 @@ def setup(app: Sphinx) -> dict:
     app.setup_extension("sphinx.ext.mathjax")
     app.add_node(RunTimesNode)
     app.add_directive("hsgeo-run-times", RunTimesDirective)
+    app.add_directive("hsgeo-docstring", DocstringDirective)
     app.connect("config-inited", _use_local_mathjax)
     app.connect("build-finished", _copy_mathjax)
     app.connect("html-page-context", _add_ipynb_download, priority=500)
