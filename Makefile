@@ -71,7 +71,7 @@ book/_build/html/index.html: $(BOOK_SOURCES)
 	$(MAKE) book
 
 check-book: $(STAMP) browser book/_build/html/index.html ## open every page of the built book in headless chromium, offline, and check it (builds the book first if needed)
-	HSGEO_CHROMIUM="$$(command -v chromium || command -v chromium-browser || echo $(CHROMIUM))" \
+	HSGEO_CHECK_BOOK=1 HSGEO_CHROMIUM="$$(command -v chromium || command -v chromium-browser || echo $(CHROMIUM))" \
 	  $(PY) -m pytest -q -p no:cacheprovider -m book tests/book
 
 bench: $(STAMP) ## run the benchmarks, results as JSON in bench/results/
