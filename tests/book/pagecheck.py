@@ -89,9 +89,9 @@ async () => {
         + " px, overflow-x " + style.overflowX);
     }
   }
-  const downloads = [...document.querySelectorAll("a[href]")]
-    .map((a) => a.getAttribute("href"))
-    .filter((h) => /\.ipynb$/.test(h));
+  const hrefs = [...document.querySelectorAll("a[href]")].map((a) => a.getAttribute("href"));
+  const downloads = hrefs.filter((h) => /\.ipynb$/.test(h));
+  const sources = hrefs.filter((h) => /_sources\/.*\.md$/.test(h));
   return {
     title: document.title,
     math_sources: main.querySelectorAll(".math, span.math, div.math").length,
@@ -108,6 +108,7 @@ async () => {
     too_wide: too_wide.slice(0, 8),
     clipped: clipped.slice(0, 8),
     ipynb_links: downloads,
+    md_links: sources,
     exercises: main.querySelectorAll(".exercise").length,
     solutions: main.querySelectorAll(".solution").length,
   };
@@ -194,17 +195,26 @@ def problems_clipped(facts: dict) -> list[str]:
     return [f"clipped: {d}" for d in facts["clipped"]]
 
 
-def problems_ipynb(facts: dict) -> list[str]:
-    """The page offers an .ipynb download that exists next to it."""
-    if not facts["ipynb_links"]:
-        return ["no .ipynb download link"]
+def _downloads(facts: dict, key: str, suffix: str) -> list[str]:
+    if not facts[key]:
+        return [f"no {suffix} download link"]
     base = Path(facts["path"]).parent
     out = []
-    for href in facts["ipynb_links"]:
+    for href in facts[key]:
         target = (base / unquote(urlparse(href).path)).resolve()
         if not target.is_file():
-            out.append(f".ipynb link {href} resolves to a missing file {target}")
+            out.append(f"{suffix} link {href} resolves to a missing file {target}")
     return out
+
+
+def problems_ipynb(facts: dict) -> list[str]:
+    """The page offers an .ipynb download that exists next to it."""
+    return _downloads(facts, "ipynb_links", ".ipynb")
+
+
+def problems_md_source(facts: dict) -> list[str]:
+    """The page offers its .md source (``_sources/…md``) and the file exists."""
+    return _downloads(facts, "md_links", ".md")
 
 
 def problems_exercises(facts: dict) -> list[str]:

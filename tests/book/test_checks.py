@@ -29,6 +29,7 @@ from pagecheck import (
     problems_equations,
     problems_exercises,
     problems_ipynb,
+    problems_md_source,
     problems_nan,
     problems_offline,
     problems_page_width,
@@ -228,6 +229,7 @@ def test_synthetic_chapter_passes_every_check(browser, demo_book, width):
         + problems_page_width(facts)
         + problems_clipped(facts)
         + problems_ipynb(facts)
+        + problems_md_source(facts)
         + problems_exercises(facts)
     )
     assert problems == []

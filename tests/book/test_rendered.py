@@ -24,6 +24,7 @@ from pagecheck import (
     problems_equations,
     problems_exercises,
     problems_ipynb,
+    problems_md_source,
     problems_nan,
     problems_offline,
     problems_page_width,
@@ -117,6 +118,11 @@ def test_nothing_clipped_at_400px(facts):
 @_params(CHAPTERS, WIDE_PX)
 def test_chapter_ipynb_download(facts):
     _check(problems_ipynb(facts), facts)
+
+
+@_params(CHAPTERS, WIDE_PX)
+def test_chapter_md_download(facts):
+    _check(problems_md_source(facts), facts)
 
 
 @_params(CHAPTERS, WIDE_PX)
