@@ -49,6 +49,9 @@ book/_build/.library-stamp: $(shell find src/hsgeo data_synthetic -name '*.py' -
 
 book: $(STAMP) book/_build/.library-stamp ## execute every chapter and render the HTML book to book/_build/html (offline; ~15 min on 2 cores from an empty cache)
 	$(PY) -m hsgeo.cli data --verify
+	@# cached outputs are only valid for the size they were computed at (the cache keys on code only)
+	@if [ "$$(cat book/_build/.scale 2>/dev/null)" != "$${HSGEO_SCALE:-full}" ]; then \
+	  rm -rf book/_build/.jupyter_cache; echo "$${HSGEO_SCALE:-full}" > book/_build/.scale; fi
 	rm -rf book/_build/html book/_build/.doctrees book/_build/jupyter_execute
 	$(VENV)/bin/jupyter-book build book -W -n --keep-going
 
