@@ -16,7 +16,7 @@ export GLIBC_TUNABLES ?= glibc.malloc.mmap_max=0:glibc.malloc.trim_threshold=429
 export PYDEVD_DISABLE_FILE_VALIDATION := 1
 
 .DEFAULT_GOAL := help
-.PHONY: help venv data test test-fast book bench lint clean lock
+.PHONY: help venv data test test-fast book check-book browser bench lint clean lock
 
 help: ## list the targets
 	@grep -hE '^[a-zA-Z_-]+:.*## ' $(MAKEFILE_LIST) | awk 'BEGIN {FS = ":.*## "}; {printf "  make %-10s %s\n", $$1, $$2}'
@@ -52,8 +52,33 @@ book: export HSGEO_RECORD_DIR := $(CURDIR)/book/_build/reproduce
 
 book: $(STAMP) book/_build/.library-stamp ## execute every chapter and render the HTML book to book/_build/html (offline; ~15 min on 2 cores from an empty cache)
 	$(PY) -m hsgeo.cli data --verify
+	@# cached outputs are only valid for the size they were computed at (the cache keys on code only)
+	@if [ "$$(cat book/_build/.scale 2>/dev/null)" != "$${HSGEO_SCALE:-full}" ]; then \
+	  rm -rf book/_build/.jupyter_cache; echo "$${HSGEO_SCALE:-full}" > book/_build/.scale; fi
 	rm -rf book/_build/html book/_build/.doctrees book/_build/jupyter_execute
 	$(VENV)/bin/jupyter-book build book -W -n --keep-going
+
+# `make check-book` opens every built page in a real headless browser, offline: Debian's chromium,
+# driven by Playwright's Python API (pinned in requirements.lock) through `executable_path`;
+# Playwright's own browser download is not used. The book is built first if it is missing or older
+# than its sources.
+CHROMIUM ?= $(shell command -v chromium || command -v chromium-browser)
+BOOK_SOURCES := $(shell find book -path book/_build -prune -o -type f -print) $(shell find src/hsgeo -name '*.py')
+
+browser: ## install Debian's chromium (apt-get, as root) if it is missing; `make check-book` needs it
+	@if [ -n "$(CHROMIUM)" ]; then echo "browser: $(CHROMIUM)"; \
+	elif [ "$$(id -u)" = 0 ]; then \
+	  apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends chromium; \
+	elif command -v sudo >/dev/null && sudo -n true 2>/dev/null; then \
+	  sudo apt-get update -qq && sudo DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends chromium; \
+	else echo "error: chromium not found; install it as root (apt-get install chromium) or set CHROMIUM=/path/to/chrome"; exit 1; fi
+
+book/_build/html/index.html: $(BOOK_SOURCES)
+	$(MAKE) book
+
+check-book: $(STAMP) browser book/_build/html/index.html ## open every page of the built book in headless chromium, offline, and check it (builds the book first if needed)
+	HSGEO_CHECK_BOOK=1 HSGEO_CHROMIUM="$$(command -v chromium || command -v chromium-browser || echo $(CHROMIUM))" \
+	  $(PY) -m pytest -q -p no:cacheprovider -m book tests/book
 
 bench: $(STAMP) ## run the benchmarks, results as JSON in bench/results/
 	$(PY) bench/run.py

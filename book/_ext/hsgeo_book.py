@@ -1,0 +1,356 @@
+"""Sphinx extension for the hsgeo book: what every page gets without its author typing it.
+
+- **Math offline**: MathJax 3 is served from the book's own ``_static/mathjax/`` directory. The
+  files come from the PyPI package ``django-static-mathjax`` (pinned in ``requirements.lock``;
+  it ships MathJax 3.2.2's ``es5`` build as static files, importable as ``mathjax``). They are
+  copied into the HTML output when the book is built, so neither the build nor a reader viewing
+  the pages needs a network connection. Only what a browser can load is copied: the
+  ``tex-mml-chtml`` component (Sphinx's default), its fonts, the lazily loaded TeX extensions,
+  the menu, the accessibility and speech components; not the SVG output, the other combined
+  components or the TypeScript sources.
+- **Notebook downloads**: every page written as a MyST Markdown notebook is converted with
+  jupytext into ``_sources/<page>.ipynb`` (code and text, no outputs), and sphinx-book-theme's
+  download menu offers it next to the ``.md`` source.
+- **"Run it yourself"**: every chapter page (``chapters/*``) gets a collapsible box saying how
+  to run it, with the run time that myst-nb measured when it executed the chapter (or when it
+  was put into the execution cache).
+- **Run times**: the ``{hsgeo-run-times}`` directive is replaced by a table of every chapter's
+  measured run time.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import inspect
+import os
+import re
+import shutil
+from datetime import UTC, datetime
+from pathlib import Path
+
+from docutils import nodes
+from docutils.parsers.rst import directives
+from sphinx.application import Sphinx
+from sphinx.errors import ExtensionError
+from sphinx.util import logging
+from sphinx.util.docutils import SphinxDirective
+
+LOGGER = logging.getLogger(__name__)
+
+#: MathJax component loaded by every page with math, relative to the HTML output's ``_static``.
+MATHJAX_COMPONENT = "mathjax/tex-mml-chtml.js"
+#: Files and directories of MathJax's ``es5`` build that a browser never loads for our pages.
+_MATHJAX_UNUSED = (
+    "mml-chtml.js",
+    "mml-svg.js",
+    "tex-chtml.js",
+    "tex-chtml-full.js",
+    "tex-chtml-full-speech.js",
+    "tex-mml-svg.js",
+    "tex-svg.js",
+    "tex-svg-full.js",
+    "node-main.js",
+    "svg",
+    "svg.js",
+)
+#: Pages that are chapters: they get the "Run it yourself" box and appear in the run-time table.
+CHAPTER_PREFIX = "chapters/"
+
+
+def mathjax_source() -> Path:
+    """The ``es5`` directory of the installed MathJax 3 (package ``django-static-mathjax``)."""
+    spec = importlib.util.find_spec("mathjax")
+    if spec is None or not spec.submodule_search_locations:
+        raise ExtensionError(
+            "MathJax is not installed: run `make venv` (or `pip install "
+            "django-static-mathjax==3.2.2.1`), the book serves MathJax from its own files"
+        )
+    es5 = Path(next(iter(spec.submodule_search_locations))) / "static" / "mathjax" / "es5"
+    if not (es5 / "tex-mml-chtml.js").is_file():
+        raise ExtensionError(
+            f"{es5} has no tex-mml-chtml.js: reinstall django-static-mathjax==3.2.2.1 "
+            "(the pin in requirements.lock)"
+        )
+    return es5
+
+
+def _use_local_mathjax(app: Sphinx, config) -> None:
+    mathjax_source()  # fail at start-up, not after executing every chapter
+    config.mathjax_path = MATHJAX_COMPONENT
+
+
+def _copy_mathjax(app: Sphinx, exception: Exception | None) -> None:
+    if exception is not None or app.builder.format != "html":
+        return
+    target = Path(app.outdir) / "_static" / "mathjax"
+    shutil.copytree(
+        mathjax_source(),
+        target,
+        ignore=shutil.ignore_patterns(*_MATHJAX_UNUSED),
+        dirs_exist_ok=True,
+    )
+    size_mb = sum(f.stat().st_size for f in target.rglob("*") if f.is_file()) / 1e6
+    LOGGER.info(f"[hsgeo] MathJax 3 copied to _static/mathjax ({size_mb:.1f} MB)")
+
+
+# --- notebook downloads -------------------------------------------------------------------
+
+
+def _notebook_of(app: Sphinx, docname: str):
+    """The page as a notebook (jupytext), or None if it is not a notebook page."""
+    import jupytext
+
+    source = Path(app.env.doc2path(docname))
+    if source.suffix != ".md":
+        return None
+    text = source.read_text(encoding="utf-8")
+    if not text.startswith("---") or "kernelspec:" not in text.split("\n---", 1)[0]:
+        return None
+    nb = jupytext.reads(text, fmt="md:myst")
+    if not any(cell.cell_type == "code" for cell in nb.cells):
+        return None
+    return nb
+
+
+def _add_ipynb_download(app: Sphinx, pagename: str, templatename, context, doctree) -> None:
+    if doctree is None or pagename not in app.env.all_docs:
+        return
+    nb = _notebook_of(app, pagename)
+    if nb is None:
+        return
+    import jupytext
+
+    nb.metadata.pop("jupytext", None)  # a plain notebook, not paired with a text file
+    target = Path(app.outdir) / "_sources" / f"{pagename}.ipynb"
+    target.parent.mkdir(parents=True, exist_ok=True)
+    jupytext.write(nb, target, fmt="ipynb")
+    # read by sphinx-book-theme's download menu (header_buttons, priority 501)
+    context["ipynb_source"] = f"{pagename}.ipynb"
+
+
+# --- measured run times -------------------------------------------------------------------
+
+
+def _exec_data(app: Sphinx, docname: str) -> dict | None:
+    from myst_nb.sphinx_ import NbMetadataCollector
+
+    return NbMetadataCollector.get_doc_data(app.env).get(docname, {}).get("exec_data")
+
+
+def _toc_order(app: Sphinx) -> list[str]:
+    """Every document in table-of-contents order (depth first from the root)."""
+    env = app.env
+    seen: list[str] = []
+
+    def walk(doc: str) -> None:
+        if doc in seen:
+            return
+        seen.append(doc)
+        for child in env.toctree_includes.get(doc, []):
+            walk(child)
+
+    walk(app.config.root_doc)
+    return seen
+
+
+def _runtime_text(data: dict | None) -> str:
+    if not data or data.get("runtime") is None:
+        return "not measured (the chapter was not executed in this build)"
+    return f"{data['runtime']:.0f} s"
+
+
+def _scale_text() -> str:
+    scale = os.environ.get("HSGEO_SCALE")
+    size = "at full size" if not scale else f"with HSGEO_SCALE={scale}"
+    return f"{size}, on the machine that built the book ({os.cpu_count()} CPU cores)"
+
+
+def _built_on(data: dict | None) -> str:
+    if not data or not data.get("mtime"):
+        return "—"
+    return datetime.fromtimestamp(data["mtime"], tz=UTC).strftime("%Y-%m-%d %H:%M UTC")
+
+
+class RunTimesNode(nodes.General, nodes.Element):
+    """Placeholder for the table of chapter run times, filled in when the page is written."""
+
+
+class RunTimesDirective(SphinxDirective):
+    """``{hsgeo-run-times}``: a table of every chapter's measured run time."""
+
+    has_content = False
+
+    def run(self):
+        self.env.metadata[self.env.docname]["hsgeo_run_times"] = True
+        return [RunTimesNode()]
+
+
+def _run_times_table(app: Sphinx, fromdocname: str) -> nodes.table:
+    table = nodes.table(classes=["colwidths-auto", "hsgeo-run-times"])
+    headers = ["chapter", "run time", "executed (or cached)"]
+    tgroup = nodes.tgroup(cols=len(headers))
+    table += tgroup
+    for _ in headers:
+        tgroup += nodes.colspec(colwidth=1)
+    thead = nodes.thead()
+    tgroup += thead
+    row = nodes.row()
+    for header in headers:
+        row += nodes.entry("", nodes.paragraph(text=header))
+    thead += row
+    tbody = nodes.tbody()
+    tgroup += tbody
+    total_s = 0.0
+    for docname in _toc_order(app):
+        if not docname.startswith(CHAPTER_PREFIX):
+            continue
+        data = _exec_data(app, docname)
+        if data and data.get("runtime") is not None:
+            total_s += data["runtime"]
+        title = app.env.titles[docname].astext() if docname in app.env.titles else docname
+        ref = nodes.reference(
+            "", title, internal=True, refuri=app.builder.get_relative_uri(fromdocname, docname)
+        )
+        row = nodes.row()
+        row += nodes.entry("", nodes.paragraph("", "", ref))
+        row += nodes.entry("", nodes.paragraph(text=_runtime_text(data)))
+        row += nodes.entry("", nodes.paragraph(text=_built_on(data)))
+        tbody += row
+    row = nodes.row()
+    row += nodes.entry("", nodes.paragraph(text="all chapters"))
+    row += nodes.entry("", nodes.paragraph(text=f"{total_s:.0f} s"))
+    row += nodes.entry("", nodes.paragraph(text="—"))
+    tbody += row
+    return table
+
+
+def _literal(text: str) -> nodes.literal_block:
+    block = nodes.literal_block(text, text)
+    block["language"] = "console"
+    return block
+
+
+def _run_box(app: Sphinx, docname: str) -> nodes.admonition:
+    name = Path(docname).name
+    data = _exec_data(app, docname)
+    box = nodes.admonition(classes=["tip", "dropdown", "hsgeo-run-box"])
+    box += nodes.title(text="Run it yourself")
+    para = nodes.paragraph()
+    para += nodes.Text("This page is the MyST Markdown notebook ")
+    para += nodes.literal(text=f"book/{docname}.md")
+    para += nodes.Text(
+        " of the repository you cloned (or the source archive you unpacked); the download "
+        "menu at the top of the page offers it as "
+    )
+    para += nodes.literal(text=f"{name}.ipynb")
+    para += nodes.Text(" and as ")
+    para += nodes.literal(text=f"{name}.md")
+    para += nodes.Text(
+        ". To rebuild the whole book, with every chapter executed, run from the repository's root:"
+    )
+    box += para
+    box += _literal("make book   # creates .venv from requirements.lock, then book/_build/html")
+    para = nodes.paragraph()
+    para += nodes.Text(
+        "To run only this chapter, create the environment once and execute the "
+        "downloaded notebook, or open it in Jupyter with the "
+    )
+    para += nodes.literal(text="python3")
+    para += nodes.Text(" kernel of ")
+    para += nodes.literal(text=".venv")
+    para += nodes.Text(" (set ")
+    para += nodes.literal(text="HSGEO_SCALE=small")
+    para += nodes.Text(" for the reduced size the tests use):")
+    box += para
+    box += _literal(f"make venv\n.venv/bin/jupyter execute --inplace {name}.ipynb")
+    para = nodes.paragraph()
+    para += nodes.Text("Run time measured when this book was built: ")
+    para += nodes.strong(text=_runtime_text(data))
+    if data and data.get("mtime"):
+        para += nodes.Text(f" (executed {_built_on(data)}, {_scale_text()}).")
+    else:
+        para += nodes.Text(".")
+    box += para
+    return box
+
+
+def _insert_run_box(doctree: nodes.document, box: nodes.Node) -> None:
+    section = next(iter(doctree.findall(nodes.section)), None)
+    if section is None:
+        doctree.insert(0, box)
+        return
+    index = 0
+    for index, child in enumerate(section.children):  # noqa: B007
+        if not isinstance(child, nodes.title | nodes.target):
+            break
+    section.insert(index, box)
+
+
+# --- a module docstring as part of a page ------------------------------------------------
+
+_PY_ROLE = re.compile(r":(?:py:)?(?:func|class|mod|data|meth|attr|obj|exc):`~?([^`]+)`")
+
+
+class DocstringDirective(SphinxDirective):
+    """``{hsgeo-docstring} module``: the module's docstring, parsed as reStructuredText.
+
+    One source for text that belongs to the code (e.g. ``hsgeo.conventions``): the page shows
+    the docstring rendered, not as printed source. Python cross-reference roles become literals
+    (the book has no API pages to link to). ``:skip-paragraphs: N`` drops the first N
+    paragraphs (the summary written for ``help()``).
+    """
+
+    required_arguments = 1
+    option_spec = {"skip-paragraphs": directives.nonnegative_int}
+
+    def run(self):
+        from docutils.core import publish_doctree
+
+        module = importlib.import_module(self.arguments[0])
+        if module.__file__:
+            self.env.note_dependency(module.__file__)
+        text = _PY_ROLE.sub(r"``\1``", inspect.getdoc(module) or "")
+        skip = self.options.get("skip-paragraphs", 0)
+        if skip:
+            text = "\n\n".join(text.split("\n\n")[skip:])
+        doctree = publish_doctree(
+            text,
+            source_path=f"{self.arguments[0]}.__doc__",
+            settings_overrides={"report_level": 5, "halt_level": 5, "file_insertion_enabled": 0},
+        )
+        problems = list(doctree.findall(nodes.system_message))
+        if problems:
+            raise self.error(
+                f"the docstring of {self.arguments[0]} is not valid reStructuredText: "
+                + problems[0].astext()
+            )
+        box = nodes.container(classes=["hsgeo-docstring"])
+        box.extend(child.deepcopy() for child in doctree.children)
+        return [box]
+
+
+def _resolve(app: Sphinx, doctree: nodes.document, docname: str) -> None:
+    for node in list(doctree.findall(RunTimesNode)):
+        node.replace_self(_run_times_table(app, docname))
+    if docname.startswith(CHAPTER_PREFIX) and app.builder.format == "html":
+        _insert_run_box(doctree, _run_box(app, docname))
+
+
+def _pages_with_run_times(app: Sphinx, env) -> list[str]:
+    # The table changes when any chapter is (re-)executed: always rewrite the pages showing it.
+    return [doc for doc, meta in env.metadata.items() if meta.get("hsgeo_run_times")]
+
+
+def setup(app: Sphinx) -> dict:
+    """Register the extension (Sphinx entry point)."""
+    app.setup_extension("sphinx.ext.mathjax")
+    app.add_node(RunTimesNode)
+    app.add_directive("hsgeo-run-times", RunTimesDirective)
+    app.add_directive("hsgeo-docstring", DocstringDirective)
+    app.connect("config-inited", _use_local_mathjax)
+    app.connect("build-finished", _copy_mathjax)
+    app.connect("html-page-context", _add_ipynb_download, priority=500)
+    app.connect("doctree-resolved", _resolve)
+    app.connect("env-updated", _pages_with_run_times)
+    return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}

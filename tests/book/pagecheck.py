@@ -1,0 +1,227 @@
+"""What a reader sees on a built page, measured in a real browser, and the checks on it.
+
+:func:`page_facts` opens one HTML file from disk (``file://``) in a Playwright browser context
+with every non-``file:`` request blocked, waits for MathJax to finish typesetting and collects
+the facts the checks need in one pass. Each ``problems_*`` function returns a list of readable
+problems (empty when the page passes), so that a failing test names the page and the element.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from urllib.parse import unquote, urlparse
+
+#: Viewport widths (px) of a phone and of a desktop screen.
+NARROW_PX = 400
+WIDE_PX = 1400
+
+# One pass over the page, after MathJax: everything below is measured, nothing is inferred.
+_FACTS_JS = r"""
+async () => {
+  if (window.MathJax && MathJax.startup && MathJax.startup.promise) {
+    await MathJax.startup.promise;
+  }
+  const main = document.querySelector("main") || document.body;
+  const describe = (el) => {
+    let s = el.tagName.toLowerCase();
+    if (el.id) s += "#" + el.id;
+    if (el.className && typeof el.className === "string") {
+      s += "." + el.className.trim().split(/\s+/).slice(0, 3).join(".");
+    }
+    const text = (el.textContent || "").trim().replace(/\s+/g, " ").slice(0, 60);
+    return text ? s + " «" + text + "»" : s;
+  };
+  // visible prose: the main content without code, scripts and MathJax's own output
+  const clone = main.cloneNode(true);
+  clone.querySelectorAll("pre, code, script, style, mjx-container, mjx-assistive-mml, textarea")
+    .forEach((el) => el.remove());
+  const prose = clone.textContent || "";
+  const raw_tex = [];
+  for (const token of ["\\(", "\\)", "\\[", "\\]", "$$"]) {
+    let i = prose.indexOf(token);
+    if (i >= 0) raw_tex.push(prose.slice(Math.max(0, i - 30), i + 40).replace(/\s+/g, " "));
+  }
+  const images = [...main.querySelectorAll("img, svg.figure, figure")].filter(
+    (el) => el.tagName.toLowerCase() !== "figure"
+  );
+  const uncaptioned = [];
+  for (const img of images) {
+    if (img.closest("mjx-container, .admonition-title, .sd-card-header, button, a.headerlink")) {
+      continue;
+    }
+    const fig = img.closest("figure");
+    const caption = fig && fig.querySelector("figcaption");
+    if (!caption || !caption.textContent.trim()) {
+      uncaptioned.push(describe(img.closest(".cell") || img) + " " + (img.src || ""));
+    }
+  }
+  const figures = main.querySelectorAll("figure").length;
+  const nan_cells = [];
+  for (const cell of main.querySelectorAll("table td, table th")) {
+    if (/(^|[^A-Za-z])nan([^A-Za-z]|$)/i.test(cell.textContent)) {
+      const table = cell.closest("table");
+      nan_cells.push(describe(table) + ": " + cell.textContent.trim().slice(0, 40));
+    }
+  }
+  const width = window.innerWidth;
+  const too_wide = [];
+  for (const el of document.querySelectorAll("body *")) {
+    const r = el.getBoundingClientRect();
+    if (r.width > 0 && r.right > width + 1 && getComputedStyle(el).position !== "fixed") {
+      // report the outermost offender only
+      const parent = el.parentElement;
+      if (parent && parent.getBoundingClientRect().right > width + 1) continue;
+      too_wide.push(describe(el) + " right=" + Math.round(r.right));
+    }
+  }
+  const clipped = [];
+  const boxes = main.querySelectorAll(
+    "pre, table, .cell_output, .cell_output .output, div.math, mjx-container[display='true'], " +
+    ".highlight, .pst-scrollable-table-container"
+  );
+  for (const el of boxes) {
+    if (el.closest("details:not([open])") || el.offsetParent === null) continue;
+    const style = getComputedStyle(el);
+    const overflowing = el.scrollWidth > el.clientWidth + 1;
+    if (overflowing && !["auto", "scroll"].includes(style.overflowX)) {
+      // content wider than its box and the box neither scrolls nor lets it show
+      clipped.push(describe(el) + " content " + el.scrollWidth + " px in " + el.clientWidth
+        + " px, overflow-x " + style.overflowX);
+    }
+  }
+  const hrefs = [...document.querySelectorAll("a[href]")].map((a) => a.getAttribute("href"));
+  const downloads = hrefs.filter((h) => /\.ipynb$/.test(h));
+  const sources = hrefs.filter((h) => /_sources\/.*\.md$/.test(h));
+  return {
+    title: document.title,
+    math_sources: main.querySelectorAll(".math, span.math, div.math").length,
+    mathjax_output: main.querySelectorAll("mjx-container").length,
+    mathjax_src: [...document.querySelectorAll("script[src]")]
+      .map((s) => s.getAttribute("src")).filter((s) => /mathjax/i.test(s)),
+    raw_tex: raw_tex,
+    images: images.length,
+    figures: figures,
+    uncaptioned: uncaptioned,
+    nan_cells: nan_cells,
+    scroll_width: document.scrollingElement.scrollWidth,
+    inner_width: width,
+    too_wide: too_wide.slice(0, 8),
+    clipped: clipped.slice(0, 8),
+    ipynb_links: downloads,
+    md_links: sources,
+    exercises: main.querySelectorAll(".exercise").length,
+    solutions: main.querySelectorAll(".solution").length,
+  };
+}
+"""
+
+
+def page_facts(browser, path: Path, width_px: int) -> dict:
+    """Open ``path`` offline at ``width_px`` and measure it (see the module docstring)."""
+    context = browser.new_context(viewport={"width": width_px, "height": 900}, offline=True)
+    blocked: list[str] = []
+    failed: list[str] = []
+
+    def route(request_route):
+        url = request_route.request.url
+        if url.startswith(("file:", "data:", "about:", "blob:")):
+            request_route.continue_()
+        else:
+            blocked.append(url)
+            request_route.abort()
+
+    context.route("**/*", route)
+    page = context.new_page()
+    page.on(
+        "requestfailed",
+        lambda r: failed.append(r.url) if r.url.startswith("file:") else None,
+    )
+    try:
+        page.goto(path.resolve().as_uri(), wait_until="load")
+        facts = page.evaluate(_FACTS_JS)
+        page.wait_for_timeout(100)  # let late font and component loads report
+    finally:
+        context.close()
+    facts["blocked"] = blocked
+    facts["failed"] = failed
+    facts["path"] = str(path)
+    return facts
+
+
+def problems_equations(facts: dict) -> list[str]:
+    """Equations typeset by the local MathJax; no TeX source left in the visible text."""
+    out = [f"raw TeX in the text: …{snippet}…" for snippet in facts["raw_tex"]]
+    if facts["math_sources"] and facts["mathjax_output"] < facts["math_sources"]:
+        out.append(
+            f"{facts['math_sources']} equations but {facts['mathjax_output']} typeset by MathJax"
+        )
+    out += [
+        f"MathJax not loaded from the book's own files: {s}"
+        for s in facts["mathjax_src"]
+        if "://" in s and not s.startswith("file:")
+    ]
+    return out
+
+
+def problems_offline(facts: dict) -> list[str]:
+    """Nothing requested from the network, no local file missing."""
+    return [f"network request (blocked): {u}" for u in facts["blocked"]] + [
+        f"missing file: {u}" for u in facts["failed"]
+    ]
+
+
+def problems_captions(facts: dict) -> list[str]:
+    """Every image is part of a figure with a caption."""
+    return [f"figure without caption: {d}" for d in facts["uncaptioned"]]
+
+
+def problems_nan(facts: dict) -> list[str]:
+    """No table cell shows NaN."""
+    return [f"NaN in a table: {d}" for d in facts["nan_cells"]]
+
+
+def problems_page_width(facts: dict) -> list[str]:
+    """The page is not wider than the viewport (no sideways scrolling of the page)."""
+    if facts["scroll_width"] <= facts["inner_width"]:
+        return []
+    return [
+        f"page is {facts['scroll_width']} px wide in a {facts['inner_width']} px viewport",
+        *[f"  too wide: {d}" for d in facts["too_wide"]],
+    ]
+
+
+def problems_clipped(facts: dict) -> list[str]:
+    """Every box whose content is wider than itself scrolls."""
+    return [f"clipped: {d}" for d in facts["clipped"]]
+
+
+def _downloads(facts: dict, key: str, suffix: str) -> list[str]:
+    if not facts[key]:
+        return [f"no {suffix} download link"]
+    base = Path(facts["path"]).parent
+    out = []
+    for href in facts[key]:
+        target = (base / unquote(urlparse(href).path)).resolve()
+        if not target.is_file():
+            out.append(f"{suffix} link {href} resolves to a missing file {target}")
+    return out
+
+
+def problems_ipynb(facts: dict) -> list[str]:
+    """The page offers an .ipynb download that exists next to it."""
+    return _downloads(facts, "ipynb_links", ".ipynb")
+
+
+def problems_md_source(facts: dict) -> list[str]:
+    """The page offers its .md source (``_sources/…md``) and the file exists."""
+    return _downloads(facts, "md_links", ".md")
+
+
+def problems_exercises(facts: dict) -> list[str]:
+    """At least one exercise and one solution."""
+    out = []
+    if facts["exercises"] < 1:
+        out.append("no {exercise}")
+    if facts["solutions"] < 1:
+        out.append("no {solution}")
+    return out

@@ -1,0 +1,253 @@
+"""The browser checks themselves, on pages whose answer is known.
+
+1. Hand-written HTML pages, each with exactly one defect (raw TeX, an uncaptioned image, NaN in
+   a table, a page wider than the screen, a clipped box, a missing notebook, no exercise, a
+   network request): the matching check must report it, and must pass the repaired page.
+2. A synthetic chapter built with the book's real configuration, extension and CSS (equations,
+   a captioned figure, an exercise with its solution, a wide table, a wide DataFrame, a long
+   output line, a long display equation): every check must pass on it at 400 px and 1400 px.
+   This is the end-to-end test of the infrastructure that every chapter relies on.
+
+Run by ``make check-book`` (needs Chromium; see ``conftest.py``).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from pagecheck import (
+    NARROW_PX,
+    WIDE_PX,
+    page_facts,
+    problems_captions,
+    problems_clipped,
+    problems_equations,
+    problems_exercises,
+    problems_ipynb,
+    problems_md_source,
+    problems_nan,
+    problems_offline,
+    problems_page_width,
+)
+
+pytestmark = pytest.mark.book
+
+BOOK = Path(__file__).resolve().parents[2] / "book"
+PNG_1PX = (
+    "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mNk"
+    "YPhfDwAChwGA60e6kgAAAABJRU5ErkJggg=="
+)
+
+
+def _page(tmp_path: Path, name: str, body: str) -> Path:
+    path = tmp_path / f"{name}.html"
+    path.write_text(
+        "<!doctype html><html><head><meta charset='utf-8'>"
+        "<meta name='viewport' content='width=device-width, initial-scale=1'></head>"
+        f"<body><main>{body}</main></body></html>",
+        encoding="utf-8",
+    )
+    return path
+
+
+# (check, defective body, repaired body)
+CASES = {
+    "raw-tex": (
+        problems_equations,
+        r"<p>The line \(\zeta = c\) and \[x^2\]</p>",
+        "<p>The line ζ = c</p>",
+    ),
+    "math-not-typeset": (
+        problems_equations,
+        '<p><span class="math">x</span></p>',
+        "<p>x</p>",
+    ),
+    "uncaptioned-image": (
+        problems_captions,
+        f'<div class="cell"><div class="cell_output"><img src="{PNG_1PX}"></div></div>',
+        f'<figure><img src="{PNG_1PX}"><figcaption>Fig. 1: a pixel.</figcaption></figure>',
+    ),
+    "empty-caption": (
+        problems_captions,
+        f'<figure><img src="{PNG_1PX}"><figcaption> </figcaption></figure>',
+        f'<figure><img src="{PNG_1PX}"><figcaption>Fig. 1</figcaption></figure>',
+    ),
+    "nan-in-table": (
+        problems_nan,
+        "<table><tr><th>c</th><td>NaN</td></tr></table>",
+        "<table><tr><th>c (nanometre)</th><td>—</td></tr></table>",
+    ),
+    "page-too-wide": (
+        problems_page_width,
+        '<div style="width: 900px">wide</div>',
+        '<div style="max-width: 100%; overflow-x: auto"><div style="width: 900px">w</div></div>',
+    ),
+    "clipped-output": (
+        problems_clipped,
+        '<pre style="width: 200px; overflow: hidden">' + "x" * 300 + "</pre>",
+        '<pre style="width: 200px; overflow-x: auto">' + "x" * 300 + "</pre>",
+    ),
+    "no-exercise": (
+        problems_exercises,
+        '<div class="exercise">Do it.</div>',
+        '<div class="exercise">Do it.</div><div class="solution">Done.</div>',
+    ),
+    "network-request": (
+        problems_offline,
+        '<img src="https://example.org/logo.png" alt="">',
+        "<p>offline</p>",
+    ),
+}
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_check_reports_the_defect_and_passes_the_repair(browser, tmp_path, case):
+    check, defective, repaired = CASES[case]
+    width = NARROW_PX if check is problems_page_width else WIDE_PX
+    bad = page_facts(browser, _page(tmp_path, "bad", defective), width)
+    good = page_facts(browser, _page(tmp_path, "good", repaired), width)
+    assert check(bad), f"{case}: the defect was not reported"
+    assert check(good) == [], f"{case}: the repaired page was reported"
+
+
+def test_ipynb_check(browser, tmp_path):
+    (tmp_path / "nb.ipynb").write_text("{}", encoding="utf-8")
+    missing = page_facts(browser, _page(tmp_path, "a", '<a href="gone.ipynb">nb</a>'), WIDE_PX)
+    absent = page_facts(browser, _page(tmp_path, "b", "<p>no link</p>"), WIDE_PX)
+    good = page_facts(browser, _page(tmp_path, "c", '<a href="nb.ipynb">nb</a>'), WIDE_PX)
+    assert problems_ipynb(missing) and problems_ipynb(absent)
+    assert problems_ipynb(good) == []
+
+
+# --- a synthetic chapter built with the book's configuration --------------------------------
+
+DEMO_CHAPTER = r"""---
+jupytext:
+  text_representation:
+    extension: .md
+    format_name: myst
+kernelspec:
+  display_name: Python 3
+  language: python
+  name: python3
+---
+
+# A synthetic chapter
+
+The line scanner maps $\zeta$ to a direction; in display,
+
+$$
+\zeta = \zeta_0 - c\,\frac{r_{11}(X - X_0) + r_{21}(Y - Y_0) + r_{31}(Z - Z_0)}
+{r_{13}(X - X_0) + r_{23}(Y - Y_0) + r_{33}(Z - Z_0)}
++ \Delta\zeta_{\mathrm{distortion}}(\zeta - \zeta_0; k_1, k_2, k_3, k_4, k_5, k_6, k_7)
++ \Delta\zeta_{\mathrm{other}}
+$$
+
+and a long path in text: `data_synthetic/generated/a_very_long_file_name_without_breaks.parquet`.
+
+| quantity | unit | paper | reproduced | σ̂ | truth | z | verdict | note | more |
+|---|---|---|---|---|---|---|---|---|---|
+| principal dist. c | px | 3539.0 | 3538.21 | 0.93 | 3539.00 | −0.85 | within 1σ̂ | a note | text |
+
+```{code-cell} ipython3
+import numpy as np
+import pandas as pd
+
+pd.DataFrame(np.arange(40.0).reshape(2, 20), columns=[f"column_{i}" for i in range(20)])
+```
+
+```{code-cell} ipython3
+print("a long output line " * 20)
+```
+
+```{code-cell} ipython3
+---
+mystnb:
+  figure:
+    caption: A captioned figure from a code cell.
+---
+import matplotlib.pyplot as plt
+
+fig, ax = plt.subplots(figsize=(4, 2))
+ax.plot([0, 1], [0, 1])
+```
+
+```{exercise}
+:label: ex-demo
+
+Give the stations σ = 1 cm and recompute σ(c).
+```
+
+```{solution} ex-demo
+:class: dropdown
+
+Recompute with `sigma_m=0.01`; σ(c) grows.
+```
+"""
+
+
+@pytest.fixture(scope="module")
+def demo_book(tmp_path_factory) -> Path:
+    """Build a two-page book (intro + synthetic chapter) with the book's config, _ext, _static."""
+    root = tmp_path_factory.mktemp("demo") / "book"
+    root.mkdir()
+    for name in ("_config.yml", "references.bib"):
+        shutil.copy(BOOK / name, root / name)
+    for name in ("_ext", "_static"):
+        shutil.copytree(BOOK / name, root / name, ignore=shutil.ignore_patterns("__pycache__"))
+    (root / "_toc.yml").write_text(
+        "format: jb-book\nroot: intro\nchapters:\n  - file: chapters/demo\n", encoding="utf-8"
+    )
+    (root / "intro.md").write_text("# Demo\n\nSee {doc}`chapters/demo`.\n", encoding="utf-8")
+    (root / "chapters").mkdir()
+    (root / "chapters" / "demo.md").write_text(DEMO_CHAPTER, encoding="utf-8")
+    jupyter_book = Path(sys.executable).with_name("jupyter-book")
+    result = subprocess.run(
+        [str(jupyter_book), "build", str(root), "-W", "-n", "--keep-going"],
+        capture_output=True,
+        text=True,
+        env={**os.environ, "HSGEO_SCALE": "small"},
+        timeout=900,
+    )
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    return root / "_build" / "html"
+
+
+@pytest.mark.parametrize("width", [NARROW_PX, WIDE_PX])
+def test_synthetic_chapter_passes_every_check(browser, demo_book, width):
+    facts = page_facts(browser, demo_book / "chapters" / "demo.html", width)
+    problems = (
+        problems_equations(facts)
+        + problems_offline(facts)
+        + problems_captions(facts)
+        + problems_nan(facts)
+        + problems_page_width(facts)
+        + problems_clipped(facts)
+        + problems_ipynb(facts)
+        + problems_md_source(facts)
+        + problems_exercises(facts)
+    )
+    assert problems == []
+    # the checks saw what they check, so passing is not vacuous
+    assert facts["mathjax_output"] >= 2 and facts["figures"] >= 1
+    assert facts["exercises"] >= 1 and facts["solutions"] >= 1
+    assert facts["ipynb_links"]
+
+
+def test_synthetic_chapter_infrastructure(demo_book):
+    """MathJax shipped locally, notebook download converted, run box and run time present."""
+    html = (demo_book / "chapters" / "demo.html").read_text(encoding="utf-8")
+    assert 'src="../_static/mathjax/tex-mml-chtml.js"' in html
+    assert (demo_book / "_static" / "mathjax" / "tex-mml-chtml.js").is_file()
+    assert list((demo_book / "_static" / "mathjax").rglob("*.woff"))
+    assert "cdn.jsdelivr.net" not in html
+    import nbformat
+
+    nb = nbformat.read(demo_book / "_sources" / "chapters" / "demo.ipynb", as_version=4)
+    assert [c.cell_type for c in nb.cells].count("code") == 3
+    assert "Run it yourself" in html and "Run time measured when this book was built" in html

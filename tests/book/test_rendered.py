@@ -1,0 +1,136 @@
+"""The built book as a reader meets it: every page opened offline in headless Chromium.
+
+Run by ``make check-book`` after ``make book`` (``make test`` does not collect it, see
+``conftest.py``). Every page of ``book/_toc.yml`` is opened from ``book/_build/html`` (or
+``$HSGEO_BOOK_HTML``) as a ``file://`` URL with the network blocked, once 400 px and once
+1400 px wide, and each check is its own test so that a failure names the page and the check.
+Chapter pages (``chapters/*``) must also offer an ``.ipynb`` download and an exercise with a
+solution.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+import yaml
+from pagecheck import (
+    NARROW_PX,
+    WIDE_PX,
+    page_facts,
+    problems_captions,
+    problems_clipped,
+    problems_equations,
+    problems_exercises,
+    problems_ipynb,
+    problems_md_source,
+    problems_nan,
+    problems_offline,
+    problems_page_width,
+)
+
+pytestmark = pytest.mark.book
+
+BOOK = Path(__file__).resolve().parents[2] / "book"
+HTML = Path(os.environ.get("HSGEO_BOOK_HTML", BOOK / "_build" / "html"))
+
+
+def _toc_docs() -> list[str]:
+    toc = yaml.safe_load((BOOK / "_toc.yml").read_text(encoding="utf-8"))
+    docs = [toc["root"]]
+
+    def walk(node) -> None:
+        if isinstance(node, dict):
+            if "file" in node:
+                docs.append(str(node["file"]).removesuffix(".md"))
+            for key in ("parts", "chapters", "sections"):
+                for child in node.get(key, []) or []:
+                    walk(child)
+
+    walk(toc)
+    return docs
+
+
+DOCS = _toc_docs()
+CHAPTERS = [doc for doc in DOCS if doc.startswith("chapters/")]
+_FACTS: dict[tuple[str, int], dict] = {}
+
+
+@pytest.fixture
+def facts(browser, request):
+    """The measured facts of one page at one width (each page is opened once per width)."""
+    doc, width_px = request.param
+    key = (doc, width_px)
+    if key not in _FACTS:
+        path = HTML / f"{doc}.html"
+        if not path.is_file():
+            pytest.fail(f"{path} is missing: build the book first (`make book`)")
+        _FACTS[key] = page_facts(browser, path, width_px)
+    return _FACTS[key]
+
+
+def _params(docs: list[str], width_px: int):
+    return pytest.mark.parametrize(
+        "facts", [(doc, width_px) for doc in docs], ids=docs, indirect=True
+    )
+
+
+def _check(problems: list[str], facts: dict) -> None:
+    assert not problems, f"{facts['path']}:\n  " + "\n  ".join(problems)
+
+
+@_params(DOCS, WIDE_PX)
+def test_equations_typeset(facts):
+    _check(problems_equations(facts), facts)
+
+
+@_params(DOCS, WIDE_PX)
+def test_offline(facts):
+    _check(problems_offline(facts), facts)
+
+
+@_params(DOCS, WIDE_PX)
+def test_figures_captioned(facts):
+    _check(problems_captions(facts), facts)
+
+
+@_params(DOCS, WIDE_PX)
+def test_no_nan_in_tables(facts):
+    _check(problems_nan(facts), facts)
+
+
+@_params(DOCS, WIDE_PX)
+def test_nothing_clipped_at_1400px(facts):
+    _check(problems_clipped(facts), facts)
+
+
+@_params(DOCS, NARROW_PX)
+def test_no_sideways_scroll_at_400px(facts):
+    _check(problems_page_width(facts), facts)
+
+
+@_params(DOCS, NARROW_PX)
+def test_nothing_clipped_at_400px(facts):
+    _check(problems_clipped(facts), facts)
+
+
+@_params(CHAPTERS, WIDE_PX)
+def test_chapter_ipynb_download(facts):
+    _check(problems_ipynb(facts), facts)
+
+
+@_params(CHAPTERS, WIDE_PX)
+def test_chapter_md_download(facts):
+    _check(problems_md_source(facts), facts)
+
+
+@_params(CHAPTERS, WIDE_PX)
+def test_chapter_exercise_with_solution(facts):
+    _check(problems_exercises(facts), facts)
+
+
+def test_every_chapter_is_in_the_toc():
+    """The chapter checks cover every chapter file (a new chapter cannot escape them)."""
+    on_disk = sorted(f"chapters/{p.stem}" for p in (BOOK / "chapters").glob("*.md"))
+    assert sorted(CHAPTERS) == on_disk
