@@ -52,7 +52,8 @@ book: $(STAMP) book/_build/.library-stamp ## execute every chapter and render th
 	rm -rf book/_build/html book/_build/.doctrees book/_build/jupyter_execute
 	$(VENV)/bin/jupyter-book build book -W -n --keep-going
 
-bench: $(STAMP) ## run the benchmarks, results as JSON in bench/results/
+bench: $(STAMP) ## run the benchmarks, results as JSON in bench/results/ (installs requirements-bench.lock: pycolmap/Ceres)
+	$(PY) -m pip install --quiet --disable-pip-version-check -r requirements-bench.lock
 	$(PY) bench/run.py
 
 lint: $(STAMP) ## ruff check and format check, and the import contracts of the layout (GUIDE §2)
