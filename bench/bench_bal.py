@@ -33,6 +33,12 @@ hsgeo and Ceres agree to 1e-9 relative.
 The machine is shared: Ceres and hsgeo alternate ``--repeats`` times (median wall time; the
 CPU times are reported too, less sensitive to the load).
 
+**Goals** (issue 14): ``goal_cost_reached`` — hsgeo's final cost at most Ceres' × (1 + 1e-6);
+``goal_time_met`` (wall) and ``goal_time_met_cpu`` — hsgeo's first iterate at Ceres' final cost
+no later than Ceres' end; ``converged_no_later_than_ceres`` — hsgeo's own convergence (its
+Gauss–Newton test at 1e-6, which ends 6.5e-6 lower than Ceres' function-tolerance stop, within
+2e-8 of the minimum ``ceres_converged_cost``) no later than Ceres' end.
+
 Usage: ``python bench/bench_bal.py [--repeats 3] [--no-scipy]``; a case alone:
 ``python bench/bench_bal.py --case hsgeo``.
 """
@@ -165,7 +171,9 @@ def case_hsgeo(target_cost: float | None = None):
     c0 = time.process_time()
     fit = adjust_bal(
         problem,
-        progress=lambda info: trace.append((info["iteration"], info["cost"], info["seconds"])),
+        progress=lambda info: trace.append(
+            (info["iteration"], info["cost"], info["seconds"], time.process_time() - c0)
+        ),
     )
     cpu = time.process_time() - c0
     reach = next((t for t in trace if target_cost and t[1] <= target_cost * (1 + 1e-6)), None)
@@ -181,6 +189,7 @@ def case_hsgeo(target_cost: float | None = None):
         "message": fit.result.message,
         "seconds_to_target": None if reach is None else reach[2],
         "iterations_to_target": None if reach is None else reach[0],
+        "cpu_seconds_to_target": None if reach is None else reach[3],
         "cost_history": [float(c) for c in fit.result.cost_history],
         "jit_load_seconds": jit,
     }
@@ -282,6 +291,10 @@ def main(argv=None) -> None:
     )
     rel = (h["final_cost"] - c["final_cost"]) / c["final_cost"]
     hs_s, ce_s = med(x["seconds"] for x in hs), med(x["seconds"] for x in ceres)
+    ce_cpu = med(x["cpu_seconds"] for x in ceres)
+    reached = all(x["seconds_to_target"] is not None for x in hs)
+    out_to = med(x["seconds_to_target"] for x in hs) if reached else None
+    cpu_to = med(x["cpu_seconds_to_target"] for x in hs) if reached else None
     out = {
         "problem": PROBLEM,
         "n_observations": h["n_observations"],
@@ -299,16 +312,13 @@ def main(argv=None) -> None:
         "hsgeo_seconds_per_iteration": hs_s / max(h["iterations"], 1),
         "hsgeo_final_cost": h["final_cost"],
         "hsgeo_converged": h["converged"],
-        "hsgeo_seconds_to_ceres_cost": med(
-            x["seconds_to_target"] for x in hs if x["seconds_to_target"] is not None
-        )
-        if all(x["seconds_to_target"] is not None for x in hs)
-        else None,
+        "hsgeo_seconds_to_ceres_cost": out_to,
+        "hsgeo_cpu_seconds_to_ceres_cost": cpu_to,
         "hsgeo_iterations_to_ceres_cost": h["iterations_to_target"],
         "hsgeo_jit_load_seconds": med(x["jit_load_seconds"] for x in hs),
         "hsgeo_cost_history": h["cost_history"],
         "ceres_seconds": ce_s,
-        "ceres_cpu_seconds": med(x["cpu_seconds"] for x in ceres),
+        "ceres_cpu_seconds": ce_cpu,
         "ceres_iterations": c["iterations"],
         "ceres_seconds_per_iteration": ce_s / max(c["iterations"], 1),
         "ceres_final_cost": c["final_cost"],
@@ -318,7 +328,12 @@ def main(argv=None) -> None:
         "ceres_num_threads": c["num_threads"],
         "final_cost_relative_difference": rel,
         "goal_cost_reached": bool(h["final_cost"] <= c["final_cost"] * (1 + 1e-6)),
-        "goal_time_met": bool(hs_s <= ce_s),
+        # the issue's goal read literally: hsgeo's first iterate at Ceres' final cost, no later
+        # than Ceres' end (wall, and CPU: less sensitive to the shared machine's load) ...
+        "goal_time_met": out_to is not None and bool(out_to <= ce_s),
+        "goal_time_met_cpu": cpu_to is not None and bool(cpu_to <= ce_cpu),
+        # ... and hsgeo's own convergence (a tighter test than Ceres' function tolerance)
+        "converged_no_later_than_ceres": bool(hs_s <= ce_s),
         "hsgeo_seconds_runs": [x["seconds"] for x in hs],
         "ceres_seconds_runs": [x["seconds"] for x in ceres],
         "scipy_seconds": None if sc is None else sc["seconds"],
