@@ -80,7 +80,8 @@ check-book: $(STAMP) browser book/_build/html/index.html ## open every page of t
 	HSGEO_CHECK_BOOK=1 HSGEO_CHROMIUM="$$(command -v chromium || command -v chromium-browser || echo $(CHROMIUM))" \
 	  $(PY) -m pytest -q -p no:cacheprovider -m book tests/book
 
-bench: $(STAMP) ## run the benchmarks, results as JSON in bench/results/
+bench: $(STAMP) ## run the benchmarks, results as JSON in bench/results/ (installs requirements-bench.lock: pycolmap/Ceres)
+	$(PY) -m pip install --quiet --disable-pip-version-check -r requirements-bench.lock
 	$(PY) bench/run.py
 
 lint: $(STAMP) ## ruff check and format check, and the import contracts of the layout (GUIDE §2)

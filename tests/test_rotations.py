@@ -244,3 +244,29 @@ def test_R_photogrammetric_from_opencv_cam():
     np.testing.assert_array_equal(F @ [0, 1, 0], [0, -1, 0])
     F[0, 0] = 5.0  # a fresh array each call
     assert R_photogrammetric_from_opencv_cam()[0, 0] == 1.0
+
+
+@pytest.mark.parametrize("scale", [1e-7, 1e-3, 0.5, 3.0])
+def test_dR_drotvec_matches_finite_differences(scale):
+    """∂R/∂v of the rotation vector against central differences of R_from_rotvec."""
+    from hsgeo.rotations import dR_drotvec
+
+    rng = np.random.default_rng(7)
+    v = rng.normal(size=(4, 3))
+    v = scale * v / np.linalg.norm(v, axis=1, keepdims=True)
+    d = dR_drotvec(v)
+    h = 1e-6
+    for k in range(3):
+        e = np.zeros(3)
+        e[k] = h
+        fd = (R_from_rotvec(v + e) - R_from_rotvec(v - e)) / (2 * h)
+        np.testing.assert_allclose(d[:, k], fd, atol=2e-9)
+
+
+def test_R_from_rotvec_matches_scipy():
+    """Rodrigues' formula against scipy.spatial.transform.Rotation (an independent code)."""
+    from scipy.spatial.transform import Rotation
+
+    rng = np.random.default_rng(3)
+    v = rng.normal(size=(20, 3)) * np.array([[1e-6], [0.1], [1.0], [3.0]]).repeat(5, 0)
+    np.testing.assert_allclose(R_from_rotvec(v), Rotation.from_rotvec(v).as_matrix(), atol=1e-14)

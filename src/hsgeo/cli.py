@@ -164,6 +164,26 @@ def _cmd_geocode(args) -> int:
     return 0
 
 
+def _cmd_adjust_bal(args) -> int:
+    import json
+
+    from hsgeo.workflows.bal import adjust_bal_file
+
+    out = adjust_bal_file(args.file, progress=None if args.json else True)
+    if args.json:
+        print(json.dumps(out, indent=1))
+    else:
+        print(
+            f"{out['file']}: {out['n_cameras']} cameras, {out['n_points']} points, "
+            f"{out['n_observations']} observations adjusted ({out['n_dropped']} behind their "
+            f"camera left out)\n"
+            f"cost ½Σr² {out['initial_cost']:.6f} → {out['final_cost']:.6f} px² in "
+            f"{out['iterations']} iterations, {out['seconds']:.2f} s ({out['message']})\n"
+            f"gauge {out['gauge']}"
+        )
+    return 0
+
+
 _POSITIVE = option_number(positive=True)
 
 
@@ -390,6 +410,14 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--json", action="store_true", help="JSON instead of the text report")
     p.set_defaults(func=_cmd_adjust_pushbroom)
+
+    p = sub.add_parser(
+        "adjust-bal",
+        help="bundle-adjust a 'Bundle Adjustment in the Large' problem file (Snavely cameras)",
+    )
+    p.add_argument("file", help="BAL problem file (.txt, or .txt.bz2)")
+    p.add_argument("--json", action="store_true", help="one JSON object instead of text")
+    p.set_defaults(func=_cmd_adjust_bal)
 
     p = sub.add_parser("versions", help="versions of hsgeo, Python and the dependencies")
     p.set_defaults(func=_cmd_versions)

@@ -45,6 +45,7 @@ __all__ = [
     "dR_drpy",
     "R_from_rotvec",
     "rotvec_from_R",
+    "dR_drotvec",
     "skew",
     "R_small",
     "R_photogrammetric_from_opencv_cam",
@@ -448,6 +449,42 @@ def R_from_rotvec(rotvec: ArrayLike) -> NDArray:
     b = np.where(small, 0.5 - t2 / 24.0 + t2 * t2 / 720.0, 2.0 * np.sin(0.5 * t) ** 2 / (t * t))
     S = skew(v)
     return np.eye(3) + a[..., None, None] * S + b[..., None, None] * (S @ S)
+
+
+def dR_drotvec(rotvec: ArrayLike) -> NDArray:
+    """Analytic derivatives of :func:`R_from_rotvec` with respect to the vector's components.
+
+    ``∂R/∂v_k = skew(J_l[:, k]) R`` with the left Jacobian of SO(3),
+    ``J_l(v) = I + ((1 − cos θ)/θ²) S + ((θ − sin θ)/θ³) S²`` (``S = skew(v)``), because
+    ``R(v + δ) ≈ R_from_rotvec(J_l δ) R(v)`` to first order (Barfoot 2017, *State Estimation
+    for Robotics*, eq. 7.86). Taylor series of the coefficients for θ < 1e-4.
+
+    Parameters
+    ----------
+    rotvec : (..., 3) array_like, rad
+
+    Returns
+    -------
+    dR : (..., 3, 3, 3) ndarray, 1/rad
+        ``dR[..., k, :, :] = ∂R/∂v_k``.
+
+    Raises
+    ------
+    InputError
+        If ``rotvec`` is not (..., 3) or contains NaN/inf.
+    """
+    v = _as_vectors(rotvec, "rotvec", 3)
+    theta = np.linalg.norm(v, axis=-1)
+    small = theta < 1e-4
+    t = np.where(small, 1.0, theta)
+    t2 = theta * theta
+    b = np.where(small, 0.5 - t2 / 24.0 + t2 * t2 / 720.0, 2.0 * np.sin(0.5 * t) ** 2 / (t * t))
+    c = np.where(small, 1.0 / 6.0 - t2 / 120.0 + t2 * t2 / 5040.0, (t - np.sin(t)) / t**3)
+    S = skew(v)
+    J = np.eye(3) + b[..., None, None] * S + c[..., None, None] * (S @ S)
+    R = R_from_rotvec(v)
+    cols = skew(np.swapaxes(J, -1, -2))  # (..., 3 (k), 3, 3): skew of column k of J
+    return cols @ R[..., None, :, :]
 
 
 def rotvec_from_R(R: ArrayLike) -> NDArray:

@@ -326,8 +326,20 @@ class _Solve:
     def _converged(self, ne: _Normal, lam: float, pred: float, tol: float, cost: float) -> bool:
         """The undamped Gauss–Newton step with this point's own matrix predicts a decrease
         below ``tol`` times the cost.
+
+        With a points block and λ above ``lambda_points_min`` the step had damped point
+        blocks; the decrease a damped step predicts never exceeds the undamped step's (it falls
+        as λ grows), so only when it is already below ``tol`` the undamped step is formed and
+        tested. Without points, convergence waits for λ ≤ ``lambda_points_min`` as before.
         """
-        return lam <= self.options.lambda_points_min and pred <= tol * cost and ne.S_chord is None
+        if pred > tol * cost or ne.S_chord is not None:
+            return False
+        if lam <= self.options.lambda_points_min:
+            return True
+        if ne.V is None:  # no point blocks: as before, wait for λ ≤ lambda_points_min
+            return False
+        dc, dp = _step(self.layout, ne, 0.0)
+        return _predicted_decrease(self.layout, ne, 0.0, dc, dp) <= tol * cost
 
     def _damped_step(
         self, ne: _Normal, cost: float, lam: float, nu: float, dc, dp, pred: float

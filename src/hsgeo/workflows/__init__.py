@@ -14,5 +14,7 @@ module                     what it does
                            ``hsgeo calibrate-frame``)
 ``pushbroom_ba``           bundle adjustment of pushbroom lines (002, ``hsgeo adjust-pushbroom``)
 ``geocoding``              orthorectification of a recorded flight line (000, ``hsgeo geocode``)
+``bal``                    a "Bundle Adjustment in the Large" problem, Snavely cameras
+                           (``hsgeo adjust-bal``)
 =========================  =====================================================================
 """
