@@ -1,7 +1,7 @@
 """``make bench``: run every ``bench/bench_*.py`` (each writes ``bench/results/<name>.json``).
 
 ``python bench/run.py [NAME ...]`` runs only the named ones (``engine``, ``pushbroom_ba``,
-``bal``); each script also runs on its own with its options
+``bal``, ``nist_strd``); each script also runs on its own with its options
 (``python bench/bench_pushbroom_ba.py --help``).
 
 Benchmarks time whole operations at realistic sizes and report peak memory, against the obvious

@@ -148,3 +148,26 @@ def test_describe_table_errors_name_the_column():
         describe_table({})
     with pytest.raises(InputError, match="non-empty dict"):
         describe_table([[1.0, 2.0]])
+
+
+# -- LRE (log relative error, McCullough 1998) ------------------------------------------------
+def test_lre_hand_values():
+    from hsgeo.stats import lre
+
+    # |x − c| / |c| = 1e-6 → 6 digits; 5.4e-7 (Misra1a's b1 to 6 digits) → 6.27
+    assert lre(1.000001, 1.0) == pytest.approx(6.0, abs=1e-9)
+    assert lre(238.942, 238.94212918) == pytest.approx(-np.log10(0.00012918 / 238.94212918))
+    assert lre(-2.0, -2.02) == pytest.approx(-np.log10(0.02 / 2.02))  # sign does not matter
+    assert lre(2.5e-9, 0.0) == pytest.approx(-np.log10(2.5e-9))  # c = 0: log absolute error
+
+
+def test_lre_caps_and_floors():
+    from hsgeo.stats import lre
+
+    np.testing.assert_array_equal(lre([3.0, 3.0], [3.0, 3.0]), [11.0, 11.0])  # exact: capped
+    assert lre(1.0, 1.0, digits=15) == 15.0
+    assert lre(0.0, 0.0) == 11.0
+    assert lre(5.0, 1.0) == 0.0  # off by 400 %: no correct digit
+    assert lre(np.nan, 1.0) == 0.0 and lre(np.inf, 1.0) == 0.0
+    with pytest.raises(InputError, match="certified values must be finite"):
+        lre(1.0, np.nan)

@@ -17,6 +17,8 @@ References
 ----------
 .. [1] Höhle, J., Höhle, M. (2009). Accuracy assessment of digital elevation models by means
    of robust statistical methods. ISPRS J. Photogramm. Remote Sens. 64(4), 398-406.
+.. [2] McCullough, B. D. (1998). Assessing the reliability of statistical software: Part I.
+   The American Statistician 52(4), 358-366.
 """
 
 from __future__ import annotations
@@ -29,7 +31,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from hsgeo.errors import InputError, ObservationError
 
-__all__ = ["bias", "std", "rms", "nmad", "describe", "describe_table", "NMAD_SCALE"]
+__all__ = ["bias", "std", "rms", "nmad", "describe", "describe_table", "lre", "NMAD_SCALE"]
 
 #: 1 / Φ⁻¹(3/4): makes the NMAD a consistent estimator of σ for normal data.
 NMAD_SCALE = 1.4826
@@ -279,3 +281,43 @@ def describe_table(
     table = pd.DataFrame(data, index=list(STATISTICS), dtype=np.float64)
     table.index.name = "statistic"
     return table
+
+
+def lre(estimate: ArrayLike, certified: ArrayLike, digits: float = 11.0) -> NDArray:
+    """Log relative error: the number of correct significant digits of ``estimate``.
+
+    ``LRE = −log10(|x − c| / |c|)``, or the log absolute error ``−log10 |x|`` where the
+    certified value ``c`` is 0, as NIST's StRD and McCullough (1998) [2]_ score solver
+    accuracy. The result is clipped to ``[0, digits]``: an exact match scores ``digits`` (the
+    number of certified digits: 11 for NIST StRD), an estimate off by 100 % or more, or not
+    finite, scores 0.
+
+    Parameters
+    ----------
+    estimate, certified : array_like
+        Same shape (or broadcastable); any units, the same for both.
+    digits : float, default 11
+        The cap: the number of significant digits the certified values carry.
+
+    Returns
+    -------
+    ndarray
+        LRE of each entry (dimensionless, digits).
+
+    Examples
+    --------
+    >>> round(float(lre(1.000001, 1.0)), 6)  # off by 1e-6 relative: 6 digits
+    6.0
+    >>> round(float(lre(2.5e-9, 0.0)), 2)  # certified 0: log absolute error
+    8.6
+    """
+    x = np.asarray(estimate, dtype=np.float64)
+    c = np.asarray(certified, dtype=np.float64)
+    if not np.all(np.isfinite(c)):
+        raise InputError("lre: the certified values must be finite")
+    x, c = np.broadcast_arrays(x, c)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        err = np.where(c == 0.0, np.abs(x), np.abs(x - c) / np.abs(np.where(c == 0.0, 1.0, c)))
+        out = -np.log10(err)
+    out = np.where(np.isfinite(x), out, 0.0)
+    return np.clip(out, 0.0, digits)

@@ -34,10 +34,29 @@ class SolverOptions:
     ftol : float, default 1e-10
         Convergence when the decrease of the cost the Gauss–Newton step predicts is below
         ``ftol`` times the cost (relative, dimensionless).
+    xtol : float, default 0
+        With ``xtol > 0``, convergence also needs the Gauss–Newton step of every free
+        parameter to be small: ``|Δx_i| ≤ xtol · (|x_i| + xtol)`` (relative, dimensionless),
+        the test that bounds the number of correct digits of the estimate (e.g. ``1e-12``
+        for the NIST StRD problems). ``0``: the cost test alone (``ftol``).
     atol : float, default 1e-24
         Convergence when the cost per residual component falls below it (noise-free data).
     lambda0 : float, default 1e-6
         Initial Marquardt damping; small means Gauss–Newton first.
+    damping_diagonal : {"current", "max"}, default "current"
+        The diagonal ``D`` of Marquardt's damping ``N + λ D`` for the non-point unknowns:
+        ``"current"``, ``diag(N)`` at the current point; ``"max"``, the largest ``diag(N)``
+        seen so far in the solve, entry by entry (Moré 1978, as MINPACK's ``lmder``), which
+        keeps a parameter damped where its column of the Jacobian has faded (a saturated
+        exponential), so the step cannot run away along it.
+    geodesic : float or None, default None
+        Geodesic acceleration (Transtrum & Sethna 2012) with this bound ``α`` (e.g. 0.75):
+        each damped step ``v`` gets the second-order correction ``½ a``, ``a`` the damped
+        solution for the residuals' second directional derivative along ``v`` (one extra
+        evaluation of the residuals, by finite differences), and a step with
+        ``‖a‖ > α ‖v‖`` (in the damping's scaled norm) is refused like one that does not
+        decrease the cost. It follows curved valleys (MGH10) and keeps the first steps out of
+        saturated regions (BoxBOD). Only for problems without a points block. ``None``: off.
     lambda_points_min : float, default 1e-4
         Below this damping the points' blocks are not damped (only the reduced system is), so
         one reduced matrix per linearisation point serves the datum check, the damped retries
@@ -88,8 +107,11 @@ class SolverOptions:
 
     max_iter: int = 50
     ftol: float = 1e-10
+    xtol: float = 0.0
     atol: float = 1e-24
     lambda0: float = 1e-6
+    damping_diagonal: str = "current"
+    geodesic: float | None = None
     lambda_points_min: float = 1e-4
     lambda_max: float = 1e16
     reject_k: float | None = None
@@ -124,7 +146,7 @@ class SolverOptions:
                 raise InputError(
                     f"SolverOptions.{name} must be a finite positive number, got {v!r}"
                 )
-        for name in ("atol", "settled"):
+        for name in ("xtol", "atol", "settled"):
             v = getattr(self, name)
             if not _is_real(v) or math.isnan(v) or v < 0.0:
                 raise InputError(f"SolverOptions.{name} must be a number ≥ 0, got {v!r}")
@@ -132,6 +154,18 @@ class SolverOptions:
             raise InputError(
                 f"SolverOptions.lambda0 ({self.lambda0!r}) exceeds lambda_max "
                 f"({self.lambda_max!r}): no step could be tried"
+            )
+        if self.damping_diagonal not in ("current", "max"):
+            raise InputError(
+                "SolverOptions.damping_diagonal must be 'current' (diag(N) at the current "
+                f"point) or 'max' (the largest seen), got {self.damping_diagonal!r}"
+            )
+        if self.geodesic is not None and (
+            not _is_real(self.geodesic) or not (0.0 < self.geodesic < math.inf)
+        ):
+            raise InputError(
+                "SolverOptions.geodesic must be None (off) or the bound α of the acceleration "
+                f"relative to the step, a positive number such as 0.75; got {self.geodesic!r}"
             )
         if self.reject_k is not None and (
             not _is_real(self.reject_k) or not (0.0 < self.reject_k < math.inf)

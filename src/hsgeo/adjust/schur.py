@@ -45,6 +45,7 @@ class _Normal:
     diag_cc: np.ndarray | None = None  # diag(N_cc)
     reduced0: tuple | None = None  # (S, rhs, V⁻¹) with undamped point blocks, see _reduced
     S_chord: np.ndarray | None = None  # a reduced matrix formed at an earlier point, see adjust
+    D_c: np.ndarray | None = None  # damping diagonal of the non-point unknowns (None: diag N_cc)
     options: SolverOptions = SolverOptions()  # compiled path, lambda_points_min
 
     @property
@@ -57,6 +58,12 @@ class _Normal:
         if self.S_chord is not None:
             self.S_chord = None
             self.reduced0 = None
+
+    def damping_diagonal(self) -> np.ndarray:
+        """The diagonal λ scales for the non-point unknowns: ``D_c``, else ``diag(N_cc)``."""
+        if self.D_c is not None:
+            return self.D_c
+        return self.diag_cc if self.diag_cc is not None else np.diag(self.Ncc)
 
     @property
     def Ncc(self) -> np.ndarray:
@@ -203,12 +210,14 @@ def _normal(
     )
 
 
-def _damped(A: np.ndarray, lam: float) -> np.ndarray:
-    """A + λ·diag(A) on the last two axes (Marquardt), with a floor on zero diagonals."""
+def _damped(A: np.ndarray, lam: float, D: np.ndarray | None = None) -> np.ndarray:
+    """A + λ·diag(A) on the last two axes (Marquardt), with a floor on zero diagonals;
+    with ``D``, A + λ·D instead (see ``SolverOptions.damping_diagonal``).
+    """
     if lam == 0.0:
         return A
     A = A.copy()
-    d = np.diagonal(A, axis1=-2, axis2=-1)
+    d = np.diagonal(A, axis1=-2, axis2=-1) if D is None else D
     floor = 1e-12 * max(float(np.max(d)) if d.size else 1.0, 1e-300)
     idx = np.arange(A.shape[-1])
     A[..., idx, idx] += lam * np.maximum(d, floor)
@@ -282,11 +291,11 @@ def _reduced(layout: _Layout, ne: _Normal, lam: float):
         S = S0.copy()
         rhs = r0.copy()
         if lam != 0.0 and layout.n_c:
-            d = ne.diag_cc
+            d = ne.diag_cc if ne.D_c is None else ne.D_c
             floor = 1e-12 * max(float(np.max(d)), 1e-300)
             S[np.diag_indices_from(S)] += lam * np.maximum(d, floor)
         return S, rhs, Vinv, None
-    S = _damped(ne.Ncc, lam)
+    S = _damped(ne.Ncc, lam, ne.D_c)
     if ne.V is None:
         return S, rhs, None, None
     Vinv = _inv_blocks(_damped(ne.V, lam_p), ne.options.compiled)
@@ -318,7 +327,7 @@ def _predicted_decrease(layout, ne: _Normal, lam, dc, dp) -> float:
     if not layout.n_c:
         Dc = np.zeros(0)
     else:
-        Dc = np.maximum(ne.diag_cc if ne.diag_cc is not None else np.diag(ne.Ncc), 0.0)
+        Dc = np.maximum(ne.damping_diagonal(), 0.0)
     pred = 0.5 * float(dc @ (lam * Dc * dc - ne.gc))
     if dp is not None:
         Dp = np.maximum(np.diagonal(ne.V, axis1=1, axis2=2), 0.0)

@@ -9,8 +9,9 @@ Gauss–Newton with Levenberg–Marquardt damping on the whitened observation eq
   damping is Marquardt's ``N + λ diag(N)`` with Nielsen's update of λ
   (:mod:`hsgeo.adjust.schur`);
 * convergence: the decrease the Gauss–Newton step predicts at the current point is below
-  ``ftol`` times the cost (the reduced matrix just formed then gives the covariance), or the
-  cost is below ``atol`` (noise-free data);
+  ``ftol`` times the cost (the reduced matrix just formed then gives the covariance) and, with
+  ``xtol``, that step is below ``xtol`` relative to each parameter; or the cost is below
+  ``atol`` (noise-free data);
 * before the first step the datum is checked (:mod:`hsgeo.adjust.datum`);
 * optional outlier rejection (:mod:`hsgeo.adjust.robust`): in rounds after convergence, or in
   every iteration from a settled iterate on (``reject_every_iteration``, as 002 §3.4 does);
@@ -25,6 +26,10 @@ References
 ----------
 Triggs, McLauchlan, Hartley, Fitzgibbon (2000): Bundle adjustment — a modern synthesis.
 Madsen, Nielsen, Tingleff (2004): Methods for non-linear least squares problems, §3.2.
+M. K. Transtrum, J. P. Sethna (2012): Improvements to the Levenberg–Marquardt algorithm
+for nonlinear least-squares minimization. arXiv:1201.5885.
+J. J. Moré (1978): The Levenberg–Marquardt algorithm: implementation and theory. Lecture
+Notes in Mathematics 630, 105–116.
 C. T. Kelley (1995): Iterative Methods for Linear and Nonlinear Equations, SIAM, ch. 5.
 """
 
@@ -51,11 +56,12 @@ from hsgeo.adjust.schur import (
     _OrderCache,
     _point_cofactor_function,
     _predicted_decrease,
+    _reduced,
     _reduced_inverse,
     _step,
 )
-from hsgeo.adjust.system import _evaluate, _Layout, _System
-from hsgeo.errors import ConvergenceError, DatumError, ObservationError
+from hsgeo.adjust.system import _evaluate, _Layout, _NonFinite, _System
+from hsgeo.errors import ConvergenceError, DatumError, InputError, ObservationError
 
 __all__ = ["adjust"]
 
@@ -193,6 +199,12 @@ class _Solve:
                 "every parameter is fixed: there is nothing to estimate (free some with "
                 "Parameters.free())"
             )
+        if options.geodesic is not None and self.layout.pblock is not None:
+            raise InputError(
+                f"SolverOptions.geodesic is not available with a points block "
+                f"({self.layout.pblock.name!r}): set geodesic=None, or add the points as an "
+                "ordinary block (points=False)"
+            )
         self.masks = [np.ones(b.m, dtype=bool) for b in blocks]
         self.orders = _OrderCache()
         self.show = _progress_printer(progress)
@@ -200,6 +212,7 @@ class _Solve:
         self.t0 = time.perf_counter()
         self.total_iter = 0
         self.each = options.reject_k is not None and options.reject_every_iteration
+        self.D_max: np.ndarray | None = None  # damping_diagonal="max": the running maximum
 
     # -- the linearised system -------------------------------------------------------------
     def linearise(self, check_redundancy: bool = False) -> tuple[_System, _Normal]:
@@ -239,6 +252,7 @@ class _Solve:
         """
         opts = self.options
         sy, ne = self.linearise(check_redundancy=True)
+        self._damping_diagonal(ne)
         if check_datum:
             _check_datum(self.layout, ne, opts.rank_rtol)
         lam, nu = opts.lambda0, 2.0
@@ -251,7 +265,7 @@ class _Solve:
             if cost <= opts.atol * sy.r.size:
                 return _Outcome(True, "cost below atol (noise-free data)"), sy, ne
             dc, dp, pred = self._gauss_newton_step(ne, lam, tol, cost)
-            if self._converged(ne, lam, pred, tol, cost):
+            if self._converged(ne, lam, pred, tol, cost) and self._small_step(dc, dp):
                 # converged before any rejection test (e.g. at the initial values)
                 if self.each and not tested and self.reject(sy, sy, ne):
                     return _Outcome(False, "", rejected=True), sy, ne
@@ -266,7 +280,7 @@ class _Solve:
                 )
             n_iter += 1
             self.total_iter += 1
-            step = self._damped_step(ne, cost, lam, nu, dc, dp, pred)
+            step = self._damped_step(ne, cost, lam, nu, dc, dp, pred, sy)
             lam, nu = step.lam, step.nu
             if lam > opts.lambda_max:
                 # no step decreases the cost: we are at the minimum to machine precision
@@ -303,6 +317,7 @@ class _Solve:
             )
             sy = ne = step = None  # free the old Jacobian before forming the new one
             sy, ne = self.linearise()
+            self._damping_diagonal(ne)
             if chord is not None and ne.compiled_schur:
                 ne.S_chord = chord
             cost = sy.cost  # (lower than new_cost when observations were just rejected)
@@ -341,8 +356,72 @@ class _Solve:
         dc, dp = _step(self.layout, ne, 0.0)
         return _predicted_decrease(self.layout, ne, 0.0, dc, dp) <= tol * cost
 
+    def _damping_diagonal(self, ne: _Normal) -> None:
+        """With ``damping_diagonal="max"``: damp by the largest diag(N_cc) seen (Moré 1978)."""
+        if self.options.damping_diagonal != "max" or not self.layout.n_c:
+            return
+        d = ne.damping_diagonal()
+        self.D_max = d.copy() if self.D_max is None else np.maximum(self.D_max, d)
+        ne.D_c = self.D_max
+
+    def _small_step(self, dc: np.ndarray, dp) -> bool:
+        """``|Δx_i| ≤ xtol (|x_i| + xtol)`` for every free parameter (True if ``xtol`` is 0)."""
+        xtol = self.options.xtol
+        if xtol == 0.0:
+            return True
+        layout = self.layout
+        for b in layout.cblocks:
+            cm = layout.colmap[b.name]
+            sel = cm >= 0
+            if np.any(np.abs(dc[cm[sel]]) > xtol * (np.abs(b.value.ravel()[sel]) + xtol)):
+                return False
+        if layout.pblock is not None and dp is not None:
+            x = layout.pblock.value
+            if np.any(np.where(layout.pfree, np.abs(dp) - xtol * (np.abs(x) + xtol), 0.0) > 0):
+                return False
+        return True
+
+    def _geodesic(self, sy: _System, ne: _Normal, lam: float, dc: np.ndarray, pred: float):
+        """The step ``v + ½ a`` with geodesic acceleration and its predicted decrease, or None
+        if ``a`` is too large (Transtrum & Sethna 2012, with their finite-difference ``r_vv``).
+        """
+        layout, h = self.layout, 0.1
+        state = layout.get_state()
+        layout.apply(h * dc, None)
+        try:
+            r_h = _evaluate(layout, self.blocks, self.masks, False, self.options.compiled).r
+        except _NonFinite:
+            return None
+        finally:
+            layout.set_state(state)
+        # second directional derivative of the residuals along v (their eq. 12)
+        r_vv = (2.0 / h) * ((r_h - sy.r) / h - sy.Jrc.matvec(dc))
+        g_vv = sy.Jrc.rmatvec(r_vv)
+        D = ne.damping_diagonal()
+        S, _, _, _ = _reduced(layout, ne, lam)
+        try:
+            a = -sla.cho_solve(sla.cho_factor(S, check_finite=False), g_vv, check_finite=False)
+        except (np.linalg.LinAlgError, sla.LinAlgError):
+            return None
+        w = np.sqrt(np.maximum(D, 0.0))
+        if np.linalg.norm(w * a) > self.options.geodesic * np.linalg.norm(w * dc):
+            return None
+        step = dc + 0.5 * a
+        # the decrease the linearised model predicts for the accelerated step
+        N = ne.Ncc
+        pred_step = -float(ne.gc @ step) - 0.5 * float(step @ (N @ step))
+        return step, pred_step if pred_step > 0 else pred
+
     def _damped_step(
-        self, ne: _Normal, cost: float, lam: float, nu: float, dc, dp, pred: float
+        self,
+        ne: _Normal,
+        cost: float,
+        lam: float,
+        nu: float,
+        dc,
+        dp,
+        pred: float,
+        sy: _System | None = None,
     ) -> _Trial:
         """Take the step, or retry with more damping (Nielsen) until the cost decreases.
 
@@ -351,11 +430,28 @@ class _Solve:
         """
         layout = self.layout
         state = layout.get_state()
+        geodesic = self.options.geodesic is not None and sy is not None
         while True:
+            if geodesic:
+                acc = self._geodesic(sy, ne, lam, dc, pred)
+                if acc is None:  # the acceleration is too large: a refused step
+                    lam *= nu
+                    nu *= 2.0
+                    if lam > self.options.lambda_max:
+                        return _Trial(sy, -np.inf, pred, lam, nu)
+                    dc, dp = _step(layout, ne, lam)
+                    pred = _predicted_decrease(layout, ne, lam, dc, dp)
+                    continue
+                dc, pred = acc
             layout.apply(dc, dp)
-            trial = _evaluate(
-                layout, self.blocks, self.masks, jacobian=False, compiled=self.options.compiled
-            )
+            try:
+                trial = _evaluate(
+                    layout, self.blocks, self.masks, jacobian=False, compiled=self.options.compiled
+                )
+            except _NonFinite:
+                # the step left the model's domain (an overflow, a log of a negative): a step
+                # that does not decrease the cost, refused like one
+                trial = _System(np.array([np.inf]), None, None, None, 0)
             actual = cost - trial.cost
             rho = actual / pred if pred > 0 else (1.0 if actual >= 0 else -1.0)
             if rho > 0 and np.isfinite(trial.cost):

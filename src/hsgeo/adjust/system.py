@@ -173,7 +173,8 @@ class _System:
 
     @property
     def cost(self) -> float:
-        return 0.5 * float(self.r @ self.r)
+        with np.errstate(over="ignore"):  # finite residuals too large to square: cost inf
+            return 0.5 * float(self.r @ self.r)
 
     @property
     def Jc(self) -> sp.csr_matrix:
@@ -298,6 +299,10 @@ class _PriorSlots:
         vals_dst[:, 0] = self.vals
 
 
+class _NonFinite(InputError):
+    """A residual block returned non-finite residuals (at a trial step: a refused step)."""
+
+
 def _evaluate(
     layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian: bool, compiled: bool = True
 ) -> _System:
@@ -319,7 +324,7 @@ def _evaluate(
             )
         if not np.all(np.isfinite(r)):
             bad = np.flatnonzero(~np.isfinite(r))[:5].tolist()
-            raise InputError(
+            raise _NonFinite(
                 f"residual block {blk.name!r} produced non-finite residuals at rows {bad}: "
                 "check the observations for NaN, or the initial values (a point behind the "
                 "camera, a zero depth)"

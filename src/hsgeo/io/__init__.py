@@ -13,7 +13,8 @@ One module per format:
 * :mod:`hsgeo.io.lines` — recorded flight lines (NetCDF);
 * :mod:`hsgeo.io.raster` — orthoimages (NetCDF and ENVI) and DEMs (NetCDF);
 * :mod:`hsgeo.io.envi` — ENVI BSQ + ``.hdr``;
-* :mod:`hsgeo.io.opencv` — OpenCV FileStorage YAML/XML.
+* :mod:`hsgeo.io.opencv` — OpenCV FileStorage YAML/XML;
+* :mod:`hsgeo.io.nist_strd` — NIST StRD nonlinear-regression files (certified values).
 
 Writers replace their file atomically (temporary file, then :func:`os.replace`) and, given the
 command's input files, refuse to write over one of them. Errors are
@@ -28,6 +29,7 @@ from hsgeo.io.config import Key, read_config, read_toml
 from hsgeo.io.envi import read_envi, write_envi
 from hsgeo.io.lines import read_lines, write_lines
 from hsgeo.io.navigation import NAV_COLUMNS, read_trajectory, write_trajectory
+from hsgeo.io.nist_strd import read_nist_strd
 from hsgeo.io.opencv import read_opencv_storage
 from hsgeo.io.raster import read_dem, to_map_files
 from hsgeo.io.sensors import read_camera_toml, read_sensor_toml
@@ -54,4 +56,5 @@ __all__ = [
     "read_envi",
     "write_envi",
     "read_opencv_storage",
+    "read_nist_strd",
 ]

@@ -1,0 +1,109 @@
+"""The LM loop's options added for the NIST StRD problems (issue 14): xtol, Moré's damping
+diagonal, and trial steps that leave the model's domain."""
+
+import numpy as np
+import pytest
+from scipy.optimize import least_squares
+from toy_models import Exponential
+
+from hsgeo.adjust import Parameters, ResidualBlock, SolverOptions, adjust
+from hsgeo.errors import InputError
+
+
+def _exp_problem():
+    t = np.linspace(0.0, 4.0, 30)
+    rng = np.random.default_rng(3)
+    y = 2.0 * np.exp(-0.7 * t) + 0.01 * rng.standard_normal(t.size)
+    return t, y
+
+
+def _scipy_reference(t, y):
+    sol = least_squares(
+        lambda b: b[0] * np.exp(-b[1] * t) - y, [1.0, 0.1], method="lm", xtol=1e-15,
+        ftol=1e-15, gtol=1e-15,
+    )  # fmt: skip
+    return sol.x
+
+
+@pytest.mark.parametrize("damping", ["current", "max"])
+def test_xtol_reaches_the_reference_to_more_digits(damping):
+    t, y = _exp_problem()
+    ref = _scipy_reference(t, y)
+    p = Parameters()
+    p.add("Ak", [1.0, 0.1])
+    loose = adjust(p, [Exponential(t, y, 1.0)], damping_diagonal=damping).value("Ak")
+    tight = adjust(p, [Exponential(t, y, 1.0)], xtol=1e-13, damping_diagonal=damping)
+    assert tight.converged
+    err_tight = np.max(np.abs(tight.value("Ak") - ref) / np.abs(ref))
+    err_loose = np.max(np.abs(loose - ref) / np.abs(ref))
+    assert err_tight < 1e-9
+    assert err_tight <= err_loose
+
+
+def test_damping_diagonal_max_keeps_the_solution_and_rejects_unknown_values():
+    t, y = _exp_problem()
+    p = Parameters()
+    p.add("Ak", [1.0, 0.1])
+    a = adjust(p, [Exponential(t, y, 1.0)], xtol=1e-13)
+    b = adjust(p, [Exponential(t, y, 1.0)], xtol=1e-13, damping_diagonal="max")
+    np.testing.assert_allclose(b.value("Ak"), a.value("Ak"), rtol=1e-9)
+    np.testing.assert_allclose(b.covariance, a.covariance, rtol=1e-8)
+    with pytest.raises(InputError, match="damping_diagonal"):
+        SolverOptions(damping_diagonal="largest")
+    with pytest.raises(InputError, match="xtol"):
+        SolverOptions(xtol=-1.0)
+
+
+class _Sqrt(ResidualBlock):
+    """y = sqrt(a) t: NaN for a < 0, where a full Gauss–Newton step from a = 4 lands."""
+
+    name = "sqrt"
+    BLOCKS = {"a": "a"}
+
+    def __init__(self, t, y):
+        super().__init__(np.ones(t.size))
+        self.t, self.y = t, y
+
+    def evaluate(self, values, jacobian):
+        a = values["a"][0]
+        with np.errstate(invalid="ignore"):
+            s = np.sqrt(a)
+        r = s * self.t - self.y
+        return r, ({"a": (0.5 / s * self.t)[:, None]} if jacobian else None)
+
+
+def test_a_trial_step_outside_the_model_domain_is_refused_not_an_error():
+    t = np.linspace(1.0, 2.0, 5)
+    y = 0.01 * t  # a = 1e-4: the Gauss–Newton step from a = 4 overshoots to a < 0
+    p = Parameters()
+    p.add("a", [4.0])
+    res = adjust(p, [_Sqrt(t, y)], xtol=1e-12)
+    assert res.converged
+    assert res.value("a")[0] == pytest.approx(1e-4, rel=1e-9)
+    p0 = Parameters()
+    p0.add("a", [-1.0])  # non-finite at the initial values: still the user's error
+    with pytest.raises(InputError, match="non-finite residuals"):
+        adjust(p0, [_Sqrt(t, y)])
+
+
+def test_geodesic_acceleration_reaches_the_same_minimum():
+    t, y = _exp_problem()
+    ref = _scipy_reference(t, y)
+    p = Parameters()
+    p.add("Ak", [1.0, 0.1])
+    res = adjust(p, [Exponential(t, y, 1.0)], xtol=1e-13, geodesic=0.75)
+    assert res.converged
+    np.testing.assert_allclose(res.value("Ak"), ref, rtol=1e-9)
+    with pytest.raises(InputError, match="geodesic"):
+        SolverOptions(geodesic=0.0)
+
+
+def test_geodesic_acceleration_refuses_a_points_block():
+    from toy_models import Bearings, bearing_scene
+
+    S, P, st, pt, th = bearing_scene(0)
+    p = Parameters()
+    p.add("stations", S)
+    p.add("points", P, points=True)
+    with pytest.raises(InputError, match="geodesic is not available with a points block"):
+        adjust(p, [Bearings(st, pt, th, 1e-3)], geodesic=0.75)
