@@ -315,7 +315,7 @@ def deviation_quiver(
     color="C0",
     label=None,
     key_m: float = 1.0,
-    key_xy=(0.72, 0.06),
+    key_xy=(0.6, 0.06),
 ):
     """Deviation vectors (geocoded − reference, E and N in m) drawn at their points on a map.
 
