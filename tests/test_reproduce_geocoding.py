@@ -21,3 +21,62 @@ def test_calibration_more_than_halves_sigma(seed):
     } <= tables
     printed = rep.table("000 Table 2").set_index("quantity")
     assert round(printed.loc["sigma_y_m", "reproduced"], 2) == 0.88
+    check_verdicts(rep, n_flights=100)
+
+
+def check_verdicts(rep, n_flights):
+    """The verdicts of the printed and simulated rows (called from the run above)."""
+    import numpy as np
+
+    from hsgeo.papers import P000_GCP_FOOTERS, P000_TABLE2_ROWS, P000_TABLE3_ROWS
+
+    # the printed footers against numpy's sample standard deviation of the printed Δ
+    for which, rows in ((2, P000_TABLE2_ROWS), (3, P000_TABLE3_ROWS)):
+        d = np.array([r[1:3] for r in rows])
+        sd = np.std(d, axis=0, ddof=1)
+        for k, axis in enumerate("yx"):
+            q = f"sigma_{axis}_m"
+            printed, dec = P000_GCP_FOOTERS[f"000 Table {which}"][q]
+            (row,) = [r for r in rep.rows_of(f"000 Table {which}") if r.quantity == q]
+            expect = "reproduced" if round(sd[k], dec) == printed else "differs"
+            assert row.judge()[0] == expect, (which, q)
+    (s3y,) = [r for r in rep.rows_of("000 Table 3") if r.quantity == "sigma_y_m"]
+    assert s3y.judge()[0] == "differs"  # printed 0.40, the printed Δ give 0.407
+    for name in ("uncalibrated", "calibrated"):
+        for r in rep.rows_of(f"simulated, {name}"):
+            v, why = r.judge()
+            assert r.n_runs == n_flights
+            if r.quantity.startswith("bias"):
+                assert v == "not testable"
+            elif name == "uncalibrated":
+                assert v == "tuned" and "flight height" in why
+            else:
+                assert v in ("reproduced", "differs")
+    assert rep.meta["displacement_edge_m"] > 0
+
+
+def test_displacement_matches_the_rays_on_a_level_flight():
+    """With zero boresight the across-track displacement is the flying height times the
+    difference of the two models' tan(view angle), up to the attitude motion (≈ 1°)."""
+    import numpy as np
+
+    from hsgeo.reproduce.geocoding import displacement_across_track
+    from hsgeo.simulate.pula_flight import nominal_sensor, simulate_flight, true_sensor
+    from hsgeo.simulate.scenarios import load_scenario
+
+    cfg = load_scenario("pula_flight")
+    obs, _ = simulate_flight(cfg, 3)
+    sensors = {"calibrated": true_sensor(cfg), "uncalibrated": nominal_sensor(cfg)}
+    zero = {k: np.zeros(3) for k in sensors}
+    d = displacement_across_track(obs, sensors, zero, cfg)
+    H = cfg["flight"]["height_agl_m"]
+    expect = H * (
+        sensors["calibrated"].tan_angle(d["zeta_px"])
+        - sensors["uncalibrated"].tan_angle(d["zeta_px"])
+    )
+    across = np.median(d["across_m"], axis=0)
+    edge = np.abs(expect).max()
+    assert edge > 1.0  # metres: the test is not trivial
+    assert np.allclose(np.abs(across), np.abs(expect), atol=0.03 * edge)
+    assert np.all(np.abs(np.median(d["along_m"], axis=0)) < 0.05 * edge)
+    assert np.allclose(d["norm_m"], np.hypot(d["across_m"], d["along_m"]))

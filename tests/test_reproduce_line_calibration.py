@@ -6,7 +6,7 @@ from hsgeo.reproduce import run
 
 
 def test_contract_and_distortion_magnitudes():
-    rep = run("line-calibration", seed=5, scale=0.01)
+    rep = run("line-calibration", seed=5, scale=0.01)  # 20 Monte Carlo runs per line
     d = json.loads(rep.to_json())
     assert d["chapter"] == "line-calibration" and d["seed"] == 5
     tables = {r["table"] for r in d["rows"]}
@@ -19,3 +19,26 @@ def test_contract_and_distortion_magnitudes():
             assert abs(r["reproduced"] - r["truth"]) < 3 * r["sigma"], r["quantity"]
     cov3 = [r["reproduced"] for r in d["rows"] if "3sigma" in r["quantity"]]
     assert len(cov3) == 20 and np.mean(cov3) >= 0.9
+    # verdicts and spreads (the same run: a Monte Carlo of 20 runs per line is slow)
+    for r in rep.rows_of("000 Table 1"):
+        v, why = r.judge()
+        if r.quantity.endswith("uncalibrated"):
+            assert v == "not testable" and "starts from" in why
+        else:  # the simulation's truth is 000 Table 1
+            assert v == "tuned" and r.truth_is_paper()
+    for r in rep.rows_of("001 Table 2"):
+        v, why = r.judge()
+        assert v == "tuned", r.quantity
+        # row 1000's truth is 000 Table 1's value, which 001 Table 2 prints rounded
+        assert abs(r.truth - r.paper) <= 0.5 * 10 ** -(len(repr(r.paper).split(".")[1]))
+    for r in rep.rows_of("distortion magnitudes"):
+        assert r.judge()[0] == "tuned"
+    cov = rep.rows_of("Monte Carlo coverage")
+    assert len(cov) == 60
+    for r in cov:
+        # binomial standard deviation of a fraction over n runs at the nominal rate
+        assert r.n_runs == 20
+        assert np.isclose(r.sigma, np.sqrt(r.truth * (1 - r.truth) / 20))
+    # a residual per observation, aligned with the measured ζ (what the chapter plots)
+    for row, res in rep.extras["results"].items():
+        assert res.residuals(0).shape == rep.extras["sims"][row]["zeta_px"].shape

@@ -18,6 +18,11 @@ __all__ = [
     "plot_gap_model",
     "plot_principal_points",
     "plot_distortion_effects",
+    "residuals_vs_position",
+    "residual_spread_vs_wavelength",
+    "scale_bar",
+    "deviation_quiver",
+    "displacement_vs_pixel",
 ]
 
 
@@ -408,4 +413,137 @@ def residuals_by_band(ax, wavelength_nm, value, sigma=None, sensor=None, *, mark
     if label:  # a grey proxy: the colours stand for the sensors, the marker for the series
         ax.scatter([], [], color="0.35", marker=marker, s=22, label=label)
     ax.set_xlabel("central wavelength of the band (nm)")
+
+
+# -- line_calibration and geocoding chapters ---------------------------------------------------
+
+
+def residuals_vs_position(ax, zeta_px, residual_px, *, label=None, color=None, n_bins=0):
+    """Residuals (model − observation) of a line calibration against image position ζ.
+
+    Parameters
+    ----------
+    ax : matplotlib Axes
+    zeta_px, residual_px : (n,) ndarray
+        Observed image coordinates and their residuals [px].
+    n_bins : int
+        When > 0, also draw the mean residual in this many equal-width bins of ζ (a line).
+    """
+    z, r = np.asarray(zeta_px, float), np.asarray(residual_px, float)
+    pts = ax.plot(z, r, ".", ms=3, alpha=0.5, color=color, label=label)[0]
+    if n_bins > 0:
+        edges = np.linspace(z.min(), z.max(), n_bins + 1)
+        k = np.clip(np.digitize(z, edges) - 1, 0, n_bins - 1)
+        cnt = np.bincount(k, minlength=n_bins)
+        mean = np.bincount(k, r, minlength=n_bins) / np.maximum(cnt, 1)
+        mid = 0.5 * (edges[1:] + edges[:-1])
+        ax.plot(mid[cnt > 0], mean[cnt > 0], "-", color=pts.get_color(), lw=1.5)
+    ax.axhline(0.0, color="0.5", lw=0.8)
+    ax.set_xlabel("image position ζ (px)")
+    ax.set_ylabel("residual (px)")
+    return ax
+
+
+def residual_spread_vs_wavelength(ax, wavelength_nm, residuals_px, *, sigma_px=None):
+    """RMS and mean of each spectral line's residuals against its wavelength.
+
+    Parameters
+    ----------
+    wavelength_nm : (m,) array
+    residuals_px : sequence of m (n_i,) arrays
+    sigma_px : float, optional
+        The a-priori σ of one observation, drawn as a dotted line.
+    """
+    lam = np.asarray(wavelength_nm, float)
+    rms = np.array([np.sqrt(np.mean(np.square(r))) for r in residuals_px])
+    mean = np.array([np.mean(r) for r in residuals_px])
+    ax.plot(lam, rms, "o-", label="RMS of the residuals")
+    ax.plot(lam, mean, "s--", label="mean residual")
+    if sigma_px is not None:
+        ax.axhline(sigma_px, color="k", ls=":", lw=1, label=f"a-priori σ = {sigma_px:g} px")
+    ax.axhline(0.0, color="0.5", lw=0.8)
+    ax.set_xlabel("wavelength (nm)")
+    ax.set_ylabel("residual (px)")
+    ax.legend()
+    return ax
+
+
+def scale_bar(ax, length_m: float, *, loc="lower left", label=None):
+    """A map scale bar of ``length_m`` metres (axes in metres, equal aspect)."""
+    from mpl_toolkits.axes_grid1.anchored_artists import AnchoredSizeBar
+
+    bar = AnchoredSizeBar(
+        ax.transData,
+        length_m,
+        label or f"{length_m:g} m",
+        loc,
+        pad=0.4,
+        frameon=False,
+        size_vertical=0.0,
+    )
+    ax.add_artist(bar)
+    return ax
+
+
+def deviation_quiver(
+    ax,
+    en_m,
+    dev_en_m,
+    *,
+    magnify: float,
+    color="C0",
+    label=None,
+    key_m: float = 1.0,
+    key_xy=(0.6, 0.06),
+):
+    """Deviation vectors (geocoded − reference, E and N in m) drawn at their points on a map.
+
+    Parameters
+    ----------
+    en_m : (n, 2) ndarray
+        Map positions E, N [m].
+    dev_en_m : (n, 2) ndarray
+        Deviations ΔE (= Δy), ΔN (= Δx) [m].
+    magnify : float
+        Vectors are drawn ``magnify`` times their length (map metres per deviation metre).
+    key_m : float
+        Length of the key vector [m], drawn at ``key_xy`` (axes fraction); 0 for none.
+    """
+    p, d = np.asarray(en_m, float), np.asarray(dev_en_m, float)
+    q = ax.quiver(
+        p[:, 0],
+        p[:, 1],
+        d[:, 0],
+        d[:, 1],
+        angles="xy",
+        scale_units="xy",
+        scale=1.0 / magnify,
+        color=color,
+        width=0.006,
+        label=label,
+    )
+    if key_m:
+        ax.quiverkey(q, *key_xy, key_m, f"{key_m:g} m deviation", labelpos="E", color=color)
+    ax.set_aspect("equal")
+    ax.margins(0.15)
+    ax.set_xlabel("E = y (m)")
+    ax.set_ylabel("N = x (m)")
+    return ax
+
+
+def displacement_vs_pixel(ax, zeta_px, displacement_m, *, label=None, color=None):
+    """Median and 5–95 % band over lines of a displacement [m] against across-track pixel.
+
+    Parameters
+    ----------
+    zeta_px : (n_px,) ndarray
+    displacement_m : (n_lines, n_px) ndarray
+    """
+    d = np.asarray(displacement_m, float)
+    lo, med, hi = np.percentile(d, [5, 50, 95], axis=0)
+    line = ax.plot(zeta_px, med, color=color, label=label)[0]
+    ax.fill_between(zeta_px, lo, hi, color=line.get_color(), alpha=0.25, lw=0)
+    ax.axhline(0.0, color="0.5", lw=0.8)
+    ax.set_xlabel("across-track pixel ζ (px)")
+    ax.set_ylabel("displacement (m)")
     return ax
