@@ -115,8 +115,29 @@ def _frame(d: Path) -> None:
     shutil.copy(CHARUCO / "board.toml", d / "board.toml")
 
 
+def _bal(d: Path) -> None:
+    """A small BAL problem: the shipped Ladybug file's first 40 observations, renumbered."""
+    from hsgeo.io.bal import ladybug_path, read_bal
+
+    d.mkdir()
+    prob = read_bal(ladybug_path())
+    keep = np.flatnonzero(prob.camera_index < 2)[:40]
+    cams, pts = np.unique(prob.camera_index[keep]), np.unique(prob.point_index[keep])
+    ci = np.searchsorted(cams, prob.camera_index[keep])
+    pi = np.searchsorted(pts, prob.point_index[keep])
+    lines = [f"{len(cams)} {len(pts)} {len(keep)}"]
+    lines += [
+        f"{c} {p} {float(x)!r} {float(y)!r}"
+        for c, p, (x, y) in zip(ci, pi, prob.xy_px[keep], strict=True)
+    ]
+    lines += [repr(float(v)) for v in prob.cameras[cams].ravel()]
+    lines += [repr(float(v)) for v in prob.points[pts].ravel()]
+    (d / "problem.txt").write_text("\n".join(lines) + "\n")
+
+
 def build_valid(root: Path) -> Path:
     """Write the valid inputs of every command under ``root`` (one folder per command)."""
+    _bal(root / "adjust-bal")
     _line(root / "calibrate-line")
     _pushbroom(root / "adjust-pushbroom")
     _geocode(root / "geocode")
@@ -158,6 +179,8 @@ def base_argv(cmd: str, d: Path) -> list[str]:
         ]
     if cmd == "calibrate-frame":
         return [cmd, *(s(d / f"img_0{i}.jpg") for i in range(3)), "--board", s(d / "board.toml")]
+    if cmd == "adjust-bal":
+        return [cmd, s(d / "problem.txt"), "--json"]
     if cmd == "reproduce":
         return [cmd, "frame-reference"]
     if cmd == "data":
@@ -247,6 +270,20 @@ def delete_rows(a: int, b: int):
         write_csv(p, h, rows[:a] + rows[b:])
 
     return edit
+
+
+def text_append(extra: str):
+    def f(p: Path):
+        p.write_text(p.read_text() + extra + "\n")
+
+    return f
+
+
+def drop_last_lines(n: int):
+    def f(p: Path):
+        p.write_text("\n".join(p.read_text().splitlines()[:-n]) + "\n")
+
+    return f
 
 
 def text(content: str | bytes):
@@ -1037,6 +1074,50 @@ def _blank(p):
 
 
 # --- reproduce, data, versions, the top level ----------------------------------------------
+C = "adjust-bal"
+F = "problem.txt"
+
+
+def bal_line(lineno: int, new: str):
+    """Replace line ``lineno`` (1-based) of the BAL file."""
+
+    def f(p: Path):
+        lines = p.read_text().splitlines()
+        lines[lineno - 1] = new
+        p.write_text("\n".join(lines) + "\n")
+
+    return f
+
+
+case(C, "missing", "no-such-file", "problem.txt", files=[(F, remove)])
+case(C, "missing", "a-folder", "problem.txt", files=[(F, make_dir)])
+case(C, "empty", "empty-file", "empty file", files=[(F, text(""))])
+case(C, "binary", "binary-file", "problem.txt", files=[(F, text(bytes(range(256)) * 8))])
+case(C, "garbage", "header-words", "line 1", files=[(F, bal_line(1, "cameras points obs"))])
+case(C, "garbage", "header-two-numbers", "line 1", files=[(F, bal_line(1, "2 5"))])
+case(C, "range", "header-zero-cameras", "positive", files=[(F, bal_line(1, "0 5 40"))])
+case(C, "range", "header-negative", "positive", files=[(F, bal_line(1, "2 -5 40"))])
+case(
+    C,
+    "degenerate",
+    "truncated-observations",
+    "observation lines",
+    files=[(F, bal_line(1, "2 500 40000"))],
+)
+case(C, "garbage", "observation-three-fields", "line 2", files=[(F, bal_line(2, "0 0 1.0"))])
+case(C, "type", "observation-text", "line 3", files=[(F, bal_line(3, "0 a 1.0 2.0"))])
+case(
+    C, "range", "camera-index-out-of-range", "out of range", files=[(F, bal_line(4, "7 0 1.0 2.0"))]
+)
+case(C, "range", "point-index-negative", "out of range", files=[(F, bal_line(4, "0 -1 1.0 2.0"))])
+case(C, "nonfinite", "observation-nan", "NaN", files=[(F, bal_line(5, "0 0 nan 2.0"))])
+case(C, "nonfinite", "observation-inf", "NaN", files=[(F, bal_line(5, "0 0 1.0 inf"))])
+case(C, "nonfinite", "camera-value-nan", "NaN", files=[(F, bal_line(45, "nan"))])
+case(C, "type", "camera-value-text", "numbers", files=[(F, bal_line(45, "focal"))])
+case(C, "garbage", "extra-values", "more values", files=[(F, text_append("1.0 2.0 3.0"))])
+case(C, "degenerate", "missing-values", "camera and point values", files=[(F, drop_last_lines(3))])
+case(C, "options", "unknown-option", "--threads", argv=flag("--threads", "2"))
+
 C = "reproduce"
 case(
     C,
