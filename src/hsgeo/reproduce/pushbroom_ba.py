@@ -6,8 +6,9 @@ four GCPs (002 Tables 1, 2, Fig. 8) and without (Table 3). ``scale`` thins the t
 paper's 113,758). The node-interval study (:func:`node_interval_study`) is separate because it
 runs one adjustment per interval. The statistics of Tables 1–3 have no σ̂ from the adjustment:
 their spread comes from repeated campaigns (:func:`table_spread`, 8 seeds at 0.05 of the tie
-points when ``scale`` is the paper's; the 13 check points are the same at every scale). This module is the only place where the adjustment's
-results meet the campaign's truth (check points, parameters, gross errors).
+points when ``scale`` is the paper's; the 13 check points are the same at every scale). This
+module is the only place where the adjustment's results meet the campaign's truth (check points,
+parameters, gross errors).
 """
 
 from __future__ import annotations
