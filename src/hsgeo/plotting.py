@@ -547,3 +547,71 @@ def displacement_vs_pixel(ax, zeta_px, displacement_m, *, label=None, color=None
     ax.set_xlabel("across-track pixel ζ (px)")
     ax.set_ylabel("displacement (m)")
     return ax
+
+
+# ---- chapter pushbroom_ba (issue 13): 002 Tables 1-3 against the paper with ±σ̂ spread, the
+# ---- check-point heights, the per-band principal distances, the node-interval study, factors
+
+
+def stats_vs_paper(ax, labels, reproduced, sigma, paper, *, unit="m"):
+    """Statistics (e.g. NMAD, mean) of a table, ± their σ̂ (spread over runs), beside the
+    paper's values (open squares); one row per statistic, labels on the y axis.
+    """
+    y = np.arange(len(labels))
+    ax.axvline(0, color="0.7", lw=0.8)
+    ax.errorbar(reproduced, y, xerr=sigma, fmt="o", color="C0", capsize=3, label="this run ± σ̂")
+    ax.plot(paper, y, "s", mfc="none", color="C1", ms=7, label="paper")
+    ax.set_yticks(y, labels)
+    ax.invert_yaxis()
+    ax.set_xlabel(f"value ({unit})")
+    ax.legend(fontsize=9)
+    return ax
+
+
+def checkpoint_heights(ax, errors_m, sigma_m, label="height error ± σ̂"):
+    """Height error of each check point (m) with its ±σ̂ from the adjustment."""
+    k = np.arange(len(errors_m))
+    ax.axhline(0, color="0.6", lw=0.8)
+    ax.errorbar(k, errors_m, yerr=sigma_m, fmt="o", capsize=3, label=label)
+    ax.set_xticks(k, [str(i + 1) for i in k])
+    ax.set_xlabel("check point")
+    ax.set_ylabel("H estimated − true (m)")
+    ax.legend(fontsize=9)
+    return ax
+
+
+def per_band_values(ax, wavelength_nm, value, sigma, truth=None, paper_bound=None, *, ylabel=""):
+    """A per-band estimate ± σ̂ against wavelength, the truth (×) and ± a paper's bound (dashed)."""
+    ax.axhline(0, color="0.6", lw=0.8)
+    ax.errorbar(wavelength_nm, value, yerr=sigma, fmt="o", capsize=3, label="reproduced ± σ̂")
+    if truth is not None:
+        ax.plot(wavelength_nm, truth, "x", color="k", label="truth")
+    if paper_bound is not None:
+        for s in (-1, 1):
+            ax.axhline(
+                s * paper_bound, color="C1", ls="--", lw=1, label="paper's bound" if s > 0 else None
+            )
+    ax.set_xlabel("band centre (nm)")
+    ax.set_ylabel(ylabel)
+    ax.legend(fontsize=9)
+    return ax
+
+
+def against_interval(ax, studies, key, ylabel, *, scale=1.0, paper_interval_s=10.0):
+    """One quantity of the node-interval study against the interval (log axis, ticks at the
+    intervals run, no minor labels), one line per study (dict label -> list of dicts).
+    """
+    from matplotlib.ticker import NullFormatter
+
+    ticks = sorted({d["interval_s"] for st in studies.values() for d in st})
+    for label, st in studies.items():
+        x = [d["interval_s"] for d in st]
+        ax.plot(x, [scale * d[key] for d in st], "o-", label=label)
+    ax.set_xscale("log")
+    ax.set_xticks(ticks, [f"{t:g}" for t in ticks])
+    ax.xaxis.set_minor_formatter(NullFormatter())
+    ax.axvline(paper_interval_s, color="0.7", lw=0.8)
+    ax.set_xlabel("node interval (s)")
+    ax.set_ylabel(ylabel)
+    ax.legend(fontsize=9)
+    return ax
