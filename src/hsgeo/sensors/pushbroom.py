@@ -38,9 +38,15 @@ across the line is instead a time: the model's crossing time ``t*`` of the line,
 
     r_y = ẏ_ref (t_e − t*),   r_x = x(θ, t*) − x_obs,   ∂t*/∂θ = −(∂y/∂θ) / ẏ
 
-``t*`` is found by Newton's method from ``t_e`` (to 1e-8 s, usually in one step), with the
-navigation pose moved by its velocity and angular rate and the spline piece of ``t_e``
-continued; ``ẏ`` and ``ẋ`` are the image rates along the corrected trajectory. The derivatives
+``t*`` is found by Newton's method (to ``NEWTON_TOL_S`` = 1e-8 s), with the navigation pose
+moved by its velocity and angular rate and the spline piece of ``t_e`` continued. It starts
+from the crossing time of the block's previous evaluation (``t_e`` at the first): near the
+solution an iteration moves most crossings by less than 1e-8 s, and one evaluation of the pose
+per observation suffices instead of two. The residuals carry the last Newton correction to
+first order (``ẏ_ref (t_e − t_k + e)`` and ``x − ẋ e``), so stopping at ``|e| < 1e-8 s`` leaves
+an error of ``½ ÿ e²`` (below 1e-13 px with the mount's ÿ of a few hundred px/s²); the
+derivatives, taken at ``t_k``, depend on where Newton started only to ~1e-9 relative. ``ẏ``
+and ``ẋ`` are the image rates along the corrected trajectory. The derivatives
 are evaluated at ``t*``, so they do not contain the time error, and the node derivatives keep
 the factored form ``B_a(t*) ∂r/∂δ``. Evaluating x at ``t*`` rather than ``t_e`` adds
 ``ẋ (t* − t_e)`` (≈ 0.1 px at the mount's angular rates) to the x residual, zero-mean.
@@ -174,6 +180,9 @@ def project(values, names, nodes, t_s, xyz_nav, rpy_nav, pidx, band, beta0, x0_m
 #: intersected point far off is held there (without the bound the time of such a point runs
 #: off with the spline extrapolated, and the first iterations are damped to a crawl).
 T_MAX = 0.25
+#: Newton on the crossing time stops when its correction is below this (s); see the module
+#: docstring for the error this leaves in the residuals (< 1e-13 px).
+NEWTON_TOL_S = 1e-8
 
 
 @njit(cache=True, parallel=True)
@@ -202,6 +211,7 @@ def _lines_kernel(
     n_newton,
     y_rate_ref,
     jac,
+    dt_start,
     r,
     w_out,
     dP,
@@ -217,7 +227,8 @@ def _lines_kernel(
     (``y(t*) = y_obs``, Newton from the line time ``t_e`` with the navigation pose moved by its
     rates and the spline piece of ``t_e`` continued); the residuals are ``x(t*) − x_obs`` and
     ``ẏ_ref (t_e − t*)``, and their derivatives follow from the implicit function theorem,
-    ``∂t*/∂θ = −(∂y/∂θ)/ẏ``. The spline weights used are returned in ``w_out``.
+    ``∂t*/∂θ = −(∂y/∂θ)/ẏ``. The spline weights used are returned in ``w_out``. ``dt_start``
+    (in and out): ``t* − t_e`` at which Newton starts, overwritten with this evaluation's.
     """
     m = pidx.size
     K1, K2, P1, P2 = dist[0], dist[1], dist[2], dist[3]
@@ -237,7 +248,7 @@ def _lines_kernel(
         w = np.empty(4)
         dw = np.empty(4)
         for j in range(ch * step, min(m, (ch + 1) * step)):
-            dt = 0.0  # t − t_e
+            dt = dt_start[j] if timed else 0.0  # t − t_e, from the last evaluation's t*
             xdot = 0.0
             ydot = 1.0
             ey = 0.0
@@ -304,14 +315,16 @@ def _lines_kernel(
                 # every real geometry has ẏ near ẏ_ref; a far-off trial point may not
                 ydot = max(ydot, 0.25 * y_rate_ref)
                 ey = (y * k_px - xy_obs[j, 1]) / ydot
-                if abs(ey) < 1e-8:
-                    # converged (≈ 2e-6 px): the last correction is kept in the residual, which
-                    # is then exact to O(ey²)
+                if abs(ey) < NEWTON_TOL_S:
+                    # converged: the last correction is kept in the residual, which is then
+                    # exact to O(ey²)
                     break
                 if it < n_it:
                     dt = min(max(dt - ey, -T_MAX), T_MAX)
             for b in range(4):
                 w_out[j, b] = w[b]
+            if timed:
+                dt_start[j] = min(max(dt - ey, -T_MAX), T_MAX)
             r[2 * j] = x * k_px - xy_obs[j, 0] - xdot * ey  # x at t* (0 if not timed)
             if timed:
                 # ẏ_ref (t_e − t*), t* = t_e + dt − ey (the last Newton correction included)
@@ -481,8 +494,9 @@ class PushbroomLines(ResidualBlock):
         Reference image rate across the line (px/s) that converts the time residual to pixels
         (required with the rates; e.g. ``c V / (Z pixel)``).
     newton_iterations : int
-        Most Newton iterations for the crossing time (from the line time; they stop when the
-        correction falls below 1e-8 s, usually after one).
+        Most Newton iterations for the crossing time per evaluation (they stop when the
+        correction falls below ``NEWTON_TOL_S``; started from the previous evaluation's
+        crossing time, usually after the first).
     """
 
     name = "image points"
@@ -553,6 +567,8 @@ class PushbroomLines(ResidualBlock):
         index, u = nodes.piece(self.t_s)
         self._basis = (index, bspline_basis(u))
         self._u0 = np.ascontiguousarray(u)  # the kernel's Newton moves along this piece
+        # t* − t_e of the last evaluation: where the next one's Newton starts (module docstring)
+        self._dt_s = np.zeros(m)
         self.timed = timed
         zeros = np.zeros((m, 3))
         self.xyz_rate = np.ascontiguousarray(xyz_rate_m_s if timed else zeros, dtype=np.float64)
@@ -705,6 +721,7 @@ class PushbroomLines(ResidualBlock):
             self.newton_iterations,
             self.y_rate_ref_px_s,
             bool(jacobian),
+            self._dt_s,
             r,
             w_out,
             dP,
