@@ -168,7 +168,7 @@ def _reduced_kernel(
         C = np.zeros((Lmax, Lmax))
         Z = np.zeros((p, Lmax))
         T = np.zeros((Lmax, p))
-        R = np.zeros(Q * kk)
+        R = np.zeros(kk)
         li = np.empty(K + kf, dtype=np.int64)
         lv = np.empty(K + kf)
         for ii in range(ch * step, min(n_pts, (ch + 1) * step)):
@@ -258,14 +258,11 @@ def _reduced_kernel(
                 for h in range(g, ng):
                     rh = grow[h]
                     half = 0.5 if h == g else 1.0
-                    # R[b, j, l] = fw_h[b] C[gj, hl]: the tiles of item a of g against the
-                    # items b of h are fw_g[a] R[b]
-                    for b in range(Q):
-                        wb = fw[rh, b]
-                        for j in range(kf):
-                            Crow = C[g * kf + j]
-                            for l in range(kf):
-                                R[(b * kf + j) * kf + l] = wb * Crow[h * kf + l]
+                    # the block C[g, h] (kf × kf, contiguous); the tile of item a of g against
+                    # item b of h is fw_g[a] fw_h[b] C[g, h]
+                    for j in range(kf):
+                        for l in range(kf):
+                            R[j * kf + l] = C[g * kf + j, h * kf + l]
                     # items of h on consecutive tiles (spline nodes): one contiguous segment
                     # of Q·kf² values in each tile row
                     tb0 = tile_of[fcol[rh, 0]] if fcol[rh, 0] >= 0 else -1
@@ -278,20 +275,29 @@ def _reduced_kernel(
                         ca = fcol[rg, a]
                         if ca < 0:
                             continue
-                        wa = half * fw[rg, a]
+                        wa = fw[rg, a]
                         Trow = tiles[tile_of[ca]]
                         if run:
+                            # g = h: C[g, g] is symmetric, so the tiles b < a are the
+                            # transposes of a < b and follow from A + Aᵀ (the tile a = b halved)
+                            b0 = a if h == g else 0
                             Tseg = Trow[tb0 * kk : (tb0 + Q) * kk]
-                            for e in range(Q * kk):
-                                Tseg[e] += wa * R[e]
+                            for b in range(b0, Q):
+                                sc = wa * fw[rh, b] * (0.5 if (h == g and b == a) else 1.0)
+                                # unsigned offsets: no negative-index wraparound test, which
+                                # keeps the loop vectorised
+                                ob = np.uint64(b * kk)
+                                for e in range(kk):
+                                    Tseg[ob + np.uint64(e)] += sc * R[e]
                             continue
                         for b in range(Q):
                             cb = fcol[rh, b]
                             if cb < 0:
                                 continue
+                            sc = half * wa * fw[rh, b]
                             Tseg = Trow[tile_of[cb] * kk : (tile_of[cb] + 1) * kk]
                             for e in range(kk):
-                                Tseg[e] += wa * R[b * kk + e]
+                                Tseg[e] += sc * R[e]
                 for a in range(Q):
                     ca = fcol[rg, a]
                     if ca < 0:
