@@ -1,3 +1,5 @@
+import types
+
 import numpy as np
 import pytest
 from scipy.optimize import least_squares
@@ -284,6 +286,7 @@ def test_reduced_kernel_equals_dense_schur(consecutive):
     Items start at columns with gaps between them (unused items) and, in the second case, a
     row's items are not on consecutive columns, so both expansion paths are exercised.
     """
+    from hsgeo.adjust import _fast
     from hsgeo.adjust._fast import reduced_points
     from hsgeo.adjust.system import _RowJac
 
@@ -322,6 +325,15 @@ def test_reduced_kernel_equals_dense_schur(consecutive):
     ptr = np.concatenate([[0], np.cumsum(rows_per_pt)]).astype(np.int64)
     S = reduced_points(J.arrays, jp, order, ptr, Vinv, n_c)
     np.testing.assert_allclose(S, S_ref, rtol=1e-12, atol=1e-12 * np.abs(S_ref).max())
+    # a pattern kept from other rows (the first point: fewer item pairs and perhaps no empty
+    # slots) no longer covers these rows: it is noticed and computed again, same S
+    cache = types.SimpleNamespace(pattern=None)
+    reduced_points(J.arrays, jp, order[: ptr[1]], ptr[:2], Vinv, n_c, cache=cache)
+    stale = cache.pattern
+    assert stale[3].size < _fast.schur_pattern(J.arrays, order, ptr, n_c)[3].size
+    S2 = reduced_points(J.arrays, jp, order, ptr, Vinv, n_c, cache=cache)
+    np.testing.assert_array_equal(S2, S)
+    assert cache.pattern is not stale
 
 
 def test_spd_inverse_against_numpy_and_singular():

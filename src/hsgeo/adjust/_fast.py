@@ -27,6 +27,7 @@ __all__ = [
     "normal_cc",
     "reduced_points",
     "factored_tiles",
+    "schur_pattern",
     "point_covariance",
     "locality_orders",
     "n_threads",
@@ -126,10 +127,16 @@ def _reduced_kernel(
     capg,
     capc,
     tile_of,
-    n_tiles,
+    slot_of,
+    n_slots,
+    sc_of,
+    n_sc,
     n_chunks,
 ):  # pragma: no cover - compiled
-    """A with ``A + Aᵀ = Σ_i (J_c,iᵀ J_c,i − W_i V_i⁻¹ W_iᵀ)`` over the points.
+    """A with ``A + Aᵀ = Σ_i (J_c,iᵀ J_c,i − W_i V_i⁻¹ W_iᵀ)`` over the points, in two
+    compact parts (see :func:`reduced_points`), and the number of units that fell outside the
+    pattern (tile or column not in ``slot_of``/``sc_of``: the pattern is stale; nothing of
+    theirs is written).
 
     Rows of point i are ``order[ptr[i]:ptr[i+1]]``; points are visited in ``pt_order``.
 
@@ -142,12 +149,16 @@ def _reduced_kernel(
     into the global columns: group g's local column j stands for the columns ``fcol[a] + j``
     with weight ``fw[a]``, so the block of groups (g, h) adds ``fw_g[a] fw_h[b] C[gj, hl]`` at
     ``(fcol_g[a] + j, fcol_h[b] + l)``. This is exact: the weights factor out of every product.
-    These group × group blocks go to the second output, *tiles* ``(n_tiles, n_tiles·kf²)``:
-    tile ``(t, u)`` is the ``kf × kf`` block of the items ``t = tile_of[fcol]`` and ``u``
-    (row-major), so an item's block against consecutive items (spline nodes) is one contiguous
-    segment, which vectorises; written into rows of S it ran scalar, at about one cycle a
-    value. Only one triangle of the pairs of local units is written (the diagonal units
-    halved), hence ``A + Aᵀ``.
+    These group × group blocks go to the second output, *tiles* ``(n_slots·kf²,)``: the
+    ``kf × kf`` block of the items ``t = tile_of[fcol]`` and ``u`` (row-major) is slot
+    ``slot_of[t, u]``, the slots of the pairs that occur numbered row by row
+    (:func:`schur_pattern`), so an item's blocks against consecutive items (spline nodes) are
+    one contiguous segment, which vectorises; written into rows of S it ran scalar, at about
+    one cycle a value, and a dense ``n_tiles² kf²`` array outgrew the caches on long blocks
+    (at 10× the paper's pushbroom campaign most item pairs never meet). The blocks against
+    slot columns go to the first output ``(n_c, n_sc)``, column ``sc_of[c]`` for column c. Only
+    one triangle of the pairs of local units is written (the diagonal units halved), hence
+    ``A + Aᵀ``.
     """
     n_pts = ptr.size - 1
     K = cols.shape[1]
@@ -156,8 +167,9 @@ def _reduced_kernel(
     p = jp.shape[1]
     Lmax = capg * kf + capc
     kk = kf * kf
-    out = np.zeros((n_chunks, n_c, n_c))
-    out_t = np.zeros((n_chunks, n_tiles, n_tiles * kk))
+    out = np.zeros((n_chunks, n_c, n_sc))
+    out_t = np.zeros((n_chunks, n_slots * kk))
+    misses = np.zeros(n_chunks, dtype=np.int64)  # units outside the pattern (see below)
     step = (n_pts + n_chunks - 1) // n_chunks
     for ch in prange(n_chunks):
         A = out[ch]
@@ -203,6 +215,9 @@ def _reduced_kernel(
                         gl[nl] = c
                         nl += 1
             L = ng * kf + nl
+            for e in range(nl):
+                if sc_of[gl[e]] < 0:
+                    misses[ch] += 1
             for a in range(L):
                 for b in range(L):
                     C[a, b] = 0.0
@@ -276,12 +291,16 @@ def _reduced_kernel(
                         if ca < 0:
                             continue
                         wa = fw[rg, a]
-                        Trow = tiles[tile_of[ca]]
+                        ta = tile_of[ca]
                         if run:
                             # g = h: C[g, g] is symmetric, so the tiles b < a are the
                             # transposes of a < b and follow from A + Aᵀ (the tile a = b halved)
                             b0 = a if h == g else 0
-                            Tseg = Trow[tb0 * kk : (tb0 + Q) * kk]
+                            s0 = slot_of[ta, tb0] * kk  # the Q slots (ta, tb0 + b) follow
+                            if s0 < 0:
+                                misses[ch] += 1
+                                continue
+                            Tseg = tiles[s0 : s0 + Q * kk]
                             for b in range(b0, Q):
                                 sc = wa * fw[rh, b] * (0.5 if (h == g and b == a) else 1.0)
                                 # unsigned offsets: no negative-index wraparound test, which
@@ -295,7 +314,11 @@ def _reduced_kernel(
                             if cb < 0:
                                 continue
                             sc = half * wa * fw[rh, b]
-                            Tseg = Trow[tile_of[cb] * kk : (tile_of[cb] + 1) * kk]
+                            s0 = slot_of[ta, tile_of[cb]] * kk
+                            if s0 < 0:
+                                misses[ch] += 1
+                                continue
+                            Tseg = tiles[s0 : s0 + kk]
                             for e in range(kk):
                                 Tseg[e] += sc * R[e]
                 for a in range(Q):
@@ -307,16 +330,16 @@ def _reduced_kernel(
                         Arow = A[ca + j]
                         Crow = C[g * kf + j]
                         for e in range(nl):
-                            Arow[gl[e]] += wa * Crow[ng * kf + e]
+                            Arow[sc_of[gl[e]]] += wa * Crow[ng * kf + e]
             for e in range(nl):
                 Arow = A[gl[e]]
                 Crow = C[ng * kf + e]
-                Arow[gl[e]] += 0.5 * Crow[ng * kf + e]
+                Arow[sc_of[gl[e]]] += 0.5 * Crow[ng * kf + e]
                 for e2 in range(e + 1, nl):
-                    Arow[gl[e2]] += Crow[ng * kf + e2]
+                    Arow[sc_of[gl[e2]]] += Crow[ng * kf + e2]
             for e in range(nl):
                 pos[gl[e]] = -1
-    return out, out_t
+    return out, out_t, misses.sum()
 
 
 def _symmetrise_upper(U: np.ndarray) -> np.ndarray:
@@ -378,10 +401,82 @@ def factored_tiles(fcol: np.ndarray, kf: int, n_c: int):
     return tile_of, starts
 
 
-def reduced_points(arrays, jp, order, ptr, Vinv, n_c: int, pt_order=None, tiles=None) -> np.ndarray:
+@njit(cache=True)
+def _pair_marks(fcol, order, ptr, tile_of, n_tiles):  # pragma: no cover - compiled
+    """The item pairs ``(t, u)`` that some point's rows couple (both orders)."""
+    Q = fcol.shape[1]
+    mark = np.zeros((n_tiles, n_tiles), dtype=np.bool_)
+    for i in range(ptr.size - 1):
+        for r1 in range(ptr[i], ptr[i + 1]):
+            ra = order[r1]
+            if r1 > ptr[i]:
+                rp = order[r1 - 1]
+                same = True
+                for a in range(Q):
+                    if fcol[ra, a] != fcol[rp, a]:
+                        same = False
+                if same:  # the y row after the x row of one observation: nothing new
+                    continue
+            for r2 in range(ptr[i], ptr[i + 1]):
+                rb = order[r2]
+                for a in range(Q):
+                    if fcol[ra, a] < 0:
+                        continue
+                    t = tile_of[fcol[ra, a]]
+                    for b in range(Q):
+                        if fcol[rb, b] >= 0:
+                            u = tile_of[fcol[rb, b]]
+                            mark[t, u] = True
+                            mark[u, t] = True
+    return mark
+
+
+@njit(cache=True)
+def _slot_columns(cols, order, n_c):  # pragma: no cover - compiled
+    """The columns that the slots of the rows ``order`` touch."""
+    used = np.zeros(n_c, dtype=np.bool_)
+    for r in order:
+        for s in range(cols.shape[1]):
+            if cols[r, s] >= 0:
+                used[cols[r, s]] = True
+    return used
+
+
+def schur_pattern(arrays, order, ptr, n_c: int):
+    """Where :func:`reduced_points` accumulates: the factored items' tiles and slot columns.
+
+    Returns ``(tile_of, starts, slot_of, slot_t, slot_u, sc_cols, sc_of)``: the items
+    (:func:`factored_tiles`); ``slot_of[t, u]`` the slot of the tile of items t and u (−1 if no
+    point couples them), numbered row by row, and ``(slot_t, slot_u)`` the items of each slot;
+    ``sc_cols`` the slot columns of the rows with a point and ``sc_of[c]`` the position of
+    column c among them (−1 if none). One pass over the points' rows; the pattern only changes
+    with the rows (the observations kept) or the items they touch.
+    """
+    cols, _, fcol, _, fd = arrays
+    kf = fd.shape[1]
+    tile_of, starts = factored_tiles(fcol, kf, n_c)
+    n_t = starts.size
+    if n_t and order.size:
+        mark = _pair_marks(fcol, order, ptr, tile_of, n_t)
+    else:
+        mark = np.zeros((n_t, n_t), dtype=bool)
+    slot_t, slot_u = np.nonzero(mark)  # row-major: consecutive items' slots follow
+    slot_of = np.full((n_t, n_t), -1, dtype=np.int64)
+    slot_of[slot_t, slot_u] = np.arange(slot_t.size)
+    sc_cols = np.flatnonzero(_slot_columns(cols, order, n_c))
+    sc_of = np.full(n_c, -1, dtype=np.int64)
+    sc_of[sc_cols] = np.arange(sc_cols.size)
+    return tile_of, starts, slot_of, slot_t, slot_u, sc_cols, sc_of
+
+
+def reduced_points(arrays, jp, order, ptr, Vinv, n_c: int, pt_order=None, cache=None) -> np.ndarray:
     """``Σ_i (J_c,iᵀ J_c,i − W_i V_i⁻¹ W_iᵀ)`` (dense ``n_c × n_c``) over the points' rows.
 
-    ``tiles`` is :func:`factored_tiles` of the factored columns (computed when not given).
+    The kernel accumulates into compact arrays (the tiles of the item pairs that occur, and the
+    columns against the slot columns: :func:`schur_pattern`), which are scattered into S here.
+    ``cache``: an object whose ``pattern`` attribute keeps the pattern from one call to the
+    next (None: computed for this call); a pattern that no longer covers the rows is computed
+    again (the kernel counts what falls outside it).
     """
     n_pts = ptr.size - 1
     if n_c == 0 or n_pts == 0:
@@ -390,26 +485,66 @@ def reduced_points(arrays, jp, order, ptr, Vinv, n_c: int, pt_order=None, tiles=
         pt_order = np.arange(n_pts, dtype=np.int64)
     cols, _, fcol, _, fd = arrays
     kf = fd.shape[1]
-    tile_of, starts = factored_tiles(fcol, kf, n_c) if tiles is None else tiles
+    pattern = getattr(cache, "pattern", None)
+    fresh = pattern is None
+    if fresh:
+        pattern = schur_pattern(arrays, order, ptr, n_c)
+    tile_of, starts, slot_of, slot_t, slot_u, sc_cols, sc_of = pattern
     max_rows = int(np.max(np.diff(ptr))) if n_pts else 0
     capg = max_rows if fcol.shape[1] else 0
     capc = int(min(n_c, max(1, max_rows * cols.shape[1])))
     nch = max(1, min(n_threads(), n_pts // 2000 + 1))
-    parts, tparts = _reduced_kernel(
-        *arrays, jp, order, ptr, pt_order, Vinv, n_c, capg, capc, tile_of, starts.size, nch
+    parts, tparts, misses = _reduced_kernel(
+        *arrays,
+        jp,
+        order,
+        ptr,
+        pt_order,
+        Vinv,
+        n_c,
+        capg,
+        capc,
+        tile_of,
+        slot_of,
+        slot_t.size,
+        sc_of,
+        sc_cols.size,
+        nch,
     )
-    A = parts.sum(axis=0) if nch > 1 else parts[0]
-    if starts.size:
-        # the tiles T[t, u] (kf × kf, row-major in each tile) into the columns of their items
-        T = tparts.sum(axis=0) if nch > 1 else tparts[0]
-        n = starts.size
-        Tm = T.reshape(n, n, kf, kf).transpose(0, 2, 1, 3).reshape(n * kf, n * kf)
-        idx = (starts[:, None] + np.arange(kf)).ravel()
-        if idx[-1] - idx[0] + 1 == idx.size:  # the items' columns are one contiguous range
-            A[idx[0] : idx[-1] + 1, idx[0] : idx[-1] + 1] += Tm
-        else:
-            A[np.ix_(idx, idx)] += Tm
-    return A + A.T
+    if misses:
+        if fresh:  # pragma: no cover - the pattern is computed from these very rows
+            raise RuntimeError("reduced_points: the Schur pattern does not cover its own rows")
+        cache.pattern = None
+        return reduced_points(arrays, jp, order, ptr, Vinv, n_c, pt_order, cache)
+    if cache is not None:
+        cache.pattern = pattern
+    return _assemble(parts, tparts, sc_cols, starts, slot_t, slot_u, n_c, kf)
+
+
+@njit(cache=True)
+def _assemble(parts, tparts, sc_cols, starts, slot_t, slot_u, n_c, kf):  # pragma: no cover
+    """S = A + Aᵀ from the kernel's compact parts (summed over the chunks in a fixed order):
+    the columns against the slot columns, and each slot's ``kf × kf`` tile (row-major) at the
+    columns of its two items.
+    """
+    A = np.zeros((n_c, n_c))
+    for ch in range(parts.shape[0]):
+        P = parts[ch]
+        for r in range(n_c):
+            for e in range(sc_cols.size):
+                A[r, sc_cols[e]] += P[r, e]
+        T = tparts[ch]
+        for s in range(slot_t.size):
+            r0 = starts[slot_t[s]]
+            c0 = starts[slot_u[s]]
+            for j in range(kf):
+                for l in range(kf):
+                    A[r0 + j, c0 + l] += T[(s * kf + j) * kf + l]
+    S = np.empty((n_c, n_c))
+    for r in range(n_c):
+        for c in range(n_c):
+            S[r, c] = A[r, c] + A[c, r]
+    return S
 
 
 @njit(cache=True, parallel=True)

@@ -47,6 +47,7 @@ class _Normal:
     S_chord: np.ndarray | None = None  # a reduced matrix formed at an earlier point, see adjust
     D_c: np.ndarray | None = None  # damping diagonal of the non-point unknowns (None: diag N_cc)
     options: SolverOptions = SolverOptions()  # compiled path, lambda_points_min
+    orders: _OrderCache | None = None  # keeps the Schur kernel's pattern between formations
 
     @property
     def compiled_schur(self) -> bool:
@@ -122,6 +123,7 @@ class _OrderCache:
     def __init__(self) -> None:
         self.key: tuple | None = None
         self.value: tuple | None = None
+        self.pattern: tuple | None = None  # _fast.schur_pattern of these rows (on first use)
 
     def get(self, layout: _Layout, sy: _System):
         """``(order, ptr, row_order, pt_order)`` for ``sy``, computed on a change of structure."""
@@ -153,6 +155,7 @@ class _OrderCache:
         row_order, pt_order = locality_orders(sy.Jrc, layout.n_c, order, ptr, rows_np)
         self.key = (layout.n_c, layout.n_pts, sy.pidx.copy(), sy.Jrc.cols.shape)
         self.value = (order, ptr, row_order, pt_order)
+        self.pattern = None
         return self.value
 
 
@@ -168,7 +171,8 @@ def _normal(
     if compiled:
         from hsgeo.adjust._fast import normal_cc
 
-        order, ptr, row_order, pt_order = (orders or _OrderCache()).get(layout, sy)
+        orders = orders or _OrderCache()
+        order, ptr, row_order, pt_order = orders.get(layout, sy)
         Jrc = sy.Jrc
         gc, diag_cc = Jrc.rmatvec(sy.r, diag=True)
         if layout.pblock is None:
@@ -206,7 +210,20 @@ def _normal(
     if not compiled:
         return _Normal(Ncc, gc, V, gp, _W_sparse(sy, n_pts), n_pts=n_pts, options=options)
     return _Normal(
-        Ncc, gc, V, gp, None, sy, order, ptr, n_pts, pt_order, Ncc_free, diag_cc, options=options
+        Ncc,
+        gc,
+        V,
+        gp,
+        None,
+        sy,
+        order,
+        ptr,
+        n_pts,
+        pt_order,
+        Ncc_free,
+        diag_cc,
+        options=options,
+        orders=orders,
     )
 
 
@@ -281,7 +298,14 @@ def _reduced(layout: _Layout, ne: _Normal, lam: float):
                 S0 = ne.S_chord  # a chord step: the matrix of an earlier point (see adjust)
             else:
                 S0 = ne.Ncc_free + reduced_points(
-                    sy.Jrc.arrays, sy.Jp, ne.order, ne.ptr, Vinv, layout.n_c, ne.pt_order
+                    sy.Jrc.arrays,
+                    sy.Jp,
+                    ne.order,
+                    ne.ptr,
+                    Vinv,
+                    layout.n_c,
+                    ne.pt_order,
+                    ne.orders,
                 )
             r0 = rhs - ne.W_dot(np.einsum("nij,nj->ni", Vinv, ne.gp)) if layout.n_c else rhs
             if lam_p == 0.0:  # keep the undamped one (datum check, steps, covariance)
