@@ -687,3 +687,38 @@ def test_parameters_docstring_examples():
     import hsgeo.adjust.parameters as mod
 
     assert doctest.testmod(mod).failed == 0
+
+
+def test_points_held_to_save_a_refused_step(monkeypatch):
+    """One point started next to a station, where its bearing changes fast: Gauss–Newton
+    steps throw it off and are refused because of it alone. With ``hold_points`` such a step
+    is retried with that point held, and accepted; the minimum is the same as without. (Here
+    the stations are fixed, so the points are independent and the damping that the refusals
+    raise slows nothing else down: the hold saves no iterations. Its use is on blocks where
+    one point's refusals damp every other unknown, see bench/results/pushbroom_scaling.json.)
+    """
+    from hsgeo.adjust import solver as SV
+
+    S, P, st, pt, th = bearing_scene(0, n_stations=6, n_points=40, coverage=4)
+    P0 = P + np.random.default_rng(1).normal(0, 0.5, P.shape)
+    P0[7] = S[st[pt == 7][0], :2] + np.array([-3.0, -1.0])
+    held = []
+    orig = SV._Solve._hold_points
+
+    def spy(self, *a):
+        out = orig(self, *a)
+        held.append(out is not None)
+        return out
+
+    monkeypatch.setattr(SV._Solve, "_hold_points", spy)
+    res = {}
+    for hold in (True, False):
+        p = Parameters()
+        p.add("stations", S.copy())
+        p.add("points", P0.copy(), points=True)
+        p.fix("stations")
+        res[hold] = adjust(p, Bearings(st, pt, th, 1e-3), hold_points=hold)
+    assert any(held)  # (only called with hold_points=True)
+    np.testing.assert_allclose(res[True].cost_history[-1], res[False].cost_history[-1], rtol=1e-9)
+    # (to the convergence tolerance: 5e-6 m, against a point σ of about 0.1 m)
+    np.testing.assert_allclose(res[True].value("points"), res[False].value("points"), atol=1e-4)

@@ -82,6 +82,10 @@ class SolverOptions:
         compiled path takes chord steps. ``inf``: every iterate counts as settled.
     chord_end : float, default 1e-3
         Chord steps end when their predicted decrease falls below ``chord_end · ftol · cost``.
+    hold_points : bool, default True
+        With a points block: a step refused because of a few points (at most 0.1 % of them
+        carrying 90 % of the excess of the actual over the linearly predicted squared
+        residuals) is tried again with those points held in place before the damping grows.
     check_datum : bool, default True
         Check the rank before the first step; raise :class:`~hsgeo.DatumError` if deficient.
     rank_rtol : float, default 1e-11
@@ -120,6 +124,7 @@ class SolverOptions:
     reject_round_ftol: float = 1e-4
     settled: float = 1e-2
     chord_end: float = 1e-3
+    hold_points: bool = True
     check_datum: bool = True
     rank_rtol: float = 1e-11
     raise_on_failure: bool = True
@@ -180,6 +185,7 @@ class SolverOptions:
             "raise_on_failure",
             "compiled",
             "keep_jacobian",
+            "hold_points",
         ):
             v = getattr(self, name)
             if not isinstance(v, (bool, np.bool_)):

@@ -123,7 +123,7 @@ class _OrderCache:
     def __init__(self) -> None:
         self.key: tuple | None = None
         self.value: tuple | None = None
-        self.pattern: tuple | None = None  # _fast.schur_pattern of these rows (on first use)
+        self.pattern: tuple | None = None  # _fast.schur_pattern (on first use, see get)
 
     def get(self, layout: _Layout, sy: _System):
         """``(order, ptr, row_order, pt_order)`` for ``sy``, computed on a change of structure."""
@@ -155,7 +155,9 @@ class _OrderCache:
         row_order, pt_order = locality_orders(sy.Jrc, layout.n_c, order, ptr, rows_np)
         self.key = (layout.n_c, layout.n_pts, sy.pidx.copy(), sy.Jrc.cols.shape)
         self.value = (order, ptr, row_order, pt_order)
-        self.pattern = None
+        # the Schur pattern is kept: it is in columns, not rows, and the rows left after an
+        # outlier rejection couple a subset of what they coupled before (the kernel notices
+        # anything outside it, and the pattern is then computed again)
         return self.value
 
 

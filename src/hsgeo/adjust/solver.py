@@ -306,6 +306,10 @@ class _Solve:
                 # the initial values, not gross errors
                 rejecting = True
                 tested = not self.reject(step.system, sy, ne)
+                if not tested and lam > opts.lambda0:
+                    # observations were rejected: a new cost surface, on which the damping
+                    # that the gross errors made necessary starts over
+                    lam, nu = opts.lambda0, 2.0
             self._report(new_cost, lam)
             # chord steps (Kelley 1995, ch. 5): from a settled iterate on, the reduced matrix
             # barely changes, so the next steps reuse the last one formed (the gradient and
@@ -455,7 +459,11 @@ class _Solve:
                 trial = _System(np.array([np.inf]), None, None, None, 0)
             actual = cost - trial.cost
             rho = actual / pred if pred > 0 else (1.0 if actual >= 0 else -1.0)
-            if not (rho > 0 and np.isfinite(trial.cost)) and sy is not None:
+            if (
+                not (rho > 0 and np.isfinite(trial.cost))
+                and sy is not None
+                and self.options.hold_points
+            ):
                 held = self._hold_points(sy, ne, trial, state, cost, dc, dp)
                 if held is not None:
                     trial, actual, pred, rho = held
