@@ -109,3 +109,49 @@ def test_reference_squares_measured_by_their_centre():
     err = o1.lines.xy_px[good, 0] - t1.xy_true_px[good, 0]
     # N(0, 0.5²) then registered at the pixel centre: σ = √(0.25 + 1/12) ≈ 0.58 px
     assert 0.4 < np.std(err) < 0.75, np.std(err)
+
+
+def _digest(obs, truth) -> str:
+    """sha256 of the bytes of every observation and truth array of one simulation."""
+    import hashlib
+
+    h = hashlib.sha256()
+    lines = obs.lines
+    arrays = [
+        lines.point,
+        lines.band,
+        lines.t_s,
+        lines.xy_px,
+        lines.xyz_nav_m,
+        lines.rpy_nav_rad,
+        lines.xyz_rate_nav_m_s,
+        lines.rpy_rate_nav_rad_s,
+        obs.gcp_index,
+        obs.gcp_xyz_m,
+        obs.lever_arm_m,
+        obs.node_prior_mean,
+        np.asarray(obs.t_span_s),
+    ]
+    arrays += [truth.values[k] for k in sorted(truth.values)]
+    arrays += [np.asarray(truth.strips, float), truth.strip, truth.cp_index, truth.outlier]
+    arrays += [truth.xy_true_px, truth.error_t_s, truth.error_samples]
+    for a in arrays:
+        if a is not None:  # the error samples of the "spline" model are None
+            h.update(np.ascontiguousarray(a).tobytes())
+    return h.hexdigest()
+
+
+# sha256 of simulate()'s arrays computed with main's code at e7c3c51 (before simulate() accepted
+# scale > 1): the chapters' numbers depend on scale ≤ 1 staying bit-identical
+DIGESTS_MAIN_E7C3C51 = {
+    (0.01, 0, False): "96bf965fbfa741e63b1a8be8d80192885684e720aee0da01963cf00179ff9789",
+    (0.05, 3, False): "3c5155ae6255bd9d9a30a67f5a8aa73a28c1446eeccd0ad3c293ed4360077477",
+    (0.01, 5, True): "8972f080742d1b6146893cbfdd01b8d33d556ed2dd65f98311ec8a4e96aac82e",
+}
+
+
+@pytest.mark.parametrize("scale, seed, noise_free", sorted(DIGESTS_MAIN_E7C3C51))
+def test_scale_up_to_one_is_bit_identical_to_main(scale, seed, noise_free):
+    kw = {"noise_free": True, "trajectory_error": "spline"} if noise_free else {}
+    obs, truth = simulate(scale, rng=seed, **kw)
+    assert _digest(obs, truth) == DIGESTS_MAIN_E7C3C51[(scale, seed, noise_free)]
