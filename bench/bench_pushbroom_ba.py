@@ -14,6 +14,11 @@ BLAS thread count are its own:
 
 Usage: ``python bench/bench_pushbroom_ba.py [--scale 1.0] [--baseline-scale 0.3] [--seed 0]``
 (``make bench`` runs it with the defaults).
+
+``--scaling 0.1,0.3,1,3,10`` runs the scaling benchmark instead (issue 14; ``make bench`` runs
+it too, through ``bench/run.py``): the chapter's adjustment at each scale (beyond 1 a longer
+block), one fresh process each, written to ``bench/results/pushbroom_scaling.json``
+(``--scaling-out``).
 """
 
 from __future__ import annotations
@@ -146,8 +151,115 @@ def case_scipy(scale, seed, max_seconds):
     }
 
 
+def case_scaling(scale, seed):
+    """One row of the scaling benchmark: the chapter's adjustment (outlier rejection) at
+    ``scale`` (beyond 1: the longer block of :func:`~hsgeo.simulate.pushbroom_campaign.simulate`).
+
+    Times ``simulate()`` inside :func:`_problem` (wrapped, not changed), frees everything the
+    solve does not need (the simulation's truth is already dropped by :func:`_problem`, the
+    observations here) and records the peak RSS before the solve, so that the solver's memory
+    can be told from the simulator's.
+    """
+    import gc
+
+    import hsgeo.simulate.pushbroom_campaign as campaign
+    from hsgeo.adjust import adjust
+    from hsgeo.reproduce.pushbroom_ba import FTOL, REJECT_K
+
+    simulate, timing = campaign.simulate, {}
+
+    def timed_simulate(*args, **kwargs):
+        t0 = time.perf_counter()
+        out = simulate(*args, **kwargs)
+        timing["simulate_seconds"] = time.perf_counter() - t0
+        return out
+
+    campaign.simulate = timed_simulate
+    try:
+        t0 = time.perf_counter()
+        obs, p, blocks = _problem(scale, seed)
+        setup = time.perf_counter() - t0
+    finally:
+        campaign.simulate = simulate
+    n_obs = obs.lines.n
+    del obs
+    gc.collect()
+    jit = _load_compiled_kernels(seed)
+    rss_before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    t0 = time.perf_counter()
+    res = adjust(p, blocks, reject_k=REJECT_K, ftol=FTOL, reject_every_iteration=True)
+    wall = time.perf_counter() - t0
+    return {
+        "scale": scale,
+        "n_observations": n_obs,
+        "n_unknowns": int(res.n_unknowns),
+        "solver_seconds": res.seconds,
+        "wall_seconds": wall,
+        "iterations": res.iterations,
+        "converged": bool(res.converged),
+        "sigma0": res.sigma0,
+        "rejected_share": float(res.outliers(0).mean()),
+        "cost_history": [float(c) for c in res.cost_history],
+        "simulate_seconds": timing["simulate_seconds"],
+        "setup_seconds": setup,
+        "jit_load_seconds": jit,
+        "peak_rss_mb_before_solve": rss_before,
+    }
+
+
+def scaling(scales, seed, out_path, timeout=3600):
+    """The scaling benchmark (issue 14): one fresh process per scale (``OPENBLAS_NUM_THREADS=1``),
+    rows as :func:`case_scaling`, the log-log slope of solver seconds against observations
+    between scales 1 and 10 (``time_exponent``) and the goals; written to ``out_path``."""
+    import math
+
+    load0 = os.getloadavg()
+    rows = []
+    for s in scales:
+        row = _spawn("scaling", s, seed, 1, timeout=timeout)
+        row.setdefault("scale", s)
+        rows.append(row)
+    by_scale = {r["scale"]: r for r in rows if "solver_seconds" in r}
+    exponent = None
+    if 1.0 in by_scale and 10.0 in by_scale:
+        a, b = by_scale[1.0], by_scale[10.0]
+        exponent = math.log(b["solver_seconds"] / a["solver_seconds"]) / math.log(
+            b["n_observations"] / a["n_observations"]
+        )
+    out = {
+        "problem": "002 pushbroom bundle adjustment as in the chapter (4 GCPs, outlier "
+        "rejection, residual across the line as a time); beyond scale 1 a block scale times "
+        "longer along track at the paper's tie-point density",
+        "rows": rows,
+        "time_exponent": exponent,
+        "time_exponent_note": "log-log slope of solver_seconds against n_observations between "
+        "scales 1 and 10 (1: linear growth)",
+        "goals": {"scale": 10, "solver_seconds_max": 30, "peak_rss_mb_max": 10240},
+        "notes": "each row in a fresh process with OPENBLAS_NUM_THREADS=1; solver_seconds is "
+        "adjust()'s own time after the compiled kernels were loaded (jit_load_seconds); "
+        "peak_rss_mb is the process peak, peak_rss_mb_before_solve the peak of the simulation "
+        "and the problem set-up (the observations and the truth freed before the solve)",
+        "machine": {
+            "cpus": os.cpu_count(),
+            "loadavg_at_start": load0,
+            "loadavg_at_end": os.getloadavg(),
+            "python": platform.python_version(),
+            "numba_threads": os.environ.get("NUMBA_NUM_THREADS", "default"),
+            "glibc_tunables": os.environ.get("GLIBC_TUNABLES", ""),
+        },
+        "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
+        "seed": seed,
+    }
+    Path(out_path).parent.mkdir(parents=True, exist_ok=True)
+    Path(out_path).write_text(json.dumps(out, indent=1) + "\n")
+    print(json.dumps(out, indent=1))
+    return 0
+
+
 def _child(args):
-    if args.case == "ours":
+    if args.case == "scaling":
+        out = case_scaling(args.scale, args.seed)
+    elif args.case == "ours":
         out = case_ours(args.scale, args.seed, args.reject)
     else:
         out = case_scipy(args.scale, args.seed, args.max_seconds)
@@ -184,15 +296,23 @@ def main(argv=None):
     ap.add_argument("--scale", type=float, default=1.0)
     ap.add_argument("--baseline-scale", type=float, default=0.3)
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--child", choices=("ours", "scipy"))
+    ap.add_argument("--child", choices=("ours", "scipy", "scaling"))
     ap.add_argument("--reject", action="store_true")
     ap.add_argument("--max-seconds", type=float, default=3600)
     ap.add_argument("--repeats", type=int, default=3, help="full-size runs of the best setting")
     ap.add_argument("--out", default=str(HERE / "results" / "pushbroom_ba.json"))
+    ap.add_argument(
+        "--scaling",
+        help="comma-separated scales (e.g. 0.1,0.3,1,3,10): run the scaling benchmark instead",
+    )
+    ap.add_argument("--scaling-out", default=str(HERE / "results" / "pushbroom_scaling.json"))
     args = ap.parse_args(argv)
     if args.child:
         args.case = args.child
         return _child(args)
+    if args.scaling:
+        scales = [float(s) for s in args.scaling.split(",")]
+        return scaling(scales, args.seed, args.scaling_out, timeout=args.max_seconds)
     load0 = os.getloadavg()
     full = {b: _spawn("ours", args.scale, args.seed, b, reject=True) for b in (1, 2)}
     best = min(full, key=lambda b: full[b]["solver_seconds"])

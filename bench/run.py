@@ -1,8 +1,9 @@
 """``make bench``: run every ``bench/bench_*.py`` (each writes ``bench/results/<name>.json``).
 
 ``python bench/run.py [NAME ...]`` runs only the named ones (``engine``, ``pushbroom_ba``,
-``bal``, ``nist_strd``); each script also runs on its own with its options
-(``python bench/bench_pushbroom_ba.py --help``).
+``pushbroom_scaling``, ``bal``, ``nist_strd``); each script also runs on its own with its
+options (``python bench/bench_pushbroom_ba.py --help``). ``pushbroom_scaling`` is
+``bench_pushbroom_ba.py --scaling …``, run after the pushbroom benchmark (issue 14).
 
 Benchmarks time whole operations at realistic sizes and report peak memory, against the obvious
 alternative in the same run (GUIDE §7). They are scripts, never timed assertions.
@@ -16,12 +17,24 @@ from pathlib import Path
 here = Path(__file__).parent
 (here / "results").mkdir(exist_ok=True)
 only = sys.argv[1:]
+jobs = []  # (name, script, arguments)
 for script in sorted(here.glob("bench_*.py")):
-    if only and script.stem.removeprefix("bench_") not in only:
+    jobs.append((script.stem.removeprefix("bench_"), script, []))
+    if (
+        script.stem == "bench_pushbroom_ba"
+    ):  # the scaling rows: bench/results/pushbroom_scaling.json
+        jobs.append(("pushbroom_scaling", script, ["--scaling", "0.1,0.3,1,3,10"]))
+for name, script, arguments in jobs:
+    if only and name not in only:
         continue
     print(
-        f"== {script.name} (OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS')})",
+        f"== {script.name} {' '.join(arguments)} "
+        f"(OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS')})",
         flush=True,
     )
-    sys.argv = [str(script)]  # each benchmark parses its own (default) arguments
-    runpy.run_path(str(script), run_name="__main__")
+    sys.argv = [str(script), *arguments]  # each benchmark parses its own arguments
+    try:
+        runpy.run_path(str(script), run_name="__main__")
+    except SystemExit as e:  # a script's main() returning through sys.exit
+        if e.code not in (0, None):
+            raise

@@ -109,3 +109,125 @@ def test_reference_squares_measured_by_their_centre():
     err = o1.lines.xy_px[good, 0] - t1.xy_true_px[good, 0]
     # N(0, 0.5²) then registered at the pixel centre: σ = √(0.25 + 1/12) ≈ 0.58 px
     assert 0.4 < np.std(err) < 0.75, np.std(err)
+
+
+def _digest(obs, truth) -> str:
+    """sha256 of the bytes of every observation and truth array of one simulation."""
+    import hashlib
+
+    h = hashlib.sha256()
+    lines = obs.lines
+    arrays = [
+        lines.point,
+        lines.band,
+        lines.t_s,
+        lines.xy_px,
+        lines.xyz_nav_m,
+        lines.rpy_nav_rad,
+        lines.xyz_rate_nav_m_s,
+        lines.rpy_rate_nav_rad_s,
+        obs.gcp_index,
+        obs.gcp_xyz_m,
+        obs.lever_arm_m,
+        obs.node_prior_mean,
+        np.asarray(obs.t_span_s),
+    ]
+    arrays += [truth.values[k] for k in sorted(truth.values)]
+    arrays += [np.asarray(truth.strips, float), truth.strip, truth.cp_index, truth.outlier]
+    arrays += [truth.xy_true_px, truth.error_t_s, truth.error_samples]
+    for a in arrays:
+        if a is not None:  # the error samples of the "spline" model are None
+            h.update(np.ascontiguousarray(a).tobytes())
+    return h.hexdigest()
+
+
+# sha256 of simulate()'s arrays computed with main's code at e7c3c51 (before simulate() accepted
+# scale > 1): the chapters' numbers depend on scale ≤ 1 staying bit-identical
+DIGESTS_MAIN_E7C3C51 = {
+    (0.01, 0, False): "96bf965fbfa741e63b1a8be8d80192885684e720aee0da01963cf00179ff9789",
+    (0.05, 3, False): "3c5155ae6255bd9d9a30a67f5a8aa73a28c1446eeccd0ad3c293ed4360077477",
+    (0.01, 5, True): "8972f080742d1b6146893cbfdd01b8d33d556ed2dd65f98311ec8a4e96aac82e",
+}
+
+
+@pytest.mark.parametrize("scale, seed, noise_free", sorted(DIGESTS_MAIN_E7C3C51))
+def test_scale_up_to_one_is_bit_identical_to_main(scale, seed, noise_free):
+    kw = {"noise_free": True, "trajectory_error": "spline"} if noise_free else {}
+    obs, truth = simulate(scale, rng=seed, **kw)
+    assert _digest(obs, truth) == DIGESTS_MAIN_E7C3C51[(scale, seed, noise_free)]
+
+
+def test_chunked_rows_give_the_same_bits(monkeypatch):
+    """The simulator's row-wise work in chunks (odd sizes, tails included) is bit-identical."""
+    import hsgeo.simulate.pushbroom_campaign as pc
+
+    monkeypatch.setattr(pc, "CHUNK_ROWS", 997)
+    obs, truth = simulate(0.01, rng=0)
+    assert obs.lines.n > 4 * 997
+    assert _digest(obs, truth) == DIGESTS_MAIN_E7C3C51[(0.01, 0, False)]
+
+
+def test_long_block_beyond_the_paper():
+    """scale > 1: a block scale × 600 m long (north) at the paper's tie-point density, the same
+    24 strips lengthened by 600 m · (scale − 1), the same per-point statistics (002 §4)."""
+    from dataclasses import replace
+
+    from hsgeo.simulate.pushbroom_campaign import CampaignConfig, block_length_m
+
+    cfg0 = CampaignConfig()
+    cfg = replace(cfg0, n_tie_points_full=4000)  # few tie points: fast, same geometry
+    scale = 2.5
+    obs, truth = simulate(scale, rng=1, cfg=cfg)
+    assert block_length_m(cfg, scale) == 1500.0 and block_length_m(cfg, 0.3) == 600.0
+    tie = truth.values["points_m"][17:]
+    assert obs.n_points == 17 + round(4000 * scale)
+    assert np.all(np.abs(tie[:, 0]) <= 300) and np.all(np.abs(tie[:, 1]) <= 750)
+    assert np.max(tie[:, 1]) > 740 and np.min(tie[:, 1]) < -740  # uniform over the long block
+    # the reference squares stay in the central 600 m
+    assert np.all(np.abs(truth.values["points_m"][:17, :2]) < 300)
+    # 24 strips, each 2 · 480 m + 600 m · 1.5 long, turns of 60 s between them
+    assert len(truth.strips) == 24
+    lengths_m = np.array([p[1] - p[0] for p in truth.strips]) * cfg.speed_m_s
+    np.testing.assert_allclose(lengths_m, 2 * cfg.strip_half_length_m + 600 * (scale - 1))
+    plan = np.array(truth.strips)
+    gaps = plan[1:, 0] - plan[:-1, 1]
+    np.testing.assert_allclose(gaps, cfg.turn_s)
+    # each tie point in ≥ 3 different strips; on average 441587 / 113758 observations (002 §4):
+    # 3 + Poisson(0.88), truncated at the strips that cover the point
+    pts = obs.lines.point
+    n_strips = np.array([np.unique(truth.strip[pts == i]).size for i in range(obs.n_points)])
+    n_obs = np.bincount(pts, minlength=obs.n_points)
+    assert np.all(n_strips >= 3) and np.array_equal(n_strips, n_obs)
+    extra = cfg0.obs_per_point_mean - 3
+    assert abs(n_obs[17:].mean() - cfg0.obs_per_point_mean) < 4 * np.sqrt(extra / tie.shape[0])
+    assert abs(truth.outlier.mean() - 0.003) < 4 * np.sqrt(0.003 / obs.lines.n)
+    # every observation in a strip's imaged time, in a line of 200 Hz
+    t0 = np.array([p[0] for p in truth.strips])[truth.strip]
+    t1 = np.array([p[1] for p in truth.strips])[truth.strip]
+    assert np.all((obs.lines.t_s >= t0) & (obs.lines.t_s <= t1))
+
+
+def test_long_block_noise_free_is_identifiable_and_recovers_the_truth():
+    """A 3× longer block held by 4 GCPs in its central 600 m and the GNSS/INS priors: full rank
+    at the truth, and the noise-free adjustment returns the truth (as at scale ≤ 1)."""
+    from dataclasses import replace
+
+    from test_pushbroom import _problem
+
+    from hsgeo.adjust import adjust, identifiability
+    from hsgeo.simulate.pushbroom_campaign import CampaignConfig
+
+    cfg = replace(CampaignConfig(), n_tie_points_full=100)
+    obs, truth = simulate(3.0, rng=11, noise_free=True, trajectory_error="spline", cfg=cfg)
+    assert np.ptp(truth.values["points_m"][:, 1]) > 1700
+    p, blocks, _ = _problem(obs, y_as_time=True)
+    assert identifiability(p, blocks).full_rank
+    res = adjust(p, blocks, ftol=1e-15)
+    for k, v in truth.values.items():
+        np.testing.assert_allclose(res.value(k), v, rtol=0, atol=1e-7, err_msg=k)
+
+
+@pytest.mark.parametrize("scale", [0.0, -1.0, float("nan"), float("inf")])
+def test_scale_must_be_positive(scale):
+    with pytest.raises(InputError, match="scale must be a positive number"):
+        simulate(scale, rng=0)

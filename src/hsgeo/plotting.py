@@ -23,6 +23,7 @@ __all__ = [
     "scale_bar",
     "deviation_quiver",
     "displacement_vs_pixel",
+    "solver_scaling",
 ]
 
 
@@ -615,3 +616,72 @@ def against_interval(ax, studies, key, ylabel, *, scale=1.0, paper_interval_s=10
     ax.set_ylabel(ylabel)
     ax.legend(fontsize=9)
     return ax
+
+
+def solver_scaling(axes, rows, *, goals=None, reference_scale: float = 1.0):
+    """Solver time and peak memory against the number of observations (log-log), two panels.
+
+    Parameters
+    ----------
+    axes : (2,) sequence of matplotlib Axes
+        Left: solver seconds, with the line of linear growth through the row at
+        ``reference_scale``. Right: the process's peak RSS (MB) and, where the rows have it,
+        the peak before the solve (the simulation and the set-up).
+    rows : sequence of dict
+        Rows of ``bench/results/pushbroom_scaling.json``: ``scale``, ``n_observations``,
+        ``solver_seconds``, ``peak_rss_mb`` (optional ``peak_rss_mb_before_solve``); rows
+        without ``solver_seconds`` (a timed-out case) are left out.
+    goals : dict, optional
+        ``solver_seconds_max`` (s) and ``peak_rss_mb_max`` (MB), drawn as dashed lines.
+    reference_scale : float
+        The scale the linear-growth line passes through.
+
+    Returns
+    -------
+    (2,) sequence of Axes
+    """
+    from hsgeo.errors import InputError
+
+    rows = sorted((r for r in rows if "solver_seconds" in r), key=lambda r: r["n_observations"])
+    ref = [r for r in rows if r["scale"] == reference_scale]
+    if not ref:
+        raise InputError(
+            f"no row at scale {reference_scale:g} for the line of linear growth: run the "
+            "scaling benchmark with that scale (bench_pushbroom_ba.py --scaling)"
+        )
+    n = np.array([r["n_observations"] for r in rows], dtype=float)
+    t_s = np.array([r["solver_seconds"] for r in rows])
+    ax_t, ax_m = axes
+    ax_t.plot(n, t_s, "o-", color="C0", label="solver time")
+    n_line = np.array([n.min(), n.max()])
+    ax_t.plot(
+        n_line,
+        ref[0]["solver_seconds"] * n_line / ref[0]["n_observations"],
+        ":",
+        color="0.4",
+        label=f"linear growth through {reference_scale:g}×",
+    )
+    ax_m.plot(n, [r["peak_rss_mb"] for r in rows], "o-", color="C0", label="peak RSS (process)")
+    before = [r.get("peak_rss_mb_before_solve") for r in rows]
+    if all(b is not None for b in before):
+        ax_m.plot(n, before, "s--", color="C2", mfc="none", label="peak RSS before the solve")
+    goals = goals or {}
+    for ax, key, unit in ((ax_t, "solver_seconds_max", "s"), (ax_m, "peak_rss_mb_max", "MB")):
+        if goals.get(key) is not None:
+            ax.axhline(goals[key], color="C3", ls="--", lw=1, label=f"goal ≤ {goals[key]:g} {unit}")
+    for ax, y in ((ax_t, t_s), (ax_m, [r["peak_rss_mb"] for r in rows])):
+        for r, xi, yi in zip(rows, n, y, strict=True):
+            ax.annotate(
+                f"{r['scale']:g}×",
+                (xi, yi),
+                textcoords="offset points",
+                xytext=(4, -10),
+                fontsize=8,
+            )
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("2-D observations")
+        ax.legend(fontsize=8)
+    ax_t.set_ylabel("solver time (s)")
+    ax_m.set_ylabel("peak memory (MB)")
+    return axes

@@ -33,6 +33,15 @@ Truth and errors:
   crossing, plus 0.3 % gross errors;
 * 17 reference squares (4 GCPs, 13 CPs, RTK σ ≈ 1 cm), seen in every strip that covers them.
 
+Beyond the paper (``scale > 1``, for the scaling benchmark): the block grows along track (north),
+not by duplicating data. Tie points are drawn over ``area_m`` (east) × ``area_m · scale`` (north,
+:func:`block_length_m`), ``round(113758 · scale)`` of them (the paper's density); every strip's
+imaged length grows by ``area_m · (scale − 1)`` (so each strip still covers the whole block with
+the same margins); the 24 strips, the turns and the per-point statistics (≥ 3 strips, 3.88
+observations on average, 0.3 % gross errors) are the same. The 17 reference squares stay in
+the central 600 m: the GNSS/INS priors hold the rest of the block. Up to ``scale = 1`` the
+output is bit-identical to the simulator before it accepted ``scale > 1``.
+
 ``noise_free=True`` records the exact image coordinates of each line (no pixel quantisation,
 no gross errors, and the GCP coordinates exact): the adjustment must then recover the truth to
 numerical precision.
@@ -63,6 +72,7 @@ __all__ = [
     "CampaignObservations",
     "CampaignTruth",
     "TRAJECTORY_ERRORS",
+    "block_length_m",
     "gauss_markov",
     "refraction_k",
     "simulate",
@@ -350,9 +360,21 @@ def refraction_k(flying_asl_m, ground_asl_m) -> np.ndarray:
     return k_urad * 1e-6
 
 
-def _strip_plan(cfg: CampaignConfig):
-    """Strips in flight order: (t_start, t_end, east_m, agl_m, direction ±1)."""
-    L = 2 * cfg.strip_half_length_m / cfg.speed_m_s
+def block_length_m(cfg: CampaignConfig, scale: float) -> float:
+    """North extent of the simulated block, m.
+
+    ``cfg.area_m`` up to scale 1, ``cfg.area_m · scale`` beyond (see :func:`simulate`).
+    """
+    return cfg.area_m * max(float(scale), 1.0)
+
+
+def _strip_plan(cfg: CampaignConfig, extra_m: float = 0.0):
+    """Strips in flight order: (t_start, t_end, east_m, agl_m, direction ±1).
+
+    ``extra_m`` lengthens every strip's imaged part (m, half at each end): the block beyond
+    the paper's 600 m (``scale > 1``).
+    """
+    L = 2 * (cfg.strip_half_length_m + extra_m / 2) / cfg.speed_m_s
     plan = []
     t = 0.0
     lines = [(e, cfg.agl_low_m) for e in cfg.lines_low_east_m] + [
@@ -363,6 +385,16 @@ def _strip_plan(cfg: CampaignConfig):
             plan.append((t, t + L, e, h, direction))
             t += L + cfg.turn_s
     return plan
+
+
+#: Rows per chunk of the simulator's row-wise work (the Newton search of the line times):
+#: bounds its temporaries (≈ 1 kB per row) at any scale.
+CHUNK_ROWS = 1 << 18
+
+
+def _row_chunks(m: int):
+    """Slices of ``range(m)`` of at most :data:`CHUNK_ROWS` rows."""
+    return [slice(a, min(a + CHUNK_ROWS, m)) for a in range(0, m, CHUNK_ROWS)]
 
 
 def _mount_motion(t, amp):
@@ -409,9 +441,14 @@ def simulate(
 
     Parameters
     ----------
-    scale : float in (0, 1]
-        Thins the tie points (1.0: 113,758 as in 002 §4). The flight, the reference squares and
-        the parameters do not change.
+    scale : float > 0
+        Up to 1: thins the tie points (1.0: 113,758 as in 002 §4); the flight, the reference
+        squares and the parameters do not change. Beyond 1: a block ``scale`` times longer
+        along track, ``cfg.area_m`` (600 m) east × ``cfg.area_m · scale`` m north, with
+        ``round(113758 · scale)`` tie points (the paper's density) and every strip
+        ``cfg.area_m · (scale − 1)`` m longer; the 24 strips, the turns and the 17 reference
+        squares (in the central 600 m) stay (see the module docstring). The per-observation
+        work runs in chunks of :data:`CHUNK_ROWS` rows: memory grows with the outputs only.
     rng : int or numpy.random.Generator
     noise_free : bool
         Exact image coordinates, no outliers, exact GCPs (for the noise-free recovery test).
@@ -428,8 +465,8 @@ def simulate(
     truth : CampaignTruth
         What only :mod:`hsgeo.reproduce` compares with.
     """
-    if not (0 < scale <= 1.0):
-        raise InputError(f"scale must be in (0, 1], got {scale!r}")
+    if not (np.isfinite(scale) and scale > 0):
+        raise InputError(f"scale must be a positive number, got {scale!r}")
     cfg = cfg or CampaignConfig()
     if trajectory_error is not None:
         cfg = replace(cfg, trajectory_error=trajectory_error)
@@ -443,7 +480,8 @@ def simulate(
             "has exact node corrections)"
         )
     rng = np.random.default_rng(rng)
-    plan = _strip_plan(cfg)
+    length_m = block_length_m(cfg, scale)
+    plan = _strip_plan(cfg, extra_m=length_m - cfg.area_m)
     t_end = plan[-1][1]
     nodes = SplineNodes(0.0, t_end, cfg.node_interval_s)
     nb = len(cfg.c_offsets_um)
@@ -510,7 +548,8 @@ def simulate(
         dtype=float,
     )
     ref_en += rng.uniform(-20, 20, ref_en.shape)
-    tie_en = rng.uniform(-half, half, (n_tie, 2))
+    # east × north: area_m × block_length_m (the same draws as a square block when scale ≤ 1)
+    tie_en = rng.uniform([-half, -length_m / 2], [half, length_m / 2], (n_tie, 2))
     en = np.vstack([ref_en, tie_en])
     h = np.r_[rng.uniform(0, 2, len(ref_en)), rng.uniform(0, cfg.terrain_relief_m, n_tie)]
     P = np.column_stack([en, h])
@@ -529,45 +568,57 @@ def simulate(
     covers = np.abs(en[:, 0:1] - east[None, :]) < half_swath[None, :] * (
         1 - h[:, None] / agl[None, :]
     )
-    covers &= np.abs(en[:, 1:2]) < cfg.strip_half_length_m - 30
+    covers &= np.abs(en[:, 1:2]) < cfg.strip_half_length_m + (length_m - cfg.area_m) / 2 - 30
     ncov = covers.sum(axis=1)
     if np.any(ncov < 3):
         raise InputError("simulated flight plan leaves points seen by fewer than 3 strips")
     extra = cfg.obs_per_point_mean - 3.0
     n_obs = np.where(is_ref, ncov, np.minimum(ncov, 3 + rng.poisson(extra, n_pts)))
-    pt_list, strip_list = [], []
-    for i in range(n_pts):  # vectorising this is not worth it: 114k cheap iterations
-        cand = np.flatnonzero(covers[i])
-        chosen = cand if is_ref[i] else rng.choice(cand, n_obs[i], replace=False)
-        pt_list.append(np.full(len(chosen), i))
-        strip_list.append(chosen)
-    pidx = np.concatenate(pt_list)
+    # the strips of each point: all for a reference square, a random n_obs of them for a tie
+    # point. One Generator.choice per point (its draws cannot be vectorised without changing
+    # the random stream); the candidates come from one np.nonzero (row-major, as flatnonzero
+    # per row did)
+    cand_strip = np.nonzero(covers)[1]
+    cand_end = np.cumsum(ncov)
+    strip_list, n_choose = [], n_obs.tolist()
+    for i, (b, e) in enumerate(zip((cand_end - ncov).tolist(), cand_end.tolist(), strict=True)):
+        cand = cand_strip[b:e]
+        strip_list.append(cand if is_ref[i] else rng.choice(cand, n_choose[i], replace=False))
+    pidx = np.repeat(np.arange(n_pts), n_obs)
     strip = np.concatenate(strip_list)
+    del strip_list, covers
     band = band_of_point[pidx]
     m = pidx.size
 
-    # -- the line that sees each point: Newton on the true y image coordinate in time
+    # -- the line that sees each point: Newton on the true y image coordinate in time, in
+    # chunks of rows (every operation is row-wise: the same bits as all rows at once, without
+    # the temporaries of millions of rows at scale > 1)
     beta0 = BETA0_CAM_FROM_PLATFORM
     t0s = np.array([p[0] for p in plan])
     t1s = np.array([p[1] for p in plan])
-    tc = 0.5 * (t0s + t1s)[strip]
-    dirn = np.array([p[4] for p in plan], float)[strip]
-    t = tc + dirn * P[pidx, 1] / cfg.speed_m_s
+    dirs = np.array([p[4] for p in plan], float)
+    # truth = nav + δ(t): project with the true pose, zero corrections
+    vals = dict(truth)
+    vals[names["nodes"]] = np.zeros_like(node_err)
 
-    def true_xy(tt):
-        xyz, rpy = _true_pose(plan, strip, tt, cfg.mount_motion_rad, cfg.speed_m_s)
-        # truth = nav + δ(t): project with the true pose, zero corrections
-        vals = dict(truth)
-        vals[names["nodes"]] = np.zeros_like(node_err)
-        xy, p = project(vals, names, nodes, tt, xyz, rpy, pidx, band, beta0, cfg.x0_mm, cfg.y0_mm)
-        return xy, p
+    def true_xy(tt, rows):
+        xyz, rpy = _true_pose(plan, strip[rows], tt, cfg.mount_motion_rad, cfg.speed_m_s)
+        return project(
+            vals, names, nodes, tt, xyz, rpy, pidx[rows], band[rows], beta0, cfg.x0_mm, cfg.y0_mm
+        )
 
-    for _ in range(6):
-        xy, _ = true_xy(t)
-        dt = 1e-3
-        xy2, _ = true_xy(t + dt)
-        deriv = (xy2[:, 1] - xy[:, 1]) / dt
-        t = t - xy[:, 1] / deriv  # the line is y = 0 (pixel centre of the line)
+    t = np.empty(m)
+    deriv = np.empty(m)
+    for rows in _row_chunks(m):
+        tt = 0.5 * (t0s + t1s)[strip[rows]] + dirs[strip[rows]] * P[pidx[rows], 1] / cfg.speed_m_s
+        for _ in range(6):
+            xy, _ = true_xy(tt, rows)
+            dt = 1e-3
+            xy2, _ = true_xy(tt + dt, rows)
+            deriv[rows] = (xy2[:, 1] - xy[:, 1]) / dt
+            tt = tt - xy[:, 1] / deriv[rows]  # the line is y = 0 (pixel centre of the line)
+        t[rows] = tt
+    del xy, xy2, tt
     line_dt = 1.0 / cfg.line_rate_hz
     # key-point localisation error (ours, see CampaignConfig): x along the line, and in y an
     # error of the matched line, i.e. of the time
@@ -578,9 +629,13 @@ def simulate(
         loc[on_ref] = cfg.sigma_ref_image_px * ref_loc[on_ref]
     t_loc = t - loc[:, 1] * cfg.pixel_mm / deriv
     t_line = np.round(t_loc / line_dt) * line_dt
-    xy_true_mm, pc = true_xy(t_line)
-    if np.any(pc[:, 2] <= 0):
-        raise InputError("simulated points behind the camera: check the flight plan")
+    del t, deriv, t_loc, ref_loc
+    xy_true_mm = np.empty((m, 2))
+    for rows in _row_chunks(m):
+        xy_true_mm[rows], pc = true_xy(t_line[rows], rows)
+        if np.any(pc[:, 2] <= 0):
+            raise InputError("simulated points behind the camera: check the flight plan")
+    del pc
     if cfg.refraction:  # the ray bends: the image point moves radially outward
         agl_obs = np.array([p[3] for p in plan])[strip]
         k = refraction_k(agl_obs + cfg.terrain_asl_m, P[pidx, 2] + cfg.terrain_asl_m)
@@ -588,25 +643,30 @@ def simulate(
         r2 = np.sum(d**2, axis=1) / truth[names["c"]][band] ** 2
         xy_true_mm = xy_true_mm + (k * (1 + r2))[:, None] * d
     xy_true_px = xy_true_mm / cfg.pixel_mm
-    # navigation solution at the line times: truth minus the spline error
-    xyz_true, rpy_true = _true_pose(plan, strip, t_line, cfg.mount_motion_rad, cfg.speed_m_s)
-    delta = nav_err(t_line)
-    xyz_nav = xyz_true - delta[:, :3]
-    rpy_nav = rpy_true - delta[:, 3:]
-    # and its rates (a GNSS/INS solution gives velocity and angular rate): the observation is
-    # a time, and its residual needs the image motion across the line (see PushbroomLines)
-    ddelta = nav_err(t_line, rate=True)
-    dirn_obs = np.array([p[4] for p in plan], float)[strip]
-    xyz_rate_true = np.column_stack([np.zeros(m), dirn_obs * cfg.speed_m_s, np.zeros(m)])
-    xyz_rate_nav = xyz_rate_true - ddelta[:, :3]
-    rpy_rate_nav = _mount_motion_rate(t_line, cfg.mount_motion_rad) - ddelta[:, 3:]
+    # navigation solution at the line times: truth minus the error (row-wise, in chunks)
+    xyz_nav, rpy_nav, xyz_rate_nav, rpy_rate_nav = (np.empty((m, 3)) for _ in range(4))
+    for rows in _row_chunks(m):
+        tl = t_line[rows]
+        xyz_true, rpy_true = _true_pose(plan, strip[rows], tl, cfg.mount_motion_rad, cfg.speed_m_s)
+        delta = nav_err(tl)
+        xyz_nav[rows] = xyz_true - delta[:, :3]
+        rpy_nav[rows] = rpy_true - delta[:, 3:]
+        # and its rates (a GNSS/INS solution gives velocity and angular rate): the observation
+        # is a time, and its residual needs the image motion across the line (PushbroomLines)
+        ddelta = nav_err(tl, rate=True)
+        n = tl.size
+        xyz_rate_true = np.column_stack(
+            [np.zeros(n), dirs[strip[rows]] * cfg.speed_m_s, np.zeros(n)]
+        )
+        xyz_rate_nav[rows] = xyz_rate_true - ddelta[:, :3]
+        rpy_rate_nav[rows] = _mount_motion_rate(tl, cfg.mount_motion_rad) - ddelta[:, 3:]
+    del xyz_true, rpy_true, delta, ddelta, xyz_rate_true
 
     if noise_free:
         xy_obs = xy_true_px.copy()
         outlier = np.zeros(m, bool)
         gcp_xyz = P[:4].copy()
     else:
-        # registered at pixel centres along the line, and in the line itself (y = 0)
         # registered at the pixel centre along the line, and in the line itself (y = 0)
         xy_obs = np.column_stack([np.floor(xy_true_px[:, 0] + loc[:, 0]) + 0.5, np.zeros(m)])
         outlier = rng.random(m) < cfg.outlier_share
