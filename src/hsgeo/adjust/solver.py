@@ -306,10 +306,6 @@ class _Solve:
                 # the initial values, not gross errors
                 rejecting = True
                 tested = not self.reject(step.system, sy, ne)
-                if not tested and lam > opts.lambda0:
-                    # observations were rejected: a new cost surface, on which the damping
-                    # that the gross errors made necessary starts over
-                    lam, nu = opts.lambda0, 2.0
             self._report(new_cost, lam)
             # chord steps (Kelley 1995, ch. 5): from a settled iterate on, the reduced matrix
             # barely changes, so the next steps reuse the last one formed (the gradient and
