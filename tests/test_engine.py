@@ -705,9 +705,12 @@ def test_points_held_to_save_a_refused_step(monkeypatch):
     held = []
     orig = SV._Solve._hold_points
 
+    counts = []
+
     def spy(self, *a):
         out = orig(self, *a)
         held.append(out is not None)
+        counts.append(max(self.hold_count.values(), default=0))
         return out
 
     monkeypatch.setattr(SV._Solve, "_hold_points", spy)
@@ -719,6 +722,17 @@ def test_points_held_to_save_a_refused_step(monkeypatch):
         p.fix("stations")
         res[hold] = adjust(p, Bearings(st, pt, th, 1e-3), hold_points=hold)
     assert any(held)  # (only called with hold_points=True)
+    assert max(counts) <= SV.HOLD_MAX
+    # with the cap at one hold per point the same minimum is reached too
+    monkeypatch.setattr(SV, "HOLD_MAX", 1)
+    counts.clear()
+    p = Parameters()
+    p.add("stations", S.copy())
+    p.add("points", P0.copy(), points=True)
+    p.fix("stations")
+    capped = adjust(p, Bearings(st, pt, th, 1e-3))
+    assert counts and max(counts) == 1
+    np.testing.assert_allclose(capped.cost_history[-1], res[False].cost_history[-1], rtol=1e-9)
     np.testing.assert_allclose(res[True].cost_history[-1], res[False].cost_history[-1], rtol=1e-9)
     # (to the convergence tolerance: 5e-6 m, against a point σ of about 0.1 m)
     np.testing.assert_allclose(res[True].value("points"), res[False].value("points"), atol=1e-4)

@@ -85,7 +85,9 @@ class SolverOptions:
     hold_points : bool, default True
         With a points block: a step refused because of a few points (at most 0.1 % of them
         carrying 90 % of the excess of the actual over the linearly predicted squared
-        residuals) is tried again with those points held in place before the damping grows.
+        residuals) is tried again with those points held in place before the damping grows;
+        a point at most 3 times a solve (its full step would otherwise keep the convergence
+        test from passing).
     check_datum : bool, default True
         Check the rank before the first step; raise :class:`~hsgeo.DatumError` if deficient.
     rank_rtol : float, default 1e-11

@@ -164,6 +164,10 @@ def adjust(
     return result
 
 
+#: Most times one point is held in place to save a refused step (see _Solve._hold_points).
+HOLD_MAX = 3
+
+
 @dataclass(frozen=True)
 class _Outcome:
     """How one minimisation (a pass of the LM loop) ended."""
@@ -214,6 +218,7 @@ class _Solve:
         self.each = options.reject_k is not None and options.reject_every_iteration
         self.D_max: np.ndarray | None = None  # damping_diagonal="max": the running maximum
         self.points_held = 0  # points held in place to save a refused step (_hold_points)
+        self.hold_count: dict[int, int] = {}  # times each point was held (at most HOLD_MAX)
 
     # -- the linearised system -------------------------------------------------------------
     def linearise(self, check_redundancy: bool = False) -> tuple[_System, _Normal]:
@@ -507,6 +512,10 @@ class _Solve:
         if k > max(1, dp.shape[0] // 1000):
             return None  # the model fails broadly: more damping, as usual
         held = np.argsort(-per_pt, kind="stable")[:k]
+        if any(self.hold_count.get(int(i), 0) >= HOLD_MAX for i in held):
+            # a point whose Gauss–Newton step keeps failing is not held again: its full step
+            # would keep the convergence test from passing; the damping takes over
+            return None
         dp_h = dp.copy()
         dp_h[held] = 0.0
         u -= point_rows_dot(sy.Jp, sy.pidx, dp - dp_h)
@@ -525,6 +534,8 @@ class _Solve:
             layout.set_state(state)
             return None
         self.points_held += k
+        for i in held:
+            self.hold_count[int(i)] = self.hold_count.get(int(i), 0) + 1
         return trial, actual, pred, rho
 
     def _report(self, cost: float, lam: float) -> None:
