@@ -239,19 +239,29 @@ def scaling(scales, seed, out_path, timeout=3600):
         "adjust()'s own time after the compiled kernels were loaded (jit_load_seconds); "
         "peak_rss_mb is the process peak, peak_rss_mb_before_solve the peak of the simulation "
         "and the problem set-up (the observations and the truth freed before the solve)",
-        "machine": {
-            "cpus": os.cpu_count(),
-            "loadavg_at_start": load0,
-            "loadavg_at_end": os.getloadavg(),
-            "python": platform.python_version(),
-            "numba_threads": os.environ.get("NUMBA_NUM_THREADS", "default"),
-            "glibc_tunables": os.environ.get("GLIBC_TUNABLES", ""),
-        },
+        "machine": _machine(load0),
         "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
         "seed": seed,
     }
-    Path(out_path).parent.mkdir(parents=True, exist_ok=True)
-    Path(out_path).write_text(json.dumps(out, indent=1) + "\n")
+    return _write(out, out_path)
+
+
+def _machine(load0):
+    """The machine a benchmark ran on (its load average at the start and now)."""
+    return {
+        "cpus": os.cpu_count(),
+        "loadavg_at_start": load0,
+        "loadavg_at_end": os.getloadavg(),
+        "python": platform.python_version(),
+        "numba_threads": os.environ.get("NUMBA_NUM_THREADS", "default"),
+        "glibc_tunables": os.environ.get("GLIBC_TUNABLES", ""),
+    }
+
+
+def _write(out, path):
+    """Write ``out`` as the JSON at ``path`` and print it."""
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    Path(path).write_text(json.dumps(out, indent=1) + "\n")
     print(json.dumps(out, indent=1))
     return 0
 
@@ -357,20 +367,10 @@ def main(argv=None):
             else None
         ),
         "goals": {"solver_seconds_max": 5.0, "peak_rss_mb_max": 1536, "speedup_min": 30},
-        "machine": {
-            "cpus": os.cpu_count(),
-            "loadavg_at_start": load0,
-            "loadavg_at_end": os.getloadavg(),
-            "python": platform.python_version(),
-            "numba_threads": os.environ.get("NUMBA_NUM_THREADS", "default"),
-            "glibc_tunables": os.environ.get("GLIBC_TUNABLES", ""),
-        },
+        "machine": _machine(load0),
         "seed": args.seed,
     }
-    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    Path(args.out).write_text(json.dumps(out, indent=1) + "\n")
-    print(json.dumps(out, indent=1))
-    return 0
+    return _write(out, args.out)
 
 
 if __name__ == "__main__":

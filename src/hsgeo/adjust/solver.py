@@ -217,7 +217,6 @@ class _Solve:
         self.total_iter = 0
         self.each = options.reject_k is not None and options.reject_every_iteration
         self.D_max: np.ndarray | None = None  # damping_diagonal="max": the running maximum
-        self.points_held = 0  # points held in place to save a refused step (_hold_points)
         self.hold_count: dict[int, int] = {}  # times each point was held (at most HOLD_MAX)
 
     # -- the linearised system -------------------------------------------------------------
@@ -533,7 +532,6 @@ class _Solve:
         if not (rho > 0 and np.isfinite(trial.cost)):
             layout.set_state(state)
             return None
-        self.points_held += k
         for i in held:
             self.hold_count[int(i)] = self.hold_count.get(int(i), 0) + 1
         return trial, actual, pred, rho
