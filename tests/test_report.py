@@ -107,3 +107,12 @@ def test_paper_values_print_at_most_six_digits_and_verdict_list():
     rep = Reproduction("x", 0, rows + [Row("t", "q", "m", reproduced=1.0)])
     v = rep.verdicts().data
     assert list(v["quantity"]) == ["fx_px"] and v.iloc[0]["verdict"] == "reproduced"
+
+
+def test_provenance_is_checked_and_survives_json():
+    with pytest.raises(InputError, match="provenance 'guessed'"):
+        Row("T", "c", "px", provenance="guessed")
+    rep = Reproduction("x", 0, [Row("T", "c", "px", 1.0, 0.1, 1.1, 0.1, 1.0, provenance="tuned")])
+    back = Reproduction.from_json(rep.to_json())
+    assert back.rows[0].provenance == "tuned"
+    assert '"provenance": "tuned"' in rep.to_json()

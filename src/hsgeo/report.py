@@ -29,6 +29,7 @@ __all__ = [
     "Row",
     "Reproduction",
     "VERDICTS",
+    "PROVENANCES",
     "Z_LIMIT",
     "agreement",
     "summarize",
@@ -39,6 +40,11 @@ __all__ = [
 #: The verdicts of a claim (ReScience style). ``tuned``: the simulation took the paper's value as
 #: its truth, so agreement with the paper is by construction and only ``z`` is an outcome.
 VERDICTS = ("reproduced", "differs", "tuned", "not testable", "planned")
+
+#: Where a row's truth comes from (GUIDE §4): ``paper`` (the paper's value used as truth),
+#: ``derived`` (computed from the paper's values), ``chosen`` (our stated assumption), ``tuned``
+#: (chosen so that an outcome meets a paper value).
+PROVENANCES = ("paper", "derived", "chosen", "tuned")
 
 #: |z| up to which a value counts as agreeing (3σ, GUIDE §6).
 Z_LIMIT = 3.0
@@ -77,6 +83,8 @@ class Row:
     verdict, reason : str, optional
         A verdict stated by the chapter (one of :data:`VERDICTS`) and its reason; computed by
         :meth:`judge` when absent.
+    provenance : str, optional
+        Where the truth comes from, one of :data:`PROVENANCES` (GUIDE §4).
     """
 
     table: str
@@ -90,10 +98,15 @@ class Row:
     n_runs: int | None = None
     verdict: str | None = None
     reason: str = ""
+    provenance: str | None = None
 
     def __post_init__(self):
         if self.verdict is not None and self.verdict not in VERDICTS:
             raise InputError(f"verdict {self.verdict!r} of {self.quantity}: use one of {VERDICTS}")
+        if self.provenance is not None and self.provenance not in PROVENANCES:
+            raise InputError(
+                f"provenance {self.provenance!r} of {self.quantity}: use one of {PROVENANCES}"
+            )
 
     @property
     def z(self) -> float | None:
@@ -163,6 +176,7 @@ class Row:
             "n_runs": self.n_runs,
             "verdict": verdict,
             "reason": reason,
+            "provenance": self.provenance,
         }
 
 
@@ -344,6 +358,7 @@ class Reproduction:
                 n_runs=r.get("n_runs"),
                 verdict=r.get("verdict"),  # as judged when written: the same numbers
                 reason=r.get("reason") or "",
+                provenance=r.get("provenance"),
             )
             for r in d["rows"]
         ]
