@@ -427,8 +427,14 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``hsgeo`` console script."""
     args = build_parser().parse_args(argv)
+    from hsgeo.adjust.threads import blas_threads
+
     try:
-        return int(args.func(args) or 0)
+        # BLAS on one thread, whatever the shell says: on small dense solves a second OpenBLAS
+        # thread was slower, and on a busy machine many times slower (README, "Threads");
+        # the engine chooses its own kernels' threads by the size of each problem
+        with blas_threads(1):
+            return int(args.func(args) or 0)
     except ConvergenceError:
         print(
             f"hsgeo {args.command}: error: the adjustment did not converge; look for gross "

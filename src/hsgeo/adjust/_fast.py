@@ -11,7 +11,8 @@ of entries, and the Schur complement
 is accumulated point by point from the rows grouped by point, without ever forming ``W``
 (GUIDE §9: for the pushbroom problem the cost is in forming the reduced system, not in solving
 it). Only the upper triangle is accumulated; the kernels run over the rows / points in
-``n_chunks`` independent chunks (one per thread) and sum the per-chunk matrices.
+``n_chunks`` independent chunks (their number set by the size of the problem, never by the
+threads: :mod:`hsgeo.adjust.threads`) and sum the per-chunk matrices in a fixed order.
 
 The generic scipy.sparse path in :mod:`hsgeo.adjust.schur` computes the same quantities;
 ``tests/test_engine.py`` checks that the two agree.
@@ -19,9 +20,10 @@ The generic scipy.sparse path in :mod:`hsgeo.adjust.schur` computes the same qua
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 from numba import njit, prange
+
+from hsgeo.adjust.threads import chunks
 
 __all__ = [
     "normal_cc",
@@ -30,12 +32,13 @@ __all__ = [
     "schur_pattern",
     "point_covariance",
     "locality_orders",
-    "n_threads",
 ]
 
 
-def n_threads() -> int:
-    return int(numba.get_num_threads())
+def _chunks(n: int, per_chunk: int) -> int:
+    # the number of partial sums depends on the size alone, never on the threads (the same
+    # bits for any thread count; hsgeo.adjust.threads)
+    return chunks(n, per_chunk)
 
 
 @njit(cache=True, inline="always")
@@ -382,7 +385,7 @@ def normal_cc(arrays, n_c: int, row_order=None) -> np.ndarray:
     if row_order is None:
         row_order = np.arange(cols.shape[0], dtype=np.int64)
     row_order = np.asarray(row_order, dtype=np.int64)
-    nch = max(1, min(n_threads(), row_order.size // 10000 + 1))
+    nch = _chunks(row_order.size, 10000)
     parts = _normal_cc_kernel(*arrays, row_order, n_c, nch)
     return _symmetrise_upper(parts.sum(axis=0) if nch > 1 else parts[0])
 
@@ -493,7 +496,7 @@ def reduced_points(arrays, jp, order, ptr, Vinv, n_c: int, pt_order=None, cache=
     max_rows = int(np.max(np.diff(ptr))) if n_pts else 0
     capg = max_rows if fcol.shape[1] else 0
     capc = int(min(n_c, max(1, max_rows * cols.shape[1])))
-    nch = max(1, min(n_threads(), n_pts // 2000 + 1))
+    nch = _chunks(n_pts, 2000)
     parts, tparts, misses = _reduced_kernel(
         *arrays,
         jp,
@@ -810,8 +813,12 @@ def point_normals(pidx, jp, r, n_pts):  # pragma: no cover - compiled
 
 
 @njit(cache=True, parallel=True)
-def inv3(V):  # pragma: no cover - compiled
-    """Inverses of ``(n, 3, 3)`` blocks by cofactors; ``ok`` False where (nearly) singular."""
+def inv3(V, rtol):  # pragma: no cover - compiled
+    """Inverses of ``(n, 3, 3)`` blocks by cofactors; ``ok`` False where (nearly) singular:
+    unless the determinant of the unit-diagonal scaled block is at least ``27·rtol``, which
+    proves its smallest eigenvalue at least ``rtol`` times its largest (those blocks are left
+    to an eigendecomposition, see ``schur._inv_blocks``).
+    """
     n = V.shape[0]
     out = np.zeros_like(V)
     ok = np.zeros(n, dtype=np.bool_)
@@ -823,11 +830,7 @@ def inv3(V):  # pragma: no cover - compiled
         B = f * g - d * k
         C = d * h - e * g
         det = a * A + b * B + c * C
-        m = 0.0
-        for x in range(3):
-            for y in range(3):
-                m = max(m, abs(V[i, x, y]))
-        if not (abs(det) > 1e-12 * m * m * m):
+        if not (a > 0.0 and e > 0.0 and k > 0.0 and det >= 27.0 * rtol * (a * e * k)):
             continue
         ok[i] = True
         r = 1.0 / det

@@ -20,6 +20,7 @@ from hsgeo.adjust.parameters import Parameters
 from hsgeo.adjust.residuals import ResidualBlock
 from hsgeo.adjust.schur import _Normal, _normal, _reduced
 from hsgeo.adjust.system import _evaluate, _Layout
+from hsgeo.adjust.threads import engine_threads
 from hsgeo.errors import DatumError
 
 __all__ = ["identifiability", "Identifiability"]
@@ -177,8 +178,9 @@ def identifiability(
     layout = _Layout(params)
     masks = [np.ones(b.m, dtype=bool) for b in blocks]
     options = SolverOptions(rank_rtol=rtol)
-    sy = _evaluate(layout, blocks, masks, jacobian=True, compiled=options.compiled)
-    return _analyse(layout, _normal(layout, sy, options), options.rank_rtol)
+    with engine_threads(options.threads, sum(b.m for b in blocks), options.blas_threads):
+        sy = _evaluate(layout, blocks, masks, jacobian=True, compiled=options.compiled)
+        return _analyse(layout, _normal(layout, sy, options), options.rank_rtol)
 
 
 def _surely_full_rank(layout: _Layout, ne: _Normal, rtol: float) -> bool:

@@ -104,6 +104,15 @@ class SolverOptions:
         Keep the Jacobian of the final iterate in the result, which
         :meth:`~hsgeo.adjust.AdjustmentResult.point_covariance` (and ``sigma`` of the points)
         needs. Off by default: the Jacobian can be the largest array of a solve.
+    threads : "auto" or int, default "auto"
+        Threads of the compiled kernels during the solve (:mod:`hsgeo.adjust.threads`).
+        ``"auto"``: one thread below ``PARALLEL_MIN_ROWS`` residual rows and numba's pool
+        above (measured: ``bench/results/busy_machine.json``); an integer: that many. Only
+        the speed depends on it, never the numbers (bit for bit).
+    blas_threads : int, default 1
+        Threads of BLAS/LAPACK (the dense reduced system) during the solve, whatever the
+        shell's ``OPENBLAS_NUM_THREADS``. Results differ in the last digits with the count,
+        the decisions taken from them (rank, datum, covariance) do not.
 
     Raises
     ------
@@ -132,12 +141,16 @@ class SolverOptions:
     raise_on_failure: bool = True
     compiled: bool = True
     keep_jacobian: bool = False
+    threads: int | str = "auto"
+    blas_threads: int = 1
 
     def __post_init__(self) -> None:
-        for name in ("max_iter", "max_reject_rounds"):
+        for name in ("max_iter", "max_reject_rounds", "blas_threads"):
             v = getattr(self, name)
             if isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers.Integral) or v < 0:
                 raise InputError(f"SolverOptions.{name} must be a non-negative integer, got {v!r}")
+        if self.blas_threads < 1:
+            raise InputError(f"SolverOptions.blas_threads must be ≥ 1, got {self.blas_threads!r}")
         positive = (
             "ftol",
             "lambda0",
@@ -192,6 +205,17 @@ class SolverOptions:
             v = getattr(self, name)
             if not isinstance(v, (bool, np.bool_)):
                 raise InputError(f"SolverOptions.{name} must be True or False, got {v!r}")
+
+        t = self.threads
+        if not (
+            t == "auto"
+            if isinstance(t, str)
+            else isinstance(t, numbers.Integral) and not isinstance(t, (bool, np.bool_)) and t >= 1
+        ):
+            raise InputError(
+                f"SolverOptions.threads must be 'auto' (chosen by the size of the problem) or a "
+                f"positive number of threads, got {t!r}"
+            )
 
     @classmethod
     def field_names(cls) -> list[str]:

@@ -10,6 +10,7 @@ import numpy as np
 from scipy import stats as sst
 
 from hsgeo.adjust.parameters import Parameters
+from hsgeo.adjust.threads import engine_threads
 from hsgeo.errors import InputError
 
 __all__ = ["AdjustmentResult"]
@@ -131,7 +132,9 @@ class AdjustmentResult:
         p = pb.shape[1]
         pts = np.arange(pb.shape[0]) if index is None else np.atleast_1d(np.asarray(index))
         s2 = self.sigma0**2 if np.isfinite(self.sigma0) else 1.0
-        out = self._point_cofactors(pts, chunk)
+        # kernels parallel only for many observations (hsgeo.adjust.threads)
+        with engine_threads("auto", int(self.n_observations)):
+            out = self._point_cofactors(pts, chunk)
         out *= s2
         fixed = ~pb.free[pts]
         for j in range(p):

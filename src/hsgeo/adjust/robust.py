@@ -27,7 +27,10 @@ def _leverage(ne: _Normal, sy: _System) -> np.ndarray | None:
         return None
     from hsgeo.adjust._fast import point_leverage
 
-    Vinv = ne.reduced0[2] if ne.reduced0 is not None else _inv_blocks(ne.V, ne.options.compiled)
+    if ne.reduced0 is not None:
+        Vinv = ne.reduced0[2]
+    else:
+        Vinv = _inv_blocks(ne.V, ne.options.compiled, ne.options.rank_rtol)
     return point_leverage(sy.Jp, sy.pidx, np.ascontiguousarray(Vinv))
 
 

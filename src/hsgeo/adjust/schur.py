@@ -243,27 +243,46 @@ def _damped(A: np.ndarray, lam: float, D: np.ndarray | None = None) -> np.ndarra
     return A
 
 
-def _inv_blocks(Vd: np.ndarray, compiled: bool = True) -> np.ndarray:
-    """The inverses of the blocks ``Vd[i]`` (pseudo-inverse for the singular ones)."""
+def _inv_blocks(Vd: np.ndarray, compiled: bool = True, rtol: float = 1e-11) -> np.ndarray:
+    """The inverses of the blocks ``Vd[i]``; a pseudo-inverse for the singular ones.
+
+    A block is singular when the smallest eigenvalue of its unit-diagonal scaling is below
+    ``rtol`` times the largest (the datum check's rule, ``SolverOptions.rank_rtol``): a point
+    whose rays have become parallel, or whose observations were all rejected. Its
+    pseudo-inverse ``D⁻¹ (D⁻¹ V D⁻¹)⁺ D⁻¹`` drops the direction its observations cannot see,
+    which no other unknown sees either (``W u = J_cᵀ J_p u = 0``), so the reduced matrix stays
+    positive semi-definite instead of taking the rounding noise of an inverse of a singular
+    block (an indefinite reduced matrix at the solution of a 4-camera BAL subset).
+    """
     if compiled and Vd.ndim == 3 and Vd.shape[1:] == (3, 3):
         from hsgeo.adjust._fast import inv3
 
-        out, ok = inv3(np.ascontiguousarray(Vd))
-        if not ok.all():
-            out[~ok] = np.linalg.pinv(Vd[~ok])
-        return out
-    try:
-        return np.linalg.inv(Vd)
-    except np.linalg.LinAlgError:
-        # some blocks are singular (e.g. a point whose observations were all rejected):
-        # pseudo-inverse for those only
-        d = np.abs(np.linalg.det(Vd))
-        scale = np.max(np.abs(Vd), axis=(1, 2)) ** Vd.shape[-1]
-        bad = ~(d > 1e-12 * scale)
+        out, ok = inv3(np.ascontiguousarray(Vd), rtol)
+    else:
+        dv = np.diagonal(Vd, axis1=-2, axis2=-1)
+        pos = np.all(dv > 0, axis=-1)
+        sq = np.sqrt(np.where(dv > 0, dv, 1.0))
+        p = Vd.shape[-1]
+        # unit diagonal: det ≥ rtol·p^p proves λ_min ≥ rtol·λ_max (as the datum check)
+        ok = pos & (np.linalg.det(Vd / sq[..., :, None] / sq[..., None, :]) >= rtol * p**p)
         out = np.empty_like(Vd)
-        out[~bad] = np.linalg.inv(Vd[~bad])
-        out[bad] = np.linalg.pinv(Vd[bad])
-        return out
+        out[ok] = np.linalg.inv(Vd[ok])
+    if not ok.all():
+        out[~ok] = _scaled_pinv(Vd[~ok], rtol)
+    return out
+
+
+def _scaled_pinv(V: np.ndarray, rtol: float) -> np.ndarray:
+    """``D⁻¹ (D⁻¹ V D⁻¹)⁺ D⁻¹`` of symmetric blocks, eigenvalues below ``rtol·λ_max`` dropped."""
+    dv = np.diagonal(V, axis1=-2, axis2=-1)
+    sq = np.sqrt(np.where(dv > 0, dv, 1.0))
+    Vs = V / sq[..., :, None] / sq[..., None, :]
+    Vs = np.where((dv > 0)[..., :, None] & (dv > 0)[..., None, :], Vs, 0.0)
+    ev, U = np.linalg.eigh(Vs)
+    keep = ev > rtol * np.maximum(ev[..., -1:], 1e-300)
+    inv_ev = np.where(keep, 1.0 / np.where(keep, ev, 1.0), 0.0)
+    P = np.einsum("...ik,...k,...jk->...ij", U, inv_ev, U)
+    return P / sq[..., :, None] / sq[..., None, :]
 
 
 def _block_diag(Vinv: np.ndarray) -> sp.csr_matrix:
@@ -294,7 +313,7 @@ def _reduced(layout: _Layout, ne: _Normal, lam: float):
 
         cached = ne.reduced0 if lam_p == 0.0 else None
         if cached is None:
-            Vinv = _inv_blocks(_damped(ne.V, lam_p), ne.options.compiled)
+            Vinv = _inv_blocks(_damped(ne.V, lam_p), ne.options.compiled, ne.options.rank_rtol)
             sy = ne.sy
             if ne.S_chord is not None and lam_p == 0.0:
                 S0 = ne.S_chord  # a chord step: the matrix of an earlier point (see adjust)
@@ -324,7 +343,7 @@ def _reduced(layout: _Layout, ne: _Normal, lam: float):
     S = _damped(ne.Ncc, lam, ne.D_c)
     if ne.V is None:
         return S, rhs, None, None
-    Vinv = _inv_blocks(_damped(ne.V, lam_p), ne.options.compiled)
+    Vinv = _inv_blocks(_damped(ne.V, lam_p), ne.options.compiled, ne.options.rank_rtol)
     WVinv = (ne.W @ _block_diag(Vinv)).tocsr()
     if layout.n_c:
         S = S - (WVinv @ ne.W.T).toarray()
@@ -365,30 +384,45 @@ def _predicted_decrease(layout, ne: _Normal, lam, dc, dp) -> float:
 # ----------------------------------------------------------------------------------------------
 # Covariances at the solution
 # ----------------------------------------------------------------------------------------------
-def _spd_inverse(S: np.ndarray) -> np.ndarray:
-    """The inverse of a symmetric positive definite matrix from its Cholesky factor.
+def _spd_inverse(S: np.ndarray, rtol: float) -> np.ndarray:
+    """The inverse of a symmetric positive definite matrix, scaled to unit diagonal first.
 
-    LAPACK potrf + potri: a third of the work of solving for the identity.
+    LAPACK potrf + potri on ``D^-½ S D^-½`` (a third of the work of solving for the identity).
+    The scaling makes the factorisation's success depend on the matrix's conditioning, not on
+    the units of its columns; if it still fails, the eigenvalues decide with the datum check's
+    rule (smallest ≥ ``rtol`` × largest), so that whether a matrix counts as singular does not
+    depend on the summation order of the BLAS threads.
     """
-    c, info = lapack.dpotrf(S, lower=True, clean=False)
+    d = np.diag(S).copy()
+    if not np.all(d > 0):
+        raise np.linalg.LinAlgError("the matrix has a zero or negative diagonal entry")
+    d = 1.0 / np.sqrt(d)
+    Ss = S * d[:, None] * d[None, :]
+    c, info = lapack.dpotrf(Ss, lower=True, clean=False)
+    if info == 0:
+        inv, info = lapack.dpotri(c, lower=True, overwrite_c=True)
+        inv = np.tril(inv) + np.tril(inv, -1).T
     if info != 0:
-        raise np.linalg.LinAlgError(f"the matrix is not positive definite (potrf info {info})")
-    inv, info = lapack.dpotri(c, lower=True, overwrite_c=True)
-    if info != 0:
-        raise np.linalg.LinAlgError(f"the matrix is singular (potri info {info})")
-    return np.tril(inv) + np.tril(inv, -1).T
+        ev, evec = np.linalg.eigh(Ss)
+        if not ev[0] >= rtol * max(float(ev[-1]), 1e-300):
+            raise np.linalg.LinAlgError(
+                f"the matrix is singular (smallest eigenvalue {ev[0]:.3g} of the unit-diagonal "
+                f"scaled matrix, largest {ev[-1]:.3g})"
+            )
+        inv = (evec / ev) @ evec.T
+    return inv * d[:, None] * d[None, :]
 
 
 def _reduced_inverse(layout: _Layout, ne: _Normal) -> np.ndarray:
     """``S⁻¹`` of the undamped reduced matrix at the point of ``ne`` (a chord matrix dropped).
 
-    Raises ``np.linalg.LinAlgError`` if ``S`` is not positive definite.
+    Raises ``np.linalg.LinAlgError`` if ``S`` is singular (see :func:`_spd_inverse`).
     """
     ne.exact()  # the covariance needs the reduced matrix of this point
     S, _, _, _ = _reduced(layout, ne, 0.0)
     if not layout.n_c:
         return np.zeros((0, 0))
-    return _spd_inverse(S)
+    return _spd_inverse(S, ne.options.rank_rtol)
 
 
 def _point_cofactors(

@@ -61,6 +61,7 @@ from hsgeo.adjust.schur import (
     _step,
 )
 from hsgeo.adjust.system import _evaluate, _Layout, _NonFinite, _System
+from hsgeo.adjust.threads import engine_threads
 from hsgeo.errors import ConvergenceError, DatumError, InputError, ObservationError
 
 __all__ = ["adjust"]
@@ -128,6 +129,12 @@ def adjust(
     blocks = [blocks] if isinstance(blocks, ResidualBlock) else list(blocks)
     if not blocks:
         raise ObservationError("no residual blocks given: nothing to adjust")
+    # threads chosen by the size of the problem (hsgeo.adjust.threads): the speed, not the bits
+    with engine_threads(opts.threads, sum(b.m for b in blocks), opts.blas_threads):
+        return _adjust(params, blocks, opts, progress)
+
+
+def _adjust(params, blocks, opts: SolverOptions, progress) -> AdjustmentResult:
     solve = _Solve(params.copy(), blocks, opts, progress)
     # rounds mode: while outliers are still being rejected, a round only needs to get close to
     # its minimum (the residuals that decide the rejection do not change at 1e-4 relative
