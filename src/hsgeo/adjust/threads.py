@@ -10,9 +10,10 @@ same on the small dense factorisations of the reduced normal matrix (GUIDE §9).
 So the engine decides, per solve, from the size of the problem:
 
 * ``threads="auto"`` (:class:`~hsgeo.adjust.SolverOptions`' default): the compiled kernels run
-  on one thread below :data:`PARALLEL_MIN_ROWS` residual rows, on numba's full pool
-  (``NUMBA_NUM_THREADS``, the number of cores) from there on; ``threads=n``: on n threads (at
-  most numba's pool size).
+  on one thread below :data:`PARALLEL_MIN_ROWS` residual rows; from there on on as many threads
+  as there are cores that other processes leave idle (sampled for 50 ms when the solve starts),
+  at most numba's pool (``NUMBA_NUM_THREADS``, the number of cores); ``threads=n``: on n
+  threads (at most the pool).
 * BLAS runs on ``SolverOptions.blas_threads`` threads, one by default, whatever the shell's
   ``OPENBLAS_NUM_THREADS``: the reduced systems of these problems have at most a few thousand
   unknowns, where one thread was the fastest, and with a fixed count the numbers do not depend
@@ -34,6 +35,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import os
 from collections.abc import Iterator
 
 import numba
@@ -54,12 +56,27 @@ def pool_size() -> int:
     return int(numba.config.NUMBA_NUM_THREADS)
 
 
+def free_cores(sample_s: float = 0.05) -> float:
+    """The cores that other processes left idle during a short sample (psutil; this process
+    sleeps while it samples).
+    """
+    import psutil
+
+    n = os.cpu_count() or 1
+    return n * (1.0 - psutil.cpu_percent(interval=sample_s) / 100.0)
+
+
 def resolve(threads: int | str, rows: int) -> int:
-    """The threads of a solve with ``rows`` residual rows: ``"auto"`` or a count (clipped to the
-    pool).
+    """The kernels' threads for a solve with ``rows`` residual rows (at most numba's pool).
+
+    ``"auto"``: one thread below :data:`PARALLEL_MIN_ROWS`; above, as many as there are cores
+    that other processes leave idle (:func:`free_cores`, sampled once per solve), at least one:
+    with one of two cores busy, a second thread only waits for it.
     """
     if threads == "auto":
-        return pool_size() if rows >= PARALLEL_MIN_ROWS else 1
+        if rows < PARALLEL_MIN_ROWS or pool_size() == 1:
+            return 1
+        return max(1, min(pool_size(), int(free_cores() + 0.25)))
     return max(1, min(int(threads), pool_size()))
 
 
