@@ -21,7 +21,7 @@ import numpy as np
 from hsgeo.adjust import adjust, identifiability
 from hsgeo.errors import InputError
 from hsgeo.papers import P002, P002_STATS
-from hsgeo.report import Reproduction, Row, agreement
+from hsgeo.report import Reproduction, Row
 from hsgeo.simulate.pushbroom_campaign import (
     CampaignConfig,
     CampaignObservations,
@@ -271,20 +271,16 @@ def run(seed: int = 0, scale: float = 1.0, progress=None, plan: dict | None = No
         ns,
         extremes=same_size,
     )
-    for row in rows:  # the key-point σ was chosen to bring the NMADs near the paper's
-        if row.quantity in ("nmad_x_px", "nmad_y_px"):
-            how = agreement(row.z_paper)
-            row.verdict = "tuned"
-            row.reason = (
-                f"the key-point localisation σ ({cfg.sigma_keypoint_px:g} px) was chosen to "
-                f"bring it near the paper's; it is {how}"
-                + ("" if "off" in how else " of it")
-                + f" (spread over {ns} runs)"
-            )
+    for row in rows:
+        # issue 22: the key-point σ per image axis was tuned to the paper's NMADs (a miss
+        # beyond 3σ is "differs: tuning missed"); the other statistics follow from our choices
+        row.provenance = "tuned" if row.quantity in ("nmad_x_px", "nmad_y_px") else "chosen"
     # -- 002 Tables 2 and 3: check points, m (the same 13 at every scale)
     E_gcp, E_nogcp = cp_errors(res, truth), cp_errors(res0, truth)
     for name, E in (("002 Table 2", E_gcp), ("002 Table 3", E_nogcp)):
         rows += _stats_rows(name, ("e", "n", "h"), E, "m", P002[name], sg[name], ns)
+    for row in rows:
+        row.provenance = row.provenance or "chosen"
     # -- 002 Fig. 8: principal distance per band minus the mean
     d_um, s_um, t_um = c_minus_mean(res, truth.values["c_mm"])
     for b, wl in enumerate(cfg.wavelengths_nm):
@@ -306,6 +302,7 @@ def run(seed: int = 0, scale: float = 1.0, progress=None, plan: dict | None = No
             paper=P002["fig8_max_abs_diff_um"],
             reproduced=np.max(np.abs(d_um)),
             truth=np.max(np.abs(t_um)),
+            provenance="tuned",  # the true per-band offsets were set from the paper's ≤ 11.8 µm
         )
     )
     c_mean = res.value("c_mm").mean()
@@ -319,6 +316,7 @@ def run(seed: int = 0, scale: float = 1.0, progress=None, plan: dict | None = No
             paper=P002["chromatic_shift_px"],
             reproduced=shift,
             truth=np.max(np.abs(t_um)) * 1e-3 / truth.values["c_mm"].mean() * half_px,
+            provenance="tuned",  # follows from the tuned per-band offsets
         )
     )
     # -- parameters: boresight, lever arm, distortion, c, nodes (with GCPs)
@@ -622,6 +620,8 @@ def _factor_rows(fac: dict) -> list[Row]:
                     paper=paper[j],
                     reproduced=float(np.mean(v[:, j])),
                     sigma=float(np.std(v[:, j], ddof=1)) if len(v) > 1 else None,
+                    n_runs=len(v),
+                    provenance="chosen",
                 )
             )
     return rows
@@ -647,6 +647,7 @@ def _interval_rows(study: list[dict], sweep: dict) -> list[Row]:
                 "s",
                 paper=10.0,  # 002 §4: "the trajectory segmentation time step was set to 10 s"
                 reproduced=optimum_interval(st),
+                provenance="chosen",
             )
         )
     return rows
