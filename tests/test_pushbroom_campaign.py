@@ -135,6 +135,22 @@ def test_check_points_see_as_many_strips_as_tie_points():
         simulate(0.001, rng=0, cfg=replace(cfg, cp_rays="some"))
 
 
+def test_distortion_ripple_is_added_along_the_line_only():
+    """The unmodelled distortion residual (issue 22) moves x by a·sin(2πk x/n), nothing else."""
+    from dataclasses import replace
+
+    from hsgeo.simulate.pushbroom_campaign import CampaignConfig, distortion_ripple_px
+
+    off = replace(CampaignConfig(), distortion_ripple_px=0.0)
+    o0, t0 = simulate(0.002, rng=3, cfg=off)
+    o1, t1 = simulate(0.002, rng=3, cfg=replace(off, distortion_ripple_px=0.2))
+    d = t1.xy_true_px - t0.xy_true_px
+    np.testing.assert_array_equal(d[:, 1], 0.0)
+    want = 0.2 * np.sin(2 * np.pi * 3.0 / 1800 * t0.xy_true_px[:, 0])
+    np.testing.assert_allclose(d[:, 0], want, atol=1e-12)
+    np.testing.assert_allclose(distortion_ripple_px(450.0, CampaignConfig()), -0.1, atol=1e-12)
+
+
 def _digest(obs, truth) -> str:
     """sha256 of the bytes of every observation and truth array of one simulation."""
     import hashlib
@@ -176,7 +192,11 @@ DIGESTS_MAIN_E7C3C51 = {
 
 #: The options of main at e7c3c51 (issue 22 changed both defaults: a key-point σ per axis, and
 #: check points seen by as many strips as a tie point).
-MAIN_E7C3C51 = {"sigma_keypoint_px": (0.35, 0.35), "cp_rays": "all strips"}
+MAIN_E7C3C51 = {
+    "sigma_keypoint_px": (0.35, 0.35),
+    "cp_rays": "all strips",
+    "distortion_ripple_px": 0.0,
+}
 
 
 def _main_cfg():

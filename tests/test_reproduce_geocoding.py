@@ -56,6 +56,12 @@ def check_verdicts(rep, n_flights):
     for r in rep.rows_of("simulated, ratio"):
         assert r.provenance == "tuned" and r.judge()[0] in ("by construction", "differs")
     assert rep.meta["displacement_edge_m"] > 0
+    # issue 22: the DEM error the geocoder does not model, on by default, and its effect
+    ue = {r.quantity: r for r in rep.rows_of("unmodelled effect")}
+    assert len(ue) == 12 and all(r.n_runs == n_flights for r in ue.values())
+    on, off = ue["dem_error_on.calibrated.sigma_y_m"], ue["dem_error_off.calibrated.sigma_y_m"]
+    (row,) = [r for r in rep.rows_of("simulated, calibrated") if r.quantity == "sigma_y_m"]
+    assert on.reproduced == row.reproduced and on.reproduced != off.reproduced
 
 
 def test_displacement_matches_the_rays_on_a_level_flight():

@@ -78,6 +78,7 @@ __all__ = [
     "CP_RAYS",
     "TRAJECTORY_ERRORS",
     "block_length_m",
+    "distortion_ripple_px",
     "gauss_markov",
     "refraction_k",
     "simulate",
@@ -163,6 +164,12 @@ class CampaignConfig:
     # CPs "tie points with known coordinates") or "all strips" (every covering strip, the
     # simulator before issue 22)
     cp_rays: str = "tie points"
+    # -- the instrument effect the estimator does not model (on by default; issue 22): a
+    # distortion residual outside 002 eq. (3), a ripple along the line of this amplitude (px)
+    # and number of periods over the line (ours: the residual of a polynomial lens model is of
+    # a tenth of a pixel; 0 switches it off). Not in the noise-free mode.
+    distortion_ripple_px: float = 0.1
+    distortion_ripple_periods: float = 3.0
 
 
 @dataclass(frozen=True)
@@ -406,6 +413,15 @@ def _strip_plan(cfg: CampaignConfig, extra_m: float = 0.0):
 CHUNK_ROWS = 1 << 18
 
 
+def distortion_ripple_px(x_px, cfg: CampaignConfig) -> np.ndarray:
+    """The distortion residual outside 002 eq. (3) at image x (px from the principal point):
+    ``a · sin(2π k x / n_px)`` with ``a = cfg.distortion_ripple_px``, ``k`` periods over the
+    ``n_px`` pixels of the line (no Brown polynomial of 002 eq. (3) represents it).
+    """
+    k = cfg.distortion_ripple_periods / cfg.pixels_per_line
+    return cfg.distortion_ripple_px * np.sin(2 * np.pi * k * np.asarray(x_px, dtype=np.float64))
+
+
 def _row_chunks(m: int):
     """Slices of ``range(m)`` of at most :data:`CHUNK_ROWS` rows."""
     return [slice(a, min(a + CHUNK_ROWS, m)) for a in range(0, m, CHUNK_ROWS)]
@@ -589,22 +605,17 @@ def simulate(
     if np.any(ncov < 3):
         raise InputError("simulated flight plan leaves points seen by fewer than 3 strips")
     extra = cfg.obs_per_point_mean - 3.0
-    # the points seen in every covering strip: the GCPs, and the check points with
-    # cp_rays="all strips" (the same draws as before issue 22)
-    all_rays = is_ref.copy()
-    if cfg.cp_rays == "tie points":
-        all_rays[4 : len(ref_en)] = False
-    n_obs = np.where(all_rays, ncov, np.minimum(ncov, 3 + rng.poisson(extra, n_pts)))
-    # the strips of each point: all for a GCP, a random n_obs of them for a tie point (and a
-    # check point, cp_rays="tie points"). One Generator.choice per point (its draws cannot be
-    # vectorised without changing the random stream); the candidates come from one np.nonzero
-    # (row-major, as flatnonzero per row did)
+    n_obs = np.where(is_ref, ncov, np.minimum(ncov, 3 + rng.poisson(extra, n_pts)))
+    # the strips of each point: all for a reference square (the check points keep a subset at
+    # the end, cp_rays="tie points"), a random n_obs of them for a tie point. One
+    # Generator.choice per point (its draws cannot be vectorised without changing the random
+    # stream); the candidates come from one np.nonzero (row-major, as flatnonzero per row did)
     cand_strip = np.nonzero(covers)[1]
     cand_end = np.cumsum(ncov)
     strip_list, n_choose = [], n_obs.tolist()
     for i, (b, e) in enumerate(zip((cand_end - ncov).tolist(), cand_end.tolist(), strict=True)):
         cand = cand_strip[b:e]
-        strip_list.append(cand if all_rays[i] else rng.choice(cand, n_choose[i], replace=False))
+        strip_list.append(cand if is_ref[i] else rng.choice(cand, n_choose[i], replace=False))
     pidx = np.repeat(np.arange(n_pts), n_obs)
     strip = np.concatenate(strip_list)
     del strip_list, covers
@@ -665,6 +676,9 @@ def simulate(
         r2 = np.sum(d**2, axis=1) / truth[names["c"]][band] ** 2
         xy_true_mm = xy_true_mm + (k * (1 + r2))[:, None] * d
     xy_true_px = xy_true_mm / cfg.pixel_mm
+    if cfg.distortion_ripple_px and not noise_free:
+        # a distortion residual outside 002 eq. (3) (issue 22): a ripple along the line
+        xy_true_px[:, 0] += distortion_ripple_px(xy_true_px[:, 0], cfg)
     # navigation solution at the line times: truth minus the error (row-wise, in chunks)
     xyz_nav, rpy_nav, xyz_rate_nav, rpy_rate_nav = (np.empty((m, 3)) for _ in range(4))
     for rows in _row_chunks(m):
@@ -697,6 +711,18 @@ def simulate(
         comp = rng.integers(0, 2, n_out)
         xy_obs[np.flatnonzero(outlier), comp] += mag
         gcp_xyz = P[:4] + cfg.sigma_gcp_m * rng.standard_normal((4, 3))
+    if cfg.cp_rays == "tie points":
+        # a check point keeps as many of its strips as a tie point sees (≥ 3, 3 + Poisson),
+        # drawn after every other draw: the tie points and the GCPs are those of "all strips"
+        keep = np.ones(m, bool)
+        for i in range(4, len(ref_en)):
+            rows_i = np.flatnonzero(pidx == i)
+            k = min(rows_i.size, 3 + int(rng.poisson(extra)))
+            keep[rng.choice(rows_i, rows_i.size - k, replace=False)] = False
+        pidx, band, t_line, xy_obs, strip = (a[keep] for a in (pidx, band, t_line, xy_obs, strip))
+        xyz_nav, rpy_nav = xyz_nav[keep], rpy_nav[keep]
+        xyz_rate_nav, rpy_rate_nav = xyz_rate_nav[keep], rpy_rate_nav[keep]
+        outlier, xy_true_px = outlier[keep], xy_true_px[keep]
     lines = PushbroomObservations(
         point=pidx,
         band=band,
