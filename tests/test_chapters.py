@@ -8,6 +8,7 @@ cell fails the test with the cell's source and traceback in the message.
 
 from __future__ import annotations
 
+import json
 import os
 import re
 from pathlib import Path
@@ -111,3 +112,7 @@ def test_chapter_executes(
         assert (records / f"{chapter}.json").is_file(), (
             f"{path.relative_to(BOOK)} does not call hsgeo.reproduce.run({chapter!r}, ...)"
         )
+        # issue 22 (GUIDE §4): every row with a verdict says where its truth comes from
+        rows = json.loads((records / f"{chapter}.json").read_text(encoding="utf-8"))["rows"]
+        missing = [r["quantity"] for r in rows if r["verdict"] and not r.get("provenance")]
+        assert not missing, f"{chapter}: verdict rows without a provenance: {missing[:5]}"

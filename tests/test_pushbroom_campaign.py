@@ -111,6 +111,46 @@ def test_reference_squares_measured_by_their_centre():
     assert 0.4 < np.std(err) < 0.75, np.std(err)
 
 
+def test_check_points_see_as_many_strips_as_tie_points():
+    """002 §4: the CPs are "tie points with known coordinates" (issue 22): by default they get
+    a tie point's ray count; cp_rays="all strips" keeps every covering strip (the GCPs always)."""
+    from dataclasses import replace
+
+    from hsgeo.simulate.pushbroom_campaign import CampaignConfig
+
+    cfg = CampaignConfig()
+    counts = {}
+    for mode in ("tie points", "all strips"):
+        obs, truth = simulate(0.01, rng=2, cfg=replace(cfg, cp_rays=mode))
+        n = np.bincount(obs.lines.point, minlength=obs.n_points)
+        strips = [np.unique(truth.strip[obs.lines.point == i]).size for i in range(17)]
+        counts[mode] = (n, strips)
+    n_tie, s_tie = counts["tie points"]
+    n_all, s_all = counts["all strips"]
+    assert n_tie[4:17].min() >= 3 and n_tie[4:17].mean() < 6  # a tie point's 3–6 rays
+    assert n_all[4:17].min() >= 10  # every covering strip: 14–20 rays
+    np.testing.assert_array_equal(s_tie[:4], s_all[:4])  # the GCPs: every covering strip
+    assert n_all[:4].min() >= 10
+    with pytest.raises(InputError, match="cp_rays"):
+        simulate(0.001, rng=0, cfg=replace(cfg, cp_rays="some"))
+
+
+def test_distortion_ripple_is_added_along_the_line_only():
+    """The unmodelled distortion residual (issue 22) moves x by a·sin(2πk x/n), nothing else."""
+    from dataclasses import replace
+
+    from hsgeo.simulate.pushbroom_campaign import CampaignConfig, distortion_ripple_px
+
+    off = replace(CampaignConfig(), distortion_ripple_px=0.0)
+    o0, t0 = simulate(0.002, rng=3, cfg=off)
+    o1, t1 = simulate(0.002, rng=3, cfg=replace(off, distortion_ripple_px=0.2))
+    d = t1.xy_true_px - t0.xy_true_px
+    np.testing.assert_array_equal(d[:, 1], 0.0)
+    want = 0.2 * np.sin(2 * np.pi * 3.0 / 1800 * t0.xy_true_px[:, 0])
+    np.testing.assert_allclose(d[:, 0], want, atol=1e-12)
+    np.testing.assert_allclose(distortion_ripple_px(450.0, CampaignConfig()), -0.1, atol=1e-12)
+
+
 def _digest(obs, truth) -> str:
     """sha256 of the bytes of every observation and truth array of one simulation."""
     import hashlib
@@ -150,11 +190,41 @@ DIGESTS_MAIN_E7C3C51 = {
 }
 
 
+#: The options of main at e7c3c51 (issue 22 changed both defaults: a key-point σ per axis, and
+#: check points seen by as many strips as a tie point).
+MAIN_E7C3C51 = {
+    "sigma_keypoint_px": (0.35, 0.35),
+    "cp_rays": "all strips",
+    "distortion_ripple_px": 0.0,
+}
+
+
+def _main_cfg():
+    from dataclasses import replace
+
+    from hsgeo.simulate.pushbroom_campaign import CampaignConfig
+
+    return replace(CampaignConfig(), **MAIN_E7C3C51)
+
+
 @pytest.mark.parametrize("scale, seed, noise_free", sorted(DIGESTS_MAIN_E7C3C51))
 def test_scale_up_to_one_is_bit_identical_to_main(scale, seed, noise_free):
     kw = {"noise_free": True, "trajectory_error": "spline"} if noise_free else {}
-    obs, truth = simulate(scale, rng=seed, **kw)
+    obs, truth = simulate(scale, rng=seed, cfg=_main_cfg(), **kw)
     assert _digest(obs, truth) == DIGESTS_MAIN_E7C3C51[(scale, seed, noise_free)]
+
+
+# sha256 of simulate()'s arrays with the code at 2361056 (before issue 22 changed the defaults of
+# sigma_keypoint_px and cp_rays): with the former values the simulator is bit-identical to it
+DIGESTS_2361056 = {
+    (0.01, 0): "728e956a5a5f913b33e98d1193b3f3dc17303017dd1389412238782099c158ce",
+    (0.05, 3): "20a1a914bcd925d38e4254acbda4834f2d059d107a4cf946b74173d4ed5ed73b",
+}
+
+
+@pytest.mark.parametrize("scale, seed", sorted(DIGESTS_2361056))
+def test_former_options_give_the_former_bits(scale, seed):
+    assert _digest(*simulate(scale, rng=seed, cfg=_main_cfg())) == DIGESTS_2361056[(scale, seed)]
 
 
 def test_chunked_rows_give_the_same_bits(monkeypatch):
@@ -162,9 +232,9 @@ def test_chunked_rows_give_the_same_bits(monkeypatch):
     import hsgeo.simulate.pushbroom_campaign as pc
 
     monkeypatch.setattr(pc, "CHUNK_ROWS", 997)
-    obs, truth = simulate(0.01, rng=0)
+    obs, truth = simulate(0.01, rng=0, cfg=_main_cfg())
     assert obs.lines.n > 4 * 997
-    assert _digest(obs, truth) == DIGESTS_MAIN_E7C3C51[(0.01, 0, False)]
+    assert _digest(obs, truth) == DIGESTS_2361056[(0.01, 0)]
 
 
 def test_long_block_beyond_the_paper():

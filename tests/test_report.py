@@ -18,7 +18,7 @@ def test_z_is_deviation_from_truth_in_sigmas():
 def test_verdicts_follow_the_numbers():
     # truth = paper: agreement with the paper is by construction, the reason gives the recovery
     v, why = Row("t", "c", "px", paper=3539, reproduced=3541, sigma=1.0, truth=3539).judge()
-    assert v == "tuned" and "within 2σ" in why
+    assert v == "by construction" and "within 2σ" in why
     # independent outcome: judged by the combined σ of ours and the paper's
     assert Row("t", "q", "m", paper=1.0, paper_sigma=0.3, reproduced=1.5, sigma=0.4).judge()[0] == (
         "reproduced"
@@ -33,7 +33,64 @@ def test_verdicts_follow_the_numbers():
         "004",
     )
     with pytest.raises(InputError, match="use one of"):
-        Row("t", "q", "m", verdict="fine")
+        Row("t", "q", "m", verdict="fine", reason="x")
+
+
+def test_provenance_decides_what_counts_as_reproduced():
+    # GUIDE §4: agreement built in (paper, derived, tuned) is never "reproduced"
+    for prov in ("paper", "derived", "tuned"):
+        r = Row(
+            "t", "q", "m", paper=1.0, paper_sigma=0.3, reproduced=1.1, sigma=0.1, provenance=prov
+        )
+        assert r.judge()[0] == "by construction", prov
+    # the same numbers from a chosen assumption are an independent outcome
+    r = Row(
+        "t", "q", "m", paper=1.0, paper_sigma=0.3, reproduced=1.1, sigma=0.1, provenance="chosen"
+    )
+    assert r.judge()[0] == "reproduced"
+    # a tuning that missed by more than 3σ differs (002 Table 1 NMAD x before issue 22)
+    v, why = Row(
+        "t",
+        "nmad_x_px",
+        "px",
+        paper=0.32,
+        reproduced=0.283,
+        sigma=0.0028,
+        n_runs=8,
+        provenance="tuned",
+    ).judge()
+    assert v == "differs" and why.startswith("tuning missed") and "8 runs" in why
+    # a derived truth that misses the paper differs too, with the chapter's reason if it gave one
+    r = Row("t", "q", "m", paper=1.0, reproduced=2.0, sigma=0.1, provenance="derived", reason="R")
+    assert r.judge() == ("differs", "R") and not r.overridden
+    # tuned without any σ: by construction, said so
+    v, why = Row("t", "q", "m", paper=1.0, reproduced=1.2, provenance="tuned").judge()
+    assert v == "by construction" and "no σ" in why
+
+
+def test_overrides_need_a_reason_and_are_marked():
+    with pytest.raises(InputError, match="without a reason"):
+        Row("t", "q", "m", paper=1.0, reproduced=1.0, verdict="not testable")
+    r = Row(
+        "t",
+        "bias",
+        "m",
+        paper=0.0,
+        paper_sigma=0.1,
+        reproduced=0.5,
+        sigma=0.1,
+        provenance="chosen",
+        verdict="not testable",
+        reason="removed by the boresight",
+    )
+    assert r.rule()[0] == "differs" and r.judge() == ("not testable", "removed by the boresight")
+    assert r.overridden and r.as_dict()["override"] is True
+    # a stated verdict equal to the rule's is no override; "planned" is a status, not one
+    same = Row("t", "q", "m", paper=1.0, reproduced=1.0, verdict="not testable", reason="x")
+    assert not same.overridden
+    assert not Row("t", "q", "m", paper=1.0, verdict="planned", reason="004").overridden
+    back = Reproduction.from_json(Reproduction("x", 0, [r, same]).to_json())
+    assert [b.overridden for b in back.rows] == [True, False]
 
 
 def test_agreement_words():

@@ -4,7 +4,14 @@ import json
 
 from hsgeo.report import Reproduction, Row
 from hsgeo.reproduce import RECORD_ENV, recorded, run
-from hsgeo.reproduce.scoreboard import PAPER_CHAPTERS, claims, counts, planned_claims
+from hsgeo.reproduce.scoreboard import (
+    PAPER_CHAPTERS,
+    claims,
+    counts,
+    counts_by,
+    overrides,
+    planned_claims,
+)
 
 
 def test_claims_are_the_paper_tables_plus_planned():
@@ -21,19 +28,58 @@ def test_claims_are_the_paper_tables_plus_planned():
                 reproduced=3541,
                 sigma=12,
                 truth=3539,
+                provenance="paper",
             ),
             Row("000 Table 1", "unpublished", "px", reproduced=1.0),  # no paper value
             Row("distortion magnitudes", "d", "px", paper=1.0, reproduced=1.0),  # not a paper
-            Row("002 Table 2", "nmad_h_m", "m", paper=0.99, reproduced=0.3, sigma=0.05, n_runs=10),
+            Row(
+                "002 Table 2",
+                "nmad_h_m",
+                "m",
+                paper=0.99,
+                reproduced=0.3,
+                sigma=0.05,
+                n_runs=10,
+                provenance="chosen",
+            ),
+            Row(
+                "002 Table 2",
+                "mean_h_m",
+                "m",
+                paper=-0.78,
+                reproduced=0.0,
+                sigma=0.05,
+                n_runs=10,
+                provenance="chosen",
+                verdict="not testable",
+                reason="an override, for the test",
+            ),
             # an experiment against 002 Table 2's values, not a claim of its own
             Row("002 check-point factors", "rtk.cp_nmad_h_m", "m", paper=0.99, reproduced=0.5),
         ],
     )
     rows = claims({"line-calibration": rep})
-    assert [r.quantity for r in rows[:2]] == ["c", "nmad_h_m"]
-    assert rows[2:] == planned_claims() and all(r.verdict == "planned" for r in rows[2:])
+    assert [r.quantity for r in rows[:3]] == ["c", "nmad_h_m", "mean_h_m"]
+    assert rows[3:] == planned_claims() and all(r.verdict == "planned" for r in rows[3:])
     c = counts(rows)
-    assert c["tuned"] == 1 and c["differs"] == 1 and c["planned"] == len(planned_claims())
+    assert c["by construction"] == 1 and c["differs"] == 1 and c["planned"] == len(planned_claims())
+    by_prov = counts_by(rows, "provenance")
+    assert by_prov["paper"]["by construction"] == 1 and by_prov["chosen"]["differs"] == 1
+    assert by_prov["none"]["planned"] == len(planned_claims())
+    assert counts_by(rows, "paper")["002"] == {
+        **dict.fromkeys(c, 0),
+        "differs": 1,
+        "not testable": 1,
+    }
+    assert overrides(rows) == [
+        {
+            "table": "002 Table 2",
+            "quantity": "mean_h_m",
+            "verdict": "not testable",
+            "rule": "differs",
+            "reason": "an override, for the test",
+        }
+    ]
     assert set(PAPER_CHAPTERS) >= {"line-calibration", "geocoding", "pushbroom-ba", "rikola"}
 
 

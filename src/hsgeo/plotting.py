@@ -249,7 +249,7 @@ def verdict_bars(ax, per_paper):
     colours = {
         "reproduced": "#1b9e77",
         "differs": "#d95f02",
-        "tuned": "#7570b3",
+        "by construction": "#7570b3",
         "not testable": "#999999",
         "planned": "#e6ab02",
     }

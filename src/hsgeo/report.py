@@ -11,8 +11,11 @@ format their tables here, in one way:
   in units of its own standard deviation (σ̂ from the adjustment, or the spread over ``n_runs``
   repeated simulations for statistics such as an NMAD that have no σ̂ of their own);
 * the **verdict** says whether the paper's value was reproduced (:data:`VERDICTS`), with its
-  reason; it is computed from the numbers (:meth:`Row.judge`) unless the chapter states it, e.g.
-  ``"planned"``;
+  reason; it is computed from the numbers and the truth's **provenance** (:meth:`Row.rule`,
+  GUIDE §4): agreement built in (the truth is the paper's value, computed from it, or tuned to
+  it) is ``"by construction"``, never ``"reproduced"``, and a tuning that missed by more than
+  3σ is ``"differs"``. A chapter may state another verdict (an *override*, e.g. ``"planned"``)
+  only with a reason, which the scoreboard prints (:meth:`Row.overridden`);
 * words about agreement in a chapter's prose come from :func:`agreement` and :func:`summarize`,
   never typed.
 """
@@ -37,9 +40,25 @@ __all__ = [
     "format_rows",
 ]
 
-#: The verdicts of a claim (ReScience style). ``tuned``: the simulation took the paper's value as
-#: its truth, so agreement with the paper is by construction and only ``z`` is an outcome.
-VERDICTS = ("reproduced", "differs", "tuned", "not testable", "planned")
+#: The verdicts of a claim (ReScience style). ``by construction``: the truth (or the outcome) is
+#: the paper's value, computed from the paper's values or tuned to meet them, so agreement with
+#: the paper was built in and only ``z`` (the recovery of the truth) is an outcome.
+VERDICTS = ("reproduced", "differs", "by construction", "not testable", "planned")
+
+#: One sentence per verdict: what it means (the scoreboard prints them).
+VERDICT_MEANING = {
+    "reproduced": "an independent outcome (our chosen assumptions, no paper value built into its "
+    "truth) lies within 3σ of the paper's value, σ combining our σ̂ or run spread with the "
+    "paper's σ",
+    "differs": "the outcome lies more than 3σ from the paper's value; for a tuned or "
+    "paper-derived truth this means the tuning missed",
+    "by construction": "the truth is the paper's value, computed from the paper's values or "
+    "tuned so that the outcome meets them: agreement was built in and is not counted as "
+    "reproduced (the reason gives how well the estimate recovered its truth)",
+    "not testable": "there is no reproduced value, or neither side has a σ to judge a "
+    "difference by, or the chapter states why the comparison carries no information",
+    "planned": "the chapter that reproduces the claim is not written yet",
+}
 
 #: Where a row's truth comes from (GUIDE §4): ``paper`` (the paper's value used as truth),
 #: ``derived`` (computed from the paper's values), ``chosen`` (our stated assumption), ``tuned``
@@ -103,6 +122,11 @@ class Row:
     def __post_init__(self):
         if self.verdict is not None and self.verdict not in VERDICTS:
             raise InputError(f"verdict {self.verdict!r} of {self.quantity}: use one of {VERDICTS}")
+        if self.verdict is not None and not self.reason:
+            raise InputError(
+                f"verdict {self.verdict!r} of {self.quantity} is stated without a reason: a "
+                "chapter may override the computed verdict only with a reason (Row.reason)"
+            )
         if self.provenance is not None and self.provenance not in PROVENANCES:
             raise InputError(
                 f"provenance {self.provenance!r} of {self.quantity}: use one of {PROVENANCES}"
@@ -133,28 +157,70 @@ class Row:
         return abs(p - t) <= 1e-9 * max(abs(p), abs(t)) or (p == 0.0 == t)
 
     def judge(self) -> tuple[str | None, str]:
-        """The verdict on the paper's value and its reason (None for a row without a paper value).
-
-        In this order: the verdict the chapter stated; ``not testable`` without a reproduced
-        value; ``tuned`` when the truth is the paper's value (agreement by construction: the
-        reason gives the recovery z); ``reproduced`` / ``differs`` by |z_paper| ≤ 3, where
-        z_paper combines our σ (σ̂ or the spread over runs) with the paper's σ; ``not testable``
-        when neither side has a σ.
+        """The verdict on the paper's value and its reason (None for a row without a paper value):
+        the verdict the chapter stated (with its reason), else :meth:`rule`'s.
         """
         if self.verdict is not None:
             return self.verdict, self.reason
+        return self.rule()
+
+    @property
+    def overridden(self) -> bool:
+        """True when the chapter stated a verdict other than :meth:`rule`'s (``planned`` is a
+        status, not an override).
+        """
+        return (
+            self.verdict is not None
+            and self.verdict != "planned"
+            and self.verdict != self.rule()[0]
+        )
+
+    def rule(self) -> tuple[str | None, str]:
+        """The verdict computed from the numbers and the provenance (GUIDE §4).
+
+        In this order:
+
+        1. None for a row without a paper value; ``not testable`` without a reproduced value;
+        2. ``by construction`` when the truth is the paper's value (provenance ``paper``, or
+           truth = paper), was computed from the paper's values (``derived``) or tuned to meet
+           them (``tuned``), and the reproduced value lies within 3σ of the paper's (or there is
+           no σ to judge by); beyond 3σ it ``differs`` ("tuning missed" for ``tuned``);
+        3. otherwise (``chosen``, or no provenance): ``reproduced`` / ``differs`` by
+           |z_paper| ≤ 3, z_paper combining our σ (σ̂ or the spread over runs) with the paper's;
+           ``not testable`` when neither side has a σ.
+
+        ``reason`` (set by the chapter without a verdict) replaces the computed reason of a
+        ``differs``.
+        """
         if _clean(self.paper) is None:
             return None, ""
         if _clean(self.reproduced) is None:
             return "not testable", self.reason or "no reproduced value"
-        if self.truth_is_paper():
-            z = self.z
-            how = f"recovered {agreement(z)} of it" if z is not None else "no σ̂ to judge recovery"
-            return "tuned", f"simulated with the paper's value as truth; {how}"
         zp = self.z_paper
+        spread = f"spread over {self.n_runs} runs" if self.n_runs else "σ̂"
+        built_in = self.provenance in ("paper", "derived", "tuned") or self.truth_is_paper()
+        if built_in:
+            if self.provenance == "tuned":
+                what = "tuned so that it meets the paper's value"
+            elif self.provenance == "derived":
+                what = "its truth was computed from the paper's values"
+            else:
+                what = "simulated with the paper's value as truth"
+            if zp is not None and abs(zp) > Z_LIMIT:
+                missed = "tuning missed" if self.provenance == "tuned" else what
+                return "differs", self.reason or (
+                    f"{missed}: {abs(zp):.1f}σ from the paper ({spread})"
+                )
+            z = self.z
+            if z is not None:
+                how = f"recovered {agreement(z)} of its truth"
+            elif zp is not None:
+                how = f"{agreement(zp)} of the paper ({spread})"
+            else:
+                how = "no σ to judge by"
+            return "by construction", f"{what}; {how}"
         if zp is None:
             return "not testable", self.reason or "neither the paper nor the reproduction has a σ"
-        spread = f"spread over {self.n_runs} runs" if self.n_runs else "σ̂"
         if abs(zp) <= Z_LIMIT:
             return "reproduced", f"{agreement(zp)} of the paper (our {spread} and the paper's σ)"
         return "differs", self.reason or f"{abs(zp):.1f}σ from the paper ({spread})"
@@ -177,6 +243,7 @@ class Row:
             "verdict": verdict,
             "reason": reason,
             "provenance": self.provenance,
+            "override": self.overridden,
         }
 
 
@@ -356,7 +423,9 @@ class Reproduction:
                 *(r[k] for k in fields),
                 truth=r["truth"],
                 n_runs=r.get("n_runs"),
-                verdict=r.get("verdict"),  # as judged when written: the same numbers
+                # as judged when written (the same numbers: an override stays one, a computed
+                # verdict equals Row.rule's)
+                verdict=r.get("verdict"),
                 reason=r.get("reason") or "",
                 provenance=r.get("provenance"),
             )
@@ -403,18 +472,25 @@ class Reproduction:
 
     def verdicts(self, tables: list[str] | None = None):
         """The chapter's "What reproduced, what did not, and why": one line per claim (rows with
-        a paper value) of ``tables`` (default: all), with its verdict and reason (a Styler).
+        a paper value) of ``tables`` (default: all), with its verdict, the provenance of its
+        truth and the reason (a Styler).
         """
         import pandas as pd
 
         rows = [r for r in self.rows if tables is None or r.table in tables]
         recs = [
-            {"table": r.table, "quantity": r.quantity, "verdict": v, "why": why}
+            {
+                "table": r.table,
+                "quantity": r.quantity,
+                "verdict": v,
+                "provenance": r.provenance or "—",
+                "why": why,
+            }
             for r in rows
             for v, why in [r.judge()]
             if v is not None
         ]
-        df = pd.DataFrame(recs, columns=["table", "quantity", "verdict", "why"])
+        df = pd.DataFrame(recs, columns=["table", "quantity", "verdict", "provenance", "why"])
         return df.style.hide(axis="index").set_table_attributes('class="hsgeo-table"')
 
     def summarize(self, name: str, what: str = "parameters") -> dict:

@@ -4,8 +4,11 @@ One row per claim in the papers' tables that a chapter reproduces (the rows of t
 ``reproduce`` tables whose name starts with the paper's number, ``000``–``004``), plus the claims
 of the chapters still to be written, marked ``planned``. Verdicts are computed by
 :meth:`hsgeo.report.Row.judge` from the numbers, in the style of ReScience C reproductions:
-*reproduced*, *differs* (with the reason), *tuned* (the simulation took the paper's value as its
-truth, so only the recovery is an outcome), *not testable*, *planned*.
+*reproduced*, *differs* (with the reason), *by construction* (the truth is the paper's value,
+computed from it or tuned to it: agreement was built in; issue 22), *not testable*, *planned*.
+Every verdict is explained in a sentence (:data:`hsgeo.report.VERDICT_MEANING`), counted per
+paper and per provenance of the truth, and a verdict a chapter stated against the rule (an
+override) is listed with its reason (:func:`overrides`).
 
 The chapters' results are taken from :func:`hsgeo.reproduce.recorded` when the book build
 recorded them (``HSGEO_RECORD_DIR``), so that the scoreboard costs nothing extra; otherwise each
@@ -17,9 +20,17 @@ from __future__ import annotations
 import re
 
 from hsgeo import papers
-from hsgeo.report import VERDICTS, Reproduction, Row
+from hsgeo.report import PROVENANCES, VERDICTS, Reproduction, Row
 
-__all__ = ["PAPER_CHAPTERS", "claims", "planned_claims", "run", "counts"]
+__all__ = [
+    "PAPER_CHAPTERS",
+    "claims",
+    "planned_claims",
+    "run",
+    "counts",
+    "counts_by",
+    "overrides",
+]
 
 #: The chapters whose tables hold claims of the papers.
 PAPER_CHAPTERS = ("line-calibration", "geocoding", "pushbroom-ba", "rikola")
@@ -88,6 +99,36 @@ def counts(rows: list[Row]) -> dict[str, int]:
     return {v: verdicts.count(v) for v in VERDICTS}
 
 
+def counts_by(rows: list[Row], key: str) -> dict[str, dict[str, int]]:
+    """Number of claims per verdict within each group: ``key`` is ``"paper"`` (the first three
+    characters of the table, ``"000"``…) or ``"provenance"`` (``"none"`` for rows without one,
+    e.g. the planned claims).
+    """
+    groups: dict[str, list[Row]] = {}
+    for r in rows:
+        g = r.table[:3] if key == "paper" else (r.provenance or "none")
+        groups.setdefault(g, []).append(r)
+    order = sorted(groups) if key == "paper" else [*PROVENANCES, "none"]
+    return {g: counts(groups[g]) for g in order if g in groups}
+
+
+def overrides(rows: list[Row]) -> list[dict]:
+    """The claims whose verdict the chapter stated against :meth:`~hsgeo.report.Row.rule`:
+    table, quantity, the stated and the computed verdict, and the chapter's reason.
+    """
+    return [
+        {
+            "table": r.table,
+            "quantity": r.quantity,
+            "verdict": r.verdict,
+            "rule": r.rule()[0],
+            "reason": r.reason,
+        }
+        for r in rows
+        if r.overridden
+    ]
+
+
 def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
     """The scoreboard as a :class:`Reproduction` whose tables are the papers' tables.
 
@@ -110,5 +151,12 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
         "scoreboard",
         seed,
         rows,
-        meta={"sources": sources, "counts": counts(rows), "n_claims": len(rows)},
+        meta={
+            "sources": sources,
+            "counts": counts(rows),
+            "counts_by_paper": counts_by(rows, "paper"),
+            "counts_by_provenance": counts_by(rows, "provenance"),
+            "overrides": overrides(rows),
+            "n_claims": len(rows),
+        },
     )
