@@ -1,7 +1,11 @@
 """The GNSS/INS error model of the 002 campaign simulator (hsgeo.simulate.pushbroom_campaign)."""
 
+import json
+from pathlib import Path
+
 import numpy as np
 import pytest
+from fingerprint import arrays, assert_same, fingerprint
 
 from hsgeo import InputError
 from hsgeo.simulate.pushbroom_campaign import RIDGE, gauss_markov, simulate, spline_fit
@@ -151,48 +155,18 @@ def test_distortion_ripple_is_added_along_the_line_only():
     np.testing.assert_allclose(distortion_ripple_px(450.0, CampaignConfig()), -0.1, atol=1e-12)
 
 
-def _digest(obs, truth) -> str:
-    """sha256 of the bytes of every observation and truth array of one simulation."""
-    import hashlib
-
-    h = hashlib.sha256()
-    lines = obs.lines
-    arrays = [
-        lines.point,
-        lines.band,
-        lines.t_s,
-        lines.xy_px,
-        lines.xyz_nav_m,
-        lines.rpy_nav_rad,
-        lines.xyz_rate_nav_m_s,
-        lines.rpy_rate_nav_rad_s,
-        obs.gcp_index,
-        obs.gcp_xyz_m,
-        obs.lever_arm_m,
-        obs.node_prior_mean,
-        np.asarray(obs.t_span_s),
-    ]
-    arrays += [truth.values[k] for k in sorted(truth.values)]
-    arrays += [np.asarray(truth.strips, float), truth.strip, truth.cp_index, truth.outlier]
-    arrays += [truth.xy_true_px, truth.error_t_s, truth.error_samples]
-    for a in arrays:
-        if a is not None:  # the error samples of the "spline" model are None
-            h.update(np.ascontiguousarray(a).tobytes())
-    return h.hexdigest()
+# Fingerprints (tests/fingerprint.py) of simulate()'s arrays written by main's code at 2366fb0,
+# whose simulator is e7c3c51's for scale ≤ 1 (before simulate() accepted scale > 1): the
+# chapters' numbers depend on it staying the same. Integer arrays compare exactly, float arrays
+# to 1e-9 (a sha256 of float bytes failed on another CPU generation with the same code).
+FINGERPRINTS_2366FB0 = json.loads(
+    (Path(__file__).parent / "data" / "pushbroom_campaign_2366fb0.json").read_text()
+)
 
 
-# sha256 of simulate()'s arrays computed with main's code at e7c3c51 (before simulate() accepted
-# scale > 1): the chapters' numbers depend on scale ≤ 1 staying bit-identical
-DIGESTS_MAIN_E7C3C51 = {
-    (0.01, 0, False): "96bf965fbfa741e63b1a8be8d80192885684e720aee0da01963cf00179ff9789",
-    (0.05, 3, False): "3c5155ae6255bd9d9a30a67f5a8aa73a28c1446eeccd0ad3c293ed4360077477",
-    (0.01, 5, True): "8972f080742d1b6146893cbfdd01b8d33d556ed2dd65f98311ec8a4e96aac82e",
-}
-
-
-#: The options of main at e7c3c51 (issue 22 changed both defaults: a key-point σ per axis, and
-#: check points seen by as many strips as a tie point).
-MAIN_E7C3C51 = {
+#: The options of main at 2366fb0 (issue 22 changed the defaults: a key-point σ per axis, check
+#: points seen by as many strips as a tie point, and a distortion ripple).
+MAIN_2366FB0 = {
     "sigma_keypoint_px": (0.35, 0.35),
     "cp_rays": "all strips",
     "distortion_ripple_px": 0.0,
@@ -204,37 +178,27 @@ def _main_cfg():
 
     from hsgeo.simulate.pushbroom_campaign import CampaignConfig
 
-    return replace(CampaignConfig(), **MAIN_E7C3C51)
+    return replace(CampaignConfig(), **MAIN_2366FB0)
 
 
-@pytest.mark.parametrize("scale, seed, noise_free", sorted(DIGESTS_MAIN_E7C3C51))
-def test_scale_up_to_one_is_bit_identical_to_main(scale, seed, noise_free):
-    kw = {"noise_free": True, "trajectory_error": "spline"} if noise_free else {}
-    obs, truth = simulate(scale, rng=seed, cfg=_main_cfg(), **kw)
-    assert _digest(obs, truth) == DIGESTS_MAIN_E7C3C51[(scale, seed, noise_free)]
-
-
-# sha256 of simulate()'s arrays with the code at 2361056 (before issue 22 changed the defaults of
-# sigma_keypoint_px and cp_rays): with the former values the simulator is bit-identical to it
-DIGESTS_2361056 = {
-    (0.01, 0): "728e956a5a5f913b33e98d1193b3f3dc17303017dd1389412238782099c158ce",
-    (0.05, 3): "20a1a914bcd925d38e4254acbda4834f2d059d107a4cf946b74173d4ed5ed73b",
-}
-
-
-@pytest.mark.parametrize("scale, seed", sorted(DIGESTS_2361056))
-def test_former_options_give_the_former_bits(scale, seed):
-    assert _digest(*simulate(scale, rng=seed, cfg=_main_cfg())) == DIGESTS_2361056[(scale, seed)]
+@pytest.mark.parametrize("key", sorted(FINGERPRINTS_2366FB0))
+def test_former_options_give_the_former_simulation(key):
+    scale, seed, noise_free = key.split("-")
+    kw = {"noise_free": True, "trajectory_error": "spline"} if noise_free == "True" else {}
+    obs, truth = simulate(float(scale), rng=int(seed), cfg=_main_cfg(), **kw)
+    assert_same(fingerprint(obs, truth), FINGERPRINTS_2366FB0[key])
 
 
 def test_chunked_rows_give_the_same_bits(monkeypatch):
     """The simulator's row-wise work in chunks (odd sizes, tails included) is bit-identical."""
     import hsgeo.simulate.pushbroom_campaign as pc
 
+    whole = simulate(0.01, rng=0, cfg=_main_cfg())
     monkeypatch.setattr(pc, "CHUNK_ROWS", 997)
-    obs, truth = simulate(0.01, rng=0, cfg=_main_cfg())
-    assert obs.lines.n > 4 * 997
-    assert _digest(obs, truth) == DIGESTS_2361056[(0.01, 0)]
+    chunked = simulate(0.01, rng=0, cfg=_main_cfg())
+    assert chunked[0].lines.n > 4 * 997
+    for name, a in arrays(*whole).items():
+        np.testing.assert_array_equal(arrays(*chunked)[name], a, err_msg=name)
 
 
 def test_long_block_beyond_the_paper():
