@@ -134,37 +134,9 @@ def commands(repeats: int, previous: Path | None, timeout: float) -> list[dict]:
     return rows
 
 
-def _block(n_points, seed=0):
-    import numpy as np
-
-    from hsgeo.adjust import Parameters
-    from hsgeo.sensors.frame import FrameOpenCV, project_opencv
-
-    rng = np.random.default_rng(seed)
-    gx, gy = np.meshgrid(np.arange(10), np.arange(8))
-    C = np.column_stack([gx.ravel() * 60.0, gy.ravel() * 60.0, np.full(gx.size, -300.0)])
-    poses = np.column_stack([rng.normal(0, 0.02, (C.shape[0], 3)), C])
-    X = np.column_stack(
-        [rng.uniform(0, 540, n_points), rng.uniform(0, 420, n_points), rng.normal(0, 5, n_points)]
-    )
-    intr = np.array([1000.0, 1000.0, 500.0, 400.0])
-    d = np.hypot(C[None, :, 0] - X[:, None, 0], C[None, :, 1] - X[:, None, 1])
-    view = np.argsort(d, axis=1)[:, :4].ravel()
-    point = np.repeat(np.arange(n_points), 4)
-    uv = project_opencv(poses, view, X[point], intr, np.zeros(5))
-    uv += 0.5 * rng.standard_normal(uv.shape)
-    p = Parameters()
-    p.add("intrinsics", intr * [1.01, 1.01, 1, 1])
-    p.add("distortion", np.zeros(5))
-    p.fix("distortion")
-    p.add("poses", poses + rng.normal(0, [0.002] * 3 + [0.5] * 3, poses.shape))
-    p.add("points", X + rng.normal(0, 0.5, X.shape), points=True)
-    for j in range(0, n_points, 50):
-        p.set_prior("points", 0.05, index=j, mean=X[j])
-    return p, FrameOpenCV(view, uv, 0.5, point=point)
-
-
 def threshold_child(sizes: list[int], repeats: int) -> list[dict]:
+    from bench_engine import make_problem as _block  # the engine benchmark's frame block
+
     from hsgeo.adjust import adjust
 
     p, b = _block(2000)
