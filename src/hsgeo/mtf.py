@@ -54,6 +54,7 @@ __all__ = [
     "coltman_mtf_coefficients",
     "ctf_from_mtf",
     "mtf_from_ctf",
+    "mtf_from_ctf_samples",
     "ctf_from_mtf_printed",
     "mtf_from_ctf_printed",
     "mtf_gaussian",
@@ -146,6 +147,23 @@ def mtf_from_ctf(ctf, f_cy_px, k_max: int = K_MAX):
     k, c = coltman_mtf_coefficients(k_max)
     terms = ctf(f[..., None] * k) * c
     return np.pi / 4.0 * terms.sum(axis=-1)  # Coltman (1954) eq. (6); 001 eq. (7)
+
+
+def mtf_from_ctf_samples(f_measured, ctf_measured, f_cy_px, k_max: int = K_MAX):
+    """MTF from CTFs measured at some frequencies (bar groups): the series of
+    :func:`mtf_from_ctf` on the CTF interpolated linearly between the measured frequencies and
+    taken as **0 above the highest measured one** (the series then stops there), so the MTF at
+    ``f`` uses the measurements up to the last odd harmonic below the highest bar frequency.
+    """
+    fm = np.asarray(f_measured, dtype=float)
+    cm = np.asarray(ctf_measured, dtype=float)
+    order = np.argsort(fm)
+    fm, cm = fm[order], cm[order]
+
+    def ctf(f):
+        return np.where(f <= fm[-1], np.interp(f, fm, cm), 0.0)
+
+    return mtf_from_ctf(ctf, f_cy_px, k_max)
 
 
 _PRINTED_K = np.array([1, 3, 5, 7, 11])
