@@ -18,7 +18,7 @@ def write_bar_inputs(d: Path, seed: int = 4, rows=ROWS) -> None:
     rec = T.render_bar_profiles(bench, list(rows), seed)
     lines = ["row,x_px,intensity_dn"]
     for r, prof in zip(rows, rec.profiles_dn, strict=True):
-        lines += [f"{r},{x:g},{int(v)}" for x, v in zip(rec.x_px, prof, strict=True)]
+        lines += [f"{r},{x:g},{v:.2f}" for x, v in zip(rec.x_px, prof, strict=True)]
     (d / "profiles.csv").write_text("\n".join(lines) + "\n")
     t = bench.target
     (d / "bars.toml").write_text(

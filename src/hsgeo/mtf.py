@@ -55,6 +55,7 @@ __all__ = [
     "ctf_from_mtf",
     "mtf_from_ctf",
     "mtf_from_ctf_samples",
+    "ctf_band_limited",
     "ctf_from_mtf_printed",
     "mtf_from_ctf_printed",
     "mtf_gaussian",
@@ -149,21 +150,71 @@ def mtf_from_ctf(ctf, f_cy_px, k_max: int = K_MAX):
     return np.pi / 4.0 * terms.sum(axis=-1)  # Coltman (1954) eq. (6); 001 eq. (7)
 
 
-def mtf_from_ctf_samples(f_measured, ctf_measured, f_cy_px, k_max: int = K_MAX):
-    """MTF from CTFs measured at some frequencies (bar groups): the series of
-    :func:`mtf_from_ctf` on the CTF interpolated linearly between the measured frequencies and
-    taken as **0 above the highest measured one** (the series then stops there), so the MTF at
-    ``f`` uses the measurements up to the last odd harmonic below the highest bar frequency.
+def mtf_from_ctf_samples(
+    f_measured, ctf_measured, f_cy_px, k_max: int = K_MAX, nyquist_cy_px: float | None = None
+):
+    """MTF from CTFs measured at some frequencies (bar groups).
+
+    The series of :func:`mtf_from_ctf` runs on the CTF interpolated linearly between the
+    measured frequencies and taken as **0 above the highest measured one** (the series stops
+    there). With ``nyquist_cy_px`` (0.5 for pixels), the measured CTFs are taken as
+    *band-limited*: the square-wave response made of the harmonics below Nyquist only (what a
+    sampled profile holds, :mod:`hsgeo.measure.ctf`); then the harmonics ``k ≥ 3`` with
+    ``k f ≥ nyquist`` are left out of the series too, which inverts the band-limited forward
+    series exactly (the Möbius sum runs over the same products ``j k``).
     """
     fm = np.asarray(f_measured, dtype=float)
     cm = np.asarray(ctf_measured, dtype=float)
     order = np.argsort(fm)
     fm, cm = fm[order], cm[order]
+    f = np.asarray(f_cy_px, dtype=float)
+    k, c = coltman_mtf_coefficients(k_max)
+    fk = f[..., None] * k
+    if nyquist_cy_px is None:
+        ctf = np.where(fk <= fm[-1], np.interp(fk, fm, cm), 0.0)
+    else:
+        ctf = np.where(fk <= fm[-1], _interp_band_limited(fk, fm, cm, nyquist_cy_px), 0.0)
+        ctf = np.where((k >= 3) & (fk >= nyquist_cy_px), 0.0, ctf)
+    return np.pi / 4.0 * (ctf * c).sum(axis=-1)  # Coltman (1954) eq. (6); 001 eq. (7)
 
-    def ctf(f):
-        return np.where(f <= fm[-1], np.interp(f, fm, cm), 0.0)
 
-    return mtf_from_ctf(ctf, f_cy_px, k_max)
+def _interp_band_limited(fq, fm, cm, nyquist):
+    """Linear interpolation of a band-limited CTF, which jumps where a harmonic crosses
+    Nyquist (f = nyquist / k, k = 3, 5, …): across a jump, the value is extrapolated from the
+    two measurements on the query's side of it.
+    """
+    fq = np.asarray(fq, dtype=float)
+    out = np.interp(fq, fm, cm)
+    i = np.clip(np.searchsorted(fm, fq) - 1, 0, fm.size - 2)  # segment [fm[i], fm[i+1]]
+    kk = np.floor(nyquist / fm[i])  # harmonics below Nyquist at the segment's ends
+    kk1 = np.floor(nyquist / fm[i + 1])
+    jump = (kk != kk1) & (fq > fm[0]) & (fq < fm[-1])
+    if not np.any(jump):
+        return out
+    # the jump closest below fm[i]'s harmonic count: f_j = nyquist / (largest odd k ≤ kk)
+    k_odd = np.where(kk % 2 == 1, kk, kk - 1)
+    f_jump = nyquist / np.maximum(k_odd, 1)
+    left = jump & (fq < f_jump)
+    right = jump & ~left
+    il = np.clip(i - 1, 0, fm.size - 2)  # left pair (fm[i-1], fm[i])
+    ir = np.clip(i + 1, 0, fm.size - 2)  # right pair (fm[i+1], fm[i+2])
+    for sel, j in ((left, il), (right, ir)):
+        if np.any(sel):
+            f0, f1 = fm[j][sel], fm[j + 1][sel]
+            c0, c1 = cm[j][sel], cm[j + 1][sel]
+            out[sel] = c0 + (c1 - c0) * (fq[sel] - f0) / (f1 - f0)
+    return out
+
+
+def ctf_band_limited(mtf, f_cy_px, nyquist_cy_px: float = 0.5, k_max: int = K_MAX):
+    """The square-wave response made of the harmonics below Nyquist only (the fundamental
+    always): what a bar group's sampled profile holds (:mod:`hsgeo.measure.ctf`).
+    """
+    f = np.asarray(f_cy_px, dtype=float)
+    k, c = coltman_ctf_coefficients(k_max)
+    fk = f[..., None] * k
+    keep = (fk < nyquist_cy_px) | (k == 1)
+    return 4.0 / np.pi * np.where(keep, mtf(fk) * c, 0.0).sum(axis=-1)
 
 
 _PRINTED_K = np.array([1, 3, 5, 7, 11])

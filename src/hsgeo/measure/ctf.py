@@ -8,8 +8,9 @@ A profile along the line crosses the groups of a :class:`hsgeo.mtf.BarTarget`. T
 2. :func:`measure_ctf` — per group, the samples inside the group (a margin from its ends, where
    the neighbouring groups' bars blur in) are fitted, by linear least squares, with the group's
    periodic response: a mean and the odd harmonics ``k f`` of the bar frequency that lie below
-   the Nyquist frequency (cos and sin: the phase of the bars on the pixels is free). The group's
-   ``I_max`` and ``I_min`` are the maximum and minimum of the fitted period, and its CTF their
+   the Nyquist frequency (cos and sin, so that a small error of the registered phase costs
+   little). The group's ``I_max`` and ``I_min`` are the fitted period's values at the centres of
+   its white and black bars (the average intensity of the bars' centres), and its CTF their
    modulation (001 eq. 5) divided by the target's own modulation (001 eq. 4).
 
 Above 1/6 cy/px the third harmonic lies beyond Nyquist: a sampled profile carries no separate
@@ -139,7 +140,7 @@ def _harmonics(f: float) -> np.ndarray:
 
 
 def _group_ctf(x, y, f, x_white):
-    """Fit the periodic response of one group; returns (I_max, I_min)."""
+    """Fit the periodic response of one group; returns (I_max, I_min) of its band-limited part."""
     k = _harmonics(f)
     ph = 2 * np.pi * f * (x - x_white)
     cols = [np.ones_like(x)]
@@ -147,11 +148,12 @@ def _group_ctf(x, y, f, x_white):
         cols += [np.cos(kk * ph), np.sin(kk * ph)]
     A = np.column_stack(cols)
     coef, *_ = np.linalg.lstsq(A, y, rcond=None)
-    t = np.linspace(0.0, 2 * np.pi, 257)[:-1]
-    w = np.full(t.size, coef[0])
+    # the fitted band-limited period at the white and the black bar's centre (phase 0 and π):
+    # values at fixed points are unbiased by noise, unlike the fitted curve's extremes
+    w = np.full(2, coef[0])
     for i, kk in enumerate(k):
-        w += coef[1 + 2 * i] * np.cos(kk * t) + coef[2 + 2 * i] * np.sin(kk * t)
-    return float(w.max()), float(w.min())
+        w += coef[1 + 2 * i] * np.cos(kk * np.array([0.0, np.pi]))
+    return float(w[0]), float(w[1])
 
 
 def measure_ctf(

@@ -184,7 +184,7 @@ def mtf_from_bars(inputs: BarInputs, options: BarOptions = BarOptions()) -> MtfR
     if f.ndim != 1 or f.size == 0 or np.any(~np.isfinite(f)) or np.any(f <= 0):
         raise InputError("the output frequencies must be positive finite numbers (cy/px)")
     f = f[f <= m.f_cy_px.max() + 1e-12]  # the bars say nothing beyond the finest group
-    mtf = mtf_from_ctf_samples(m.f_cy_px, m.ctf, f)
+    mtf = mtf_from_ctf_samples(m.f_cy_px, m.ctf, f, nyquist_cy_px=0.5)  # band-limited CTFs
     fb = crossing_frequency(np.r_[0.0, f], np.r_[1.0, mtf], BORDERLINE_LEVEL)
     return MtfResult(
         "bars",
