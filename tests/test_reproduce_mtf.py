@@ -39,8 +39,11 @@ def test_ctf_series_and_edge_meet_the_truth(rep):
             assert abs(r.reproduced - r.truth) < 0.05, r.quantity
             assert abs(r.z) < 4.5, (r.quantity, r.z)
     for r in rep.rows_of("slanted edge"):
-        if r.quantity.startswith("MTF line") and float(r.quantity.split()[-2]) <= 0.5:
-            assert abs(r.reproduced - r.truth) < 0.03, r.quantity
+        if r.quantity.startswith("MTF line") and "noise-free" not in r.quantity:
+            if float(r.quantity.split()[-2]) <= 0.5:
+                assert abs(r.reproduced - r.truth) < 0.03, r.quantity
+        if "noise-free" in r.quantity:  # the method's own bias is small
+            assert abs(r.reproduced - r.truth) < 0.01, r.quantity
 
 
 def test_verdicts(rep):

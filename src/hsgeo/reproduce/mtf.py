@@ -18,6 +18,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from hsgeo.measure.edge import slanted_edge
 from hsgeo.mtf import (
     crossing_frequency,
     ctf_from_mtf,
@@ -26,7 +27,13 @@ from hsgeo.mtf import (
 )
 from hsgeo.papers import GSD_001_TABLE3_MM, P001_MTF
 from hsgeo.report import Reproduction, Row, agreement
-from hsgeo.simulate.mtf_target import MtfBench, mtf_true, render_bar_profiles, render_edge
+from hsgeo.simulate.mtf_target import (
+    MtfBench,
+    edge_electrons,
+    mtf_true,
+    render_bar_profiles,
+    render_edge,
+)
 from hsgeo.workflows.mtf import (
     BORDERLINE_LEVEL,
     BarInputs,
@@ -183,6 +190,14 @@ def _edge_rows(bench, sim, n_runs) -> list[Row]:
         m, s = _stats(sim["fwhm"][:, j])
         rows.append(Row("slanted edge", f"LSF FWHM line {r}", "px", None, None, m, s, None,
                         n_runs=n_runs, provenance="chosen"))  # fmt: skip
+    for r in (100, 1000):  # the method's own bias: a noise-free edge (Hamming window, bins)
+        e = slanted_edge(edge_electrons(bench, r))
+        for f in (0.1, 0.2):
+            rows.append(
+                Row("slanted edge", f"MTF line {r} at {f:g} cy/px, noise-free edge", "1", None,
+                    None, float(np.interp(f, e.f_cy_px, e.mtf)), None,
+                    float(mtf_true(bench, r, f, ang)), provenance="chosen")
+            )  # fmt: skip
     for r, key in ((100, "borderline_blue_cy_px"), (1000, "borderline_nir_cy_px")):
         j = TABLE_LINES.index(r)
         m, s = _stats(sim["borderline_edge"][:, j])
