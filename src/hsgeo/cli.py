@@ -198,11 +198,16 @@ def _cmd_mtf(args) -> int:
         return 0
     for r, res in out.items():
         head = "profile" if r is None else f"row {r}"
-        print(
-            f"{head}: {res.ctf.size} bar groups, GSD {res.gsd_mm:.4f} mm, borderline frequency "
-            f"(MTF 0.1) {res.borderline_cy_px:.3f} cy/px, determined GSD "
-            f"{res.determined_gsd_mm:.3f} mm"
-        )
+        if res.borderline_cy_px == res.borderline_cy_px:  # not NaN
+            border = (
+                f"borderline frequency (MTF 0.1) {res.borderline_cy_px:.3f} cy/px, determined "
+                f"GSD {res.determined_gsd_mm:.3f} mm"
+            )
+        else:
+            border = (
+                f"MTF above 0.1 up to the finest bars ({res.ctf_frequency_cy_px.max():.3f} cy/px)"
+            )
+        print(f"{head}: {res.ctf.size} bar groups, GSD {res.gsd_mm:.4f} mm, {border}")
         print("  f_cy_px   MTF")
         for f, m in zip(res.frequency_cy_px, res.mtf, strict=True):
             print(f"  {f:7.3f}  {m:6.3f}")
