@@ -43,3 +43,19 @@ def test_mtf_edge_with_and_without_roi(tmp_path, capsys, bits):
         assert np.abs(m[k] - truth).max() < tol
     assert main(["mtf-edge", str(tmp_path / "edge.png")]) == 0
     assert "LSF FWHM" in capsys.readouterr().out
+
+
+def test_mtf_on_the_generated_data(capsys):
+    """``make data``'s mtf_bench files: ``hsgeo mtf`` against the written truth."""
+    import pandas as pd
+
+    from hsgeo.simulate.scenarios import data_dir
+
+    g = data_dir() / "generated"
+    argv = ["mtf", str(g / "mtf_bench_profiles.csv"), "--bars", str(g / "mtf_bench_bars.toml")]
+    assert main([*argv, "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    truth = pd.read_csv(g / "mtf_bench_truth.csv")
+    for p in out["profiles"]:
+        t = np.interp(p["frequency_cy_px"], truth["f_cy_px"], truth[f"mtf_row{p['row']}"])
+        assert np.abs(np.array(p["mtf"]) - t).max() < 0.05

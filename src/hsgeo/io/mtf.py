@@ -26,11 +26,19 @@ from pathlib import Path
 import numpy as np
 
 from hsgeo.errors import InputError
-from hsgeo.io._files import check_input_file
+from hsgeo.io._files import atomic_path, check_input_file
 from hsgeo.io.config import Key, read_config
 from hsgeo.io.tables import read_table
 
-__all__ = ["BARS_SCHEMA", "read_bars", "read_profiles", "read_gray_image"]
+__all__ = [
+    "BARS_SCHEMA",
+    "read_bars",
+    "read_profiles",
+    "read_gray_image",
+    "write_profiles",
+    "write_bars",
+    "write_columns",
+]
 
 BARS_SCHEMA = {
     "target": {
@@ -108,3 +116,43 @@ def read_gray_image(path) -> np.ndarray:
     if not np.all(np.isfinite(img)):
         raise InputError(f"image file {str(path)!r} holds NaN or infinite pixels")
     return img
+
+
+def write_profiles(path, rows, x_px, profiles_dn) -> Path:
+    """Write profiles (one per spectral row) as the CSV ``hsgeo mtf`` reads (atomically)."""
+    lines = ["row,x_px,intensity_dn"]
+    for r, prof in zip(rows, np.atleast_2d(profiles_dn), strict=True):
+        lines += [f"{int(r)},{x:.17g},{v:.17g}" for x, v in zip(x_px, prof, strict=True)]
+    with atomic_path(path) as tmp:
+        tmp.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return Path(path)
+
+
+def write_bars(path, target, profile: dict) -> Path:
+    """Write the bar file (``[target]`` from a :class:`~hsgeo.mtf.BarTarget`, ``[profile]`` from
+    ``profile``: gsd_mm, start_px, dark_dn, saturation_dn) atomically.
+    """
+    unknown = set(profile) - set(BARS_SCHEMA["profile"])
+    if unknown:
+        raise InputError(f"unknown [profile] keys {sorted(unknown)}")
+    text = (
+        "[target]\n"
+        f"pair_mm = [{', '.join(f'{p:.17g}' for p in target.pair_mm)}]\n"
+        f"n_pairs = [{', '.join(str(int(n)) for n in target.n_pairs)}]\n"
+        f"white_reflectance = {target.white_reflectance!r}\n"
+        f"black_reflectance = {target.black_reflectance!r}\n"
+        "[profile]\n" + "".join(f"{k} = {float(v)!r}\n" for k, v in profile.items())
+    )
+    with atomic_path(path) as tmp:
+        tmp.write_text(text, encoding="utf-8")
+    return Path(path)
+
+
+def write_columns(path, columns: dict) -> Path:
+    """Write equal-length numeric columns as a CSV (``%.17g``) atomically."""
+    names = list(columns)
+    data = np.column_stack([np.asarray(columns[n], dtype=float) for n in names])
+    lines = [",".join(names)] + [",".join(f"{v:.17g}" for v in row) for row in data]
+    with atomic_path(path) as tmp:
+        tmp.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return Path(path)

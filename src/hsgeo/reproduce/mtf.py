@@ -44,7 +44,16 @@ from hsgeo.workflows.mtf import (
     mtf_from_edge,
 )
 
-__all__ = ["run", "simulate_runs", "LINES", "TABLE_LINES", "F_TABLE", "F_GRID", "STRAY_LIGHT"]
+__all__ = [
+    "run",
+    "generate",
+    "simulate_runs",
+    "LINES",
+    "TABLE_LINES",
+    "F_TABLE",
+    "F_GRID",
+    "STRAY_LIGHT",
+]
 
 #: The ten spectral lines (001 §3.1 and Fig. 8b: every 100 px).
 LINES = tuple(range(100, 1001, 100))
@@ -407,3 +416,25 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
     return Reproduction(
         "mtf", seed, rows, meta, extras={"bench": bench, "sim": sim, "glare": sim_glare}
     )
+
+
+def generate(cfg: dict, outdir) -> list:
+    """``make data`` (generator ``mtf_bench``): bar profiles of the lines of 001 Table 3 and the
+    bar file, in the formats ``hsgeo mtf`` reads, and the analytic MTF (the truth).
+    """
+    from pathlib import Path
+
+    from hsgeo.io.mtf import write_bars, write_columns, write_profiles
+
+    bench = MtfBench()
+    rows = [int(r) for r in cfg.get("bars", {}).get("rows", TABLE_LINES)]
+    rec = render_bar_profiles(bench, rows, int(cfg["scenario"]["seed"]))
+    out = Path(outdir)
+    prof = write_profiles(out / "mtf_bench_profiles.csv", rows, rec.x_px, rec.profiles_dn)
+    profile = {"gsd_mm": rec.gsd_mm, "start_px": round(rec.start_px, 1),
+               "dark_dn": rec.dark_dn, "saturation_dn": rec.saturation_dn}  # fmt: skip
+    bars = write_bars(out / "mtf_bench_bars.toml", bench.target, profile)
+    f = np.asarray(F_GRID)
+    truth = {"f_cy_px": f, **{f"mtf_row{r}": mtf_true(bench, r, f) for r in rows}}
+    tru = write_columns(out / "mtf_bench_truth.csv", truth)
+    return [prof, bars, tru]
