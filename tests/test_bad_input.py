@@ -135,8 +135,24 @@ def _bal(d: Path) -> None:
     (d / "problem.txt").write_text("\n".join(lines) + "\n")
 
 
+def _mtf(d: Path) -> None:
+    from mtf_inputs import write_bar_inputs
+
+    d.mkdir()
+    write_bar_inputs(d)
+
+
+def _mtf_edge(d: Path) -> None:
+    from mtf_inputs import write_edge_image
+
+    d.mkdir()
+    write_edge_image(d / "edge.png")
+
+
 def build_valid(root: Path) -> Path:
     """Write the valid inputs of every command under ``root`` (one folder per command)."""
+    _mtf(root / "mtf")
+    _mtf_edge(root / "mtf-edge")
     _bal(root / "adjust-bal")
     _line(root / "calibrate-line")
     _pushbroom(root / "adjust-pushbroom")
@@ -181,6 +197,10 @@ def base_argv(cmd: str, d: Path) -> list[str]:
         return [cmd, *(s(d / f"img_0{i}.jpg") for i in range(3)), "--board", s(d / "board.toml")]
     if cmd == "adjust-bal":
         return [cmd, s(d / "problem.txt"), "--json"]
+    if cmd == "mtf":
+        return [cmd, s(d / "profiles.csv"), "--bars", s(d / "bars.toml")]
+    if cmd == "mtf-edge":
+        return [cmd, s(d / "edge.png"), "--json"]
     if cmd == "reproduce":
         return [cmd, "frame-reference"]
     if cmd == "data":
@@ -1118,6 +1138,59 @@ case(C, "garbage", "extra-values", "more values", files=[(F, text_append("1.0 2.
 case(C, "degenerate", "missing-values", "camera and point values", files=[(F, drop_last_lines(3))])
 case(C, "options", "unknown-option", "--threads", argv=flag("--threads", "2"))
 
+# --- mtf, mtf-edge ---------------------------------------------------------------------------
+C = "mtf"
+table_file_cases(C, "profiles.csv", "profile", ["x_px", "intensity_dn"], "bars.toml")
+case(C, "degenerate", "too-few-bars", "row 100", [("profiles.csv", keep_rows(200))])
+case(
+    C, "range", "saturated", "saturated", [("profiles.csv", set_cell("intensity_dn", "4095", 300))]
+)
+case(C, "duplicates", "same-x-twice", "line", [("profiles.csv", duplicate_row(5))])
+case(C, "missing", "bars-missing", "bars.toml", [("bars.toml", remove)])
+case(C, "empty", "bars-empty", "bars.toml", [("bars.toml", text(""))])
+case(C, "garbage", "bars-garbage", "bars.toml", [("bars.toml", text("[target\npair_mm = \n"))])
+case(C, "binary", "bars-binary", "bars.toml", [("bars.toml", text(BINARY))])
+case(C, "range", "gsd-negative", "gsd_mm", [("bars.toml", toml_set("profile", "gsd_mm", "-0.5"))])
+case(C, "nonfinite", "gsd-nan", "gsd_mm", [("bars.toml", toml_set("profile", "gsd_mm", "nan"))])
+case(C, "mistyped", "gsd-misspelled", "gsd_mm", [("bars.toml", toml_rename("gsd_mm", "gsd_m"))])
+case(C, "missing", "no-start", "start_px", [("bars.toml", toml_set("profile", "start_px", None))])
+case(
+    C, "degenerate", "start-far-off", "start_px",
+    [("bars.toml", toml_set("profile", "start_px", "600.0"))],
+)  # fmt: skip
+case(
+    C, "mistyped", "pairs-counts-differ", "n_pairs",
+    [("bars.toml", toml_set("target", "pair_mm", "[20.88, 18.6]"))],
+)  # fmt: skip
+case(
+    C, "range", "black-above-white", "black",
+    [("bars.toml", toml_set("target", "black_reflectance", "0.95"))],
+)  # fmt: skip
+case(C, "options", "no-bars", "--bars", argv=opt("--bars"))
+case(C, "options", "unknown-option", "--roi", argv=flag("--roi", "1,2,3,4"))
+C = "mtf-edge"
+case(C, "missing", "no-image", "edge.png", [("edge.png", remove)])
+case(C, "missing", "image-directory", "edge.png", [("edge.png", make_dir)])
+case(C, "empty", "image-empty", "edge.png", [("edge.png", text(""))])
+case(C, "garbage", "image-text", "edge.png", [("edge.png", text("not an image\n"))])
+case(C, "binary", "image-binary", "edge.png", [("edge.png", text(BINARY))])
+for v in ("abc", "1,2,3", "10,10,5,5", "-1,0,10,10"):
+    case(C, "options", f"--roi={v}", "--roi", argv=opt("--roi", v))
+case(C, "range", "roi-outside", "--roi", argv=opt("--roi", "0,0,5000,5000"))
+case(C, "degenerate", "roi-without-edge", "no edge", argv=opt("--roi", "0,0,30,30"))
+case(C, "degenerate", "flat-image", "--roi", [("edge.png", lambda p: _blank(p))])
+case(C, "degenerate", "edge-not-slanted", "slanted", [("edge.png", lambda p: _straight_edge(p))])
+
+
+def _straight_edge(p):
+    import cv2
+
+    img = np.full((200, 160), 300, np.uint16)
+    img[:, 80:] = 3000
+    img += np.random.default_rng(0).integers(0, 20, img.shape).astype(np.uint16)
+    cv2.imwrite(str(p), img)
+
+
 C = "reproduce"
 case(
     C,
@@ -1330,6 +1403,9 @@ BENIGN = [
         lambda a, d: replace_arg("obs.csv", lambda d: d / "obs.parquet")(a, d) + ["--json"],
     ),
     ("calibrate-frame", "gray16-png", [(f"img_0{i}.jpg", _gray16) for i in range(3)], None),
+    ("mtf", "crlf-bom-reordered", [("profiles.csv", _reorder), ("bars.toml", _crlf)], None),
+    ("mtf", "json", [("profiles.csv", _bom)], flag("--json")),
+    ("mtf-edge", "roi", [], flag("--roi", "10,10,150,190")),
 ]
 
 

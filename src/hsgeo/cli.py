@@ -184,6 +184,57 @@ def _cmd_adjust_bal(args) -> int:
     return 0
 
 
+def _cmd_mtf(args) -> int:
+    import json
+
+    from hsgeo.workflows.mtf import bars_files
+
+    out = bars_files(args.profiles, args.bars)
+    if args.json:
+        d = {"profiles": [{"row": r, **res.to_dict()} for r, res in out.items()]}
+        if len(out) == 1:
+            d = next(iter(d["profiles"]))
+        print(json.dumps(d, indent=1, allow_nan=False))
+        return 0
+    for r, res in out.items():
+        head = "profile" if r is None else f"row {r}"
+        if res.borderline_cy_px == res.borderline_cy_px:  # not NaN
+            border = (
+                f"borderline frequency (MTF 0.1) {res.borderline_cy_px:.3f} cy/px, determined "
+                f"GSD {res.determined_gsd_mm:.3f} mm"
+            )
+        else:
+            border = (
+                f"MTF above 0.1 up to the finest bars ({res.ctf_frequency_cy_px.max():.3f} cy/px)"
+            )
+        print(f"{head}: {res.ctf.size} bar groups, GSD {res.gsd_mm:.4f} mm, {border}")
+        print("  f_cy_px   MTF")
+        for f, m in zip(res.frequency_cy_px, res.mtf, strict=True):
+            print(f"  {f:7.3f}  {m:6.3f}")
+    return 0
+
+
+def _cmd_mtf_edge(args) -> int:
+    import json
+
+    import numpy as np
+
+    from hsgeo.workflows.mtf import edge_file
+
+    res = edge_file(args.image, args.roi)
+    if args.json:
+        print(json.dumps(res.to_dict(), indent=1, allow_nan=False))
+        return 0
+    print(
+        f"edge at {res.edge_angle_deg:.2f} deg in ROI {res.roi}, LSF FWHM {res.lsf_fwhm_px:.2f} "
+        f"px, borderline frequency (MTF 0.1) {res.borderline_cy_px:.3f} cy/px"
+    )
+    print("  f_cy_px   MTF")
+    for f in np.arange(0.0, 1.0001, 0.05):
+        print(f"  {f:7.3f}  {np.interp(f, res.frequency_cy_px, res.mtf):6.3f}")
+    return 0
+
+
 _POSITIVE = option_number(positive=True)
 
 
@@ -418,6 +469,33 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("file", help="BAL problem file (.txt, or .txt.bz2)")
     p.add_argument("--json", action="store_true", help="one JSON object instead of text")
     p.set_defaults(func=_cmd_adjust_bal)
+
+    p = sub.add_parser(
+        "mtf",
+        help="MTF from bar-target profiles: CTF per bar group, then the Coltman series",
+        description="MTF from bar-target profiles (001 eq. 5-7, Coltman 1954). PROFILES: CSV "
+        "or Parquet with columns x_px (position along the line, px) and intensity_dn (raw "
+        "intensity), optionally row (spectral line; one MTF per row). BARS: TOML with [target] "
+        "pair_mm (pair width per group, mm), n_pairs, white_reflectance, black_reflectance and "
+        "[profile] gsd_mm, start_px (target start on the profile, to a few px), dark_dn, "
+        "saturation_dn. Groups follow each other, each starting with a white bar.",
+    )
+    p.add_argument("profiles", help="profile table (x_px, intensity_dn[, row])")
+    p.add_argument("--bars", required=True, help="bar-target TOML ([target], [profile])")
+    p.add_argument("--json", action="store_true", help="one JSON object instead of text")
+    p.set_defaults(func=_cmd_mtf)
+
+    p = sub.add_parser(
+        "mtf-edge",
+        help="slanted-edge MTF (ISO 12233) of an image",
+        description="The ISO 12233 slanted-edge MTF of an 8- or 16-bit PNG or TIFF: edge angle, "
+        "4x oversampled edge spread, derivative, Hamming window, FFT. Without --roi the region "
+        "around the strongest edge is used.",
+    )
+    p.add_argument("image", help="8- or 16-bit PNG or TIFF holding one slanted edge")
+    p.add_argument("--roi", help="region x0,y0,x1,y1 in pixels around the edge")
+    p.add_argument("--json", action="store_true", help="one JSON object instead of text")
+    p.set_defaults(func=_cmd_mtf_edge)
 
     p = sub.add_parser("versions", help="versions of hsgeo, Python and the dependencies")
     p.set_defaults(func=_cmd_versions)

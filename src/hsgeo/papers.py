@@ -342,6 +342,25 @@ __all__ += ["P002_STATS", "P002"]
 #: spectral lines 100, 500, 700 and 1000 px.
 GSD_001_TABLE3_MM = {"theoretical": 0.48, "actual": {100: 0.58, 500: 0.58, 700: 0.51, 1000: 0.51}}
 
+#: 001 §2.3, §3.1, §4: the sharpness (MTF) experiment: the bar target (pair widths from the
+#: widest to the narrowest, shrinking by 2^(1/6), §2.3), the distance and the field ratio of the
+#: theoretical GSD ((1.7 m × 0.333)/1170, §3.1), and the statements of §3.1 and §4 on the MTF
+#: curves (Fig. 9): "falls almost linearly from an initial value of 0.7 to 0.1, with a
+#: borderline frequency of around 0.3 cy/px for blue, and to 0.6 cy/px for near infrared".
+P001_MTF = {
+    "widest_pair_mm": 20.88,  # 001 §2.3
+    "narrowest_pair_mm": 0.92,  # 001 §2.3
+    "pair_ratio": 2 ** (1 / 6),  # 001 §2.3 "increase factor ... 2^(1/6)"
+    "distance_m": 1.7,  # 001 §3.1
+    "fov_ratio": 0.333,  # 001 §3.1 "(1.7 m × 0.333)/1170"
+    "mtf_initial": 0.7,  # 001 §3.1, §4 (Fig. 9)
+    "mtf_final": 0.1,  # 001 §3.1, §4 (Fig. 9): the "borderline" level
+    "borderline_blue_cy_px": 0.3,  # 001 §4 (Fig. 9, line 100)
+    "borderline_nir_cy_px": 0.6,  # 001 §4 (Fig. 9, line 1000)
+    "source": "001 §2.3, §3.1, §4, Table 3, Fig. 9",
+}
+__all__ += ["P001_MTF", "GSD_001_TABLE3_MM"]
+
 #: 004 (abstract and text): the DAEDALUS AADS 1268's numbers: (value, unit).
 ASF_004 = {
     "ASF variation, largest channel": (15.0, "%"),  # abstract: "variations up to 15 %"

@@ -32,6 +32,7 @@ __all__ = ["GENERATORS", "VERIFY_RTOL", "generate_all"]
 GENERATORS = {
     "frame_bench": "hsgeo.simulate.frame_bench",
     "line_lab": "hsgeo.reproduce.line_calibration",
+    "mtf_bench": "hsgeo.reproduce.mtf",
     "pula_flight": "hsgeo.simulate.pula_flight",
     "rikola": "hsgeo.simulate.rikola",
 }

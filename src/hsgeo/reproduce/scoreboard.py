@@ -33,7 +33,7 @@ __all__ = [
 ]
 
 #: The chapters whose tables hold claims of the papers.
-PAPER_CHAPTERS = ("line-calibration", "geocoding", "pushbroom-ba", "rikola")
+PAPER_CHAPTERS = ("line-calibration", "geocoding", "pushbroom-ba", "rikola", "mtf")
 
 _PAPER_TABLE = re.compile(r"^00[0-4] ")
 #: Tables named after a paper that hold experiments rather than claims: the factors table runs
@@ -44,28 +44,7 @@ NOT_CLAIMS = ("002 check-point factors",)
 
 def planned_claims() -> list[Row]:
     """The papers' claims of chapters not written yet (``verdict="planned"``)."""
-    rows = []
-    for pixel, gsd_mm in papers.GSD_001_TABLE3_MM["actual"].items():
-        rows.append(
-            Row(
-                "001 Table 3",
-                f"GSDv at line {pixel} px",
-                "mm",
-                paper=gsd_mm,
-                verdict="planned",
-                reason="MTF chapter (bar targets) not written yet",
-            )
-        )
-    rows.append(
-        Row(
-            "001 Table 3",
-            "theoretical GSDv, binning 1",
-            "mm",
-            paper=papers.GSD_001_TABLE3_MM["theoretical"],
-            verdict="planned",
-            reason="MTF chapter (bar targets) not written yet",
-        )
-    )
+    rows = []  # 001 Table 3 and Fig. 9 are the mtf chapter's
     for quantity, (value, unit) in papers.ASF_004.items():
         rows.append(
             Row(

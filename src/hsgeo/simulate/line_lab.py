@@ -47,6 +47,7 @@ __all__ = [
     "LabRecording",
     "LabTruth",
     "record",
+    "spectral_level",
 ]
 
 
@@ -185,6 +186,10 @@ def _reflectance_along_rays(lab: LineLab, eop, tan):
 def _spectral_level(lab: LineLab, lam_nm):
     """Relative signal of the white board: halogen lamp × CCD response (assumption)."""
     return np.exp(-(((np.asarray(lam_nm) - 650.0) / 260.0) ** 2))
+
+
+#: The white board's relative signal per wavelength (public: the sharpness bench shares it).
+spectral_level = _spectral_level
 
 
 def render_rows(lab: LineLab, eop, rows, rng, iop: dict | None = None) -> np.ndarray:

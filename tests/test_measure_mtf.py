@@ -1,0 +1,113 @@
+"""Bar-target CTF (hsgeo.measure.ctf) and slanted-edge MTF (hsgeo.measure.edge) against the
+analytic MTF of the simulated optics (hsgeo.simulate.mtf_target), over several seeds."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from hsgeo.errors import InputError, ObservationError
+from hsgeo.measure.ctf import measure_ctf
+from hsgeo.measure.edge import find_edge_roi, slanted_edge
+from hsgeo.mtf import crossing_frequency, ctf_band_limited, mtf_from_ctf_samples
+from hsgeo.simulate import mtf_target as T
+
+BENCH = T.MtfBench()
+ROWS = [100, 500, 700, 1000]
+F = np.linspace(0.03, 0.5, 20)
+
+
+def _measure(rec, i, **kw):
+    return measure_ctf(
+        rec.x_px,
+        rec.profiles_dn[i],
+        BENCH.target,
+        rec.start_px,
+        rec.gsd_mm,
+        dark_dn=rec.dark_dn,
+        saturation_dn=rec.saturation_dn,
+        **kw,
+    )
+
+
+def test_the_tuned_optics_meet_the_papers_borderline_frequencies():
+    f = np.linspace(0, 1, 4001)
+    assert abs(crossing_frequency(f, T.mtf_true(BENCH, 100, f), 0.1) - 0.3) < 0.002
+    assert abs(crossing_frequency(f, T.mtf_true(BENCH, 1000, f), 0.1) - 0.6) < 0.002
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2, 3, 4, 5, 6, 7])
+def test_ctf_series_within_0_05_of_the_truth_up_to_0_5(seed):
+    rec = T.render_bar_profiles(BENCH, ROWS, seed)
+    for i, r in enumerate(ROWS):
+        m = _measure(rec, i)
+        assert abs(m.start_px - rec.true_start_px) < 0.2
+        est = mtf_from_ctf_samples(m.f_cy_px, m.ctf, F, nyquist_cy_px=0.5)
+        err = np.abs(est - T.mtf_true(BENCH, r, F))
+        assert err.max() < 0.05, (r, err.max())
+
+
+@pytest.mark.parametrize("row", [100, 1000])
+def test_measured_ctf_is_the_band_limited_square_wave_response(row):
+    """The measured CTF is the square wave's response made of the harmonics below Nyquist."""
+    rec = T.render_bar_profiles(BENCH, [row], 11)
+    m = _measure(rec, 0)
+    truth = ctf_band_limited(lambda f: T.mtf_true(BENCH, row, f), m.f_cy_px)
+    assert np.abs(m.ctf - truth).max() < 0.04
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2, 3, 4, 5, 6, 7])
+def test_slanted_edge_within_0_03_up_to_nyquist(seed):
+    for r in ROWS:
+        m = slanted_edge(T.render_edge(BENCH, r, seed).astype(float))
+        assert abs(m.edge_angle_deg - BENCH.edge_angle_deg) < 0.1
+        k = m.f_cy_px <= 0.5
+        truth = T.mtf_true(BENCH, r, m.f_cy_px[k], BENCH.edge_angle_deg)
+        assert np.abs(m.mtf[k] - truth).max() < 0.03
+
+
+def test_slanted_edge_horizontal_and_falling_edges():
+    img = T.render_edge(BENCH, 1000, 3).astype(float)
+    ref = slanted_edge(img)
+    for variant in (img.T, img[:, ::-1], img[::-1, :].T):
+        m = slanted_edge(variant)
+        np.testing.assert_allclose(m.mtf[:40], ref.mtf[:40], atol=0.02)
+    assert slanted_edge(img.T).vertical is False
+
+
+def test_find_edge_roi_and_no_edge():
+    img = np.full((300, 300), 100.0)
+    img[:, :] += T.render_edge(BENCH, 500, 1, (300, 300)).astype(float)
+    x0, y0, x1, y1 = find_edge_roi(img)
+    assert x0 < 150 < x1 and y0 < 150 < y1
+    flat = np.random.default_rng(0).normal(100, 1, (200, 200))
+    with pytest.raises(ObservationError, match="--roi"):
+        find_edge_roi(flat)
+    with pytest.raises(ObservationError):
+        slanted_edge(flat)
+
+
+def test_edge_not_slanted_is_refused():
+    img = np.zeros((64, 64))
+    img[:, 32:] = 1000.0
+    with pytest.raises(ObservationError, match="slanted"):
+        slanted_edge(img + np.random.default_rng(1).normal(0, 1, img.shape))
+
+
+def test_bad_profiles_get_one_clear_error():
+    rec = T.render_bar_profiles(BENCH, [500], 2)
+    x, y = rec.x_px, rec.profiles_dn[0].astype(float)
+    tgt = BENCH.target
+    with pytest.raises(InputError, match="NaN"):
+        y2 = y.copy()
+        y2[300] = np.nan
+        measure_ctf(x, y2, tgt, rec.start_px, rec.gsd_mm)
+    with pytest.raises(ObservationError, match="saturated"):
+        measure_ctf(x, np.minimum(y * 3, 4095), tgt, rec.start_px, rec.gsd_mm, saturation_dn=4095)
+    with pytest.raises(ObservationError, match="bar groups|edges"):
+        keep = x < rec.start_px + 120  # only the first two groups
+        measure_ctf(x[keep], y[keep], tgt, rec.start_px, rec.gsd_mm)
+    with pytest.raises(ObservationError, match="start_px"):
+        measure_ctf(x, np.full_like(y, 2000.0), tgt, rec.start_px, rec.gsd_mm)
+    with pytest.raises(InputError, match="increase"):
+        measure_ctf(x[::-1], y, tgt, rec.start_px, rec.gsd_mm)
