@@ -91,6 +91,10 @@ def test_overrides_need_a_reason_and_are_marked():
     assert not Row("t", "q", "m", paper=1.0, verdict="planned", reason="004").overridden
     back = Reproduction.from_json(Reproduction("x", 0, [r, same]).to_json())
     assert [b.overridden for b in back.rows] == [True, False]
+    # a record written before issue 22 (verdict "tuned") still reads
+    old = Reproduction("x", 0, [Row("t", "c", "px", 1.0, None, 1.0, truth=1.0)]).to_json()
+    old = old.replace('"by construction"', '"tuned"')
+    assert Reproduction.from_json(old).rows[0].judge()[0] == "by construction"
 
 
 def test_agreement_words():
