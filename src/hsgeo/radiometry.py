@@ -272,14 +272,14 @@ def reflectance(e_ref, e_inc, *, g_ref=1.0, g_inc=1.0, f_alpha=1.0, f_theta=1.0)
     -------
     (..., rows, samples) ndarray
     """
-    e_ref = np.asarray(e_ref, dtype=float)
-    num = np.asarray(g_ref, dtype=float)[..., None] * e_ref * np.asarray(f_alpha, float)[..., None]
-    den = (
-        np.asarray(g_inc, dtype=float)[..., None]
-        * np.asarray(e_inc, dtype=float)[..., None]
-        * np.asarray(f_theta, dtype=float)
-    )
-    return num / den  # 001 §2.1
+    e_ref = np.asarray(e_ref)
+    if e_ref.dtype != np.float32:
+        e_ref = e_ref.astype(float)
+    g = np.asarray(g_ref, dtype=float) * np.asarray(f_alpha, dtype=float)
+    per_row = g / (np.asarray(g_inc, dtype=float) * np.asarray(e_inc, dtype=float))
+    per_sample = 1.0 / np.asarray(f_theta, dtype=float)
+    # 001 §2.1, in the dtype of e_ref (float32 keeps a chunk of a cube small)
+    return e_ref * per_row[..., None].astype(e_ref.dtype) * per_sample.astype(e_ref.dtype)
 
 
 def bin_rows(x, rows_per_band: int, axis: int = -2) -> np.ndarray:

@@ -81,7 +81,7 @@ def write_cube(ds, path, *, inputs=(), progress=None) -> list[Path]:
         out["reflectance"] = refl.copy(data=data.astype(np.float32))
         enc = {
             "reflectance": {
-                "chunksizes": (min(64, n_lines), data.shape[1], data.shape[2]),
+                "chunksizes": (data.chunks[0][0], data.shape[1], data.shape[2]),
                 "_FillValue": np.float32(np.nan),
             }
         }

@@ -223,7 +223,11 @@ def process_frames(
     raw = np.asarray(raw_dn)
     t = np.asarray(exposure_s, dtype=float)
     nr = layout.n_reflected
-    corr = raw - (dark.a_dn_per_s[None] * t[:, None, None] + dark.b_dn[None])  # 001 §2.4
+    a32 = dark.a_dn_per_s.astype(np.float32)
+    b32 = dark.b_dn.astype(np.float32)
+    corr = raw.astype(np.float32)
+    for k in range(corr.shape[0]):  # in place, frame by frame: a chunk's memory stays small
+        corr[k] -= a32 * np.float32(t[k]) + b32  # 001 §2.4, h = a·T_exp + b
     sat = raw >= FULL_SCALE_DN
     bad = sat[:, :, nr:].any(axis=2)
     if bad.any():
@@ -245,13 +249,14 @@ def process_frames(
     with np.errstate(divide="ignore", invalid="ignore"):
         r = reflectance(
             corr[:, :, :nr],
-            np.where(dim, np.nan, e_inc),
+            np.where(dim, np.nan, e_inc).astype(np.float32),
             g_ref=options.g_ref,
             g_inc=options.g_inc,
             f_alpha=options.f_alpha,
             f_theta=f_theta,
         )  # (n, rows, samples), 001 §2.1
-    r = np.where(sat[:, :, :nr], np.nan, r)
+    r[sat[:, :, :nr]] = np.nan
+    del corr
     k = options.rows_per_band
     cube = bin_rows(r, k, axis=1).transpose(0, 2, 1).astype(np.float32)
     inc = bin_rows(e_inc, k, axis=1).astype(np.float32)
