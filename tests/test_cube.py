@@ -217,3 +217,33 @@ def test_bad_frames_and_dark_sets(small):
     )
     with pytest.raises(InputError, match="saturated"):
         res2.cube["reflectance"].values  # noqa: B018 - computing raises
+
+
+def test_cube_files_front_end_with_progress(tmp_path):
+    """hsgeo cube's front end on TIFF frame folders: progress while stacking, the same cube as
+    the in-memory core, and no input written over."""
+    from hsgeo.io.frames import write_frame_folder
+    from hsgeo.workflows.cube import CubeOptions, cube_files
+
+    cfg = CS.CubeSurvey(length_m=0.02)
+    frames, (dark, t), _ = CS.simulate(cfg, 2)
+    raw = frames.read(0, frames.n_frames)
+    lam, fw = cfg.row_wavelength_nm(), cfg.row_fwhm_nm()
+    write_frame_folder(
+        tmp_path / "raw", raw, frames.exposure_s, wavelength_nm=lam, fwhm_nm=fw, fmt="tif"
+    )
+    write_frame_folder(tmp_path / "dark", dark, t, fmt="tif")
+    seen = []
+    res = cube_files(
+        tmp_path / "raw",
+        tmp_path / "dark",
+        tmp_path / "c.nc",
+        options=CubeOptions(lines_per_chunk=4),
+        progress=lambda done, total: seen.append((done, total)),
+    )
+    assert seen and seen[-1] == (frames.n_frames, frames.n_frames)
+    assert [d for d, _ in seen] == sorted(d for d, _ in seen)
+    core, _, _ = RC.survey(cfg, 2, CubeOptions())
+    with read_cube(tmp_path / "c.nc") as back:
+        np.testing.assert_array_equal(back["reflectance"].values, core.cube["reflectance"].values)
+    assert res.to_dict()["lines"] == frames.n_frames

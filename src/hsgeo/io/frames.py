@@ -23,7 +23,7 @@ import numpy as np
 from hsgeo.errors import InputError
 from hsgeo.io.tables import read_table
 
-__all__ = ["FrameFolder", "read_wavelengths", "FRAME_SUFFIXES"]
+__all__ = ["FrameFolder", "read_wavelengths", "write_frame_folder", "FRAME_SUFFIXES"]
 
 FRAME_SUFFIXES = (".tif", ".tiff", ".npy")
 
@@ -207,3 +207,65 @@ def read_wavelengths(path, n_rows: int):
         df["wavelength_nm"].to_numpy(float)[order],
         df["fwhm_nm"].to_numpy(float)[order],
     )
+
+
+def write_frame_folder(
+    folder, frames, exposure_s, *, wavelength_nm=None, fwhm_nm=None, fmt: str = "npy"
+) -> list[Path]:
+    """Write frames in the folder format of :class:`FrameFolder` (the folder is created).
+
+    Parameters
+    ----------
+    folder : str or Path
+    frames : (n, rows, columns) uint16 array_like
+    exposure_s : (n,) array_like
+    wavelength_nm, fwhm_nm : (rows,) array_like, optional
+        Written as ``wavelengths.csv`` when given.
+    fmt : {"npy", "tif"}
+        One ``.npy`` file per frame, or one 16-bit TIFF per frame.
+
+    Returns
+    -------
+    list of Path
+        The files written.
+    """
+    from hsgeo.io._files import atomic_path
+
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    frames = np.asarray(frames, dtype=np.uint16)
+    t = np.asarray(exposure_s, dtype=float)
+    if fmt not in ("npy", "tif"):
+        raise InputError(f"frame format {fmt!r}: use 'npy' or 'tif'")
+    out, names = [], []
+    for i, frame in enumerate(frames):
+        name = f"frame_{i:06d}.{fmt}"
+        with atomic_path(folder / name) as tmp:
+            if fmt == "npy":
+                with open(tmp, "wb") as fh:
+                    np.save(fh, frame)
+            else:
+                from PIL import Image
+
+                Image.fromarray(np.ascontiguousarray(frame)).save(tmp, format="TIFF")  # I;16
+        names.append(name)
+        out.append(folder / name)
+    with atomic_path(folder / "exposures.csv") as tmp:
+        Path(tmp).write_text(
+            "file,exposure_s\n"
+            + "".join(f"{n},{float(ti)!r}\n" for n, ti in zip(names, t, strict=True))
+        )
+    out.append(folder / "exposures.csv")
+    if wavelength_nm is not None:
+        lam = np.asarray(wavelength_nm, dtype=float)
+        fw = np.full(lam.shape, np.nan) if fwhm_nm is None else np.asarray(fwhm_nm, float)
+        with atomic_path(folder / "wavelengths.csv") as tmp:
+            Path(tmp).write_text(
+                "row,wavelength_nm,fwhm_nm\n"
+                + "".join(
+                    f"{i},{float(w)!r},{float(f)!r}\n"
+                    for i, (w, f) in enumerate(zip(lam, fw, strict=True))
+                )
+            )
+        out.append(folder / "wavelengths.csv")
+    return out
