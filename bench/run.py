@@ -1,7 +1,7 @@
 """``make bench``: run every ``bench/bench_*.py`` (each writes ``bench/results/<name>.json``).
 
 ``python bench/run.py [NAME ...]`` runs only the named ones (``engine``, ``pushbroom_ba``,
-``pushbroom_scaling``, ``bal``, ``nist_strd``); each script also runs on its own with its
+``pushbroom_scaling``, ``bal``, ``nist_strd``, ``cube``); each script also runs on its own with its
 options (``python bench/bench_pushbroom_ba.py --help``). ``pushbroom_scaling`` is
 ``bench_pushbroom_ba.py --scaling …``, run after the pushbroom benchmark (issue 14).
 

@@ -39,6 +39,7 @@ __all__ = [
     "material_patches",
     "patch_spectra",
     "rounds_to",
+    "speed_tradeoff",
 ]
 
 #: Band groups of the reflectance table (chosen): the usual broad regions of a leaf spectrum.
@@ -124,6 +125,37 @@ def _group_means(cube, patches, wavelength_nm):
         for g, (lo, hi) in BAND_GROUPS_NM.items():
             sel = (wavelength_nm >= lo) & (wavelength_nm <= hi)
             out[name, g] = R.patch_mean(block[..., sel].mean(axis=-1))
+    return out
+
+
+def speed_tradeoff(cfg: CS.CubeSurvey, factors=(0.5, 1.0, 2.0, 4.0), wavelength_nm=800.0):
+    """What the speed does to the image along track (eq. (8)): for each speed factor × the
+    eq. (8) speed, the true NIR reflectance of the lines across the grey panel's centre sample,
+    placed as a user placing lines one GSD apart (square pixels) would place them.
+
+    Returns
+    -------
+    dict
+        ``speed_mm_s`` (factor → S), ``profiles`` (factor → (along_mm, reflectance)), the
+        panel's true along-track length ``panel_mm`` and its apparent length per factor
+        ``apparent_mm`` (width at half height, in lines × GSDv).
+    """
+    row = int(np.argmin(np.abs(cfg.row_wavelength_nm() - wavelength_nm)))
+    x0, x1, y0, y1 = cfg.panel_m
+    sample = int(np.argmin(np.abs(cfg.sample_y_m() - (y0 + y1) / 2)))
+    out = {"speed_mm_s": {}, "profiles": {}, "apparent_mm": {}, "panel_mm": (x1 - x0) * 1000}
+    for f in factors:
+        c = CS.at_speed(cfg, f)
+        dx = c.speed / c.layout.frame_rate_hz
+        lines = np.arange(int(np.ceil((x1 + 0.03) / dx)))
+        prof = CS.true_reflectance_lines(c, lines, row)[:, sample]
+        along = lines * cfg.gsd_m * 1000  # lines placed one GSD apart
+        soil = prof[0]
+        half = soil + 0.5 * (prof.max() - soil)
+        above = np.flatnonzero(prof >= half)
+        out["speed_mm_s"][f] = c.speed * 1000
+        out["profiles"][f] = (along, prof)
+        out["apparent_mm"][f] = (above[-1] - above[0] + 1) * cfg.gsd_m * 1000
     return out
 
 

@@ -22,7 +22,7 @@ from hsgeo.report import VERDICTS, Reproduction, Row
 __all__ = ["PAPER_CHAPTERS", "claims", "planned_claims", "run", "counts"]
 
 #: The chapters whose tables hold claims of the papers.
-PAPER_CHAPTERS = ("line-calibration", "geocoding", "pushbroom-ba", "rikola")
+PAPER_CHAPTERS = ("line-calibration", "geocoding", "pushbroom-ba", "rikola", "cube")
 
 _PAPER_TABLE = re.compile(r"^00[0-4] ")
 #: Tables named after a paper that hold experiments rather than claims: the factors table runs

@@ -48,6 +48,8 @@ __all__ = [
     "SurveyTruth",
     "simulate",
     "simulate_dark",
+    "at_speed",
+    "true_reflectance_lines",
 ]
 
 #: Materials of the scene, in the order of the material map's ids.
@@ -333,3 +335,17 @@ def simulate(cfg: CubeSurvey, rng) -> tuple[SurveyFrames, tuple, SurveyTruth]:
 def at_speed(cfg: CubeSurvey, factor: float) -> CubeSurvey:
     """The same survey at ``factor`` × the eq. (8) speed (the speed trade-off of the chapter)."""
     return replace(cfg, speed_m_s=factor * eq8_speed_m_s(cfg.gsd_m, cfg.layout.frame_rate_hz))
+
+
+def true_reflectance_lines(cfg: CubeSurvey, lines, row: int) -> np.ndarray:
+    """Noise-free reflectance seen by ``lines`` at one spectral row: (lines, samples).
+
+    The mixture of materials in each pixel's footprint (slit width smeared by the motion), for
+    figures of what the sampling along track does to the scene.
+    """
+    spectra = np.stack(list(material_spectra(cfg.row_wavelength_nm()[[row]]).values()), axis=1)
+    out = []
+    lines = np.asarray(lines)
+    for k in range(0, lines.size, 64):
+        out.append(_fractions(cfg, lines[k : k + 64]) @ spectra[0])
+    return np.concatenate(out, axis=0)
