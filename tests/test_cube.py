@@ -94,8 +94,8 @@ def test_truth_recovered_within_3_sigma(seed):
         assert abs(r.reproduced - r.truth) < 0.003
     # the unmodelled collector error moves reflectance far beyond σ̂, not NDVI (a ratio)
     un = {r.quantity: r for r in rep.rows_of("unmodelled effect")}
-    assert abs(un["panel, NIR reflectance"].z) > 20
-    assert abs(un["NDVI, variant A"].z) < 4
+    assert abs(un["panel, NIR reflectance, with the error"].z) > 20
+    assert abs(un["NDVI, variant A, with the error"].z) < 4
     json.loads(rep.to_json())
 
 
