@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from hsgeo import radiometry as R
 from hsgeo.errors import InputError
 from hsgeo.io.cube import ENVI_IGNORE_VALUE, read_cube, write_cube
 from hsgeo.reproduce import cube as RC
@@ -79,7 +80,9 @@ def _share_within_3(rep, table):
     return np.mean(np.abs(z) <= 3), len(z)
 
 
-@pytest.mark.parametrize("seed", [0, 1, pytest.param(2, marks=pytest.mark.slow), 5])
+@pytest.mark.parametrize(
+    "seed", [0, 1, 5, *(pytest.param(k, marks=pytest.mark.slow) for k in (2, 3, 4, 6, 7))]
+)
 def test_truth_recovered_within_3_sigma(seed):
     """Hot-pixel coefficients, reflectance and indices within 3σ̂ of the truth (≥ 95 % of rows)."""
     rep = RC.run(seed=seed, scale=0.2)
@@ -247,3 +250,16 @@ def test_cube_files_front_end_with_progress(tmp_path):
     with read_cube(tmp_path / "c.nc") as back:
         np.testing.assert_array_equal(back["reflectance"].values, core.cube["reflectance"].values)
     assert res.to_dict()["lines"] == frames.n_frames
+
+
+def test_binning_1_frames():
+    """Binning 1 (1024 × 1280 frames, 1170 + 110 columns, 12.5 fps, 001 §2.1) end to end."""
+    cfg = CS.CubeSurvey(binning=1, length_m=0.025)
+    res, frames, truth = RC.survey(cfg, 0)
+    assert frames.frame_shape == (1024, 1280)
+    cube = res.cube.compute()
+    assert cube.sizes["sample"] == 1170 and cube.sizes["line"] == frames.n_frames
+    panel = truth.material == CS.MATERIALS.index("netting")
+    r = cube["reflectance"].values[panel]  # (pixels, bands)
+    true = R.bin_rows(truth.spectra["netting"], res.options.rows_per_band, axis=0)
+    assert np.abs(r.mean(axis=0) - true).max() < 0.005
