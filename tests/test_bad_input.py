@@ -1202,6 +1202,16 @@ case(
     "unknown cube format",
     argv=lambda a, d: [x.replace("cube.nc", "cube.txt") for x in a],
 )
+
+
+def _envi_data_exists(a, d):
+    """-o cube.hdr while the ENVI data file 'cube' exists (not only the header is checked)."""
+    (d.parent / "out").mkdir(exist_ok=True)
+    (d.parent / "out" / "cube").write_text("an earlier result\n")
+    return [x.replace("cube.nc", "cube.hdr") for x in a]
+
+
+case(C, "outputs", "envi-data-file-exists", "exists", argv=_envi_data_exists)
 case(
     C,
     "outputs",

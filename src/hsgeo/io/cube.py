@@ -17,7 +17,7 @@ from hsgeo.errors import InputError
 from hsgeo.io._files import atomic_path
 from hsgeo.io.envi import EnviWriter
 
-__all__ = ["write_cube", "read_cube", "ENVI_IGNORE_VALUE", "cube_format"]
+__all__ = ["write_cube", "read_cube", "ENVI_IGNORE_VALUE", "cube_format", "cube_outputs"]
 
 #: The ENVI ``data ignore value`` written for pixels without a value (NaN in the Dataset).
 ENVI_IGNORE_VALUE = -9999.0
@@ -41,6 +41,16 @@ def cube_format(path) -> str:
 def _envi_paths(path: Path, interleave: str) -> Path:
     """The ENVI data file for ``-o``: ``cube.hdr`` → ``cube``; ``cube.bil`` → itself."""
     return path.with_suffix("") if path.suffix.lower() == ".hdr" else path
+
+
+def cube_outputs(path) -> list[Path]:
+    """The files :func:`write_cube` writes for ``path`` (ENVI: the data file and its header)."""
+    path = Path(path)
+    fmt = cube_format(path)
+    if fmt == "netcdf":
+        return [path]
+    data = _envi_paths(path, fmt)
+    return [data, data.with_name(data.name + ".hdr")]
 
 
 def _default_bands(wavelength_nm) -> list[int]:

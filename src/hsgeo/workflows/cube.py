@@ -379,14 +379,14 @@ def cube_files(
         True draws a bar on stderr while stacking; a callable gets ``(done, total)``.
     """
     from hsgeo.io._files import check_outputs
-    from hsgeo.io.cube import cube_format, write_cube
+    from hsgeo.io.cube import cube_outputs, write_cube
     from hsgeo.io.frames import FrameFolder, read_wavelengths
 
-    cube_format(output)
+    outputs = cube_outputs(output)  # checks the format
     frames = FrameFolder(raw_dir, "RAW_DIR")
     dark = FrameFolder(dark_dir, "--dark")
     inputs_files = [*frames.files, *dark.files, Path(raw_dir) / "wavelengths.csv"]
-    check_outputs([(output, "-o")], inputs_files, overwrite=overwrite)
+    check_outputs([(p, "-o") for p in outputs], inputs_files, overwrite=overwrite)
     layout = frame_layout(options.binning)
     for src, what in ((frames, "RAW_DIR"), (dark, "--dark")):
         if tuple(src.frame_shape) != (layout.n_rows, layout.n_columns):
