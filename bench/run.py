@@ -1,9 +1,10 @@
 """``make bench``: run every ``bench/bench_*.py`` (each writes ``bench/results/<name>.json``).
 
 ``python bench/run.py [NAME ...]`` runs only the named ones (``engine``, ``pushbroom_ba``,
-``pushbroom_scaling``, ``bal``, ``nist_strd``, ``mtf``); each script also runs on its own with its
-options (``python bench/bench_pushbroom_ba.py --help``). ``pushbroom_scaling`` is
-``bench_pushbroom_ba.py --scaling …``, run after the pushbroom benchmark (issue 14).
+``pushbroom_scaling``, ``bal``, ``nist_strd``, ``mtf``, ``cube``, ``busy_machine``); each
+script also runs on its own with its options (``python bench/bench_pushbroom_ba.py --help``).
+``pushbroom_scaling`` is ``bench_pushbroom_ba.py --scaling …``, run after the pushbroom
+benchmark (issue 14).
 
 Benchmarks time whole operations at realistic sizes and report peak memory, against the obvious
 alternative in the same run (GUIDE §7). They are scripts, never timed assertions.

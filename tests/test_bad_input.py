@@ -149,11 +149,30 @@ def _mtf_edge(d: Path) -> None:
     write_edge_image(d / "edge.png")
 
 
+def _cube(d: Path) -> None:
+    """A short simulated ImSpector run (binning 2): raw/ and dark/ frame folders (.npy)."""
+    from hsgeo.io.frames import write_frame_folder
+    from hsgeo.simulate import cube_survey as CS
+
+    cfg = CS.CubeSurvey(length_m=0.02)
+    frames, (dark, t), _ = CS.simulate(cfg, 4)
+    raw = frames.read(0, frames.n_frames)
+    write_frame_folder(
+        d / "raw",
+        raw,
+        frames.exposure_s,
+        wavelength_nm=cfg.row_wavelength_nm(),
+        fwhm_nm=cfg.row_fwhm_nm(),
+    )
+    write_frame_folder(d / "dark", dark, t)
+
+
 def build_valid(root: Path) -> Path:
     """Write the valid inputs of every command under ``root`` (one folder per command)."""
     _mtf(root / "mtf")
     _mtf_edge(root / "mtf-edge")
     _bal(root / "adjust-bal")
+    _cube(root / "cube")
     _line(root / "calibrate-line")
     _pushbroom(root / "adjust-pushbroom")
     _geocode(root / "geocode")
@@ -201,6 +220,10 @@ def base_argv(cmd: str, d: Path) -> list[str]:
         return [cmd, s(d / "profiles.csv"), "--bars", s(d / "bars.toml")]
     if cmd == "mtf-edge":
         return [cmd, s(d / "edge.png"), "--json"]
+    if cmd == "cube":
+        out = d.parent / "out"
+        out.mkdir(exist_ok=True)
+        return [cmd, s(d / "raw"), "--dark", s(d / "dark"), "-o", s(out / "cube.nc"), "--quiet"]
     if cmd == "reproduce":
         return [cmd, "frame-reference"]
     if cmd == "data":
@@ -1093,6 +1116,134 @@ def _blank(p):
     cv2.imwrite(str(p), np.full_like(img, 128))
 
 
+# --- cube ----------------------------------------------------------------------------------
+C = "cube"
+
+
+def _npy(edit):
+    """Rewrite a .npy frame through ``edit(array) -> array``."""
+
+    def f(p: Path):
+        a = np.load(p)
+        np.save(p, edit(a))
+
+    return f
+
+
+def _saturate_incident(a):
+    a = a.copy()
+    a[100:140, 585:] = 4095
+    return a
+
+
+case(
+    C,
+    "degenerate",
+    "mixed-frame-sizes",
+    "mixed sizes",
+    [("raw/frame_000003.npy", _npy(lambda a: a[:, :600]))],
+)
+case(
+    C,
+    "degenerate",
+    "dark-mixed-sizes",
+    "mixed sizes",
+    [("dark/frame_000002.npy", _npy(lambda a: a[:500]))],
+)
+case(
+    C,
+    "degenerate",
+    "dark-one-exposure-time",
+    "one exposure time",
+    [
+        ("dark/exposures.csv", scale_column("exposure_s", 0.0)),
+        ("dark/exposures.csv", lambda p: p.write_text(p.read_text().replace(",0.0", ",0.2"))),
+    ],
+)
+case(
+    C,
+    "range",
+    "saturated-incident",
+    "saturated",
+    [("raw/frame_000002.npy", _npy(_saturate_incident))],
+)
+case(C, "missing", "wavelengths-missing", "wavelengths.csv", [("raw/wavelengths.csv", remove)])
+case(
+    C,
+    "missing",
+    "wavelengths-rows-missing",
+    "missing wavelengths",
+    [("raw/wavelengths.csv", keep_rows(300))],
+)
+case(
+    C,
+    "mistyped",
+    "wavelengths-no-fwhm",
+    "fwhm_nm",
+    [("raw/wavelengths.csv", drop_column("fwhm_nm"))],
+)
+case(
+    C,
+    "nonfinite",
+    "wavelength-nan",
+    "wavelength_nm",
+    [("raw/wavelengths.csv", set_cell("wavelength_nm", "nan"))],
+)
+case(C, "missing", "exposures-missing", "exposures.csv", [("raw/exposures.csv", remove)])
+case(
+    C,
+    "missing",
+    "exposure-of-a-frame-missing",
+    "frame_000005.npy",
+    [("raw/exposures.csv", delete_rows(5, 6))],
+)
+case(
+    C,
+    "range",
+    "exposure-in-ms",
+    "exposure_s",
+    [("raw/exposures.csv", scale_column("exposure_s", 1e4))],
+)
+case(C, "garbage", "frame-not-npy", "frame_000001.npy", [("raw/frame_000001.npy", text("hello\n"))])
+case(C, "missing", "raw-dir-missing", "RAW_DIR", argv=replace_arg("raw", lambda d: d / "nope"))
+case(C, "options", "binning-1", "--binning", argv=flag("--binning", "1"))
+for o, vals in {
+    "--binning": ["3", "0", "abc"],
+    "--rows-per-band": ["0", "2.5"],
+    "--f-alpha": ["0", "nan"],
+}.items():
+    for v in vals:
+        case(C, "options", f"{o}={v}", o, argv=opt(o, v))
+case(C, "options", "no-dark", "--dark", argv=opt("--dark"))
+case(
+    C,
+    "outputs",
+    "output-txt",
+    "unknown cube format",
+    argv=lambda a, d: [x.replace("cube.nc", "cube.txt") for x in a],
+)
+
+
+def _envi_data_exists(a, d):
+    """-o cube.hdr while the ENVI data file 'cube' exists (not only the header is checked)."""
+    (d.parent / "out").mkdir(exist_ok=True)
+    (d.parent / "out" / "cube").write_text("an earlier result\n")
+    return [x.replace("cube.nc", "cube.hdr") for x in a]
+
+
+case(C, "outputs", "envi-data-file-exists", "exists", argv=_envi_data_exists)
+case(
+    C,
+    "outputs",
+    "output-is-an-input",
+    "input",
+    argv=lambda a, d: (
+        [str(d / "raw" / "wavelengths.csv") if x.endswith("cube.nc") else x for x in a][:-1]
+        + ["--overwrite"]
+    ),
+)
+
+
 # --- reproduce, data, versions, the top level ----------------------------------------------
 C = "adjust-bal"
 F = "problem.txt"
@@ -1372,6 +1523,16 @@ def _gray16(p: Path):
     cv2.imwrite(str(p.with_suffix(".png")), img)
 
 
+def _npy_to_tiff(p: Path):
+    """Every .npy frame of the folder of ``p`` as a 16-bit TIFF (exposures.csv renamed)."""
+    from PIL import Image
+
+    for f in sorted(p.parent.glob("*.npy")):
+        Image.fromarray(np.load(f)).save(f.with_suffix(".tif"), format="TIFF")
+        f.unlink()
+    p.write_text(p.read_text().replace(".npy", ".tif"))
+
+
 BENIGN = [
     ("calibrate-line", "crlf", [("obs.csv", _crlf), ("control.csv", _crlf)], None),
     ("calibrate-line", "bom", [("obs.csv", _bom), ("control.csv", _bom)], None),
@@ -1406,6 +1567,18 @@ BENIGN = [
     ("mtf", "crlf-bom-reordered", [("profiles.csv", _reorder), ("bars.toml", _crlf)], None),
     ("mtf", "json", [("profiles.csv", _bom)], flag("--json")),
     ("mtf-edge", "roi", [], flag("--roi", "10,10,150,190")),
+    (
+        "cube",
+        "tiff-frames-envi",
+        [("raw/exposures.csv", _npy_to_tiff)],
+        lambda a, d: [x.replace("cube.nc", "cube.hdr") for x in a],
+    ),
+    (
+        "cube",
+        "binning-2-bil-json",
+        [],
+        lambda a, d: [x.replace("cube.nc", "cube.bil") for x in a] + ["--json"],
+    ),
 ]
 
 

@@ -95,3 +95,28 @@ def test_run_records_and_recorded_round_trips(tmp_path, monkeypatch):
     )
     monkeypatch.delenv(RECORD_ENV)
     assert recorded("frame-reference") is None
+
+
+def test_cube_chapter_claims_reach_the_scoreboard():
+    """001 §3.2's printed acquisition numbers are claims of the cube chapter (they were not
+    listed as planned before the chapter existed); its truth-recovery tables are not."""
+    rep = Reproduction(
+        "cube",
+        0,
+        [
+            Row(
+                "001 §3.2",
+                "speed S of eq. (8)",
+                "mm/s",
+                paper=33.0,
+                reproduced=34.15,
+                verdict="differs",
+                reason="eq. (8)",
+                provenance="derived",
+            ),
+            Row("reflectance", "panel, NIR", "1", reproduced=0.5, sigma=1e-4, truth=0.5),
+        ],
+    )
+    rows = claims({"cube": rep})
+    assert "cube" in PAPER_CHAPTERS
+    assert [r.quantity for r in rows if r.verdict != "planned"] == ["speed S of eq. (8)"]

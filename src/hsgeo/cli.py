@@ -235,6 +235,37 @@ def _cmd_mtf_edge(args) -> int:
     return 0
 
 
+def _cmd_cube(args) -> int:
+    import json
+
+    from hsgeo.workflows.cube import CubeOptions, cube_files
+
+    opts = CubeOptions(
+        binning=args.binning,
+        rows_per_band=args.rows_per_band,
+        lines_per_chunk=args.lines_per_chunk,
+        f_alpha=args.f_alpha,
+    )
+    res = cube_files(
+        args.raw_dir,
+        args.dark,
+        args.output,
+        options=opts,
+        overwrite=args.overwrite,
+        progress=not args.quiet and sys.stderr.isatty(),
+    )
+    d = res.to_dict()
+    if args.json:
+        print(json.dumps(d, indent=1))
+    else:
+        print(
+            f"reflectance cube of {d['lines']} lines x {d['samples']} samples x {d['bands']} "
+            f"bands ({d['wavelength_nm'][0]:.1f}-{d['wavelength_nm'][1]:.1f} nm), "
+            f"{d['n_hot_pixels']} hot pixels corrected: " + ", ".join(d["files"])
+        )
+    return 0
+
+
 _POSITIVE = option_number(positive=True)
 
 
@@ -496,6 +527,60 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--roi", help="region x0,y0,x1,y1 in pixels around the edge")
     p.add_argument("--json", action="store_true", help="one JSON object instead of text")
     p.set_defaults(func=_cmd_mtf_edge)
+
+    p = sub.add_parser(
+        "cube",
+        help="raw ImSpector frames -> reflectance cube (dark current, hot pixels, 001 §2.1/§2.4)",
+        description="Build a reflectance cube from raw frames of the ImSpector V9 + PixelFly "
+        "(001 §2.1, §2.4): fit h = a*T_exp + b to every pixel of the dark frames, find the hot "
+        "pixels, subtract h from every frame, average the diffuse collector's columns along "
+        "each spectral line and compute r = G_ref*E_ref*F(alpha) / (G_inc*E_inc*F(theta)); "
+        "stack the lines, in chunks, into a cube (line, sample, band). "
+        "RAW_DIR and DARK_DIR: frames in file-name order, 16-bit grayscale TIFF (.tif/.tiff, "
+        "one frame per file) or NumPy (.npy, one frame (rows, columns) or a stack (n, rows, "
+        "columns)), raw 12-bit DN, spectral rows down, spatial columns across (binning 1: "
+        "1024 x 1280 with the scene in columns 0-1169 and the diffuse collector in 1170-1279; "
+        "binning 2: 512 x 640, 585 + 55 columns); each folder has exposures.csv with columns "
+        "file, exposure_s (one row per frame file; a .npy stack shares its value). The dark "
+        "frames (aperture closed) need two or more exposure times. RAW_DIR also has "
+        "wavelengths.csv with columns row, wavelength_nm, fwhm_nm for every spectral row. "
+        "Output: .nc (NetCDF-4) or .hdr / .bsq / .bil / .bip (ENVI with wavelength, fwhm, data "
+        "ignore value -9999 and default bands 850/650/550 nm).",
+    )
+    p.add_argument("raw_dir", metavar="RAW_DIR", help="folder of raw frames (see above)")
+    p.add_argument("--dark", required=True, metavar="DARK_DIR", help="folder of dark frames")
+    p.add_argument(
+        "--binning",
+        type=option_number(integer=True, lo=1, hi=2),
+        default=2,
+        help="the camera's binning factor, 1 or 2 (default 2, 001 §3.2)",
+    )
+    p.add_argument(
+        "--rows-per-band",
+        type=option_number(integer=True, lo=1, hi=64),
+        default=5,
+        help="spectral rows averaged into one band (default 5: 4.4 nm at binning 2)",
+    )
+    p.add_argument(
+        "--f-alpha",
+        type=option_number(positive=True, hi=10.0),
+        default=1.0,
+        help="the diffuse collector's receiving pattern F(alpha) at the light's incidence "
+        "(default 1)",
+    )
+    p.add_argument(
+        "--lines-per-chunk",
+        type=option_number(integer=True, lo=1, hi=4096),
+        default=64,
+        help="lines processed together (memory is about one chunk; default 64)",
+    )
+    p.add_argument("-o", "--output", required=True, metavar="CUBE.nc|CUBE.hdr")
+    p.add_argument(
+        "--overwrite", action="store_true", help="replace an existing output (default: refuse)"
+    )
+    p.add_argument("--quiet", action="store_true", help="no progress bar (shown on a terminal)")
+    p.add_argument("--json", action="store_true", help="a JSON summary instead of one line")
+    p.set_defaults(func=_cmd_cube)
 
     p = sub.add_parser("versions", help="versions of hsgeo, Python and the dependencies")
     p.set_defaults(func=_cmd_versions)

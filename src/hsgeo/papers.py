@@ -370,3 +370,32 @@ ASF_004 = {
     "nadir GSD at 300 m": (0.7, "m"),  # "about 0.7 m for nadir"
     "runway width": (50.0, "px"),  # "about 50 pixels"
 }
+
+
+# ---- 001 §2.1, §2.4, §3.2: building the hyperspectral cube (the `cube` chapter) ----
+
+#: The acquisition of the vineyard survey and the frame layout per binning factor, as printed.
+P001_CUBE = {
+    "n_reflected_columns": {1: 1170, 2: 585},  # 001 §2.1 "1170 × 1024 or 585 × 512 pixels"
+    "n_incident_columns": {1: 110, 2: 55},  # 001 §2.1 "110 × 512 or 55 × 512 pixels"
+    "frame_rate_hz": {1: 12.5, 2: 24.0},  # 001 §2.1 / Table 1 "12.5 fps ... 24 fps"
+    "swath_per_height": 0.333,  # 001 §2.1 "a narrow strip measuring (0.333 × h) × (0.00208 × h)"
+    "slit_per_height": 0.00208,  # 001 §2.1
+    "spectral_resolution_nm": 4.4,  # 001 §2.1 "a spectral resolution of 4.4 nm for 95 channels"
+    "n_channels": 95,  # 001 §2.1
+    "binning": 2,  # 001 §3.2 "The HSLS V9 was used with binning factor 2"
+    "gain": 1.0,  # 001 §3.2 "a default gain value of 1"
+    "height_m": 2.5,  # 001 §3.2 "the tops of the vines (top leaves) were about 2.5 m from the lens"
+    "gsd_v_mm": 1.4,  # 001 §3.2 "GSDv ≈ 1.4 mm" (binning 2, along the line sensor)
+    "gsd_h_mm": 5.2,  # 001 §3.2 "GSDh across the line sensor was 5.2 mm"
+    "exposure_s": 0.042,  # 001 §3.2 "the exposition time was 0.042 s"
+    "speed_mm_s": 33.0,  # 001 §3.2 "calculated according to (8) at 33 mm/s"
+    "section_length_m": 2.4,  # 001 §3.2 "in two sections, each 2.4 m long"
+    "n_vegetation_indices": 16,  # 001 §3.2 "16 selected vegetation indices"
+    "source": "001 §2.1, Table 1, §3.2",
+}
+
+#: 001 §3.2: the irrigation variants of the Jadrtovac trial, share of the vines' water need (ET).
+P001_VARIANTS = {"A": 0.50, "B": 0.75, "C": 1.00, "control": 0.0}
+
+__all__ += ["P001_CUBE", "P001_VARIANTS"]

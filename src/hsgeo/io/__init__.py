@@ -12,7 +12,10 @@ One module per format:
   trajectory, :class:`~hsgeo.trajectory.Trajectory`);
 * :mod:`hsgeo.io.lines` — recorded flight lines (NetCDF);
 * :mod:`hsgeo.io.raster` — orthoimages (NetCDF and ENVI) and DEMs (NetCDF);
-* :mod:`hsgeo.io.envi` — ENVI BSQ + ``.hdr``;
+* :mod:`hsgeo.io.envi` — ENVI BSQ/BIL/BIP + ``.hdr``, also written in blocks of lines;
+* :mod:`hsgeo.io.frames` — folders of raw ImSpector frames (16-bit TIFF or ``.npy``) with their
+  exposure times and wavelengths (``hsgeo cube``);
+* :mod:`hsgeo.io.cube` — reflectance cubes, NetCDF-4 or ENVI, written chunk by chunk;
 * :mod:`hsgeo.io.opencv` — OpenCV FileStorage YAML/XML;
 * :mod:`hsgeo.io.nist_strd` — NIST StRD nonlinear-regression files (certified values).
 

@@ -28,6 +28,7 @@ CHAPTERS: dict[str, str] = {
     "rikola": "rikola",
     "pushbroom-ba": "pushbroom_ba",
     "mtf": "mtf",
+    "cube": "cube",
     "scoreboard": "scoreboard",
 }
 

@@ -33,7 +33,7 @@ __all__ = [
 ]
 
 #: The chapters whose tables hold claims of the papers.
-PAPER_CHAPTERS = ("line-calibration", "geocoding", "pushbroom-ba", "rikola", "mtf")
+PAPER_CHAPTERS = ("line-calibration", "geocoding", "pushbroom-ba", "rikola", "mtf", "cube")
 
 _PAPER_TABLE = re.compile(r"^00[0-4] ")
 #: Tables named after a paper that hold experiments rather than claims: the factors table runs

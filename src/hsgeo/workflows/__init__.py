@@ -14,6 +14,9 @@ module                     what it does
                            ``hsgeo calibrate-frame``)
 ``pushbroom_ba``           bundle adjustment of pushbroom lines (002, ``hsgeo adjust-pushbroom``)
 ``geocoding``              orthorectification of a recorded flight line (000, ``hsgeo geocode``)
+``cube``                   raw ImSpector frames → reflectance cube: dark current and hot pixels,
+                           reflectance from the diffuse collector, chunked (001 §2.1, §2.4,
+                           ``hsgeo cube``)
 ``bal``                    a "Bundle Adjustment in the Large" problem, Snavely cameras
                            (``hsgeo adjust-bal``)
 =========================  =====================================================================
