@@ -10,9 +10,7 @@ from hsgeo import ConvergenceError, InputError, ObservationError
 from hsgeo.adjust.checks import check_jacobian
 from hsgeo.geocode import (
     BoresightGCP,
-    CalibratedLine,
     DemTerrain,
-    LinearIFOV,
     PlaneTerrain,
     calibrate_boresight,
     geocode_image,
@@ -22,6 +20,7 @@ from hsgeo.geocode import (
 )
 from hsgeo.io import write_lines
 from hsgeo.io.navigation import write_trajectory
+from hsgeo.sensors.line import CalibratedLine, LinearIFOV
 from hsgeo.simulate.pula_flight import observe_gcps, simulate_flight
 from hsgeo.simulate.scenarios import load_scenario
 from hsgeo.trajectory import Trajectory

@@ -8,7 +8,6 @@ import pandas as pd
 import pytest
 
 from hsgeo import InputError
-from hsgeo.geocode import CalibratedLine, LinearIFOV
 from hsgeo.io import (
     Key,
     atomic_path,
@@ -24,6 +23,7 @@ from hsgeo.io import (
     write_lines,
 )
 from hsgeo.io.boards import OPENCV_TUTORIAL_CHARUCO, Board
+from hsgeo.sensors.line import CalibratedLine, LinearIFOV
 from hsgeo.simulate.scenarios import load_scenario
 
 

@@ -76,7 +76,7 @@ def read_sensor_toml(path):
 
     Returns
     -------
-    geometry : hsgeo.geocode.CalibratedLine or hsgeo.geocode.LinearIFOV
+    geometry : hsgeo.sensors.line.CalibratedLine or hsgeo.sensors.line.LinearIFOV
     boresight_rad : (3,) ndarray
         Roll, pitch, heading (rad).
 
@@ -86,7 +86,7 @@ def read_sensor_toml(path):
         Missing file, malformed TOML, unknown or misspelled keys, missing ``zeta0_px`` /
         ``c_px``, values of the wrong type (:func:`~hsgeo.io.config.read_config`).
     """
-    from hsgeo.geocode import CalibratedLine, LinearIFOV
+    from hsgeo.sensors.line import CalibratedLine, LinearIFOV
 
     s = read_config(path, SENSOR_SCHEMA, "sensor file", required_tables=("sensor",))["sensor"]
     if s["model"] == "linear-ifov" and any(s["K"]):

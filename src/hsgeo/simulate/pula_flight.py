@@ -21,14 +21,10 @@ from pathlib import Path
 
 import numpy as np
 
-from hsgeo.geocode import (
-    CalibratedLine,
-    LinearIFOV,
-    LineGeometry,
-    PlaneTerrain,
-)
+from hsgeo.geocode import PlaneTerrain
 from hsgeo.io.navigation import write_trajectory
 from hsgeo.rotations import R_from_rpy
+from hsgeo.sensors.line import CalibratedLine, LinearIFOV, LineGeometry
 from hsgeo.simulate import as_rng
 from hsgeo.trajectory import Trajectory
 

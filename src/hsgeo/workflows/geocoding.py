@@ -13,7 +13,6 @@ import numpy as np
 from hsgeo.errors import InputError
 from hsgeo.geocode import (
     DemTerrain,
-    LineGeometry,
     PlaneTerrain,
     calibrate_boresight,
     geocode_image,
@@ -21,6 +20,7 @@ from hsgeo.geocode import (
     orthorectify,
 )
 from hsgeo.io import read_dem, read_lines, read_sensor_toml, to_map_files
+from hsgeo.sensors.line import LineGeometry
 
 __all__ = ["geocode_files", "gcp_deviations"]
 

@@ -1,0 +1,99 @@
+"""The 000 line scanner's geometry: pixel ζ ↔ across-track view angle, and its rays.
+
+The inner geometry (:class:`LineGeometry`): the uncalibrated linear-IFOV model
+(:class:`LinearIFOV`) and the calibrated model of 000 eq. (2) in its ray form
+(:class:`CalibratedLine`, the equations in :mod:`hsgeo.sensors.line1d`).
+
+Frames: **body** x forward, y right, z down (a GNSS/INS attitude, NED); **sensor** like body,
+looking down with its pixel line along y: pixel ζ sees the direction ``(0, t(ζ), 1)``, ``t`` the
+tangent of the across-track view angle, positive to the right. The map frame is east-north-up.
+
+:mod:`hsgeo.sensors.line1d` holds the 000 laboratory calibration model (eq. (2) and its
+residual blocks); this module holds what a flying line scanner needs of it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from hsgeo.rotations import R_ENU_FROM_NED, R_from_rpy
+from hsgeo.sensors import line1d
+
+__all__ = ["LineGeometry", "LinearIFOV", "CalibratedLine", "ray_directions"]
+
+
+class LineGeometry:
+    """The inner geometry of a line scanner: pixel ζ ↔ tangent of the across-track view angle."""
+
+    def tan_angle(self, zeta_px) -> np.ndarray:
+        """Tangent of the view angle (positive to the right) of pixel ζ."""
+        raise NotImplementedError
+
+    def zeta(self, tan_angle) -> np.ndarray:
+        """The pixel that sees the given tangent (inverse of :meth:`tan_angle`)."""
+        raise NotImplementedError
+
+
+@dataclass(frozen=True)
+class LinearIFOV(LineGeometry):
+    """The uncalibrated model of Jakšić (2009): the view angle is linear in the pixel distance.
+
+    ``θ = −(ζ − ζ0)·IFOV`` with ``IFOV = 1/c`` (rad per pixel) and no distortion (000 §
+    "Verification": "IFOV ... linear function of the distance from the central pixel ... optical
+    distortion was neglected").
+    """
+
+    zeta0_px: float = 485.0
+    c_px: float = 3600.0
+
+    def tan_angle(self, zeta_px):
+        return np.tan(-(np.asarray(zeta_px, dtype=float) - self.zeta0_px) / self.c_px)
+
+    def zeta(self, tan_angle):
+        return self.zeta0_px - np.arctan(np.asarray(tan_angle, dtype=float)) * self.c_px
+
+
+@dataclass(frozen=True)
+class CalibratedLine(LineGeometry):
+    """The calibrated 1D model of 000 eq. (2) in its ray form (:mod:`hsgeo.sensors.line1d`).
+
+    ``ζ = ζ0 − c·tan θ + δ(ζ − ζ0)``, δ the odd 7th-order polynomial in units of 100 px.
+    """
+
+    zeta0_px: float
+    c_px: float
+    K: tuple[float, ...] = (0.0, 0.0, 0.0)
+
+    def tan_angle(self, zeta_px):
+        return line1d.tan_from_zeta(zeta_px, self.zeta0_px, self.c_px, self.K)
+
+    def zeta(self, tan_angle):
+        return line1d.zeta_from_tan(tan_angle, self.zeta0_px, self.c_px, self.K)
+
+
+def ray_directions(rpy_rad, tan_angle, R_body_from_sensor=None) -> np.ndarray:
+    """Map-frame directions of line-scanner pixels.
+
+    Parameters
+    ----------
+    rpy_rad : (n, 3) ndarray
+        INS roll, pitch, heading of the body (NED).
+    tan_angle : (n,) ndarray
+        Tangent of each pixel's across-track view angle (:class:`LineGeometry`).
+    R_body_from_sensor : (3, 3) ndarray, optional
+        Boresight misalignment (identity if omitted).
+
+    Returns
+    -------
+    (n, 3) ndarray
+        Unnormalised directions ``R_enu_from_ned R_ned_from_body R_body_from_sensor (0, t, 1)``.
+    """
+    rpy = np.atleast_2d(np.asarray(rpy_rad, dtype=float))
+    t = np.asarray(tan_angle, dtype=float).ravel()
+    d_s = np.stack([np.zeros_like(t), t, np.ones_like(t)], axis=1)
+    if R_body_from_sensor is not None:
+        d_s = d_s @ np.asarray(R_body_from_sensor).T
+    R = R_ENU_FROM_NED @ R_from_rpy(rpy[:, 0], rpy[:, 1], rpy[:, 2])
+    return np.einsum("nij,nj->ni", R, d_s)
