@@ -14,14 +14,23 @@ residual blocks); this module holds what a flying line scanner needs of it.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
+from hsgeo.errors import ObservationError
 from hsgeo.rotations import R_ENU_FROM_NED, R_from_rpy
 from hsgeo.sensors import line1d
+from hsgeo.sensors.mount import Mount, line_time, unit
 
-__all__ = ["LineGeometry", "LinearIFOV", "CalibratedLine", "ray_directions"]
+__all__ = [
+    "LineGeometry",
+    "LinearIFOV",
+    "CalibratedLine",
+    "LineScanner",
+    "line_time",
+    "ray_directions",
+]
 
 
 class LineGeometry:
@@ -97,3 +106,70 @@ def ray_directions(rpy_rad, tan_angle, R_body_from_sensor=None) -> np.ndarray:
         d_s = d_s @ np.asarray(R_body_from_sensor).T
     R = R_ENU_FROM_NED @ R_from_rpy(rpy[:, 0], rpy[:, 1], rpy[:, 2])
     return np.einsum("nij,nj->ni", R, d_s)
+
+
+@dataclass(frozen=True)
+class LineScanner:
+    """A line scanner on a moving body: the sensor interface of :mod:`hsgeo.sensors.mount`.
+
+    Parameters
+    ----------
+    geometry : LineGeometry
+        Pixel ζ ↔ tangent of the across-track view angle.
+    mount : Mount
+        Lever arm and boresight ``R_body_from_sensor`` on the body of the trajectory.
+
+    Pixels are ζ (px along the line) at a time ``t_s`` each; ``project`` returns
+    ``(ζ, across_px)`` with ``across_px = c_px · x_s / z_s`` the along-track offset of the point
+    from the line's plane in pixels (zero on the line).
+    """
+
+    geometry: LineGeometry
+    mount: Mount = field(default_factory=Mount)
+
+    def rays(self, zeta_px, t_s, trajectory) -> tuple[np.ndarray, np.ndarray]:
+        """Origins (m) and unit directions of the rays of pixels ζ at times ``t_s``, map frame.
+
+        Parameters
+        ----------
+        zeta_px : (n,) array_like, px
+        t_s : (n,) array_like, s
+        trajectory : hsgeo.trajectory.Trajectory
+
+        Returns
+        -------
+        origins_m : (n, 3) ndarray
+        directions : (n, 3) ndarray, unit length
+        """
+        t = np.asarray(self.geometry.tan_angle(zeta_px), dtype=float).ravel()
+        pos, _ = trajectory.pose(t_s)
+        R = trajectory.R_map_from_body(t_s)
+        d_s = np.stack([np.zeros_like(t), t, np.ones_like(t)], axis=1)
+        return self.mount.origins(pos, R), unit(self.mount.directions(R, d_s))
+
+    def _sensor_xyz(self, xyz_map_m, t_s, trajectory) -> np.ndarray:
+        pos, _ = trajectory.pose(t_s)
+        p = self.mount.to_sensor(xyz_map_m, pos, trajectory.R_map_from_body(t_s))
+        if np.any(p[:, 2] <= 0):
+            raise ObservationError("points behind the line scanner (sensor z ≤ 0)")
+        return p
+
+    def project(self, xyz_map_m, t_s, trajectory) -> np.ndarray:
+        """``(ζ, across_px)`` of map points seen at times ``t_s``, ``(n, 2)`` px."""
+        p = self._sensor_xyz(xyz_map_m, t_s, trajectory)
+        zeta = np.asarray(self.geometry.zeta(p[:, 1] / p[:, 2]), dtype=float)
+        return np.column_stack([zeta, self.geometry.c_px * p[:, 0] / p[:, 2]])
+
+    def line_time(
+        self, xyz_map_m, trajectory, t_start_s, *, tol_s: float = 1e-10, max_iter: int = 30
+    ) -> np.ndarray:
+        """Time at which each map point lies on the scan line (``across_px = 0``), s.
+
+        Secant iteration from ``t_start_s`` (one per point), within the trajectory's span.
+        """
+
+        def across_px(X, t):
+            p = self._sensor_xyz(X, t, trajectory)
+            return self.geometry.c_px * p[:, 0] / p[:, 2]
+
+        return line_time(across_px, xyz_map_m, trajectory, t_start_s, tol_s, max_iter)

@@ -74,7 +74,7 @@ Jonassen et al. (2024), 002 eq. (2)–(4), §3.3–3.5.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from types import MappingProxyType
 
 import numpy as np
@@ -88,11 +88,14 @@ from hsgeo._kernels import (
     rpy_rotation,
 )
 from hsgeo.adjust import Indexed, ResidualBlock
-from hsgeo.errors import InputError
+from hsgeo.distortion import distort_pushbroom_line, undistort_pushbroom_line
+from hsgeo.errors import InputError, ObservationError
 from hsgeo.rotations import R_from_opk, R_from_rpy, dR_dopk, dR_drpy
-from hsgeo.trajectory import SplineNodes, bspline_basis
+from hsgeo.sensors.mount import Mount
+from hsgeo.trajectory import R_BODY_FROM_PLATFORM, SplineNodes, bspline_basis
 
 __all__ = [
+    "PushbroomCamera",
     "PushbroomLines",
     "PushbroomObservations",
     "BETA0_CAM_FROM_PLATFORM",
@@ -743,3 +746,136 @@ class PushbroomLines(ResidualBlock):
             nm["c"]: Indexed(self._band2, dC),
         }
         return r, jac
+
+
+# ----------------------------------------------------------------------------------------------
+# The sensor interface (hsgeo.sensors.mount): pixels ↔ rays of the LP camera
+# ----------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class PushbroomCamera:
+    """The 002 LP camera as a sensor: pixel → ray and map point → pixel (002 eq. 2–4).
+
+    The same model as :class:`PushbroomLines` without the trajectory corrections (give a
+    corrected trajectory for an adjusted one): ``p^c = β (R_map_from_platformᵀ (p^m − x) − l^p)``,
+    ``x̄ = c_b p^c_x / p^c_z``, ``ȳ = c_b p^c_y / p^c_z`` and the line distortion of 002
+    eq. (3) (:func:`hsgeo.distortion.distort_pushbroom_line`; a ray undistorts with
+    :func:`~hsgeo.distortion.undistort_pushbroom_line`).
+
+    Parameters
+    ----------
+    c_mm : sequence of float, mm
+        Principal distance of each band.
+    pixel_mm : float, mm
+        Pixel pitch.
+    distortion : (4,) sequence
+        K1 (mm⁻²), K2 (mm⁻⁴), P1, P2 (mm⁻¹) of 002 eq. (3).
+    x0_mm, y0_mm : float, mm
+        Principal point.
+    boresight_rad : (3,) sequence, rad
+        ω, φ, κ of ``β = R_from_opk(ω, φ, κ) β₀``.
+    lever_arm_m : (3,) sequence, m
+        Lever arm ``l^p`` in the platform frame (x forward, y left, z up).
+    beta0 : (3, 3) array_like
+        Nominal camera-from-platform rotation (:data:`BETA0_CAM_FROM_PLATFORM`).
+
+    Pixels are ``(x, y)`` px from the line centre (x along the line, y across it; ``y = 0`` on
+    the line) with a band each, at a time ``t_s`` each. The :attr:`mount` is the same mount in
+    the body frame of a :class:`hsgeo.trajectory.Trajectory` (x forward, y right, z down).
+    """
+
+    c_mm: tuple
+    pixel_mm: float
+    distortion: tuple = (0.0, 0.0, 0.0, 0.0)
+    x0_mm: float = 0.0
+    y0_mm: float = 0.0
+    boresight_rad: tuple = (0.0, 0.0, 0.0)
+    lever_arm_m: tuple = (0.0, 0.0, 0.0)
+    beta0: np.ndarray = field(default_factory=lambda: BETA0_CAM_FROM_PLATFORM.copy())
+
+    def __post_init__(self):
+        c = np.atleast_1d(np.asarray(self.c_mm, dtype=float))
+        if c.ndim != 1 or not np.all(np.isfinite(c) & (c > 0)):
+            raise InputError(f"c_mm must be positive principal distances per band, got {c}")
+        if not self.pixel_mm > 0:
+            raise InputError(f"pixel pitch must be positive, got {self.pixel_mm!r} mm")
+        if np.shape(self.distortion) != (4,):
+            raise InputError("distortion must be (K1, K2, P1, P2) of 002 eq. (3)")
+
+    @property
+    def beta(self) -> np.ndarray:
+        """``β = R_cam_from_platform = R_from_opk(ω, φ, κ) β₀``."""
+        return R_from_opk(*np.asarray(self.boresight_rad, float)) @ np.asarray(self.beta0)
+
+    @property
+    def mount(self) -> Mount:
+        """The camera's mount on the trajectory's body frame (lever arm and boresight)."""
+        D = R_BODY_FROM_PLATFORM
+        return Mount(D @ np.asarray(self.lever_arm_m, float), D @ self.beta.T)
+
+    def _band_c(self, band, n) -> np.ndarray:
+        c = np.atleast_1d(np.asarray(self.c_mm, dtype=float))
+        b = np.broadcast_to(np.asarray(band), (n,))
+        if not np.issubdtype(b.dtype, np.integer) or np.any((b < 0) | (b >= c.size)):
+            raise InputError(f"band indices must be integers in 0…{c.size - 1}")
+        return c[b]
+
+    def rays_at(self, xy_px, band, xyz_platform_m, R_map_from_platform):
+        """Rays of pixels at given platform poses (the core of :meth:`rays`).
+
+        Parameters
+        ----------
+        xy_px : (n, 2) array_like, px
+        band : int or (n,) int array_like
+        xyz_platform_m : (n, 3) array_like, m
+            Position of the platform (navigation reference point), map frame.
+        R_map_from_platform : (n, 3, 3) array_like
+
+        Returns
+        -------
+        origins_m, directions : (n, 3) ndarray
+            Projection centres ``x + R l^p`` and unit directions ``R βᵀ (x̄, ȳ, c_b)``.
+        """
+        xy_mm = np.asarray(xy_px, dtype=float) * self.pixel_mm - np.array([self.x0_mm, self.y0_mm])
+        if any(self.distortion):
+            xy_mm = undistort_pushbroom_line(xy_mm, self.distortion)  # 002 eq. (3) inverted
+        n = xy_mm.shape[0]
+        d_cam = np.column_stack([xy_mm, self._band_c(band, n)])
+        R = np.asarray(R_map_from_platform, dtype=float)
+        d = np.einsum("mij,mj->mi", R, d_cam @ self.beta)  # R βᵀ d_cam
+        d /= np.linalg.norm(d, axis=1, keepdims=True)
+        o = np.asarray(xyz_platform_m, dtype=float) + R @ np.asarray(self.lever_arm_m, float)
+        return o, d
+
+    def rays(self, xy_px, band, t_s, trajectory) -> tuple[np.ndarray, np.ndarray]:
+        """Origins (m) and unit directions of the rays of pixels seen at times ``t_s``.
+
+        Parameters
+        ----------
+        xy_px : (n, 2) array_like, px
+        band : int or (n,) int array_like
+        t_s : (n,) array_like, s
+        trajectory : hsgeo.trajectory.Trajectory
+            GNSS/INS poses of the body (corrected ones, for an adjusted trajectory).
+        """
+        pos, _ = trajectory.pose(t_s)
+        R = trajectory.R_map_from_body(t_s) @ R_BODY_FROM_PLATFORM
+        return self.rays_at(xy_px, band, pos, R)
+
+    def project_at(self, xyz_map_m, band, xyz_platform_m, R_map_from_platform) -> np.ndarray:
+        """Pixels ``(n, 2)`` of map points at given platform poses (002 eq. (2)–(4))."""
+        R = np.asarray(R_map_from_platform, dtype=float)
+        d = np.atleast_2d(np.asarray(xyz_map_m, float)) - np.asarray(xyz_platform_m, float)
+        q = np.einsum("nji,nj->ni", R, d) - np.asarray(self.lever_arm_m, float)  # 002 eq. (4)
+        p = q @ self.beta.T
+        if np.any(p[:, 2] <= 0):
+            raise ObservationError("points behind the pushbroom camera (p^c_z ≤ 0)")
+        c = self._band_c(band, p.shape[0])
+        xy_bar = c[:, None] * p[:, :2] / p[:, 2:3]  # 002 eq. (3), collinearity
+        xy = distort_pushbroom_line(xy_bar, self.distortion)
+        return (xy + np.array([self.x0_mm, self.y0_mm])) / self.pixel_mm
+
+    def project(self, xyz_map_m, band, t_s, trajectory) -> np.ndarray:
+        """Pixels ``(x, y)`` ``(n, 2)`` of map points at times ``t_s`` (y = 0 on the line)."""
+        pos, _ = trajectory.pose(t_s)
+        R = trajectory.R_map_from_body(t_s) @ R_BODY_FROM_PLATFORM
+        return self.project_at(xyz_map_m, band, pos, R)

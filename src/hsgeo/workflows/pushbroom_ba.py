@@ -21,10 +21,10 @@ import numpy as np
 from hsgeo.adjust import Parameters
 from hsgeo.errors import InputError
 from hsgeo.io import read_camera_toml, read_table
-from hsgeo.rotations import R_from_opk, R_from_rpy
+from hsgeo.rotations import R_from_rpy
 from hsgeo.sensors.pushbroom import (
-    BETA0_CAM_FROM_PLATFORM,
     BLOCK_NAMES,
+    PushbroomCamera,
     PushbroomLines,
     PushbroomObservations,
 )
@@ -55,19 +55,6 @@ class CameraPrior:
     sigma_att_rad: tuple = tuple(np.deg2rad([0.005, 0.005, 0.008]))
     sigma_obs_px: float = 0.5
     sigma_gcp_m: float = 0.01
-
-
-def _rays(obs: PushbroomObservations, cam: CameraPrior, c_mm, boresight_rad, lever_arm_m):
-    xy_mm = obs.xy_px * cam.pixel_mm - np.array([cam.x0_mm, cam.y0_mm])
-    m = xy_mm.shape[0]
-    d_cam = np.column_stack([xy_mm, np.broadcast_to(c_mm, (m,))])
-    beta = R_from_opk(*boresight_rad) @ BETA0_CAM_FROM_PLATFORM
-    rpy = obs.rpy_nav_rad
-    R = R_from_rpy(rpy[:, 0], rpy[:, 1], rpy[:, 2])
-    d = np.einsum("mij,mj->mi", R, d_cam @ beta)  # R βᵀ d_cam
-    d /= np.linalg.norm(d, axis=1, keepdims=True)
-    o = obs.xyz_nav_m + R @ np.asarray(lever_arm_m)
-    return o, d
 
 
 def intersect_two_rays(point, origin, direction, n_points, min_angle_deg: float = 20.0):
@@ -183,7 +170,14 @@ def build_problem(
     names = BLOCK_NAMES
     if np.any(obs.band >= cam.n_bands):
         raise InputError(f"band index ≥ the camera's {cam.n_bands} bands")
-    o, d = _rays(obs, cam, cam.c_mm, np.zeros(3), cam.lever_arm_m)
+    rpy = obs.rpy_nav_rad
+    o, d = PushbroomCamera(
+        (cam.c_mm,) * cam.n_bands,
+        cam.pixel_mm,
+        x0_mm=cam.x0_mm,
+        y0_mm=cam.y0_mm,
+        lever_arm_m=cam.lever_arm_m,
+    ).rays_at(obs.xy_px, obs.band, obs.xyz_nav_m, R_from_rpy(rpy[:, 0], rpy[:, 1], rpy[:, 2]))
     P0 = intersect_two_rays(obs.point, o, d, n_points)
     p = Parameters()
     p.add(names["points"], P0, points=True, columns=("E_m", "N_m", "H_m"))
