@@ -595,6 +595,16 @@ class PushbroomLines(ResidualBlock):
         for a in ("xyz_nav", "rpy_nav", "xy_px"):
             setattr(self, a, np.ascontiguousarray(getattr(self, a)))
 
+    def fresh(self) -> PushbroomLines:
+        """A copy with its own Newton start (the line times), as this block was built.
+
+        Checks at the truth (:func:`hsgeo.adjust.identifiability`) evaluate such a copy: the
+        crossing times it finds never become the start of the adjustment's evaluations.
+        """
+        other = super().fresh()
+        other._dt_s = np.zeros_like(self._dt_s)
+        return other
+
     def image_mm(self, values):
         """Modelled image coordinates in mm, ``(m, 2)``."""
         xy, _ = project(
