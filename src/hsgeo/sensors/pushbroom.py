@@ -856,16 +856,17 @@ class PushbroomCamera:
         o = np.asarray(xyz_platform_m, dtype=float) + R @ np.asarray(self.lever_arm_m, float)
         return o, d
 
-    def rays(self, xy_px, band, t_s, trajectory) -> tuple[np.ndarray, np.ndarray]:
+    def rays(self, xy_px, t_s, trajectory, band=0) -> tuple[np.ndarray, np.ndarray]:
         """Origins (m) and unit directions of the rays of pixels seen at times ``t_s``.
 
         Parameters
         ----------
         xy_px : (n, 2) array_like, px
-        band : int or (n,) int array_like
         t_s : (n,) array_like, s
         trajectory : hsgeo.trajectory.Trajectory
             GNSS/INS poses of the body (corrected ones, for an adjusted trajectory).
+        band : int or (n,) int array_like
+            Band of each pixel (its principal distance).
         """
         pos, _ = trajectory.pose(t_s)
         R = trajectory.R_map_from_body(t_s) @ R_BODY_FROM_PLATFORM
@@ -884,7 +885,7 @@ class PushbroomCamera:
         xy = distort_pushbroom_line(xy_bar, self.distortion)
         return (xy + np.array([self.x0_mm, self.y0_mm])) / self.pixel_mm
 
-    def project(self, xyz_map_m, band, t_s, trajectory) -> np.ndarray:
+    def project(self, xyz_map_m, t_s, trajectory, band=0) -> np.ndarray:
         """Pixels ``(x, y)`` ``(n, 2)`` of map points at times ``t_s`` (y = 0 on the line)."""
         pos, _ = trajectory.pose(t_s)
         R = trajectory.R_map_from_body(t_s) @ R_BODY_FROM_PLATFORM
