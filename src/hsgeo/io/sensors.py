@@ -9,7 +9,14 @@ import numpy as np
 from hsgeo.errors import InputError
 from hsgeo.io.config import Key, read_config
 
-__all__ = ["SENSOR_SCHEMA", "CAMERA_SCHEMA", "read_sensor_toml", "read_camera_toml"]
+__all__ = [
+    "SENSOR_SCHEMA",
+    "CAMERA_SCHEMA",
+    "read_sensor_toml",
+    "read_camera_toml",
+    "read_pushbroom_camera",
+    "read_scanning_sensor",
+]
 
 #: ``hsgeo geocode --sensor``: a line scanner (000 eq. (2)) and its boresight.
 SENSOR_SCHEMA = {
@@ -50,6 +57,15 @@ CAMERA_SCHEMA = {
         "y0_mm": Key("float", doc="principal point y, mm"),
         "lever_arm_m": Key("floats", length=3, doc="lever arm (platform frame), m"),
         "sigma_lever_m": Key("float", positive=True, doc="σ of the measured lever arm, m"),
+        "c_band_mm": Key(
+            "floats", positive=True, doc="principal distance of each band, mm (geocoding)"
+        ),
+        "distortion": Key(
+            "floats", length=4, doc="K1 (mm^-2), K2 (mm^-4), P1, P2 (mm^-1) of 002 eq. (3)"
+        ),
+        "boresight_deg": Key(
+            "floats", length=3, doc="omega, phi, kappa of the boresight on the nominal mount, deg"
+        ),
     },
     "gnss_ins": {
         "sigma_pos_m": Key("floats", length=3, positive=True, doc="σ of E, N, H, m"),
@@ -128,3 +144,59 @@ def read_camera_toml(path) -> dict:
         The tables with the keys the file gives (angles still in degrees, as named).
     """
     return read_config(path, CAMERA_SCHEMA, "camera file", required_tables=("camera",))
+
+
+def read_pushbroom_camera(path):
+    """The 002 camera file (:data:`CAMERA_SCHEMA`) as a sensor for geocoding.
+
+    Uses ``c_band_mm`` (one principal distance per band; default ``c_mm`` for all
+    ``n_bands``), ``pixel_mm``, ``x0_mm``, ``y0_mm``, ``distortion``, ``boresight_deg`` and
+    ``lever_arm_m``; the σ keys (for ``hsgeo adjust-pushbroom``) are read and not used.
+
+    Returns
+    -------
+    hsgeo.sensors.pushbroom.PushbroomCamera
+    """
+    from hsgeo.sensors.pushbroom import PushbroomCamera
+
+    cam = read_camera_toml(path)["camera"]
+    c = cam.get("c_band_mm", (cam["c_mm"],) * cam["n_bands"])
+    if len(c) != cam["n_bands"]:
+        raise InputError(
+            f"camera file {path}: [camera] c_band_mm has {len(c)} values for n_bands = "
+            f"{cam['n_bands']}; give one principal distance per band"
+        )
+    return PushbroomCamera(
+        tuple(c),
+        cam["pixel_mm"],
+        tuple(cam.get("distortion", (0.0, 0.0, 0.0, 0.0))),
+        cam.get("x0_mm", 0.0),
+        cam.get("y0_mm", 0.0),
+        tuple(np.deg2rad(cam.get("boresight_deg", (0.0, 0.0, 0.0)))),
+        tuple(cam.get("lever_arm_m", (0.0, 0.0, 0.0))),
+    )
+
+
+def read_scanning_sensor(path):
+    """A scanning sensor for ``hsgeo geocode --sensor``: the 000 sensor file (``[sensor]``,
+    :func:`read_sensor_toml`) or the 002 camera file (``[camera]``,
+    :func:`read_pushbroom_camera`), told apart by their table.
+
+    Returns
+    -------
+    hsgeo.sensors.line.LineScanner or hsgeo.sensors.pushbroom.PushbroomCamera
+    """
+    import tomllib
+    from pathlib import Path
+
+    from hsgeo.sensors.line import LineScanner
+    from hsgeo.sensors.mount import Mount
+
+    try:
+        tables = set(tomllib.loads(Path(path).read_text(encoding="utf-8")))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        tables = {"sensor"}  # read_sensor_toml gives the one clear error
+    if "camera" in tables and "sensor" not in tables:
+        return read_pushbroom_camera(path)
+    geom, boresight_rad = read_sensor_toml(path)
+    return LineScanner(geom, Mount.from_rpy(boresight_rad))
