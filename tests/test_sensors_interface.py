@@ -214,3 +214,47 @@ def test_geocoding_002_lines_with_the_true_trajectory_hits_the_reference_squares
         assert np.all(err < 0.1 * gsd_m), (k, err.max(), gsd_m.min())
         n_seen += rows.size
     assert n_seen >= 3 * 17
+
+
+def _frame_poses(rng, n=5):
+    return np.column_stack([rng.normal(0, 0.2, (n, 3)), rng.normal(0, 2.0, (n, 3))])
+
+
+@pytest.mark.parametrize("mount", [Mount(), MOUNT])
+def test_frame_camera_round_trip(mount):
+    from hsgeo.sensors.frame import FrameCamera
+
+    rng = np.random.default_rng(5)
+    # OpenCV's calibration of its tutorial camera (hsgeo/data/reference/opencv-chessboard)
+    cam = FrameCamera((657.3, 657.3, 319.5, 239.5), (-0.42, 0.50, 0.0, 0.0, -0.57), mount)
+    poses = _frame_poses(rng)
+    n = 200
+    view = rng.integers(0, 5, n)
+    uv = np.column_stack([rng.uniform(20, 620, n), rng.uniform(20, 460, n)])
+    o, d = cam.rays(uv, poses, view)
+    X = o + rng.uniform(2, 50, n)[:, None] * d
+    np.testing.assert_allclose(cam.project(X, poses, view), uv, rtol=0, atol=1e-9)
+
+
+def test_frame_camera_projects_as_the_adjustment_model():
+    """Independent: project_opencv (the residual block's projection) and OpenCV's
+    cv2.projectPoints (R_cam_from_world = R_from_opk(ω, φ, κ)ᵀ, t = −R X0)."""
+    import cv2
+
+    from hsgeo.sensors.frame import FrameCamera, project_opencv
+
+    rng = np.random.default_rng(6)
+    K = (657.3, 650.1, 319.5, 239.5)
+    dist = (-0.2, 0.1, 1e-3, -2e-3, 0.0)
+    cam = FrameCamera(K, dist)
+    poses = _frame_poses(rng, 1)
+    X = np.column_stack([rng.uniform(-1, 1, (30, 2)), rng.uniform(4, 8, 30)])
+    X = (R_from_opk(*poses[0, :3]) @ X.T).T + poses[0, 3:]  # in front of the camera
+    view = np.zeros(30, np.int64)
+    uv = cam.project(X, poses, view)
+    np.testing.assert_allclose(uv, project_opencv(poses, view, X, K, dist), atol=1e-9)
+    R_cw = R_from_opk(*poses[0, :3]).T
+    rvec, _ = cv2.Rodrigues(R_cw)
+    Kmat = np.array([[K[0], 0, K[2]], [0, K[1], K[3]], [0, 0, 1.0]])
+    ref, _ = cv2.projectPoints(X, rvec, -R_cw @ poses[0, 3:], Kmat, np.array(dist))
+    np.testing.assert_allclose(uv, ref[:, 0, :], atol=1e-6)
