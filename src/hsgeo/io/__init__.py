@@ -38,12 +38,14 @@ from hsgeo.io.sensors import (
     read_scanning_sensor,
     read_sensor_toml,
 )
-from hsgeo.io.tables import read_table
+from hsgeo.io.tables import read_table, write_csv_array, write_csv_lines
 
 __all__ = [
     "atomic_path",
     "refuse_inputs",
     "read_table",
+    "write_csv_array",
+    "write_csv_lines",
     "NAV_COLUMNS",
     "read_trajectory",
     "write_trajectory",
