@@ -34,10 +34,35 @@ __all__ = [
     "CameraPrior",
     "PushbroomObservations",
     "build_problem",
+    "solve",
+    "REJECT_K",
+    "FTOL",
+    "Y_AS_TIME",
+    "REPORTED_PARAMETERS",
     "intersect_two_rays",
     "adjust_files",
     "fit_verdict",
 ]
+
+
+#: 002's solver settings, once (``hsgeo adjust-pushbroom``, ``hsgeo reproduce pushbroom-ba`` and
+#: the chapter): the reject threshold in robust σ of the standardised residuals (ours: about the
+#: largest residual / NMAD ratio of 002 Table 1, ≈ 6, with a margin) ...
+REJECT_K = 5.0
+#: ... the relative cost decrease at which the iteration stops (at full size 1e-6 of the cost
+#: is ≈ 0.3, below half a unit of χ², far below any statistical effect) ...
+FTOL = 1e-6
+#: ... and the residual across the line as a time (:func:`build_problem`): with the image y of
+#: 002 eq. (2) the principal distance and the pitch corrections are biased (the chapter shows by
+#: how much).
+Y_AS_TIME = True
+#: The estimated camera and mount blocks reported by both faces: (block, unit shown, factor).
+REPORTED_PARAMETERS = (
+    ("boresight_rad", "deg", 180 / np.pi),
+    ("lever_arm_m", "m", 1.0),
+    ("distortion", "", 1.0),
+    ("c_mm", "mm", 1.0),
+)
 
 
 @dataclass(frozen=True)
@@ -120,7 +145,7 @@ def build_problem(
     gcp_xyz_m=None,
     t_span_s=None,
     node_prior_mean=None,
-    y_as_time: bool = False,
+    y_as_time: bool = Y_AS_TIME,
 ):
     """Parameters and residual blocks of the LP bundle adjustment.
 
@@ -143,7 +168,8 @@ def build_problem(
     node_prior_mean : (n_nodes, 6) ndarray, optional
         Prior mean of the node corrections (default zero: the GNSS/INS solution as it is).
     y_as_time : bool
-        Residual across the line as a *time* (the line a point is registered in) rather than
+        Default :data:`Y_AS_TIME` (True). Residual across the line as a *time* (the line a
+        point is registered in) rather than
         the image y of 002 eq. (2): the line time minus the model's crossing time of the line
         (:class:`~hsgeo.sensors.pushbroom.PushbroomLines`), in pixels at the reference rate
         ``c_ref V / (Z_ref pixel)`` (``c_ref`` the initial principal distance, ``V`` the median
@@ -233,6 +259,37 @@ def build_problem(
     return p, [blk], nodes
 
 
+def solve(
+    params,
+    blocks,
+    *,
+    reject_k: float | None = REJECT_K,
+    ftol: float = FTOL,
+    progress=None,
+    keep_jacobian: bool = False,
+    raise_on_failure: bool = True,
+):
+    """Adjust a problem of :func:`build_problem` with 002's solver settings (002 §3.4: outliers
+    rejected at every iteration); the one place they are spelled.
+
+    Returns
+    -------
+    hsgeo.adjust.AdjustmentResult
+    """
+    from hsgeo.adjust import adjust
+
+    return adjust(
+        params,
+        blocks,
+        reject_k=reject_k,
+        ftol=ftol,
+        progress=progress,
+        reject_every_iteration=True,  # 002 §3.4
+        keep_jacobian=keep_jacobian,
+        raise_on_failure=raise_on_failure,
+    )
+
+
 # ----------------------------------------------------------------------------------------------
 # Files: ``hsgeo adjust-pushbroom``
 # ----------------------------------------------------------------------------------------------
@@ -270,9 +327,9 @@ def adjust_files(
     gcp=None,
     *,
     node_interval_s: float = 10.0,
-    reject_k: float | None = 5.0,
+    reject_k: float | None = REJECT_K,
     progress=None,
-    y_as_time: bool = True,
+    y_as_time: bool = Y_AS_TIME,
     max_nav_gap_s: float = 1.0,
 ) -> dict:
     """Adjust a user's pushbroom observations (``hsgeo adjust-pushbroom``).
@@ -307,7 +364,6 @@ def adjust_files(
         ``fit``, the plausibility verdict of :func:`fit_verdict` (``hsgeo adjust-pushbroom`` exits
         2 on a poor fit unless ``--accept-poor-fit``).
     """
-    from hsgeo.adjust import adjust
     from hsgeo.io.navigation import read_trajectory
     from hsgeo.trajectory import platform_rpy_from_rph, platform_rpy_rate_from_rph_rate
     from hsgeo.validate import check_navigation_covers, check_range
@@ -389,13 +445,11 @@ def adjust_files(
         gcp_xyz_m=gx,
         y_as_time=y_as_time,
     )
-    res = adjust(
+    res = solve(
         p,
         blocks,
         reject_k=reject_k,
-        ftol=1e-6,
         progress=progress,
-        reject_every_iteration=True,  # 002 §3.4
         raise_on_failure=False,  # no convergence is a verdict of the fit (fit_verdict)
     )
     out = {
@@ -410,12 +464,7 @@ def adjust_files(
         "node_interval_s": node_interval_s,
         "parameters": {},
     }
-    for name, f in [
-        ("boresight_rad", 180 / np.pi),
-        ("lever_arm_m", 1.0),
-        ("distortion", 1.0),
-        ("c_mm", 1.0),
-    ]:
+    for name, _, f in REPORTED_PARAMETERS:
         key = name.replace("_rad", "_deg")
         out["parameters"][key] = {
             "value": (res.value(name) * f).tolist(),
