@@ -33,6 +33,7 @@ from hsgeo.io.nist_strd import read_nist_strd
 from hsgeo.io.opencv import read_opencv_storage
 from hsgeo.io.raster import read_dem, to_map_files
 from hsgeo.io.sensors import (
+    read_band_split,
     read_camera_toml,
     read_pushbroom_camera,
     read_scanning_sensor,
@@ -54,6 +55,7 @@ __all__ = [
     "read_toml",
     "read_sensor_toml",
     "read_camera_toml",
+    "read_band_split",
     "read_pushbroom_camera",
     "read_scanning_sensor",
     "Board",

@@ -16,6 +16,7 @@ __all__ = [
     "read_camera_toml",
     "read_pushbroom_camera",
     "read_scanning_sensor",
+    "read_band_split",
 ]
 
 #: ``hsgeo geocode --sensor``: a line scanner (000 eq. (2)) and its boresight.
@@ -200,3 +201,52 @@ def read_scanning_sensor(path):
         return read_pushbroom_camera(path)
     geom, boresight_rad = read_sensor_toml(path)
     return LineScanner(geom, Mount.from_rpy(boresight_rad))
+
+
+#: An instrument's band split (``data/instruments/*.toml``): which sensor records each band.
+BAND_SPLIT_SCHEMA = {
+    "instrument": {
+        "name": Key("str", required=True, doc="instrument name"),
+        "n_sensors": Key("int", required=True, positive=True, doc="number of sensors"),
+    },
+    "bands": {
+        "band": Key("floats", required=True, doc="band numbers, 1-based"),
+        "sensor": Key("floats", required=True, doc="sensor of each band, 1-based"),
+        "gap_nm": Key("floats", required=True, positive=True, doc="FPI air gap of each band, nm"),
+    },
+}
+
+
+def read_band_split(path=None) -> np.ndarray:
+    """An instrument's band split: band, sensor and FPI air gap (:data:`BAND_SPLIT_SCHEMA`).
+
+    Parameters
+    ----------
+    path : str or Path, optional
+        Default: the Rikola FPI2015 of 003 (``hsgeo/data/instruments/rikola_fpi2015.toml``).
+
+    Returns
+    -------
+    structured ndarray
+        Fields ``band`` (i4), ``sensor`` (i4), ``gap_nm`` (f8), one row per band, in band order.
+    """
+    from pathlib import Path
+
+    if path is None:
+        path = Path(__file__).parent.parent / "data" / "instruments" / "rikola_fpi2015.toml"
+    cfg = read_config(path, BAND_SPLIT_SCHEMA, "instrument file", required_tables=("bands",))
+    b, n = cfg["bands"], cfg["instrument"]["n_sensors"]
+    lengths = {len(b[k]) for k in ("band", "sensor", "gap_nm")}
+    band, sensor = np.asarray(b["band"]), np.asarray(b["sensor"])
+    problems = []
+    if len(lengths) != 1:
+        problems.append("[bands] band, sensor and gap_nm must have one entry per band")
+    elif not (np.array_equal(band, np.arange(1, band.size + 1))):
+        problems.append("[bands] band must be 1, 2, 3, … in order")
+    elif not (np.all(sensor == np.round(sensor)) and np.all((sensor >= 1) & (sensor <= n))):
+        problems.append(f"[bands] sensor must be integers 1…{n} (n_sensors)")
+    if problems:
+        raise InputError(f"instrument file {path}: " + "; ".join(problems))
+    out = np.zeros(band.size, dtype=[("band", "i4"), ("sensor", "i4"), ("gap_nm", "f8")])
+    out["band"], out["sensor"], out["gap_nm"] = band, sensor, b["gap_nm"]
+    return out

@@ -26,8 +26,8 @@ import numpy as np
 from hsgeo.adjust import AdjustmentResult, Parameters, adjust
 from hsgeo.distortion import ideal_from_measured_mm
 from hsgeo.errors import InputError, ObservationError
+from hsgeo.io import read_band_split
 from hsgeo.measure.targets import Observations
-from hsgeo.papers import RIKOLA_BANDS
 from hsgeo.rotations import R_from_opk, opk_from_R
 from hsgeo.sensors.frame import (
     PHOTOGRAMMETRIC_DISTORTION,
@@ -65,6 +65,10 @@ __all__ = [
     "rop_transformation_test",
     "cluster_keys",
 ]
+
+#: The Rikola FPI2015's band split (band, sensor, FPI air gap), an instrument description read
+#: by :func:`hsgeo.io.read_band_split` (``hsgeo/data/instruments/rikola_fpi2015.toml``).
+BANDS = read_band_split()
 
 
 def detect_targets_in_images(
@@ -451,7 +455,7 @@ def calibrate_joint(
     o = obs.select(keep)
     bands = np.unique(o.band)
     cubes = np.unique(o.cube)
-    table = RIKOLA_BANDS
+    table = BANDS
     brow = np.searchsorted(table["band"], o.band)
     for s in (1, 2):
         on = [b for b in bands if table["sensor"][b - 1] == s and b not in _OFF_LINE]
@@ -543,7 +547,7 @@ def predict_band(joint: JointCalibration, obs: Observations, band: int) -> np.nd
     if not sel.any():
         raise ObservationError(f"no observations of band {band} in the joint model's cubes")
     o = obs.select(sel)
-    table = RIKOLA_BANDS
+    table = BANDS
     blk = JointCentroids(
         np.searchsorted(joint.cubes, o.cube),
         np.searchsorted(table["band"], o.band),
@@ -591,10 +595,14 @@ def track_targets(obs: Observations, cube: int, ref_band: int) -> dict[str, tupl
 
 
 def radial_effect_px(KP, r_mm, pixel_mm: float) -> np.ndarray:
-    """Magnitude of the symmetric radial correction ``r (K1 r² + K2 r⁴ + K3 r⁶)`` in px."""
+    """Magnitude of the symmetric radial correction ``r (K1 r² + K2 r⁴ + K3 r⁶)`` in px: the
+    radial part of Brown's correction (:func:`hsgeo.distortion.brown_correction`) at ``(r, 0)``.
+    """
+    from hsgeo.distortion import brown_correction
+
     r = np.asarray(r_mm, float)
-    K = np.asarray(KP, float)[:3]
-    return r * (K[0] * r**2 + K[1] * r**4 + K[2] * r**6) / pixel_mm
+    xy = np.stack([r, np.zeros_like(r)], axis=-1)
+    return brown_correction(xy, np.asarray(KP, float)[:3], np.zeros(2))[..., 0] / pixel_mm
 
 
 def decentering_effect_px(KP, xy_mm, pixel_mm: float) -> np.ndarray:
@@ -757,7 +765,7 @@ def calibrate_frame_files(
 def cluster_keys(obs, cal) -> np.ndarray:
     """(cube, target, sensor) key of each observation of a band's adjustment, in its order."""
     sel = obs.band == cal.band
-    sensor = RIKOLA_BANDS["sensor"][cal.band - 1]
+    sensor = BANDS["sensor"][cal.band - 1]
     return obs.cube[sel] * 1_000_000 + obs.target[sel] * 10 + sensor
 
 
@@ -851,14 +859,12 @@ def predict_per_band(cals, obs, band, bands):
     regression of the other bands of its sensor, the mean principal point of the sensor, the
     mean distortion, and per cube the mean exterior orientation of the sensor's other bands.
     """
-    s = RIKOLA_BANDS["sensor"][band - 1]
-    others = [
-        b for b in bands if b != band and RIKOLA_BANDS["sensor"][b - 1] == s and b not in (1, 11)
-    ]
+    s = BANDS["sensor"][band - 1]
+    others = [b for b in bands if b != band and BANDS["sensor"][b - 1] == s and b not in (1, 11)]
     reg = gap_regression(
-        RIKOLA_BANDS["gap_nm"][np.array(others) - 1], [cals[b].value("interior")[0] for b in others]
+        BANDS["gap_nm"][np.array(others) - 1], [cals[b].value("interior")[0] for b in others]
     )
-    f = reg["a"] * RIKOLA_BANDS["gap_nm"][band - 1] + reg["b"]
+    f = reg["a"] * BANDS["gap_nm"][band - 1] + reg["b"]
     pp = np.mean([cals[b].value("interior")[1:] for b in others], axis=0)
     KP = np.mean([cals[b].value("distortion_mm") for b in cals if b != band], axis=0)
     sel = obs.band == band
