@@ -79,7 +79,7 @@ def _cmd_calibrate_line(args) -> int:
 
 
 def _cmd_calibrate_frame(args) -> int:
-    from hsgeo.workflows.rikola import calibrate_frame_files
+    from hsgeo.workflows.frame_calibration import calibrate_frame_files
 
     out = calibrate_frame_files(
         args.images,
