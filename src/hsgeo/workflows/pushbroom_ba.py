@@ -452,11 +452,21 @@ def adjust_files(
         progress=progress,
         raise_on_failure=False,  # no convergence is a verdict of the fit (fit_verdict)
     )
+    out = summary(res, nodes, ids, int(len(obs_df)), node_interval_s)
+    out["_result"] = res
+    return out
+
+
+def summary(res, nodes, point_ids, n_observations_2d: int, node_interval_s: float) -> dict:
+    """What ``hsgeo adjust-pushbroom`` reports of a solve: counts, σ0, the camera parameters
+    (:data:`REPORTED_PARAMETERS`) with σ̂, the node corrections, the points and the fit verdict.
+    """
+    ids, n_obs = point_ids, n_observations_2d
     out = {
         "converged": res.converged,
         "iterations": res.iterations,
         "sigma0": res.sigma0,
-        "n_observations_2d": int(len(obs_df)),
+        "n_observations_2d": n_obs,
         "n_points": int(ids.size),
         "n_unknowns": int(res.n_unknowns),
         "rejected": int(res.outliers(0).sum()),
@@ -477,8 +487,7 @@ def adjust_files(
         "columns": list(res.params["nodes"].columns),
     }
     out["points"] = {"point_id": ids.tolist(), "xyz_m": res.value("points_m").tolist()}
-    out["fit"] = fit_verdict(res, int(len(obs_df)))
-    out["_result"] = res
+    out["fit"] = fit_verdict(res, n_obs)
     return out
 
 
