@@ -82,9 +82,10 @@ def _pushbroom(d: Path) -> None:
 def _geocode(d: Path) -> None:
     import xarray as xr
 
-    from hsgeo.geocode import CalibratedLine, PlaneTerrain, geocode_image
+    from hsgeo.geocode import PlaneTerrain, geocode_image
     from hsgeo.io import write_lines
     from hsgeo.io.navigation import write_trajectory
+    from hsgeo.sensors.line import CalibratedLine
     from hsgeo.trajectory import Trajectory
 
     d.mkdir()

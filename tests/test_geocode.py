@@ -10,9 +10,7 @@ from hsgeo import ConvergenceError, InputError, ObservationError
 from hsgeo.adjust.checks import check_jacobian
 from hsgeo.geocode import (
     BoresightGCP,
-    CalibratedLine,
     DemTerrain,
-    LinearIFOV,
     PlaneTerrain,
     calibrate_boresight,
     geocode_image,
@@ -22,6 +20,7 @@ from hsgeo.geocode import (
 )
 from hsgeo.io import write_lines
 from hsgeo.io.navigation import write_trajectory
+from hsgeo.sensors.line import CalibratedLine, LinearIFOV
 from hsgeo.simulate.pula_flight import observe_gcps, simulate_flight
 from hsgeo.simulate.scenarios import load_scenario
 from hsgeo.trajectory import Trajectory
@@ -262,3 +261,57 @@ def test_geocode_command_end_to_end(tmp_path):
 def test_zeta_outside_the_model_raises():
     with pytest.raises(ConvergenceError):
         CAL.zeta(np.array([0.2]))  # 700 px from the centre: beyond the calibrated 450 px
+
+
+def test_geocode_command_takes_the_002_camera_file(tmp_path):
+    """``hsgeo geocode --sensor camera.toml`` (the 002 camera file): the LINES pixel is x px from
+    the line centre; the orthoimage of an image whose value is the pixel's own E (geocoded by
+    the camera the file describes) holds each cell's E to within the nearest-neighbour
+    distance, and the file's c_band_mm / distortion / boresight are the camera's."""
+    from hsgeo.cli import main
+    from hsgeo.io import read_pushbroom_camera
+    from hsgeo.sensors.pushbroom import PushbroomCamera
+
+    nav = straight_nav(heading_deg=0.0, T=10.0)
+    write_trajectory(tmp_path / "nav.csv", nav)
+    (tmp_path / "camera.toml").write_text(
+        "[camera]\nn_bands = 2\npixel_mm = 0.0065\nc_mm = 40.0\nc_band_mm = [36.0, 40.0]\n"
+        "x0_mm = 0.01\ndistortion = [-4.0e-5, 3.0e-7, 2.5e-5, -3.0e-5]\n"
+        "boresight_deg = [0.2, -0.1, 0.3]\nlever_arm_m = [0.1, 0.0, -0.2]\n"
+    )
+    cam = PushbroomCamera(
+        (36.0, 40.0),
+        0.0065,
+        (-4.0e-5, 3.0e-7, 2.5e-5, -3.0e-5),
+        0.01,
+        0.0,
+        tuple(np.deg2rad([0.2, -0.1, 0.3])),
+        (0.1, 0.0, -0.2),
+    )
+    got = read_pushbroom_camera(tmp_path / "camera.toml")
+    assert got.c_mm == cam.c_mm and got.distortion == cam.distortion
+    np.testing.assert_allclose(got.beta, cam.beta, atol=1e-15)
+    x = np.arange(-600.0, 600.0, 4.0)
+    xy = np.column_stack([x, np.zeros_like(x)])
+    g = geocode_image(
+        nav, cam, 80, xy, t0_s=0.0, line_rate_hz=8.0, terrain=PlaneTerrain(3.0), band=1
+    )
+    write_lines(tmp_path / "lines.nc", g[..., 0], x, t0_s=0.0, line_rate_hz=8.0)
+    args = ["geocode", str(tmp_path / "lines.nc"), "--trajectory", str(tmp_path / "nav.csv")]
+    args += ["--sensor", str(tmp_path / "camera.toml"), "--height", "3", "--quiet"]
+    assert main(args + ["-o", str(tmp_path / "o.nc"), "--band", "1"]) == 0
+    ds = xr.open_dataset(tmp_path / "o.nc")
+    E = np.broadcast_to(ds["E"].values, ds["radiance"].shape[1:])
+    v = ds["radiance"].values[0]
+    ok = np.isfinite(v)
+    assert ok.mean() > 0.5
+    assert np.abs(v[ok] - E[ok]).max() <= ds["radiance"].attrs["max_distance_m"]
+    # band 0 (c 10 % shorter): the same pixels cover an 11 % wider swath
+    assert main(args + ["-o", str(tmp_path / "b0.nc"), "--band", "0"]) == 0
+    d0 = xr.open_dataset(tmp_path / "b0.nc")
+
+    def swath_m(d):
+        return np.ptp(d["E"].values[np.isfinite(d["radiance"].values[0]).any(axis=0)])
+
+    np.testing.assert_allclose(swath_m(d0) / swath_m(ds), 40.0 / 36.0, rtol=0.02)
+    assert main(args + ["-o", str(tmp_path / "x.nc"), "--band", "2"]) == 2

@@ -8,7 +8,6 @@ import pandas as pd
 import pytest
 
 from hsgeo import InputError
-from hsgeo.geocode import CalibratedLine, LinearIFOV
 from hsgeo.io import (
     Key,
     atomic_path,
@@ -24,6 +23,7 @@ from hsgeo.io import (
     write_lines,
 )
 from hsgeo.io.boards import OPENCV_TUTORIAL_CHARUCO, Board
+from hsgeo.sensors.line import CalibratedLine, LinearIFOV
 from hsgeo.simulate.scenarios import load_scenario
 
 
@@ -410,3 +410,26 @@ def test_load_scenario_errors(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     with pytest.raises(InputError, match="malformed TOML"):
         load_scenario("broken")
+
+
+def test_the_rikola_band_split_is_the_papers():
+    """The instrument file (hsgeo/data/instruments/rikola_fpi2015.toml) against 003 Table 2."""
+    from hsgeo.io import read_band_split
+    from hsgeo.papers import RIKOLA_BANDS
+
+    b = read_band_split()
+    for k in ("band", "sensor", "gap_nm"):
+        np.testing.assert_array_equal(b[k], RIKOLA_BANDS[k])
+        assert b[k].dtype == RIKOLA_BANDS[k].dtype
+
+
+def test_a_bad_band_split_names_the_problem(tmp_path):
+    from hsgeo.io import read_band_split
+
+    f = tmp_path / "i.toml"
+    f.write_text(
+        "[instrument]\nname = 'x'\nn_sensors = 2\n[bands]\nband = [1, 2]\nsensor = [1, 3]\n"
+        "gap_nm = [500.0, 600.0]\n"
+    )
+    with pytest.raises(InputError, match="sensor must be integers 1…2"):
+        read_band_split(f)

@@ -79,7 +79,7 @@ def _cmd_calibrate_line(args) -> int:
 
 
 def _cmd_calibrate_frame(args) -> int:
-    from hsgeo.workflows.rikola import calibrate_frame_files
+    from hsgeo.workflows.frame_calibration import calibrate_frame_files
 
     out = calibrate_frame_files(
         args.images,
@@ -156,6 +156,7 @@ def _cmd_geocode(args) -> int:
         overwrite=args.overwrite,
         max_grid_gib=args.max_grid_gib,
         max_nav_gap_s=args.max_nav_gap_s,
+        band=args.band,
     )
     print(
         f"orthorectified {ortho.sizes['band']} band(s) onto {ortho.sizes['N']} x "
@@ -403,8 +404,10 @@ def build_parser() -> argparse.ArgumentParser:
         "NAV: the navigation file of every command, CSV or Parquet with t_s, E_m, N_m, U_m, "
         "roll_deg, pitch_deg, heading_deg (positions east-north-up in m; attitude of the body, "
         "x forward, y right, z down, in north-east-down, in degrees; see hsgeo.io.navigation). "
-        "SENSOR: TOML, see hsgeo.io.read_sensor_toml. DEM: NetCDF with height(N, E) in "
-        "metres.",
+        "SENSOR: TOML, the 000 line-scanner file ([sensor], see hsgeo.io.read_sensor_toml) or "
+        "the 002 pushbroom camera file ([camera], see hsgeo.io.read_pushbroom_camera; then the "
+        "LINES pixel coordinate is x in px from the line centre). DEM: NetCDF with "
+        "height(N, E) in metres.",
     )
     p.add_argument("lines", metavar="LINES")
     p.add_argument(
@@ -439,6 +442,12 @@ def build_parser() -> argparse.ArgumentParser:
         type=_POSITIVE,
         default=1.0,
         help="longest gap between navigation records interpolated across, s (default 1)",
+    )
+    p.add_argument(
+        "--band",
+        type=int,
+        default=0,
+        help="band of a pushbroom camera file whose geometry is used (default 0)",
     )
     p.add_argument("--quiet", action="store_true", help="no progress display")
     p.set_defaults(func=_cmd_geocode)

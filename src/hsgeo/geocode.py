@@ -1,32 +1,36 @@
-"""Direct georeferencing of line-scanner pixels: rays from the sensor, intersected with the terrain.
+"""Direct georeferencing: any sensor's rays, intersected with the terrain; orthorectification.
 
-Frames (see also ``hsgeo.rotations``):
-
-* **map**: a local east-north-up frame in metres (E, N, U); the 000 paper's y is E, x is N.
-* **nav**: north-east-down at the aircraft; the INS attitude (roll, pitch, heading) gives
-  ``R_ned_from_body = R_from_rpy(roll, pitch, heading)``.
-* **body**: x forward, y right, z down. The line scanner is mounted looking down with its pixel
-  line along body y; its small misalignment (boresight) is ``R_body_from_sensor``.
-* **sensor**: like body. A pixel ζ sees the direction ``(0, t(ζ), 1)`` where ``t`` is the tangent
-  of the across-track view angle, positive to the right (:class:`LineGeometry`).
+This module knows no particular sensor: a sensor of :mod:`hsgeo.sensors` gives the rays of its
+pixels (``rays(pixels, t_s, trajectory)``, origins and unit directions in the map frame, see
+:mod:`hsgeo.sensors.mount`), and :func:`intersect` meets them with the terrain. The map frame is
+a local east-north-up frame in metres (E, N, U); the 000 paper's y is E, x is N.
 
 A ray ``X(s) = O + s·d`` (``O`` the projection centre in the map frame, ``d`` its direction) is
 intersected with a plane of constant height in closed form, or with a DEM by fixed-point iteration
 on the height (:func:`intersect`).
+
+The 000 line scanner's geometries (``LineGeometry``, ``LinearIFOV``, ``CalibratedLine``,
+``ray_directions``) and its GCP boresight calibration (``BoresightGCP``,
+``calibrate_boresight``) live in :mod:`hsgeo.sensors.line`; they are re-exported here for
+existing callers.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from dataclasses import dataclass
-from types import MappingProxyType
 
 import numpy as np
 
-from hsgeo.adjust import Parameters, ResidualBlock, adjust
 from hsgeo.errors import ConvergenceError, InputError, ObservationError
-from hsgeo.rotations import R_ENU_FROM_NED, R_from_rpy, dR_drpy
-from hsgeo.sensors import line1d
+from hsgeo.sensors import as_sensor
+from hsgeo.sensors.line import (
+    BoresightGCP,
+    CalibratedLine,
+    LinearIFOV,
+    LineGeometry,
+    calibrate_boresight,
+    ray_directions,
+)
 
 __all__ = [
     "LineGeometry",
@@ -36,61 +40,13 @@ __all__ = [
     "DemTerrain",
     "intersect",
     "ray_directions",
+    "geocode_rays",
     "geocode_observations",
     "BoresightGCP",
     "calibrate_boresight",
     "geocode_image",
     "orthorectify",
 ]
-
-
-class LineGeometry:
-    """The inner geometry of a line scanner: pixel ζ ↔ tangent of the across-track view angle."""
-
-    def tan_angle(self, zeta_px) -> np.ndarray:
-        """Tangent of the view angle (positive to the right) of pixel ζ."""
-        raise NotImplementedError
-
-    def zeta(self, tan_angle) -> np.ndarray:
-        """The pixel that sees the given tangent (inverse of :meth:`tan_angle`)."""
-        raise NotImplementedError
-
-
-@dataclass(frozen=True)
-class LinearIFOV(LineGeometry):
-    """The uncalibrated model of Jakšić (2009): the view angle is linear in the pixel distance.
-
-    ``θ = −(ζ − ζ0)·IFOV`` with ``IFOV = 1/c`` (rad per pixel) and no distortion (000 §
-    "Verification": "IFOV ... linear function of the distance from the central pixel ... optical
-    distortion was neglected").
-    """
-
-    zeta0_px: float = 485.0
-    c_px: float = 3600.0
-
-    def tan_angle(self, zeta_px):
-        return np.tan(-(np.asarray(zeta_px, dtype=float) - self.zeta0_px) / self.c_px)
-
-    def zeta(self, tan_angle):
-        return self.zeta0_px - np.arctan(np.asarray(tan_angle, dtype=float)) * self.c_px
-
-
-@dataclass(frozen=True)
-class CalibratedLine(LineGeometry):
-    """The calibrated 1D model of 000 eq. (2) in its ray form (:mod:`hsgeo.sensors.line1d`).
-
-    ``ζ = ζ0 − c·tan θ + δ(ζ − ζ0)``, δ the odd 7th-order polynomial in units of 100 px.
-    """
-
-    zeta0_px: float
-    c_px: float
-    K: tuple[float, ...] = (0.0, 0.0, 0.0)
-
-    def tan_angle(self, zeta_px):
-        return line1d.tan_from_zeta(zeta_px, self.zeta0_px, self.c_px, self.K)
-
-    def zeta(self, tan_angle):
-        return line1d.zeta_from_tan(tan_angle, self.zeta0_px, self.c_px, self.K)
 
 
 @dataclass(frozen=True)
@@ -197,161 +153,68 @@ def intersect(origin_m, direction, terrain, *, tol_m: float = 1e-4, max_iter: in
     )
 
 
-def ray_directions(rpy_rad, tan_angle, R_body_from_sensor=None) -> np.ndarray:
-    """Map-frame directions of line-scanner pixels.
+# ----------------------------------------------------------------------------------------------
+# Geocoding of any sensor's pixels (the GCP calibration of the boresight: hsgeo.sensors.line)
+# ----------------------------------------------------------------------------------------------
+def geocode_rays(sensor, pixels, t_s, trajectory, terrain, **pixel_kwargs) -> np.ndarray:
+    """Ground coordinates of pixels of any sensor: its rays (``sensor.rays``) meet the terrain.
 
     Parameters
     ----------
-    rpy_rad : (n, 3) ndarray
-        INS roll, pitch, heading of the body (NED).
-    tan_angle : (n,) ndarray
-        Tangent of each pixel's across-track view angle (:class:`LineGeometry`).
-    R_body_from_sensor : (3, 3) ndarray, optional
-        Boresight misalignment (identity if omitted).
+    sensor : a sensor of :mod:`hsgeo.sensors` (the interface of :mod:`hsgeo.sensors.mount`)
+        A scanning sensor with ``rays(pixels, t_s, trajectory, **pixel_kwargs)``.
+    pixels : (n,) or (n, 2) ndarray
+        The sensor's pixel coordinates (ζ of a line scanner, ``(x, y)`` of a pushbroom camera).
+    t_s : (n,) ndarray, s
+    trajectory : hsgeo.trajectory.Trajectory
+    terrain : PlaneTerrain or DemTerrain
+    **pixel_kwargs
+        What else the sensor's ``rays`` takes per pixel (``band=`` of a pushbroom camera).
 
     Returns
     -------
-    (n, 3) ndarray
-        Unnormalised directions ``R_enu_from_ned R_ned_from_body R_body_from_sensor (0, t, 1)``.
+    (n, 3) ndarray of (E, N, U)
     """
-    rpy = np.atleast_2d(np.asarray(rpy_rad, dtype=float))
-    t = np.asarray(tan_angle, dtype=float).ravel()
-    d_s = np.stack([np.zeros_like(t), t, np.ones_like(t)], axis=1)
-    if R_body_from_sensor is not None:
-        d_s = d_s @ np.asarray(R_body_from_sensor).T
-    R = R_ENU_FROM_NED @ R_from_rpy(rpy[:, 0], rpy[:, 1], rpy[:, 2])
-    return np.einsum("nij,nj->ni", R, d_s)
+    o, d = sensor.rays(pixels, t_s, trajectory, **pixel_kwargs)
+    return intersect(o, d, terrain)
 
 
-# ----------------------------------------------------------------------------------------------
-# Geocoding of point observations and the GCP calibration of the boresight (PARGE-style)
-# ----------------------------------------------------------------------------------------------
 def geocode_observations(
     nav,
-    sensor: LineGeometry,
+    sensor,
     line,
     zeta_px,
     *,
     t0_s: float,
     line_rate_hz: float,
     terrain,
-    boresight_rad=(0.0, 0.0, 0.0),
+    boresight_rad=None,
+    **pixel_kwargs,
 ):
-    """Ground coordinates of observations (fractional line, ζ) of a line scanner.
+    """Ground coordinates of observations (fractional line, pixel) of a scanning sensor.
 
     Parameters
     ----------
     nav : hsgeo.trajectory.Trajectory
-        Recorded navigation of the projection centre.
-    sensor : LineGeometry
-        The assumed inner geometry (calibrated or not).
+        Recorded navigation of the body.
+    sensor : a scanning sensor of :mod:`hsgeo.sensors`, or a LineGeometry
+        A bare :class:`~hsgeo.sensors.line.LineGeometry` (the 000 inner geometry) is mounted
+        with ``boresight_rad`` (:func:`hsgeo.sensors.as_sensor`).
     line : (n,) ndarray
         Line numbers (time ``t0_s + line / line_rate_hz``; fractional for sub-line centroids).
-    zeta_px : (n,) ndarray
+    zeta_px : (n,) or (n, 2) ndarray
+        The sensor's pixel coordinates.
     terrain : PlaneTerrain or DemTerrain
-    boresight_rad : (3,) sequence
-        Roll, pitch, heading of ``R_body_from_sensor``.
+    boresight_rad : (3,) sequence, optional
+        Roll, pitch, heading of ``R_body_from_sensor`` of a bare LineGeometry.
 
     Returns
     -------
     (n, 3) ndarray of (E, N, U)
     """
     line = np.asarray(line, dtype=float)
-    pos, rpy = nav.pose(t0_s + line / line_rate_hz)
-    d = ray_directions(rpy, sensor.tan_angle(zeta_px), R_from_rpy(*boresight_rad))
-    return intersect(pos, d, terrain)
-
-
-class BoresightGCP(ResidualBlock):
-    """Residuals geocoded − reference (E, N) at GCPs as a function of the boresight angles.
-
-    Over a plane of height h: ``X = O + s·d``, ``s = (h − O_U)/d_U`` and
-    ``∂X/∂b = s·(∂d/∂b − d·(∂d_U/∂b)/d_U)`` with ``∂d/∂b = R_map_from_body (∂R_bs/∂b) d_sensor``.
-    Parameter block of role ``boresight`` (default name ``boresight``, see ``blocks``):
-    (roll, pitch, heading) of ``R_body_from_sensor`` in rad.
-    """
-
-    name = "GCP deviations"
-    group_size = 2
-    BLOCKS = MappingProxyType({"boresight": "boresight"})
-
-    def __init__(
-        self,
-        nav,
-        sensor: LineGeometry,
-        line,
-        zeta_px,
-        gcp_enu_m,
-        *,
-        t0_s: float,
-        line_rate_hz: float,
-        height_m: float,
-        sigma_m: float,
-        blocks: Mapping[str, str] | None = None,
-    ):
-        gcp = np.asarray(gcp_enu_m, dtype=float)
-        super().__init__(np.full(2 * gcp.shape[0], sigma_m), blocks=blocks)
-        t_s = t0_s + np.asarray(line, float) / line_rate_hz
-        self.pos, _ = nav.pose(t_s)
-        self.R_mb = nav.R_map_from_body(t_s)
-        t = sensor.tan_angle(zeta_px)
-        self.d_s = np.stack([np.zeros_like(t), t, np.ones_like(t)], axis=1)
-        self.gcp_en = gcp[:, :2]
-        self.h = height_m
-
-    def evaluate(self, values, jacobian):
-        b = values[self.blocks["boresight"]]
-        d = np.einsum("nij,jk,nk->ni", self.R_mb, R_from_rpy(*b), self.d_s)
-        if np.any(d[:, 2] >= 0):
-            raise ObservationError("a GCP ray does not point downwards: check the attitude")
-        s = (self.h - self.pos[:, 2]) / d[:, 2]
-        X = self.pos + s[:, None] * d
-        r = (X[:, :2] - self.gcp_en).ravel()
-        if not jacobian:
-            return r, None
-        dR = dR_drpy(*b)  # (3 angles, 3, 3)
-        dd = np.einsum("nij,kjl,nl->nki", self.R_mb, dR, self.d_s)  # (n, 3 angles, 3)
-        dX = s[:, None, None] * (dd - d[:, None, :] * (dd[:, :, 2:3] / d[:, None, 2:3]))
-        return r, {self.blocks["boresight"]: np.transpose(dX[:, :, :2], (0, 2, 1)).reshape(-1, 3)}
-
-
-def calibrate_boresight(
-    nav,
-    sensor: LineGeometry,
-    line,
-    zeta_px,
-    gcp_enu_m,
-    *,
-    t0_s,
-    line_rate_hz,
-    height_m,
-    sigma_m=0.3,
-):
-    """Estimate the boresight angles from GCPs (as PARGE does with GCP-calibrated data).
-
-    The rank of the design is checked first: with one straight line over a flat field, the three
-    angles are determined by the GCPs' along- and across-track spread; a GNSS position offset
-    could not be separated from roll and pitch and is therefore absorbed by them.
-
-    Returns
-    -------
-    hsgeo.adjust.AdjustmentResult
-        Block ``boresight`` (roll, pitch, heading in rad) with σ̂.
-    """
-    p = Parameters()
-    p.add("boresight", np.zeros(3), columns=("roll_rad", "pitch_rad", "heading_rad"))
-    blk = BoresightGCP(
-        nav,
-        sensor,
-        line,
-        zeta_px,
-        gcp_enu_m,
-        t0_s=t0_s,
-        line_rate_hz=line_rate_hz,
-        height_m=height_m,
-        sigma_m=sigma_m,
-    )
-    return adjust(p, blk)
+    t = t0_s + line / line_rate_hz
+    return geocode_rays(as_sensor(sensor, boresight_rad), zeta_px, t, nav, terrain, **pixel_kwargs)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -359,33 +222,37 @@ def calibrate_boresight(
 # ----------------------------------------------------------------------------------------------
 def geocode_image(
     nav,
-    sensor: LineGeometry,
+    sensor,
     n_lines: int,
     zeta_px,
     *,
     t0_s: float,
     line_rate_hz: float,
     terrain,
-    boresight_rad=(0.0, 0.0, 0.0),
+    boresight_rad=None,
     chunk_lines: int = 2000,
     progress=None,
+    **pixel_kwargs,
 ) -> np.ndarray:
     """Ground coordinates of every pixel of a flight line: ``(n_lines, n_px, 3)`` (E, N, U).
 
-    ``progress``: True prints the share done to stderr; a callable gets ``(done, total)``.
+    ``sensor``: any scanning sensor of :mod:`hsgeo.sensors` (or a bare LineGeometry with
+    ``boresight_rad``, see :func:`geocode_observations`); ``zeta_px`` the pixel coordinates of
+    one line in the sensor's convention ((n_px,) ζ, or (n_px, 2) ``(x, y)``), the same in every
+    line. ``progress``: True prints the share done to stderr; a callable gets ``(done, total)``.
     """
     import sys
 
-    zeta = np.asarray(zeta_px, dtype=float).ravel()
-    tan = sensor.tan_angle(zeta)
-    R_bs = R_from_rpy(*boresight_rad)
-    out = np.empty((n_lines, zeta.size, 3))
+    sensor = as_sensor(sensor, boresight_rad)
+    px = np.asarray(zeta_px, dtype=float)
+    n_px = px.shape[0]
+    out = np.empty((n_lines, n_px, 3))
     for a in range(0, n_lines, chunk_lines):
         b = min(n_lines, a + chunk_lines)
-        pos, rpy = nav.pose(t0_s + np.arange(a, b) / line_rate_hz)
         m = b - a
-        d = ray_directions(np.repeat(rpy, zeta.size, axis=0), np.tile(tan, m), R_bs)
-        out[a:b] = intersect(np.repeat(pos, zeta.size, axis=0), d, terrain).reshape(m, -1, 3)
+        t = np.repeat(t0_s + np.arange(a, b) / line_rate_hz, n_px)
+        pixels = np.tile(px, (m,) + (1,) * (px.ndim - 1))
+        out[a:b] = geocode_rays(sensor, pixels, t, nav, terrain, **pixel_kwargs).reshape(m, -1, 3)
         if progress is True:
             print(
                 f"\r  geocoded {b}/{n_lines} lines",

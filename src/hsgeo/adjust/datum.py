@@ -173,8 +173,14 @@ def identifiability(
     Returns
     -------
     Identifiability
+
+    Notes
+    -----
+    The blocks are evaluated as fresh copies (:meth:`ResidualBlock.fresh`): a check at the
+    truth never leaves state (a Newton start) in the blocks an adjustment then uses.
     """
     blocks = [blocks] if isinstance(blocks, ResidualBlock) else list(blocks)
+    blocks = [b.fresh() for b in blocks]
     layout = _Layout(params)
     masks = [np.ones(b.m, dtype=bool) for b in blocks]
     options = SolverOptions(rank_rtol=rtol)

@@ -32,6 +32,7 @@ with the constructor argument ``blocks={"poses": "poses_band3"}``. ``evaluate`` 
 
 from __future__ import annotations
 
+import copy
 import difflib
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -224,6 +225,15 @@ class ResidualBlock:
     def m(self) -> int:
         """Number of residual components."""
         return self.sigma.size
+
+    def fresh(self) -> ResidualBlock:
+        """A copy of this block in the state it was built in, for checks (e.g. at the truth).
+
+        A block that keeps state between evaluations (a Newton start, a cache) overrides this
+        to give the copy its own initial state; evaluating the copy then never changes what an
+        adjustment of this block computes. The observations are shared, not copied.
+        """
+        return copy.copy(self)
 
     def evaluate(self, values: dict[str, np.ndarray], jacobian: bool):
         """Model minus observation, and optionally the Jacobian.

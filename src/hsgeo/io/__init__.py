@@ -35,13 +35,21 @@ from hsgeo.io.navigation import NAV_COLUMNS, read_trajectory, write_trajectory
 from hsgeo.io.nist_strd import read_nist_strd
 from hsgeo.io.opencv import read_opencv_storage
 from hsgeo.io.raster import read_dem, to_map_files
-from hsgeo.io.sensors import read_camera_toml, read_sensor_toml
-from hsgeo.io.tables import read_table
+from hsgeo.io.sensors import (
+    read_band_split,
+    read_camera_toml,
+    read_pushbroom_camera,
+    read_scanning_sensor,
+    read_sensor_toml,
+)
+from hsgeo.io.tables import read_table, write_csv_array, write_csv_lines
 
 __all__ = [
     "atomic_path",
     "refuse_inputs",
     "read_table",
+    "write_csv_array",
+    "write_csv_lines",
     "NAV_COLUMNS",
     "read_trajectory",
     "write_trajectory",
@@ -50,6 +58,9 @@ __all__ = [
     "read_toml",
     "read_sensor_toml",
     "read_camera_toml",
+    "read_band_split",
+    "read_pushbroom_camera",
+    "read_scanning_sensor",
     "Board",
     "read_board",
     "read_lines",

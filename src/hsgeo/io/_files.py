@@ -156,3 +156,34 @@ def atomic_path(path, inputs: Iterable = ()) -> Iterator[Path]:
         os.replace(tmp, path)
     finally:
         tmp.unlink(missing_ok=True)
+
+
+def write_text(path, text: str, *, atomic: bool = False, make_parents: bool = False) -> Path:
+    """Write ``text`` to ``path`` (UTF-8); ``atomic``: through :func:`atomic_path`;
+    ``make_parents``: create the missing folders first. The one text writer outside the
+    format modules (scoreboard records, ``hsgeo data``'s manifest).
+    """
+    path = Path(path)
+    if make_parents:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    if atomic:
+        with atomic_path(path) as tmp:
+            Path(tmp).write_text(text, encoding="utf-8")
+    else:
+        path.write_text(text, encoding="utf-8")
+    return path
+
+
+def make_folder(path, *, parents: bool = False) -> Path:
+    """Create the folder ``path`` (an existing one is fine)."""
+    path = Path(path)
+    path.mkdir(parents=parents, exist_ok=True)
+    return path
+
+
+def copy_file(src, dest) -> Path:
+    """Copy the bytes of ``src`` to ``dest``."""
+    import shutil
+
+    shutil.copyfile(src, dest)
+    return Path(dest)

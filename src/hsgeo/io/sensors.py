@@ -9,7 +9,15 @@ import numpy as np
 from hsgeo.errors import InputError
 from hsgeo.io.config import Key, read_config
 
-__all__ = ["SENSOR_SCHEMA", "CAMERA_SCHEMA", "read_sensor_toml", "read_camera_toml"]
+__all__ = [
+    "SENSOR_SCHEMA",
+    "CAMERA_SCHEMA",
+    "read_sensor_toml",
+    "read_camera_toml",
+    "read_pushbroom_camera",
+    "read_scanning_sensor",
+    "read_band_split",
+]
 
 #: ``hsgeo geocode --sensor``: a line scanner (000 eq. (2)) and its boresight.
 SENSOR_SCHEMA = {
@@ -50,6 +58,15 @@ CAMERA_SCHEMA = {
         "y0_mm": Key("float", doc="principal point y, mm"),
         "lever_arm_m": Key("floats", length=3, doc="lever arm (platform frame), m"),
         "sigma_lever_m": Key("float", positive=True, doc="σ of the measured lever arm, m"),
+        "c_band_mm": Key(
+            "floats", positive=True, doc="principal distance of each band, mm (geocoding)"
+        ),
+        "distortion": Key(
+            "floats", length=4, doc="K1 (mm^-2), K2 (mm^-4), P1, P2 (mm^-1) of 002 eq. (3)"
+        ),
+        "boresight_deg": Key(
+            "floats", length=3, doc="omega, phi, kappa of the boresight on the nominal mount, deg"
+        ),
     },
     "gnss_ins": {
         "sigma_pos_m": Key("floats", length=3, positive=True, doc="σ of E, N, H, m"),
@@ -76,7 +93,7 @@ def read_sensor_toml(path):
 
     Returns
     -------
-    geometry : hsgeo.geocode.CalibratedLine or hsgeo.geocode.LinearIFOV
+    geometry : hsgeo.sensors.line.CalibratedLine or hsgeo.sensors.line.LinearIFOV
     boresight_rad : (3,) ndarray
         Roll, pitch, heading (rad).
 
@@ -86,7 +103,7 @@ def read_sensor_toml(path):
         Missing file, malformed TOML, unknown or misspelled keys, missing ``zeta0_px`` /
         ``c_px``, values of the wrong type (:func:`~hsgeo.io.config.read_config`).
     """
-    from hsgeo.geocode import CalibratedLine, LinearIFOV
+    from hsgeo.sensors.line import CalibratedLine, LinearIFOV
 
     s = read_config(path, SENSOR_SCHEMA, "sensor file", required_tables=("sensor",))["sensor"]
     if s["model"] == "linear-ifov" and any(s["K"]):
@@ -128,3 +145,108 @@ def read_camera_toml(path) -> dict:
         The tables with the keys the file gives (angles still in degrees, as named).
     """
     return read_config(path, CAMERA_SCHEMA, "camera file", required_tables=("camera",))
+
+
+def read_pushbroom_camera(path):
+    """The 002 camera file (:data:`CAMERA_SCHEMA`) as a sensor for geocoding.
+
+    Uses ``c_band_mm`` (one principal distance per band; default ``c_mm`` for all
+    ``n_bands``), ``pixel_mm``, ``x0_mm``, ``y0_mm``, ``distortion``, ``boresight_deg`` and
+    ``lever_arm_m``; the σ keys (for ``hsgeo adjust-pushbroom``) are read and not used.
+
+    Returns
+    -------
+    hsgeo.sensors.pushbroom.PushbroomCamera
+    """
+    from hsgeo.sensors.pushbroom import PushbroomCamera
+
+    cam = read_camera_toml(path)["camera"]
+    c = cam.get("c_band_mm", (cam["c_mm"],) * cam["n_bands"])
+    if len(c) != cam["n_bands"]:
+        raise InputError(
+            f"camera file {path}: [camera] c_band_mm has {len(c)} values for n_bands = "
+            f"{cam['n_bands']}; give one principal distance per band"
+        )
+    return PushbroomCamera(
+        tuple(c),
+        cam["pixel_mm"],
+        tuple(cam.get("distortion", (0.0, 0.0, 0.0, 0.0))),
+        cam.get("x0_mm", 0.0),
+        cam.get("y0_mm", 0.0),
+        tuple(np.deg2rad(cam.get("boresight_deg", (0.0, 0.0, 0.0)))),
+        tuple(cam.get("lever_arm_m", (0.0, 0.0, 0.0))),
+    )
+
+
+def read_scanning_sensor(path):
+    """A scanning sensor for ``hsgeo geocode --sensor``: the 000 sensor file (``[sensor]``,
+    :func:`read_sensor_toml`) or the 002 camera file (``[camera]``,
+    :func:`read_pushbroom_camera`), told apart by their table.
+
+    Returns
+    -------
+    hsgeo.sensors.line.LineScanner or hsgeo.sensors.pushbroom.PushbroomCamera
+    """
+    import tomllib
+    from pathlib import Path
+
+    from hsgeo.sensors.line import LineScanner
+    from hsgeo.sensors.mount import Mount
+
+    try:
+        tables = set(tomllib.loads(Path(path).read_text(encoding="utf-8")))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        tables = {"sensor"}  # read_sensor_toml gives the one clear error
+    if "camera" in tables and "sensor" not in tables:
+        return read_pushbroom_camera(path)
+    geom, boresight_rad = read_sensor_toml(path)
+    return LineScanner(geom, Mount.from_rpy(boresight_rad))
+
+
+#: An instrument's band split (``data/instruments/*.toml``): which sensor records each band.
+BAND_SPLIT_SCHEMA = {
+    "instrument": {
+        "name": Key("str", required=True, doc="instrument name"),
+        "n_sensors": Key("int", required=True, positive=True, doc="number of sensors"),
+    },
+    "bands": {
+        "band": Key("floats", required=True, doc="band numbers, 1-based"),
+        "sensor": Key("floats", required=True, doc="sensor of each band, 1-based"),
+        "gap_nm": Key("floats", required=True, positive=True, doc="FPI air gap of each band, nm"),
+    },
+}
+
+
+def read_band_split(path=None) -> np.ndarray:
+    """An instrument's band split: band, sensor and FPI air gap (:data:`BAND_SPLIT_SCHEMA`).
+
+    Parameters
+    ----------
+    path : str or Path, optional
+        Default: the Rikola FPI2015 of 003 (``hsgeo/data/instruments/rikola_fpi2015.toml``).
+
+    Returns
+    -------
+    structured ndarray
+        Fields ``band`` (i4), ``sensor`` (i4), ``gap_nm`` (f8), one row per band, in band order.
+    """
+    from pathlib import Path
+
+    if path is None:
+        path = Path(__file__).parent.parent / "data" / "instruments" / "rikola_fpi2015.toml"
+    cfg = read_config(path, BAND_SPLIT_SCHEMA, "instrument file", required_tables=("bands",))
+    b, n = cfg["bands"], cfg["instrument"]["n_sensors"]
+    lengths = {len(b[k]) for k in ("band", "sensor", "gap_nm")}
+    band, sensor = np.asarray(b["band"]), np.asarray(b["sensor"])
+    problems = []
+    if len(lengths) != 1:
+        problems.append("[bands] band, sensor and gap_nm must have one entry per band")
+    elif not (np.array_equal(band, np.arange(1, band.size + 1))):
+        problems.append("[bands] band must be 1, 2, 3, … in order")
+    elif not (np.all(sensor == np.round(sensor)) and np.all((sensor >= 1) & (sensor <= n))):
+        problems.append(f"[bands] sensor must be integers 1…{n} (n_sensors)")
+    if problems:
+        raise InputError(f"instrument file {path}: " + "; ".join(problems))
+    out = np.zeros(band.size, dtype=[("band", "i4"), ("sensor", "i4"), ("gap_nm", "f8")])
+    out["band"], out["sensor"], out["gap_nm"] = band, sensor, b["gap_nm"]
+    return out

@@ -17,7 +17,7 @@ from hsgeo.errors import InputError
 from hsgeo.io._files import check_input_file, read_text
 from hsgeo.io.config import closest
 
-__all__ = ["read_table", "UNIT_SUFFIXES"]
+__all__ = ["read_table", "write_csv_array", "write_csv_lines", "UNIT_SUFFIXES"]
 
 #: Column-name endings that mark a physical quantity (the column must be numeric and finite).
 UNIT_SUFFIXES = (
@@ -218,3 +218,35 @@ def read_table(
                 )
             first[k] = i
     return df
+
+
+def write_csv_array(path, table, *, fmt, header: str):
+    """Write a numeric table as CSV (comma-separated, one header line, no comment marker).
+
+    ``np.savetxt(path, table, delimiter=",", fmt=fmt, header=header, comments="")``: the
+    generated data files of ``make data`` (their bytes are in ``MANIFEST.sha256``).
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    from pathlib import Path
+
+    np.savetxt(path, table, delimiter=",", fmt=fmt, header=header, comments="")
+    return Path(path)
+
+
+def write_csv_lines(path, header: str, lines) -> object:
+    """Write CSV text: the header line, then each already formatted line, newline-ended.
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    from pathlib import Path
+
+    with Path(path).open("w") as fh:
+        fh.write(header + "\n")
+        for line in lines:
+            fh.write(line + "\n")
+    return Path(path)

@@ -76,18 +76,15 @@ def observe_files(
     import cv2
 
     from hsgeo.measure.aruco import detect_targets, make_detector
+    from hsgeo.measure.charuco import detect_charuco
     from hsgeo.measure.targets import Observations
 
     paths = [Path(p) for p in paths]
     if not paths:
         raise InputError("no image files given")
-    cvb = board.cv_board()
-    if board.type == "charuco":
-        det = cv2.aruco.CharucoDetector(cvb)
-        obj_all = np.asarray(cvb.getChessboardCorners(), float)
-    else:
+    if board.type != "charuco":
         det = make_detector(board.dictionary, refine=refine)
-        obj_all = np.asarray(cvb.getObjPoints(), float)
+        obj_all = np.asarray(board.cv_board().getObjPoints(), float)
     rows = {k: [] for k in ("cube", "band", "target", "corners", "obj")}
     size = None
     for i, p in enumerate(paths):
@@ -100,13 +97,16 @@ def observe_files(
             raise InputError(f"{p}: size {img.shape[::-1]} differs from the first image's {size}")
         band = _number(band_regex, p.name, 1)
         cube = _number(cube_regex, p.name, i)
-        if board.type == "charuco":
-            cc, ids, _, _ = det.detectBoard(img)
-            if ids is None or len(ids) < 6:
-                raise ObservationError(f"{p}: {_not_found(board, 'fewer than 6 ChArUco corners')}")
-            ids = np.asarray(ids).ravel().astype(np.int64)
-            px = np.repeat(np.asarray(cc, float).reshape(-1, 1, 2), 4, axis=1)
-            obj = np.repeat(obj_all[ids][:, None, :], 4, axis=1)
+        if board.type == "charuco":  # the one ChArUco detection (hsgeo.measure.charuco)
+            try:
+                ids, cc, X = detect_charuco(img, board, min_corners=6)
+            except ObservationError:
+                raise ObservationError(
+                    f"{p}: {_not_found(board, 'fewer than 6 ChArUco corners')}"
+                ) from None
+            ids = ids.astype(np.int64)
+            px = np.repeat(cc.reshape(-1, 1, 2), 4, axis=1)
+            obj = np.repeat(X[:, None, :], 4, axis=1)
         else:
             d = detect_targets(img, det, valid_ids=np.arange(len(obj_all)))
             if len(d) < 4:

@@ -51,11 +51,11 @@ def run(chapter: str, seed: int = 0, scale: float = 1.0) -> Reproduction:
     rep.meta.setdefault("scale", scale)
     directory = os.environ.get(RECORD_ENV)
     if directory and chapter != "scoreboard":
-        from hsgeo.io._files import atomic_path
+        from hsgeo.io._files import write_text
 
-        Path(directory).mkdir(parents=True, exist_ok=True)
-        with atomic_path(Path(directory) / f"{chapter}.json") as tmp:
-            Path(tmp).write_text(rep.to_json(), encoding="utf-8")
+        write_text(
+            Path(directory) / f"{chapter}.json", rep.to_json(), atomic=True, make_parents=True
+        )
     return rep
 
 

@@ -17,13 +17,13 @@ from __future__ import annotations
 
 import hashlib
 import importlib
-import shutil
 import sys
 import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from hsgeo.io._files import copy_file, make_folder, write_text
 from hsgeo.simulate.scenarios import data_dir, load_scenario
 
 __all__ = ["GENERATORS", "VERIFY_RTOL", "generate_all"]
@@ -122,7 +122,7 @@ def generate_all(
     out = Path(out) if out is not None else default_out(ddir)
     repo = out.resolve() == repo_out.resolve()
     _check_out(out, repo=repo, overwrite=overwrite, default=default)  # before the work
-    out.mkdir(parents=default, exist_ok=True)
+    make_folder(out, parents=default)
     sums: dict[str, str] = {}
     close: list[str] = []
     previous: dict[str, str] = {}
@@ -134,14 +134,14 @@ def generate_all(
                 dest = out / path.name
                 if dest.is_file():
                     previous[path.name] = dest.read_text()
-                shutil.copyfile(path, dest)
+                copy_file(path, dest)
                 sums[f"generated/{path.name}"] = _sha256(dest)
                 print(f"  generated {dest}", file=sys.stderr)
     manifest = ddir / "MANIFEST.sha256"
     text = "".join(f"{h}  {p}\n" for p, h in sorted(sums.items()))
     if update or not manifest.exists():
         target = manifest if repo else out / "MANIFEST.sha256"
-        target.write_text(text)
+        write_text(target, text)
         print(f"wrote {target} ({len(sums)} files)", file=sys.stderr)
         return 0
     expected = {}
@@ -162,7 +162,7 @@ def generate_all(
             and _same_numbers(old, (out / name).read_text(), VERIFY_RTOL)
         ):
             close.append(p)
-            (out / name).write_text(old)  # keep the committed bytes
+            write_text(out / name, old)  # keep the committed bytes
             continue
         bad.append(p)
     if bad:

@@ -13,9 +13,9 @@ from __future__ import annotations
 import numpy as np
 
 from hsgeo.gcp import deviation_table, recompute_printed_table
-from hsgeo.geocode import CalibratedLine
 from hsgeo.papers import P000_GCP_FOOTERS
 from hsgeo.report import Reproduction, Row, agreement
+from hsgeo.sensors.line import CalibratedLine
 from hsgeo.simulate.pula_flight import FlightObservations, nominal_sensor, simulate_flight
 from hsgeo.simulate.scenarios import load_scenario
 from hsgeo.stats import nmad

@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from hsgeo.adjust import adjust
+from hsgeo.io.tables import write_csv_lines
 from hsgeo.papers import (
     P000_TABLE1_CALIBRATED,
     P000_TABLE1_UNCALIBRATED,
@@ -399,29 +400,24 @@ def generate(cfg: dict, outdir: Path) -> list[Path]:
     row = int(cfg.get("calibration", {}).get("row", 1000))
     sim = simulate_observations(lab, row, int(cfg["scenario"]["seed"]))
     ids = sim["point_ids"]
-    obs = outdir / "line_lab_observations.csv"
-    with obs.open("w") as fh:
-        fh.write("image,point,zeta_px\n")
-        for i, p, z in zip(sim["image"], sim["point"], sim["zeta_px"], strict=True):
-            fh.write(f"img{i},{ids[p]},{z:.17g}\n")
-    ctl = outdir / "line_lab_control.csv"
-    with ctl.open("w") as fh:
-        fh.write("point,x_m,y_m\n")
-        for pid, (x, y) in zip(ids, sim["xy_m"], strict=True):
-            fh.write(f"{pid},{x:.17g},{y:.17g}\n")
-    tru = outdir / "line_lab_truth.csv"
-    with tru.open("w") as fh:
-        fh.write("quantity,value\n")
-        t = sim["iop_true"]
-        for k, v in [
-            ("zeta0_px", t["zeta0_px"]),
-            ("c_px", t["c_px"]),
-            ("K1", t["K"][0]),
-            ("K2", t["K"][1]),
-            ("K3", t["K"][2]),
-        ]:
-            fh.write(f"{k},{float(v):.17g}\n")
-        for i, e in enumerate(sim["eop_true"]):
-            for k, v in zip(line1d.EOP_COLUMNS, e, strict=True):
-                fh.write(f"img{i}.{k},{v:.17g}\n")
+    obs = write_csv_lines(
+        outdir / "line_lab_observations.csv",
+        "image,point,zeta_px",
+        (
+            f"img{i},{ids[p]},{z:.17g}"
+            for i, p, z in zip(sim["image"], sim["point"], sim["zeta_px"], strict=True)
+        ),
+    )
+    ctl = write_csv_lines(
+        outdir / "line_lab_control.csv",
+        "point,x_m,y_m",
+        (f"{pid},{x:.17g},{y:.17g}" for pid, (x, y) in zip(ids, sim["xy_m"], strict=True)),
+    )
+    t = sim["iop_true"]
+    iop = [("zeta0_px", t["zeta0_px"]), ("c_px", t["c_px"])]
+    iop += [("K1", t["K"][0]), ("K2", t["K"][1]), ("K3", t["K"][2])]
+    truth_lines = [f"{k},{float(v):.17g}" for k, v in iop]
+    for i, e in enumerate(sim["eop_true"]):
+        truth_lines += [f"img{i}.{k},{v:.17g}" for k, v in zip(line1d.EOP_COLUMNS, e, strict=True)]
+    tru = write_csv_lines(outdir / "line_lab_truth.csv", "quantity,value", truth_lines)
     return [obs, ctl, tru]

@@ -18,7 +18,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from hsgeo.adjust import adjust, identifiability
+from hsgeo.adjust import identifiability
 from hsgeo.errors import InputError
 from hsgeo.papers import P002, P002_STATS
 from hsgeo.report import Reproduction, Row
@@ -29,7 +29,15 @@ from hsgeo.simulate.pushbroom_campaign import (
     simulate,
 )
 from hsgeo.stats import describe, nmad
-from hsgeo.workflows.pushbroom_ba import CameraPrior, build_problem
+from hsgeo.workflows.pushbroom_ba import (  # 002's settings, spelled once in the workflow
+    FTOL,
+    REJECT_K,
+    REPORTED_PARAMETERS,
+    Y_AS_TIME,
+    CameraPrior,
+    build_problem,
+    solve,
+)
 
 __all__ = [
     "run",
@@ -45,17 +53,6 @@ __all__ = [
 ]
 
 RAD2DEG = 180 / np.pi
-#: The reject threshold, in robust σ of the standardised residuals (ours: about the largest
-#: residual / NMAD ratio of 002 Table 1, ≈ 6, with a margin).
-REJECT_K = 5.0
-#: Relative cost decrease at which the iteration stops: at full size 1e-6 of the cost is
-#: ≈ 0.3, below half a unit of χ², i.e. far below any statistical effect.
-FTOL = 1e-6
-#: Model the residual across the line as a time (see
-#: hsgeo.workflows.pushbroom_ba.build_problem): with
-#: the image y of 002 eq. (2) the principal distance and the pitch corrections are biased (the
-#: chapter shows by how much).
-Y_AS_TIME = True
 
 
 def camera_prior(cfg: CampaignConfig, obs: CampaignObservations) -> CameraPrior:
@@ -117,14 +114,8 @@ def adjust_campaign(
         ident = identifiability(q, blocks)
         info["rank_at_truth"] = ident.rank
         info["n_nonpoint_unknowns"] = ident.n_unknowns
-    res = adjust(
-        p,
-        blocks,
-        reject_k=reject_k,
-        ftol=ftol,
-        progress=progress,
-        reject_every_iteration=True,  # 002 §3.4
-        keep_jacobian=True,
+    res = solve(
+        p, blocks, reject_k=reject_k, ftol=ftol, progress=progress, keep_jacobian=True
     )  # the check points' covariance (run)
     info["solver_seconds"] = res.seconds
     return res, p, blocks, info
@@ -321,12 +312,7 @@ def run(seed: int = 0, scale: float = 1.0, progress=None, plan: dict | None = No
     )
     # -- parameters: boresight, lever arm, distortion, c, nodes (with GCPs)
     par = []
-    for name, unit, f in [
-        ("boresight_rad", "deg", RAD2DEG),
-        ("lever_arm_m", "m", 1.0),
-        ("distortion", "", 1.0),
-        ("c_mm", "mm", 1.0),
-    ]:
+    for name, unit, f in REPORTED_PARAMETERS:
         lab = res.params[name].labels()
         v, s, t = res.value(name).ravel(), res.sigma(name).ravel(), truth.values[name].ravel()
         for j in range(v.size):

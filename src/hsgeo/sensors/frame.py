@@ -25,6 +25,7 @@ world units, so that ``X_c = R_world_from_camᵀ (X − X0)``.
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
 from types import MappingProxyType
 
 import numpy as np
@@ -35,11 +36,14 @@ from hsgeo.distortion import (
     brown_correction_jacobian,
     distort_opencv,
     distort_opencv_jacobian,
+    undistort_opencv,
 )
-from hsgeo.errors import InputError
+from hsgeo.errors import InputError, ObservationError
 from hsgeo.rotations import R_from_opk, dR_dopk
+from hsgeo.sensors.mount import Mount, unit
 
 __all__ = [
+    "FrameCamera",
     "POSE_COLUMNS",
     "camera_coordinates",
     "project_opencv",
@@ -315,3 +319,57 @@ class FramePhotogrammetric(_FrameBase):
             self.blocks["distortion"]: d_dist.reshape(2 * n, 5),
         }
         return self._pack(r2, dp, dX, extra)
+
+
+# ----------------------------------------------------------------------------------------------
+# The sensor interface (hsgeo.sensors.mount): pixels ↔ rays of a frame camera
+# ----------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class FrameCamera:
+    """A frame camera in OpenCV's form as a sensor: ``project`` and ``rays`` at given poses.
+
+    Parameters
+    ----------
+    intrinsics : (4,) sequence
+        ``fx_px, fy_px, cx_px, cy_px``.
+    dist : (5,) sequence
+        ``k1, k2, p1, p2, k3`` (OpenCV order; :func:`hsgeo.distortion.distort_opencv`).
+    mount : Mount
+        The camera on its body (a rig): ``R_body_from_sensor`` takes OpenCV camera vectors
+        (x right, y down, z forward) to the body. The identity mount makes the poses the
+        camera's own.
+
+    The poses are rows ``(ω, φ, κ, X0, Y0, Z0)`` of the body (``R_world_from_body =
+    R_from_opk(ω, φ, κ)``, the ``poses`` block of :class:`FrameOpenCV`), ``view`` the pose of
+    each pixel or point.
+    """
+
+    intrinsics: tuple
+    dist: tuple = (0.0, 0.0, 0.0, 0.0, 0.0)
+    mount: Mount = field(default_factory=Mount)
+
+    def _frames(self, poses, view):
+        poses = np.atleast_2d(np.asarray(poses, dtype=float))
+        view = np.asarray(view, dtype=np.int64)
+        R = R_from_opk(poses[:, 0], poses[:, 1], poses[:, 2])[view]  # R_world_from_body
+        return poses[view, 3:6], R
+
+    def rays(self, uv_px, poses, view) -> tuple[np.ndarray, np.ndarray]:
+        """Origins and unit directions (world frame) of the rays of pixels ``(n, 2)``."""
+        fx, fy, cx, cy = self.intrinsics
+        uv = np.atleast_2d(np.asarray(uv_px, dtype=float))
+        xd = np.column_stack([(uv[:, 0] - cx) / fx, (uv[:, 1] - cy) / fy])
+        xn = undistort_opencv(xd, self.dist) if any(self.dist) else xd
+        X0, R = self._frames(poses, view)
+        d_cam = np.column_stack([xn, np.ones(len(xn))])
+        return self.mount.origins(X0, R), unit(self.mount.directions(R, d_cam))
+
+    def project(self, xyz_world, poses, view) -> np.ndarray:
+        """Pixels ``(n, 2)`` of world points seen from the poses ``view``."""
+        X0, R = self._frames(poses, view)
+        Xc = self.mount.to_sensor(xyz_world, X0, R)
+        if np.any(Xc[:, 2] <= 0):
+            raise ObservationError("points behind the frame camera (Z_c ≤ 0)")
+        xd = distort_opencv(Xc[:, :2] / Xc[:, 2:3], self.dist)
+        fx, fy, cx, cy = self.intrinsics
+        return np.column_stack([fx * xd[:, 0] + cx, fy * xd[:, 1] + cy])

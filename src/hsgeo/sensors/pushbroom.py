@@ -1,5 +1,10 @@
 """Linear pushbroom (LP) lines as pinhole exposures with spline trajectory corrections.
 
+Kept as one file: the one 002 LP camera model in its three faces (the sensor
+:class:`PushbroomCamera`, the numpy reference :func:`project`, the residual block
+:class:`PushbroomLines`) sharing its geometry; the compiled kernel is in
+:mod:`hsgeo.sensors._pushbroom_kernel`.
+
 002 eq. 2–4.
 
 Every LP image line is a pinhole exposure at its time ``t_e``. An observation is a tie point
@@ -74,25 +79,26 @@ Jonassen et al. (2024), 002 eq. (2)–(4), §3.3–3.5.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from types import MappingProxyType
 
 import numpy as np
-from numba import njit, prange
 
-from hsgeo._kernels import (
-    bspline_weights,
-    pushbroom_camera_point,
-    pushbroom_image_mm,
-    pushbroom_image_rows,
-    rpy_rotation,
-)
+from hsgeo._kernels import pushbroom_image_rows
 from hsgeo.adjust import Indexed, ResidualBlock
-from hsgeo.errors import InputError
+from hsgeo.distortion import (
+    distort_pushbroom_line,
+    distort_pushbroom_line_jacobian,
+    undistort_pushbroom_line,
+)
+from hsgeo.errors import InputError, ObservationError
 from hsgeo.rotations import R_from_opk, R_from_rpy, dR_dopk, dR_drpy
-from hsgeo.trajectory import SplineNodes, bspline_basis
+from hsgeo.sensors._pushbroom_kernel import _lines_kernel
+from hsgeo.sensors.mount import Mount
+from hsgeo.trajectory import R_BODY_FROM_PLATFORM, SplineNodes, bspline_basis
 
 __all__ = [
+    "PushbroomCamera",
     "PushbroomLines",
     "PushbroomObservations",
     "BETA0_CAM_FROM_PLATFORM",
@@ -173,211 +179,6 @@ def project(values, names, nodes, t_s, xyz_nav, rpy_nav, pidx, band, beta0, x0_m
         values, names, nodes, t_s, xyz_nav, rpy_nav, pidx, band, beta0, x0_mm, y0_mm
     )
     return g["xy"], g["p"]
-
-
-#: The crossing time is sought within ± this of the line time (s): 0.25 s is ~55 px of image
-#: motion, beyond any gross error left after RANSAC; a trial step that throws a weakly
-#: intersected point far off is held there (without the bound the time of such a point runs
-#: off with the spline extrapolated, and the first iterations are damped to a crawl).
-T_MAX = 0.25
-#: Newton on the crossing time stops when its correction is below this (s); see the module
-#: docstring for the error this leaves in the residuals (< 1e-13 px).
-NEWTON_TOL_S = 1e-8
-
-
-@njit(cache=True, parallel=True)
-def _lines_kernel(
-    P,
-    pidx,
-    idx,
-    u0,
-    inv_dt,
-    nodes,
-    xyz_nav,
-    rpy_nav,
-    xyz_rate,
-    rpy_rate,
-    band,
-    c_b,
-    dist,
-    beta,
-    dbeta,
-    lever,
-    x0,
-    y0,
-    k_px,
-    xy_obs,
-    timed,
-    n_newton,
-    y_rate_ref,
-    jac,
-    dt_start,
-    r,
-    w_out,
-    dP,
-    dN,
-    dB,
-    dL,
-    dD,
-    dC,
-):  # pragma: no cover
-    """002 eq. (2)–(4) and their derivatives, one observation per iteration (rows 2j, 2j+1).
-
-    ``timed``: the observation is evaluated at the model's crossing time ``t*`` of the line
-    (``y(t*) = y_obs``, Newton from the line time ``t_e`` with the navigation pose moved by its
-    rates and the spline piece of ``t_e`` continued); the residuals are ``x(t*) − x_obs`` and
-    ``ẏ_ref (t_e − t*)``, and their derivatives follow from the implicit function theorem,
-    ``∂t*/∂θ = −(∂y/∂θ)/ẏ``. The spline weights used are returned in ``w_out``. ``dt_start``
-    (in and out): ``t* − t_e`` at which Newton starts, overwritten with this evaluation's.
-    """
-    m = pidx.size
-    K1, K2, P1, P2 = dist[0], dist[1], dist[2], dist[3]
-    n_chunks = 64 if m > 6400 else 1
-    step = (m + n_chunks - 1) // n_chunks
-    for ch in prange(n_chunks):
-        R = np.empty((3, 3))
-        dR = np.empty((3, 3, 3))
-        d = np.empty(3)
-        q = np.empty(3)
-        p = np.empty(3)
-        dl = np.empty(6)
-        rate = np.empty(6)
-        Jp = np.empty((2, 3))
-        JpB = np.empty((2, 3))
-        d6 = np.empty((2, 6))
-        w = np.empty(4)
-        dw = np.empty(4)
-        for j in range(ch * step, min(m, (ch + 1) * step)):
-            dt = dt_start[j] if timed else 0.0  # t − t_e, from the last evaluation's t*
-            xdot = 0.0
-            ydot = 1.0
-            ey = 0.0
-            n_it = n_newton if timed else 0
-            for it in range(n_it + 1):
-                bspline_weights(u0[j] + dt * inv_dt, inv_dt, w, dw)
-                for a in range(6):
-                    acc = 0.0
-                    acc_r = 0.0
-                    for b in range(4):
-                        acc += w[b] * nodes[idx[j, b], a]
-                        acc_r += dw[b] * nodes[idx[j, b], a]
-                    dl[a] = acc
-                    rate[a] = acc_r + (xyz_rate[j, a] if a < 3 else rpy_rate[j, a - 3])
-                rpy_rotation(
-                    rpy_nav[j, 0] + dt * rpy_rate[j, 0] + dl[3],
-                    rpy_nav[j, 1] + dt * rpy_rate[j, 1] + dl[4],
-                    rpy_nav[j, 2] + dt * rpy_rate[j, 2] + dl[5],
-                    R,
-                    dR,
-                )
-                pt = pidx[j]
-                for a in range(3):
-                    d[a] = P[pt, a] - xyz_nav[j, a] - dt * xyz_rate[j, a] - dl[a]
-                pushbroom_camera_point(R, d, lever, beta, q, p)  # 002 eq. (4)
-                c = c_b[band[j]]
-                x, y, xb, yb, iz, gx, gy = pushbroom_image_mm(
-                    p[0], p[1], p[2], c, K1, K2, P1, P2
-                )  # 002 eq. (3)
-                x = x + x0
-                y = y + y0
-                a_ = c * iz
-                Jp[0, 0] = gx * a_ * k_px
-                Jp[0, 1] = 0.0
-                Jp[0, 2] = -gx * xb * iz * k_px
-                Jp[1, 0] = gy * a_ * k_px
-                Jp[1, 1] = a_ * k_px
-                Jp[1, 2] = (-yb * iz - gy * xb * iz) * k_px
-                for u in range(2):
-                    for a in range(3):
-                        JpB[u, a] = (
-                            Jp[u, 0] * beta[0, a] + Jp[u, 1] * beta[1, a] + Jp[u, 2] * beta[2, a]
-                        )
-                # d6: derivatives w.r.t. the pose (position, attitude) of the platform
-                for u in range(2):
-                    for a in range(3):
-                        d6[u, a] = -(
-                            JpB[u, 0] * R[a, 0] + JpB[u, 1] * R[a, 1] + JpB[u, 2] * R[a, 2]
-                        )
-                    for kk in range(3):
-                        v = 0.0
-                        for i in range(3):
-                            dq = dR[kk, 0, i] * d[0] + dR[kk, 1, i] * d[1] + dR[kk, 2, i] * d[2]
-                            v += JpB[u, i] * dq
-                        d6[u, 3 + kk] = v
-                if not timed:
-                    break
-                # image rates (px/s) along the trajectory: ∂(x, y)/∂pose · pose rate
-                xdot = 0.0
-                ydot = 0.0
-                for a in range(6):
-                    xdot += d6[0, a] * rate[a]
-                    ydot += d6[1, a] * rate[a]
-                # every real geometry has ẏ near ẏ_ref; a far-off trial point may not
-                ydot = max(ydot, 0.25 * y_rate_ref)
-                ey = (y * k_px - xy_obs[j, 1]) / ydot
-                if abs(ey) < NEWTON_TOL_S:
-                    # converged: the last correction is kept in the residual, which is then
-                    # exact to O(ey²)
-                    break
-                if it < n_it:
-                    dt = min(max(dt - ey, -T_MAX), T_MAX)
-            for b in range(4):
-                w_out[j, b] = w[b]
-            if timed:
-                dt_start[j] = min(max(dt - ey, -T_MAX), T_MAX)
-            r[2 * j] = x * k_px - xy_obs[j, 0] - xdot * ey  # x at t* (0 if not timed)
-            if timed:
-                # ẏ_ref (t_e − t*), t* = t_e + dt − ey (the last Newton correction included)
-                r[2 * j + 1] = y_rate_ref * (ey - dt)
-            else:
-                r[2 * j + 1] = y * k_px - xy_obs[j, 1]
-            if not jac:
-                continue
-            for u in range(2):
-                row = 2 * j + u
-                for a in range(3):
-                    dP[row, a] = -d6[u, a]  # dp/dP = β Rᵀ = −dp/dx
-                    dN[row, a] = d6[u, a]  # × the spline weights (factored Jacobian)
-                    dL[row, a] = -JpB[u, a]
-                    dN[row, 3 + a] = d6[u, 3 + a]
-                for kk in range(3):
-                    # boresight: dp/dbore_k = dβ_k q
-                    v = 0.0
-                    for i in range(3):
-                        v += Jp[u, i] * (
-                            dbeta[kk, i, 0] * q[0] + dbeta[kk, i, 1] * q[1] + dbeta[kk, i, 2] * q[2]
-                        )
-                    dB[row, kk] = v
-            dC[2 * j, 0] = gx * xb / c * k_px
-            dC[2 * j + 1, 0] = (yb / c + gy * xb / c) * k_px
-            dD[2 * j, 0] = xb**3 * k_px
-            dD[2 * j, 1] = xb**5 * k_px
-            dD[2 * j, 2] = 3 * xb**2 * k_px
-            dD[2 * j, 3] = 0.0
-            dD[2 * j + 1, 0] = 0.0
-            dD[2 * j + 1, 1] = 0.0
-            dD[2 * j + 1, 2] = 0.0
-            dD[2 * j + 1, 3] = xb**2 * k_px
-            if timed:
-                # x(t*(θ)): ∂x/∂θ − (ẋ/ẏ) ∂y/∂θ; ẏ_ref (t_e − t*): (ẏ_ref/ẏ) ∂y/∂θ
-                fx = xdot / ydot
-                fy = y_rate_ref / ydot
-                rx, ry = 2 * j, 2 * j + 1
-                for a in range(3):
-                    dP[rx, a] -= fx * dP[ry, a]
-                    dL[rx, a] -= fx * dL[ry, a]
-                    dB[rx, a] -= fx * dB[ry, a]
-                    dP[ry, a] *= fy
-                    dL[ry, a] *= fy
-                    dB[ry, a] *= fy
-                for a in range(6):
-                    dN[rx, a] -= fx * dN[ry, a]
-                    dN[ry, a] *= fy
-                for a in range(4):
-                    dD[rx, a] -= fx * dD[ry, a]
-                    dD[ry, a] *= fy
-                dC[rx, 0] -= fx * dC[ry, 0]
-                dC[ry, 0] *= fy
 
 
 @dataclass(frozen=True)
@@ -592,6 +393,16 @@ class PushbroomLines(ResidualBlock):
         for a in ("xyz_nav", "rpy_nav", "xy_px"):
             setattr(self, a, np.ascontiguousarray(getattr(self, a)))
 
+    def fresh(self) -> PushbroomLines:
+        """A copy with its own Newton start (the line times), as this block was built.
+
+        Checks at the truth (:func:`hsgeo.adjust.identifiability`) evaluate such a copy: the
+        crossing times it finds never become the start of the adjustment's evaluations.
+        """
+        other = super().fresh()
+        other._dt_s = np.zeros_like(self._dt_s)
+        return other
+
     def image_mm(self, values):
         """Modelled image coordinates in mm, ``(m, 2)``."""
         xy, _ = project(
@@ -665,11 +476,10 @@ class PushbroomLines(ResidualBlock):
         dBore = np.einsum("mrj,kji,mi->mrk", Jp, dbeta, q)
         dLever = -JpB
         dC = np.stack([gx * xb / c, yb / c + gy * xb / c], axis=1) * k  # (m, 2)
-        dDist = np.zeros((m, 2, 4))
-        dDist[:, 0, 0] = xb**3 * k
-        dDist[:, 0, 1] = xb**5 * k
-        dDist[:, 0, 2] = 3 * xb**2 * k
-        dDist[:, 1, 3] = xb**2 * k
+        # ∂(x, y)/∂(K1, K2, P1, P2) of 002 eq. (3): hsgeo.distortion's (the compiled kernel
+        # has the same terms inline)
+        dist = np.asarray(values[nm["distortion"]], dtype=np.float64)
+        dDist = distort_pushbroom_line_jacobian(np.column_stack([xb, yb]), dist)[1] * k
         jac = {
             nm["points"]: Indexed(self._pidx2, dP.reshape(2 * m, 3)),
             nm["nodes"]: Indexed(np.repeat(idx, 2, axis=0), dnodes.reshape(2 * m, 4, 6)),
@@ -743,3 +553,137 @@ class PushbroomLines(ResidualBlock):
             nm["c"]: Indexed(self._band2, dC),
         }
         return r, jac
+
+
+# ----------------------------------------------------------------------------------------------
+# The sensor interface (hsgeo.sensors.mount): pixels ↔ rays of the LP camera
+# ----------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class PushbroomCamera:
+    """The 002 LP camera as a sensor: pixel → ray and map point → pixel (002 eq. 2–4).
+
+    The same model as :class:`PushbroomLines` without the trajectory corrections (give a
+    corrected trajectory for an adjusted one): ``p^c = β (R_map_from_platformᵀ (p^m − x) − l^p)``,
+    ``x̄ = c_b p^c_x / p^c_z``, ``ȳ = c_b p^c_y / p^c_z`` and the line distortion of 002
+    eq. (3) (:func:`hsgeo.distortion.distort_pushbroom_line`; a ray undistorts with
+    :func:`~hsgeo.distortion.undistort_pushbroom_line`).
+
+    Parameters
+    ----------
+    c_mm : sequence of float, mm
+        Principal distance of each band.
+    pixel_mm : float, mm
+        Pixel pitch.
+    distortion : (4,) sequence
+        K1 (mm⁻²), K2 (mm⁻⁴), P1, P2 (mm⁻¹) of 002 eq. (3).
+    x0_mm, y0_mm : float, mm
+        Principal point.
+    boresight_rad : (3,) sequence, rad
+        ω, φ, κ of ``β = R_from_opk(ω, φ, κ) β₀``.
+    lever_arm_m : (3,) sequence, m
+        Lever arm ``l^p`` in the platform frame (x forward, y left, z up).
+    beta0 : (3, 3) array_like
+        Nominal camera-from-platform rotation (:data:`BETA0_CAM_FROM_PLATFORM`).
+
+    Pixels are ``(x, y)`` px from the line centre (x along the line, y across it; ``y = 0`` on
+    the line) with a band each, at a time ``t_s`` each. The :attr:`mount` is the same mount in
+    the body frame of a :class:`hsgeo.trajectory.Trajectory` (x forward, y right, z down).
+    """
+
+    c_mm: tuple
+    pixel_mm: float
+    distortion: tuple = (0.0, 0.0, 0.0, 0.0)
+    x0_mm: float = 0.0
+    y0_mm: float = 0.0
+    boresight_rad: tuple = (0.0, 0.0, 0.0)
+    lever_arm_m: tuple = (0.0, 0.0, 0.0)
+    beta0: np.ndarray = field(default_factory=lambda: BETA0_CAM_FROM_PLATFORM.copy())
+
+    def __post_init__(self):
+        c = np.atleast_1d(np.asarray(self.c_mm, dtype=float))
+        if c.ndim != 1 or not np.all(np.isfinite(c) & (c > 0)):
+            raise InputError(f"c_mm must be positive principal distances per band, got {c}")
+        if not self.pixel_mm > 0:
+            raise InputError(f"pixel pitch must be positive, got {self.pixel_mm!r} mm")
+        if np.shape(self.distortion) != (4,):
+            raise InputError("distortion must be (K1, K2, P1, P2) of 002 eq. (3)")
+
+    @property
+    def beta(self) -> np.ndarray:
+        """``β = R_cam_from_platform = R_from_opk(ω, φ, κ) β₀``."""
+        return R_from_opk(*np.asarray(self.boresight_rad, float)) @ np.asarray(self.beta0)
+
+    @property
+    def mount(self) -> Mount:
+        """The camera's mount on the trajectory's body frame (lever arm and boresight)."""
+        D = R_BODY_FROM_PLATFORM
+        return Mount(D @ np.asarray(self.lever_arm_m, float), D @ self.beta.T)
+
+    def _band_c(self, band, n) -> np.ndarray:
+        c = np.atleast_1d(np.asarray(self.c_mm, dtype=float))
+        b = np.broadcast_to(np.asarray(band), (n,))
+        if not np.issubdtype(b.dtype, np.integer) or np.any((b < 0) | (b >= c.size)):
+            raise InputError(f"band indices must be integers in 0…{c.size - 1}")
+        return c[b]
+
+    def rays_at(self, xy_px, band, xyz_platform_m, R_map_from_platform):
+        """Rays of pixels at given platform poses (the core of :meth:`rays`).
+
+        Parameters
+        ----------
+        xy_px : (n, 2) array_like, px
+        band : int or (n,) int array_like
+        xyz_platform_m : (n, 3) array_like, m
+            Position of the platform (navigation reference point), map frame.
+        R_map_from_platform : (n, 3, 3) array_like
+
+        Returns
+        -------
+        origins_m, directions : (n, 3) ndarray
+            Projection centres ``x + R l^p`` and unit directions ``R βᵀ (x̄, ȳ, c_b)``.
+        """
+        xy_mm = np.asarray(xy_px, dtype=float) * self.pixel_mm - np.array([self.x0_mm, self.y0_mm])
+        if any(self.distortion):
+            xy_mm = undistort_pushbroom_line(xy_mm, self.distortion)  # 002 eq. (3) inverted
+        n = xy_mm.shape[0]
+        d_cam = np.column_stack([xy_mm, self._band_c(band, n)])
+        R = np.asarray(R_map_from_platform, dtype=float)
+        d = np.einsum("mij,mj->mi", R, d_cam @ self.beta)  # R βᵀ d_cam
+        d /= np.linalg.norm(d, axis=1, keepdims=True)
+        o = np.asarray(xyz_platform_m, dtype=float) + R @ np.asarray(self.lever_arm_m, float)
+        return o, d
+
+    def rays(self, xy_px, t_s, trajectory, band=0) -> tuple[np.ndarray, np.ndarray]:
+        """Origins (m) and unit directions of the rays of pixels seen at times ``t_s``.
+
+        Parameters
+        ----------
+        xy_px : (n, 2) array_like, px
+        t_s : (n,) array_like, s
+        trajectory : hsgeo.trajectory.Trajectory
+            GNSS/INS poses of the body (corrected ones, for an adjusted trajectory).
+        band : int or (n,) int array_like
+            Band of each pixel (its principal distance).
+        """
+        pos, _ = trajectory.pose(t_s)
+        R = trajectory.R_map_from_body(t_s) @ R_BODY_FROM_PLATFORM
+        return self.rays_at(xy_px, band, pos, R)
+
+    def project_at(self, xyz_map_m, band, xyz_platform_m, R_map_from_platform) -> np.ndarray:
+        """Pixels ``(n, 2)`` of map points at given platform poses (002 eq. (2)–(4))."""
+        R = np.asarray(R_map_from_platform, dtype=float)
+        d = np.atleast_2d(np.asarray(xyz_map_m, float)) - np.asarray(xyz_platform_m, float)
+        q = np.einsum("nji,nj->ni", R, d) - np.asarray(self.lever_arm_m, float)  # 002 eq. (4)
+        p = q @ self.beta.T
+        if np.any(p[:, 2] <= 0):
+            raise ObservationError("points behind the pushbroom camera (p^c_z ≤ 0)")
+        c = self._band_c(band, p.shape[0])
+        xy_bar = c[:, None] * p[:, :2] / p[:, 2:3]  # 002 eq. (3), collinearity
+        xy = distort_pushbroom_line(xy_bar, self.distortion)
+        return (xy + np.array([self.x0_mm, self.y0_mm])) / self.pixel_mm
+
+    def project(self, xyz_map_m, t_s, trajectory, band=0) -> np.ndarray:
+        """Pixels ``(x, y)`` ``(n, 2)`` of map points at times ``t_s`` (y = 0 on the line)."""
+        pos, _ = trajectory.pose(t_s)
+        R = trajectory.R_map_from_body(t_s) @ R_BODY_FROM_PLATFORM
+        return self.project_at(xyz_map_m, band, pos, R)

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from hsgeo.io.tables import write_csv_array
 from hsgeo.rotations import R_from_opk, opk_from_R
 from hsgeo.sensors.frame import project_opencv
 from hsgeo.simulate import as_rng
@@ -144,21 +145,17 @@ def generate(cfg: dict, outdir: Path) -> list[Path]:
     obs = outdir / "frame_bench_observations.csv"
     X = sim.X_mm[sim.point]
     table = np.column_stack([sim.view, sim.point, X, sim.uv_px])
-    np.savetxt(
+    write_csv_array(
         obs,
         table,
-        delimiter=",",
         fmt=["%d", "%d"] + ["%.17g"] * 5,
         header="view,point,X_mm,Y_mm,Z_mm,u_px,v_px",
-        comments="",
     )
     truth_csv = outdir / "frame_bench_truth.csv"
-    np.savetxt(
+    write_csv_array(
         truth_csv,
         truth.poses,
-        delimiter=",",
         fmt="%.17g",
         header="omega_rad,phi_rad,kappa_rad,X0_mm,Y0_mm,Z0_mm",
-        comments="",
     )
     return [obs, truth_csv]

@@ -21,14 +21,11 @@ from pathlib import Path
 
 import numpy as np
 
-from hsgeo.geocode import (
-    CalibratedLine,
-    LinearIFOV,
-    LineGeometry,
-    PlaneTerrain,
-)
+from hsgeo.geocode import PlaneTerrain
 from hsgeo.io.navigation import write_trajectory
+from hsgeo.io.tables import write_csv_array
 from hsgeo.rotations import R_from_rpy
+from hsgeo.sensors.line import CalibratedLine, LinearIFOV, LineGeometry
 from hsgeo.simulate import as_rng
 from hsgeo.trajectory import Trajectory
 
@@ -238,13 +235,11 @@ def generate(cfg: dict, outdir: Path) -> list[Path]:
     fl, _ = simulate_flight(cfg, cfg["scenario"]["seed"])
     nav = write_trajectory(outdir / "pula_flight_navigation.csv", fl.recorded_nav)
     obs = outdir / "pula_flight_gcp_observations.csv"
-    np.savetxt(
+    write_csv_array(
         obs,
         np.column_stack([fl.gcp_id, fl.line, fl.zeta_px, fl.gcp_enu_m]),
-        delimiter=",",
         fmt=["%d"] + ["%.17g"] * 5,
         header="gcp,line,zeta_px,E_m,N_m,U_m",
-        comments="",
     )
     return [nav, obs]
 

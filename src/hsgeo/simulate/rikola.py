@@ -26,6 +26,7 @@ import numpy as np
 
 from hsgeo.distortion import brown_correction
 from hsgeo.errors import InputError
+from hsgeo.io.tables import write_csv_array
 from hsgeo.papers import RIKOLA_BANDS
 from hsgeo.rotations import R_from_opk, opk_from_R
 from hsgeo.sensors.frame import pixel_to_mm
@@ -401,21 +402,17 @@ def generate(cfg: dict, outdir: Path) -> list[Path]:
     table = np.column_stack(
         [truth.bands["band"], truth.bands["sensor"], truth.bands["gap_nm"], truth.f_mm, pp]
     )
-    np.savetxt(
+    write_csv_array(
         bands,
         table,
-        delimiter=",",
         fmt=["%d", "%d", "%.17g", "%.17g", "%.17g", "%.17g"],
         header="band,sensor,gap_nm,f_mm,x0_mm,y0_mm",
-        comments="",
     )
     cubes = outdir / "rikola_bench_truth_cubes.csv"
-    np.savetxt(
+    write_csv_array(
         cubes,
         truth.poses,
-        delimiter=",",
         fmt="%.17g",
         header="omega_rad,phi_rad,kappa_rad,X0_mm,Y0_mm,Z0_mm",
-        comments="",
     )
     return [bands, cubes]

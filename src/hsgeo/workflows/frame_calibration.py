@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
@@ -33,6 +34,8 @@ __all__ = [
     "calibrate_opencv",
     "calibrate_photogrammetric",
     "initial_poses",
+    "calibrate_frame_files",
+    "MIN_VIEWS",
 ]
 
 
@@ -290,3 +293,157 @@ def calibrate_photogrammetric(
         pixel_pitch_mm,
         _blocks=("interior", "distortion_mm"),
     )
+
+
+# ----------------------------------------------------------------------------------------------
+# ``hsgeo calibrate-frame``: a board in image files, per band or jointly (moved from rikola.py)
+# ----------------------------------------------------------------------------------------------
+#: Fewest views (images of the board) of a band for a self-calibration: a planar board gives
+#: two constraints on the interior orientation per view (Zhang 2000, §3.1).
+MIN_VIEWS = 3
+
+
+def _check_images(images) -> list:
+    """The image files exist, are files, and none is given twice (same path or same bytes)."""
+    import hashlib
+
+    from hsgeo.io._files import check_input_file
+
+    images = [Path(p) for p in images]
+    seen_path: dict = {}
+    seen_hash: dict = {}
+    for p in images:
+        check_input_file(p, "image file")
+        key = p.resolve()
+        if key in seen_path:
+            raise InputError(
+                f"image file {str(p)!r} is given twice (as {str(seen_path[key])!r}); give each "
+                "view once"
+            )
+        seen_path[key] = p
+        h = hashlib.sha256(p.read_bytes()).hexdigest()
+        if h in seen_hash:
+            raise InputError(
+                f"image files {str(seen_hash[h])!r} and {str(p)!r} are the same image (identical "
+                "bytes); give each view once"
+            )
+        seen_hash[h] = p
+    return images
+
+
+def _check_regex(option: str, rx: str, images) -> None:
+    """``rx`` compiles, has one group, and takes a whole number from every file name."""
+    import re
+
+    try:
+        pat = re.compile(rx)
+    except re.error as exc:
+        raise InputError(f"{option} {rx!r} is not a regular expression ({exc})") from None
+    if pat.groups != 1:
+        raise InputError(
+            f"{option} {rx!r} has {pat.groups} groups; it needs exactly one, e.g. 'band(\\d+)'"
+        )
+    for p in images:
+        m = pat.search(p.name)
+        if m is None or m.group(1) is None or not m.group(1).isdigit():
+            raise InputError(
+                f"{option} {rx!r} takes no number from the file name {p.name!r}; its group must "
+                "match the digits of the band or cube number"
+            )
+
+
+def calibrate_frame_files(
+    images,
+    board_path,
+    *,
+    joint: bool = False,
+    band_regex=None,
+    cube_regex=None,
+    sigma_px: float = 0.1,
+):
+    """``hsgeo calibrate-frame``: detect a board in image files and self-calibrate, per band
+    (:func:`hsgeo.workflows.rikola.calibrate_band`) or jointly
+    (:func:`hsgeo.workflows.rikola.calibrate_joint`, Rikola band numbering).
+
+    Returns
+    -------
+    hsgeo.reproduce.Reproduction
+        Rows ``interior band N`` (f, x0, y0, K1–K3, P1, P2 with σ̂, in mm or — without
+        ``camera.pixel_mm`` in the board file — px) or ``joint model``; ``meta`` has σ0, the
+        RMS residual and the number of points per band.
+    """
+    from hsgeo.io import read_board
+    from hsgeo.measure.boards import observe_files
+    from hsgeo.report import Reproduction, Row
+    from hsgeo.workflows.rikola import calibrate_band, calibrate_joint, initial_focal_mm
+
+    board = read_board(board_path)
+    images = _check_images(images)
+    for option, rx in (("--band-regex", band_regex), ("--cube-regex", cube_regex)):
+        if rx is not None:
+            _check_regex(option, rx, images)
+    if joint and (band_regex is None or cube_regex is None):
+        raise InputError(
+            "--joint needs --band-regex and --cube-regex (which band and cube each file is)"
+        )
+    obs = observe_files(images, board, band_regex=band_regex, cube_regex=cube_regex)
+    for band in np.unique(obs.band):
+        views = np.unique(obs.cube[obs.band == band]).size
+        if views < MIN_VIEWS:
+            raise InputError(
+                f"band {band} has {views} image(s) of the board; a self-calibration needs at "
+                f"least {MIN_VIEWS} views from different directions (Zhang 2000): add images"
+            )
+    unit = "mm" if board.pixel_mm is not None else "px"
+    rows, meta = (
+        [],
+        {
+            "images": len(list(images)),
+            "points": int(len(obs.cube)),
+            "length_unit": unit,
+            "board": board.type,
+        },
+    )
+    if joint:
+        if band_regex is None or cube_regex is None:
+            raise InputError(
+                "--joint needs --band-regex and --cube-regex (which band and cube each file is)"
+            )
+        j = calibrate_joint(obs, f0_mm=initial_focal_mm(obs), sigma_px=sigma_px)
+        R = j.result
+        for blk in ("gap_model", "pp_mm", "distortion_mm", "sensor2_rotation"):
+            b = R.params[blk]
+            for lab, v, s in zip(b.labels(), b.value.ravel(), R.sigma(blk).ravel(), strict=True):
+                rows.append(Row("joint model", lab, "", None, None, v, s, None))
+        meta.update(
+            sigma0=R.sigma0, rms_px=float(np.sqrt(np.mean(np.sum(j.residuals_px**2, axis=1))))
+        )
+        return Reproduction("calibrate-frame", 0, rows, meta)
+    for band in np.unique(obs.band):
+        c = calibrate_band(obs, int(band), f0_mm=None, sigma_px=sigma_px)
+        for q, (v, s) in c.iop.items():
+            u = q.split("_", 1)[1].replace("per_", "1/") if "_" in q else ""
+            if board.pixel_mm is None:  # nominal pitch -> px: lengths /p, K_i ·p^(2i), P ·p
+                power = {"f": -1, "x0": -1, "y0": -1, "K1": 2, "K2": 4, "K3": 6, "P1": 1, "P2": 1}[
+                    q.split("_")[0]
+                ]
+                v, s = v * obs.pixel_mm**power, s * obs.pixel_mm**power
+            rows.append(
+                Row(
+                    f"interior band {band}",
+                    q.split("_")[0],
+                    u.replace("mm", unit),
+                    None,
+                    None,
+                    v,
+                    s,
+                    None,
+                )
+            )
+        meta[f"band {band}"] = {
+            "sigma0": c.result.sigma0,
+            "points": int(np.sum(obs.band == band)),
+            "rms_px": float(np.sqrt(np.mean(np.sum(c.residuals_px**2, 1)))),
+            "views": int(len(c.cubes)),
+        }
+    return Reproduction("calibrate-frame", 0, rows, meta)

@@ -10,17 +10,18 @@ from __future__ import annotations
 
 import numpy as np
 
-from hsgeo.errors import InputError
+from hsgeo.errors import HsgeoError, InputError
 from hsgeo.geocode import (
     DemTerrain,
-    LineGeometry,
     PlaneTerrain,
     calibrate_boresight,
     geocode_image,
     geocode_observations,
     orthorectify,
 )
-from hsgeo.io import read_dem, read_lines, read_sensor_toml, to_map_files
+from hsgeo.io import read_dem, read_lines, read_scanning_sensor, to_map_files
+from hsgeo.sensors.line import LineGeometry
+from hsgeo.sensors.pushbroom import PushbroomCamera
 
 __all__ = ["geocode_files", "gcp_deviations"]
 
@@ -53,8 +54,13 @@ def geocode_files(
     overwrite: bool = False,
     max_grid_gib: float = MAX_GRID_GIB,
     max_nav_gap_s: float = MAX_NAV_GAP_S,
+    band: int = 0,
 ):
     """Orthorectify a recorded flight line from files (see ``hsgeo geocode --help``).
+
+    ``sensor``: the 000 sensor file (``[sensor]``, the LINES pixel coordinate is ζ) or the 002
+    camera file (``[camera]``, the LINES pixel coordinate is x in px from the line centre; the
+    geometry of camera band ``band`` is used for every band of the LINES file).
 
     Every check comes before the work: the outputs (folder exists and is writable, not an
     input, an existing file replaced only with ``overwrite``), the inputs (:mod:`hsgeo.io`),
@@ -77,7 +83,7 @@ def geocode_files(
     check_outputs(outs, inputs, overwrite=overwrite)  # before the work, not after it
     da, t0, rate = read_lines(lines)
     nav = read_trajectory(trajectory)
-    geom, bs = read_sensor_toml(sensor)
+    scanner = read_scanning_sensor(sensor)
     n_lines, n_px = da.sizes["line"], da.sizes["pixel"]
     t_lines = t0 + np.arange(n_lines) / rate
     check_navigation_covers(
@@ -87,17 +93,9 @@ def geocode_files(
         used=f"the lines of {str(lines)!r} (t0_s + line / line_rate_hz)",
         max_gap_s=max_nav_gap_s,
     )
-    zeta = np.asarray(da["pixel"].values, dtype=float)
-    with np.errstate(all="ignore"):
-        tan = np.asarray(geom.tan_angle(zeta), dtype=float)
-    ang = np.degrees(np.arctan(tan))
-    if not (np.all(np.isfinite(tan)) and np.all(np.abs(ang) < 80.0)):
-        raise InputError(
-            f"sensor file {str(sensor)!r}: the pixels ζ {zeta.min():g}…{zeta.max():g} px of the "
-            f"LINES file look {np.nanmin(ang):.3g}…{np.nanmax(ang):.3g}° off the axis with "
-            f"zeta0_px = {geom.zeta0_px:g}, c_px = {geom.c_px:g}; check zeta0_px and c_px "
-            "(px of this sensor) and the LINES pixel coordinate"
-        )
+    pixel = np.asarray(da["pixel"].values, dtype=float)
+    pixels, pixel_kw = _line_pixels(scanner, pixel, band, sensor)
+    _check_view_angles(scanner, pixels, pixel_kw, t_lines[0], nav, sensor)
     need = n_lines * n_px * 3 * 8.0
     if need > max_grid_gib * _GIB:
         raise InputError(
@@ -125,14 +123,14 @@ def geocode_files(
             )
     ground = geocode_image(
         nav,
-        geom,
+        scanner,
         n_lines,
-        zeta,
+        pixels,
         t0_s=t0,
         line_rate_hz=rate,
         terrain=terrain,
-        boresight_rad=bs,
         progress=progress,
+        **pixel_kw,
     )
     EN = ground[..., :2].reshape(-1, 2)
     span = EN.max(axis=0) - EN.min(axis=0)
@@ -153,6 +151,36 @@ def geocode_files(
         attrs={"source": str(lines), "sensor": str(sensor)},
     )
     return ortho, to_map_files(ortho, output, envi, inputs=inputs)
+
+
+def _line_pixels(scanner, pixel, band, sensor):
+    """The pixel coordinates of one line in the sensor's convention, and its per-pixel keywords."""
+    if not isinstance(scanner, PushbroomCamera):  # a line scanner: ζ
+        return pixel, {}
+    n_bands = len(scanner.c_mm)
+    if not (isinstance(band, int | np.integer) and 0 <= band < n_bands):
+        raise InputError(
+            f"--band {band!r}: the camera file {str(sensor)!r} has bands 0…{n_bands - 1}"
+        )
+    return np.column_stack([pixel, np.zeros_like(pixel)]), {"band": int(band)}
+
+
+def _check_view_angles(scanner, pixels, pixel_kw, t0_s, nav, sensor):
+    """The rays of the first line must look down, within 80° of the nadir."""
+    with np.errstate(all="ignore"):
+        try:
+            _, d = scanner.rays(pixels, np.full(len(pixels), t0_s), nav, **pixel_kw)
+            ang = np.degrees(np.arccos(np.clip(-d[:, 2], -1.0, 1.0)))
+        except HsgeoError:
+            ang = np.array([np.nan])
+    if not (np.all(np.isfinite(ang)) and np.all(ang < 80.0)):
+        p = np.asarray(pixels)[..., 0] if np.ndim(pixels) == 2 else np.asarray(pixels)
+        raise InputError(
+            f"sensor file {str(sensor)!r}: the pixels {p.min():g}…{p.max():g} px of the LINES "
+            f"file look {np.nanmin(ang):.3g}…{np.nanmax(ang):.3g}° off the nadir (over 80°, or "
+            "not at all); check the principal point and distance (zeta0_px and c_px, or x0_mm "
+            "and c_mm, in this sensor's units), the boresight and the LINES pixel coordinate"
+        )
 
 
 def gcp_deviations(

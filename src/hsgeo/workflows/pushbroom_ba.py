@@ -21,10 +21,10 @@ import numpy as np
 from hsgeo.adjust import Parameters
 from hsgeo.errors import InputError
 from hsgeo.io import read_camera_toml, read_table
-from hsgeo.rotations import R_from_opk, R_from_rpy
+from hsgeo.rotations import R_from_rpy
 from hsgeo.sensors.pushbroom import (
-    BETA0_CAM_FROM_PLATFORM,
     BLOCK_NAMES,
+    PushbroomCamera,
     PushbroomLines,
     PushbroomObservations,
 )
@@ -34,10 +34,35 @@ __all__ = [
     "CameraPrior",
     "PushbroomObservations",
     "build_problem",
+    "solve",
+    "REJECT_K",
+    "FTOL",
+    "Y_AS_TIME",
+    "REPORTED_PARAMETERS",
     "intersect_two_rays",
     "adjust_files",
     "fit_verdict",
 ]
+
+
+#: 002's solver settings, once (``hsgeo adjust-pushbroom``, ``hsgeo reproduce pushbroom-ba`` and
+#: the chapter): the reject threshold in robust σ of the standardised residuals (ours: about the
+#: largest residual / NMAD ratio of 002 Table 1, ≈ 6, with a margin) ...
+REJECT_K = 5.0
+#: ... the relative cost decrease at which the iteration stops (at full size 1e-6 of the cost
+#: is ≈ 0.3, below half a unit of χ², far below any statistical effect) ...
+FTOL = 1e-6
+#: ... and the residual across the line as a time (:func:`build_problem`): with the image y of
+#: 002 eq. (2) the principal distance and the pitch corrections are biased (the chapter shows by
+#: how much).
+Y_AS_TIME = True
+#: The estimated camera and mount blocks reported by both faces: (block, unit shown, factor).
+REPORTED_PARAMETERS = (
+    ("boresight_rad", "deg", 180 / np.pi),
+    ("lever_arm_m", "m", 1.0),
+    ("distortion", "", 1.0),
+    ("c_mm", "mm", 1.0),
+)
 
 
 @dataclass(frozen=True)
@@ -55,19 +80,6 @@ class CameraPrior:
     sigma_att_rad: tuple = tuple(np.deg2rad([0.005, 0.005, 0.008]))
     sigma_obs_px: float = 0.5
     sigma_gcp_m: float = 0.01
-
-
-def _rays(obs: PushbroomObservations, cam: CameraPrior, c_mm, boresight_rad, lever_arm_m):
-    xy_mm = obs.xy_px * cam.pixel_mm - np.array([cam.x0_mm, cam.y0_mm])
-    m = xy_mm.shape[0]
-    d_cam = np.column_stack([xy_mm, np.broadcast_to(c_mm, (m,))])
-    beta = R_from_opk(*boresight_rad) @ BETA0_CAM_FROM_PLATFORM
-    rpy = obs.rpy_nav_rad
-    R = R_from_rpy(rpy[:, 0], rpy[:, 1], rpy[:, 2])
-    d = np.einsum("mij,mj->mi", R, d_cam @ beta)  # R βᵀ d_cam
-    d /= np.linalg.norm(d, axis=1, keepdims=True)
-    o = obs.xyz_nav_m + R @ np.asarray(lever_arm_m)
-    return o, d
 
 
 def intersect_two_rays(point, origin, direction, n_points, min_angle_deg: float = 20.0):
@@ -133,7 +145,7 @@ def build_problem(
     gcp_xyz_m=None,
     t_span_s=None,
     node_prior_mean=None,
-    y_as_time: bool = False,
+    y_as_time: bool = Y_AS_TIME,
 ):
     """Parameters and residual blocks of the LP bundle adjustment.
 
@@ -156,7 +168,8 @@ def build_problem(
     node_prior_mean : (n_nodes, 6) ndarray, optional
         Prior mean of the node corrections (default zero: the GNSS/INS solution as it is).
     y_as_time : bool
-        Residual across the line as a *time* (the line a point is registered in) rather than
+        Default :data:`Y_AS_TIME` (True). Residual across the line as a *time* (the line a
+        point is registered in) rather than
         the image y of 002 eq. (2): the line time minus the model's crossing time of the line
         (:class:`~hsgeo.sensors.pushbroom.PushbroomLines`), in pixels at the reference rate
         ``c_ref V / (Z_ref pixel)`` (``c_ref`` the initial principal distance, ``V`` the median
@@ -183,7 +196,14 @@ def build_problem(
     names = BLOCK_NAMES
     if np.any(obs.band >= cam.n_bands):
         raise InputError(f"band index ≥ the camera's {cam.n_bands} bands")
-    o, d = _rays(obs, cam, cam.c_mm, np.zeros(3), cam.lever_arm_m)
+    rpy = obs.rpy_nav_rad
+    o, d = PushbroomCamera(
+        (cam.c_mm,) * cam.n_bands,
+        cam.pixel_mm,
+        x0_mm=cam.x0_mm,
+        y0_mm=cam.y0_mm,
+        lever_arm_m=cam.lever_arm_m,
+    ).rays_at(obs.xy_px, obs.band, obs.xyz_nav_m, R_from_rpy(rpy[:, 0], rpy[:, 1], rpy[:, 2]))
     P0 = intersect_two_rays(obs.point, o, d, n_points)
     p = Parameters()
     p.add(names["points"], P0, points=True, columns=("E_m", "N_m", "H_m"))
@@ -239,6 +259,37 @@ def build_problem(
     return p, [blk], nodes
 
 
+def solve(
+    params,
+    blocks,
+    *,
+    reject_k: float | None = REJECT_K,
+    ftol: float = FTOL,
+    progress=None,
+    keep_jacobian: bool = False,
+    raise_on_failure: bool = True,
+):
+    """Adjust a problem of :func:`build_problem` with 002's solver settings (002 §3.4: outliers
+    rejected at every iteration); the one place they are spelled.
+
+    Returns
+    -------
+    hsgeo.adjust.AdjustmentResult
+    """
+    from hsgeo.adjust import adjust
+
+    return adjust(
+        params,
+        blocks,
+        reject_k=reject_k,
+        ftol=ftol,
+        progress=progress,
+        reject_every_iteration=True,  # 002 §3.4
+        keep_jacobian=keep_jacobian,
+        raise_on_failure=raise_on_failure,
+    )
+
+
 # ----------------------------------------------------------------------------------------------
 # Files: ``hsgeo adjust-pushbroom``
 # ----------------------------------------------------------------------------------------------
@@ -276,9 +327,9 @@ def adjust_files(
     gcp=None,
     *,
     node_interval_s: float = 10.0,
-    reject_k: float | None = 5.0,
+    reject_k: float | None = REJECT_K,
     progress=None,
-    y_as_time: bool = True,
+    y_as_time: bool = Y_AS_TIME,
     max_nav_gap_s: float = 1.0,
 ) -> dict:
     """Adjust a user's pushbroom observations (``hsgeo adjust-pushbroom``).
@@ -313,7 +364,6 @@ def adjust_files(
         ``fit``, the plausibility verdict of :func:`fit_verdict` (``hsgeo adjust-pushbroom`` exits
         2 on a poor fit unless ``--accept-poor-fit``).
     """
-    from hsgeo.adjust import adjust
     from hsgeo.io.navigation import read_trajectory
     from hsgeo.trajectory import platform_rpy_from_rph, platform_rpy_rate_from_rph_rate
     from hsgeo.validate import check_navigation_covers, check_range
@@ -395,20 +445,28 @@ def adjust_files(
         gcp_xyz_m=gx,
         y_as_time=y_as_time,
     )
-    res = adjust(
+    res = solve(
         p,
         blocks,
         reject_k=reject_k,
-        ftol=1e-6,
         progress=progress,
-        reject_every_iteration=True,  # 002 §3.4
         raise_on_failure=False,  # no convergence is a verdict of the fit (fit_verdict)
     )
+    out = summary(res, nodes, ids, int(len(obs_df)), node_interval_s)
+    out["_result"] = res
+    return out
+
+
+def summary(res, nodes, point_ids, n_observations_2d: int, node_interval_s: float) -> dict:
+    """What ``hsgeo adjust-pushbroom`` reports of a solve: counts, σ0, the camera parameters
+    (:data:`REPORTED_PARAMETERS`) with σ̂, the node corrections, the points and the fit verdict.
+    """
+    ids, n_obs = point_ids, n_observations_2d
     out = {
         "converged": res.converged,
         "iterations": res.iterations,
         "sigma0": res.sigma0,
-        "n_observations_2d": int(len(obs_df)),
+        "n_observations_2d": n_obs,
         "n_points": int(ids.size),
         "n_unknowns": int(res.n_unknowns),
         "rejected": int(res.outliers(0).sum()),
@@ -416,12 +474,7 @@ def adjust_files(
         "node_interval_s": node_interval_s,
         "parameters": {},
     }
-    for name, f in [
-        ("boresight_rad", 180 / np.pi),
-        ("lever_arm_m", 1.0),
-        ("distortion", 1.0),
-        ("c_mm", 1.0),
-    ]:
+    for name, _, f in REPORTED_PARAMETERS:
         key = name.replace("_rad", "_deg")
         out["parameters"][key] = {
             "value": (res.value(name) * f).tolist(),
@@ -434,8 +487,7 @@ def adjust_files(
         "columns": list(res.params["nodes"].columns),
     }
     out["points"] = {"point_id": ids.tolist(), "xyz_m": res.value("points_m").tolist()}
-    out["fit"] = fit_verdict(res, int(len(obs_df)))
-    out["_result"] = res
+    out["fit"] = fit_verdict(res, n_obs)
     return out
 
 

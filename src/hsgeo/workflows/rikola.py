@@ -19,15 +19,14 @@ The road of the chapter ``rikola``:
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
 from hsgeo.adjust import AdjustmentResult, Parameters, adjust
 from hsgeo.distortion import ideal_from_measured_mm
 from hsgeo.errors import InputError, ObservationError
+from hsgeo.io import read_band_split
 from hsgeo.measure.targets import Observations
-from hsgeo.papers import RIKOLA_BANDS
 from hsgeo.rotations import R_from_opk, opk_from_R
 from hsgeo.sensors.frame import (
     PHOTOGRAMMETRIC_DISTORTION,
@@ -65,6 +64,10 @@ __all__ = [
     "rop_transformation_test",
     "cluster_keys",
 ]
+
+#: The Rikola FPI2015's band split (band, sensor, FPI air gap), an instrument description read
+#: by :func:`hsgeo.io.read_band_split` (``hsgeo/data/instruments/rikola_fpi2015.toml``).
+BANDS = read_band_split()
 
 
 def detect_targets_in_images(
@@ -451,7 +454,7 @@ def calibrate_joint(
     o = obs.select(keep)
     bands = np.unique(o.band)
     cubes = np.unique(o.cube)
-    table = RIKOLA_BANDS
+    table = BANDS
     brow = np.searchsorted(table["band"], o.band)
     for s in (1, 2):
         on = [b for b in bands if table["sensor"][b - 1] == s and b not in _OFF_LINE]
@@ -543,7 +546,7 @@ def predict_band(joint: JointCalibration, obs: Observations, band: int) -> np.nd
     if not sel.any():
         raise ObservationError(f"no observations of band {band} in the joint model's cubes")
     o = obs.select(sel)
-    table = RIKOLA_BANDS
+    table = BANDS
     blk = JointCentroids(
         np.searchsorted(joint.cubes, o.cube),
         np.searchsorted(table["band"], o.band),
@@ -591,10 +594,14 @@ def track_targets(obs: Observations, cube: int, ref_band: int) -> dict[str, tupl
 
 
 def radial_effect_px(KP, r_mm, pixel_mm: float) -> np.ndarray:
-    """Magnitude of the symmetric radial correction ``r (K1 r² + K2 r⁴ + K3 r⁶)`` in px."""
+    """Magnitude of the symmetric radial correction ``r (K1 r² + K2 r⁴ + K3 r⁶)`` in px: the
+    radial part of Brown's correction (:func:`hsgeo.distortion.brown_correction`) at ``(r, 0)``.
+    """
+    from hsgeo.distortion import brown_correction
+
     r = np.asarray(r_mm, float)
-    K = np.asarray(KP, float)[:3]
-    return r * (K[0] * r**2 + K[1] * r**4 + K[2] * r**6) / pixel_mm
+    xy = np.stack([r, np.zeros_like(r)], axis=-1)
+    return brown_correction(xy, np.asarray(KP, float)[:3], np.zeros(2))[..., 0] / pixel_mm
 
 
 def decentering_effect_px(KP, xy_mm, pixel_mm: float) -> np.ndarray:
@@ -605,159 +612,10 @@ def decentering_effect_px(KP, xy_mm, pixel_mm: float) -> np.ndarray:
     return brown_correction(np.asarray(xy_mm, float), np.zeros(3), KP[3:]) / pixel_mm
 
 
-#: Fewest views (images of the board) of a band for a self-calibration: a planar board gives
-#: two constraints on the interior orientation per view (Zhang 2000, §3.1).
-MIN_VIEWS = 3
-
-
-def _check_images(images) -> list:
-    """The image files exist, are files, and none is given twice (same path or same bytes)."""
-    import hashlib
-
-    from hsgeo.io._files import check_input_file
-
-    images = [Path(p) for p in images]
-    seen_path: dict = {}
-    seen_hash: dict = {}
-    for p in images:
-        check_input_file(p, "image file")
-        key = p.resolve()
-        if key in seen_path:
-            raise InputError(
-                f"image file {str(p)!r} is given twice (as {str(seen_path[key])!r}); give each "
-                "view once"
-            )
-        seen_path[key] = p
-        h = hashlib.sha256(p.read_bytes()).hexdigest()
-        if h in seen_hash:
-            raise InputError(
-                f"image files {str(seen_hash[h])!r} and {str(p)!r} are the same image (identical "
-                "bytes); give each view once"
-            )
-        seen_hash[h] = p
-    return images
-
-
-def _check_regex(option: str, rx: str, images) -> None:
-    """``rx`` compiles, has one group, and takes a whole number from every file name."""
-    import re
-
-    try:
-        pat = re.compile(rx)
-    except re.error as exc:
-        raise InputError(f"{option} {rx!r} is not a regular expression ({exc})") from None
-    if pat.groups != 1:
-        raise InputError(
-            f"{option} {rx!r} has {pat.groups} groups; it needs exactly one, e.g. 'band(\\d+)'"
-        )
-    for p in images:
-        m = pat.search(p.name)
-        if m is None or m.group(1) is None or not m.group(1).isdigit():
-            raise InputError(
-                f"{option} {rx!r} takes no number from the file name {p.name!r}; its group must "
-                "match the digits of the band or cube number"
-            )
-
-
-def calibrate_frame_files(
-    images,
-    board_path,
-    *,
-    joint: bool = False,
-    band_regex=None,
-    cube_regex=None,
-    sigma_px: float = 0.1,
-):
-    """``hsgeo calibrate-frame``: detect a board in image files and self-calibrate, per band
-    (:func:`calibrate_band`) or jointly (:func:`calibrate_joint`, Rikola band numbering).
-
-    Returns
-    -------
-    hsgeo.reproduce.Reproduction
-        Rows ``interior band N`` (f, x0, y0, K1–K3, P1, P2 with σ̂, in mm or — without
-        ``camera.pixel_mm`` in the board file — px) or ``joint model``; ``meta`` has σ0, the
-        RMS residual and the number of points per band.
-    """
-    from hsgeo.io import read_board
-    from hsgeo.measure.boards import observe_files
-    from hsgeo.report import Reproduction, Row
-
-    board = read_board(board_path)
-    images = _check_images(images)
-    for option, rx in (("--band-regex", band_regex), ("--cube-regex", cube_regex)):
-        if rx is not None:
-            _check_regex(option, rx, images)
-    if joint and (band_regex is None or cube_regex is None):
-        raise InputError(
-            "--joint needs --band-regex and --cube-regex (which band and cube each file is)"
-        )
-    obs = observe_files(images, board, band_regex=band_regex, cube_regex=cube_regex)
-    for band in np.unique(obs.band):
-        views = np.unique(obs.cube[obs.band == band]).size
-        if views < MIN_VIEWS:
-            raise InputError(
-                f"band {band} has {views} image(s) of the board; a self-calibration needs at "
-                f"least {MIN_VIEWS} views from different directions (Zhang 2000): add images"
-            )
-    unit = "mm" if board.pixel_mm is not None else "px"
-    rows, meta = (
-        [],
-        {
-            "images": len(list(images)),
-            "points": int(len(obs.cube)),
-            "length_unit": unit,
-            "board": board.type,
-        },
-    )
-    if joint:
-        if band_regex is None or cube_regex is None:
-            raise InputError(
-                "--joint needs --band-regex and --cube-regex (which band and cube each file is)"
-            )
-        j = calibrate_joint(obs, f0_mm=initial_focal_mm(obs), sigma_px=sigma_px)
-        R = j.result
-        for blk in ("gap_model", "pp_mm", "distortion_mm", "sensor2_rotation"):
-            b = R.params[blk]
-            for lab, v, s in zip(b.labels(), b.value.ravel(), R.sigma(blk).ravel(), strict=True):
-                rows.append(Row("joint model", lab, "", None, None, v, s, None))
-        meta.update(
-            sigma0=R.sigma0, rms_px=float(np.sqrt(np.mean(np.sum(j.residuals_px**2, axis=1))))
-        )
-        return Reproduction("calibrate-frame", 0, rows, meta)
-    for band in np.unique(obs.band):
-        c = calibrate_band(obs, int(band), f0_mm=None, sigma_px=sigma_px)
-        for q, (v, s) in c.iop.items():
-            u = q.split("_", 1)[1].replace("per_", "1/") if "_" in q else ""
-            if board.pixel_mm is None:  # nominal pitch -> px: lengths /p, K_i ·p^(2i), P ·p
-                power = {"f": -1, "x0": -1, "y0": -1, "K1": 2, "K2": 4, "K3": 6, "P1": 1, "P2": 1}[
-                    q.split("_")[0]
-                ]
-                v, s = v * obs.pixel_mm**power, s * obs.pixel_mm**power
-            rows.append(
-                Row(
-                    f"interior band {band}",
-                    q.split("_")[0],
-                    u.replace("mm", unit),
-                    None,
-                    None,
-                    v,
-                    s,
-                    None,
-                )
-            )
-        meta[f"band {band}"] = {
-            "sigma0": c.result.sigma0,
-            "points": int(np.sum(obs.band == band)),
-            "rms_px": float(np.sqrt(np.mean(np.sum(c.residuals_px**2, 1)))),
-            "views": int(len(c.cubes)),
-        }
-    return Reproduction("calibrate-frame", 0, rows, meta)
-
-
 def cluster_keys(obs, cal) -> np.ndarray:
     """(cube, target, sensor) key of each observation of a band's adjustment, in its order."""
     sel = obs.band == cal.band
-    sensor = RIKOLA_BANDS["sensor"][cal.band - 1]
+    sensor = BANDS["sensor"][cal.band - 1]
     return obs.cube[sel] * 1_000_000 + obs.target[sel] * 10 + sensor
 
 
@@ -851,14 +709,12 @@ def predict_per_band(cals, obs, band, bands):
     regression of the other bands of its sensor, the mean principal point of the sensor, the
     mean distortion, and per cube the mean exterior orientation of the sensor's other bands.
     """
-    s = RIKOLA_BANDS["sensor"][band - 1]
-    others = [
-        b for b in bands if b != band and RIKOLA_BANDS["sensor"][b - 1] == s and b not in (1, 11)
-    ]
+    s = BANDS["sensor"][band - 1]
+    others = [b for b in bands if b != band and BANDS["sensor"][b - 1] == s and b not in (1, 11)]
     reg = gap_regression(
-        RIKOLA_BANDS["gap_nm"][np.array(others) - 1], [cals[b].value("interior")[0] for b in others]
+        BANDS["gap_nm"][np.array(others) - 1], [cals[b].value("interior")[0] for b in others]
     )
-    f = reg["a"] * RIKOLA_BANDS["gap_nm"][band - 1] + reg["b"]
+    f = reg["a"] * BANDS["gap_nm"][band - 1] + reg["b"]
     pp = np.mean([cals[b].value("interior")[1:] for b in others], axis=0)
     KP = np.mean([cals[b].value("distortion_mm") for b in cals if b != band], axis=0)
     sel = obs.band == band

@@ -1,0 +1,224 @@
+"""The compiled residual kernel of :class:`hsgeo.sensors.pushbroom.PushbroomLines` (002 eq. 2–4).
+
+Moved out of :mod:`hsgeo.sensors.pushbroom` unchanged: one observation per iteration, the
+crossing time by Newton (the residual across the line as a time) and the derivatives; see that
+module's docstring for the model and the time residual.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+from hsgeo._kernels import (
+    bspline_weights,
+    pushbroom_camera_point,
+    pushbroom_image_mm,
+    rpy_rotation,
+)
+
+__all__ = ["T_MAX", "NEWTON_TOL_S"]
+
+#: The crossing time is sought within ± this of the line time (s): 0.25 s is ~55 px of image
+#: motion, beyond any gross error left after RANSAC; a trial step that throws a weakly
+#: intersected point far off is held there (without the bound the time of such a point runs
+#: off with the spline extrapolated, and the first iterations are damped to a crawl).
+T_MAX = 0.25
+#: Newton on the crossing time stops when its correction is below this (s); see the module
+#: docstring for the error this leaves in the residuals (< 1e-13 px).
+NEWTON_TOL_S = 1e-8
+
+
+@njit(cache=True, parallel=True)
+def _lines_kernel(
+    P,
+    pidx,
+    idx,
+    u0,
+    inv_dt,
+    nodes,
+    xyz_nav,
+    rpy_nav,
+    xyz_rate,
+    rpy_rate,
+    band,
+    c_b,
+    dist,
+    beta,
+    dbeta,
+    lever,
+    x0,
+    y0,
+    k_px,
+    xy_obs,
+    timed,
+    n_newton,
+    y_rate_ref,
+    jac,
+    dt_start,
+    r,
+    w_out,
+    dP,
+    dN,
+    dB,
+    dL,
+    dD,
+    dC,
+):  # pragma: no cover
+    """002 eq. (2)–(4) and their derivatives, one observation per iteration (rows 2j, 2j+1).
+
+    ``timed``: the observation is evaluated at the model's crossing time ``t*`` of the line
+    (``y(t*) = y_obs``, Newton from the line time ``t_e`` with the navigation pose moved by its
+    rates and the spline piece of ``t_e`` continued); the residuals are ``x(t*) − x_obs`` and
+    ``ẏ_ref (t_e − t*)``, and their derivatives follow from the implicit function theorem,
+    ``∂t*/∂θ = −(∂y/∂θ)/ẏ``. The spline weights used are returned in ``w_out``. ``dt_start``
+    (in and out): ``t* − t_e`` at which Newton starts, overwritten with this evaluation's.
+    """
+    m = pidx.size
+    K1, K2, P1, P2 = dist[0], dist[1], dist[2], dist[3]
+    n_chunks = 64 if m > 6400 else 1
+    step = (m + n_chunks - 1) // n_chunks
+    for ch in prange(n_chunks):
+        R = np.empty((3, 3))
+        dR = np.empty((3, 3, 3))
+        d = np.empty(3)
+        q = np.empty(3)
+        p = np.empty(3)
+        dl = np.empty(6)
+        rate = np.empty(6)
+        Jp = np.empty((2, 3))
+        JpB = np.empty((2, 3))
+        d6 = np.empty((2, 6))
+        w = np.empty(4)
+        dw = np.empty(4)
+        for j in range(ch * step, min(m, (ch + 1) * step)):
+            dt = dt_start[j] if timed else 0.0  # t − t_e, from the last evaluation's t*
+            xdot = 0.0
+            ydot = 1.0
+            ey = 0.0
+            n_it = n_newton if timed else 0
+            for it in range(n_it + 1):
+                bspline_weights(u0[j] + dt * inv_dt, inv_dt, w, dw)
+                for a in range(6):
+                    acc = 0.0
+                    acc_r = 0.0
+                    for b in range(4):
+                        acc += w[b] * nodes[idx[j, b], a]
+                        acc_r += dw[b] * nodes[idx[j, b], a]
+                    dl[a] = acc
+                    rate[a] = acc_r + (xyz_rate[j, a] if a < 3 else rpy_rate[j, a - 3])
+                rpy_rotation(
+                    rpy_nav[j, 0] + dt * rpy_rate[j, 0] + dl[3],
+                    rpy_nav[j, 1] + dt * rpy_rate[j, 1] + dl[4],
+                    rpy_nav[j, 2] + dt * rpy_rate[j, 2] + dl[5],
+                    R,
+                    dR,
+                )
+                pt = pidx[j]
+                for a in range(3):
+                    d[a] = P[pt, a] - xyz_nav[j, a] - dt * xyz_rate[j, a] - dl[a]
+                pushbroom_camera_point(R, d, lever, beta, q, p)  # 002 eq. (4)
+                c = c_b[band[j]]
+                x, y, xb, yb, iz, gx, gy = pushbroom_image_mm(
+                    p[0], p[1], p[2], c, K1, K2, P1, P2
+                )  # 002 eq. (3)
+                x = x + x0
+                y = y + y0
+                a_ = c * iz
+                Jp[0, 0] = gx * a_ * k_px
+                Jp[0, 1] = 0.0
+                Jp[0, 2] = -gx * xb * iz * k_px
+                Jp[1, 0] = gy * a_ * k_px
+                Jp[1, 1] = a_ * k_px
+                Jp[1, 2] = (-yb * iz - gy * xb * iz) * k_px
+                for u in range(2):
+                    for a in range(3):
+                        JpB[u, a] = (
+                            Jp[u, 0] * beta[0, a] + Jp[u, 1] * beta[1, a] + Jp[u, 2] * beta[2, a]
+                        )
+                # d6: derivatives w.r.t. the pose (position, attitude) of the platform
+                for u in range(2):
+                    for a in range(3):
+                        d6[u, a] = -(
+                            JpB[u, 0] * R[a, 0] + JpB[u, 1] * R[a, 1] + JpB[u, 2] * R[a, 2]
+                        )
+                    for kk in range(3):
+                        v = 0.0
+                        for i in range(3):
+                            dq = dR[kk, 0, i] * d[0] + dR[kk, 1, i] * d[1] + dR[kk, 2, i] * d[2]
+                            v += JpB[u, i] * dq
+                        d6[u, 3 + kk] = v
+                if not timed:
+                    break
+                # image rates (px/s) along the trajectory: ∂(x, y)/∂pose · pose rate
+                xdot = 0.0
+                ydot = 0.0
+                for a in range(6):
+                    xdot += d6[0, a] * rate[a]
+                    ydot += d6[1, a] * rate[a]
+                # every real geometry has ẏ near ẏ_ref; a far-off trial point may not
+                ydot = max(ydot, 0.25 * y_rate_ref)
+                ey = (y * k_px - xy_obs[j, 1]) / ydot
+                if abs(ey) < NEWTON_TOL_S:
+                    # converged: the last correction is kept in the residual, which is then
+                    # exact to O(ey²)
+                    break
+                if it < n_it:
+                    dt = min(max(dt - ey, -T_MAX), T_MAX)
+            for b in range(4):
+                w_out[j, b] = w[b]
+            if timed:
+                dt_start[j] = min(max(dt - ey, -T_MAX), T_MAX)
+            r[2 * j] = x * k_px - xy_obs[j, 0] - xdot * ey  # x at t* (0 if not timed)
+            if timed:
+                # ẏ_ref (t_e − t*), t* = t_e + dt − ey (the last Newton correction included)
+                r[2 * j + 1] = y_rate_ref * (ey - dt)
+            else:
+                r[2 * j + 1] = y * k_px - xy_obs[j, 1]
+            if not jac:
+                continue
+            for u in range(2):
+                row = 2 * j + u
+                for a in range(3):
+                    dP[row, a] = -d6[u, a]  # dp/dP = β Rᵀ = −dp/dx
+                    dN[row, a] = d6[u, a]  # × the spline weights (factored Jacobian)
+                    dL[row, a] = -JpB[u, a]
+                    dN[row, 3 + a] = d6[u, 3 + a]
+                for kk in range(3):
+                    # boresight: dp/dbore_k = dβ_k q
+                    v = 0.0
+                    for i in range(3):
+                        v += Jp[u, i] * (
+                            dbeta[kk, i, 0] * q[0] + dbeta[kk, i, 1] * q[1] + dbeta[kk, i, 2] * q[2]
+                        )
+                    dB[row, kk] = v
+            dC[2 * j, 0] = gx * xb / c * k_px
+            dC[2 * j + 1, 0] = (yb / c + gy * xb / c) * k_px
+            dD[2 * j, 0] = xb**3 * k_px
+            dD[2 * j, 1] = xb**5 * k_px
+            dD[2 * j, 2] = 3 * xb**2 * k_px
+            dD[2 * j, 3] = 0.0
+            dD[2 * j + 1, 0] = 0.0
+            dD[2 * j + 1, 1] = 0.0
+            dD[2 * j + 1, 2] = 0.0
+            dD[2 * j + 1, 3] = xb**2 * k_px
+            if timed:
+                # x(t*(θ)): ∂x/∂θ − (ẋ/ẏ) ∂y/∂θ; ẏ_ref (t_e − t*): (ẏ_ref/ẏ) ∂y/∂θ
+                fx = xdot / ydot
+                fy = y_rate_ref / ydot
+                rx, ry = 2 * j, 2 * j + 1
+                for a in range(3):
+                    dP[rx, a] -= fx * dP[ry, a]
+                    dL[rx, a] -= fx * dL[ry, a]
+                    dB[rx, a] -= fx * dB[ry, a]
+                    dP[ry, a] *= fy
+                    dL[ry, a] *= fy
+                    dB[ry, a] *= fy
+                for a in range(6):
+                    dN[rx, a] -= fx * dN[ry, a]
+                    dN[ry, a] *= fy
+                for a in range(4):
+                    dD[rx, a] -= fx * dD[ry, a]
+                    dD[ry, a] *= fy
+                dC[rx, 0] -= fx * dC[ry, 0]
+                dC[ry, 0] *= fy
