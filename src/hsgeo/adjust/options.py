@@ -106,9 +106,10 @@ class SolverOptions:
         needs. Off by default: the Jacobian can be the largest array of a solve.
     threads : "auto" or int, default "auto"
         Threads of the compiled kernels during the solve (:mod:`hsgeo.adjust.threads`).
-        ``"auto"``: one thread below ``PARALLEL_MIN_ROWS`` residual rows and numba's pool
-        above (measured: ``bench/results/busy_machine.json``); an integer: that many. Only
-        the speed depends on it, never the numbers (bit for bit).
+        ``"auto"``: one thread below ``PARALLEL_MIN_ROWS`` (400,000) residual rows and
+        numba's pool above (measured idle and with one core busy:
+        ``bench/results/busy_machine.json``); an integer: that many. Only the speed depends on
+        it, never the numbers (bit for bit).
     blas_threads : int, default 1
         Threads of BLAS/LAPACK (the dense reduced system) during the solve, whatever the
         shell's ``OPENBLAS_NUM_THREADS``. Results differ in the last digits with the count,

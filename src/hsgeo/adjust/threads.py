@@ -10,10 +10,9 @@ same on the small dense factorisations of the reduced normal matrix (GUIDE §9).
 So the engine decides, per solve, from the size of the problem:
 
 * ``threads="auto"`` (:class:`~hsgeo.adjust.SolverOptions`' default): the compiled kernels run
-  on one thread below :data:`PARALLEL_MIN_ROWS` residual rows; from there on on as many threads
-  as there are cores that other processes leave idle (sampled for 50 ms when the solve starts),
-  at most numba's pool (``NUMBA_NUM_THREADS``, the number of cores); ``threads=n``: on n
-  threads (at most the pool).
+  on one thread below :data:`PARALLEL_MIN_ROWS` residual rows and on numba's pool
+  (``NUMBA_NUM_THREADS``, the number of cores) from there on; ``threads=n``: on n threads (at
+  most the pool).
 * BLAS runs on ``SolverOptions.blas_threads`` threads, one by default, whatever the shell's
   ``OPENBLAS_NUM_THREADS``: the reduced systems of these problems have at most a few thousand
   unknowns, where one thread was the fastest, and with a fixed count the numbers do not depend
@@ -35,7 +34,6 @@ from __future__ import annotations
 
 import contextlib
 import functools
-import os
 from collections.abc import Iterator
 
 import numba
@@ -43,8 +41,13 @@ import numba
 __all__ = ["PARALLEL_MIN_ROWS", "MAX_CHUNKS", "resolve", "engine_threads", "blas_threads"]
 
 #: Residual rows (observation components, priors included) from which ``threads="auto"`` runs
-#: the compiled kernels in parallel (bench/results/busy_machine.json, 2026-11-24).
-PARALLEL_MIN_ROWS = 200_000
+#: the compiled kernels in parallel. Measured with bench/bench_busy_machine.py (2026-11-24,
+#: 2 cores, bench/results/busy_machine.json): on frame-camera blocks of 16,000–480,000 rows two
+#: threads were 1.1–1.2× faster than one on the quiet machine, but 3.2× (16,000 rows) to 1.65×
+#: (240,000) slower with one core busy and 1.19× slower at 480,000; the paper-size pushbroom
+#: solve (884,000 rows) was faster on two threads busy or not (6.7 s against 11.5 s busy). So
+#: below 400,000 rows one thread: never more than 1.5× slower than the best, busy or not.
+PARALLEL_MIN_ROWS = 400_000
 
 #: The most chunks a kernel splits its rows or points into (the sum of the chunks, in a fixed
 #: order, is the same whatever the number of threads that compute them).
@@ -56,27 +59,13 @@ def pool_size() -> int:
     return int(numba.config.NUMBA_NUM_THREADS)
 
 
-def free_cores(sample_s: float = 0.05) -> float:
-    """The cores that other processes left idle during a short sample (psutil; this process
-    sleeps while it samples).
-    """
-    import psutil
-
-    n = os.cpu_count() or 1
-    return n * (1.0 - psutil.cpu_percent(interval=sample_s) / 100.0)
-
-
 def resolve(threads: int | str, rows: int) -> int:
     """The kernels' threads for a solve with ``rows`` residual rows (at most numba's pool).
 
-    ``"auto"``: one thread below :data:`PARALLEL_MIN_ROWS`; above, as many as there are cores
-    that other processes leave idle (:func:`free_cores`, sampled once per solve), at least one:
-    with one of two cores busy, a second thread only waits for it.
+    ``"auto"``: one thread below :data:`PARALLEL_MIN_ROWS`, numba's pool from there on.
     """
     if threads == "auto":
-        if rows < PARALLEL_MIN_ROWS or pool_size() == 1:
-            return 1
-        return max(1, min(pool_size(), int(free_cores() + 0.25)))
+        return 1 if rows < PARALLEL_MIN_ROWS else pool_size()
     return max(1, min(int(threads), pool_size()))
 
 
