@@ -27,6 +27,7 @@ import math
 from dataclasses import dataclass, field
 
 from hsgeo.errors import InputError
+from hsgeo.vocabulary import display_unit, quantity_label
 
 __all__ = [
     "Row",
@@ -38,6 +39,8 @@ __all__ = [
     "summarize",
     "format_value",
     "format_rows",
+    "styled",
+    "NUMERIC_COLUMNS",
 ]
 
 #: The verdicts of a claim (ReScience style). ``by construction``: the truth (or the outcome) is
@@ -359,9 +362,17 @@ def _format_paper(x) -> str:
     return text.replace("-", _MINUS)
 
 
+#: Columns of :func:`format_rows` that hold numbers (right-aligned by :func:`styled`).
+NUMERIC_COLUMNS = ("paper", "reproduced", "σ̂", "truth", "z")
+
+
 def format_rows(rows: list[Row]):
     """The rows as a DataFrame of display strings: quantity | unit | paper | reproduced | σ̂ |
     truth | z | verdict (no index; σ is marked ``(n runs)`` when it is a spread over runs).
+
+    Quantities and units are shown in a reader's words (:mod:`hsgeo.vocabulary`: ``um`` → µm,
+    ``c_minus_mean_band0_450nm_um`` → "c − mean c, band 0 (450 nm)"); the rows themselves, and
+    so ``to_json``, keep their internal keys.
     """
     import pandas as pd
 
@@ -377,8 +388,8 @@ def format_rows(rows: list[Row]):
         z = r.z
         out.append(
             {
-                "quantity": r.quantity,
-                "unit": r.unit if r.unit not in ("", "1") else "—",
+                "quantity": quantity_label(r.quantity),
+                "unit": display_unit(r.quantity, r.unit),
                 "paper": paper,
                 "reproduced": format_value(r.reproduced, r.sigma),
                 "σ̂": sig,
@@ -389,6 +400,42 @@ def format_rows(rows: list[Row]):
         )
     cols = ["quantity", "unit", "paper", "reproduced", "σ̂", "truth", "z", "verdict"]
     return pd.DataFrame(out, columns=cols)
+
+
+#: Cell padding of the book's tables (also in book/_static/hsgeo.css, for tables made elsewhere).
+_PAD = "0.3em 0.75em"
+
+
+def styled(df, numeric: tuple[str, ...] = NUMERIC_COLUMNS):
+    """A DataFrame of display strings as the book shows a table: a pandas Styler without index,
+    class ``hsgeo-table``, every cell padded, the ``numeric`` columns right-aligned (header too,
+    class ``hsgeo-num``) and the others left-aligned (``hsgeo-text``).
+    """
+    import pandas as pd
+
+    num = [c for c in df.columns if c in numeric]
+    text = [c for c in df.columns if c not in numeric]
+    classes = pd.DataFrame(
+        [["hsgeo-num" if c in num else "hsgeo-text" for c in df.columns]] * len(df),
+        index=df.index,
+        columns=df.columns,
+    )
+    heads = {
+        c: [{"selector": "th", "props": f"text-align: {'right' if c in num else 'left'}"}]
+        for c in df.columns
+    }
+    style = (
+        df.style.hide(axis="index")
+        .set_table_attributes('class="hsgeo-table"')
+        .set_td_classes(classes)
+        .set_table_styles([{"selector": "th, td", "props": f"padding: {_PAD}"}])
+        .set_table_styles(heads, overwrite=False)
+    )
+    if num:
+        style = style.set_properties(subset=num, **{"text-align": "right", "white-space": "nowrap"})
+    if text:
+        style = style.set_properties(subset=text, **{"text-align": "left"})
+    return style
 
 
 @dataclass
@@ -463,12 +510,7 @@ class Reproduction:
         df = format_rows(self.rows_of(name))
         if columns is not None:
             df = df[columns]
-        return (
-            df.style.hide(axis="index")
-            .set_table_attributes('class="hsgeo-table"')
-            .set_properties(**{"text-align": "right"})
-            .set_properties(subset=["quantity"], **{"text-align": "left"})
-        )
+        return styled(df)
 
     def verdicts(self, tables: list[str] | None = None):
         """The chapter's "What reproduced, what did not, and why": one line per claim (rows with
@@ -481,7 +523,7 @@ class Reproduction:
         recs = [
             {
                 "table": r.table,
-                "quantity": r.quantity,
+                "quantity": quantity_label(r.quantity),
                 "verdict": v,
                 "provenance": r.provenance or "—",
                 "why": why,
@@ -491,7 +533,7 @@ class Reproduction:
             if v is not None
         ]
         df = pd.DataFrame(recs, columns=["table", "quantity", "verdict", "provenance", "why"])
-        return df.style.hide(axis="index").set_table_attributes('class="hsgeo-table"')
+        return styled(df, numeric=())
 
     def summarize(self, name: str, what: str = "parameters") -> dict:
         """:func:`summarize` over one table's rows."""
@@ -507,7 +549,7 @@ class Reproduction:
             out.append(
                 "  "
                 + "  ".join(
-                    c.ljust(widths[c]) if c == "quantity" else c.rjust(widths[c])
+                    c.ljust(widths[c]) if c not in NUMERIC_COLUMNS else c.rjust(widths[c])
                     for c in df.columns
                 )
             )
@@ -516,7 +558,7 @@ class Reproduction:
                     "  "
                     + "  ".join(
                         rec[c].ljust(widths[c])
-                        if c in ("quantity", "verdict")
+                        if c not in NUMERIC_COLUMNS
                         else rec[c].rjust(widths[c])
                         for c in df.columns
                     ).rstrip()
