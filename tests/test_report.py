@@ -184,3 +184,20 @@ def test_shown_tables_pad_cells_and_right_align_numbers():
     assert "th.col3 {\n  text-align: right" in html and "th.col0 {\n  text-align: left" in html
     assert "principal distance c" in html and "c_px" not in html
     assert 'class="hsgeo-table"' in rep.verdicts().to_html()
+
+
+def test_glued_numbers_are_text_not_reprs():
+    import numpy as np
+    from IPython.core.formatters import format_display_data
+
+    from hsgeo.report import _Prose, as_text
+
+    assert as_text(np.float64(1.23456)) == "1.235" and as_text(np.int64(-8)) == "−8"
+    assert as_text(np.float64(-0.0213), 0.004, unit="um") == "−0.0213 µm"  # σ to two digits
+    assert as_text(None, unit="px") == "—" and as_text(3, unit="1") == "3"
+    assert as_text("within 1σ") == "within 1σ"
+    data, _ = format_display_data(_Prose("a_b |z| 1.2"))
+    # {glue:text} literal-evaluates text/plain back to the string; {glue} renders the markdown
+    assert data["text/plain"] == "'a_b |z| 1.2'"
+    assert data["text/markdown"] == r"a\_b \|z\| 1.2"
+    assert "np.float64" not in data["text/plain"]

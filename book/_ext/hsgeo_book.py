@@ -16,6 +16,13 @@
   was put into the execution cache).
 - **Run times**: the ``{hsgeo-run-times}`` directive is replaced by a table of every chapter's
   measured run time.
+- **Glued values as text**: a ``{glue}`` role in running text whose value is plain text (a
+  number or a string) shows as text, like ``{glue:text}``, instead of myst-nb's code box (for a
+  value glued in another document) or the Python repr with its quotes (in the same document).
+  Chapters glue numbers with ``hsgeo.report.glue_text``, which formats them; a ``np.float64(…)``
+  that still reaches a page is reported by ``make check-book``, not hidden here.
+- **Version**: every page's footer names the hsgeo version the book was built with
+  (``hsgeo.__version__``) and how to cite it (``CITATION.cff``).
 """
 
 from __future__ import annotations
@@ -33,6 +40,7 @@ from docutils import nodes
 from docutils.parsers.rst import directives
 from sphinx.application import Sphinx
 from sphinx.errors import ExtensionError
+from sphinx.transforms.post_transforms import SphinxPostTransform
 from sphinx.util import logging
 from sphinx.util.docutils import SphinxDirective
 
@@ -73,6 +81,20 @@ def mathjax_source() -> Path:
             "(the pin in requirements.lock)"
         )
     return es5
+
+
+def _version_footer(app: Sphinx, config) -> None:
+    """The hsgeo version in every page's footer (sphinx-book-theme's ``extra_footer``)."""
+    import hsgeo
+
+    config.version = config.release = hsgeo.__version__
+    options = dict(config.html_theme_options or {})
+    options["extra_footer"] = (
+        f'<p class="hsgeo-version">Built with hsgeo {hsgeo.__version__} '
+        "(<code>hsgeo.__version__</code>). To cite it, use <code>CITATION.cff</code> at the "
+        "root of the repository; to install it, see the page “Install hsgeo”.</p>"
+    )
+    config.html_theme_options = options
 
 
 def _use_local_mathjax(app: Sphinx, config) -> None:
@@ -330,7 +352,51 @@ class DocstringDirective(SphinxDirective):
         return [box]
 
 
+# --- glued values in running text -------------------------------------------------------
+
+#: Mime types that make a glued value more than text (rendered by myst-nb as they are).
+_RICH_MIME = ("text/html", "text/markdown", "text/latex", "image/", "application/")
+
+
+class GluedTextAsText(SphinxPostTransform):
+    """A cross-document inline ``{glue}`` of a text-only value becomes ``{glue:text}``.
+
+    Runs before myst-nb's ``ReplacePendingGlueReferences`` (priority 5), which would render the
+    value's text/plain as inline code.
+    """
+
+    default_priority = 4
+
+    def apply(self, **kwargs) -> None:
+        from myst_nb.ext.glue.crossref import read_glue_cache
+        from myst_nb.ext.glue.utils import PendingGlueReference
+
+        folder = self.env.mystnb_config.output_folder
+        for node in list(self.document.findall(PendingGlueReference)):
+            if not node.inline or node.gtype == "text":
+                continue
+            data = read_glue_cache(folder, node.refdoc).get(node.key, {}).get("data", {})
+            if "text/plain" in data and not any(m.startswith(_RICH_MIME) for m in data):
+                node["gtype"] = "text"
+                node["fmt_spec"] = "s"
+
+
+def _glued_text_without_quotes(doctree: nodes.document) -> None:
+    """A same-document inline ``{glue}`` of a string shows the string, not its repr."""
+    from myst_nb.core.variables import format_plain_text
+
+    for node in list(doctree.findall(nodes.inline)):
+        classes = node.get("classes", [])
+        if "text_plain" not in classes or "output" not in classes:
+            continue
+        if not isinstance(node.parent, nodes.TextElement):
+            continue  # a cell's output, not running text
+        text = format_plain_text(node.astext(), "s")
+        node.replace_self(nodes.inline(text, text, classes=["pasted-text"]))
+
+
 def _resolve(app: Sphinx, doctree: nodes.document, docname: str) -> None:
+    _glued_text_without_quotes(doctree)
     for node in list(doctree.findall(RunTimesNode)):
         node.replace_self(_run_times_table(app, docname))
     if docname.startswith(CHAPTER_PREFIX) and app.builder.format == "html":
@@ -348,7 +414,9 @@ def setup(app: Sphinx) -> dict:
     app.add_node(RunTimesNode)
     app.add_directive("hsgeo-run-times", RunTimesDirective)
     app.add_directive("hsgeo-docstring", DocstringDirective)
+    app.add_post_transform(GluedTextAsText)
     app.connect("config-inited", _use_local_mathjax)
+    app.connect("config-inited", _version_footer)
     app.connect("build-finished", _copy_mathjax)
     app.connect("html-page-context", _add_ipynb_download, priority=500)
     app.connect("doctree-resolved", _resolve)

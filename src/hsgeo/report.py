@@ -41,6 +41,8 @@ __all__ = [
     "format_rows",
     "styled",
     "NUMERIC_COLUMNS",
+    "as_text",
+    "glue_text",
 ]
 
 #: The verdicts of a claim (ReScience style). ``by construction``: the truth (or the outcome) is
@@ -436,6 +438,59 @@ def styled(df, numeric: tuple[str, ...] = NUMERIC_COLUMNS):
     if text:
         style = style.set_properties(subset=text, **{"text-align": "left"})
     return style
+
+
+class _Prose(str):
+    """Text glued into a chapter's prose: ``{glue:text}`` reads its text/plain (the string),
+    ``{glue}`` its text/markdown (the same text, Markdown-escaped), so neither shows a Python
+    repr (``np.float64(…)``, quotes) or a code box.
+    """
+
+    def _repr_markdown_(self) -> str:
+        return "".join("\\" + ch if ch in _MD_SPECIAL else ch for ch in self)
+
+
+_MD_SPECIAL = set("\\`*_{}[]<>|$~#")
+
+
+def as_text(value, sigma=None, *, unit: str = "", sig: int = 4) -> str:
+    """A value as a chapter's prose shows it: an integer (Python or numpy) as digits, a float
+    through :func:`format_value` (rounded to σ when given, else to ``sig`` significant digits,
+    a true minus sign, "—" when absent), anything else as ``str``; ``unit`` appended after a
+    space, shown in a reader's spelling (:func:`hsgeo.vocabulary.unit_label`: ``um`` → µm).
+
+    >>> import numpy as np
+    >>> as_text(np.float64(1.23456)), as_text(np.int64(8)), as_text(-0.0213, 0.004, unit="um")
+    ('1.235', '8', '−0.0213 µm')
+    """
+    from numbers import Integral, Real
+
+    from hsgeo.vocabulary import unit_label
+
+    if isinstance(value, bool):
+        text = str(value)
+    elif isinstance(value, Integral):
+        text = str(int(value)).replace("-", _MINUS)
+    elif isinstance(value, Real) or value is None:
+        text = format_value(value, sigma, sig=sig)
+    else:
+        text = str(value)
+    if unit and text != "—":
+        shown = unit_label(unit)
+        text += "" if shown == "—" else f" {shown}"
+    return text
+
+
+def glue_text(name: str, value, sigma=None, *, unit: str = "", sig: int = 4) -> str:
+    """Glue ``value`` for a chapter's prose as formatted text (:func:`as_text`), never as a
+    Python repr: ``{glue:text}`name``` and ``{glue}`name``` both show e.g. ``1.235 µm``. Returns
+    the text. Needs myst-nb (the book's environment).
+    """
+    from myst_nb import glue
+
+    text = _Prose(as_text(value, sigma, unit=unit, sig=sig))
+    glue(name, text, display=False)
+    return str(text)
 
 
 @dataclass
