@@ -21,6 +21,8 @@
   value glued in another document) or the Python repr with its quotes (in the same document).
   Chapters glue numbers with ``hsgeo.report.glue_text``, which formats them; a ``np.float64(…)``
   that still reaches a page is reported by ``make check-book``, not hidden here.
+- **Student edition**: with ``HSGEO_STUDENT=1`` (``make book-student``) the solutions of the
+  exercises are left out.
 - **Version**: every page's footer names the hsgeo version the book was built with
   (``hsgeo.__version__``) and how to cite it (``CITATION.cff``).
 """
@@ -95,6 +97,19 @@ def _version_footer(app: Sphinx, config) -> None:
         "root of the repository; to install it, see the page “Install hsgeo”.</p>"
     )
     config.html_theme_options = options
+
+
+def _student_edition(app: Sphinx, config) -> None:
+    """``make book-student`` (``HSGEO_STUDENT=1``): the exercises without their solutions
+    (sphinx-exercise's ``hide_solutions``), executed from ``make book``'s cache
+    (``HSGEO_JUPYTER_CACHE``) instead of a cache of its own.
+    """
+    if os.environ.get("HSGEO_STUDENT") != "1":
+        return
+    config.hide_solutions = True
+    cache = os.environ.get("HSGEO_JUPYTER_CACHE")
+    if cache:
+        config.nb_execution_cache_path = cache
 
 
 def _use_local_mathjax(app: Sphinx, config) -> None:
@@ -286,6 +301,19 @@ def _run_box(app: Sphinx, docname: str) -> nodes.admonition:
     para += nodes.Text(" for the reduced size the tests use):")
     box += para
     box += _literal(f"make venv\n.venv/bin/jupyter execute --inplace {name}.ipynb")
+    if "install" in app.env.all_docs:
+        para = nodes.paragraph()
+        para += nodes.Text("To install the library elsewhere (with pip, or as a wheel from ")
+        para += nodes.literal(text="make dist")
+        para += nodes.Text(") and cite it, see ")
+        para += nodes.reference(
+            "",
+            "Install hsgeo",
+            internal=True,
+            refuri=app.builder.get_relative_uri(docname, "install"),
+        )
+        para += nodes.Text(".")
+        box += para
     para = nodes.paragraph()
     para += nodes.Text("Run time measured when this book was built: ")
     para += nodes.strong(text=_runtime_text(data))
@@ -381,6 +409,9 @@ class GluedTextAsText(SphinxPostTransform):
                 node["fmt_spec"] = "s"
 
 
+_QUOTE_PAIRS = ("''", '""', "\u2018\u2019", "\u201c\u201d")
+
+
 def _glued_text_without_quotes(doctree: nodes.document) -> None:
     """A same-document inline ``{glue}`` of a string shows the string, not its repr."""
     from myst_nb.core.variables import format_plain_text
@@ -391,8 +422,15 @@ def _glued_text_without_quotes(doctree: nodes.document) -> None:
             continue
         if not isinstance(node.parent, nodes.TextElement):
             continue  # a cell's output, not running text
-        text = format_plain_text(node.astext(), "s")
-        node.replace_self(nodes.inline(text, text, classes=["pasted-text"]))
+        text = node.astext()
+        if len(text) >= 2 and text[0] + text[-1] in _QUOTE_PAIRS:
+            text = text[1:-1]  # the repr's quotes (made typographic by smartquotes)
+        else:
+            text = format_plain_text(text, "s")
+        # in place: replace_self would merge the old classes into the new node
+        node.children = []
+        node += nodes.Text(text)
+        node["classes"] = ["pasted-text"]
 
 
 def _resolve(app: Sphinx, doctree: nodes.document, docname: str) -> None:
@@ -417,6 +455,7 @@ def setup(app: Sphinx) -> dict:
     app.add_post_transform(GluedTextAsText)
     app.connect("config-inited", _use_local_mathjax)
     app.connect("config-inited", _version_footer)
+    app.connect("config-inited", _student_edition)
     app.connect("build-finished", _copy_mathjax)
     app.connect("html-page-context", _add_ipynb_download, priority=500)
     app.connect("doctree-resolved", _resolve)
