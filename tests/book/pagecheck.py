@@ -168,7 +168,8 @@ async () => {
     slips: slips.slice(0, 8),
     unpadded: unpadded.slice(0, 8),
     table_cells: cells,
-    footer: (document.querySelector("footer, .bd-footer, .footer") || {}).textContent || "",
+    footer: [...document.querySelectorAll("footer, .bd-footer, .extra_footer")]
+      .map((el) => el.textContent || "").join(" "),
     exercises: main.querySelectorAll(".exercise").length,
     solutions: main.querySelectorAll(".solution").length,
   };
@@ -301,3 +302,12 @@ def problems_glue_slips(facts: dict) -> list[str]:
 def problems_cell_padding(facts: dict) -> list[str]:
     """Every table cell has horizontal padding, so no cell's text touches its neighbour's."""
     return [f"unpadded: {d}" for d in facts["unpadded"]]
+
+
+def problems_version_footer(facts: dict) -> list[str]:
+    """The footer names the hsgeo version the book was built with."""
+    import re
+
+    if re.search(r"hsgeo \d+\.\d+", facts["footer"]):
+        return []
+    return [f"no hsgeo version in the footer: «{facts['footer'].strip()[:80]}»"]
