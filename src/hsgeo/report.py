@@ -285,7 +285,8 @@ def summarize(rows: list[Row], what: str = "parameters") -> dict:
     quantity with the largest |z|), ``n_negative``, ``n_positive``, ``sign_p`` (two-sided sign
     test probability of a sign balance at least this lopsided under zero-mean errors) and
     ``sentence``, e.g. "7 of 8 parameters lie within 3σ̂ of the truth; the largest deviation is
-    c_line100 at 1.8σ̂."
+    K1, band 5 at 1.8σ̂." (the quantity in a reader's words, :mod:`hsgeo.vocabulary`; ``worst``
+    keeps the key).
     """
     zs = [(r.quantity, r.z) for r in rows if r.z is not None]
     n = len(zs)
@@ -306,7 +307,10 @@ def summarize(rows: list[Row], what: str = "parameters") -> dict:
         )
     else:
         head = f"{within3} of {n} {what} lie within 3σ̂ of the truth"
-    sentence = f"{head[0].upper()}{head[1:]}; the largest deviation is {worst} at {abs(zw):.1f}σ̂"
+    sentence = (
+        f"{head[0].upper()}{head[1:]}; the largest deviation is {quantity_label(worst)} at "
+        f"{abs(zw):.1f}σ̂"
+    )
     if n >= 4 and k == 0:
         side = "below" if neg else "above"
         sentence += f"; all {n} lie {side} the truth (sign test p = {sign_p:.2g})"

@@ -8,12 +8,12 @@ typeset units (``µm``, ``mm⁻²``, ``°``). :func:`hsgeo.report.format_rows` (
 ``Reproduction.show``, ``Reproduction.to_text`` and the scoreboard) applies both.
 
 A key is translated by, in order: an exact entry of :data:`LABELS`; the ``σ(…)`` wrapper; the
-dotted form ``context.quantity`` (``even_distortion_on.mean_z_c_px`` → ``mean z of c (even
-distortion term on)``); space-separated words (``K1 line100 in 1sigma`` → ``K1, line 100, share
-within 1σ̂``); otherwise word by word on the underscores (:data:`WORDS` and the patterns of
-:data:`_PATTERNS`), dropping a trailing unit word that the unit column already shows. A new key
-therefore always gets a label without underscores; give it an entry in :data:`LABELS` when the
-word-by-word label reads badly.
+dotted form ``context.quantity`` (``even_distortion_on.mean_z_c_px`` → ``mean z of principal
+distance c — even distortion term on``); space-separated words (``K1 line100 in 1sigma`` →
+``K1, line 100, share within 1σ̂``); otherwise word by word on the underscores (:data:`WORDS`
+and the patterns of :data:`_PATTERNS`), dropping a trailing unit word that the unit column
+already shows. A new key therefore always gets a label without underscores; give it an entry in
+:data:`LABELS` when the word-by-word label reads badly.
 
 >>> quantity_label("c_minus_mean_band0_450nm_um")
 'c − mean c, band 0 (450 nm)'
