@@ -58,8 +58,8 @@ book: $(STAMP) book/_build/.library-stamp ## execute every chapter and render th
 	rm -rf book/_build/html book/_build/.doctrees book/_build/jupyter_execute
 	$(VENV)/bin/jupyter-book build book -W -n --keep-going
 
-# The student edition: the same book without the exercises' solutions (sphinx-exercise's
-# hide_solutions, set by book/_ext/hsgeo_book.py when HSGEO_STUDENT=1). It is built in its own
+# The student edition: the same book without the exercises' solutions (removed by
+# book/_ext/hsgeo_book.py when HSGEO_STUDENT=1). It is built in its own
 # directory but executes from `make book`'s cache, so after `make book` it takes minutes.
 book-student: export HSGEO_RECORD_DIR := $(CURDIR)/book/_build/reproduce
 

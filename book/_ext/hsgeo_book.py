@@ -22,7 +22,7 @@
   Chapters glue numbers with ``hsgeo.report.glue_text``, which formats them; a ``np.float64(…)``
   that still reaches a page is reported by ``make check-book``, not hidden here.
 - **Student edition**: with ``HSGEO_STUDENT=1`` (``make book-student``) the solutions of the
-  exercises are left out.
+  exercises are left out (``RemoveSolutions``).
 - **Version**: every page's footer names the hsgeo version the book was built with
   (``hsgeo.__version__``) and how to cite it (``CITATION.cff``).
 """
@@ -42,6 +42,7 @@ from docutils import nodes
 from docutils.parsers.rst import directives
 from sphinx.application import Sphinx
 from sphinx.errors import ExtensionError
+from sphinx.transforms import SphinxTransform
 from sphinx.transforms.post_transforms import SphinxPostTransform
 from sphinx.util import logging
 from sphinx.util.docutils import SphinxDirective
@@ -101,15 +102,33 @@ def _version_footer(app: Sphinx, config) -> None:
 
 def _student_edition(app: Sphinx, config) -> None:
     """``make book-student`` (``HSGEO_STUDENT=1``): the exercises without their solutions
-    (sphinx-exercise's ``hide_solutions``), executed from ``make book``'s cache
+    (:class:`RemoveSolutions`), executed from ``make book``'s cache
     (``HSGEO_JUPYTER_CACHE``) instead of a cache of its own.
     """
     if os.environ.get("HSGEO_STUDENT") != "1":
         return
-    config.hide_solutions = True
+    # not sphinx-exercise's own hide_solutions: it leaves the body and the end marker of the
+    # gated form ({solution-start} … {solution-end}) on the page ("unknown node type"); the
+    # transform below removes every solution once the gated ones are merged
     cache = os.environ.get("HSGEO_JUPYTER_CACHE")
     if cache:
         config.nb_execution_cache_path = cache
+
+
+class RemoveSolutions(SphinxTransform):
+    """The student edition (``HSGEO_STUDENT=1``): every exercise's solution is removed, after
+    sphinx-exercise has merged the gated ones (its ``MergeGatedSolutions``, priority 10).
+    """
+
+    default_priority = 50
+
+    def apply(self, **kwargs) -> None:
+        if os.environ.get("HSGEO_STUDENT") != "1":
+            return
+        from sphinx_exercise.nodes import solution_node
+
+        for node in list(self.document.findall(solution_node)):
+            node.parent.remove(node)
 
 
 def _use_local_mathjax(app: Sphinx, config) -> None:
@@ -453,6 +472,7 @@ def setup(app: Sphinx) -> dict:
     app.add_directive("hsgeo-run-times", RunTimesDirective)
     app.add_directive("hsgeo-docstring", DocstringDirective)
     app.add_post_transform(GluedTextAsText)
+    app.add_transform(RemoveSolutions)
     app.connect("config-inited", _use_local_mathjax)
     app.connect("config-inited", _version_footer)
     app.connect("config-inited", _student_edition)
