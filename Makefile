@@ -16,7 +16,7 @@ export GLIBC_TUNABLES ?= glibc.malloc.mmap_max=0:glibc.malloc.trim_threshold=429
 export PYDEVD_DISABLE_FILE_VALIDATION := 1
 
 .DEFAULT_GOAL := help
-.PHONY: help venv data test test-fast book check-book browser bench lint clean lock
+.PHONY: help venv data test test-fast book book-student check-book browser bench lint clean lock dist
 
 help: ## list the targets
 	@grep -hE '^[a-zA-Z_-]+:.*## ' $(MAKEFILE_LIST) | awk 'BEGIN {FS = ":.*## "}; {printf "  make %-10s %s\n", $$1, $$2}'
@@ -58,6 +58,20 @@ book: $(STAMP) book/_build/.library-stamp ## execute every chapter and render th
 	rm -rf book/_build/html book/_build/.doctrees book/_build/jupyter_execute
 	$(VENV)/bin/jupyter-book build book -W -n --keep-going
 
+# The student edition: the same book without the exercises' solutions (removed by
+# book/_ext/hsgeo_book.py when HSGEO_STUDENT=1). It is built in its own
+# directory but executes from `make book`'s cache, so after `make book` it takes minutes.
+book-student: export HSGEO_RECORD_DIR := $(CURDIR)/book/_build/reproduce
+
+book-student: $(STAMP) book/_build/.library-stamp ## the book without the exercises' solutions, to book/_build/html-student (reuses the cache of `make book`)
+	$(PY) -m hsgeo.cli data --verify
+	rm -rf book/_build/student book/_build/html-student
+	HSGEO_STUDENT=1 HSGEO_JUPYTER_CACHE="$(CURDIR)/book/_build/.jupyter_cache" \
+	  $(VENV)/bin/jupyter-book build book -W -n --keep-going --path-output book/_build/student
+	mv book/_build/student/_build/html book/_build/html-student
+	rm -rf book/_build/student
+	@echo "student edition: book/_build/html-student/index.html"
+
 # `make check-book` opens every built page in a real headless browser, offline: Debian's chromium,
 # driven by Playwright's Python API (pinned in requirements.lock) through `executable_path`;
 # Playwright's own browser download is not used. The book is built first if it is missing or older
@@ -83,6 +97,13 @@ check-book: $(STAMP) browser book/_build/html/index.html ## open every page of t
 bench: $(STAMP) ## run the benchmarks, results as JSON in bench/results/ (installs requirements-bench.lock: pycolmap/Ceres)
 	$(PY) -m pip install --quiet --disable-pip-version-check -r requirements-bench.lock
 	$(PY) bench/run.py
+
+# The wheel is built with the environment's own setuptools (no build isolation, so nothing is
+# downloaded); `pip install dist/hsgeo-*.whl` then installs the library and the `hsgeo` command.
+dist: $(STAMP) ## build the hsgeo wheel into dist/ (pip wheel, offline)
+	rm -rf dist build
+	$(PY) -m pip wheel --quiet --disable-pip-version-check --no-deps --no-build-isolation -w dist .
+	@ls dist/*.whl
 
 lint: $(STAMP) ## ruff check and format check, and the import contracts of the layout (GUIDE §2)
 	$(VENV)/bin/ruff check src tests bench

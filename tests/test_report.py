@@ -167,7 +167,7 @@ def test_paper_values_print_at_most_six_digits_and_verdict_list():
     assert format_rows([Row("t", "K1", "1/mm2", paper=-0.00414)]).iloc[0]["paper"] == "−0.00414"
     rep = Reproduction("x", 0, rows + [Row("t", "q", "m", reproduced=1.0)])
     v = rep.verdicts().data
-    assert list(v["quantity"]) == ["fx_px"] and v.iloc[0]["verdict"] == "reproduced"
+    assert list(v["quantity"]) == ["focal length fx"] and v.iloc[0]["verdict"] == "reproduced"
 
 
 def test_provenance_is_checked_and_survives_json():
@@ -177,3 +177,31 @@ def test_provenance_is_checked_and_survives_json():
     back = Reproduction.from_json(rep.to_json())
     assert back.rows[0].provenance == "tuned"
     assert '"provenance": "tuned"' in rep.to_json()
+
+
+def test_shown_tables_pad_cells_and_right_align_numbers():
+    rep = Reproduction("x", 0, [Row("T", "c_px", "px", 3539, 14, 3538.2, 0.9, 3539.0)])
+    html = rep.show("T").to_html()
+    assert "padding: 0.3em 0.75em" in html  # cells never touch their neighbours
+    assert 'class="data row0 col3 hsgeo-num"' in html  # reproduced
+    assert 'class="data row0 col0 hsgeo-text"' in html  # quantity
+    assert "th.col3 {\n  text-align: right" in html and "th.col0 {\n  text-align: left" in html
+    assert "principal distance c" in html and "c_px" not in html
+    assert 'class="hsgeo-table"' in rep.verdicts().to_html()
+
+
+def test_glued_numbers_are_text_not_reprs():
+    import numpy as np
+    from IPython.core.formatters import format_display_data
+
+    from hsgeo.report import _Prose, as_text
+
+    assert as_text(np.float64(1.23456)) == "1.235" and as_text(np.int64(-8)) == "−8"
+    assert as_text(np.float64(-0.0213), 0.004, unit="um") == "−0.0213 µm"  # σ to two digits
+    assert as_text(None, unit="px") == "—" and as_text(3, unit="1") == "3"
+    assert as_text("within 1σ") == "within 1σ"
+    data, _ = format_display_data(_Prose("a_b |z| 1.2"))
+    # {glue:text} literal-evaluates text/plain back to the string; {glue} renders the markdown
+    assert data["text/plain"] == "'a_b |z| 1.2'"
+    assert data["text/markdown"] == r"a\_b \|z\| 1.2"
+    assert "np.float64" not in data["text/plain"]

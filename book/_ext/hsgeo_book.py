@@ -16,6 +16,15 @@
   was put into the execution cache).
 - **Run times**: the ``{hsgeo-run-times}`` directive is replaced by a table of every chapter's
   measured run time.
+- **Glued values as text**: a ``{glue}`` role in running text whose value is plain text (a
+  number or a string) shows as text, like ``{glue:text}``, instead of myst-nb's code box (for a
+  value glued in another document) or the Python repr with its quotes (in the same document).
+  Chapters glue numbers with ``hsgeo.report.glue_text``, which formats them; a ``np.float64(…)``
+  that still reaches a page is reported by ``make check-book``, not hidden here.
+- **Student edition**: with ``HSGEO_STUDENT=1`` (``make book-student``) the solutions of the
+  exercises are left out (``RemoveSolutions``).
+- **Version**: every page's footer names the hsgeo version the book was built with
+  (``hsgeo.__version__``) and how to cite it (``CITATION.cff``).
 """
 
 from __future__ import annotations
@@ -33,6 +42,8 @@ from docutils import nodes
 from docutils.parsers.rst import directives
 from sphinx.application import Sphinx
 from sphinx.errors import ExtensionError
+from sphinx.transforms import SphinxTransform
+from sphinx.transforms.post_transforms import SphinxPostTransform
 from sphinx.util import logging
 from sphinx.util.docutils import SphinxDirective
 
@@ -73,6 +84,51 @@ def mathjax_source() -> Path:
             "(the pin in requirements.lock)"
         )
     return es5
+
+
+def _version_footer(app: Sphinx, config) -> None:
+    """The hsgeo version in every page's footer (sphinx-book-theme's ``extra_footer``)."""
+    import hsgeo
+
+    config.version = config.release = hsgeo.__version__
+    options = dict(config.html_theme_options or {})
+    options["extra_footer"] = (
+        f'<p class="hsgeo-version">Built with hsgeo {hsgeo.__version__} '
+        "(<code>hsgeo.__version__</code>). To cite it, use <code>CITATION.cff</code> at the "
+        "root of the repository; to install it, see the page “Install hsgeo”.</p>"
+    )
+    config.html_theme_options = options
+
+
+def _student_edition(app: Sphinx, config) -> None:
+    """``make book-student`` (``HSGEO_STUDENT=1``): the exercises without their solutions
+    (:class:`RemoveSolutions`), executed from ``make book``'s cache
+    (``HSGEO_JUPYTER_CACHE``) instead of a cache of its own.
+    """
+    if os.environ.get("HSGEO_STUDENT") != "1":
+        return
+    # not sphinx-exercise's own hide_solutions: it leaves the body and the end marker of the
+    # gated form ({solution-start} … {solution-end}) on the page ("unknown node type"); the
+    # transform below removes every solution once the gated ones are merged
+    cache = os.environ.get("HSGEO_JUPYTER_CACHE")
+    if cache:
+        config.nb_execution_cache_path = cache
+
+
+class RemoveSolutions(SphinxTransform):
+    """The student edition (``HSGEO_STUDENT=1``): every exercise's solution is removed, after
+    sphinx-exercise has merged the gated ones (its ``MergeGatedSolutions``, priority 10).
+    """
+
+    default_priority = 50
+
+    def apply(self, **kwargs) -> None:
+        if os.environ.get("HSGEO_STUDENT") != "1":
+            return
+        from sphinx_exercise.nodes import solution_node
+
+        for node in list(self.document.findall(solution_node)):
+            node.parent.remove(node)
 
 
 def _use_local_mathjax(app: Sphinx, config) -> None:
@@ -264,6 +320,19 @@ def _run_box(app: Sphinx, docname: str) -> nodes.admonition:
     para += nodes.Text(" for the reduced size the tests use):")
     box += para
     box += _literal(f"make venv\n.venv/bin/jupyter execute --inplace {name}.ipynb")
+    if "install" in app.env.all_docs:
+        para = nodes.paragraph()
+        para += nodes.Text("To install the library elsewhere (with pip, or as a wheel from ")
+        para += nodes.literal(text="make dist")
+        para += nodes.Text(") and cite it, see ")
+        para += nodes.reference(
+            "",
+            "Install hsgeo",
+            internal=True,
+            refuri=app.builder.get_relative_uri(docname, "install"),
+        )
+        para += nodes.Text(".")
+        box += para
     para = nodes.paragraph()
     para += nodes.Text("Run time measured when this book was built: ")
     para += nodes.strong(text=_runtime_text(data))
@@ -330,7 +399,61 @@ class DocstringDirective(SphinxDirective):
         return [box]
 
 
+# --- glued values in running text -------------------------------------------------------
+
+#: Mime types that make a glued value more than text (rendered by myst-nb as they are).
+_RICH_MIME = ("text/html", "text/markdown", "text/latex", "image/", "application/")
+
+
+class GluedTextAsText(SphinxPostTransform):
+    """A cross-document inline ``{glue}`` of a text-only value becomes ``{glue:text}``.
+
+    Runs before myst-nb's ``ReplacePendingGlueReferences`` (priority 5), which would render the
+    value's text/plain as inline code.
+    """
+
+    default_priority = 4
+
+    def apply(self, **kwargs) -> None:
+        from myst_nb.ext.glue.crossref import read_glue_cache
+        from myst_nb.ext.glue.utils import PendingGlueReference
+
+        folder = self.env.mystnb_config.output_folder
+        for node in list(self.document.findall(PendingGlueReference)):
+            if not node.inline or node.gtype == "text":
+                continue
+            data = read_glue_cache(folder, node.refdoc).get(node.key, {}).get("data", {})
+            if "text/plain" in data and not any(m.startswith(_RICH_MIME) for m in data):
+                node["gtype"] = "text"
+                node["fmt_spec"] = "s"
+
+
+_QUOTE_PAIRS = ("''", '""', "\u2018\u2019", "\u201c\u201d")
+
+
+def _glued_text_without_quotes(doctree: nodes.document) -> None:
+    """A same-document inline ``{glue}`` of a string shows the string, not its repr."""
+    from myst_nb.core.variables import format_plain_text
+
+    for node in list(doctree.findall(nodes.inline)):
+        classes = node.get("classes", [])
+        if "text_plain" not in classes or "output" not in classes:
+            continue
+        if not isinstance(node.parent, nodes.TextElement):
+            continue  # a cell's output, not running text
+        text = node.astext()
+        if len(text) >= 2 and text[0] + text[-1] in _QUOTE_PAIRS:
+            text = text[1:-1]  # the repr's quotes (made typographic by smartquotes)
+        else:
+            text = format_plain_text(text, "s")
+        # in place: replace_self would merge the old classes into the new node
+        node.children = []
+        node += nodes.Text(text)
+        node["classes"] = ["pasted-text"]
+
+
 def _resolve(app: Sphinx, doctree: nodes.document, docname: str) -> None:
+    _glued_text_without_quotes(doctree)
     for node in list(doctree.findall(RunTimesNode)):
         node.replace_self(_run_times_table(app, docname))
     if docname.startswith(CHAPTER_PREFIX) and app.builder.format == "html":
@@ -348,7 +471,11 @@ def setup(app: Sphinx) -> dict:
     app.add_node(RunTimesNode)
     app.add_directive("hsgeo-run-times", RunTimesDirective)
     app.add_directive("hsgeo-docstring", DocstringDirective)
+    app.add_post_transform(GluedTextAsText)
+    app.add_transform(RemoveSolutions)
     app.connect("config-inited", _use_local_mathjax)
+    app.connect("config-inited", _version_footer)
+    app.connect("config-inited", _student_edition)
     app.connect("build-finished", _copy_mathjax)
     app.connect("html-page-context", _add_ipynb_download, priority=500)
     app.connect("doctree-resolved", _resolve)

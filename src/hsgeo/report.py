@@ -27,6 +27,7 @@ import math
 from dataclasses import dataclass, field
 
 from hsgeo.errors import InputError
+from hsgeo.vocabulary import display_unit, quantity_label
 
 __all__ = [
     "Row",
@@ -38,6 +39,10 @@ __all__ = [
     "summarize",
     "format_value",
     "format_rows",
+    "styled",
+    "NUMERIC_COLUMNS",
+    "as_text",
+    "glue_text",
 ]
 
 #: The verdicts of a claim (ReScience style). ``by construction``: the truth (or the outcome) is
@@ -280,7 +285,8 @@ def summarize(rows: list[Row], what: str = "parameters") -> dict:
     quantity with the largest |z|), ``n_negative``, ``n_positive``, ``sign_p`` (two-sided sign
     test probability of a sign balance at least this lopsided under zero-mean errors) and
     ``sentence``, e.g. "7 of 8 parameters lie within 3σ̂ of the truth; the largest deviation is
-    c_line100 at 1.8σ̂."
+    K1, band 5 at 1.8σ̂." (the quantity in a reader's words, :mod:`hsgeo.vocabulary`; ``worst``
+    keeps the key).
     """
     zs = [(r.quantity, r.z) for r in rows if r.z is not None]
     n = len(zs)
@@ -301,7 +307,10 @@ def summarize(rows: list[Row], what: str = "parameters") -> dict:
         )
     else:
         head = f"{within3} of {n} {what} lie within 3σ̂ of the truth"
-    sentence = f"{head[0].upper()}{head[1:]}; the largest deviation is {worst} at {abs(zw):.1f}σ̂"
+    sentence = (
+        f"{head[0].upper()}{head[1:]}; the largest deviation is {quantity_label(worst)} at "
+        f"{abs(zw):.1f}σ̂"
+    )
     if n >= 4 and k == 0:
         side = "below" if neg else "above"
         sentence += f"; all {n} lie {side} the truth (sign test p = {sign_p:.2g})"
@@ -359,9 +368,17 @@ def _format_paper(x) -> str:
     return text.replace("-", _MINUS)
 
 
+#: Columns of :func:`format_rows` that hold numbers (right-aligned by :func:`styled`).
+NUMERIC_COLUMNS = ("paper", "reproduced", "σ̂", "truth", "z")
+
+
 def format_rows(rows: list[Row]):
     """The rows as a DataFrame of display strings: quantity | unit | paper | reproduced | σ̂ |
     truth | z | verdict (no index; σ is marked ``(n runs)`` when it is a spread over runs).
+
+    Quantities and units are shown in a reader's words (:mod:`hsgeo.vocabulary`: ``um`` → µm,
+    ``c_minus_mean_band0_450nm_um`` → "c − mean c, band 0 (450 nm)"); the rows themselves, and
+    so ``to_json``, keep their internal keys.
     """
     import pandas as pd
 
@@ -377,8 +394,8 @@ def format_rows(rows: list[Row]):
         z = r.z
         out.append(
             {
-                "quantity": r.quantity,
-                "unit": r.unit if r.unit not in ("", "1") else "—",
+                "quantity": quantity_label(r.quantity),
+                "unit": display_unit(r.quantity, r.unit),
                 "paper": paper,
                 "reproduced": format_value(r.reproduced, r.sigma),
                 "σ̂": sig,
@@ -389,6 +406,95 @@ def format_rows(rows: list[Row]):
         )
     cols = ["quantity", "unit", "paper", "reproduced", "σ̂", "truth", "z", "verdict"]
     return pd.DataFrame(out, columns=cols)
+
+
+#: Cell padding of the book's tables (also in book/_static/hsgeo.css, for tables made elsewhere).
+_PAD = "0.3em 0.75em"
+
+
+def styled(df, numeric: tuple[str, ...] = NUMERIC_COLUMNS):
+    """A DataFrame of display strings as the book shows a table: a pandas Styler without index,
+    class ``hsgeo-table``, every cell padded, the ``numeric`` columns right-aligned (header too,
+    class ``hsgeo-num``) and the others left-aligned (``hsgeo-text``).
+    """
+    import pandas as pd
+
+    num = [c for c in df.columns if c in numeric]
+    text = [c for c in df.columns if c not in numeric]
+    classes = pd.DataFrame(
+        [["hsgeo-num" if c in num else "hsgeo-text" for c in df.columns]] * len(df),
+        index=df.index,
+        columns=df.columns,
+    )
+    heads = {
+        c: [{"selector": "th", "props": f"text-align: {'right' if c in num else 'left'}"}]
+        for c in df.columns
+    }
+    style = (
+        df.style.hide(axis="index")
+        .set_table_attributes('class="hsgeo-table"')
+        .set_td_classes(classes)
+        .set_table_styles([{"selector": "th, td", "props": f"padding: {_PAD}"}])
+        .set_table_styles(heads, overwrite=False)
+    )
+    if num:
+        style = style.set_properties(subset=num, **{"text-align": "right", "white-space": "nowrap"})
+    if text:
+        style = style.set_properties(subset=text, **{"text-align": "left"})
+    return style
+
+
+class _Prose(str):
+    """Text glued into a chapter's prose: ``{glue:text}`` reads its text/plain (the string),
+    ``{glue}`` its text/markdown (the same text, Markdown-escaped), so neither shows a Python
+    repr (``np.float64(…)``, quotes) or a code box.
+    """
+
+    def _repr_markdown_(self) -> str:
+        return "".join("\\" + ch if ch in _MD_SPECIAL else ch for ch in self)
+
+
+_MD_SPECIAL = set("\\`*_{}[]<>|$~#")
+
+
+def as_text(value, sigma=None, *, unit: str = "", sig: int = 4) -> str:
+    """A value as a chapter's prose shows it: an integer (Python or numpy) as digits, a float
+    through :func:`format_value` (rounded to σ when given, else to ``sig`` significant digits,
+    a true minus sign, "—" when absent), anything else as ``str``; ``unit`` appended after a
+    space, shown in a reader's spelling (:func:`hsgeo.vocabulary.unit_label`: ``um`` → µm).
+
+    >>> import numpy as np
+    >>> as_text(np.float64(1.23456)), as_text(np.int64(8)), as_text(-0.0213, 0.004, unit="um")
+    ('1.235', '8', '−0.0213 µm')
+    """
+    from numbers import Integral, Real
+
+    from hsgeo.vocabulary import unit_label
+
+    if isinstance(value, bool):
+        text = str(value)
+    elif isinstance(value, Integral):
+        text = str(int(value)).replace("-", _MINUS)
+    elif isinstance(value, Real) or value is None:
+        text = format_value(value, sigma, sig=sig)
+    else:
+        text = str(value)
+    if unit and text != "—":
+        shown = unit_label(unit)
+        text += "" if shown == "—" else f" {shown}"
+    return text
+
+
+def glue_text(name: str, value, sigma=None, *, unit: str = "", sig: int = 4) -> str:
+    """Glue ``value`` for a chapter's prose as formatted text (:func:`as_text`), never as a
+    Python repr: ``{glue:text}`name``` and ``{glue}`name``` both show e.g. ``1.235 µm``. Returns
+    the text. Needs myst-nb (the book's environment).
+    """
+    from myst_nb import glue
+
+    text = _Prose(as_text(value, sigma, unit=unit, sig=sig))
+    glue(name, text, display=False)
+    return str(text)
 
 
 @dataclass
@@ -463,12 +569,7 @@ class Reproduction:
         df = format_rows(self.rows_of(name))
         if columns is not None:
             df = df[columns]
-        return (
-            df.style.hide(axis="index")
-            .set_table_attributes('class="hsgeo-table"')
-            .set_properties(**{"text-align": "right"})
-            .set_properties(subset=["quantity"], **{"text-align": "left"})
-        )
+        return styled(df)
 
     def verdicts(self, tables: list[str] | None = None):
         """The chapter's "What reproduced, what did not, and why": one line per claim (rows with
@@ -481,7 +582,7 @@ class Reproduction:
         recs = [
             {
                 "table": r.table,
-                "quantity": r.quantity,
+                "quantity": quantity_label(r.quantity),
                 "verdict": v,
                 "provenance": r.provenance or "—",
                 "why": why,
@@ -491,7 +592,7 @@ class Reproduction:
             if v is not None
         ]
         df = pd.DataFrame(recs, columns=["table", "quantity", "verdict", "provenance", "why"])
-        return df.style.hide(axis="index").set_table_attributes('class="hsgeo-table"')
+        return styled(df, numeric=())
 
     def summarize(self, name: str, what: str = "parameters") -> dict:
         """:func:`summarize` over one table's rows."""
@@ -507,7 +608,7 @@ class Reproduction:
             out.append(
                 "  "
                 + "  ".join(
-                    c.ljust(widths[c]) if c == "quantity" else c.rjust(widths[c])
+                    c.ljust(widths[c]) if c not in NUMERIC_COLUMNS else c.rjust(widths[c])
                     for c in df.columns
                 )
             )
@@ -516,7 +617,7 @@ class Reproduction:
                     "  "
                     + "  ".join(
                         rec[c].ljust(widths[c])
-                        if c in ("quantity", "verdict")
+                        if c not in NUMERIC_COLUMNS
                         else rec[c].rjust(widths[c])
                         for c in df.columns
                     ).rstrip()

@@ -89,6 +89,61 @@ async () => {
         + " px, overflow-x " + style.overflowX);
     }
   }
+  // what leaks from the machinery into what a reader sees (issue 28): the prose and the cell
+  // outputs, not the (collapsed) code of the cells
+  const visible = main.cloneNode(true);
+  visible.querySelectorAll("div.cell_input, script, style, mjx-container, mjx-assistive-mml, "
+    + "textarea, .hsgeo-run-box").forEach((el) => el.remove());
+  const seen = (visible.textContent || "").replace(/\s+/g, " ");
+  const leaks = [];
+  const leakPatterns = [
+    [/np\.(float|int|bool_)\d*\(/, "a numpy repr"],
+    [/\/tmp\//, "a /tmp/ path"],
+    [/\bissues? #?\d+/i, "an issue number"],
+    [/\b[A-Z][A-Za-z]*Warning\b/, "a Python warning"],
+    [/Traceback \(most recent call last\)/, "a traceback"],
+  ];
+  for (const [re, what] of leakPatterns) {
+    const m = seen.match(re);
+    if (m) {
+      const i = m.index;
+      leaks.push(what + ": …" + seen.slice(Math.max(0, i - 40), i + 50) + "…");
+    }
+  }
+  for (const el of main.querySelectorAll(".cell_output .output.stderr")) {
+    leaks.push("stderr output: " + describe(el));
+  }
+  // glue slips in running text: a repeated word ("Exercise Exercise"), a range with equal ends
+  const slips = [];
+  const textEls = main.querySelectorAll(
+    "p, li, figcaption, dt, dd, h1, h2, h3, h4, td, th, .admonition-title, caption");
+  for (const el of textEls) {
+    if (el.closest("div.cell_input, pre, .highlight")) continue;
+    const c = el.cloneNode(true);
+    c.querySelectorAll("code, pre, mjx-container, mjx-assistive-mml, script")
+      .forEach((x) => x.remove());
+    // only the element's own text, not that of a nested paragraph or list (checked by itself)
+    c.querySelectorAll("p, li, ul, ol, dl, table").forEach((x) => x.remove());
+    const t = (c.textContent || "").replace(/\s+/g, " ");
+    const rep = t.match(/\b([A-Za-z]{2,})\s+\1\b/i);
+    if (rep) slips.push("repeated word «" + rep[0] + "» in " + describe(el));
+    const range = t.match(/(?<![\d.,])(\d+(?:\.\d+)?)\s*(?:–|to)\s*\1(?![\d.]*\d)/);
+    if (range) slips.push("range with equal ends «" + range[0] + "» in " + describe(el));
+  }
+  // table cells whose text would touch their neighbour's: no horizontal padding
+  const unpadded = [];
+  let cells = 0;
+  for (const cell of main.querySelectorAll("table td, table th")) {
+    if (cell.closest("pre, .highlight, mjx-container") || cell.offsetParent === null) continue;
+    if (!(cell.textContent || "").trim()) continue;
+    cells += 1;
+    const st = getComputedStyle(cell);
+    const left = parseFloat(st.paddingLeft), right = parseFloat(st.paddingRight);
+    if (!(left >= 2 && right >= 2)) {
+      unpadded.push(describe(cell.closest("table")) + ": cell «"
+        + cell.textContent.trim().slice(0, 30) + "» padding " + left + "/" + right + " px");
+    }
+  }
   const hrefs = [...document.querySelectorAll("a[href]")].map((a) => a.getAttribute("href"));
   const downloads = hrefs.filter((h) => /\.ipynb$/.test(h));
   const sources = hrefs.filter((h) => /_sources\/.*\.md$/.test(h));
@@ -109,6 +164,12 @@ async () => {
     clipped: clipped.slice(0, 8),
     ipynb_links: downloads,
     md_links: sources,
+    leaks: leaks,
+    slips: slips.slice(0, 8),
+    unpadded: unpadded.slice(0, 8),
+    table_cells: cells,
+    footer: [...document.querySelectorAll("footer, .bd-footer, .extra_footer")]
+      .map((el) => el.textContent || "").join(" "),
     exercises: main.querySelectorAll(".exercise").length,
     solutions: main.querySelectorAll(".solution").length,
   };
@@ -225,3 +286,28 @@ def problems_exercises(facts: dict) -> list[str]:
     if facts["solutions"] < 1:
         out.append("no {solution}")
     return out
+
+
+def problems_leaks(facts: dict) -> list[str]:
+    """No machinery on the page: numpy reprs, /tmp/ paths, issue numbers, Python warnings,
+    tracebacks or stderr output in the prose or the cell outputs."""
+    return [f"leak, {d}" for d in facts["leaks"]]
+
+
+def problems_glue_slips(facts: dict) -> list[str]:
+    """No repeated word and no range whose two ends are equal in the running text."""
+    return list(facts["slips"])
+
+
+def problems_cell_padding(facts: dict) -> list[str]:
+    """Every table cell has horizontal padding, so no cell's text touches its neighbour's."""
+    return [f"unpadded: {d}" for d in facts["unpadded"]]
+
+
+def problems_version_footer(facts: dict) -> list[str]:
+    """The footer names the hsgeo version the book was built with."""
+    import re
+
+    if re.search(r"hsgeo \d+\.\d+", facts["footer"]):
+        return []
+    return [f"no hsgeo version in the footer: «{facts['footer'].strip()[:80]}»"]

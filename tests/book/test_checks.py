@@ -25,14 +25,18 @@ from pagecheck import (
     WIDE_PX,
     page_facts,
     problems_captions,
+    problems_cell_padding,
     problems_clipped,
     problems_equations,
     problems_exercises,
+    problems_glue_slips,
     problems_ipynb,
+    problems_leaks,
     problems_md_source,
     problems_nan,
     problems_offline,
     problems_page_width,
+    problems_version_footer,
 )
 
 pytestmark = pytest.mark.book
@@ -96,6 +100,47 @@ CASES = {
         problems_exercises,
         '<div class="exercise">Do it.</div>',
         '<div class="exercise">Do it.</div><div class="solution">Done.</div>',
+    ),
+    "numpy-repr": (
+        problems_leaks,
+        "<p>the largest deviation is np.float64(1.25)σ̂</p>",
+        "<p>the largest deviation is 1.25σ̂</p>",
+    ),
+    "tmp-path-and-warning": (
+        problems_leaks,
+        '<div class="cell_output"><pre>/tmp/x.py:3: RuntimeWarning: overflow</pre></div>',
+        '<div class="cell_output"><pre>done</pre></div>',
+    ),
+    "issue-number": (
+        problems_leaks,
+        "<figure><figcaption>Red: the goals of issue 14.</figcaption></figure>",
+        "<figure><figcaption>Red: the goals of the solver study.</figcaption></figure>",
+    ),
+    "traceback": (
+        problems_leaks,
+        '<div class="cell_output"><pre>Traceback (most recent call last):</pre></div>',
+        "<p>no error</p>",
+    ),
+    "repeated-word": (
+        problems_glue_slips,
+        "<p>See Exercise Exercise 9.</p>",
+        "<p>See Exercise 9.</p>",
+    ),
+    "range-with-equal-ends": (
+        problems_glue_slips,
+        "<p>precision estimates of 1.3–1.3 µm</p>",
+        "<p>precision estimates of 1.3–1.35 µm and 13–130 px</p>",
+    ),
+    "unpadded-cells": (
+        problems_cell_padding,
+        '<table><tr><td style="padding:0">657</td><td style="padding:0">20</td></tr></table>',
+        '<table><tr><td style="padding:0 6px">657</td>'
+        '<td style="padding:0 6px">20</td></tr></table>',
+    ),
+    "version-footer": (
+        problems_version_footer,
+        "<footer>Built by hand</footer>",
+        "<footer>Built with hsgeo 0.1.0</footer>",
     ),
     "network-request": (
         problems_offline,
@@ -231,12 +276,17 @@ def test_synthetic_chapter_passes_every_check(browser, demo_book, width):
         + problems_ipynb(facts)
         + problems_md_source(facts)
         + problems_exercises(facts)
+        + problems_leaks(facts)
+        + problems_glue_slips(facts)
+        + problems_cell_padding(facts)
+        + problems_version_footer(facts)
     )
     assert problems == []
     # the checks saw what they check, so passing is not vacuous
     assert facts["mathjax_output"] >= 2 and facts["figures"] >= 1
     assert facts["exercises"] >= 1 and facts["solutions"] >= 1
     assert facts["ipynb_links"]
+    assert facts["table_cells"] >= 10  # the padding check measured the tables
 
 
 def test_synthetic_chapter_infrastructure(demo_book):

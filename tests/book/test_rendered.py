@@ -20,14 +20,18 @@ from pagecheck import (
     WIDE_PX,
     page_facts,
     problems_captions,
+    problems_cell_padding,
     problems_clipped,
     problems_equations,
     problems_exercises,
+    problems_glue_slips,
     problems_ipynb,
+    problems_leaks,
     problems_md_source,
     problems_nan,
     problems_offline,
     problems_page_width,
+    problems_version_footer,
 )
 
 pytestmark = pytest.mark.book
@@ -113,6 +117,28 @@ def test_no_sideways_scroll_at_400px(facts):
 @_params(DOCS, NARROW_PX)
 def test_nothing_clipped_at_400px(facts):
     _check(problems_clipped(facts), facts)
+
+
+@_params(DOCS, WIDE_PX)
+def test_no_internals_leak(facts):
+    """No numpy repr, /tmp/ path, issue number, Python warning or traceback on the page."""
+    _check(problems_leaks(facts), facts)
+
+
+@_params(DOCS, WIDE_PX)
+def test_no_glue_slips(facts):
+    """No repeated word ("Exercise Exercise") and no range with equal ends ("1.3–1.3")."""
+    _check(problems_glue_slips(facts), facts)
+
+
+@_params(DOCS, WIDE_PX)
+def test_table_cells_are_padded(facts):
+    _check(problems_cell_padding(facts), facts)
+
+
+@_params(DOCS, WIDE_PX)
+def test_version_in_the_footer(facts):
+    _check(problems_version_footer(facts), facts)
 
 
 @_params(CHAPTERS, WIDE_PX)

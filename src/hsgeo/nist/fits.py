@@ -245,16 +245,20 @@ def fit_scipy(
         return residuals(problem, b)[1]
 
     tol = 1e-15
-    sol = least_squares(
-        fun,
-        _start(problem, start),
-        jac=jacobian if jac == "analytic" else "2-point",
-        method=method,
-        ftol=tol,
-        xtol=tol,
-        gtol=tol,
-        max_nfev=100_000,
-    )
+    # From some of the hard starts scipy's trust region steps into overflow; the fit then fails
+    # and is scored as failed (its message says why). numpy's RuntimeWarning on the way would
+    # only print a path and a line of scipy's source into the book's engine page (issue 28).
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        sol = least_squares(
+            fun,
+            _start(problem, start),
+            jac=jacobian if jac == "analytic" else "2-point",
+            method=method,
+            ftol=tol,
+            xtol=tol,
+            gtol=tol,
+            max_nfev=100_000,
+        )
     b = sol.x
     r = fun(b)
     rss = float(r @ r)
