@@ -34,7 +34,7 @@ venv: $(STAMP) ## create .venv from requirements.lock and install hsgeo (about 1
 data: $(STAMP) ## regenerate data_synthetic/generated from the scenario TOMLs and verify the SHA-256 manifest
 	$(PY) -m hsgeo.cli data --verify
 
-test: $(STAMP) ## the whole test suite, chapters included (about 8 min on 2 cores)
+test: $(STAMP) ## the whole test suite, chapters included (about 6 min on 2 cores)
 	$(PY) -m hsgeo.cli data --verify
 	$(PY) -m pytest -q tests
 
