@@ -6,11 +6,16 @@ from hsgeo.report import Reproduction, Row
 from hsgeo.reproduce import RECORD_ENV, recorded, run
 from hsgeo.reproduce.scoreboard import (
     PAPER_CHAPTERS,
+    PROVENANCE_GROUPS,
     claims,
+    claims_with_chapters,
+    compact_table,
     counts,
     counts_by,
     overrides,
+    paper_paragraph,
     planned_claims,
+    provenance_group,
 )
 
 
@@ -120,3 +125,72 @@ def test_cube_chapter_claims_reach_the_scoreboard():
     rows = claims({"cube": rep})
     assert "cube" in PAPER_CHAPTERS
     assert [r.quantity for r in rows if r.verdict != "planned"] == ["speed S of eq. (8)"]
+
+
+def _board_rows():
+    tuned = dict(unit="px", paper=0.32, paper_sigma=0.003, sigma=0.002, n_runs=8)
+    return {
+        "pushbroom-ba": Reproduction(
+            "pushbroom-ba",
+            0,
+            [
+                Row("002 Table 1", "nmad_x_px", reproduced=0.321, provenance="tuned", **tuned),
+                Row("002 Table 1", "nmad_y_px", reproduced=0.283, provenance="tuned", **tuned),
+                Row(
+                    "002 Table 2",
+                    "nmad_h_m",
+                    "m",
+                    paper=0.99,
+                    reproduced=0.98,
+                    sigma=0.05,
+                    n_runs=8,
+                    provenance="chosen",
+                ),
+            ],
+        )
+    }
+
+
+def test_tuned_claims_are_split_into_met_and_missed():
+    """Issue 28: a tuning that missed its target by more than 3σ is counted apart (0.283 px
+    lies 10σ from 0.32 px with σ = hypot(0.002, 0.003))."""
+    rows = claims(_board_rows())
+    assert [provenance_group(r) for r in rows[:3]] == ["tuned (met)", "tuned (missed)", "chosen"]
+    by = counts_by(rows, "provenance")
+    assert list(by) == [g for g in PROVENANCE_GROUPS if g in by]
+    assert by["tuned (met)"]["by construction"] == 1 and by["tuned (missed)"]["differs"] == 1
+
+
+def test_paper_paragraph_is_computed_from_the_verdicts():
+    rows = claims(_board_rows())
+    text = paper_paragraph(rows, "002")
+    assert text.startswith("Of its 3 claims, 1 reproduced, 1 differs and 1 agrees by construction.")
+    assert "NMAD" in text and "tuning missed: 10.3σ from the paper" in text
+    assert "were tuned to meet the paper" in text
+    assert "nmad_" not in text  # claims in a reader's words, never internal keys
+    planned = paper_paragraph(rows, "004")
+    assert planned.startswith(f"Of its {len(planned_claims())} claims, ")
+    assert "Planned: ASF chapter" in planned
+    assert paper_paragraph(rows, "009") == "No claim of paper 009 is in the book yet."
+
+
+def test_compact_table_has_one_short_line_per_claim_with_a_link():
+    pairs = claims_with_chapters(_board_rows())
+    html = compact_table(pairs, "002")._repr_html_()
+    df = compact_table(pairs, "002").data
+    assert list(df.columns) == [
+        "claim",
+        "unit",
+        "paper",
+        "reproduced ± σ",
+        "z",
+        "verdict",
+        "provenance",
+        "chapter",
+    ]
+    assert len(df) == 3 and df["verdict"].tolist() == ["by construction", "differs", "reproduced"]
+    assert df["z"].tolist() == ["+0.3", "−10.3", "−0.2"]  # against the paper, σ combined
+    assert html.count('<a href="chapters/pushbroom_ba.html"') == 3 and html.count("<tr>") == 4
+    assert 'data-label="reproduced ± σ">0.2830 ± 0.0020</td>' in html  # a card's labels
+    assert "tuned (missed)" in html
+    assert compact_table(pairs, "004").data["chapter"].eq("—").all()  # planned: no page yet

@@ -20,7 +20,15 @@ from __future__ import annotations
 import re
 
 from hsgeo import papers
-from hsgeo.report import PROVENANCES, VERDICTS, Reproduction, Row
+from hsgeo.report import (
+    _MINUS,
+    VERDICTS,
+    Reproduction,
+    Row,
+    _format_paper,
+    format_value,
+)
+from hsgeo.vocabulary import display_unit, quantity_label
 
 __all__ = [
     "PAPER_CHAPTERS",
@@ -30,10 +38,49 @@ __all__ = [
     "counts",
     "counts_by",
     "overrides",
+    "PAPERS",
+    "CHAPTER_DOCS",
+    "PROVENANCE_GROUPS",
+    "provenance_group",
+    "claims_with_chapters",
+    "paper_paragraph",
+    "compact_table",
 ]
 
 #: The chapters whose tables hold claims of the papers.
 PAPER_CHAPTERS = ("line-calibration", "geocoding", "pushbroom-ba", "rikola", "mtf", "cube")
+
+#: The papers as the scoreboard names them (../shared/papers/README.md).
+PAPERS = {
+    "000": "Miljković, Gajski and Vela (2017): spatial calibration of the ImSpector line scanner",
+    "001": "Krtalić, Miljković, Gajski and Racetin (2019): distortion, sharpness and cube of the "
+    "ImSpector system",
+    "002": "Jonassen, Ressl, Pfeifer, Kjørsvik and Gjevestad (2024): bundle adjustment of aerial "
+    "pushbroom lines",
+    "003": "Tommaselli, Santos, Berveglieri, Oliveira and Honkavaara: inner orientation of the "
+    "Rikola frame camera",
+    "004": "the angular sensitivity of the DAEDALUS AADS 1268 whiskbroom scanner",
+}
+
+#: A chapter's name (``hsgeo reproduce``) -> its page in the book, relative to the book's root.
+CHAPTER_DOCS = {
+    "frame-reference": "chapters/frame_reference",
+    "line-calibration": "chapters/line_calibration",
+    "geocoding": "chapters/geocoding",
+    "pushbroom-ba": "chapters/pushbroom_ba",
+    "rikola": "chapters/rikola",
+    "mtf": "chapters/mtf",
+    "cube": "chapters/cube",
+    "asf": "chapters/asf",
+}
+
+#: The provenance groups the scoreboard counts by: the provenances of
+#: :data:`hsgeo.report.PROVENANCES` with ``tuned`` split by whether the tuning met its target
+#: (issue 28), and ``none`` for rows without a simulation (the planned claims).
+PROVENANCE_GROUPS = ("paper", "derived", "chosen", "tuned (met)", "tuned (missed)", "none")
+
+#: How many claims a paragraph names per verdict before it says "and n more".
+NAMED = 6
 
 _PAPER_TABLE = re.compile(r"^00[0-4] ")
 #: Tables named after a paper that hold experiments rather than claims: the factors table runs
@@ -59,17 +106,33 @@ def planned_claims() -> list[Row]:
     return rows
 
 
-def claims(reps: dict[str, Reproduction]) -> list[Row]:
-    """The claim rows of the chapters' results (tables named after a paper), then the planned."""
+def claims_with_chapters(reps: dict[str, Reproduction]) -> list[tuple[str | None, Row]]:
+    """``(chapter, row)`` for every claim row of the chapters' results (tables named after a
+    paper, with a paper value), then ``(None, row)`` for the planned claims.
+    """
     out = []
     for chapter in PAPER_CHAPTERS:
         if chapter in reps:
             out += [
-                r
+                (chapter, r)
                 for r in reps[chapter].rows
                 if _PAPER_TABLE.match(r.table) and r.table not in NOT_CLAIMS and r.paper is not None
             ]
-    return out + planned_claims()
+    return out + [(None, r) for r in planned_claims()]
+
+
+def claims(reps: dict[str, Reproduction]) -> list[Row]:
+    """The claim rows of the chapters' results (tables named after a paper), then the planned."""
+    return [r for _, r in claims_with_chapters(reps)]
+
+
+def provenance_group(row: Row) -> str:
+    """The row's group in :data:`PROVENANCE_GROUPS`: its provenance, ``tuned`` split into
+    ``tuned (met)`` and ``tuned (missed)`` by its verdict, ``none`` without a provenance.
+    """
+    if row.provenance == "tuned":
+        return "tuned (missed)" if row.judge()[0] == "differs" else "tuned (met)"
+    return row.provenance or "none"
 
 
 def counts(rows: list[Row]) -> dict[str, int]:
@@ -85,9 +148,9 @@ def counts_by(rows: list[Row], key: str) -> dict[str, dict[str, int]]:
     """
     groups: dict[str, list[Row]] = {}
     for r in rows:
-        g = r.table[:3] if key == "paper" else (r.provenance or "none")
+        g = r.table[:3] if key == "paper" else provenance_group(r)
         groups.setdefault(g, []).append(r)
-    order = sorted(groups) if key == "paper" else [*PROVENANCES, "none"]
+    order = sorted(groups) if key == "paper" else PROVENANCE_GROUPS
     return {g: counts(groups[g]) for g in order if g in groups}
 
 
@@ -108,6 +171,173 @@ def overrides(rows: list[Row]) -> list[dict]:
     ]
 
 
+def _claim_label(r: Row) -> str:
+    """A claim in a reader's words: its quantity and the part of the paper it comes from."""
+    return f"{quantity_label(r.quantity)} ({r.table[4:]})"
+
+
+def _named(rows: list[Row]) -> str:
+    """The claims' labels as a list in prose ("a, b and c"; "a, b, … and 3 more")."""
+    names = [_claim_label(r) for r in rows[:NAMED]]
+    if len(rows) > NAMED:
+        names.append(f"{len(rows) - NAMED} more")
+    return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
+
+
+def _listed(parts: list[str]) -> str:
+    return parts[0] if len(parts) == 1 else ", ".join(parts[:-1]) + " and " + parts[-1]
+
+
+def _count_words(n: int, verdict: str) -> str:
+    verb = {
+        "reproduced": "reproduced",
+        "differs": "differs" if n == 1 else "differ",
+        "by construction": ("agrees" if n == 1 else "agree") + " by construction",
+        "not testable": ("is" if n == 1 else "are") + " not testable",
+        "planned": ("is" if n == 1 else "are") + " planned",
+    }[verdict]
+    return f"{n} {verb}"
+
+
+def paper_paragraph(rows: list[Row], paper: str) -> str:
+    """One paragraph on paper ``paper``'s claims, computed from the rows' verdicts: how many
+    claims and how they were judged, which were reproduced, which differ and why, what agreement
+    was built in (by provenance), and what could not be judged. The scoreboard page glues it.
+    """
+    mine = [r for r in rows if r.table.startswith(paper)]
+    if not mine:
+        return f"No claim of paper {paper} is in the book yet."
+    by = {v: [r for r in mine if r.judge()[0] == v] for v in VERDICTS}
+    head = _listed([_count_words(len(by[v]), v) for v in VERDICTS if by[v]])
+    out = [f"Of its {len(mine)} claims, {head}."]
+    if by["reproduced"]:
+        out.append(f"Reproduced as independent outcomes: {_named(by['reproduced'])}.")
+    if by["differs"]:
+        reasons: dict[str, list[Row]] = {}  # claims that differ for the same reason, together
+        for r in by["differs"]:
+            reasons.setdefault(r.judge()[1], []).append(r)
+        why = "; ".join(f"{_named(rs)}: {reason}" for reason, rs in reasons.items())
+        out.append(f"{'Differs' if len(by['differs']) == 1 else 'Differ'}: {why}.")
+    if by["by construction"]:
+        prov = {}
+        for r in by["by construction"]:
+            key = r.provenance or ("paper" if r.truth_is_paper() else "none")
+            prov[key] = prov.get(key, 0) + 1
+        words = {
+            "paper": "took the paper's value as truth",
+            "derived": "computed their truth from the paper's values",
+            "tuned": "were tuned to meet the paper",
+            "chosen": "have a chosen truth equal to the paper's value",
+            "none": "have no stated provenance",
+        }
+        parts = [f"{n} {words[k]}" for k, n in prov.items()]
+        n = len(by["by construction"])
+        out.append(
+            f"Agreement was built in for {n} claim{'s' if n > 1 else ''} "
+            f"({_listed(parts)}): for {'them' if n > 1 else 'it'} only the recovery of the "
+            "truth is an outcome."
+        )
+    if by["not testable"]:
+        out.append(f"Not testable: {_named(by['not testable'])}.")
+    if by["planned"]:
+        reasons = sorted({r.judge()[1] for r in by["planned"]})
+        out.append(f"Planned: {'; '.join(reasons)}.")
+    return " ".join(out)
+
+
+def _pm(value, sigma) -> str:
+    text = format_value(value, sigma)
+    if text != "—" and sigma is not None and format_value(sigma, sigma, sig=2) != "—":
+        text += f" ± {format_value(sigma, sigma, sig=2)}"
+    return text
+
+
+def _signed(z: float) -> str:
+    """A z-score with one decimal and its sign (0.0 without one)."""
+    return "0.0" if abs(z) < 0.05 else f"{z:+.1f}".replace("-", _MINUS)
+
+
+class ClaimTable:
+    """The scoreboard's compact table of claims: :attr:`data` (a DataFrame of display strings)
+    and an HTML form that a phone can read: on a narrow screen every claim becomes a card whose
+    cells carry their column's name (``data-label``, book/_static/hsgeo.css), on a wide one a
+    table with one or two short lines per claim. The claim links to the chapter computing it.
+    """
+
+    COLUMNS = ("claim", "paper", "reproduced ± σ", "z", "verdict")
+
+    def __init__(self, data, chapters: list[str | None], provenance: list[str]):
+        self.data = data
+        self.chapters = chapters
+        self.provenance = provenance
+
+    def _repr_html_(self) -> str:
+        from html import escape
+
+        head = "".join(
+            f'<th class="{"hsgeo-num" if c in ("paper", "reproduced ± σ", "z") else "hsgeo-text"}"'
+            f">{escape(c)}</th>"
+            for c in self.COLUMNS
+        )
+        body = []
+        rows = zip(self.data.iterrows(), self.chapters, self.provenance, strict=True)
+        for (_, rec), chapter, prov in rows:
+            doc = CHAPTER_DOCS.get(chapter or "")
+            claim = escape(rec["claim"])
+            if doc:
+                claim = f'<a href="{doc}.html" title="computed in {chapter}">{claim}</a>'
+            if rec["unit"] not in ("—", ""):
+                claim += f'<br><span class="hsgeo-unit">in {escape(rec["unit"])}</span>'
+            cells = [f'<td class="hsgeo-text hsgeo-claim" data-label="claim">{claim}</td>']
+            for c in ("paper", "reproduced ± σ", "z"):
+                cells.append(f'<td class="hsgeo-num" data-label="{c}">{escape(rec[c])}</td>')
+            cells.append(
+                f'<td class="hsgeo-text" data-label="verdict">'
+                f'<span class="hsgeo-verdict">{escape(rec["verdict"])}</span>'
+                f'<br><span class="hsgeo-provenance">{escape(prov)}</span></td>'
+            )
+            body.append("<tr>" + "".join(cells) + "</tr>")
+        return (
+            '<table class="hsgeo-table hsgeo-claims">'
+            f"<thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
+        )
+
+
+def compact_table(pairs: list[tuple[str | None, Row]], paper: str | None = None) -> ClaimTable:
+    """The claims as the scoreboard page shows them (:class:`ClaimTable`): claim (a link to its
+    chapter, its unit under it) | paper | reproduced ± σ | z against the paper | verdict, with the
+    provenance of the truth under the verdict; one claim per row. ``pairs`` is the output of
+    :func:`claims_with_chapters`; ``paper`` keeps one paper's claims. ``data`` also holds the
+    ``provenance`` and ``chapter`` columns.
+    """
+    import pandas as pd
+
+    recs, chapters, provs = [], [], []
+    for chapter, r in pairs:
+        if paper is not None and not r.table.startswith(paper):
+            continue
+        shown = _format_paper(r.paper)
+        if r.paper_sigma is not None and _format_paper(r.paper_sigma) != "—":
+            shown += f" ± {_format_paper(r.paper_sigma)}"
+        zp = r.z_paper
+        recs.append(
+            {
+                "claim": _claim_label(r),
+                "unit": display_unit(r.quantity, r.unit),
+                "paper": shown,
+                "reproduced ± σ": _pm(r.reproduced, r.sigma),
+                "z": "—" if zp is None else _signed(zp),
+                "verdict": r.judge()[0],
+                "provenance": provenance_group(r),
+                "chapter": chapter or "—",
+            }
+        )
+        chapters.append(chapter)
+        provs.append(provenance_group(r))
+    cols = ["claim", "unit", "paper", "reproduced ± σ", "z", "verdict", "provenance", "chapter"]
+    return ClaimTable(pd.DataFrame(recs, columns=cols), chapters, provs)
+
+
 def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
     """The scoreboard as a :class:`Reproduction` whose tables are the papers' tables.
 
@@ -125,7 +355,8 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
             rep, how = run_chapter(chapter, seed=seed, scale=scale), "run for the scoreboard"
         reps[chapter] = rep
         sources[chapter] = {"seed": rep.seed, "scale": rep.meta.get("scale"), "source": how}
-    rows = claims(reps)
+    pairs = claims_with_chapters(reps)
+    rows = [r for _, r in pairs]
     return Reproduction(
         "scoreboard",
         seed,
@@ -137,5 +368,7 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
             "counts_by_provenance": counts_by(rows, "provenance"),
             "overrides": overrides(rows),
             "n_claims": len(rows),
+            "chapters": [c for c, _ in pairs],
+            "paragraphs": {p: paper_paragraph(rows, p) for p in PAPERS},
         },
     )
