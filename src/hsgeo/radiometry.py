@@ -529,8 +529,9 @@ def asf_ratio(
         c_mean = np.where(w > 0, c, 0.0).sum(axis=1) / n  # 004 step 2
         a_mean = np.where(w > 0, a, 0.0).sum(axis=1) / n
         ratio = c_mean / a_mean  # 004 step 3
-        r = np.where(w > 0, c / np.where(a > 0, a, 1.0), np.nan)
-        sd = np.sqrt(np.nansum((r - np.nanmean(r, axis=1, keepdims=True)) ** 2, axis=1) / (n - 1))
+        r = np.where(w > 0, c / np.where(a > 0, a, 1.0), 0.0)
+        r_mean = r.sum(axis=1, keepdims=True) / n
+        sd = np.sqrt((w * (r - r_mean) ** 2).sum(axis=1) / (n - 1))
     usable = n >= max(min_samples, 2)
     ratio = np.where(usable, ratio, np.nan)
     sigma = np.where(usable, sd / np.sqrt(np.maximum(n, 1)), np.nan)
