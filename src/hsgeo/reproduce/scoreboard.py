@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import re
 
-from hsgeo import papers
 from hsgeo.report import PROVENANCES, VERDICTS, Reproduction, Row
 
 __all__ = [
@@ -33,7 +32,7 @@ __all__ = [
 ]
 
 #: The chapters whose tables hold claims of the papers.
-PAPER_CHAPTERS = ("line-calibration", "geocoding", "pushbroom-ba", "rikola", "mtf", "cube")
+PAPER_CHAPTERS = ("line-calibration", "geocoding", "pushbroom-ba", "rikola", "mtf", "cube", "asf")
 
 _PAPER_TABLE = re.compile(r"^00[0-4] ")
 #: Tables named after a paper that hold experiments rather than claims: the factors table runs
@@ -43,20 +42,12 @@ NOT_CLAIMS = ("002 check-point factors",)
 
 
 def planned_claims() -> list[Row]:
-    """The papers' claims of chapters not written yet (``verdict="planned"``)."""
-    rows = []  # 001 Table 3 and Fig. 9 are the mtf chapter's
-    for quantity, (value, unit) in papers.ASF_004.items():
-        rows.append(
-            Row(
-                "004 text",
-                quantity,
-                unit,
-                paper=value,
-                verdict="planned",
-                reason="ASF chapter (crossing flight lines) not written yet",
-            )
-        )
-    return rows
+    """The papers' claims of chapters not written yet (``verdict="planned"``).
+
+    None are left: 001 Table 3 and Fig. 9 are the mtf chapter's, 004's numbers
+    (:data:`hsgeo.papers.ASF_004`) the asf chapter's table ``"004 text"``.
+    """
+    return []
 
 
 def claims(reps: dict[str, Reproduction]) -> list[Row]:

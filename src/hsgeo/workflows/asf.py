@@ -41,6 +41,7 @@ __all__ = [
     "register",
     "asf_from_scans",
     "asf_files",
+    "peak_to_peak_percent",
 ]
 
 
@@ -171,6 +172,9 @@ class AsfOptions:
     search_m, search_step_m : float
         The coarse search of the shift: a grid of ± ``search_m`` in steps of ``search_step_m``
         (every third sample), then ± half a step in quarter steps.
+    smooth_px : int
+        Local quadratic fit over this many columns (odd) before the peak-to-peak variation is
+        taken (:func:`peak_to_peak_percent`).
     """
 
     margin_m: float = 2.0
@@ -182,6 +186,7 @@ class AsfOptions:
     registration_bands: tuple | None = None
     search_m: float = 4.0
     search_step_m: float = 0.8
+    smooth_px: int = 31
 
 
 @dataclass(frozen=True)
@@ -207,6 +212,7 @@ class Registration:
     scatter_px: float
     sigma_px: float
     gsd_m: float
+    sigma_m: np.ndarray  # (E, N) standard errors of the median shift
 
     @property
     def n_windows(self) -> int:
@@ -369,7 +375,24 @@ def register(
     med = np.median(S, axis=0)
     nmad = 1.4826 * np.median(np.abs(S - med), axis=0)
     scatter = float(np.hypot(*nmad)) / gsd
-    return Registration(med, S, np.array(centres), scatter, 1.2533 * scatter / np.sqrt(len(S)), gsd)
+    se = 1.2533 / np.sqrt(len(S))  # standard error of a median, normal errors
+    return Registration(med, S, np.array(centres), scatter, se * scatter, gsd, se * nmad)
+
+
+def peak_to_peak_percent(asf, usable, smooth_px: int) -> np.ndarray:
+    """Max − min of each band's ASF over the usable columns, % of nadir, smoothed first.
+
+    The max − min of a noisy curve is biased upwards by its noise; a local quadratic fit over
+    ``smooth_px`` columns (Savitzky–Golay, polynomial fits at the ends) takes most of that bias
+    away and leaves a smooth curve — slopes and curvature at the ends of the scan included —
+    as it is.
+    """
+    from scipy.signal import savgol_filter
+
+    a = np.asarray(asf, float)[:, np.asarray(usable, bool)]
+    if smooth_px > 2 and a.shape[1] > smooth_px:
+        a = savgol_filter(a, int(smooth_px) | 1, 2, axis=1, mode="interp")
+    return 100.0 * (a.max(axis=1) - a.min(axis=1))
 
 
 @dataclass(frozen=True)
@@ -382,6 +405,7 @@ class AsfResult:
     n_samples: np.ndarray
     usable: np.ndarray  # (pixels,) bool
     registration: Registration | None
+    smooth_px: int = 31
 
     @property
     def scan_angle_deg(self) -> np.ndarray:
@@ -389,9 +413,10 @@ class AsfResult:
 
     @property
     def peak_to_peak_percent(self) -> np.ndarray:
-        """Max − min of each band's ASF over the usable columns, % of nadir."""
-        a = self.asf[:, self.usable]
-        return 100.0 * (a.max(axis=1) - a.min(axis=1))
+        """Max − min of each band's ASF over the usable columns, % of nadir, after a local
+        quadratic smoothing over ``smooth_px`` columns (:func:`peak_to_peak_percent`).
+        """
+        return peak_to_peak_percent(self.asf, self.usable, self.smooth_px)
 
     def table(self):
         """One row per column: scan angle, samples, the ASF and σ̂ of every band (pandas)."""
@@ -467,7 +492,9 @@ def asf_from_scans(inputs: AsfInputs, options: AsfOptions = AsfOptions()) -> Asf
         min_samples=options.min_samples,
     )
     usable = np.all(np.isfinite(r.asf), axis=0)
-    return AsfResult(cross.scan_angle_rad, r.asf, r.sigma, r.n_samples, usable, reg)
+    return AsfResult(
+        cross.scan_angle_rad, r.asf, r.sigma, r.n_samples, usable, reg, options.smooth_px
+    )
 
 
 def asf_files(cross_path, along_path, runway_path, options: AsfOptions = AsfOptions()):
