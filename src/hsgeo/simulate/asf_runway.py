@@ -29,7 +29,7 @@ the speed and line rate (0.63 m per line), the navigation errors.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -46,7 +46,6 @@ __all__ = [
     "true_asf",
     "simulate_runway",
     "add_noise",
-    "with_brdf",
     "ASF_PEAK_TO_PEAK_PERCENT",
 ]
 
@@ -252,7 +251,6 @@ def _render(scene, field_, traj, lines, zeta, t0_s, asf):
     nb, nl, nz = scene.n_channels, lines.size, zeta.size
     out = np.zeros((nb, nl, nz))
     brdf = np.zeros((nl, nz))
-    th = s.scan_angle_rad(zeta)
     terrain = PlaneTerrain(0.0)
     for a in range(0, nl, 64):
         ll = lines[a : a + 64]
@@ -268,7 +266,7 @@ def _render(scene, field_, traj, lines, zeta, t0_s, asf):
         t = s.times(L.ravel(), Z.ravel(), t0_s, scene.line_rate_hz)
         o, d = s.rays(Z.ravel(), t, traj)
         brdf[a : a + ll.size] = _brdf(scene, o, d).reshape(ll.size, nz)
-    return out * asf[:, None, :] * brdf[None], brdf, th
+    return out * asf[:, None, :] * brdf[None], brdf
 
 
 def _flight(scene, heading_rad, start_en, n_lines, nav_error_m):
@@ -321,7 +319,7 @@ def simulate_runway(scene: RunwayScene | None = None, rng=0, *, reverse: bool = 
     for name, (heading, start, n, err, zeta) in flights.items():
         true, rec, t0 = _flight(scene, heading, start, n, err)
         a = asf[:, np.rint(zeta).astype(int)]
-        img, brdf, _ = _render(scene, field_, true, np.arange(n), zeta, t0, a)
+        img, brdf = _render(scene, field_, true, np.arange(n), zeta, t0, a)
         clean[name] = img
         brdfs[name] = brdf
         scans[name] = Scan(
@@ -358,8 +356,3 @@ def add_noise(clean, scene: RunwayScene, rng) -> np.ndarray:
     rng = as_rng(rng)
     x = np.asarray(clean, dtype=float)
     return x * (1.0 + scene.noise_relative * rng.standard_normal(x.shape))
-
-
-def with_brdf(scene: RunwayScene, on: bool = True) -> RunwayScene:
-    """The scene with the BRDF switched on or off."""
-    return replace(scene, brdf=on)
