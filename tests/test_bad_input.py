@@ -168,8 +168,16 @@ def _cube(d: Path) -> None:
     write_frame_folder(d / "dark", dark, t)
 
 
+def _asf(d: Path) -> None:
+    from asf_inputs import write_asf_inputs
+
+    d.mkdir()
+    write_asf_inputs(d)
+
+
 def build_valid(root: Path) -> Path:
     """Write the valid inputs of every command under ``root`` (one folder per command)."""
+    _asf(root / "asf")
     _mtf(root / "mtf")
     _mtf_edge(root / "mtf-edge")
     _bal(root / "adjust-bal")
@@ -225,6 +233,8 @@ def base_argv(cmd: str, d: Path) -> list[str]:
         out = d.parent / "out"
         out.mkdir(exist_ok=True)
         return [cmd, s(d / "raw"), "--dark", s(d / "dark"), "-o", s(out / "cube.nc"), "--quiet"]
+    if cmd == "asf":
+        return [cmd, s(d / "cross.nc"), s(d / "along.nc"), "--runway", s(d / "runway.csv")]
     if cmd == "reproduce":
         return [cmd, "frame-reference"]
     if cmd == "data":
@@ -1341,6 +1351,80 @@ def _straight_edge(p):
     img[:, 80:] = 3000
     img += np.random.default_rng(0).integers(0, 20, img.shape).astype(np.uint16)
     cv2.imwrite(str(p), img)
+
+
+# --- asf ---------------------------------------------------------------------------------------
+C = "asf"
+table_file_cases(C, "runway.csv", "runway", ["E_m", "N_m"], "cross.nc")
+case(C, "degenerate", "runway-two-corners", "3 corners", [("runway.csv", keep_rows(2))])
+case(C, "duplicates", "runway-flattened", "line 4", [("runway.csv", scale_column("N_m", 0.0))])
+case(
+    C,
+    "degenerate",
+    "runway-collinear",
+    "no area",
+    [("runway.csv", lambda p: p.write_text("E_m,N_m\n0,0\n10,1\n20,2\n"))],
+)
+case(
+    C,
+    "degenerate",
+    "runway-outside-the-image",
+    "outside the cross scan",
+    [("runway.csv", lambda p: p.write_text("E_m,N_m\n5000,-16\n5400,-16\n5400,16\n5000,16\n"))],
+)
+for f in ("cross.nc", "along.nc"):
+    case(C, "missing", f"{f}-missing", f, [(f, remove)])
+    case(C, "missing", f"{f}-directory", f, [(f, make_dir)])
+    case(C, "empty", f"{f}-empty", f, [(f, text(""))])
+    case(C, "garbage", f"{f}-text", f, [(f, text("hello world\n"))])
+    case(C, "binary", f"{f}-binary", f, [(f, text(BINARY))])
+    case(C, "mistyped", f"{f}-csv", f, [(f, copy_from("runway.csv"))])
+    case(
+        C, "mistyped", f"{f}-no-reflectance", "reflectance",
+        [(f, nc_edit(lambda ds: ds.rename({"reflectance": "radiance"})))],
+    )  # fmt: skip
+    case(C, "mistyped", f"{f}-no-E_m", "E_m", [(f, nc_edit(lambda ds: ds.drop_vars("E_m")))])
+    case(
+        C, "mistyped", f"{f}-no-scan-angle", "scan_angle_deg",
+        [(f, nc_edit(lambda ds: ds.drop_vars("scan_angle_deg")))],
+    )  # fmt: skip
+    case(
+        C, "nonfinite", f"{f}-N_m-nan", "N_m",
+        [(f, nc_edit(lambda ds: ds.assign(N_m=ds["N_m"].where(ds["N_m"] > 1e9))))],
+    )  # fmt: skip
+    case(
+        C, "units", f"{f}-scan-angle-in-px", "scan_angle_deg",
+        [(f, nc_edit(lambda ds: ds.assign(scan_angle_deg=ds["scan_angle_deg"] * 100)))],
+    )  # fmt: skip
+    case(
+        C, "degenerate", f"{f}-scan-angle-constant", "scan_angle_deg",
+        [(f, nc_edit(lambda ds: ds.assign(scan_angle_deg=ds["scan_angle_deg"] * 0)))],
+    )  # fmt: skip
+case(
+    C,
+    "degenerate",
+    "scans-do-not-cross",
+    "do the scans cross",
+    [("along.nc", nc_edit(lambda ds: ds.assign(N_m=ds["N_m"] + 5000.0)))],
+)
+case(
+    C,
+    "degenerate",
+    "scans-do-not-cross-unregistered",
+    "do the two scans cross",
+    [("along.nc", nc_edit(lambda ds: ds.assign(N_m=ds["N_m"] + 5000.0)))],
+    argv=flag("--no-register"),
+)
+case(
+    C,
+    "mistyped",
+    "bands-differ",
+    "bands",
+    [("along.nc", nc_edit(lambda ds: ds.isel(band=slice(0, 3))))],
+)
+for v in ("nan", "-1", "abc"):
+    case(C, "options", f"--margin={v}", "--margin", argv=opt("--margin", v))
+case(C, "options", "no-runway", "--runway", argv=opt("--runway"))
 
 
 C = "reproduce"

@@ -70,7 +70,7 @@ def test_claims_are_the_paper_tables_plus_planned():
     assert c["by construction"] == 1 and c["differs"] == 1 and c["planned"] == len(planned_claims())
     by_prov = counts_by(rows, "provenance")
     assert by_prov["paper"]["by construction"] == 1 and by_prov["chosen"]["differs"] == 1
-    assert by_prov["none"]["planned"] == len(planned_claims())
+    assert by_prov.get("none", {}).get("planned", 0) == len(planned_claims())
     assert counts_by(rows, "paper")["002"] == {
         **dict.fromkeys(c, 0),
         "differs": 1,
@@ -168,9 +168,8 @@ def test_paper_paragraph_is_computed_from_the_verdicts():
     assert "NMAD" in text and "tuning missed: 10.3σ from the paper" in text
     assert "were tuned to meet the paper" in text
     assert "nmad_" not in text  # claims in a reader's words, never internal keys
-    planned = paper_paragraph(rows, "004")
-    assert planned.startswith(f"Of its {len(planned_claims())} claims, ")
-    assert "Planned: ASF chapter" in planned
+    planned = [Row("004 text", "asf_pct", "%", paper=15.0, verdict="planned", reason="not yet")]
+    assert paper_paragraph(planned, "004") == "Of its 1 claim, 1 is planned. Planned: not yet."
     assert paper_paragraph(rows, "009") == "No claim of paper 009 is in the book yet."
 
 
@@ -193,4 +192,23 @@ def test_compact_table_has_one_short_line_per_claim_with_a_link():
     assert html.count('<a href="chapters/pushbroom_ba.html"') == 3 and html.count("<tr>") == 4
     assert 'data-label="reproduced ± σ">0.2830 ± 0.0020</td>' in html  # a card's labels
     assert "tuned (missed)" in html
-    assert compact_table(pairs, "004").data["chapter"].eq("—").all()  # planned: no page yet
+    planned = [(None, Row("004 text", "asf_pct", "%", paper=15.0, verdict="planned", reason="-"))]
+    assert compact_table(planned, "004").data["chapter"].eq("—").all()  # planned: no page yet
+
+
+def test_asf_chapter_claims_replace_the_planned_004_rows():
+    """004's numbers were planned; the asf chapter's "004 text" rows are now the claims."""
+    from hsgeo.papers import ASF_004
+
+    assert "asf" in PAPER_CHAPTERS and planned_claims() == []
+    rep = Reproduction(
+        "asf",
+        0,
+        [
+            Row("004 text", q, u, paper=v, reproduced=v, provenance="paper")
+            for q, (v, u) in ASF_004.items()
+        ]
+        + [Row("004 ASF", "ASF at +40°, channel 1", "1", reproduced=0.96, sigma=0.001, truth=0.96)],
+    )
+    rows = claims({"asf": rep})
+    assert [r.quantity for r in rows] == list(ASF_004)

@@ -236,6 +236,40 @@ def _cmd_mtf_edge(args) -> int:
     return 0
 
 
+def _cmd_asf(args) -> int:
+    import json
+
+    import numpy as np
+
+    from hsgeo.workflows.asf import AsfOptions, asf_files
+
+    opts = AsfOptions(margin_m=args.margin, register=not args.no_register)
+    res = asf_files(args.cross, args.along, args.runway, opts)
+    if args.json:
+        print(json.dumps(res.to_dict(), indent=1, allow_nan=False))
+        return 0
+    reg = res.registration
+    if reg is not None:
+        print(
+            f"registration: along image shifted by ({reg.shift_m[0]:+.2f}, {reg.shift_m[1]:+.2f}) "
+            f"m (E, N) from {reg.n_windows} windows; scatter between windows "
+            f"{reg.scatter_px:.2f} px, σ̂ of the shift {reg.sigma_px:.3f} px"
+        )
+    print(f"{int(res.usable.sum())} of {res.usable.size} columns usable")
+    pp = ", ".join(f"{v:.1f}" for v in res.peak_to_peak_percent)
+    print(f"peak-to-peak ASF variation per band, %: {pp}")
+    print(
+        "scan_angle_deg " + " ".join(f"{'band ' + str(b + 1):>8}" for b in range(res.asf.shape[0]))
+    )
+    for ang in (-40, -30, -20, -10, 0, 10, 20, 30, 40):
+        j = int(np.argmin(np.abs(res.scan_angle_deg - ang)))
+        if abs(res.scan_angle_deg[j] - ang) > 1 or not res.usable[j]:
+            continue
+        vals = " ".join(f"{v:8.4f}" for v in res.asf[:, j])
+        print(f"{res.scan_angle_deg[j]:14.2f} {vals}")
+    return 0
+
+
 def _cmd_cube(args) -> int:
     import json
 
@@ -590,6 +624,38 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", action="store_true", help="no progress bar (shown on a terminal)")
     p.add_argument("--json", action="store_true", help="a JSON summary instead of one line")
     p.set_defaults(func=_cmd_cube)
+
+    p = sub.add_parser(
+        "asf",
+        help="angular sensitivity of a whiskbroom scanner: cross-runway / along-runway (004)",
+        description="The angular sensitivity function (ASF) of a whiskbroom scanner from a scan "
+        "crossing a runway divided by an overflight along it (004 steps 1-3): the along image "
+        "is registered onto the cross scan by the landmarks at the runway's sides (a shift per "
+        "window along both long edges, their median), both are averaged over the runway's "
+        "width, divided, and normalised to nadir. CROSS and ALONG: georegistered scans, NetCDF "
+        "with reflectance(band, line, pixel), E_m(line, pixel) and N_m(line, pixel) (the "
+        "ground point of every sample, m, in one map frame) and scan_angle_deg(pixel) "
+        "(positive to the right of the heading). RUNWAY: CSV or Parquet with columns E_m, N_m, "
+        "the runway's corners in order around it.",
+    )
+    p.add_argument("cross", metavar="CROSS.nc", help="the scan crossing the runway")
+    p.add_argument("along", metavar="ALONG.nc", help="the scan flown along the runway")
+    p.add_argument(
+        "--runway", required=True, metavar="RUNWAY.csv", help="runway corners (E_m, N_m)"
+    )
+    p.add_argument(
+        "--margin",
+        type=option_number(lo=0.0, hi=100.0),
+        default=2.0,
+        help="samples closer than this to the runway's edge are left out, m (default 2)",
+    )
+    p.add_argument(
+        "--no-register",
+        action="store_true",
+        help="take the georegistration as it is (no shift by the landmarks)",
+    )
+    p.add_argument("--json", action="store_true", help="one JSON object instead of text")
+    p.set_defaults(func=_cmd_asf)
 
     p = sub.add_parser("versions", help="versions of hsgeo, Python and the dependencies")
     p.set_defaults(func=_cmd_versions)

@@ -369,6 +369,7 @@ ASF_004 = {
     "angular pixel size": (0.12, "deg"),  # 2 · 43° / 716
     "nadir GSD at 300 m": (0.7, "m"),  # "about 0.7 m for nadir"
     "runway width": (50.0, "px"),  # "about 50 pixels"
+    "registration accuracy": (1.0, "px"),  # "estimated to be about one pixel"
 }
 
 

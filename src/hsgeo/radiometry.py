@@ -12,11 +12,16 @@ simulation in it:
   (:func:`incident_mean`), and spectral rows averaged into bands (:func:`bin_rows`);
 * the mean of a patch of the cube with a σ̂ that allows for errors shared by a column (the dark
   fit) or by a line (the incident signal) (:func:`patch_mean`);
-* vegetation indices (:data:`INDICES`, :func:`vegetation_index`) with σ̂ by the delta method.
+* vegetation indices (:data:`INDICES`, :func:`vegetation_index`) with σ̂ by the delta method;
+* the angular sensitivity function of a whiskbroom scanner from a cross-runway scan divided by
+  the along-runway overflight (004 steps 2–3, :func:`asf_ratio`), and its parts even and odd in
+  the scan angle (:func:`even_odd_parts`, :func:`combine_opposite_crossings`).
 
 References
 ----------
 Krtalić, Miljković, Gajski, Racetin (2019), Sensors 19(19) 4267 (paper 001 of this book).
+Determination of the angular sensitivity of a multispectral line scanner from image data
+(DAEDALUS AADS 1268; paper 004 of this book).
 """
 
 from __future__ import annotations
@@ -44,6 +49,10 @@ __all__ = [
     "INDICES",
     "vegetation_index",
     "eq8_speed_m_s",
+    "AsfRatio",
+    "asf_ratio",
+    "even_odd_parts",
+    "combine_opposite_crossings",
 ]
 
 #: Largest raw value of the 12-bit PixelFly (001 §2.1).
@@ -447,3 +456,122 @@ def vegetation_index(name: str, wavelength_nm, spectrum, sigma=None):
         xp[j] += h
         grad[j] = (value(xp) - v) / h
     return v, float(np.sqrt(np.sum((grad * sig) ** 2)))
+
+
+# --- the angular sensitivity function (004) ----------------------------------------------------
+
+
+@dataclass(frozen=True)
+class AsfRatio:
+    """The ASF of each channel and pixel from one crossing (:func:`asf_ratio`).
+
+    Attributes
+    ----------
+    asf : (bands, pixels) ndarray
+        Cross / along, averaged over the runway width, normalised to nadir (NaN where a column
+        has fewer than ``min_samples`` runway samples).
+    sigma : (bands, pixels) ndarray
+        σ̂ of ``asf`` from the scatter of the per-sample ratios over the width.
+    n_samples : (pixels,) ndarray of int
+        Runway samples averaged in each column.
+    nadir : (bands,) ndarray
+        The ratio at nadir that ``asf`` was divided by.
+    """
+
+    asf: np.ndarray
+    sigma: np.ndarray
+    n_samples: np.ndarray
+    nadir: np.ndarray
+
+
+def asf_ratio(
+    cross, along, inside, scan_angle_rad, *, nadir_halfwidth_rad: float, min_samples: int = 10
+) -> AsfRatio:
+    """The angular sensitivity function: cross-runway scan / along-runway overflight (004).
+
+    004 step 2: "Average the values over the width of the runway for both images"; step 3:
+    "Divide the cross-runway scan by the along-runway scan. The ratio gives the ASF ... after
+    normalization to nadir". ``along`` is the along-runway image already registered onto the
+    cross scan (004 step 1), i.e. sampled at the ground points of the cross scan's pixels, so
+    both averages run over the same ground.
+
+    Parameters
+    ----------
+    cross, along : (bands, lines, pixels) ndarray
+        Cross-runway scan and the along-runway image at the same ground points (NaN where the
+        along image does not reach).
+    inside : (lines, pixels) bool ndarray
+        Samples on the runway (less a margin from its edges).
+    scan_angle_rad : (pixels,) ndarray
+        Scan angle of each column.
+    nadir_halfwidth_rad : float
+        The nadir value is the mean ratio of the columns with ``|θ| ≤`` this.
+    min_samples : int
+        Columns with fewer runway samples are NaN (not usable).
+
+    Returns
+    -------
+    AsfRatio
+    """
+    c = np.asarray(cross, dtype=float)
+    a = np.asarray(along, dtype=float)
+    if c.ndim != 3 or a.shape != c.shape or np.shape(inside) != c.shape[1:]:
+        raise InputError(
+            f"cross {c.shape}, along {a.shape} and runway mask {np.shape(inside)} must be "
+            "(bands, lines, pixels), (bands, lines, pixels) and (lines, pixels)"
+        )
+    th = np.asarray(scan_angle_rad, dtype=float)
+    ok = np.asarray(inside, bool) & np.all(np.isfinite(a), axis=0) & np.all(np.isfinite(c), axis=0)
+    ok &= np.all(a > 0, axis=0)
+    n = ok.sum(axis=0)
+    w = ok[None].astype(float)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        c_mean = np.where(w > 0, c, 0.0).sum(axis=1) / n  # 004 step 2
+        a_mean = np.where(w > 0, a, 0.0).sum(axis=1) / n
+        ratio = c_mean / a_mean  # 004 step 3
+        r = np.where(w > 0, c / np.where(a > 0, a, 1.0), 0.0)
+        r_mean = r.sum(axis=1, keepdims=True) / n
+        sd = np.sqrt((w * (r - r_mean) ** 2).sum(axis=1) / (n - 1))
+    usable = n >= max(min_samples, 2)
+    ratio = np.where(usable, ratio, np.nan)
+    sigma = np.where(usable, sd / np.sqrt(np.maximum(n, 1)), np.nan)
+    near = usable & (np.abs(th) <= nadir_halfwidth_rad)
+    if not near.any():
+        raise InputError(
+            f"no usable column within ±{np.rad2deg(nadir_halfwidth_rad):.2f}° of nadir: the "
+            "runway must be seen at nadir to normalise the ASF there"
+        )
+    nadir = ratio[:, near].mean(axis=1)  # 004: "after normalization to nadir"
+    return AsfRatio(ratio / nadir[:, None], sigma / nadir[:, None], n, nadir)
+
+
+def even_odd_parts(asf) -> tuple[np.ndarray, np.ndarray]:
+    """The parts of an ASF even and odd in the scan angle, as factors: ``asf = even · odd``.
+
+    ``even(θ) = sqrt(asf(θ)·asf(−θ))``, ``odd(θ) = sqrt(asf(θ)/asf(−θ))``, on a pixel grid
+    symmetric about nadir (pixel ``i`` ↔ ``n − 1 − i``, as the 004 scanner's). A BRDF of a
+    rotationally symmetric surface seen across the principal plane is even in θ, so the even
+    part of the ASF cannot be told from it (004 § ASF: "Symmetric ASF effects cannot be detected
+    by our procedure if the BRDF of the surface is unknown").
+    """
+    x = np.asarray(asf, dtype=float)
+    flipped = x[..., ::-1]
+    return np.sqrt(x * flipped), np.sqrt(x / flipped)
+
+
+def combine_opposite_crossings(asf_a, asf_b) -> tuple[np.ndarray, np.ndarray]:
+    """Two crossings of the runway with opposite headings: the ASF and the BRDF's odd part.
+
+    With the heading reversed the scan sweeps the ground the other way round, so a BRDF factor
+    odd in the scan angle changes sign relative to the pixels while the ASF does not:
+    ``r_a = ASF·B_even·B_odd``, ``r_b = ASF·B_even/B_odd``. Hence ``sqrt(r_a·r_b) = ASF·B_even``
+    (the odd part of the ASF freed of the BRDF's odd part) and ``sqrt(r_a/r_b) = B_odd`` (beyond
+    004, which flew one crossing). The even parts of ASF and BRDF stay inseparable.
+
+    Returns
+    -------
+    asf, brdf_odd : ndarray
+    """
+    a = np.asarray(asf_a, dtype=float)
+    b = np.asarray(asf_b, dtype=float)
+    return np.sqrt(a * b), np.sqrt(a / b)

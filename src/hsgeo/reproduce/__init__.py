@@ -29,6 +29,7 @@ CHAPTERS: dict[str, str] = {
     "pushbroom-ba": "pushbroom_ba",
     "mtf": "mtf",
     "cube": "cube",
+    "asf": "asf",
     "scoreboard": "scoreboard",
 }
 

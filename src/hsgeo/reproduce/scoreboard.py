@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import re
 
-from hsgeo import papers
 from hsgeo.report import (
     _MINUS,
     VERDICTS,
@@ -48,7 +47,7 @@ __all__ = [
 ]
 
 #: The chapters whose tables hold claims of the papers.
-PAPER_CHAPTERS = ("line-calibration", "geocoding", "pushbroom-ba", "rikola", "mtf", "cube")
+PAPER_CHAPTERS = ("line-calibration", "geocoding", "pushbroom-ba", "rikola", "mtf", "cube", "asf")
 
 #: The papers as the scoreboard names them (../shared/papers/README.md).
 PAPERS = {
@@ -90,20 +89,12 @@ NOT_CLAIMS = ("002 check-point factors",)
 
 
 def planned_claims() -> list[Row]:
-    """The papers' claims of chapters not written yet (``verdict="planned"``)."""
-    rows = []  # 001 Table 3 and Fig. 9 are the mtf chapter's
-    for quantity, (value, unit) in papers.ASF_004.items():
-        rows.append(
-            Row(
-                "004 text",
-                quantity,
-                unit,
-                paper=value,
-                verdict="planned",
-                reason="ASF chapter (crossing flight lines) not written yet",
-            )
-        )
-    return rows
+    """The papers' claims of chapters not written yet (``verdict="planned"``).
+
+    None are left: 001 Table 3 and Fig. 9 are the mtf chapter's, 004's numbers
+    (:data:`hsgeo.papers.ASF_004`) the asf chapter's table ``"004 text"``.
+    """
+    return []
 
 
 def claims_with_chapters(reps: dict[str, Reproduction]) -> list[tuple[str | None, Row]]:
@@ -209,7 +200,7 @@ def paper_paragraph(rows: list[Row], paper: str) -> str:
         return f"No claim of paper {paper} is in the book yet."
     by = {v: [r for r in mine if r.judge()[0] == v] for v in VERDICTS}
     head = _listed([_count_words(len(by[v]), v) for v in VERDICTS if by[v]])
-    out = [f"Of its {len(mine)} claims, {head}."]
+    out = [f"Of its {len(mine)} claim{'s' if len(mine) > 1 else ''}, {head}."]
     if by["reproduced"]:
         out.append(f"Reproduced as independent outcomes: {_named(by['reproduced'])}.")
     if by["differs"]:

@@ -7,8 +7,9 @@
 * :mod:`~hsgeo.sensors.pushbroom`: the 002 LP camera (``PushbroomCamera``, ``PushbroomLines``);
 * :mod:`~hsgeo.sensors.frame`, :mod:`~hsgeo.sensors.bal`, :mod:`~hsgeo.sensors.rikola`: frame
   cameras (``FrameCamera`` offers ``rays`` / ``project`` at given exposure poses);
-* a panoramic (whiskbroom) scanner for 004 comes as ``sensors/panoramic.py``: a scanning
-  sensor like ``LineScanner`` whose samples along one scan have their own times.
+* :mod:`~hsgeo.sensors.panoramic`: the 004 panoramic (whiskbroom) scanner
+  (``PanoramicScanner``): a scanning sensor like ``LineScanner`` whose samples along one scan
+  have their own times.
 """
 
 from __future__ import annotations
