@@ -79,9 +79,10 @@ def _cmd_calibrate_line(args) -> int:
 
 
 def _cmd_calibrate_frame(args) -> int:
+    from hsgeo.report import from_estimates
     from hsgeo.workflows.frame_calibration import calibrate_frame_files
 
-    out = calibrate_frame_files(
+    res = calibrate_frame_files(
         args.images,
         args.board,
         joint=args.joint,
@@ -89,6 +90,7 @@ def _cmd_calibrate_frame(args) -> int:
         cube_regex=args.cube_regex,
         sigma_px=args.sigma_px,
     )
+    out = from_estimates("calibrate-frame", res)
     print(
         out.to_json()
         if args.json

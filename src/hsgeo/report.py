@@ -43,6 +43,7 @@ __all__ = [
     "NUMERIC_COLUMNS",
     "as_text",
     "glue_text",
+    "from_estimates",
 ]
 
 #: The verdicts of a claim (ReScience style). ``by construction``: the truth (or the outcome) is
@@ -623,3 +624,15 @@ class Reproduction:
                     ).rstrip()
                 )
         return "\n".join(out)
+
+
+def from_estimates(name: str, result) -> Reproduction:
+    """A workflow's estimates as report rows (reproduced and σ̂ only): ``result`` has
+    ``estimates`` (each with ``group``, ``name``, ``unit``, ``value``, ``sigma``) and ``meta``,
+    as :class:`hsgeo.workflows.frame_calibration.FrameFilesResult`; the rows' tables are the
+    groups. ``hsgeo calibrate-frame`` prints this, and the chapter shows it.
+    """
+    rows = [
+        Row(e.group, e.name, e.unit, None, None, e.value, e.sigma, None) for e in result.estimates
+    ]
+    return Reproduction(name, 0, rows, result.meta)
