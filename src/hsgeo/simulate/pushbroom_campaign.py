@@ -475,6 +475,248 @@ def _true_pose(plan, strip, t, amp, speed_m_s):
     return xyz, rpy
 
 
+#: The 17 reference squares' nominal east, north (m) about the block centre: 4 GCPs at the
+#: corners, then the 13 check points (each moved by up to ±20 m at random).
+REFERENCE_EN_M = (
+    (-270, -270),
+    (270, -270),
+    (-270, 270),
+    (270, 270),  # 4 GCPs (corners)
+    (0, 0),
+    (-150, 0),
+    (150, 0),
+    (0, -150),
+    (0, 150),
+    (-150, -150),
+    (150, 150),
+    (-150, 150),
+    (150, -150),
+    (-270, 0),
+    (270, 0),
+    (0, -270),
+    (0, 270),
+)
+
+
+def _checked_config(scale, noise_free, cfg, trajectory_error) -> CampaignConfig:
+    if not (np.isfinite(scale) and scale > 0):
+        raise InputError(f"scale must be a positive number, got {scale!r}")
+    cfg = cfg or CampaignConfig()
+    if trajectory_error is not None:
+        cfg = replace(cfg, trajectory_error=trajectory_error)
+    if cfg.trajectory_error not in TRAJECTORY_ERRORS:
+        raise InputError(
+            f"trajectory_error must be one of {TRAJECTORY_ERRORS}, got {cfg.trajectory_error!r}"
+        )
+    if cfg.cp_rays not in CP_RAYS:
+        raise InputError(f"cp_rays must be one of {CP_RAYS}, got {cfg.cp_rays!r}")
+    if noise_free and cfg.trajectory_error != "spline":
+        raise InputError(
+            "noise_free=True needs trajectory_error='spline' (only the estimator's own model "
+            "has exact node corrections)"
+        )
+    return cfg
+
+
+def _trajectory_error(cfg: CampaignConfig, nodes, plan, t_end, rng):
+    """The navigation error (true minus navigation): ``(node_err, err_t, err_x, nav_err)`` with
+    ``nav_err(t, rate=False)`` the error (or its rate) at times ``t``.
+    """
+    sigma_nav = np.r_[cfg.sigma_pos_m, cfg.sigma_att_rad]
+    if cfg.trajectory_error == "spline":
+        node_err = rng.standard_normal((nodes.n_nodes, 6)) * sigma_nav
+        err_t = err_x = None
+
+        def nav_err(tt, rate=False):
+            return (nodes.evaluate_rate if rate else nodes.evaluate)(node_err, tt)
+
+    else:  # post-processed GNSS/INS errors: first-order Gauss–Markov per axis (002 §4 σ)
+        n_s = int(np.ceil(t_end / cfg.error_sample_s)) + 2
+        err_t = np.arange(n_s) * cfg.error_sample_s
+        err_x = gauss_markov(
+            n_s, cfg.error_sample_s, np.r_[cfg.tau_pos_s, cfg.tau_att_s], sigma_nav, rng
+        )
+        err_cs = CubicSpline(err_t, err_x, axis=0)
+        t_fit = _imaged(plan, np.arange(0.0, t_end, 0.1))
+        node_err = spline_fit(nodes, t_fit, err_cs(t_fit))
+        err_rate_cs = err_cs.derivative()
+
+        def nav_err(tt, rate=False):
+            return (err_rate_cs if rate else err_cs)(tt)
+
+    return node_err, err_t, err_x, nav_err
+
+
+def _points(cfg: CampaignConfig, scale, length_m, nb, rng):
+    """Reference squares first, then tie points: ``(P, is_ref, band_of_point)``."""
+    half = cfg.area_m / 2
+    n_tie = max(int(round(cfg.n_tie_points_full * scale)), 50)
+    ref_en = np.array(REFERENCE_EN_M, dtype=float)
+    ref_en += rng.uniform(-20, 20, ref_en.shape)
+    # east × north: area_m × block_length_m (the same draws as a square block when scale ≤ 1)
+    tie_en = rng.uniform([-half, -length_m / 2], [half, length_m / 2], (n_tie, 2))
+    en = np.vstack([ref_en, tie_en])
+    h = np.r_[rng.uniform(0, 2, len(ref_en)), rng.uniform(0, cfg.terrain_relief_m, n_tie)]
+    P = np.column_stack([en, h])
+    is_ref = np.zeros(len(P), bool)
+    is_ref[: len(ref_en)] = True
+    band_of_point = np.r_[rng.integers(0, 3, len(ref_en)), rng.integers(0, nb, n_tie)]
+    return P, is_ref, band_of_point
+
+
+def _strips_of_points(cfg: CampaignConfig, plan, P, is_ref, length_m, rng):
+    """Which strips see which points: inside the swath (with a 3 % margin) and the strip;
+    ``(pidx, strip)``, one row per observation.
+    """
+    en, h = P[:, :2], P[:, 2]
+    n_pts = len(P)
+    c_fov = cfg.c_nominal_mm
+    half_line_mm = cfg.pixels_per_line / 2 * cfg.pixel_mm
+    east = np.array([p[2] for p in plan])
+    agl = np.array([p[3] for p in plan])
+    half_swath = 0.97 * half_line_mm / c_fov * (agl - 0)  # m on the ground
+    covers = np.abs(en[:, 0:1] - east[None, :]) < half_swath[None, :] * (
+        1 - h[:, None] / agl[None, :]
+    )
+    covers &= np.abs(en[:, 1:2]) < cfg.strip_half_length_m + (length_m - cfg.area_m) / 2 - 30
+    ncov = covers.sum(axis=1)
+    if np.any(ncov < 3):
+        raise InputError("simulated flight plan leaves points seen by fewer than 3 strips")
+    extra = cfg.obs_per_point_mean - 3.0
+    n_obs = np.where(is_ref, ncov, np.minimum(ncov, 3 + rng.poisson(extra, n_pts)))
+    # the strips of each point: all for a reference square (the check points keep a subset at
+    # the end, cp_rays="tie points"), a random n_obs of them for a tie point. One
+    # Generator.choice per point (its draws cannot be vectorised without changing the random
+    # stream); the candidates come from one np.nonzero (row-major, as flatnonzero per row did)
+    cand_strip = np.nonzero(covers)[1]
+    cand_end = np.cumsum(ncov)
+    strip_list, n_choose = [], n_obs.tolist()
+    for i, (b, e) in enumerate(zip((cand_end - ncov).tolist(), cand_end.tolist(), strict=True)):
+        cand = cand_strip[b:e]
+        strip_list.append(cand if is_ref[i] else rng.choice(cand, n_choose[i], replace=False))
+    pidx = np.repeat(np.arange(n_pts), n_obs)
+    strip = np.concatenate(strip_list)
+    return pidx, strip
+
+
+def _line_times(cfg: CampaignConfig, plan, true_xy, P, pidx, strip, is_ref, noise_free, rng):
+    """The line that sees each point: Newton on the true y image coordinate in time, in chunks
+    of rows (every operation is row-wise: the same bits as all rows at once, without the
+    temporaries of millions of rows at scale > 1), then the key-point localisation error.
+
+    Returns ``(t_line, loc)``: the registered line times and the localisation error (px).
+    """
+    m = pidx.size
+    t0s = np.array([p[0] for p in plan])
+    t1s = np.array([p[1] for p in plan])
+    dirs = np.array([p[4] for p in plan], float)
+    t = np.empty(m)
+    deriv = np.empty(m)
+    for rows in _row_chunks(m):
+        tt = 0.5 * (t0s + t1s)[strip[rows]] + dirs[strip[rows]] * P[pidx[rows], 1] / cfg.speed_m_s
+        for _ in range(6):
+            xy, _ = true_xy(tt, rows)
+            dt = 1e-3
+            xy2, _ = true_xy(tt + dt, rows)
+            deriv[rows] = (xy2[:, 1] - xy[:, 1]) / dt
+            tt = tt - xy[:, 1] / deriv[rows]  # the line is y = 0 (pixel centre of the line)
+        t[rows] = tt
+    line_dt = 1.0 / cfg.line_rate_hz
+    # key-point localisation error (ours, see CampaignConfig): x along the line, and in y an
+    # error of the matched line, i.e. of the time
+    sigma_kp = np.broadcast_to(np.asarray(cfg.sigma_keypoint_px, dtype=np.float64), (2,))
+    loc = (0.0 if noise_free else sigma_kp) * rng.standard_normal((m, 2))
+    ref_loc = rng.standard_normal((m, 2))  # drawn always: the same stream with or without
+    if cfg.sigma_ref_image_px is not None and not noise_free:
+        on_ref = is_ref[pidx]
+        loc[on_ref] = cfg.sigma_ref_image_px * ref_loc[on_ref]
+    t_loc = t - loc[:, 1] * cfg.pixel_mm / deriv
+    t_line = np.round(t_loc / line_dt) * line_dt
+    return t_line, loc
+
+
+def _true_image_px(
+    cfg: CampaignConfig, plan, true_xy, c_true_mm, P, pidx, strip, band, t_line, noise_free
+):
+    """The true image coordinates (px) at the registered line times, with refraction and the
+    unmodelled distortion ripple.
+    """
+    m = pidx.size
+    xy_true_mm = np.empty((m, 2))
+    for rows in _row_chunks(m):
+        xy_true_mm[rows], pc = true_xy(t_line[rows], rows)
+        if np.any(pc[:, 2] <= 0):
+            raise InputError("simulated points behind the camera: check the flight plan")
+    if cfg.refraction:  # the ray bends: the image point moves radially outward
+        agl_obs = np.array([p[3] for p in plan])[strip]
+        k = refraction_k(agl_obs + cfg.terrain_asl_m, P[pidx, 2] + cfg.terrain_asl_m)
+        d = xy_true_mm - np.array([cfg.x0_mm, cfg.y0_mm])
+        r2 = np.sum(d**2, axis=1) / c_true_mm[band] ** 2
+        xy_true_mm = xy_true_mm + (k * (1 + r2))[:, None] * d
+    xy_true_px = xy_true_mm / cfg.pixel_mm
+    if cfg.distortion_ripple_px and not noise_free:
+        # a distortion residual outside 002 eq. (3) (issue 22): a ripple along the line
+        xy_true_px[:, 0] += distortion_ripple_px(xy_true_px[:, 0], cfg)
+    return xy_true_px
+
+
+def _navigation(cfg: CampaignConfig, plan, strip, t_line, nav_err):
+    """The navigation solution at the line times, truth minus the error (row-wise, in chunks),
+    and its rates: ``(xyz_nav, rpy_nav, xyz_rate_nav, rpy_rate_nav)``.
+    """
+    m = t_line.size
+    dirs = np.array([p[4] for p in plan], float)
+    xyz_nav, rpy_nav, xyz_rate_nav, rpy_rate_nav = (np.empty((m, 3)) for _ in range(4))
+    for rows in _row_chunks(m):
+        tl = t_line[rows]
+        xyz_true, rpy_true = _true_pose(plan, strip[rows], tl, cfg.mount_motion_rad, cfg.speed_m_s)
+        delta = nav_err(tl)
+        xyz_nav[rows] = xyz_true - delta[:, :3]
+        rpy_nav[rows] = rpy_true - delta[:, 3:]
+        # and its rates (a GNSS/INS solution gives velocity and angular rate): the observation
+        # is a time, and its residual needs the image motion across the line (PushbroomLines)
+        ddelta = nav_err(tl, rate=True)
+        n = tl.size
+        xyz_rate_true = np.column_stack(
+            [np.zeros(n), dirs[strip[rows]] * cfg.speed_m_s, np.zeros(n)]
+        )
+        xyz_rate_nav[rows] = xyz_rate_true - ddelta[:, :3]
+        rpy_rate_nav[rows] = _mount_motion_rate(tl, cfg.mount_motion_rad) - ddelta[:, 3:]
+    return xyz_nav, rpy_nav, xyz_rate_nav, rpy_rate_nav
+
+
+def _register(cfg: CampaignConfig, xy_true_px, loc, P, noise_free, rng):
+    """What is recorded: ``(xy_obs, outlier, gcp_xyz)``, the image coordinates registered at the
+    pixel centre along the line and in the line itself (y = 0), with gross errors, and the
+    surveyed GCPs.
+    """
+    m = len(xy_true_px)
+    if noise_free:
+        return xy_true_px.copy(), np.zeros(m, bool), P[:4].copy()
+    xy_obs = np.column_stack([np.floor(xy_true_px[:, 0] + loc[:, 0]) + 0.5, np.zeros(m)])
+    outlier = rng.random(m) < cfg.outlier_share
+    n_out = int(outlier.sum())
+    mag = rng.uniform(3, 20, n_out) * rng.choice([-1, 1], n_out)
+    comp = rng.integers(0, 2, n_out)
+    xy_obs[np.flatnonzero(outlier), comp] += mag
+    gcp_xyz = P[:4] + cfg.sigma_gcp_m * rng.standard_normal((4, 3))
+    return xy_obs, outlier, gcp_xyz
+
+
+def _check_point_rows(cfg: CampaignConfig, pidx, rng) -> np.ndarray:
+    """``cp_rays="tie points"``: a check point keeps as many of its strips as a tie point sees
+    (≥ 3, 3 + Poisson), drawn after every other draw: the tie points and the GCPs are those of
+    "all strips". Returns the rows kept.
+    """
+    extra = cfg.obs_per_point_mean - 3.0
+    keep = np.ones(pidx.size, bool)
+    for i in range(4, len(REFERENCE_EN_M)):
+        rows_i = np.flatnonzero(pidx == i)
+        k = min(rows_i.size, 3 + int(rng.poisson(extra)))
+        keep[rng.choice(rows_i, rows_i.size - k, replace=False)] = False
+    return keep
+
+
 def simulate(
     scale: float = 1.0,
     rng=0,
@@ -510,22 +752,7 @@ def simulate(
     truth : CampaignTruth
         What only :mod:`hsgeo.reproduce` compares with.
     """
-    if not (np.isfinite(scale) and scale > 0):
-        raise InputError(f"scale must be a positive number, got {scale!r}")
-    cfg = cfg or CampaignConfig()
-    if trajectory_error is not None:
-        cfg = replace(cfg, trajectory_error=trajectory_error)
-    if cfg.trajectory_error not in TRAJECTORY_ERRORS:
-        raise InputError(
-            f"trajectory_error must be one of {TRAJECTORY_ERRORS}, got {cfg.trajectory_error!r}"
-        )
-    if cfg.cp_rays not in CP_RAYS:
-        raise InputError(f"cp_rays must be one of {CP_RAYS}, got {cfg.cp_rays!r}")
-    if noise_free and cfg.trajectory_error != "spline":
-        raise InputError(
-            "noise_free=True needs trajectory_error='spline' (only the estimator's own model "
-            "has exact node corrections)"
-        )
+    cfg = _checked_config(scale, noise_free, cfg, trajectory_error)
     rng = np.random.default_rng(rng)
     length_m = block_length_m(cfg, scale)
     plan = _strip_plan(cfg, extra_m=length_m - cfg.area_m)
@@ -535,28 +762,7 @@ def simulate(
     names = BLOCK_NAMES
 
     # -- truth of the camera and the trajectory errors (true minus navigation)
-    sigma_nav = np.r_[cfg.sigma_pos_m, cfg.sigma_att_rad]
-    if cfg.trajectory_error == "spline":
-        node_err = rng.standard_normal((nodes.n_nodes, 6)) * sigma_nav
-        err_t = err_x = None
-
-        def nav_err(tt, rate=False):
-            return (nodes.evaluate_rate if rate else nodes.evaluate)(node_err, tt)
-
-    else:  # post-processed GNSS/INS errors: first-order Gauss–Markov per axis (002 §4 σ)
-        n_s = int(np.ceil(t_end / cfg.error_sample_s)) + 2
-        err_t = np.arange(n_s) * cfg.error_sample_s
-        err_x = gauss_markov(
-            n_s, cfg.error_sample_s, np.r_[cfg.tau_pos_s, cfg.tau_att_s], sigma_nav, rng
-        )
-        err_cs = CubicSpline(err_t, err_x, axis=0)
-        t_fit = _imaged(plan, np.arange(0.0, t_end, 0.1))
-        node_err = spline_fit(nodes, t_fit, err_cs(t_fit))
-        err_rate_cs = err_cs.derivative()
-
-        def nav_err(tt, rate=False):
-            return (err_rate_cs if rate else err_cs)(tt)
-
+    node_err, err_t, err_x, nav_err = _trajectory_error(cfg, nodes, plan, t_end, rng)
     lever = np.array(cfg.lever_arm_m)
     truth = {
         names["nodes"]: node_err,
@@ -568,83 +774,15 @@ def simulate(
     lever_measured = lever + (0.0 if noise_free else 1.0) * cfg.sigma_lever_m * (
         rng.standard_normal(3)
     )
-
-    # -- points: reference squares first, then tie points
-    half = cfg.area_m / 2
-    n_tie = max(int(round(cfg.n_tie_points_full * scale)), 50)
-    ref_en = np.array(
-        [
-            [-270, -270],
-            [270, -270],
-            [-270, 270],
-            [270, 270],  # 4 GCPs (corners)
-            [0, 0],
-            [-150, 0],
-            [150, 0],
-            [0, -150],
-            [0, 150],
-            [-150, -150],
-            [150, 150],
-            [-150, 150],
-            [150, -150],
-            [-270, 0],
-            [270, 0],
-            [0, -270],
-            [0, 270],
-        ],
-        dtype=float,
-    )
-    ref_en += rng.uniform(-20, 20, ref_en.shape)
-    # east × north: area_m × block_length_m (the same draws as a square block when scale ≤ 1)
-    tie_en = rng.uniform([-half, -length_m / 2], [half, length_m / 2], (n_tie, 2))
-    en = np.vstack([ref_en, tie_en])
-    h = np.r_[rng.uniform(0, 2, len(ref_en)), rng.uniform(0, cfg.terrain_relief_m, n_tie)]
-    P = np.column_stack([en, h])
+    # -- points (reference squares first, then tie points) and the strips that see them
+    P, is_ref, band_of_point = _points(cfg, scale, length_m, nb, rng)
     truth[names["points"]] = P
     n_pts = len(P)
-    is_ref = np.zeros(n_pts, bool)
-    is_ref[: len(ref_en)] = True
-    band_of_point = np.r_[rng.integers(0, 3, len(ref_en)), rng.integers(0, nb, n_tie)]
-
-    # -- which strips see which points: inside the swath (with a 3 % margin) and the strip
-    c_fov = cfg.c_nominal_mm
-    half_line_mm = cfg.pixels_per_line / 2 * cfg.pixel_mm
-    east = np.array([p[2] for p in plan])
-    agl = np.array([p[3] for p in plan])
-    half_swath = 0.97 * half_line_mm / c_fov * (agl - 0)  # m on the ground
-    covers = np.abs(en[:, 0:1] - east[None, :]) < half_swath[None, :] * (
-        1 - h[:, None] / agl[None, :]
-    )
-    covers &= np.abs(en[:, 1:2]) < cfg.strip_half_length_m + (length_m - cfg.area_m) / 2 - 30
-    ncov = covers.sum(axis=1)
-    if np.any(ncov < 3):
-        raise InputError("simulated flight plan leaves points seen by fewer than 3 strips")
-    extra = cfg.obs_per_point_mean - 3.0
-    n_obs = np.where(is_ref, ncov, np.minimum(ncov, 3 + rng.poisson(extra, n_pts)))
-    # the strips of each point: all for a reference square (the check points keep a subset at
-    # the end, cp_rays="tie points"), a random n_obs of them for a tie point. One
-    # Generator.choice per point (its draws cannot be vectorised without changing the random
-    # stream); the candidates come from one np.nonzero (row-major, as flatnonzero per row did)
-    cand_strip = np.nonzero(covers)[1]
-    cand_end = np.cumsum(ncov)
-    strip_list, n_choose = [], n_obs.tolist()
-    for i, (b, e) in enumerate(zip((cand_end - ncov).tolist(), cand_end.tolist(), strict=True)):
-        cand = cand_strip[b:e]
-        strip_list.append(cand if is_ref[i] else rng.choice(cand, n_choose[i], replace=False))
-    pidx = np.repeat(np.arange(n_pts), n_obs)
-    strip = np.concatenate(strip_list)
-    del strip_list, covers
+    pidx, strip = _strips_of_points(cfg, plan, P, is_ref, length_m, rng)
     band = band_of_point[pidx]
-    m = pidx.size
 
-    # -- the line that sees each point: Newton on the true y image coordinate in time, in
-    # chunks of rows (every operation is row-wise: the same bits as all rows at once, without
-    # the temporaries of millions of rows at scale > 1)
-    beta0 = BETA0_CAM_FROM_PLATFORM
-    t0s = np.array([p[0] for p in plan])
-    t1s = np.array([p[1] for p in plan])
-    dirs = np.array([p[4] for p in plan], float)
     # truth = nav + δ(t): project with the true pose, zero corrections
+    beta0 = BETA0_CAM_FROM_PLATFORM
     vals = dict(truth)
     vals[names["nodes"]] = np.zeros_like(node_err)
 
@@ -654,86 +792,14 @@ def simulate(
             vals, names, nodes, tt, xyz, rpy, pidx[rows], band[rows], beta0, cfg.x0_mm, cfg.y0_mm
         )
 
-    t = np.empty(m)
-    deriv = np.empty(m)
-    for rows in _row_chunks(m):
-        tt = 0.5 * (t0s + t1s)[strip[rows]] + dirs[strip[rows]] * P[pidx[rows], 1] / cfg.speed_m_s
-        for _ in range(6):
-            xy, _ = true_xy(tt, rows)
-            dt = 1e-3
-            xy2, _ = true_xy(tt + dt, rows)
-            deriv[rows] = (xy2[:, 1] - xy[:, 1]) / dt
-            tt = tt - xy[:, 1] / deriv[rows]  # the line is y = 0 (pixel centre of the line)
-        t[rows] = tt
-    del xy, xy2, tt
-    line_dt = 1.0 / cfg.line_rate_hz
-    # key-point localisation error (ours, see CampaignConfig): x along the line, and in y an
-    # error of the matched line, i.e. of the time
-    sigma_kp = np.broadcast_to(np.asarray(cfg.sigma_keypoint_px, dtype=np.float64), (2,))
-    loc = (0.0 if noise_free else sigma_kp) * rng.standard_normal((m, 2))
-    ref_loc = rng.standard_normal((m, 2))  # drawn always: the same stream with or without
-    if cfg.sigma_ref_image_px is not None and not noise_free:
-        on_ref = is_ref[pidx]
-        loc[on_ref] = cfg.sigma_ref_image_px * ref_loc[on_ref]
-    t_loc = t - loc[:, 1] * cfg.pixel_mm / deriv
-    t_line = np.round(t_loc / line_dt) * line_dt
-    del t, deriv, t_loc, ref_loc
-    xy_true_mm = np.empty((m, 2))
-    for rows in _row_chunks(m):
-        xy_true_mm[rows], pc = true_xy(t_line[rows], rows)
-        if np.any(pc[:, 2] <= 0):
-            raise InputError("simulated points behind the camera: check the flight plan")
-    del pc
-    if cfg.refraction:  # the ray bends: the image point moves radially outward
-        agl_obs = np.array([p[3] for p in plan])[strip]
-        k = refraction_k(agl_obs + cfg.terrain_asl_m, P[pidx, 2] + cfg.terrain_asl_m)
-        d = xy_true_mm - np.array([cfg.x0_mm, cfg.y0_mm])
-        r2 = np.sum(d**2, axis=1) / truth[names["c"]][band] ** 2
-        xy_true_mm = xy_true_mm + (k * (1 + r2))[:, None] * d
-    xy_true_px = xy_true_mm / cfg.pixel_mm
-    if cfg.distortion_ripple_px and not noise_free:
-        # a distortion residual outside 002 eq. (3) (issue 22): a ripple along the line
-        xy_true_px[:, 0] += distortion_ripple_px(xy_true_px[:, 0], cfg)
-    # navigation solution at the line times: truth minus the error (row-wise, in chunks)
-    xyz_nav, rpy_nav, xyz_rate_nav, rpy_rate_nav = (np.empty((m, 3)) for _ in range(4))
-    for rows in _row_chunks(m):
-        tl = t_line[rows]
-        xyz_true, rpy_true = _true_pose(plan, strip[rows], tl, cfg.mount_motion_rad, cfg.speed_m_s)
-        delta = nav_err(tl)
-        xyz_nav[rows] = xyz_true - delta[:, :3]
-        rpy_nav[rows] = rpy_true - delta[:, 3:]
-        # and its rates (a GNSS/INS solution gives velocity and angular rate): the observation
-        # is a time, and its residual needs the image motion across the line (PushbroomLines)
-        ddelta = nav_err(tl, rate=True)
-        n = tl.size
-        xyz_rate_true = np.column_stack(
-            [np.zeros(n), dirs[strip[rows]] * cfg.speed_m_s, np.zeros(n)]
-        )
-        xyz_rate_nav[rows] = xyz_rate_true - ddelta[:, :3]
-        rpy_rate_nav[rows] = _mount_motion_rate(tl, cfg.mount_motion_rad) - ddelta[:, 3:]
-    del xyz_true, rpy_true, delta, ddelta, xyz_rate_true
-
-    if noise_free:
-        xy_obs = xy_true_px.copy()
-        outlier = np.zeros(m, bool)
-        gcp_xyz = P[:4].copy()
-    else:
-        # registered at the pixel centre along the line, and in the line itself (y = 0)
-        xy_obs = np.column_stack([np.floor(xy_true_px[:, 0] + loc[:, 0]) + 0.5, np.zeros(m)])
-        outlier = rng.random(m) < cfg.outlier_share
-        n_out = int(outlier.sum())
-        mag = rng.uniform(3, 20, n_out) * rng.choice([-1, 1], n_out)
-        comp = rng.integers(0, 2, n_out)
-        xy_obs[np.flatnonzero(outlier), comp] += mag
-        gcp_xyz = P[:4] + cfg.sigma_gcp_m * rng.standard_normal((4, 3))
+    t_line, loc = _line_times(cfg, plan, true_xy, P, pidx, strip, is_ref, noise_free, rng)
+    xy_true_px = _true_image_px(
+        cfg, plan, true_xy, truth[names["c"]], P, pidx, strip, band, t_line, noise_free
+    )
+    xyz_nav, rpy_nav, xyz_rate_nav, rpy_rate_nav = _navigation(cfg, plan, strip, t_line, nav_err)
+    xy_obs, outlier, gcp_xyz = _register(cfg, xy_true_px, loc, P, noise_free, rng)
     if cfg.cp_rays == "tie points":
-        # a check point keeps as many of its strips as a tie point sees (≥ 3, 3 + Poisson),
-        # drawn after every other draw: the tie points and the GCPs are those of "all strips"
-        keep = np.ones(m, bool)
-        for i in range(4, len(ref_en)):
-            rows_i = np.flatnonzero(pidx == i)
-            k = min(rows_i.size, 3 + int(rng.poisson(extra)))
-            keep[rng.choice(rows_i, rows_i.size - k, replace=False)] = False
+        keep = _check_point_rows(cfg, pidx, rng)
         pidx, band, t_line, xy_obs, strip = (a[keep] for a in (pidx, band, t_line, xy_obs, strip))
         xyz_nav, rpy_nav = xyz_nav[keep], rpy_nav[keep]
         xyz_rate_nav, rpy_rate_nav = xyz_rate_nav[keep], rpy_rate_nav[keep]
