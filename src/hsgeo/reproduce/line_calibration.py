@@ -258,15 +258,9 @@ def _unmodelled_rows(mc_on: dict, mc_off: dict) -> list[Row]:
     return rows
 
 
-def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
-    """The chapter's numbers. ``scale`` sets the Monte Carlo size: max(20, round(200·scale))."""
-    lab = LineLab()
+def _iop_table_rows(results: dict, sims: dict) -> list[Row]:
+    """000 Table 1 (row 1000, λ = 870 nm) and 001 Table 2: the calibrated inner orientation."""
     rows: list[Row] = []
-    results, sims = {}, {}
-    for r in lab.rows:
-        row_seed = np.random.SeedSequence([seed, r]).generate_state(1)[0]
-        res, sim = calibrate_simulated(lab, r, row_seed)
-        results[r], sims[r] = res, sim
     # 000 Table 1 (row 1000, λ = 870 nm)
     u, c = P000_TABLE1_UNCALIBRATED, P000_TABLE1_CALIBRATED
     start = "the nominal value the adjustment starts from (Jakšić 2009), not an estimate"
@@ -315,6 +309,12 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
                 # row 1000's truth is 000 Table 1, which 001 Table 2 prints rounded
                 row.provenance = "derived"
             rows.append(row)
+    return rows
+
+
+def _distortion_magnitude_rows() -> list[Row]:
+    """The distortion magnitudes of the published coefficients (100-px normalisation)."""
+    rows: list[Row] = []
     # distortion magnitudes from the published coefficients (100-px normalisation)
     k100 = [P001_TABLE2[0].K1, P001_TABLE2[0].K2, P001_TABLE2[0].K3]
     k1000 = [P001_TABLE2[3].K1, P001_TABLE2[3].K2, P001_TABLE2[3].K3]
@@ -343,15 +343,12 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
                 ),
             )
         )
-    # Monte Carlo: does σ̂ tell the truth under the estimator's own model (the even distortion
-    # term off)? Then the unmodelled effect: the same first runs of row 1000 with it on
-    n_mc = max(20, int(round(200 * scale)))
-    lab_own = replace(lab, even_distortion_px=0.0)
-    mc = {r: monte_carlo(lab_own, r, n_mc, seed) for r in lab.rows}
-    rows += _precision_rows(results[1000], mc[1000], lab)
-    n_ue = max(20, n_mc // 4)
-    mc_on = monte_carlo(lab, 1000, n_ue, seed)  # the same draws as mc[1000]'s first n_ue runs
-    rows += _unmodelled_rows(mc_on, {k: v[:n_ue] for k, v in mc[1000].items() if k in _RUNS})
+    return rows
+
+
+def _coverage_rows(lab, mc: dict, n_mc: int) -> list[Row]:
+    """Monte Carlo coverage: the share of runs whose estimate lies within k σ̂ of the truth."""
+    rows: list[Row] = []
     for r in lab.rows:
         for k in (1, 2, 3):
             cov = mc[r]["coverage"][k]
@@ -369,6 +366,30 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
                         n_runs=n_mc,
                     )
                 )
+    return rows
+
+
+def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
+    """The chapter's numbers. ``scale`` sets the Monte Carlo size: max(20, round(200·scale))."""
+    lab = LineLab()
+    rows: list[Row] = []
+    results, sims = {}, {}
+    for r in lab.rows:
+        row_seed = np.random.SeedSequence([seed, r]).generate_state(1)[0]
+        res, sim = calibrate_simulated(lab, r, row_seed)
+        results[r], sims[r] = res, sim
+    rows += _iop_table_rows(results, sims)
+    rows += _distortion_magnitude_rows()
+    # Monte Carlo: does σ̂ tell the truth under the estimator's own model (the even distortion
+    # term off)? Then the unmodelled effect: the same first runs of row 1000 with it on
+    n_mc = max(20, int(round(200 * scale)))
+    lab_own = replace(lab, even_distortion_px=0.0)
+    mc = {r: monte_carlo(lab_own, r, n_mc, seed) for r in lab.rows}
+    rows += _precision_rows(results[1000], mc[1000], lab)
+    n_ue = max(20, n_mc // 4)
+    mc_on = monte_carlo(lab, 1000, n_ue, seed)  # the same draws as mc[1000]'s first n_ue runs
+    rows += _unmodelled_rows(mc_on, {k: v[:n_ue] for k, v in mc[1000].items() if k in _RUNS})
+    rows += _coverage_rows(lab, mc, n_mc)
     meta = {
         "n_monte_carlo": n_mc,
         "n_unmodelled_effect_runs": n_ue,
