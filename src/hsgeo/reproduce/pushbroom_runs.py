@@ -29,8 +29,10 @@ from hsgeo.workflows.pushbroom_ba import (  # 002's settings, spelled once in th
     REJECT_K,
     Y_AS_TIME,
     CameraPrior,
+    PushbroomInputs,
+    PushbroomOptions,
+    adjust_pushbroom,
     build_problem,
-    solve,
 )
 
 __all__ = [
@@ -91,32 +93,46 @@ def adjust_campaign(
     the normal equations at the true values is added to ``info`` (``rank_at_truth``,
     ``n_nonpoint_unknowns``); the adjustment itself never sees it.
     """
-    t0 = time.perf_counter()
-    p, blocks, nodes = build_problem(
+    inputs = PushbroomInputs(
         obs.lines,
         obs.n_points,
         camera_prior(cfg, obs),
-        node_interval_s=node_interval_s,
-        t_span_s=obs.t_span_s,
-        node_prior_mean=(obs.node_prior_mean if node_interval_s == cfg.node_interval_s else None),
         gcp_index=obs.gcp_index if with_gcp else None,
         gcp_xyz_m=obs.gcp_xyz_m if with_gcp else None,
-        y_as_time=y_as_time,
+        t_span_s=obs.t_span_s,
+        node_prior_mean=(obs.node_prior_mean if node_interval_s == cfg.node_interval_s else None),
     )
-    info = {"setup_seconds": time.perf_counter() - t0, "nodes": nodes}
+    options = PushbroomOptions(
+        node_interval_s=node_interval_s,
+        reject_k=reject_k,
+        ftol=ftol,
+        y_as_time=y_as_time,
+        keep_jacobian=True,  # the check points' covariance (run)
+    )
+    r = adjust_pushbroom(inputs, options, progress=progress)  # the CLI's core, 002's settings
+    info = {"setup_seconds": r.setup_seconds, "nodes": r.nodes}
     if truth is not None:
-        q = p.copy()
+        # the check at the truth sets up a problem of its own: truth never touches the
+        # adjusted parameters or blocks
+        q, blocks_t, _ = build_problem(
+            inputs.observations,
+            inputs.n_points,
+            inputs.camera,
+            node_interval_s=node_interval_s,
+            gcp_index=inputs.gcp_index,
+            gcp_xyz_m=inputs.gcp_xyz_m,
+            t_span_s=inputs.t_span_s,
+            node_prior_mean=inputs.node_prior_mean,
+            y_as_time=y_as_time,
+        )
         for k, v in truth.values.items():
             if q[k].shape == np.shape(v):
                 q.set(k, v)
-        ident = identifiability(q, blocks)
+        ident = identifiability(q, blocks_t)
         info["rank_at_truth"] = ident.rank
         info["n_nonpoint_unknowns"] = ident.n_unknowns
-    res = solve(
-        p, blocks, reject_k=reject_k, ftol=ftol, progress=progress, keep_jacobian=True
-    )  # the check points' covariance (run)
-    info["solver_seconds"] = res.seconds
-    return res, p, blocks, info
+    info["solver_seconds"] = r.result.seconds
+    return r.result, r.params, r.blocks, info
 
 
 def cp_errors(res, truth: CampaignTruth) -> np.ndarray:
