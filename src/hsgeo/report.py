@@ -1,5 +1,9 @@
 """Tables of results: paper | reproduced | σ̂ | truth | z | verdict (GUIDE §4–§5).
 
+Kept as one file: one concern, the table of a reproduction — the row model, the verdict rules
+and the one way tables and agreement words are formatted read the same fields (σ̂, z,
+provenance) and change together.
+
 :class:`Row` is one quantity of a table and :class:`Reproduction` a set of tables with metadata;
 ``hsgeo reproduce`` and the workflows that print tables (``hsgeo calibrate-frame``) return them,
 as text (:meth:`Reproduction.to_text`), strict JSON (:meth:`Reproduction.to_json`, ``null`` for
