@@ -33,11 +33,9 @@ def _cmd_reproduce(args) -> int:
 def _cmd_calibrate_line(args) -> int:
     import json
 
-    import numpy as np
-
     from hsgeo.workflows.line_calibration import calibrate_files
 
-    out = calibrate_files(
+    cal = calibrate_files(
         args.observations,
         args.control,
         zeta0_px=args.zeta0_px,
@@ -45,32 +43,11 @@ def _cmd_calibrate_line(args) -> int:
         sigma_px=args.sigma_px,
         reject_k=args.reject_k,
     )
-    res, v = out["result"], out["residuals_px"]
-    names = [("zeta0_px", res.value("zeta0_px"), res.sigma("zeta0_px"))]
-    names += [("c_px", res.value("c_px"), res.sigma("c_px"))]
-    names += [
-        (k, a, s)
-        for k, a, s in zip(("K1", "K2", "K3"), res.value("K"), res.sigma("K"), strict=True)
-    ]
-    stats = {
-        "sigma0": res.sigma0,
-        "dof": res.dof,
-        "rms_px": float(np.sqrt(np.mean(v**2))),
-        "max_abs_px": float(np.max(np.abs(v))),
-        "n_observations": int(v.size),
-    }
     if args.json:
-        print(
-            json.dumps(
-                {
-                    "parameters": {k: {"value": float(a), "sigma": float(s)} for k, a, s in names},
-                    "residuals": stats,
-                },
-                indent=1,
-            )
-        )
+        print(json.dumps(cal.to_dict(), indent=1))
     else:
-        print(res.report())
+        stats = cal.residual_stats()
+        print(cal.result.report())
         print(
             f"residuals: RMS {stats['rms_px']:.4f} px, max |v| {stats['max_abs_px']:.4f} px "
             f"over {stats['n_observations']} observations"

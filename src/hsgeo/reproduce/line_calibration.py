@@ -26,7 +26,12 @@ from hsgeo.report import Reproduction, Row
 from hsgeo.sensors import line1d
 from hsgeo.simulate import as_rng
 from hsgeo.simulate.line_lab import LineLab, pattern_points, record, stations
-from hsgeo.workflows.line_calibration import calibrate, observe_rows
+from hsgeo.workflows.line_calibration import (
+    LineInputs,
+    LineOptions,
+    calibrate_line,
+    observe_rows,
+)
 
 __all__ = [
     "run",
@@ -74,20 +79,19 @@ def simulate_observations(lab: LineLab, row: int, rng, eop_true=None, method: st
 def calibrate_simulated(lab: LineLab, row: int, rng, method: str = "parabola"):
     """Render, measure and calibrate one spectral row; returns ``(result, sim)``."""
     sim = simulate_observations(lab, row, rng, method=method)
-    xy = sim["xy_m"]
-    line1d.check_minimum_observations(sim["image"], sim["point"], np.ones(len(xy), bool))
     u = P000_TABLE1_UNCALIBRATED
-    p = line1d.make_parameters(
-        stations(lab),
-        u.zeta0_px,
-        u.c_px,
-        [0.0, 0.0, 0.0],
-        xy,
-        np.ones(len(xy), bool),
-        point_ids=sim["point_ids"],
+    cal = calibrate_line(  # the core of ``hsgeo calibrate-line``, started at the stations
+        LineInputs(
+            sim["image"],
+            sim["point"],
+            sim["zeta_px"],
+            sim["xy_m"],
+            point_ids=sim["point_ids"],
+            initial_eop=stations(lab),
+        ),
+        LineOptions(zeta0_px=u.zeta0_px, c_px=u.c_px, sigma_px=lab.zeta_sigma_px),
     )
-    blk = line1d.LineObservations(sim["image"], sim["point"], sim["zeta_px"], lab.zeta_sigma_px)
-    return calibrate(p, blk), sim
+    return cal.result, sim
 
 
 def _iop(res):
