@@ -48,6 +48,14 @@ def test_charuco_photographs_match_opencv(capsys):
         (r["quantity"], r["reproduced"], r["sigma"]) for r in out["rows"]
     ]
     assert d["meta"] == out["meta"]
+    # and the in-memory core's result in plain types
+    from hsgeo.reproduce.frame_reference import charuco_views
+    from hsgeo.workflows.frame_calibration import calibrate_opencv
+
+    views, size, _ = charuco_views()
+    cal = json.loads(json.dumps(calibrate_opencv(views, size).to_dict(), allow_nan=False))
+    assert cal["form"] == "opencv" and abs(cal["rms_px"] - 0.1878) < 0.01
+    assert set(cal["values"]) == set(cal["sigmas"]) >= {"fx_px", "k1"}
 
 
 def test_rendered_aruco_grid_recovers_truth(tmp_path, capsys):

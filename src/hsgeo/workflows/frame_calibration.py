@@ -174,6 +174,19 @@ class FrameCalibration:
             out.update(dict(zip(b.columns, self.result.sigma(blk).ravel().tolist(), strict=True)))
         return out
 
+    def to_dict(self) -> dict:
+        """Plain types: form, image size, σ0, RMS residual (px), values and σ̂ by name (None
+        where fixed).
+        """
+        return {
+            "form": self.form,
+            "image_size": list(self.image_size),
+            "sigma0": float(self.result.sigma0),
+            "rms_px": self.rms_px,
+            "values": self.values(),
+            "sigmas": {k: (v if v == v else None) for k, v in self.sigmas().items()},
+        }
+
 
 def _stack(views):
     view = np.concatenate([np.full(v.X.shape[0], i) for i, v in enumerate(views)])
