@@ -215,6 +215,20 @@ REFERENCE_EN_M = (
 )
 
 
+def _camera_truth(cfg: CampaignConfig, node_err) -> dict:
+    """The true values of the node corrections, boresight, lever arm, distortion and the
+    per-band principal distances (their spread about the mean: 002 Fig. 8).
+    """
+    names = BLOCK_NAMES
+    return {
+        names["nodes"]: node_err,
+        names["boresight"]: np.array(cfg.boresight_deg) * DEG,
+        names["lever_arm"]: np.array(cfg.lever_arm_m),
+        names["distortion"]: np.array(cfg.distortion),
+        names["c"]: cfg.c_mean_mm + (np.array(cfg.c_offsets_um) - np.mean(cfg.c_offsets_um)) * 1e-3,
+    }
+
+
 def _checked_config(scale, noise_free, cfg, trajectory_error) -> CampaignConfig:
     if not (np.isfinite(scale) and scale > 0):
         raise InputError(f"scale must be a positive number, got {scale!r}")
@@ -480,17 +494,10 @@ def simulate(
 
     # -- truth of the camera and the trajectory errors (true minus navigation)
     node_err, err_t, err_x, nav_err = _trajectory_error(cfg, nodes, plan, t_end, rng)
-    lever = np.array(cfg.lever_arm_m)
-    truth = {
-        names["nodes"]: node_err,
-        names["boresight"]: np.array(cfg.boresight_deg) * DEG,
-        names["lever_arm"]: lever,
-        names["distortion"]: np.array(cfg.distortion),
-        names["c"]: cfg.c_mean_mm + (np.array(cfg.c_offsets_um) - np.mean(cfg.c_offsets_um)) * 1e-3,
-    }
-    lever_measured = lever + (0.0 if noise_free else 1.0) * cfg.sigma_lever_m * (
-        rng.standard_normal(3)
-    )
+    truth = _camera_truth(cfg, node_err)
+    lever_measured = truth[names["lever_arm"]] + (
+        0.0 if noise_free else 1.0
+    ) * cfg.sigma_lever_m * (rng.standard_normal(3))
     # -- points (reference squares first, then tie points) and the strips that see them
     P, is_ref, band_of_point = _points(cfg, scale, length_m, nb, rng)
     truth[names["points"]] = P
