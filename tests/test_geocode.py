@@ -232,6 +232,27 @@ def test_geocode_command_end_to_end(tmp_path):
     assert np.median(err) < 0.1
     data, hdr = read_envi(tmp_path / "o_envi")
     assert data.shape == ds["radiance"].shape and hdr["map_info"][2] == 0.5
+    # the in-memory core the command runs: the same grid and values, no files
+    from hsgeo.io import read_lines, read_scanning_sensor
+    from hsgeo.workflows.geocoding import GeocodeInputs, orthorectify_lines
+
+    da, t0, rate = read_lines(tmp_path / "lines.nc")
+    core = orthorectify_lines(
+        GeocodeInputs(
+            da,
+            t0,
+            rate,
+            nav,
+            read_scanning_sensor(tmp_path / "sensor.toml"),
+            PlaneTerrain(3.0),
+            np.asarray(da["pixel"].values, dtype=float),
+        ),
+        progress=False,
+    )
+    np.testing.assert_array_equal(core.ortho.values, ds["radiance"].values)
+    d = core.to_dict()
+    assert (d["bands"], d["n_north"], d["n_east"]) == ds["radiance"].shape
+    assert core.ground_m.shape == (80, zeta.size, 3)
     assert (
         main(
             [

@@ -423,6 +423,44 @@ def test_the_rikola_band_split_is_the_papers():
         assert b[k].dtype == RIKOLA_BANDS[k].dtype
 
 
+def test_the_imspector_frame_layout_is_the_papers():
+    """The instrument file (hsgeo/data/instruments/imspector_v9_pixelfly.toml) against 001
+    Table 1 and §2.1 as hsgeo.papers has them."""
+    from hsgeo.io import read_frame_layouts
+    from hsgeo.papers import P001_CUBE, P001_SENSOR
+
+    d = read_frame_layouts()
+    assert d["bits"] == P001_SENSOR["bits"]
+    assert sorted(d["layouts"]) == sorted(P001_CUBE["frame_rate_hz"]) == [1, 2]
+    for b, lay in d["layouts"].items():
+        assert lay["n_rows"] == P001_SENSOR["n_rows"] // b
+        assert lay["n_columns"] == P001_SENSOR["n_columns"] // b
+        assert lay["n_reflected"] == P001_CUBE["n_reflected_columns"][b]
+        assert lay["n_incident"] == P001_CUBE["n_incident_columns"][b]
+        assert lay["frame_rate_hz"] == P001_CUBE["frame_rate_hz"][b]
+    lay1 = d["layouts"][1]
+    assert (lay1["n_reflected"], lay1["n_incident"]) == (
+        P001_SENSOR["n_reflected_columns"],
+        P001_SENSOR["n_incident_columns"],
+    )
+
+
+def test_a_bad_frame_layout_names_the_problem(tmp_path):
+    from hsgeo.io import read_frame_layouts
+
+    f = tmp_path / "i.toml"
+    f.write_text(
+        "[instrument]\nname = 'x'\nbits = 12\n[frame]\nbinning = [1]\nn_rows = [1024]\n"
+        "n_columns = [1280]\nn_reflected_columns = [1170]\nn_incident_columns = [100]\n"
+        "frame_rate_hz = [12.5]\n"
+    )
+    with pytest.raises(InputError, match="n_reflected_columns \\+ n_incident_columns must be"):
+        read_frame_layouts(f)
+    f.write_text(f.read_text().replace("n_rows", "n_row"))
+    with pytest.raises(InputError, match="unknown key; did you mean 'n_rows'"):
+        read_frame_layouts(f)
+
+
 def test_a_bad_band_split_names_the_problem(tmp_path):
     from hsgeo.io import read_band_split
 

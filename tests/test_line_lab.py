@@ -86,5 +86,8 @@ def test_generate_writes_cli_files(tmp_path):
         "line_lab_truth.csv",
     ]
     assert paths[0].read_text().splitlines()[0] == "image,point,zeta_px"
-    with pytest.raises(InputError, match="unknown line-lab settings"):
+    with pytest.raises(InputError, match=r"line-lab settings \[lab\] bogus: unknown key"):
         LL.LineLab.from_config({"bogus": 1})
+    with pytest.raises(InputError, match="distance_mm: unknown key; did you mean 'distance_m'"):
+        LL.LineLab.from_config({"distance_mm": 3.0})
+    assert LL.LineLab.from_config({"azimuths_deg": [-45.0, 0.0]}).azimuths_deg == (-45.0, 0.0)

@@ -38,6 +38,24 @@ def test_charuco_photographs_match_opencv(capsys):
     f = rows["f"]
     assert abs(f["reproduced"] - 459.3) < 3 * f["sigma"]
     assert abs(rows["x0"]["reproduced"] - (317.22 - 319.5)) < 3 * rows["x0"]["sigma"]
+    # the workflow's own result type (no report rows) carries the same numbers, in plain types
+    from hsgeo.workflows.frame_calibration import FrameFilesResult, calibrate_frame_files
+
+    res = calibrate_frame_files(sorted(map(str, CHARUCO.glob("*.jpg"))), BOARD)
+    assert isinstance(res, FrameFilesResult)
+    d = json.loads(json.dumps(res.to_dict(), allow_nan=False))
+    assert [(e["name"], e["value"], e["sigma"]) for e in d["estimates"]] == [
+        (r["quantity"], r["reproduced"], r["sigma"]) for r in out["rows"]
+    ]
+    assert d["meta"] == out["meta"]
+    # and the in-memory core's result in plain types
+    from hsgeo.reproduce.frame_reference import charuco_views
+    from hsgeo.workflows.frame_calibration import calibrate_opencv
+
+    views, size, _ = charuco_views()
+    cal = json.loads(json.dumps(calibrate_opencv(views, size).to_dict(), allow_nan=False))
+    assert cal["form"] == "opencv" and abs(cal["rms_px"] - 0.1878) < 0.01
+    assert set(cal["values"]) == set(cal["sigmas"]) >= {"fx_px", "k1"}
 
 
 def test_rendered_aruco_grid_recovers_truth(tmp_path, capsys):

@@ -1,4 +1,9 @@
-"""Plotting helpers (matplotlib only): every function takes an Axes and returns it."""
+"""Plotting helpers (matplotlib only): every function takes an Axes and returns it.
+
+Kept as one file: one concern, matplotlib figures that take and return an Axes and compute
+nothing a chapter reports. The split into ``plotting/`` per chapter (GUIDE §2) was left for
+after issue 21: its 003 (Rikola) functions were being changed in parallel.
+"""
 
 from __future__ import annotations
 

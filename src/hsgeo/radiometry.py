@@ -28,11 +28,11 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
 from hsgeo.errors import InputError
-from hsgeo.papers import P001_CUBE, P001_SENSOR
 
 __all__ = [
     "FrameLayout",
@@ -55,8 +55,19 @@ __all__ = [
     "combine_opposite_crossings",
 ]
 
+
+@lru_cache(maxsize=1)
+def _imspector() -> dict:
+    """The ImSpector V9 + PixelFly description (``hsgeo/data/instruments/
+    imspector_v9_pixelfly.toml``, :func:`hsgeo.io.read_frame_layouts`; 001 Table 1, §2.1).
+    """
+    from hsgeo.io import read_frame_layouts
+
+    return read_frame_layouts()
+
+
 #: Largest raw value of the 12-bit PixelFly (001 §2.1).
-FULL_SCALE_DN = 2 ** P001_SENSOR["bits"] - 1
+FULL_SCALE_DN = 2 ** _imspector()["bits"] - 1
 
 
 @dataclass(frozen=True)
@@ -85,15 +96,17 @@ def frame_layout(binning: int) -> FrameLayout:
     >>> frame_layout(2).n_reflected, frame_layout(2).n_incident, frame_layout(2).n_columns
     (585, 55, 640)
     """
-    if binning not in (1, 2):
+    layouts = _imspector()["layouts"]
+    if binning not in tuple(layouts):  # compared by value, as (1, 2) was
         raise InputError(f"binning must be 1 or 2 (001 §2.1), got {binning!r}; use --binning 1|2")
+    lay = layouts[binning]
     return FrameLayout(
         binning,
-        P001_SENSOR["n_rows"] // binning,
-        P001_SENSOR["n_columns"] // binning,
-        P001_CUBE["n_reflected_columns"][binning],
-        P001_CUBE["n_incident_columns"][binning],
-        P001_CUBE["frame_rate_hz"][binning],
+        lay["n_rows"],
+        lay["n_columns"],
+        lay["n_reflected"],
+        lay["n_incident"],
+        lay["frame_rate_hz"],
     )
 
 

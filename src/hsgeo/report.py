@@ -1,5 +1,9 @@
 """Tables of results: paper | reproduced | σ̂ | truth | z | verdict (GUIDE §4–§5).
 
+Kept as one file: one concern, the table of a reproduction — the row model, the verdict rules
+and the one way tables and agreement words are formatted read the same fields (σ̂, z,
+provenance) and change together.
+
 :class:`Row` is one quantity of a table and :class:`Reproduction` a set of tables with metadata;
 ``hsgeo reproduce`` and the workflows that print tables (``hsgeo calibrate-frame``) return them,
 as text (:meth:`Reproduction.to_text`), strict JSON (:meth:`Reproduction.to_json`, ``null`` for
@@ -43,6 +47,7 @@ __all__ = [
     "NUMERIC_COLUMNS",
     "as_text",
     "glue_text",
+    "from_estimates",
 ]
 
 #: The verdicts of a claim (ReScience style). ``by construction``: the truth (or the outcome) is
@@ -623,3 +628,15 @@ class Reproduction:
                     ).rstrip()
                 )
         return "\n".join(out)
+
+
+def from_estimates(name: str, result) -> Reproduction:
+    """A workflow's estimates as report rows (reproduced and σ̂ only): ``result`` has
+    ``estimates`` (each with ``group``, ``name``, ``unit``, ``value``, ``sigma``) and ``meta``,
+    as :class:`hsgeo.workflows.frame_calibration.FrameFilesResult`; the rows' tables are the
+    groups. ``hsgeo calibrate-frame`` prints this, and the chapter shows it.
+    """
+    rows = [
+        Row(e.group, e.name, e.unit, None, None, e.value, e.sigma, None) for e in result.estimates
+    ]
+    return Reproduction(name, 0, rows, result.meta)

@@ -1,5 +1,13 @@
 """Compiled kernels of the engine's normal equations and Schur complement (numba).
 
+Kept as one file: one concern, the compiled kernels of the reduced normal equations; they
+share the row-compressed layout and the chunking described below. ``_reduced_kernel`` (~230
+lines) is kept as one function: it runs with ``fastmath`` under ``prange``, where moving its
+per-point loop into inlined ``@njit`` helpers may let LLVM reorder the sums (the results would
+no longer be bitwise those of today) and a call that is not inlined costs time in the hottest
+loop of the engine. Issue 21 left it whole because no ``farm-bench`` run showed a split to be
+neither slower nor different in the last bit.
+
 The engine keeps the whitened Jacobian of the non-point unknowns *row-compressed*: every row
 ``i`` has ``K`` slots ``(cols[i, s], vals[i, s])`` (``cols = -1``: empty slot). Bundle problems
 have few non-zeros per row (a pushbroom observation touches 4 spline nodes × 6 + 11 camera

@@ -1,5 +1,9 @@
 """The least-squares solver: Levenberg–Marquardt on the Schur-reduced normal equations.
 
+Kept as one file: one concern, the Levenberg–Marquardt iteration; the entry point, the state of
+one solve (:class:`_Solve`: steps, trials, rejection rounds, chord steps) and its progress
+display share that state and change together.
+
 Gauss–Newton with Levenberg–Marquardt damping on the whitened observation equations
 ``r_w = (f(x) - l) / σ``, minimising ``½ Σ r_w²`` over the free parameters:
 

@@ -303,86 +303,50 @@ class _NonFinite(InputError):
     """A residual block returned non-finite residuals (at a trial step: a refused step)."""
 
 
-def _evaluate(
-    layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian: bool, compiled: bool = True
-) -> _System:
-    """Whitened residuals (and with ``jacobian`` the row-compressed Jacobian) at the current
-    values of ``layout.params``; rows of ``masks[i] == False`` are left out. ``compiled``
-    keeps factored Jacobians factored (the compiled kernels' form).
-    """
-    values = layout.params.values()
-    r_parts, slot_parts, pidx_parts, jp_parts = [], [], [], []
-    factored_k = None  # width k of the factored Jacobians (one per row, one k for all)
-    offset = 0
-    pname = layout.pblock.name if layout.pblock is not None else None
-    for ib, (blk, keep) in enumerate(zip(blocks, masks, strict=True)):
-        r, jac = blk.evaluate(values, jacobian)
-        r = np.asarray(r, dtype=np.float64)
-        if r.shape != (blk.m,):
-            raise InputError(
-                f"residual block {blk.name!r} returned {r.shape} residuals, expected ({blk.m},)"
-            )
-        if not np.all(np.isfinite(r)):
-            bad = np.flatnonzero(~np.isfinite(r))[:5].tolist()
-            raise _NonFinite(
-                f"residual block {blk.name!r} produced non-finite residuals at rows {bad}: "
-                "check the observations for NaN, or the initial values (a point behind the "
-                "camera, a zero depth)"
-            )
-        w = 1.0 / blk.sigma
-        rows_kept = np.flatnonzero(keep)
-        all_kept = rows_kept.size == blk.m
-        r_parts.append(r * w if all_kept else r.take(rows_kept) * w.take(rows_kept))
-        if jacobian:
-            pidx = np.full(rows_kept.size, -1, dtype=np.int64)
-            jp = np.zeros((rows_kept.size, layout.p))
-            blk_slots = []
-            for name, J in jac.items():
-                b = layout.params[name]
-                if name == pname:
-                    if isinstance(J, Indexed):
-                        J = J.expanded()
-                    if not isinstance(J, Indexed) or J.index.shape[1] != 1 or J.k != layout.p:
-                        raise InputError(
-                            f"the Jacobian w.r.t. the points block {name!r} must be "
-                            f"Indexed((m,), (m, {layout.p})): each row touches one point"
-                        )
-                    pidx, jp = J.index[:, 0], J.d[:, 0, :]
-                    layout.row_point[ib] = pidx
-                    if all_kept:
-                        jp = jp * w[:, None]
-                    else:
-                        pidx = pidx.take(rows_kept)
-                        jp = jp.take(rows_kept, axis=0) * w.take(rows_kept)[:, None]
-                    if not layout.pfree.all():
-                        jp = jp * layout.pfree[np.maximum(pidx, 0)]
-                    if (pidx < 0).any():
-                        jp = np.where(pidx[:, None] >= 0, jp, 0.0)
-                    continue
-                if name in layout.tie_blocks and isinstance(J, Indexed):
-                    J = J.expanded()
-                has_f = any(sl.factored for sl in blk_slots)
-                sl = _Slots(
-                    J,
-                    blk.m,
-                    b.size,
-                    name,
-                    layout.colmap[name],
-                    None if all_kept else rows_kept,
-                    w,
-                    factored_k=-1 if has_f else factored_k,
-                    compiled=compiled,
-                )
-                if sl.factored:
-                    factored_k = sl.qk[1]
-                blk_slots.append(sl)
-            slot_parts.append(blk_slots)
-            pidx_parts.append(pidx)
-            jp_parts.append(jp)
-        offset += rows_kept.size
-    n_obs_rows = offset
+def _block_residuals(blk: ResidualBlock, values, jacobian: bool):
+    """One block's residuals (checked: shape and finite) and Jacobians."""
+    r, jac = blk.evaluate(values, jacobian)
+    r = np.asarray(r, dtype=np.float64)
+    if r.shape != (blk.m,):
+        raise InputError(
+            f"residual block {blk.name!r} returned {r.shape} residuals, expected ({blk.m},)"
+        )
+    if not np.all(np.isfinite(r)):
+        bad = np.flatnonzero(~np.isfinite(r))[:5].tolist()
+        raise _NonFinite(
+            f"residual block {blk.name!r} produced non-finite residuals at rows {bad}: "
+            "check the observations for NaN, or the initial values (a point behind the "
+            "camera, a zero depth)"
+        )
+    return r, jac
 
-    # priors as pseudo-observations (x - μ) / σ
+
+def _point_jacobian(layout: _Layout, ib: int, name: str, J, w, rows_kept, all_kept: bool):
+    """The whitened Jacobian w.r.t. the points block, one point per row: ``(pidx, jp)``."""
+    if isinstance(J, Indexed):
+        J = J.expanded()
+    if not isinstance(J, Indexed) or J.index.shape[1] != 1 or J.k != layout.p:
+        raise InputError(
+            f"the Jacobian w.r.t. the points block {name!r} must be "
+            f"Indexed((m,), (m, {layout.p})): each row touches one point"
+        )
+    pidx, jp = J.index[:, 0], J.d[:, 0, :]
+    layout.row_point[ib] = pidx
+    if all_kept:
+        jp = jp * w[:, None]
+    else:
+        pidx = pidx.take(rows_kept)
+        jp = jp.take(rows_kept, axis=0) * w.take(rows_kept)[:, None]
+    if not layout.pfree.all():
+        jp = jp * layout.pfree[np.maximum(pidx, 0)]
+    if (pidx < 0).any():
+        jp = np.where(pidx[:, None] >= 0, jp, 0.0)
+    return pidx, jp
+
+
+def _prior_rows(layout: _Layout, jacobian: bool, r_parts, slot_parts, pidx_parts, jp_parts):
+    """Priors as pseudo-observations (x - μ) / σ, appended to the parts; returns their count."""
+    n = 0
     for b in layout.params.blocks():
         hp = b.has_prior
         if not hp.any():
@@ -402,13 +366,14 @@ def _evaluate(
                 slot_parts.append([_PriorSlots(layout.colmap[b.name][idx], 1.0 / s)])
                 pidx_parts.append(np.full(idx.size, -1, dtype=np.int64))
                 jp_parts.append(np.zeros((idx.size, layout.p)))
-        offset += idx.size
+        n += idx.size
+    return n
 
-    r_all = np.concatenate(r_parts) if r_parts else np.zeros(0)
-    if not jacobian:
-        return _System(r_all, None, None, None, n_obs_rows)
-    M = offset
-    # one (M, K) row-compressed matrix: each part's slots side by side, padded to the widest
+
+def _assemble(layout: _Layout, slot_parts, pidx_parts, jp_parts, M: int, factored_k):
+    """One (M, K) row-compressed matrix: each part's slots side by side, padded to the widest;
+    returns ``(Jrc, pidx, Jp)``.
+    """
     K = max([sum(sl.width for sl in part) for part in slot_parts] + [1])
     itype = np.int32 if layout.n_c < 2**31 else np.int64
     cols_all = np.empty((M, K), dtype=itype)
@@ -440,6 +405,63 @@ def _evaluate(
     pidx = np.concatenate(pidx_parts) if pidx_parts else np.full(M, -1)
     Jp = np.concatenate(jp_parts) if jp_parts else np.zeros((M, layout.p))
     Jrc = _RowJac(cols_all, vals_all, layout.n_c, *((fcol, fw, fd) if Q else ()))
+    return Jrc, pidx, Jp
+
+
+def _evaluate(
+    layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian: bool, compiled: bool = True
+) -> _System:
+    """Whitened residuals (and with ``jacobian`` the row-compressed Jacobian) at the current
+    values of ``layout.params``; rows of ``masks[i] == False`` are left out. ``compiled``
+    keeps factored Jacobians factored (the compiled kernels' form).
+    """
+    values = layout.params.values()
+    r_parts, slot_parts, pidx_parts, jp_parts = [], [], [], []
+    factored_k = None  # width k of the factored Jacobians (one per row, one k for all)
+    offset = 0
+    pname = layout.pblock.name if layout.pblock is not None else None
+    for ib, (blk, keep) in enumerate(zip(blocks, masks, strict=True)):
+        r, jac = _block_residuals(blk, values, jacobian)
+        w = 1.0 / blk.sigma
+        rows_kept = np.flatnonzero(keep)
+        all_kept = rows_kept.size == blk.m
+        r_parts.append(r * w if all_kept else r.take(rows_kept) * w.take(rows_kept))
+        if jacobian:
+            pidx = np.full(rows_kept.size, -1, dtype=np.int64)
+            jp = np.zeros((rows_kept.size, layout.p))
+            blk_slots = []
+            for name, J in jac.items():
+                b = layout.params[name]
+                if name == pname:
+                    pidx, jp = _point_jacobian(layout, ib, name, J, w, rows_kept, all_kept)
+                    continue
+                if name in layout.tie_blocks and isinstance(J, Indexed):
+                    J = J.expanded()
+                has_f = any(sl.factored for sl in blk_slots)
+                sl = _Slots(
+                    J,
+                    blk.m,
+                    b.size,
+                    name,
+                    layout.colmap[name],
+                    None if all_kept else rows_kept,
+                    w,
+                    factored_k=-1 if has_f else factored_k,
+                    compiled=compiled,
+                )
+                if sl.factored:
+                    factored_k = sl.qk[1]
+                blk_slots.append(sl)
+            slot_parts.append(blk_slots)
+            pidx_parts.append(pidx)
+            jp_parts.append(jp)
+        offset += rows_kept.size
+    n_obs_rows = offset
+    offset += _prior_rows(layout, jacobian, r_parts, slot_parts, pidx_parts, jp_parts)
+    r_all = np.concatenate(r_parts) if r_parts else np.zeros(0)
+    if not jacobian:
+        return _System(r_all, None, None, None, n_obs_rows)
+    Jrc, pidx, Jp = _assemble(layout, slot_parts, pidx_parts, jp_parts, offset, factored_k)
     return _System(r_all, Jrc, pidx, Jp, n_obs_rows)
 
 

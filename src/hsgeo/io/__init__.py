@@ -38,6 +38,7 @@ from hsgeo.io.raster import read_dem, to_map_files
 from hsgeo.io.sensors import (
     read_band_split,
     read_camera_toml,
+    read_frame_layouts,
     read_pushbroom_camera,
     read_scanning_sensor,
     read_sensor_toml,
@@ -59,6 +60,7 @@ __all__ = [
     "read_sensor_toml",
     "read_camera_toml",
     "read_band_split",
+    "read_frame_layouts",
     "read_pushbroom_camera",
     "read_scanning_sensor",
     "Board",

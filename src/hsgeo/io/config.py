@@ -21,7 +21,7 @@ from pathlib import Path
 from hsgeo.errors import InputError
 from hsgeo.validate import unit_limits
 
-__all__ = ["Key", "read_toml", "read_config", "closest", "did_you_mean"]
+__all__ = ["Key", "read_toml", "read_config", "closest", "did_you_mean", "dataclass_from_table"]
 
 _KINDS = ("float", "int", "str", "floats")
 
@@ -217,3 +217,26 @@ def read_config(
     if problems:
         raise InputError(f"{what} {path}: " + "; ".join(problems))
     return out
+
+
+def dataclass_from_table(cls, table: Mapping | None, what: str):
+    """The dataclass ``cls`` with its defaults replaced by the entries of a TOML table.
+
+    The fields of ``cls`` are the table's schema: an unknown key is an error that names the
+    closest field (all unknown keys in one message); arrays become tuples. ``what`` names the
+    table in the message (``"scenario line_lab [lab]"``).
+    """
+    import dataclasses
+
+    if not table:
+        return cls()
+    names = [f.name for f in dataclasses.fields(cls)]
+    bad = [k for k in table if k not in names]
+    if bad:
+        raise InputError(
+            "; ".join(
+                f"{what} {k}: unknown key{did_you_mean(k, names)} (known: {', '.join(names)})"
+                for k in bad
+            )
+        )
+    return cls(**{k: tuple(v) if isinstance(v, list) else v for k, v in table.items()})

@@ -17,6 +17,7 @@ __all__ = [
     "read_pushbroom_camera",
     "read_scanning_sensor",
     "read_band_split",
+    "read_frame_layouts",
 ]
 
 #: ``hsgeo geocode --sensor``: a line scanner (000 eq. (2)) and its boresight.
@@ -250,3 +251,80 @@ def read_band_split(path=None) -> np.ndarray:
     out = np.zeros(band.size, dtype=[("band", "i4"), ("sensor", "i4"), ("gap_nm", "f8")])
     out["band"], out["sensor"], out["gap_nm"] = band, sensor, b["gap_nm"]
     return out
+
+
+#: A line scanner's raw-frame layout (``data/instruments/*.toml``): rows, columns, the scene's
+#: and the diffuse collector's columns and the frame rate, one entry per binning factor.
+FRAME_LAYOUT_SCHEMA = {
+    "instrument": {
+        "name": Key("str", required=True, doc="instrument name"),
+        "bits": Key("int", required=True, positive=True, doc="bit depth of a raw value"),
+    },
+    "frame": {
+        "binning": Key("floats", required=True, positive=True, doc="binning factors"),
+        "n_rows": Key("floats", required=True, positive=True, doc="spectral rows per frame"),
+        "n_columns": Key("floats", required=True, positive=True, doc="columns per frame"),
+        "n_reflected_columns": Key(
+            "floats", required=True, positive=True, doc="columns that see the scene"
+        ),
+        "n_incident_columns": Key(
+            "floats", required=True, positive=True, doc="columns of the diffuse collector"
+        ),
+        "frame_rate_hz": Key("floats", required=True, positive=True, doc="frame rate, Hz"),
+    },
+}
+
+
+def read_frame_layouts(path=None) -> dict:
+    """A line scanner's raw-frame layout per binning factor (:data:`FRAME_LAYOUT_SCHEMA`).
+
+    Parameters
+    ----------
+    path : str or Path, optional
+        Default: the ImSpector V9 + PixelFly of 001
+        (``hsgeo/data/instruments/imspector_v9_pixelfly.toml``).
+
+    Returns
+    -------
+    dict
+        ``name``, ``bits`` and ``layouts``: binning factor -> dict with ``n_rows``,
+        ``n_columns``, ``n_reflected``, ``n_incident`` (int) and ``frame_rate_hz`` (float).
+    """
+    from pathlib import Path
+
+    if path is None:
+        path = Path(__file__).parent.parent / "data" / "instruments" / "imspector_v9_pixelfly.toml"
+    cfg = read_config(path, FRAME_LAYOUT_SCHEMA, "instrument file", required_tables=("frame",))
+    f = cfg["frame"]
+    counts = ("binning", "n_rows", "n_columns", "n_reflected_columns", "n_incident_columns")
+    problems = []
+    if len({len(v) for v in f.values()}) != 1:
+        problems.append("[frame] every key must have one entry per binning factor")
+    elif not all(float(x).is_integer() for k in counts for x in f[k]):
+        problems.append(f"[frame] {', '.join(counts)} must be whole numbers")
+    elif any(
+        r + i != c
+        for r, i, c in zip(
+            f["n_reflected_columns"], f["n_incident_columns"], f["n_columns"], strict=True
+        )
+    ):
+        problems.append("[frame] n_reflected_columns + n_incident_columns must be n_columns")
+    elif len(set(f["binning"])) != len(f["binning"]):
+        problems.append("[frame] binning factors must differ")
+    if problems:
+        raise InputError(f"instrument file {path}: " + "; ".join(problems))
+    layouts = {
+        int(b): {
+            "n_rows": int(f["n_rows"][i]),
+            "n_columns": int(f["n_columns"][i]),
+            "n_reflected": int(f["n_reflected_columns"][i]),
+            "n_incident": int(f["n_incident_columns"][i]),
+            "frame_rate_hz": float(f["frame_rate_hz"][i]),
+        }
+        for i, b in enumerate(f["binning"])
+    }
+    return {
+        "name": cfg["instrument"]["name"],
+        "bits": cfg["instrument"]["bits"],
+        "layouts": layouts,
+    }

@@ -58,6 +58,103 @@ def _data_lines(text: str) -> list[int]:
     return lines
 
 
+def _parse(path, text, parquet: bool, name: str, columns, text_columns):
+    """The table as pandas reads it; a parser error becomes an :class:`InputError`."""
+    import pandas as pd
+
+    try:
+        if parquet:
+            df = pd.read_parquet(path)
+        else:
+            df = pd.read_csv(
+                io.StringIO(text),
+                comment="#",
+                skipinitialspace=True,
+                dtype={c: str for c in text_columns},
+            )
+    except pd.errors.EmptyDataError:
+        raise InputError(
+            f"{name} is empty; it needs a header line with the columns "
+            f"{', '.join(columns)} and one row per record"
+        ) from None
+    except Exception as exc:  # noqa: BLE001 - any parser error becomes an InputError
+        kind = "Parquet" if parquet else "CSV"
+        msg = " ".join(str(exc).split())
+        raise InputError(f"{name} is not a readable {kind} table: {msg}") from None
+    df.columns = [str(c).strip() for c in df.columns]
+    return df
+
+
+def _check_header(df, name: str, columns) -> None:
+    """Every required column once, and at least one data row."""
+    dup = [c for c in columns if list(df.columns).count(c) > 1]
+    if dup:
+        raise InputError(f"{name}: the header names column {dup[0]} twice; keep one")
+    missing = [c for c in columns if c not in df.columns]
+    if missing:
+        near = {c: closest(c, df.columns) for c in missing}
+        hints = "".join(f"; rename {n!r} to {c!r}?" for c, n in near.items() if n)
+        found = ", ".join(df.columns)
+        if len(found) > 120:
+            found = found[:120] + "..."
+        raise InputError(
+            f"{name}: missing column(s) {', '.join(missing)}; the header must "
+            f"name {', '.join(columns)} (found: {found}){hints}"
+        )
+    if len(df) == 0:
+        raise InputError(f"{name} has a header but no data rows; add one row per record")
+
+
+def _check_column(df, c: str, name: str, where, text_columns, integer_columns, limits) -> None:
+    """One required column: text stripped, numbers parsed, no empty or non-finite value, whole
+    numbers where asked, inside the unit's range (``df`` is updated in place).
+    """
+    import pandas as pd
+
+    from hsgeo.validate import check_range, unit_limits
+
+    col = df[c]
+    if c in text_columns:
+        na = col.isna()
+        col = col.astype(str).str.strip().where(~na, "")
+        df[c] = col
+        bad = col == ""
+    elif _has_unit(c) or c in integer_columns:
+        num = pd.to_numeric(col, errors="coerce")
+        txt = col.notna() & num.isna()
+        if txt.any():
+            r = int(np.flatnonzero(txt.to_numpy())[0])
+            raise InputError(
+                f"{name}, {where(r)}, column {c}: {col.iloc[r]!r} is not a "
+                "number; correct the value"
+            )
+        df[c] = num
+        bad = ~np.isfinite(num.to_numpy(dtype=float))
+    else:
+        bad = col.isna().to_numpy()
+    bad = np.asarray(bad)
+    if bad.any():
+        r = int(np.flatnonzero(bad)[0])
+        more = int(bad.sum()) - 1
+        raise InputError(
+            f"{name}, {where(r)}, column {c}: empty, NaN or infinite value"
+            + (f" (and {more} more)" if more else "")
+            + "; fill it in or delete the row"
+        )
+    if c in integer_columns:
+        v = df[c].to_numpy(dtype=float)
+        frac = v != np.round(v)
+        if frac.any():
+            r = int(np.flatnonzero(frac)[0])
+            raise InputError(
+                f"{name}, {where(r)}, column {c}: {v[r]:g} is not a whole number; correct the value"
+            )
+        df[c] = v.astype(np.int64)
+    lim = limits.get(c) or (unit_limits(c) if c not in text_columns else None)
+    if lim is not None:
+        check_range(df[c].to_numpy(dtype=float), *lim, f"{name}, column {c}", where=where)
+
+
 def read_table(
     path,
     columns,
@@ -106,9 +203,7 @@ def read_table(
         out-of-range value in a required column, or repeats an id or a row (the message gives
         the lines and the column).
     """
-    import pandas as pd
-
-    from hsgeo.validate import check_range, check_unique, unit_limits
+    from hsgeo.validate import check_unique
 
     path = Path(path)
     columns = list(columns)
@@ -116,42 +211,8 @@ def read_table(
     check_input_file(path, f"{what} file")
     parquet = path.suffix.lower() in _PARQUET
     text = None if parquet else read_text(path, f"{what} file", "CSV table")
-    try:
-        if parquet:
-            df = pd.read_parquet(path)
-        else:
-            df = pd.read_csv(
-                io.StringIO(text),
-                comment="#",
-                skipinitialspace=True,
-                dtype={c: str for c in text_columns},
-            )
-    except pd.errors.EmptyDataError:
-        raise InputError(
-            f"{name} is empty; it needs a header line with the columns "
-            f"{', '.join(columns)} and one row per record"
-        ) from None
-    except Exception as exc:  # noqa: BLE001 - any parser error becomes an InputError
-        kind = "Parquet" if parquet else "CSV"
-        msg = " ".join(str(exc).split())
-        raise InputError(f"{name} is not a readable {kind} table: {msg}") from None
-    df.columns = [str(c).strip() for c in df.columns]
-    dup = [c for c in columns if list(df.columns).count(c) > 1]
-    if dup:
-        raise InputError(f"{name}: the header names column {dup[0]} twice; keep one")
-    missing = [c for c in columns if c not in df.columns]
-    if missing:
-        near = {c: closest(c, df.columns) for c in missing}
-        hints = "".join(f"; rename {n!r} to {c!r}?" for c, n in near.items() if n)
-        found = ", ".join(df.columns)
-        if len(found) > 120:
-            found = found[:120] + "..."
-        raise InputError(
-            f"{name}: missing column(s) {', '.join(missing)}; the header must "
-            f"name {', '.join(columns)} (found: {found}){hints}"
-        )
-    if len(df) == 0:
-        raise InputError(f"{name} has a header but no data rows; add one row per record")
+    df = _parse(path, text, parquet, name, columns, text_columns)
+    _check_header(df, name, columns)
     lines = None if parquet else _data_lines(text)
 
     def where(row: int) -> str:
@@ -161,47 +222,7 @@ def read_table(
 
     limits = dict(limits or {})
     for c in columns:
-        col = df[c]
-        if c in text_columns:
-            na = col.isna()
-            col = col.astype(str).str.strip().where(~na, "")
-            df[c] = col
-            bad = col == ""
-        elif _has_unit(c) or c in integer_columns:
-            num = pd.to_numeric(col, errors="coerce")
-            txt = col.notna() & num.isna()
-            if txt.any():
-                r = int(np.flatnonzero(txt.to_numpy())[0])
-                raise InputError(
-                    f"{name}, {where(r)}, column {c}: {col.iloc[r]!r} is not a "
-                    "number; correct the value"
-                )
-            df[c] = num
-            bad = ~np.isfinite(num.to_numpy(dtype=float))
-        else:
-            bad = col.isna().to_numpy()
-        bad = np.asarray(bad)
-        if bad.any():
-            r = int(np.flatnonzero(bad)[0])
-            more = int(bad.sum()) - 1
-            raise InputError(
-                f"{name}, {where(r)}, column {c}: empty, NaN or infinite value"
-                + (f" (and {more} more)" if more else "")
-                + "; fill it in or delete the row"
-            )
-        if c in integer_columns:
-            v = df[c].to_numpy(dtype=float)
-            frac = v != np.round(v)
-            if frac.any():
-                r = int(np.flatnonzero(frac)[0])
-                raise InputError(
-                    f"{name}, {where(r)}, column {c}: {v[r]:g} is not a whole number; "
-                    "correct the value"
-                )
-            df[c] = v.astype(np.int64)
-        lim = limits.get(c) or (unit_limits(c) if c not in text_columns else None)
-        if lim is not None:
-            check_range(df[c].to_numpy(dtype=float), *lim, f"{name}, column {c}", where=where)
+        _check_column(df, c, name, where, text_columns, integer_columns, limits)
     for u in unique:
         cols = [u] if isinstance(u, str) else list(u)
         keys = list(df[cols].itertuples(index=False, name=None))

@@ -163,15 +163,11 @@ INTRINSIC_ROWS = (
 )
 
 
-def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
-    """Compute every table of the chapter (``scale`` is unused: the data are small)."""
-    from hsgeo.simulate.frame_bench import simulate
-    from hsgeo.simulate.scenarios import load_scenario
-
+def _chessboard_rows(extras: dict) -> list[Row]:
+    """1. The chessboard under OpenCV's constraints (flags 14), the σ̂ of all nine intrinsics
+    against OpenCV's, and the two forms of Brown's model.
+    """
     rows: list[Row] = []
-    extras: dict = {}
-
-    # 1. chessboard under OpenCV's constraints (flags 14)
     views, size, ref = chessboard_views()
     cal = calibrate_opencv(
         views, size, fix_principal_point=True, square_pixels=True, zero_tangent=True
@@ -221,8 +217,14 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
         "photogrammetric_form": pg,
         "reference": ref,
     }
+    return rows
 
-    # 2. ChArUco: hsgeo vs today's cv2.calibrateCamera on the same detected corners
+
+def _charuco_rows(extras: dict) -> list[Row]:
+    """2. ChArUco: hsgeo against today's ``cv2.calibrateCamera`` on the same detected corners,
+    and against OpenCV's reference file of 2021.
+    """
+    rows: list[Row] = []
     cviews, csize, cref = charuco_views()
     ccal = calibrate_opencv(cviews, csize)
     K, dist, rms_cv = opencv_calibrate(cviews, csize)
@@ -281,8 +283,15 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
             reason="other corners (the 2021 file used an older detector); no σ for an RMS",
         )
     )
+    return rows
 
-    # 3. simulated bench, truth known
+
+def _bench_rows(seed: int, extras: dict) -> list[Row]:
+    """3. The simulated bench, truth known."""
+    from hsgeo.simulate.frame_bench import simulate
+    from hsgeo.simulate.scenarios import load_scenario
+
+    rows: list[Row] = []
     cfg = load_scenario("frame_bench")
     sim, sim_truth = simulate(cfg, seed)
     sviews = [
@@ -303,17 +312,26 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
         "observations": sim,
         "simulation_truth": sim_truth,
     }
+    return rows
 
+
+def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
+    """Compute every table of the chapter (``scale`` is unused: the data are small)."""
+    extras: dict = {}
+    rows = _chessboard_rows(extras) + _charuco_rows(extras) + _bench_rows(seed, extras)
     meta = {
         "chessboard_source": "opencv/opencv samples/cpp/tutorial_code/calib3d/camera_calibration/"
         "out_camera_data.yml (flags 14)",
         "charuco_source": "opencv_contrib aruco tutorial images img_00..03.jpg; board 5x7, "
         "0.04 m squares, 0.02 m markers, DICT_6X6_250",
-        "charuco_corners_per_image": [int(v.X.shape[0]) for v in cviews],
+        "charuco_corners_per_image": [int(v.X.shape[0]) for v in extras["charuco"]["views"]],
         "charuco_reference_2021": extras["charuco"]["reference_2021"],
         "pixel_pitch_mm_nominal": PIXEL_PITCH_MM,
         "bench_seed": seed,
-        "iterations": {"chessboard": cal.result.iterations, "charuco": ccal.result.iterations},
+        "iterations": {
+            "chessboard": extras["chessboard"]["opencv_form"].result.iterations,
+            "charuco": extras["charuco"]["hsgeo"].result.iterations,
+        },
     }
     for r in rows:
         if r.paper is not None:

@@ -192,11 +192,9 @@ def _unmodelled_rows(mc_on: dict, mc_off: dict, n: int) -> list[Row]:
     return rows
 
 
-def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
-    """The chapter's tables; ``scale`` sets the Monte Carlo size, max(20, round(200·scale))."""
+def _printed_table_rows(meta: dict) -> list[Row]:
+    """1. 000 Tables 2 and 3 recomputed from their printed deviations (flags into ``meta``)."""
     rows: list[Row] = []
-    meta: dict = {"flags": {}}
-    # 1. the printed tables, recomputed
     for which in (2, 3):
         table = f"000 Table {which}"
         _, summary, flags = recompute_printed_table(which)
@@ -228,22 +226,12 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
             )
         meta["flags"][table] = [str(f) for f in flags]
 
-    # 2. the experiment
-    cfg = load_scenario("pula_flight")
-    cal, cal_res = calibrated_iop(seed)
-    sensors = {"uncalibrated": nominal_sensor(cfg), "calibrated": cal}
-    n = max(20, round(200 * scale))
-    mc = monte_carlo(cfg, sensors, n, seed)
-    # the inner orientation used for the calibrated geocoding: the line-calibration estimate
-    st = cfg["sensor_truth"]
-    for q, v, sg, t in zip(
-        ("zeta0_px", "c_px", "K1", "K2", "K3"),
-        (cal.zeta0_px, cal.c_px, *cal.K),
-        np.r_[cal_res.sigma("zeta0_px"), cal_res.sigma("c_px"), cal_res.sigma("K")],
-        (st["zeta0_px"], st["c_px"], *st["K"]),
-        strict=True,
-    ):
-        rows.append(Row("calibrated IOP", q, "px", reproduced=v, sigma=float(sg), truth=float(t)))
+    return rows
+
+
+def _simulated_rows(cfg, mc, n: int) -> list[Row]:
+    """The simulated flights' σ against 000 Tables 2 and 3 (uncalibrated and calibrated)."""
+    rows: list[Row] = []
     height = cfg["flight"]["height_agl_m"]
     for name, paper_table in (("uncalibrated", "000 Table 2"), ("calibrated", "000 Table 3")):
         for k, q in enumerate(QUANTITIES):
@@ -275,6 +263,31 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
                     f"of the paper (spread over {n} flights)"
                 )
             rows.append(row)
+    return rows
+
+
+def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
+    """The chapter's tables; ``scale`` sets the Monte Carlo size, max(20, round(200·scale))."""
+    meta: dict = {"flags": {}}
+    rows = _printed_table_rows(meta)
+
+    # 2. the experiment
+    cfg = load_scenario("pula_flight")
+    cal, cal_res = calibrated_iop(seed)
+    sensors = {"uncalibrated": nominal_sensor(cfg), "calibrated": cal}
+    n = max(20, round(200 * scale))
+    mc = monte_carlo(cfg, sensors, n, seed)
+    # the inner orientation used for the calibrated geocoding: the line-calibration estimate
+    st = cfg["sensor_truth"]
+    for q, v, sg, t in zip(
+        ("zeta0_px", "c_px", "K1", "K2", "K3"),
+        (cal.zeta0_px, cal.c_px, *cal.K),
+        np.r_[cal_res.sigma("zeta0_px"), cal_res.sigma("c_px"), cal_res.sigma("K")],
+        (st["zeta0_px"], st["c_px"], *st["K"]),
+        strict=True,
+    ):
+        rows.append(Row("calibrated IOP", q, "px", reproduced=v, sigma=float(sg), truth=float(t)))
+    rows += _simulated_rows(cfg, mc, n)
     ratio = mc["uncalibrated"][:, 2:] / mc["calibrated"][:, 2:]
     # the unmodelled effect: the same flights with an exact DEM
     mc_off = monte_carlo(cfg, sensors, n, seed, dem_sigma_m=0.0)

@@ -26,7 +26,12 @@ from hsgeo.report import Reproduction, Row
 from hsgeo.sensors import line1d
 from hsgeo.simulate import as_rng
 from hsgeo.simulate.line_lab import LineLab, pattern_points, record, stations
-from hsgeo.workflows.line_calibration import calibrate, observe_rows
+from hsgeo.workflows.line_calibration import (
+    LineInputs,
+    LineOptions,
+    calibrate_line,
+    observe_rows,
+)
 
 __all__ = [
     "run",
@@ -74,20 +79,19 @@ def simulate_observations(lab: LineLab, row: int, rng, eop_true=None, method: st
 def calibrate_simulated(lab: LineLab, row: int, rng, method: str = "parabola"):
     """Render, measure and calibrate one spectral row; returns ``(result, sim)``."""
     sim = simulate_observations(lab, row, rng, method=method)
-    xy = sim["xy_m"]
-    line1d.check_minimum_observations(sim["image"], sim["point"], np.ones(len(xy), bool))
     u = P000_TABLE1_UNCALIBRATED
-    p = line1d.make_parameters(
-        stations(lab),
-        u.zeta0_px,
-        u.c_px,
-        [0.0, 0.0, 0.0],
-        xy,
-        np.ones(len(xy), bool),
-        point_ids=sim["point_ids"],
+    cal = calibrate_line(  # the core of ``hsgeo calibrate-line``, started at the stations
+        LineInputs(
+            sim["image"],
+            sim["point"],
+            sim["zeta_px"],
+            sim["xy_m"],
+            point_ids=sim["point_ids"],
+            initial_eop=stations(lab),
+        ),
+        LineOptions(zeta0_px=u.zeta0_px, c_px=u.c_px, sigma_px=lab.zeta_sigma_px),
     )
-    blk = line1d.LineObservations(sim["image"], sim["point"], sim["zeta_px"], lab.zeta_sigma_px)
-    return calibrate(p, blk), sim
+    return cal.result, sim
 
 
 def _iop(res):
@@ -258,15 +262,9 @@ def _unmodelled_rows(mc_on: dict, mc_off: dict) -> list[Row]:
     return rows
 
 
-def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
-    """The chapter's numbers. ``scale`` sets the Monte Carlo size: max(20, round(200·scale))."""
-    lab = LineLab()
+def _iop_table_rows(results: dict, sims: dict) -> list[Row]:
+    """000 Table 1 (row 1000, λ = 870 nm) and 001 Table 2: the calibrated inner orientation."""
     rows: list[Row] = []
-    results, sims = {}, {}
-    for r in lab.rows:
-        row_seed = np.random.SeedSequence([seed, r]).generate_state(1)[0]
-        res, sim = calibrate_simulated(lab, r, row_seed)
-        results[r], sims[r] = res, sim
     # 000 Table 1 (row 1000, λ = 870 nm)
     u, c = P000_TABLE1_UNCALIBRATED, P000_TABLE1_CALIBRATED
     start = "the nominal value the adjustment starts from (Jakšić 2009), not an estimate"
@@ -315,6 +313,12 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
                 # row 1000's truth is 000 Table 1, which 001 Table 2 prints rounded
                 row.provenance = "derived"
             rows.append(row)
+    return rows
+
+
+def _distortion_magnitude_rows() -> list[Row]:
+    """The distortion magnitudes of the published coefficients (100-px normalisation)."""
+    rows: list[Row] = []
     # distortion magnitudes from the published coefficients (100-px normalisation)
     k100 = [P001_TABLE2[0].K1, P001_TABLE2[0].K2, P001_TABLE2[0].K3]
     k1000 = [P001_TABLE2[3].K1, P001_TABLE2[3].K2, P001_TABLE2[3].K3]
@@ -343,15 +347,12 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
                 ),
             )
         )
-    # Monte Carlo: does σ̂ tell the truth under the estimator's own model (the even distortion
-    # term off)? Then the unmodelled effect: the same first runs of row 1000 with it on
-    n_mc = max(20, int(round(200 * scale)))
-    lab_own = replace(lab, even_distortion_px=0.0)
-    mc = {r: monte_carlo(lab_own, r, n_mc, seed) for r in lab.rows}
-    rows += _precision_rows(results[1000], mc[1000], lab)
-    n_ue = max(20, n_mc // 4)
-    mc_on = monte_carlo(lab, 1000, n_ue, seed)  # the same draws as mc[1000]'s first n_ue runs
-    rows += _unmodelled_rows(mc_on, {k: v[:n_ue] for k, v in mc[1000].items() if k in _RUNS})
+    return rows
+
+
+def _coverage_rows(lab, mc: dict, n_mc: int) -> list[Row]:
+    """Monte Carlo coverage: the share of runs whose estimate lies within k σ̂ of the truth."""
+    rows: list[Row] = []
     for r in lab.rows:
         for k in (1, 2, 3):
             cov = mc[r]["coverage"][k]
@@ -369,6 +370,30 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
                         n_runs=n_mc,
                     )
                 )
+    return rows
+
+
+def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
+    """The chapter's numbers. ``scale`` sets the Monte Carlo size: max(20, round(200·scale))."""
+    lab = LineLab()
+    rows: list[Row] = []
+    results, sims = {}, {}
+    for r in lab.rows:
+        row_seed = np.random.SeedSequence([seed, r]).generate_state(1)[0]
+        res, sim = calibrate_simulated(lab, r, row_seed)
+        results[r], sims[r] = res, sim
+    rows += _iop_table_rows(results, sims)
+    rows += _distortion_magnitude_rows()
+    # Monte Carlo: does σ̂ tell the truth under the estimator's own model (the even distortion
+    # term off)? Then the unmodelled effect: the same first runs of row 1000 with it on
+    n_mc = max(20, int(round(200 * scale)))
+    lab_own = replace(lab, even_distortion_px=0.0)
+    mc = {r: monte_carlo(lab_own, r, n_mc, seed) for r in lab.rows}
+    rows += _precision_rows(results[1000], mc[1000], lab)
+    n_ue = max(20, n_mc // 4)
+    mc_on = monte_carlo(lab, 1000, n_ue, seed)  # the same draws as mc[1000]'s first n_ue runs
+    rows += _unmodelled_rows(mc_on, {k: v[:n_ue] for k, v in mc[1000].items() if k in _RUNS})
+    rows += _coverage_rows(lab, mc, n_mc)
     meta = {
         "n_monte_carlo": n_mc,
         "n_unmodelled_effect_runs": n_ue,

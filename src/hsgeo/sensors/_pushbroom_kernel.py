@@ -1,5 +1,11 @@
 """The compiled residual kernel of :class:`hsgeo.sensors.pushbroom.PushbroomLines` (002 eq. 2–4).
 
+``_lines_kernel`` (~190 lines) is kept as one function: one pass per observation (pose at the
+line time, the Newton on the crossing time, the projection and every derivative) whose
+intermediate values the derivatives reuse; split into ``@njit`` helpers they would pass a dozen
+arrays each way in the hottest loop of the pushbroom adjustment. Issue 21 left it whole because
+no ``farm-bench`` run showed a split to be neither slower nor different in the last bit.
+
 Moved out of :mod:`hsgeo.sensors.pushbroom` unchanged: one observation per iteration, the
 crossing time by Newton (the residual across the line as a time) and the derivatives; see that
 module's docstring for the model and the time residual.

@@ -94,15 +94,13 @@ class LineLab:
 
     @classmethod
     def from_config(cls, cfg: dict | None) -> LineLab:
-        """From a TOML-like dict (``[lab]`` table entries override the defaults)."""
-        if not cfg:
-            return cls()
-        known = set(cls.__dataclass_fields__)
-        bad = sorted(set(cfg) - known)
-        if bad:
-            raise InputError(f"unknown line-lab settings {bad}; known: {sorted(known)}")
-        conv = {k: tuple(v) if isinstance(v, list) else v for k, v in cfg.items()}
-        return replace(cls(), **conv)
+        """From the ``[lab]`` table of ``data_synthetic/line_lab.toml``: its entries override
+        the defaults; the fields are the schema (:func:`hsgeo.io.config.dataclass_from_table`,
+        unknown keys are errors with a suggestion).
+        """
+        from hsgeo.io.config import dataclass_from_table
+
+        return dataclass_from_table(cls, cfg, "line-lab settings [lab]")
 
 
 def wavelength_nm(row, lab: LineLab = LineLab()):

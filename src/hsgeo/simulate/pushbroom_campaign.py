@@ -53,13 +53,10 @@ numerical precision.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from types import MappingProxyType
 
 import numpy as np
-import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 from scipy.interpolate import CubicSpline
 
 from hsgeo.errors import InputError
@@ -68,6 +65,20 @@ from hsgeo.sensors.pushbroom import (
     BLOCK_NAMES,
     PushbroomObservations,
     project,
+)
+from hsgeo.simulate.error_processes import (  # re-exported
+    RIDGE,
+    _imaged,
+    gauss_markov,
+    refraction_k,
+    spline_fit,
+)
+from hsgeo.simulate.pushbroom_campaign_types import (  # re-exported
+    CP_RAYS,
+    TRAJECTORY_ERRORS,
+    CampaignConfig,
+    CampaignObservations,
+    CampaignTruth,
 )
 from hsgeo.trajectory import SplineNodes
 
@@ -83,304 +94,10 @@ __all__ = [
     "refraction_k",
     "simulate",
     "spline_fit",
+    "RIDGE",
 ]
 
-#: The models of the GNSS/INS error the simulator knows (see the module docstring).
-TRAJECTORY_ERRORS = ("gauss-markov", "spline")
-#: How many strips see a check point (:attr:`CampaignConfig.cp_rays`).
-CP_RAYS = ("tie points", "all strips")
-#: Weight of the ridge of :func:`spline_fit`, in samples per node.
-RIDGE = 0.1
-
 DEG = np.pi / 180
-
-
-@dataclass(frozen=True)
-class CampaignConfig:
-    """Published values of 002 §4 (and the simulation's own choices, marked)."""
-
-    n_tie_points_full: int = 113758  # 002 §4
-    obs_per_point_mean: float = 441587 / 113758  # 002 §4: 2D observations / tie points
-    pixels_per_line: int = 1800  # 002 §4
-    pixel_mm: float = 0.0065  # 002 §4: 6.5 µm
-    c_nominal_mm: float = 40.0  # 002 §4: initial principal distance 4 cm
-    c_mean_mm: float = 40.3  # 002 Fig. 8: mean of the estimated principal distances
-    # per-band principal distance minus the mean, µm: spread ≤ 11.8 µm (002 Fig. 8); the
-    # shape (decreasing with wavelength) is our choice
-    c_offsets_um: tuple = (11.0, 6.5, 2.9, -1.0, -4.6, -7.3, -7.5)
-    wavelengths_nm: tuple = (450.0, 527.0, 604.0, 681.0, 758.0, 835.0, 912.0)  # ~77 nm, 002 §4
-    speed_m_s: float = 67.0  # 002 §4
-    line_rate_hz: float = 200.0  # 002 §4: 200 lines ≈ 1 s
-    area_m: float = 600.0  # 002 §4
-    agl_low_m: float = 1875.0  # 002 §4
-    agl_high_m: float = 2500.0  # 002 §4
-    lines_low_east_m: tuple = (-350.0, -250.0, -150.0, -50.0, 50.0, 150.0, 250.0, 350.0)  # ours
-    lines_high_east_m: tuple = (-150.0, -50.0, 50.0, 150.0)  # ours: over the centre (Fig. 5)
-    strip_half_length_m: float = 480.0  # ours: imaged length along each strip
-    turn_s: float = 60.0  # ours: time between strips
-    node_interval_s: float = 10.0  # 002 §4
-    # 002 §4: "a positional STD of < 1.3 cm in each of east and north, and < 2.0 cm in height"
-    # (the bounds are taken as the σ)
-    sigma_pos_m: tuple = (0.013, 0.013, 0.020)
-    # POS AV 510 post-processed attitude RMS, roll/pitch 0.005°, heading 0.008°, as commonly
-    # quoted from Applanix's specification sheet (002 §4 names the POS-AV 510 but gives no
-    # attitude σ; we could not check the sheet itself): heading worst
-    sigma_att_rad: tuple = (0.005 * DEG, 0.005 * DEG, 0.008 * DEG)
-    # the GNSS/INS error model of the truth: "gauss-markov" (default) or "spline" (the
-    # estimator's own model; for the noise-free and identifiability tests)
-    trajectory_error: str = "gauss-markov"
-    # ours: correlation times of the first-order Gauss–Markov errors, s ("seconds to minutes":
-    # GNSS position errors of a smoothed solution wander over minutes, the INS attitude errors
-    # over tens of seconds, heading slowest)
-    tau_pos_s: tuple = (60.0, 60.0, 120.0)
-    tau_att_s: tuple = (20.0, 20.0, 60.0)
-    error_sample_s: float = 0.1  # ours: the error is sampled at 10 Hz (a GNSS epoch rate)
-    boresight_deg: tuple = (0.25, -0.35, 0.15)  # ours: "a few tenths of a degree"
-    lever_arm_m: tuple = (0.12, -0.05, -0.30)  # ours
-    sigma_lever_m: float = 0.02  # ours: tape-measured lever arm
-    # Brown terms of 002 eq. (3), x̄ in mm: ≈ −1.2, 0.3, 0.5, −0.15 px at the line's end (ours)
-    distortion: tuple = (-4.0e-5, 3.0e-7, 2.5e-5, -3.0e-5)
-    x0_mm: float = 0.013  # principal point (fixed, calibrated), ours
-    y0_mm: float = 0.0
-    sigma_obs_px: float = 0.5  # 002 §4: observation precision 1/2 px
-    # ours, TUNED to 002 Table 1: key-point localisation error before the registration at pixel
-    # centres, per image axis: x along the line (across track), y across the line (the matched
-    # line, i.e. along track). Tuned so that the reprojection NMADs over 8 campaigns at 0.05 of
-    # the tie points meet the paper's 0.32 px (x) and 0.42 px (y) (issue 22: one σ for both
-    # axes, 0.35 px, gave 0.283 and 0.456 px, 13σ and 12σ off; these give 0.321 and 0.419 px)
-    sigma_keypoint_px: tuple = (0.432, 0.29)
-    outlier_share: float = 0.003  # ours: gross errors left after RANSAC
-    sigma_gcp_m: float = 0.01  # 002 §4: RTK ≈ 1 cm
-    terrain_relief_m: float = 15.0  # ours: tie points between 0 and 15 m above the datum
-    mount_motion_rad: float = 0.02 * DEG  # ours: residual motion of the stabilised mount
-    # -- candidate explanations of 002's check-point errors (off by default; issue 15)
-    # the 17 reference squares (1.2 m, 002 §4) measured in the images by their centre: None as
-    # the tie points; a σ (px): the centre of a 3–4 px square picked with this error
-    sigma_ref_image_px: float | None = None
-    # atmospheric refraction in the images (standard photogrammetric model, see refraction_k)
-    refraction: bool = False
-    terrain_asl_m: float = 90.0  # ours: Ås (002 §4: 59.665° N, 10.775° E) lies ≈ 90 m a.s.l.
-    # the rays of a check point: "tie points" (as many strips as a tie point: 002 §4 calls the
-    # CPs "tie points with known coordinates") or "all strips" (every covering strip, the
-    # simulator before issue 22)
-    cp_rays: str = "tie points"
-    # -- an instrument effect the estimator does not model (issue 22): a distortion residual
-    # outside 002 eq. (3), a ripple along the line of this amplitude (px) and number of periods
-    # over the line, less what the model absorbs (distortion_ripple_px). Off by default: at the
-    # paper's size even 0.1 px biases K1, K2 by more than 15σ̂ (the observations' x are not
-    # spread evenly enough for the ripple to be orthogonal to the Brown terms), so the chapter
-    # runs it as a factor (hsgeo.reproduce.pushbroom_ba.RIPPLE_PX). Not in the noise-free mode.
-    distortion_ripple_px: float = 0.0
-    distortion_ripple_periods: float = 3.0
-
-
-@dataclass(frozen=True)
-class CampaignObservations:
-    """What the operator of the simulated campaign has: nothing here is truth.
-
-    Attributes
-    ----------
-    lines : PushbroomObservations
-        The tie-point observations and the GNSS/INS solution at their line times.
-    n_points : int
-        Number of points (rows of the points block: 17 reference squares, then the tie points).
-    gcp_index : (4,) int ndarray
-        Rows of the points that are GCPs.
-    gcp_xyz_m : (4, 3) ndarray
-        Their RTK coordinates, E, N, H in m (σ ``cfg.sigma_gcp_m``; exact when noise-free).
-    lever_arm_m : (3,) ndarray
-        The tape-measured lever arm, m (σ ``cfg.sigma_lever_m``; exact when noise-free).
-    node_prior_mean : (n_nodes, 6) ndarray
-        GNSS/INS prior mean of the node corrections at the campaign's node interval: zero (the
-        solution's own estimate), or the exact corrections in the noise-free mode (every
-        pseudo-observation exact).
-    t_span_s : (float, float)
-        Time span of the navigation solution, s (the whole flight, turns included).
-    """
-
-    lines: PushbroomObservations
-    n_points: int
-    gcp_index: np.ndarray
-    gcp_xyz_m: np.ndarray
-    lever_arm_m: np.ndarray
-    node_prior_mean: np.ndarray
-    t_span_s: tuple
-
-
-@dataclass(frozen=True)
-class CampaignTruth:
-    """The truth of one simulated campaign (for :mod:`hsgeo.reproduce` only).
-
-    Attributes
-    ----------
-    cfg : CampaignConfig
-    scale : float
-    values : mapping
-        Parameter block name (:data:`~hsgeo.sensors.pushbroom.BLOCK_NAMES`) -> true value: the
-        points ``(n_points, 3)`` m, the node errors of the navigation ``(n_nodes, 6)``, the
-        boresight (3,) rad, the lever arm (3,) m, K1, K2, P1, P2 and c per band (mm).
-    nodes : SplineNodes
-        The node layout of the true trajectory error.
-    strips : list of tuple
-        The flight plan: (t_start_s, t_end_s, east_m, agl_m, heading sign) per strip.
-    strip : (m,) int ndarray
-        Strip of each observation.
-    cp_index : (13,) int ndarray
-        Rows of the points that are check points.
-    outlier : (m,) bool ndarray
-        Observations with a gross error.
-    xy_true_px : (m, 2) ndarray
-        Exact image coordinates of each observation in its line.
-    trajectory_error : str
-        The error model of the navigation solution (:data:`TRAJECTORY_ERRORS`).
-    error_t_s, error_samples : (k,) and (k, 6) ndarray or None
-        With ``"gauss-markov"``: the sample times and the sampled error (true minus navigation:
-        E, N, H in m, roll, pitch, yaw in rad). None with ``"spline"``.
-
-    Notes
-    -----
-    With ``"spline"`` the node values in :attr:`values` are the exact error; with
-    ``"gauss-markov"`` they are its best least-squares spline fit (:func:`spline_fit`) at the
-    campaign's node interval over the strips (10 Hz samples while imaging), which the
-    adjustment can at best recover; nodes that no strip touches are zero (their prior).
-    """
-
-    cfg: CampaignConfig
-    scale: float
-    values: Mapping[str, np.ndarray]
-    nodes: SplineNodes
-    strips: list = field(default_factory=list)
-    strip: np.ndarray | None = None
-    cp_index: np.ndarray | None = None
-    outlier: np.ndarray | None = None
-    xy_true_px: np.ndarray | None = None
-    trajectory_error: str = "spline"
-    error_t_s: np.ndarray | None = None
-    error_samples: np.ndarray | None = None
-
-    def nav_error(self, t_s, rate: bool = False) -> np.ndarray:
-        """The true error of the navigation solution (truth minus navigation) at ``t_s``.
-
-        Parameters
-        ----------
-        t_s : (m,) array_like
-            Times, s, within the flight.
-        rate : bool
-            Return the time derivative (m/s, rad/s) instead.
-
-        Returns
-        -------
-        (m, 6) ndarray
-            E, N, H in m and roll, pitch, yaw in rad (or their rates).
-        """
-        if self.error_samples is None:
-            f = self.nodes.evaluate_rate if rate else self.nodes.evaluate
-            return f(self.values[BLOCK_NAMES["nodes"]], t_s)
-        cs = CubicSpline(self.error_t_s, self.error_samples, axis=0)
-        return (cs.derivative() if rate else cs)(np.asarray(t_s, dtype=np.float64))
-
-    def node_fit(self, interval_s: float) -> tuple[SplineNodes, np.ndarray]:
-        """The best spline fit of the true error with nodes every ``interval_s`` over the strips.
-
-        Returns ``(nodes, values (n_nodes, 6))``; with ``"spline"`` at the campaign's own
-        interval this is the exact error.
-        """
-        nodes = SplineNodes(self.nodes.t_start_s, self.nodes.t_end_s, float(interval_s))
-        if self.error_samples is None and interval_s == self.nodes.interval_s:
-            return nodes, np.array(self.values[BLOCK_NAMES["nodes"]])
-        t = _imaged(self.strips, np.arange(self.nodes.t_start_s, self.nodes.t_end_s, 0.1))
-        return nodes, spline_fit(nodes, t, self.nav_error(t))
-
-
-def _imaged(plan, t_s):
-    """The times of ``t_s`` that lie within a strip of ``plan``."""
-    t = np.asarray(t_s, dtype=np.float64)
-    inside = np.zeros(t.shape, bool)
-    for p in plan:
-        inside |= (t >= p[0]) & (t <= p[1])
-    return t[inside]
-
-
-def gauss_markov(n: int, dt_s: float, tau_s, sigma, rng) -> np.ndarray:
-    r"""Stationary first-order Gauss–Markov processes sampled every ``dt_s``.
-
-    The exact discrete recursion of the continuous process
-    :math:`\dot x = -x/\tau + w`: :math:`x_{k+1} = e^{-\Delta t/\tau} x_k +
-    \sigma\sqrt{1 - e^{-2\Delta t/\tau}}\, w_k`, :math:`w_k \sim N(0, 1)`, started from the
-    stationary distribution :math:`x_0 \sim N(0, \sigma^2)`; its autocorrelation is
-    :math:`\sigma^2 e^{-|\Delta t|/\tau}` at every lag.
-
-    Parameters
-    ----------
-    n : int
-        Number of samples.
-    dt_s : float
-        Sample interval, s.
-    tau_s, sigma : (k,) array_like
-        Correlation time (s) and stationary σ (any unit) of each of the ``k`` processes.
-    rng : int or numpy.random.Generator
-
-    Returns
-    -------
-    (n, k) ndarray
-    """
-    rng = np.random.default_rng(rng)
-    tau = np.atleast_1d(np.asarray(tau_s, dtype=np.float64))
-    sig = np.atleast_1d(np.asarray(sigma, dtype=np.float64)) * np.ones_like(tau)
-    if np.any(tau <= 0) or not dt_s > 0:
-        raise InputError("correlation times and the sample interval must be positive")
-    phi = np.exp(-dt_s / tau)
-    q = sig * np.sqrt(1.0 - phi**2)
-    w = rng.standard_normal((n, tau.size))
-    x = np.empty((n, tau.size))
-    x[0] = sig * w[0]
-    for k in range(1, n):  # a recursion: 18,000 steps of a 6-vector, negligible
-        x[k] = phi * x[k - 1] + q * w[k]
-    return x
-
-
-def spline_fit(nodes: SplineNodes, t_s, values) -> np.ndarray:
-    r"""Least-squares node values of the cubic B-spline ``nodes`` that best fit ``values``.
-
-    Parameters
-    ----------
-    nodes : SplineNodes
-    t_s : (m,) array_like
-        Sample times, s, within the span of ``nodes``.
-    values : (m, k) array_like
-        The samples.
-
-    Returns
-    -------
-    (n_nodes, k) ndarray
-        Minimises :math:`\sum_i \|\,\delta(t_i) - v_i\|^2` with :math:`\delta` the spline of
-        :meth:`SplineNodes.evaluate`, plus a ridge :math:`0.1 \sum_j \|c_j\|^2` (a tenth of a sample
-        per node) that holds nodes the samples barely touch near zero.
-    """
-    t = np.asarray(t_s, dtype=np.float64).ravel()
-    v = np.asarray(values, dtype=np.float64).reshape(t.size, -1)
-    idx, w = nodes.basis(t)
-    rows = np.repeat(np.arange(t.size), 4)
-    A = sp.csr_matrix((w.ravel(), (rows, idx.ravel())), shape=(t.size, nodes.n_nodes))
-    # a ridge of a tenth of a sample per node: the end nodes, which only the tails of their
-    # basis functions touch, would otherwise wander (untouched nodes stay zero)
-    N = (A.T @ A + RIDGE * sp.identity(nodes.n_nodes)).tocsc()
-    return np.asarray(spla.spsolve(N, A.T @ v)).reshape(nodes.n_nodes, -1)
-
-
-def refraction_k(flying_asl_m, ground_asl_m) -> np.ndarray:
-    """Photogrammetric refraction constant K (rad) of the ARDC standard atmosphere.
-
-    ``K = 2410 H / (H² − 6 H + 250) − 2410 h² / ((h² − 6 h + 250) H)`` µrad with H, h the
-    flying and ground heights above sea level in km; the image point moves radially outward by
-    ``Δr = K (r + r³ / c²)``. As commonly quoted from Wolf, Dewitt & Wilkinson, *Elements of
-    Photogrammetry* (§ on atmospheric refraction; the book itself was not at hand to check).
-    At 1875 and 2500 m AGL over ground 90 m a.s.l., K ≈ 20 and 26 µrad.
-    """
-    H = np.asarray(flying_asl_m, dtype=np.float64) / 1e3
-    h = np.asarray(ground_asl_m, dtype=np.float64) / 1e3
-    k_urad = 2410 * H / (H**2 - 6 * H + 250) - 2410 * h**2 / ((h**2 - 6 * h + 250) * H)
-    return k_urad * 1e-6
 
 
 def block_length_m(cfg: CampaignConfig, scale: float) -> float:
@@ -475,6 +192,262 @@ def _true_pose(plan, strip, t, amp, speed_m_s):
     return xyz, rpy
 
 
+#: The 17 reference squares' nominal east, north (m) about the block centre: 4 GCPs at the
+#: corners, then the 13 check points (each moved by up to ±20 m at random).
+REFERENCE_EN_M = (
+    (-270, -270),
+    (270, -270),
+    (-270, 270),
+    (270, 270),  # 4 GCPs (corners)
+    (0, 0),
+    (-150, 0),
+    (150, 0),
+    (0, -150),
+    (0, 150),
+    (-150, -150),
+    (150, 150),
+    (-150, 150),
+    (150, -150),
+    (-270, 0),
+    (270, 0),
+    (0, -270),
+    (0, 270),
+)
+
+
+def _camera_truth(cfg: CampaignConfig, node_err) -> dict:
+    """The true values of the node corrections, boresight, lever arm, distortion and the
+    per-band principal distances (their spread about the mean: 002 Fig. 8).
+    """
+    names = BLOCK_NAMES
+    return {
+        names["nodes"]: node_err,
+        names["boresight"]: np.array(cfg.boresight_deg) * DEG,
+        names["lever_arm"]: np.array(cfg.lever_arm_m),
+        names["distortion"]: np.array(cfg.distortion),
+        names["c"]: cfg.c_mean_mm + (np.array(cfg.c_offsets_um) - np.mean(cfg.c_offsets_um)) * 1e-3,
+    }
+
+
+def _checked_config(scale, noise_free, cfg, trajectory_error) -> CampaignConfig:
+    if not (np.isfinite(scale) and scale > 0):
+        raise InputError(f"scale must be a positive number, got {scale!r}")
+    cfg = cfg or CampaignConfig()
+    if trajectory_error is not None:
+        cfg = replace(cfg, trajectory_error=trajectory_error)
+    if cfg.trajectory_error not in TRAJECTORY_ERRORS:
+        raise InputError(
+            f"trajectory_error must be one of {TRAJECTORY_ERRORS}, got {cfg.trajectory_error!r}"
+        )
+    if cfg.cp_rays not in CP_RAYS:
+        raise InputError(f"cp_rays must be one of {CP_RAYS}, got {cfg.cp_rays!r}")
+    if noise_free and cfg.trajectory_error != "spline":
+        raise InputError(
+            "noise_free=True needs trajectory_error='spline' (only the estimator's own model "
+            "has exact node corrections)"
+        )
+    return cfg
+
+
+def _trajectory_error(cfg: CampaignConfig, nodes, plan, t_end, rng):
+    """The navigation error (true minus navigation): ``(node_err, err_t, err_x, nav_err)`` with
+    ``nav_err(t, rate=False)`` the error (or its rate) at times ``t``.
+    """
+    sigma_nav = np.r_[cfg.sigma_pos_m, cfg.sigma_att_rad]
+    if cfg.trajectory_error == "spline":
+        node_err = rng.standard_normal((nodes.n_nodes, 6)) * sigma_nav
+        err_t = err_x = None
+
+        def nav_err(tt, rate=False):
+            return (nodes.evaluate_rate if rate else nodes.evaluate)(node_err, tt)
+
+    else:  # post-processed GNSS/INS errors: first-order Gauss–Markov per axis (002 §4 σ)
+        n_s = int(np.ceil(t_end / cfg.error_sample_s)) + 2
+        err_t = np.arange(n_s) * cfg.error_sample_s
+        err_x = gauss_markov(
+            n_s, cfg.error_sample_s, np.r_[cfg.tau_pos_s, cfg.tau_att_s], sigma_nav, rng
+        )
+        err_cs = CubicSpline(err_t, err_x, axis=0)
+        t_fit = _imaged(plan, np.arange(0.0, t_end, 0.1))
+        node_err = spline_fit(nodes, t_fit, err_cs(t_fit))
+        err_rate_cs = err_cs.derivative()
+
+        def nav_err(tt, rate=False):
+            return (err_rate_cs if rate else err_cs)(tt)
+
+    return node_err, err_t, err_x, nav_err
+
+
+def _points(cfg: CampaignConfig, scale, length_m, nb, rng):
+    """Reference squares first, then tie points: ``(P, is_ref, band_of_point)``."""
+    half = cfg.area_m / 2
+    n_tie = max(int(round(cfg.n_tie_points_full * scale)), 50)
+    ref_en = np.array(REFERENCE_EN_M, dtype=float)
+    ref_en += rng.uniform(-20, 20, ref_en.shape)
+    # east × north: area_m × block_length_m (the same draws as a square block when scale ≤ 1)
+    tie_en = rng.uniform([-half, -length_m / 2], [half, length_m / 2], (n_tie, 2))
+    en = np.vstack([ref_en, tie_en])
+    h = np.r_[rng.uniform(0, 2, len(ref_en)), rng.uniform(0, cfg.terrain_relief_m, n_tie)]
+    P = np.column_stack([en, h])
+    is_ref = np.zeros(len(P), bool)
+    is_ref[: len(ref_en)] = True
+    band_of_point = np.r_[rng.integers(0, 3, len(ref_en)), rng.integers(0, nb, n_tie)]
+    return P, is_ref, band_of_point
+
+
+def _strips_of_points(cfg: CampaignConfig, plan, P, is_ref, length_m, rng):
+    """Which strips see which points: inside the swath (with a 3 % margin) and the strip;
+    ``(pidx, strip)``, one row per observation.
+    """
+    en, h = P[:, :2], P[:, 2]
+    n_pts = len(P)
+    c_fov = cfg.c_nominal_mm
+    half_line_mm = cfg.pixels_per_line / 2 * cfg.pixel_mm
+    east = np.array([p[2] for p in plan])
+    agl = np.array([p[3] for p in plan])
+    half_swath = 0.97 * half_line_mm / c_fov * (agl - 0)  # m on the ground
+    covers = np.abs(en[:, 0:1] - east[None, :]) < half_swath[None, :] * (
+        1 - h[:, None] / agl[None, :]
+    )
+    covers &= np.abs(en[:, 1:2]) < cfg.strip_half_length_m + (length_m - cfg.area_m) / 2 - 30
+    ncov = covers.sum(axis=1)
+    if np.any(ncov < 3):
+        raise InputError("simulated flight plan leaves points seen by fewer than 3 strips")
+    extra = cfg.obs_per_point_mean - 3.0
+    n_obs = np.where(is_ref, ncov, np.minimum(ncov, 3 + rng.poisson(extra, n_pts)))
+    # the strips of each point: all for a reference square (the check points keep a subset at
+    # the end, cp_rays="tie points"), a random n_obs of them for a tie point. One
+    # Generator.choice per point (its draws cannot be vectorised without changing the random
+    # stream); the candidates come from one np.nonzero (row-major, as flatnonzero per row did)
+    cand_strip = np.nonzero(covers)[1]
+    cand_end = np.cumsum(ncov)
+    strip_list, n_choose = [], n_obs.tolist()
+    for i, (b, e) in enumerate(zip((cand_end - ncov).tolist(), cand_end.tolist(), strict=True)):
+        cand = cand_strip[b:e]
+        strip_list.append(cand if is_ref[i] else rng.choice(cand, n_choose[i], replace=False))
+    pidx = np.repeat(np.arange(n_pts), n_obs)
+    strip = np.concatenate(strip_list)
+    return pidx, strip
+
+
+def _line_times(cfg: CampaignConfig, plan, true_xy, P, pidx, strip, is_ref, noise_free, rng):
+    """The line that sees each point: Newton on the true y image coordinate in time, in chunks
+    of rows (every operation is row-wise: the same bits as all rows at once, without the
+    temporaries of millions of rows at scale > 1), then the key-point localisation error.
+
+    Returns ``(t_line, loc)``: the registered line times and the localisation error (px).
+    """
+    m = pidx.size
+    t0s = np.array([p[0] for p in plan])
+    t1s = np.array([p[1] for p in plan])
+    dirs = np.array([p[4] for p in plan], float)
+    t = np.empty(m)
+    deriv = np.empty(m)
+    for rows in _row_chunks(m):
+        tt = 0.5 * (t0s + t1s)[strip[rows]] + dirs[strip[rows]] * P[pidx[rows], 1] / cfg.speed_m_s
+        for _ in range(6):
+            xy, _ = true_xy(tt, rows)
+            dt = 1e-3
+            xy2, _ = true_xy(tt + dt, rows)
+            deriv[rows] = (xy2[:, 1] - xy[:, 1]) / dt
+            tt = tt - xy[:, 1] / deriv[rows]  # the line is y = 0 (pixel centre of the line)
+        t[rows] = tt
+    line_dt = 1.0 / cfg.line_rate_hz
+    # key-point localisation error (ours, see CampaignConfig): x along the line, and in y an
+    # error of the matched line, i.e. of the time
+    sigma_kp = np.broadcast_to(np.asarray(cfg.sigma_keypoint_px, dtype=np.float64), (2,))
+    loc = (0.0 if noise_free else sigma_kp) * rng.standard_normal((m, 2))
+    ref_loc = rng.standard_normal((m, 2))  # drawn always: the same stream with or without
+    if cfg.sigma_ref_image_px is not None and not noise_free:
+        on_ref = is_ref[pidx]
+        loc[on_ref] = cfg.sigma_ref_image_px * ref_loc[on_ref]
+    t_loc = t - loc[:, 1] * cfg.pixel_mm / deriv
+    t_line = np.round(t_loc / line_dt) * line_dt
+    return t_line, loc
+
+
+def _true_image_px(
+    cfg: CampaignConfig, plan, true_xy, c_true_mm, P, pidx, strip, band, t_line, noise_free
+):
+    """The true image coordinates (px) at the registered line times, with refraction and the
+    unmodelled distortion ripple.
+    """
+    m = pidx.size
+    xy_true_mm = np.empty((m, 2))
+    for rows in _row_chunks(m):
+        xy_true_mm[rows], pc = true_xy(t_line[rows], rows)
+        if np.any(pc[:, 2] <= 0):
+            raise InputError("simulated points behind the camera: check the flight plan")
+    if cfg.refraction:  # the ray bends: the image point moves radially outward
+        agl_obs = np.array([p[3] for p in plan])[strip]
+        k = refraction_k(agl_obs + cfg.terrain_asl_m, P[pidx, 2] + cfg.terrain_asl_m)
+        d = xy_true_mm - np.array([cfg.x0_mm, cfg.y0_mm])
+        r2 = np.sum(d**2, axis=1) / c_true_mm[band] ** 2
+        xy_true_mm = xy_true_mm + (k * (1 + r2))[:, None] * d
+    xy_true_px = xy_true_mm / cfg.pixel_mm
+    if cfg.distortion_ripple_px and not noise_free:
+        # a distortion residual outside 002 eq. (3) (issue 22): a ripple along the line
+        xy_true_px[:, 0] += distortion_ripple_px(xy_true_px[:, 0], cfg)
+    return xy_true_px
+
+
+def _navigation(cfg: CampaignConfig, plan, strip, t_line, nav_err):
+    """The navigation solution at the line times, truth minus the error (row-wise, in chunks),
+    and its rates: ``(xyz_nav, rpy_nav, xyz_rate_nav, rpy_rate_nav)``.
+    """
+    m = t_line.size
+    dirs = np.array([p[4] for p in plan], float)
+    xyz_nav, rpy_nav, xyz_rate_nav, rpy_rate_nav = (np.empty((m, 3)) for _ in range(4))
+    for rows in _row_chunks(m):
+        tl = t_line[rows]
+        xyz_true, rpy_true = _true_pose(plan, strip[rows], tl, cfg.mount_motion_rad, cfg.speed_m_s)
+        delta = nav_err(tl)
+        xyz_nav[rows] = xyz_true - delta[:, :3]
+        rpy_nav[rows] = rpy_true - delta[:, 3:]
+        # and its rates (a GNSS/INS solution gives velocity and angular rate): the observation
+        # is a time, and its residual needs the image motion across the line (PushbroomLines)
+        ddelta = nav_err(tl, rate=True)
+        n = tl.size
+        xyz_rate_true = np.column_stack(
+            [np.zeros(n), dirs[strip[rows]] * cfg.speed_m_s, np.zeros(n)]
+        )
+        xyz_rate_nav[rows] = xyz_rate_true - ddelta[:, :3]
+        rpy_rate_nav[rows] = _mount_motion_rate(tl, cfg.mount_motion_rad) - ddelta[:, 3:]
+    return xyz_nav, rpy_nav, xyz_rate_nav, rpy_rate_nav
+
+
+def _register(cfg: CampaignConfig, xy_true_px, loc, P, noise_free, rng):
+    """What is recorded: ``(xy_obs, outlier, gcp_xyz)``, the image coordinates registered at the
+    pixel centre along the line and in the line itself (y = 0), with gross errors, and the
+    surveyed GCPs.
+    """
+    m = len(xy_true_px)
+    if noise_free:
+        return xy_true_px.copy(), np.zeros(m, bool), P[:4].copy()
+    xy_obs = np.column_stack([np.floor(xy_true_px[:, 0] + loc[:, 0]) + 0.5, np.zeros(m)])
+    outlier = rng.random(m) < cfg.outlier_share
+    n_out = int(outlier.sum())
+    mag = rng.uniform(3, 20, n_out) * rng.choice([-1, 1], n_out)
+    comp = rng.integers(0, 2, n_out)
+    xy_obs[np.flatnonzero(outlier), comp] += mag
+    gcp_xyz = P[:4] + cfg.sigma_gcp_m * rng.standard_normal((4, 3))
+    return xy_obs, outlier, gcp_xyz
+
+
+def _check_point_rows(cfg: CampaignConfig, pidx, rng) -> np.ndarray:
+    """``cp_rays="tie points"``: a check point keeps as many of its strips as a tie point sees
+    (≥ 3, 3 + Poisson), drawn after every other draw: the tie points and the GCPs are those of
+    "all strips". Returns the rows kept.
+    """
+    extra = cfg.obs_per_point_mean - 3.0
+    keep = np.ones(pidx.size, bool)
+    for i in range(4, len(REFERENCE_EN_M)):
+        rows_i = np.flatnonzero(pidx == i)
+        k = min(rows_i.size, 3 + int(rng.poisson(extra)))
+        keep[rng.choice(rows_i, rows_i.size - k, replace=False)] = False
+    return keep
+
+
 def simulate(
     scale: float = 1.0,
     rng=0,
@@ -510,22 +483,7 @@ def simulate(
     truth : CampaignTruth
         What only :mod:`hsgeo.reproduce` compares with.
     """
-    if not (np.isfinite(scale) and scale > 0):
-        raise InputError(f"scale must be a positive number, got {scale!r}")
-    cfg = cfg or CampaignConfig()
-    if trajectory_error is not None:
-        cfg = replace(cfg, trajectory_error=trajectory_error)
-    if cfg.trajectory_error not in TRAJECTORY_ERRORS:
-        raise InputError(
-            f"trajectory_error must be one of {TRAJECTORY_ERRORS}, got {cfg.trajectory_error!r}"
-        )
-    if cfg.cp_rays not in CP_RAYS:
-        raise InputError(f"cp_rays must be one of {CP_RAYS}, got {cfg.cp_rays!r}")
-    if noise_free and cfg.trajectory_error != "spline":
-        raise InputError(
-            "noise_free=True needs trajectory_error='spline' (only the estimator's own model "
-            "has exact node corrections)"
-        )
+    cfg = _checked_config(scale, noise_free, cfg, trajectory_error)
     rng = np.random.default_rng(rng)
     length_m = block_length_m(cfg, scale)
     plan = _strip_plan(cfg, extra_m=length_m - cfg.area_m)
@@ -535,116 +493,20 @@ def simulate(
     names = BLOCK_NAMES
 
     # -- truth of the camera and the trajectory errors (true minus navigation)
-    sigma_nav = np.r_[cfg.sigma_pos_m, cfg.sigma_att_rad]
-    if cfg.trajectory_error == "spline":
-        node_err = rng.standard_normal((nodes.n_nodes, 6)) * sigma_nav
-        err_t = err_x = None
-
-        def nav_err(tt, rate=False):
-            return (nodes.evaluate_rate if rate else nodes.evaluate)(node_err, tt)
-
-    else:  # post-processed GNSS/INS errors: first-order Gauss–Markov per axis (002 §4 σ)
-        n_s = int(np.ceil(t_end / cfg.error_sample_s)) + 2
-        err_t = np.arange(n_s) * cfg.error_sample_s
-        err_x = gauss_markov(
-            n_s, cfg.error_sample_s, np.r_[cfg.tau_pos_s, cfg.tau_att_s], sigma_nav, rng
-        )
-        err_cs = CubicSpline(err_t, err_x, axis=0)
-        t_fit = _imaged(plan, np.arange(0.0, t_end, 0.1))
-        node_err = spline_fit(nodes, t_fit, err_cs(t_fit))
-        err_rate_cs = err_cs.derivative()
-
-        def nav_err(tt, rate=False):
-            return (err_rate_cs if rate else err_cs)(tt)
-
-    lever = np.array(cfg.lever_arm_m)
-    truth = {
-        names["nodes"]: node_err,
-        names["boresight"]: np.array(cfg.boresight_deg) * DEG,
-        names["lever_arm"]: lever,
-        names["distortion"]: np.array(cfg.distortion),
-        names["c"]: cfg.c_mean_mm + (np.array(cfg.c_offsets_um) - np.mean(cfg.c_offsets_um)) * 1e-3,
-    }
-    lever_measured = lever + (0.0 if noise_free else 1.0) * cfg.sigma_lever_m * (
-        rng.standard_normal(3)
-    )
-
-    # -- points: reference squares first, then tie points
-    half = cfg.area_m / 2
-    n_tie = max(int(round(cfg.n_tie_points_full * scale)), 50)
-    ref_en = np.array(
-        [
-            [-270, -270],
-            [270, -270],
-            [-270, 270],
-            [270, 270],  # 4 GCPs (corners)
-            [0, 0],
-            [-150, 0],
-            [150, 0],
-            [0, -150],
-            [0, 150],
-            [-150, -150],
-            [150, 150],
-            [-150, 150],
-            [150, -150],
-            [-270, 0],
-            [270, 0],
-            [0, -270],
-            [0, 270],
-        ],
-        dtype=float,
-    )
-    ref_en += rng.uniform(-20, 20, ref_en.shape)
-    # east × north: area_m × block_length_m (the same draws as a square block when scale ≤ 1)
-    tie_en = rng.uniform([-half, -length_m / 2], [half, length_m / 2], (n_tie, 2))
-    en = np.vstack([ref_en, tie_en])
-    h = np.r_[rng.uniform(0, 2, len(ref_en)), rng.uniform(0, cfg.terrain_relief_m, n_tie)]
-    P = np.column_stack([en, h])
+    node_err, err_t, err_x, nav_err = _trajectory_error(cfg, nodes, plan, t_end, rng)
+    truth = _camera_truth(cfg, node_err)
+    lever_measured = truth[names["lever_arm"]] + (
+        0.0 if noise_free else 1.0
+    ) * cfg.sigma_lever_m * (rng.standard_normal(3))
+    # -- points (reference squares first, then tie points) and the strips that see them
+    P, is_ref, band_of_point = _points(cfg, scale, length_m, nb, rng)
     truth[names["points"]] = P
     n_pts = len(P)
-    is_ref = np.zeros(n_pts, bool)
-    is_ref[: len(ref_en)] = True
-    band_of_point = np.r_[rng.integers(0, 3, len(ref_en)), rng.integers(0, nb, n_tie)]
-
-    # -- which strips see which points: inside the swath (with a 3 % margin) and the strip
-    c_fov = cfg.c_nominal_mm
-    half_line_mm = cfg.pixels_per_line / 2 * cfg.pixel_mm
-    east = np.array([p[2] for p in plan])
-    agl = np.array([p[3] for p in plan])
-    half_swath = 0.97 * half_line_mm / c_fov * (agl - 0)  # m on the ground
-    covers = np.abs(en[:, 0:1] - east[None, :]) < half_swath[None, :] * (
-        1 - h[:, None] / agl[None, :]
-    )
-    covers &= np.abs(en[:, 1:2]) < cfg.strip_half_length_m + (length_m - cfg.area_m) / 2 - 30
-    ncov = covers.sum(axis=1)
-    if np.any(ncov < 3):
-        raise InputError("simulated flight plan leaves points seen by fewer than 3 strips")
-    extra = cfg.obs_per_point_mean - 3.0
-    n_obs = np.where(is_ref, ncov, np.minimum(ncov, 3 + rng.poisson(extra, n_pts)))
-    # the strips of each point: all for a reference square (the check points keep a subset at
-    # the end, cp_rays="tie points"), a random n_obs of them for a tie point. One
-    # Generator.choice per point (its draws cannot be vectorised without changing the random
-    # stream); the candidates come from one np.nonzero (row-major, as flatnonzero per row did)
-    cand_strip = np.nonzero(covers)[1]
-    cand_end = np.cumsum(ncov)
-    strip_list, n_choose = [], n_obs.tolist()
-    for i, (b, e) in enumerate(zip((cand_end - ncov).tolist(), cand_end.tolist(), strict=True)):
-        cand = cand_strip[b:e]
-        strip_list.append(cand if is_ref[i] else rng.choice(cand, n_choose[i], replace=False))
-    pidx = np.repeat(np.arange(n_pts), n_obs)
-    strip = np.concatenate(strip_list)
-    del strip_list, covers
+    pidx, strip = _strips_of_points(cfg, plan, P, is_ref, length_m, rng)
     band = band_of_point[pidx]
-    m = pidx.size
 
-    # -- the line that sees each point: Newton on the true y image coordinate in time, in
-    # chunks of rows (every operation is row-wise: the same bits as all rows at once, without
-    # the temporaries of millions of rows at scale > 1)
-    beta0 = BETA0_CAM_FROM_PLATFORM
-    t0s = np.array([p[0] for p in plan])
-    t1s = np.array([p[1] for p in plan])
-    dirs = np.array([p[4] for p in plan], float)
     # truth = nav + δ(t): project with the true pose, zero corrections
+    beta0 = BETA0_CAM_FROM_PLATFORM
     vals = dict(truth)
     vals[names["nodes"]] = np.zeros_like(node_err)
 
@@ -654,86 +516,14 @@ def simulate(
             vals, names, nodes, tt, xyz, rpy, pidx[rows], band[rows], beta0, cfg.x0_mm, cfg.y0_mm
         )
 
-    t = np.empty(m)
-    deriv = np.empty(m)
-    for rows in _row_chunks(m):
-        tt = 0.5 * (t0s + t1s)[strip[rows]] + dirs[strip[rows]] * P[pidx[rows], 1] / cfg.speed_m_s
-        for _ in range(6):
-            xy, _ = true_xy(tt, rows)
-            dt = 1e-3
-            xy2, _ = true_xy(tt + dt, rows)
-            deriv[rows] = (xy2[:, 1] - xy[:, 1]) / dt
-            tt = tt - xy[:, 1] / deriv[rows]  # the line is y = 0 (pixel centre of the line)
-        t[rows] = tt
-    del xy, xy2, tt
-    line_dt = 1.0 / cfg.line_rate_hz
-    # key-point localisation error (ours, see CampaignConfig): x along the line, and in y an
-    # error of the matched line, i.e. of the time
-    sigma_kp = np.broadcast_to(np.asarray(cfg.sigma_keypoint_px, dtype=np.float64), (2,))
-    loc = (0.0 if noise_free else sigma_kp) * rng.standard_normal((m, 2))
-    ref_loc = rng.standard_normal((m, 2))  # drawn always: the same stream with or without
-    if cfg.sigma_ref_image_px is not None and not noise_free:
-        on_ref = is_ref[pidx]
-        loc[on_ref] = cfg.sigma_ref_image_px * ref_loc[on_ref]
-    t_loc = t - loc[:, 1] * cfg.pixel_mm / deriv
-    t_line = np.round(t_loc / line_dt) * line_dt
-    del t, deriv, t_loc, ref_loc
-    xy_true_mm = np.empty((m, 2))
-    for rows in _row_chunks(m):
-        xy_true_mm[rows], pc = true_xy(t_line[rows], rows)
-        if np.any(pc[:, 2] <= 0):
-            raise InputError("simulated points behind the camera: check the flight plan")
-    del pc
-    if cfg.refraction:  # the ray bends: the image point moves radially outward
-        agl_obs = np.array([p[3] for p in plan])[strip]
-        k = refraction_k(agl_obs + cfg.terrain_asl_m, P[pidx, 2] + cfg.terrain_asl_m)
-        d = xy_true_mm - np.array([cfg.x0_mm, cfg.y0_mm])
-        r2 = np.sum(d**2, axis=1) / truth[names["c"]][band] ** 2
-        xy_true_mm = xy_true_mm + (k * (1 + r2))[:, None] * d
-    xy_true_px = xy_true_mm / cfg.pixel_mm
-    if cfg.distortion_ripple_px and not noise_free:
-        # a distortion residual outside 002 eq. (3) (issue 22): a ripple along the line
-        xy_true_px[:, 0] += distortion_ripple_px(xy_true_px[:, 0], cfg)
-    # navigation solution at the line times: truth minus the error (row-wise, in chunks)
-    xyz_nav, rpy_nav, xyz_rate_nav, rpy_rate_nav = (np.empty((m, 3)) for _ in range(4))
-    for rows in _row_chunks(m):
-        tl = t_line[rows]
-        xyz_true, rpy_true = _true_pose(plan, strip[rows], tl, cfg.mount_motion_rad, cfg.speed_m_s)
-        delta = nav_err(tl)
-        xyz_nav[rows] = xyz_true - delta[:, :3]
-        rpy_nav[rows] = rpy_true - delta[:, 3:]
-        # and its rates (a GNSS/INS solution gives velocity and angular rate): the observation
-        # is a time, and its residual needs the image motion across the line (PushbroomLines)
-        ddelta = nav_err(tl, rate=True)
-        n = tl.size
-        xyz_rate_true = np.column_stack(
-            [np.zeros(n), dirs[strip[rows]] * cfg.speed_m_s, np.zeros(n)]
-        )
-        xyz_rate_nav[rows] = xyz_rate_true - ddelta[:, :3]
-        rpy_rate_nav[rows] = _mount_motion_rate(tl, cfg.mount_motion_rad) - ddelta[:, 3:]
-    del xyz_true, rpy_true, delta, ddelta, xyz_rate_true
-
-    if noise_free:
-        xy_obs = xy_true_px.copy()
-        outlier = np.zeros(m, bool)
-        gcp_xyz = P[:4].copy()
-    else:
-        # registered at the pixel centre along the line, and in the line itself (y = 0)
-        xy_obs = np.column_stack([np.floor(xy_true_px[:, 0] + loc[:, 0]) + 0.5, np.zeros(m)])
-        outlier = rng.random(m) < cfg.outlier_share
-        n_out = int(outlier.sum())
-        mag = rng.uniform(3, 20, n_out) * rng.choice([-1, 1], n_out)
-        comp = rng.integers(0, 2, n_out)
-        xy_obs[np.flatnonzero(outlier), comp] += mag
-        gcp_xyz = P[:4] + cfg.sigma_gcp_m * rng.standard_normal((4, 3))
+    t_line, loc = _line_times(cfg, plan, true_xy, P, pidx, strip, is_ref, noise_free, rng)
+    xy_true_px = _true_image_px(
+        cfg, plan, true_xy, truth[names["c"]], P, pidx, strip, band, t_line, noise_free
+    )
+    xyz_nav, rpy_nav, xyz_rate_nav, rpy_rate_nav = _navigation(cfg, plan, strip, t_line, nav_err)
+    xy_obs, outlier, gcp_xyz = _register(cfg, xy_true_px, loc, P, noise_free, rng)
     if cfg.cp_rays == "tie points":
-        # a check point keeps as many of its strips as a tie point sees (≥ 3, 3 + Poisson),
-        # drawn after every other draw: the tie points and the GCPs are those of "all strips"
-        keep = np.ones(m, bool)
-        for i in range(4, len(ref_en)):
-            rows_i = np.flatnonzero(pidx == i)
-            k = min(rows_i.size, 3 + int(rng.poisson(extra)))
-            keep[rng.choice(rows_i, rows_i.size - k, replace=False)] = False
+        keep = _check_point_rows(cfg, pidx, rng)
         pidx, band, t_line, xy_obs, strip = (a[keep] for a in (pidx, band, t_line, xy_obs, strip))
         xyz_nav, rpy_nav = xyz_nav[keep], rpy_nav[keep]
         xyz_rate_nav, rpy_rate_nav = xyz_rate_nav[keep], rpy_rate_nav[keep]

@@ -45,9 +45,9 @@ __all__ = ["BALFit", "prepare", "gauge_fix", "adjust_bal", "BAL_OPTIONS"]
 BAL_OPTIONS = SolverOptions(max_iter=200, lambda0=1e-4, lambda_points_min=1e-300, ftol=1e-6)
 
 
-@dataclass
+@dataclass(frozen=True)
 class BALFit:
-    """The outcome of :func:`adjust_bal`.
+    """The outcome of :func:`adjust_bal` (the workflow's one result type, GUIDE §2).
 
     Attributes
     ----------
@@ -60,6 +60,8 @@ class BALFit:
         Observations of points behind their camera, left out.
     fixed : list of (int, int)
         The gauge: (camera, column) entries of the cameras block held fixed.
+    n_cameras, n_points : int
+        Size of the problem as read.
     """
 
     result: AdjustmentResult
@@ -68,6 +70,8 @@ class BALFit:
     n_observations: int
     n_dropped: int
     fixed: list
+    n_cameras: int = 0
+    n_points: int = 0
 
     @property
     def iterations(self) -> int:
@@ -76,6 +80,26 @@ class BALFit:
     @property
     def seconds(self) -> float:
         return self.result.seconds
+
+    def to_dict(self) -> dict:
+        """``n_cameras``, ``n_points``, ``n_observations`` (adjusted), ``n_dropped`` (behind
+        their camera), ``initial_cost`` and ``final_cost`` (½ Σ r², px²), ``iterations``,
+        ``seconds`` (solver), ``converged``, ``message``, ``gauge``.
+        """
+        return {
+            "n_cameras": self.n_cameras,
+            "n_points": self.n_points,
+            "n_observations": self.n_observations,
+            "n_dropped": self.n_dropped,
+            "initial_cost": self.initial_cost,
+            "final_cost": self.final_cost,
+            "iterations": self.iterations,
+            "seconds": self.seconds,
+            "converged": self.result.converged,
+            "message": self.result.message,
+            "gauge": "fixed: camera 0's rotation and translation, one translation component of "
+            f"camera 1 (column {CAMERA_COLUMNS[self.fixed[-1][1]]})",
+        }
 
 
 def prepare(problem: BALProblem) -> tuple[BALProblem, int]:
@@ -157,35 +181,22 @@ def adjust_bal(
         n_observations=prob.n_observations,
         n_dropped=n_dropped,
         fixed=fixed,
+        n_cameras=problem.n_cameras,
+        n_points=problem.n_points,
     )
 
 
 def adjust_bal_file(path, options: SolverOptions | None = None, *, progress=None) -> dict:
-    """Read a BAL file (``.txt`` or ``.txt.bz2``), adjust it, and summarise (``hsgeo adjust-bal``).
+    """Read a BAL file (``.txt`` or ``.txt.bz2``), adjust it, and summarise (``hsgeo adjust-bal``):
+    the file front end of :func:`adjust_bal`.
 
     Returns
     -------
     dict
-        ``file``, ``n_cameras``, ``n_points``, ``n_observations`` (adjusted), ``n_dropped``
-        (behind their camera), ``initial_cost`` and ``final_cost`` (½ Σ r², px²),
-        ``iterations``, ``seconds`` (solver), ``converged``, ``message``, ``gauge``.
+        ``file`` and :meth:`BALFit.to_dict`.
     """
     from hsgeo.io.bal import read_bal
 
     problem = read_bal(path)
     fit = adjust_bal(problem, options, progress=progress)
-    return {
-        "file": str(path),
-        "n_cameras": problem.n_cameras,
-        "n_points": problem.n_points,
-        "n_observations": fit.n_observations,
-        "n_dropped": fit.n_dropped,
-        "initial_cost": fit.initial_cost,
-        "final_cost": fit.final_cost,
-        "iterations": fit.iterations,
-        "seconds": fit.seconds,
-        "converged": fit.result.converged,
-        "message": fit.result.message,
-        "gauge": "fixed: camera 0's rotation and translation, one translation component of "
-        f"camera 1 (column {CAMERA_COLUMNS[fit.fixed[-1][1]]})",
-    }
+    return {"file": str(path), **fit.to_dict()}

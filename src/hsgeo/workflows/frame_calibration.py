@@ -35,6 +35,8 @@ __all__ = [
     "calibrate_photogrammetric",
     "initial_poses",
     "calibrate_frame_files",
+    "Estimate",
+    "FrameFilesResult",
     "MIN_VIEWS",
 ]
 
@@ -171,6 +173,19 @@ class FrameCalibration:
             b = self.result.params[blk]
             out.update(dict(zip(b.columns, self.result.sigma(blk).ravel().tolist(), strict=True)))
         return out
+
+    def to_dict(self) -> dict:
+        """Plain types: form, image size, σ0, RMS residual (px), values and σ̂ by name (None
+        where fixed).
+        """
+        return {
+            "form": self.form,
+            "image_size": list(self.image_size),
+            "sigma0": float(self.result.sigma0),
+            "rms_px": self.rms_px,
+            "values": self.values(),
+            "sigmas": {k: (v if v == v else None) for k, v in self.sigmas().items()},
+        }
 
 
 def _stack(views):
@@ -352,6 +367,109 @@ def _check_regex(option: str, rx: str, images) -> None:
             )
 
 
+@dataclass(frozen=True)
+class Estimate:
+    """One estimated parameter of ``hsgeo calibrate-frame``.
+
+    Attributes
+    ----------
+    group : str
+        ``"interior band N"`` (per band) or ``"joint model"``.
+    name : str
+        ``f``, ``x0``, ``y0``, ``K1``–``K3``, ``P1``, ``P2`` (per band) or the joint model's
+        parameter label.
+    unit : str
+        ``mm`` (``mm``, ``1/mm2`` …) or, without ``camera.pixel_mm`` in the board file, ``px``.
+    value, sigma : float
+        The estimate and its a-posteriori σ̂.
+    """
+
+    group: str
+    name: str
+    unit: str
+    value: float
+    sigma: float
+
+
+@dataclass(frozen=True)
+class FrameFilesResult:
+    """What ``hsgeo calibrate-frame`` found: the estimates and a summary.
+
+    Attributes
+    ----------
+    estimates : tuple of Estimate
+    meta : dict
+        ``images``, ``points``, ``length_unit``, ``board``; per band (``"band N"``) σ0, the
+        number of points, the RMS residual (px) and of views, or for the joint model σ0 and
+        ``rms_px``.
+    """
+
+    estimates: tuple[Estimate, ...]
+    meta: dict
+
+    def table(self):
+        """The estimates as a pandas DataFrame (group, name, unit, value, sigma)."""
+        import pandas as pd
+
+        return pd.DataFrame(
+            [vars(e) for e in self.estimates], columns=["group", "name", "unit", "value", "sigma"]
+        )
+
+    def to_dict(self) -> dict:
+        """Plain types: ``{"estimates": [{group, name, unit, value, sigma}, ...], "meta": ...}``."""
+        return {
+            "estimates": [
+                {**vars(e), "value": float(e.value), "sigma": float(e.sigma)}
+                for e in self.estimates
+            ],
+            "meta": self.meta,
+        }
+
+
+def _px_power(name: str) -> int:
+    """Power of the pixel pitch that turns a per-band estimate in mm units into px units:
+    lengths /p, K_i ·p^(2i), P ·p.
+    """
+    return {"f": -1, "x0": -1, "y0": -1, "K1": 2, "K2": 4, "K3": 6, "P1": 1, "P2": 1}[name]
+
+
+def _joint_estimates(obs, sigma_px: float) -> tuple[list[Estimate], dict]:
+    from hsgeo.workflows.rikola import calibrate_joint, initial_focal_mm
+
+    j = calibrate_joint(obs, f0_mm=initial_focal_mm(obs), sigma_px=sigma_px)
+    R = j.result
+    est = []
+    for blk in ("gap_model", "pp_mm", "distortion_mm", "sensor2_rotation"):
+        b = R.params[blk]
+        for lab, v, s in zip(b.labels(), b.value.ravel(), R.sigma(blk).ravel(), strict=True):
+            est.append(Estimate("joint model", lab, "", v, s))
+    meta = {
+        "sigma0": R.sigma0,
+        "rms_px": float(np.sqrt(np.mean(np.sum(j.residuals_px**2, axis=1)))),
+    }
+    return est, meta
+
+
+def _band_estimates(obs, band: int, sigma_px: float, unit: str) -> tuple[list[Estimate], dict]:
+    from hsgeo.workflows.rikola import calibrate_band
+
+    c = calibrate_band(obs, band, f0_mm=None, sigma_px=sigma_px)
+    est = []
+    for q, (v, s) in c.iop.items():
+        u = q.split("_", 1)[1].replace("per_", "1/") if "_" in q else ""
+        name = q.split("_")[0]
+        if unit == "px":  # nominal pitch -> px
+            v, s = v * obs.pixel_mm ** _px_power(name), s * obs.pixel_mm ** _px_power(name)
+        est.append(Estimate(f"interior band {band}", name, u.replace("mm", unit), v, s))
+    meta = {
+        "sigma0": c.result.sigma0,
+        "points": int(np.sum(obs.band == band)),
+        "rms_px": float(np.sqrt(np.mean(np.sum(c.residuals_px**2, 1)))),
+        "views": int(len(c.cubes)),
+    }
+    return est, meta
+
+
 def calibrate_frame_files(
     images,
     board_path,
@@ -360,22 +478,21 @@ def calibrate_frame_files(
     band_regex=None,
     cube_regex=None,
     sigma_px: float = 0.1,
-):
+) -> FrameFilesResult:
     """``hsgeo calibrate-frame``: detect a board in image files and self-calibrate, per band
     (:func:`hsgeo.workflows.rikola.calibrate_band`) or jointly
     (:func:`hsgeo.workflows.rikola.calibrate_joint`, Rikola band numbering).
 
     Returns
     -------
-    hsgeo.reproduce.Reproduction
-        Rows ``interior band N`` (f, x0, y0, K1–K3, P1, P2 with σ̂, in mm or — without
+    FrameFilesResult
+        Estimates ``interior band N`` (f, x0, y0, K1–K3, P1, P2 with σ̂, in mm or — without
         ``camera.pixel_mm`` in the board file — px) or ``joint model``; ``meta`` has σ0, the
-        RMS residual and the number of points per band.
+        RMS residual and the number of points per band. :func:`hsgeo.report.from_estimates`
+        turns it into report rows.
     """
     from hsgeo.io import read_board
     from hsgeo.measure.boards import observe_files
-    from hsgeo.report import Reproduction, Row
-    from hsgeo.workflows.rikola import calibrate_band, calibrate_joint, initial_focal_mm
 
     board = read_board(board_path)
     images = _check_images(images)
@@ -395,55 +512,18 @@ def calibrate_frame_files(
                 f"least {MIN_VIEWS} views from different directions (Zhang 2000): add images"
             )
     unit = "mm" if board.pixel_mm is not None else "px"
-    rows, meta = (
-        [],
-        {
-            "images": len(list(images)),
-            "points": int(len(obs.cube)),
-            "length_unit": unit,
-            "board": board.type,
-        },
-    )
+    meta = {
+        "images": len(list(images)),
+        "points": int(len(obs.cube)),
+        "length_unit": unit,
+        "board": board.type,
+    }
     if joint:
-        if band_regex is None or cube_regex is None:
-            raise InputError(
-                "--joint needs --band-regex and --cube-regex (which band and cube each file is)"
-            )
-        j = calibrate_joint(obs, f0_mm=initial_focal_mm(obs), sigma_px=sigma_px)
-        R = j.result
-        for blk in ("gap_model", "pp_mm", "distortion_mm", "sensor2_rotation"):
-            b = R.params[blk]
-            for lab, v, s in zip(b.labels(), b.value.ravel(), R.sigma(blk).ravel(), strict=True):
-                rows.append(Row("joint model", lab, "", None, None, v, s, None))
-        meta.update(
-            sigma0=R.sigma0, rms_px=float(np.sqrt(np.mean(np.sum(j.residuals_px**2, axis=1))))
-        )
-        return Reproduction("calibrate-frame", 0, rows, meta)
+        est, m = _joint_estimates(obs, sigma_px)
+        meta.update(m)
+        return FrameFilesResult(tuple(est), meta)
+    est = []
     for band in np.unique(obs.band):
-        c = calibrate_band(obs, int(band), f0_mm=None, sigma_px=sigma_px)
-        for q, (v, s) in c.iop.items():
-            u = q.split("_", 1)[1].replace("per_", "1/") if "_" in q else ""
-            if board.pixel_mm is None:  # nominal pitch -> px: lengths /p, K_i ·p^(2i), P ·p
-                power = {"f": -1, "x0": -1, "y0": -1, "K1": 2, "K2": 4, "K3": 6, "P1": 1, "P2": 1}[
-                    q.split("_")[0]
-                ]
-                v, s = v * obs.pixel_mm**power, s * obs.pixel_mm**power
-            rows.append(
-                Row(
-                    f"interior band {band}",
-                    q.split("_")[0],
-                    u.replace("mm", unit),
-                    None,
-                    None,
-                    v,
-                    s,
-                    None,
-                )
-            )
-        meta[f"band {band}"] = {
-            "sigma0": c.result.sigma0,
-            "points": int(np.sum(obs.band == band)),
-            "rms_px": float(np.sqrt(np.mean(np.sum(c.residuals_px**2, 1)))),
-            "views": int(len(c.cubes)),
-        }
-    return Reproduction("calibrate-frame", 0, rows, meta)
+        e, meta[f"band {band}"] = _band_estimates(obs, int(band), sigma_px, unit)
+        est += e
+    return FrameFilesResult(tuple(est), meta)

@@ -1,12 +1,16 @@
 """Geocoding of a recorded flight line (000): orthorectification and GCP deviations.
 
-:func:`geocode_files` (``hsgeo geocode``) reads the recorded lines, the navigation and the sensor
-description, casts every pixel's ray onto a plane or a DEM (:mod:`hsgeo.geocode`) and writes the
-orthoimage as NetCDF and, on request, ENVI. :func:`gcp_deviations` geocodes GCP observations
-after a GCP calibration of the boresight (as PARGE does, 000 Tables 2–3).
+:func:`geocode_files` (``hsgeo geocode``, the file front end) reads the recorded lines, the
+navigation and the sensor description, checks them, and writes the orthoimage as NetCDF and, on
+request, ENVI; the in-memory core :func:`orthorectify_lines` (:class:`GeocodeInputs`,
+:class:`GeocodeOptions` -> :class:`GeocodeResult`) casts every pixel's ray onto a plane or a DEM
+(:mod:`hsgeo.geocode`) and resamples it onto the map grid. :func:`gcp_deviations` geocodes GCP
+observations after a GCP calibration of the boresight (as PARGE does, 000 Tables 2–3).
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -23,7 +27,14 @@ from hsgeo.io import read_dem, read_lines, read_scanning_sensor, to_map_files
 from hsgeo.sensors.line import LineGeometry
 from hsgeo.sensors.pushbroom import PushbroomCamera
 
-__all__ = ["geocode_files", "gcp_deviations"]
+__all__ = [
+    "geocode_files",
+    "gcp_deviations",
+    "GeocodeInputs",
+    "GeocodeOptions",
+    "GeocodeResult",
+    "orthorectify_lines",
+]
 
 
 #: Default memory limit of the map grid and the ground coordinates (GiB), ``--max-grid-gib``.
@@ -103,10 +114,20 @@ def geocode_files(
             f"{need / _GIB:.3g} GiB, over --max-grid-gib {max_grid_gib:g}; split the LINES file "
             "or raise --max-grid-gib"
         )
-    U = nav.pose(t_lines)[0][:, 2]
+    terrain = _terrain(dem, height_m, nav.pose(t_lines)[0][:, 2])
+    res = orthorectify_lines(
+        GeocodeInputs(da, t0, rate, nav, scanner, terrain, pixels, pixel_kw),
+        GeocodeOptions(resolution_m=resolution_m, max_grid_gib=max_grid_gib),
+        attrs={"source": str(lines), "sensor": str(sensor)},
+        progress=progress,
+    )
+    return res.ortho, to_map_files(res.ortho, output, envi, inputs=inputs)
+
+
+def _terrain(dem, height_m, U):
+    """The DEM or the plane, checked to lie below the aircraft (``U``: its heights, m)."""
     if dem is not None:
         dem_da = read_dem(dem)
-        terrain = DemTerrain(dem_da)
         top = float(np.max(dem_da.values))
         if top >= U.min():
             raise InputError(
@@ -114,26 +135,93 @@ def geocode_files(
                 f"{U.min():.6g} m in the navigation): are the DEM and the navigation in the same "
                 "height system and unit?"
             )
-    else:
-        terrain = PlaneTerrain(float(height_m))
-        if not height_m < U.min():
-            raise InputError(
-                f"--height {height_m:g} m is not below the aircraft (U_m down to {U.min():.6g} m "
-                "in the navigation); give the terrain height in the navigation's height system"
-            )
+        return DemTerrain(dem_da)
+    if not height_m < U.min():
+        raise InputError(
+            f"--height {height_m:g} m is not below the aircraft (U_m down to {U.min():.6g} m "
+            "in the navigation); give the terrain height in the navigation's height system"
+        )
+    return PlaneTerrain(float(height_m))
+
+
+@dataclass(frozen=True)
+class GeocodeInputs:
+    """A recorded flight line and what geocoding it needs.
+
+    Attributes
+    ----------
+    radiance : xarray.DataArray
+        ``(band, line, pixel)`` as :func:`hsgeo.io.read_lines` returns it.
+    t0_s, line_rate_hz : float
+        Time of line 0 (s) and the line rate (Hz).
+    nav : Trajectory
+    scanner : a sensor with ``rays`` (:mod:`hsgeo.sensors`)
+    terrain : DemTerrain or PlaneTerrain
+    pixels : ndarray
+        One line's pixel coordinates in the sensor's convention.
+    pixel_kw : dict
+        The sensor's per-pixel keywords (``band`` of a pushbroom camera).
+    """
+
+    radiance: object
+    t0_s: float
+    line_rate_hz: float
+    nav: object
+    scanner: object
+    terrain: object
+    pixels: np.ndarray
+    pixel_kw: dict = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class GeocodeOptions:
+    """Cell size of the map grid (m) and the largest memory it may take (GiB)."""
+
+    resolution_m: float = 0.5
+    max_grid_gib: float = MAX_GRID_GIB
+
+
+@dataclass(frozen=True)
+class GeocodeResult:
+    """The orthoimage ``(band, N, E)`` and every pixel's ground coordinates ``(line, pixel, 3)``."""
+
+    ortho: object
+    ground_m: np.ndarray
+
+    def to_dict(self) -> dict:
+        """Bands, grid size and extent (m) of the orthoimage."""
+        E, N = self.ortho["E"].values, self.ortho["N"].values
+        return {
+            "bands": int(self.ortho.sizes["band"]),
+            "n_north": int(self.ortho.sizes["N"]),
+            "n_east": int(self.ortho.sizes["E"]),
+            "east_m": [float(E.min()), float(E.max())],
+            "north_m": [float(N.min()), float(N.max())],
+        }
+
+
+def orthorectify_lines(
+    inputs: GeocodeInputs, options: GeocodeOptions = GeocodeOptions(), *, attrs=None, progress=True
+) -> GeocodeResult:
+    """Every pixel's ray onto the terrain (:func:`hsgeo.geocode.geocode_image`), then onto a
+    north-up grid (:func:`hsgeo.geocode.orthorectify`), once the grid fits in
+    ``options.max_grid_gib``.
+    """
+    da = inputs.radiance
     ground = geocode_image(
-        nav,
-        scanner,
-        n_lines,
-        pixels,
-        t0_s=t0,
-        line_rate_hz=rate,
-        terrain=terrain,
+        inputs.nav,
+        inputs.scanner,
+        da.sizes["line"],
+        inputs.pixels,
+        t0_s=inputs.t0_s,
+        line_rate_hz=inputs.line_rate_hz,
+        terrain=inputs.terrain,
         progress=progress,
-        **pixel_kw,
+        **inputs.pixel_kw,
     )
     EN = ground[..., :2].reshape(-1, 2)
     span = EN.max(axis=0) - EN.min(axis=0)
+    resolution_m, max_grid_gib = options.resolution_m, options.max_grid_gib
     cells = float(np.prod(np.floor(span / resolution_m) + 2))
     need = grid_bytes(cells, da.sizes["band"])
     if need > max_grid_gib * _GIB:
@@ -148,9 +236,9 @@ def geocode_files(
         ground,
         resolution_m=resolution_m,
         band_names=da["band"].values,
-        attrs={"source": str(lines), "sensor": str(sensor)},
+        attrs=attrs or {},
     )
-    return ortho, to_map_files(ortho, output, envi, inputs=inputs)
+    return GeocodeResult(ortho, ground)
 
 
 def _line_pixels(scanner, pixel, band, sensor):

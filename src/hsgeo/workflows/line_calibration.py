@@ -4,11 +4,17 @@ The model (000 eq. (1)–(3)), its residual block, the design checks and the res
 :mod:`hsgeo.sensors.line1d`; this module strings them into the calibration a user runs:
 read the measured minima and the control points, check the minimum-observation rule, resect
 every image for initial values, and adjust in stages (:func:`calibrate`).
+
+The in-memory core (GUIDE §2): :class:`LineInputs` and :class:`LineOptions` ->
+:func:`calibrate_line` -> :class:`LineCalibration` (with ``to_dict()``); ``hsgeo
+calibrate-line`` (:func:`calibrate_files`, the file front end) and ``hsgeo reproduce
+line-calibration`` both call it.
 """
 
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -23,7 +29,15 @@ from hsgeo.sensors.line1d import (
     resect,
 )
 
-__all__ = ["observe_rows", "calibrate", "calibrate_files"]
+__all__ = [
+    "observe_rows",
+    "calibrate",
+    "calibrate_files",
+    "LineInputs",
+    "LineOptions",
+    "LineCalibration",
+    "calibrate_line",
+]
 
 
 def observe_rows(
@@ -110,6 +124,121 @@ def calibrate(params: Parameters, block: LineObservations, *, stages: bool = Tru
     return adjust(p, block, **kw)
 
 
+@dataclass(frozen=True)
+class LineInputs:
+    """The observations of one spectral line and the control points.
+
+    Attributes
+    ----------
+    image, point : (m,) int ndarray
+        Image and point index of every measured ζ.
+    zeta_px : (m,) ndarray
+        Measured ζ, px (pixel-centre origin at column 0).
+    xy_m : (n_points, 2) ndarray
+        Control-point coordinates in the scanner plane, m.
+    image_ids, point_ids : sequence, optional
+        The user's ids (labels of the parameters).
+    initial_eop : (n_images, 3) ndarray, optional
+        Initial exterior orientation; None: each image resected (:func:`~hsgeo.sensors.line1d.
+        resect`) from the initial ζ0 and c.
+    """
+
+    image: np.ndarray
+    point: np.ndarray
+    zeta_px: np.ndarray
+    xy_m: np.ndarray
+    image_ids: tuple | None = None
+    point_ids: tuple | None = None
+    initial_eop: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class LineOptions:
+    """Initial inner orientation (000 Table 1 'uncalibrated': 485 / 3600 px), the a-priori σ
+    of ζ, outlier rejection and the staged start of :func:`calibrate`.
+    """
+
+    zeta0_px: float = 485.0
+    c_px: float = 3600.0
+    sigma_px: float = 0.1
+    reject_k: float | None = None
+    stages: bool = True
+
+
+@dataclass(frozen=True)
+class LineCalibration:
+    """One calibrated spectral line.
+
+    Attributes
+    ----------
+    result : hsgeo.adjust.AdjustmentResult
+    image_ids, point_ids : list or None
+    residuals_px : (m,) ndarray
+        Residuals of the measured ζ (model − observed), px.
+    """
+
+    result: object
+    image_ids: list | None
+    point_ids: list | None
+    residuals_px: np.ndarray
+
+    def parameters(self) -> list[tuple[str, float, float]]:
+        """``(name, value, σ̂)`` of ζ0, c, K1, K2, K3 (px)."""
+        res = self.result
+        out = [("zeta0_px", res.value("zeta0_px"), res.sigma("zeta0_px"))]
+        out += [("c_px", res.value("c_px"), res.sigma("c_px"))]
+        out += [
+            (k, a, s)
+            for k, a, s in zip(("K1", "K2", "K3"), res.value("K"), res.sigma("K"), strict=True)
+        ]
+        return out
+
+    def residual_stats(self) -> dict:
+        """σ0, degrees of freedom, RMS and largest |residual| (px), number of observations."""
+        v = self.residuals_px
+        return {
+            "sigma0": self.result.sigma0,
+            "dof": self.result.dof,
+            "rms_px": float(np.sqrt(np.mean(v**2))),
+            "max_abs_px": float(np.max(np.abs(v))),
+            "n_observations": int(v.size),
+        }
+
+    def to_dict(self) -> dict:
+        """``{"parameters": {name: {"value", "sigma"}}, "residuals": residual_stats()}``."""
+        return {
+            "parameters": {
+                k: {"value": float(a), "sigma": float(s)} for k, a, s in self.parameters()
+            },
+            "residuals": self.residual_stats(),
+        }
+
+
+def calibrate_line(inputs: LineInputs, options: LineOptions = LineOptions()) -> LineCalibration:
+    """Calibrate one spectral line: the minimum-observation rule (000 §4.1), initial exterior
+    orientation (given, or resected per image), then :func:`calibrate` in stages.
+    """
+    xy = np.asarray(inputs.xy_m, dtype=float)
+    control = np.ones(len(xy), bool)
+    blk = LineObservations(inputs.image, inputs.point, inputs.zeta_px, options.sigma_px)
+    check_minimum_observations(inputs.image, inputs.point, control)
+    eop = inputs.initial_eop
+    if eop is None:
+        z, img, pt = blk.zeta_px, blk.image, blk.point
+        eop = np.array(
+            [
+                resect(xy[pt[img == i]], z[img == i], options.zeta0_px, options.c_px).eop
+                for i in range(int(img.max()) + 1)
+            ]
+        )
+    ids = {} if inputs.image_ids is None else {"image_ids": inputs.image_ids}
+    if inputs.point_ids is not None:
+        ids["point_ids"] = inputs.point_ids
+    p = make_parameters(eop, options.zeta0_px, options.c_px, [0.0, 0.0, 0.0], xy, control, **ids)
+    res = calibrate(p, blk, stages=options.stages, reject_k=options.reject_k)
+    return LineCalibration(res, inputs.image_ids, inputs.point_ids, res.residuals(blk.name))
+
+
 def calibrate_files(
     observations,
     control,
@@ -118,8 +247,9 @@ def calibrate_files(
     c_px: float = 3600.0,
     sigma_px: float = 0.1,
     reject_k: float | None = None,
-) -> dict:
-    """Calibrate one spectral line from a user's files (``hsgeo calibrate-line``).
+) -> LineCalibration:
+    """Calibrate one spectral line from a user's files (``hsgeo calibrate-line``): the file
+    front end of :func:`calibrate_line`.
 
     Parameters
     ----------
@@ -138,7 +268,7 @@ def calibrate_files(
 
     Returns
     -------
-    dict with ``result`` (AdjustmentResult), ``image_ids``, ``point_ids``, ``residuals_px``.
+    LineCalibration
     """
     obs = read_table(
         observations,
@@ -168,7 +298,7 @@ def calibrate_files(
     image_ids = list(dict.fromkeys(obs["image"]))
     img = np.array([image_ids.index(i) for i in obs["image"]])
     pt = np.array([index[p] for p in obs["point"]])
-    blk = LineObservations(img, pt, z, sigma_px)  # NaN check
+    LineObservations(img, pt, z, sigma_px)  # the NaN check, before the design checks
     try:
         check_minimum_observations(img, pt, np.ones(len(pid), bool), len(image_ids))
     except ObservationError as exc:  # the user's image id instead of its index
@@ -192,21 +322,8 @@ def calibrate_files(
                 f"observation file {str(observations)!r}, image {name}: {exc}; check its zeta_px "
                 "values and point ids, and --zeta0-px / --c-px"
             ) from None
-    eop = np.array(eop)
-    p = make_parameters(
-        eop,
-        zeta0_px,
-        c_px,
-        [0.0, 0.0, 0.0],
-        xy,
-        np.ones(len(pid), bool),
-        image_ids=image_ids,
-        point_ids=pid,
+    cal = calibrate_line(
+        LineInputs(img, pt, z, xy, image_ids, pid, initial_eop=np.array(eop)),
+        LineOptions(zeta0_px=zeta0_px, c_px=c_px, sigma_px=sigma_px, reject_k=reject_k),
     )
-    res = calibrate(p, blk, reject_k=reject_k)
-    return {
-        "result": res,
-        "image_ids": image_ids,
-        "point_ids": pid,
-        "residuals_px": res.residuals(blk.name),
-    }
+    return cal

@@ -1,5 +1,9 @@
 """Bundle adjustment of LP lines with spline trajectory corrections (002 §3.4): set-up and run.
 
+Kept as one file: one workflow in GUIDE §2's template — the set-up, the in-memory core
+(:class:`PushbroomInputs`, :class:`PushbroomOptions` -> :func:`adjust_pushbroom` ->
+:class:`PushbroomResult`) and its thin file front end (:func:`adjust_files`) belong together.
+
 :func:`build_problem` turns observations, the navigation poses at the line times, a camera and
 optional GCPs into the engine's :class:`~hsgeo.adjust.Parameters` and residual blocks;
 :func:`intersect_two_rays` gives the tie points their initial coordinates (002 §3.4: "the point
@@ -42,6 +46,10 @@ __all__ = [
     "intersect_two_rays",
     "adjust_files",
     "fit_verdict",
+    "PushbroomInputs",
+    "PushbroomOptions",
+    "PushbroomResult",
+    "adjust_pushbroom",
 ]
 
 
@@ -135,6 +143,53 @@ def intersect_two_rays(point, origin, direction, n_points, min_angle_deg: float 
     return xyz
 
 
+def _parameters(P0, nodes, cam: CameraPrior, gcp_index, gcp_xyz_m, node_prior_mean):
+    """The unknowns of 002 §4 with their priors: points (GCPs with theirs), node corrections,
+    boresight, lever arm, distortion and one principal distance per band.
+    """
+    names = BLOCK_NAMES
+    p = Parameters()
+    p.add(names["points"], P0, points=True, columns=("E_m", "N_m", "H_m"))
+    p.add(
+        names["nodes"],
+        np.zeros((nodes.n_nodes, 6)),
+        columns=CORRECTION_COLUMNS,
+        prior_mean=0.0 if node_prior_mean is None else node_prior_mean,
+        prior_sigma=np.r_[cam.sigma_pos_m, cam.sigma_att_rad][None, :],
+    )
+    p.add(names["boresight"], np.zeros(3), columns=("omega_rad", "phi_rad", "kappa_rad"))
+    p.add(
+        names["lever_arm"],
+        np.asarray(cam.lever_arm_m, float),
+        columns=("x_m", "y_m", "z_m"),
+        prior_sigma=cam.sigma_lever_m,
+    )
+    p.add(names["distortion"], np.zeros(4), columns=("K1", "K2", "P1", "P2"))
+    p.add(names["c"], np.full(cam.n_bands, cam.c_mm))
+    if gcp_index is not None:
+        gi = np.asarray(gcp_index)
+        p.set(names["points"], np.asarray(gcp_xyz_m, float), index=gi)
+        p.set_prior(names["points"], cam.sigma_gcp_m, index=gi, mean=np.asarray(gcp_xyz_m, float))
+    return p
+
+
+def _time_residual(obs: PushbroomObservations, cam: CameraPrior, P0) -> dict:
+    """The GNSS/INS rates and the reference rate of the residual across the line as a time."""
+    if not obs.has_rates:
+        raise InputError(
+            "y_as_time needs the GNSS/INS rates at the line times (xyz_rate_nav_m_s, "
+            "rpy_rate_nav_rad_s): give them (hsgeo.trajectory.Trajectory.rates, converted by "
+            "hsgeo.trajectory.platform_rpy_rate_from_rph_rate) or use y_as_time=False"
+        )
+    z_ref = float(np.median(obs.xyz_nav_m[:, 2] - P0[obs.point, 2]))
+    v_ref = float(np.median(np.linalg.norm(obs.xyz_rate_nav_m_s, axis=1)))
+    return {
+        "xyz_rate_m_s": obs.xyz_rate_nav_m_s,
+        "rpy_rate_rad_s": obs.rpy_rate_nav_rad_s,
+        "y_rate_ref_px_s": cam.c_mm * v_ref / (z_ref * cam.pixel_mm),
+    }
+
+
 def build_problem(
     obs: PushbroomObservations,
     n_points: int,
@@ -193,7 +248,6 @@ def build_problem(
         raise InputError("no observations")
     t0, t1 = (t.min(), t.max()) if t_span_s is None else t_span_s
     nodes = SplineNodes(float(t0), float(t1), float(node_interval_s))
-    names = BLOCK_NAMES
     if np.any(obs.band >= cam.n_bands):
         raise InputError(f"band index ≥ the camera's {cam.n_bands} bands")
     rpy = obs.rpy_nav_rad
@@ -205,43 +259,8 @@ def build_problem(
         lever_arm_m=cam.lever_arm_m,
     ).rays_at(obs.xy_px, obs.band, obs.xyz_nav_m, R_from_rpy(rpy[:, 0], rpy[:, 1], rpy[:, 2]))
     P0 = intersect_two_rays(obs.point, o, d, n_points)
-    p = Parameters()
-    p.add(names["points"], P0, points=True, columns=("E_m", "N_m", "H_m"))
-    p.add(
-        names["nodes"],
-        np.zeros((nodes.n_nodes, 6)),
-        columns=CORRECTION_COLUMNS,
-        prior_mean=0.0 if node_prior_mean is None else node_prior_mean,
-        prior_sigma=np.r_[cam.sigma_pos_m, cam.sigma_att_rad][None, :],
-    )
-    p.add(names["boresight"], np.zeros(3), columns=("omega_rad", "phi_rad", "kappa_rad"))
-    p.add(
-        names["lever_arm"],
-        np.asarray(cam.lever_arm_m, float),
-        columns=("x_m", "y_m", "z_m"),
-        prior_sigma=cam.sigma_lever_m,
-    )
-    p.add(names["distortion"], np.zeros(4), columns=("K1", "K2", "P1", "P2"))
-    p.add(names["c"], np.full(cam.n_bands, cam.c_mm))
-    if gcp_index is not None:
-        gi = np.asarray(gcp_index)
-        p.set(names["points"], np.asarray(gcp_xyz_m, float), index=gi)
-        p.set_prior(names["points"], cam.sigma_gcp_m, index=gi, mean=np.asarray(gcp_xyz_m, float))
-    timed = {}
-    if y_as_time:
-        if not obs.has_rates:
-            raise InputError(
-                "y_as_time needs the GNSS/INS rates at the line times (xyz_rate_nav_m_s, "
-                "rpy_rate_nav_rad_s): give them (hsgeo.trajectory.Trajectory.rates, converted by "
-                "hsgeo.trajectory.platform_rpy_rate_from_rph_rate) or use y_as_time=False"
-            )
-        z_ref = float(np.median(obs.xyz_nav_m[:, 2] - P0[obs.point, 2]))
-        v_ref = float(np.median(np.linalg.norm(obs.xyz_rate_nav_m_s, axis=1)))
-        timed = {
-            "xyz_rate_m_s": obs.xyz_rate_nav_m_s,
-            "rpy_rate_rad_s": obs.rpy_rate_nav_rad_s,
-            "y_rate_ref_px_s": cam.c_mm * v_ref / (z_ref * cam.pixel_mm),
-        }
+    p = _parameters(P0, nodes, cam, gcp_index, gcp_xyz_m, node_prior_mean)
+    timed = _time_residual(obs, cam, P0) if y_as_time else {}
     blk = PushbroomLines(
         obs.point,
         obs.band,
@@ -287,6 +306,128 @@ def solve(
         reject_every_iteration=True,  # 002 §3.4
         keep_jacobian=keep_jacobian,
         raise_on_failure=raise_on_failure,
+    )
+
+
+# ----------------------------------------------------------------------------------------------
+# The in-memory core: inputs and options -> one result (the CLI and hsgeo.reproduce both call it)
+# ----------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class PushbroomInputs:
+    """What one LP bundle adjustment is given.
+
+    Attributes
+    ----------
+    observations : PushbroomObservations
+        The image observations and the GNSS/INS poses (and rates) at their line times.
+    n_points : int
+        Number of tie points (``observations.point`` indexes them).
+    camera : CameraPrior
+    gcp_index, gcp_xyz_m : ndarray, optional
+        Rows of the points that are GCPs and their surveyed coordinates; None: no GCPs.
+    point_ids : ndarray, optional
+        The user's point ids, in point order (for the report; default ``0 … n_points − 1``).
+    t_span_s : (float, float), optional
+        Time span of the trajectory-correction nodes (default: the observations').
+    node_prior_mean : (n_nodes, 6) ndarray, optional
+        Prior mean of the node corrections (default zero).
+    """
+
+    observations: PushbroomObservations
+    n_points: int
+    camera: CameraPrior
+    gcp_index: np.ndarray | None = None
+    gcp_xyz_m: np.ndarray | None = None
+    point_ids: np.ndarray | None = None
+    t_span_s: tuple | None = None
+    node_prior_mean: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class PushbroomOptions:
+    """How to adjust: 002's settings (:data:`REJECT_K`, :data:`FTOL`, :data:`Y_AS_TIME`) by
+    default, and the node interval of 002 §4.
+    """
+
+    node_interval_s: float = 10.0
+    reject_k: float | None = REJECT_K
+    ftol: float = FTOL
+    y_as_time: bool = Y_AS_TIME
+    keep_jacobian: bool = False
+    raise_on_failure: bool = True
+
+
+@dataclass(frozen=True)
+class PushbroomResult:
+    """One LP bundle adjustment: the engine's result, the problem it solved and a summary.
+
+    Attributes
+    ----------
+    result : hsgeo.adjust.AdjustmentResult
+    params : Parameters
+        The problem's parameters as set up (initial values and priors).
+    blocks : list of ResidualBlock
+    nodes : SplineNodes
+    point_ids : ndarray
+    n_observations_2d : int
+    node_interval_s : float
+    setup_seconds : float
+    """
+
+    result: object
+    params: Parameters
+    blocks: list
+    nodes: SplineNodes
+    point_ids: np.ndarray
+    n_observations_2d: int
+    node_interval_s: float
+    setup_seconds: float
+
+    def to_dict(self) -> dict:
+        """Counts, σ0, the camera parameters with σ̂, nodes, points and the fit verdict
+        (:func:`summary`).
+        """
+        return summary(
+            self.result, self.nodes, self.point_ids, self.n_observations_2d, self.node_interval_s
+        )
+
+
+def adjust_pushbroom(
+    inputs: PushbroomInputs, options: PushbroomOptions = PushbroomOptions(), *, progress=None
+) -> PushbroomResult:
+    """Set up (:func:`build_problem`) and adjust (:func:`solve`) one LP bundle adjustment.
+
+    ``hsgeo adjust-pushbroom`` (:func:`adjust_files`) and ``hsgeo reproduce pushbroom-ba`` both
+    call this, so 002's solver settings and the set-up exist once.
+    """
+    import time
+
+    t0 = time.perf_counter()
+    obs = inputs.observations
+    p, blocks, nodes = build_problem(
+        obs,
+        inputs.n_points,
+        inputs.camera,
+        node_interval_s=options.node_interval_s,
+        gcp_index=inputs.gcp_index,
+        gcp_xyz_m=inputs.gcp_xyz_m,
+        t_span_s=inputs.t_span_s,
+        node_prior_mean=inputs.node_prior_mean,
+        y_as_time=options.y_as_time,
+    )
+    setup_s = time.perf_counter() - t0
+    res = solve(
+        p,
+        blocks,
+        reject_k=options.reject_k,
+        ftol=options.ftol,
+        progress=progress,
+        keep_jacobian=options.keep_jacobian,
+        raise_on_failure=options.raise_on_failure,
+    )
+    ids = np.arange(inputs.n_points) if inputs.point_ids is None else inputs.point_ids
+    return PushbroomResult(
+        res, p, blocks, nodes, ids, int(obs.point.size), options.node_interval_s, setup_s
     )
 
 
@@ -365,10 +506,8 @@ def adjust_files(
         2 on a poor fit unless ``--accept-poor-fit``).
     """
     from hsgeo.io.navigation import read_trajectory
-    from hsgeo.trajectory import platform_rpy_from_rph, platform_rpy_rate_from_rph_rate
-    from hsgeo.validate import check_navigation_covers, check_range
 
-    obs_df = read_table(
+    obs_df = read_table(  # the files in this order: the first bad one is reported
         observations,
         OBS_COLUMNS,
         "observation",
@@ -377,6 +516,28 @@ def adjust_files(
     )
     traj = read_trajectory(trajectory)
     cam = read_camera(camera)
+    obs, ids = _observations(obs_df, observations, trajectory, traj, cam, max_nav_gap_s)
+    gi = gx = None
+    if gcp is not None:
+        gi, gx = _read_gcp(gcp, ids, observations, trajectory, traj)
+    inputs = PushbroomInputs(obs, ids.size, cam, gcp_index=gi, gcp_xyz_m=gx, point_ids=ids)
+    options = PushbroomOptions(
+        node_interval_s=node_interval_s,
+        reject_k=reject_k,
+        y_as_time=y_as_time,
+        raise_on_failure=False,  # no convergence is a verdict of the fit (fit_verdict)
+    )
+    r = adjust_pushbroom(inputs, options, progress=progress)
+    out = r.to_dict()
+    out["_result"] = r.result
+    return out
+
+
+def _observations(obs_df, observations, trajectory, traj, cam: CameraPrior, max_nav_gap_s):
+    """The observation table with the navigation at its line times: ``(obs, point_ids)``."""
+    from hsgeo.trajectory import platform_rpy_from_rph, platform_rpy_rate_from_rph_rate
+    from hsgeo.validate import check_navigation_covers, check_range
+
     check_range(
         obs_df["band"].to_numpy(),
         0,
@@ -404,57 +565,40 @@ def adjust_files(
     )
     xyz, rph = traj.pose(t)
     vel, rph_rate = traj.rates(t)
-    rpy = platform_rpy_from_rph(rph)  # the model's ENU platform angles (002)
-    rate = platform_rpy_rate_from_rph_rate(rph_rate)
     obs = PushbroomObservations(
         point=point.astype(np.int64),
         band=obs_df["band"].to_numpy().astype(np.int64),
         t_s=t,
         xy_px=obs_df[["x_px", "y_px"]].to_numpy(dtype=float),
         xyz_nav_m=xyz,
-        rpy_nav_rad=rpy,
+        rpy_nav_rad=platform_rpy_from_rph(rph),  # the model's ENU platform angles (002)
         xyz_rate_nav_m_s=vel,
-        rpy_rate_nav_rad_s=rate,
+        rpy_rate_nav_rad_s=platform_rpy_rate_from_rph_rate(rph_rate),
     )
-    gi = gx = None
-    if gcp is not None:
-        g = read_table(gcp, GCP_COLUMNS, "GCP", text_columns=("point_id",), unique=("point_id",))
-        pos = {v: i for i, v in enumerate(ids)}
-        unknown = [v for v in g["point_id"] if v not in pos]
-        if unknown:
-            raise InputError(
-                f"GCP file {str(gcp)!r}: point_id(s) {', '.join(map(str, unknown[:5]))} are not "
-                f"in the observation file {str(observations)!r}; correct the id or delete the row"
-            )
-        gi = np.array([pos[v] for v in g["point_id"]])
-        gx = g[["E_m", "N_m", "H_m"]].to_numpy(dtype=float)
-        low = float(traj.xyz_m[:, 2].min())
-        high = int(np.argmax(gx[:, 2]))
-        if gx[high, 2] >= low:
-            raise InputError(
-                f"GCP file {str(gcp)!r}: point_id {g['point_id'].iloc[high]} at H_m = "
-                f"{gx[high, 2]:.6g} m is not below the aircraft (U_m down to {low:.6g} m in the "
-                f"navigation file {str(trajectory)!r}); are both heights in metres, in one system?"
-            )
-    p, blocks, nodes = build_problem(
-        obs,
-        ids.size,
-        cam,
-        node_interval_s=node_interval_s,
-        gcp_index=gi,
-        gcp_xyz_m=gx,
-        y_as_time=y_as_time,
-    )
-    res = solve(
-        p,
-        blocks,
-        reject_k=reject_k,
-        progress=progress,
-        raise_on_failure=False,  # no convergence is a verdict of the fit (fit_verdict)
-    )
-    out = summary(res, nodes, ids, int(len(obs_df)), node_interval_s)
-    out["_result"] = res
-    return out
+    return obs, ids
+
+
+def _read_gcp(gcp, ids, observations, trajectory, traj):
+    """The GCP table: rows of the points that are GCPs and their coordinates ``(gi, gx)``."""
+    g = read_table(gcp, GCP_COLUMNS, "GCP", text_columns=("point_id",), unique=("point_id",))
+    pos = {v: i for i, v in enumerate(ids)}
+    unknown = [v for v in g["point_id"] if v not in pos]
+    if unknown:
+        raise InputError(
+            f"GCP file {str(gcp)!r}: point_id(s) {', '.join(map(str, unknown[:5]))} are not "
+            f"in the observation file {str(observations)!r}; correct the id or delete the row"
+        )
+    gi = np.array([pos[v] for v in g["point_id"]])
+    gx = g[["E_m", "N_m", "H_m"]].to_numpy(dtype=float)
+    low = float(traj.xyz_m[:, 2].min())
+    high = int(np.argmax(gx[:, 2]))
+    if gx[high, 2] >= low:
+        raise InputError(
+            f"GCP file {str(gcp)!r}: point_id {g['point_id'].iloc[high]} at H_m = "
+            f"{gx[high, 2]:.6g} m is not below the aircraft (U_m down to {low:.6g} m in the "
+            f"navigation file {str(trajectory)!r}); are both heights in metres, in one system?"
+        )
+    return gi, gx
 
 
 def summary(res, nodes, point_ids, n_observations_2d: int, node_interval_s: float) -> dict:

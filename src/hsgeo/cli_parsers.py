@@ -1,0 +1,430 @@
+"""The ``hsgeo`` command's argument parsers, one function per subcommand.
+
+:func:`hsgeo.cli.build_parser` assembles them and attaches each subcommand's handler; what a
+subcommand does lives in :mod:`hsgeo.cli` (and the workflows it calls), what it accepts here.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from hsgeo.validate import option_number
+
+__all__ = ["HsgeoParser", "root_parser", "SUBCOMMANDS"]
+
+_POSITIVE = option_number(positive=True)
+
+
+class HsgeoParser(argparse.ArgumentParser):
+    """argparse with one-line errors: ``hsgeo geocode: error: ... (see hsgeo geocode --help)``
+    and exit status 2 (the usage, which wraps over many lines, is left to ``--help``).
+    """
+
+    def error(self, message: str):
+        msg = " ".join(message.split())
+        self.exit(2, f"{self.prog}: error: {msg} (see {self.prog} --help)\n")
+
+
+def root_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]:
+    """The ``hsgeo`` parser and its subparsers action (no subcommand yet)."""
+    from hsgeo import __version__
+
+    ap = HsgeoParser(
+        prog="hsgeo",
+        description="Geometry of hyperspectral sensors: reproduce the book's tables, calibrate, "
+        "geocode.",
+    )
+    ap.add_argument("--version", action="version", version=f"hsgeo {__version__}")
+    sub = ap.add_subparsers(dest="command", required=True)
+    return ap, sub
+
+
+def add_reproduce(sub) -> argparse.ArgumentParser:
+    """``hsgeo reproduce``."""
+    from hsgeo.reproduce import chapter_names
+
+    p = sub.add_parser("reproduce", help="print a chapter's tables (paper | reproduced | truth)")
+    p.add_argument(
+        "chapter",
+        choices=chapter_names(),
+        metavar="CHAPTER",
+        help="one of: " + ", ".join(chapter_names()),
+    )
+    p.add_argument(
+        "--seed",
+        type=option_number(integer=True, lo=0),
+        default=0,
+        help="random seed (default 0); any works",
+    )
+    p.add_argument(
+        "--scale",
+        type=option_number(positive=True, hi=1.0),
+        default=1.0,
+        help="problem size in (0, 1] for chapters that have a size knob (default 1)",
+    )
+    p.add_argument("--json", action="store_true", help="one JSON object instead of text tables")
+    return p
+
+
+def add_calibrate_line(sub) -> argparse.ArgumentParser:
+    """``hsgeo calibrate-line``."""
+    p = sub.add_parser(
+        "calibrate-line",
+        help="calibrate one spectral line of a 1D line scanner (000 eq. 2) from measured minima",
+        description="OBSERVATIONS: CSV 'image,point,zeta_px' (ids, ζ in px, pixel-centre "
+        "origin); CONTROL: CSV 'point,x_m,y_m' (coordinates in the scanner plane, m). Some "
+        "control points must lie off the pattern line, or the scale c is undetermined.",
+    )
+    p.add_argument("observations", metavar="OBSERVATIONS")
+    p.add_argument("--control", required=True, metavar="CONTROL")
+    p.add_argument(
+        "--zeta0-px",
+        type=option_number(lo=-1e6, hi=1e6),
+        default=485.0,
+        help="initial ζ0 (000 Table 1: 485)",
+    )
+    p.add_argument(
+        "--c-px",
+        type=option_number(positive=True, hi=1e6),
+        default=3600.0,
+        help="initial c (000 Table 1: 3600)",
+    )
+    p.add_argument("--sigma-px", type=_POSITIVE, default=0.1, help="a-priori σ of ζ (px, positive)")
+    p.add_argument(
+        "--reject-k",
+        type=_POSITIVE,
+        default=None,
+        help="reject observations whose standardised residual exceeds k robust σ (default: none)",
+    )
+    p.add_argument("--json", action="store_true", help="estimates and residual statistics as JSON")
+    return p
+
+
+def add_calibrate_frame(sub) -> argparse.ArgumentParser:
+    """``hsgeo calibrate-frame``."""
+    p = sub.add_parser(
+        "calibrate-frame",
+        help="self-calibrate a frame camera (per band or "
+        "jointly, 003) from images of an ArUco / ChArUco board",
+    )
+    p.add_argument("images", nargs="+", metavar="IMAGES", help="image files")
+    p.add_argument("--board", required=True, help="board description (TOML, see hsgeo.io.boards)")
+    g = p.add_mutually_exclusive_group()
+    g.add_argument(
+        "--per-band", action="store_false", dest="joint", help="one calibration per band (default)"
+    )
+    g.add_argument(
+        "--joint",
+        action="store_true",
+        help="one joint adjustment of all bands "
+        "(Rikola band numbering of 003 Table 2; needs --band-regex and --cube-regex)",
+    )
+    p.add_argument("--band-regex", help="regex with one group: band number from the file name")
+    p.add_argument("--cube-regex", help="regex with one group: cube (view) from the file name")
+    p.add_argument(
+        "--sigma-px",
+        type=_POSITIVE,
+        default=0.1,
+        help="a-priori σ of an image point in px (default 0.1)",
+    )
+    p.add_argument("--json", action="store_true", help="one JSON object instead of text")
+    p.set_defaults(joint=False)
+    return p
+
+
+def add_data(sub) -> argparse.ArgumentParser:
+    """``hsgeo data``."""
+    p = sub.add_parser("data", help="generate data_synthetic/generated from the scenario TOMLs")
+    mode = p.add_mutually_exclusive_group()  # verifying and rewriting the manifest exclude
+    mode.add_argument(
+        "--verify",
+        action="store_true",
+        help="fail if a generated file differs from data_synthetic/MANIFEST.sha256",
+    )
+    mode.add_argument(
+        "--update-manifest",
+        action="store_true",
+        help="rewrite the manifest from what was generated (after a deliberate change)",
+    )
+    p.add_argument(
+        "--out",
+        metavar="DIR",
+        help="folder for the generated files (default: data_synthetic/generated of the "
+        "repository the working directory is in, else ./data_synthetic/generated); never the "
+        "installed package",
+    )
+    p.add_argument("--overwrite", action="store_true", help="replace existing files in --out DIR")
+    return p
+
+
+def add_geocode(sub) -> argparse.ArgumentParser:
+    """``hsgeo geocode``."""
+    p = sub.add_parser(
+        "geocode",
+        help="orthorectify a line-scanner flight line onto a map grid",
+        description="Geocode every pixel of a flight line (ray from the recorded navigation and "
+        "the sensor model, intersected with a DEM or a plane) and resample it onto a north-up "
+        "grid by nearest neighbour. LINES: NetCDF with radiance(line, pixel) or (band, line, "
+        "pixel), coordinate pixel (ζ, px), attributes t0_s and line_rate_hz. "
+        "NAV: the navigation file of every command, CSV or Parquet with t_s, E_m, N_m, U_m, "
+        "roll_deg, pitch_deg, heading_deg (positions east-north-up in m; attitude of the body, "
+        "x forward, y right, z down, in north-east-down, in degrees; see hsgeo.io.navigation). "
+        "SENSOR: TOML, the 000 line-scanner file ([sensor], see hsgeo.io.read_sensor_toml) or "
+        "the 002 pushbroom camera file ([camera], see hsgeo.io.read_pushbroom_camera; then the "
+        "LINES pixel coordinate is x in px from the line centre). DEM: NetCDF with "
+        "height(N, E) in metres.",
+    )
+    p.add_argument("lines", metavar="LINES")
+    p.add_argument(
+        "--trajectory",
+        required=True,
+        metavar="NAV",
+        help="navigation file (GNSS/INS solution, CSV or Parquet; see above)",
+    )
+    p.add_argument("--sensor", required=True, metavar="SENSOR.toml")
+    g = p.add_mutually_exclusive_group(required=True)
+    g.add_argument("--dem", metavar="DEM.nc")
+    g.add_argument(
+        "--height",
+        type=option_number(lo=-1e5, hi=1e5),
+        metavar="H",
+        help="terrain height of a plane (m)",
+    )
+    p.add_argument("-o", "--output", required=True, metavar="ORTHO.nc")
+    p.add_argument("--envi", metavar="PATH", help="also write ENVI BSQ + .hdr with map info")
+    p.add_argument(
+        "--overwrite", action="store_true", help="replace existing output files (default: refuse)"
+    )
+    p.add_argument("--resolution", type=_POSITIVE, default=0.5, help="cell size in m (default 0.5)")
+    p.add_argument(
+        "--max-grid-gib",
+        type=_POSITIVE,
+        default=2.0,
+        help="largest memory of the map grid, GiB (default 2); checked before the work",
+    )
+    p.add_argument(
+        "--max-nav-gap-s",
+        type=_POSITIVE,
+        default=1.0,
+        help="longest gap between navigation records interpolated across, s (default 1)",
+    )
+    p.add_argument(
+        "--band",
+        type=int,
+        default=0,
+        help="band of a pushbroom camera file whose geometry is used (default 0)",
+    )
+    p.add_argument("--quiet", action="store_true", help="no progress display")
+    return p
+
+
+def add_adjust_pushbroom(sub) -> argparse.ArgumentParser:
+    """``hsgeo adjust-pushbroom``."""
+    p = sub.add_parser(
+        "adjust-pushbroom",
+        help="bundle-adjust LP lines with spline trajectory corrections (002 eq. 2-4)",
+        description="Observation table: point_id, band, t_s, x_px, y_px; GCPs: point_id, E_m, "
+        "N_m, H_m (CSV or Parquet); camera TOML: see hsgeo.io.read_camera_toml. "
+        "NAV: the navigation file of every command, CSV or Parquet with t_s, E_m, N_m, U_m, "
+        "roll_deg, pitch_deg, heading_deg (positions east-north-up in m; attitude of the body, "
+        "x forward, y right, z down, in north-east-down, in degrees; see hsgeo.io.navigation). "
+        "The former format (H_m, roll_rad, pitch_rad, yaw_rad in ENU platform angles) converts "
+        "as U_m = H_m, roll_deg = deg(roll_rad), pitch_deg = -deg(pitch_rad), heading_deg = "
+        "90 - deg(yaw_rad).",
+    )
+    p.add_argument("observations", help="observation table (CSV or Parquet)")
+    p.add_argument(
+        "--trajectory",
+        required=True,
+        metavar="NAV",
+        help="navigation file (GNSS/INS solution, CSV or Parquet; see above)",
+    )
+    p.add_argument("--camera", required=True, help="camera and prior σ (TOML)")
+    p.add_argument("--gcp", help="ground control points table (optional)")
+    p.add_argument(
+        "--max-nav-gap-s",
+        type=_POSITIVE,
+        default=1.0,
+        help="longest gap between navigation records interpolated across, s (default 1)",
+    )
+    p.add_argument(
+        "--node-interval",
+        type=_POSITIVE,
+        default=10.0,
+        help="spline node interval in s (default 10, 002 §4)",
+    )
+    p.add_argument(
+        "--image-y",
+        action="store_true",
+        help="residual across the line as the image y of 002 eq. 2 (default: as a "
+        "time, the image y over its rate from the trajectory's velocity and angular "
+        "rate, which avoids a bias of the principal distance and the pitch "
+        "corrections)",
+    )
+    p.add_argument(
+        "--accept-poor-fit",
+        action="store_true",
+        help="exit 0 even when the fit is implausible (σ0 off by more than a factor of 3, more "
+        "than 5 %% of the observations rejected, or no convergence; the JSON's 'fit' says why)",
+    )
+    p.add_argument("--json", action="store_true", help="JSON instead of the text report")
+    return p
+
+
+def add_adjust_bal(sub) -> argparse.ArgumentParser:
+    """``hsgeo adjust-bal``."""
+    p = sub.add_parser(
+        "adjust-bal",
+        help="bundle-adjust a 'Bundle Adjustment in the Large' problem file (Snavely cameras)",
+    )
+    p.add_argument("file", help="BAL problem file (.txt, or .txt.bz2)")
+    p.add_argument("--json", action="store_true", help="one JSON object instead of text")
+    return p
+
+
+def add_mtf(sub) -> argparse.ArgumentParser:
+    """``hsgeo mtf``."""
+    p = sub.add_parser(
+        "mtf",
+        help="MTF from bar-target profiles: CTF per bar group, then the Coltman series",
+        description="MTF from bar-target profiles (001 eq. 5-7, Coltman 1954). PROFILES: CSV "
+        "or Parquet with columns x_px (position along the line, px) and intensity_dn (raw "
+        "intensity), optionally row (spectral line; one MTF per row). BARS: TOML with [target] "
+        "pair_mm (pair width per group, mm), n_pairs, white_reflectance, black_reflectance and "
+        "[profile] gsd_mm, start_px (target start on the profile, to a few px), dark_dn, "
+        "saturation_dn. Groups follow each other, each starting with a white bar.",
+    )
+    p.add_argument("profiles", help="profile table (x_px, intensity_dn[, row])")
+    p.add_argument("--bars", required=True, help="bar-target TOML ([target], [profile])")
+    p.add_argument("--json", action="store_true", help="one JSON object instead of text")
+    return p
+
+
+def add_mtf_edge(sub) -> argparse.ArgumentParser:
+    """``hsgeo mtf-edge``."""
+    p = sub.add_parser(
+        "mtf-edge",
+        help="slanted-edge MTF (ISO 12233) of an image",
+        description="The ISO 12233 slanted-edge MTF of an 8- or 16-bit PNG or TIFF: edge angle, "
+        "4x oversampled edge spread, derivative, Hamming window, FFT. Without --roi the region "
+        "around the strongest edge is used.",
+    )
+    p.add_argument("image", help="8- or 16-bit PNG or TIFF holding one slanted edge")
+    p.add_argument("--roi", help="region x0,y0,x1,y1 in pixels around the edge")
+    p.add_argument("--json", action="store_true", help="one JSON object instead of text")
+    return p
+
+
+def add_cube(sub) -> argparse.ArgumentParser:
+    """``hsgeo cube``."""
+    p = sub.add_parser(
+        "cube",
+        help="raw ImSpector frames -> reflectance cube (dark current, hot pixels, 001 §2.1/§2.4)",
+        description="Build a reflectance cube from raw frames of the ImSpector V9 + PixelFly "
+        "(001 §2.1, §2.4): fit h = a*T_exp + b to every pixel of the dark frames, find the hot "
+        "pixels, subtract h from every frame, average the diffuse collector's columns along "
+        "each spectral line and compute r = G_ref*E_ref*F(alpha) / (G_inc*E_inc*F(theta)); "
+        "stack the lines, in chunks, into a cube (line, sample, band). "
+        "RAW_DIR and DARK_DIR: frames in file-name order, 16-bit grayscale TIFF (.tif/.tiff, "
+        "one frame per file) or NumPy (.npy, one frame (rows, columns) or a stack (n, rows, "
+        "columns)), raw 12-bit DN, spectral rows down, spatial columns across (binning 1: "
+        "1024 x 1280 with the scene in columns 0-1169 and the diffuse collector in 1170-1279; "
+        "binning 2: 512 x 640, 585 + 55 columns); each folder has exposures.csv with columns "
+        "file, exposure_s (one row per frame file; a .npy stack shares its value). The dark "
+        "frames (aperture closed) need two or more exposure times. RAW_DIR also has "
+        "wavelengths.csv with columns row, wavelength_nm, fwhm_nm for every spectral row. "
+        "Output: .nc (NetCDF-4) or .hdr / .bsq / .bil / .bip (ENVI with wavelength, fwhm, data "
+        "ignore value -9999 and default bands 850/650/550 nm).",
+    )
+    p.add_argument("raw_dir", metavar="RAW_DIR", help="folder of raw frames (see above)")
+    p.add_argument("--dark", required=True, metavar="DARK_DIR", help="folder of dark frames")
+    p.add_argument(
+        "--binning",
+        type=option_number(integer=True, lo=1, hi=2),
+        default=2,
+        help="the camera's binning factor, 1 or 2 (default 2, 001 §3.2)",
+    )
+    p.add_argument(
+        "--rows-per-band",
+        type=option_number(integer=True, lo=1, hi=64),
+        default=5,
+        help="spectral rows averaged into one band (default 5: 4.4 nm at binning 2)",
+    )
+    p.add_argument(
+        "--f-alpha",
+        type=option_number(positive=True, hi=10.0),
+        default=1.0,
+        help="the diffuse collector's receiving pattern F(alpha) at the light's incidence "
+        "(default 1)",
+    )
+    p.add_argument(
+        "--lines-per-chunk",
+        type=option_number(integer=True, lo=1, hi=4096),
+        default=64,
+        help="lines processed together (memory is about one chunk; default 64)",
+    )
+    p.add_argument("-o", "--output", required=True, metavar="CUBE.nc|CUBE.hdr")
+    p.add_argument(
+        "--overwrite", action="store_true", help="replace an existing output (default: refuse)"
+    )
+    p.add_argument("--quiet", action="store_true", help="no progress bar (shown on a terminal)")
+    p.add_argument("--json", action="store_true", help="a JSON summary instead of one line")
+    return p
+
+
+def add_asf(sub) -> argparse.ArgumentParser:
+    """``hsgeo asf``."""
+    p = sub.add_parser(
+        "asf",
+        help="angular sensitivity of a whiskbroom scanner: cross-runway / along-runway (004)",
+        description="The angular sensitivity function (ASF) of a whiskbroom scanner from a scan "
+        "crossing a runway divided by an overflight along it (004 steps 1-3): the along image "
+        "is registered onto the cross scan by the landmarks at the runway's sides (a shift per "
+        "window along both long edges, their median), both are averaged over the runway's "
+        "width, divided, and normalised to nadir. CROSS and ALONG: georegistered scans, NetCDF "
+        "with reflectance(band, line, pixel), E_m(line, pixel) and N_m(line, pixel) (the "
+        "ground point of every sample, m, in one map frame) and scan_angle_deg(pixel) "
+        "(positive to the right of the heading). RUNWAY: CSV or Parquet with columns E_m, N_m, "
+        "the runway's corners in order around it.",
+    )
+    p.add_argument("cross", metavar="CROSS.nc", help="the scan crossing the runway")
+    p.add_argument("along", metavar="ALONG.nc", help="the scan flown along the runway")
+    p.add_argument(
+        "--runway", required=True, metavar="RUNWAY.csv", help="runway corners (E_m, N_m)"
+    )
+    p.add_argument(
+        "--margin",
+        type=option_number(lo=0.0, hi=100.0),
+        default=2.0,
+        help="samples closer than this to the runway's edge are left out, m (default 2)",
+    )
+    p.add_argument(
+        "--no-register",
+        action="store_true",
+        help="take the georegistration as it is (no shift by the landmarks)",
+    )
+    p.add_argument("--json", action="store_true", help="one JSON object instead of text")
+    return p
+
+
+def add_versions(sub) -> argparse.ArgumentParser:
+    """``hsgeo versions``."""
+    p = sub.add_parser("versions", help="versions of hsgeo, Python and the dependencies")
+    return p
+
+
+#: Subcommands in the order of ``hsgeo --help``: (name of the handler in hsgeo.cli, adder).
+SUBCOMMANDS = (
+    ("_cmd_reproduce", add_reproduce),
+    ("_cmd_calibrate_line", add_calibrate_line),
+    ("_cmd_calibrate_frame", add_calibrate_frame),
+    ("_cmd_data", add_data),
+    ("_cmd_geocode", add_geocode),
+    ("_cmd_adjust_pushbroom", add_adjust_pushbroom),
+    ("_cmd_adjust_bal", add_adjust_bal),
+    ("_cmd_mtf", add_mtf),
+    ("_cmd_mtf_edge", add_mtf_edge),
+    ("_cmd_cube", add_cube),
+    ("_cmd_asf", add_asf),
+    ("_cmd_versions", add_versions),
+)
