@@ -83,3 +83,14 @@ def test_asf_at_shift_places_the_along_image(rep):
     assert np.max(np.abs(at.asf - reg.asf)) < 0.001
     off = asf_at_shift(gc, ga, P, truth.shift_m + [2 * reg.registration.gsd_m, 0.0])
     assert np.max(np.abs(off.asf - true_n)) > 1.2 * np.max(np.abs(at.asf - true_n))
+
+
+def test_unmodelled_effects_carry_their_noise_spread(rep):
+    """Every unmodelled-effect row has a spread over the noise runs; the BRDF and the missing
+    registration move the headline error by far more than that spread."""
+    u = {r.quantity.split(", ", 1)[1]: r for r in rep.rows_of("unmodelled effect")}
+    assert all(r.sigma is not None and 0 < r.sigma < 0.2 for r in u.values())
+    base = u["none (Lambertian runway, registered)"]
+    assert base.reproduced == rep.meta["max_abs_error_percent_runs"][0]
+    for k in ("BRDF of the runway (one crossing)", "no registration (navigation only)"):
+        assert u[k].reproduced - base.reproduced > 5 * max(u[k].sigma, base.sigma)
