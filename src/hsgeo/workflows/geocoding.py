@@ -70,6 +70,7 @@ def geocode_files(
     """
     from hsgeo.io._files import check_outputs
     from hsgeo.io.navigation import read_trajectory
+    from hsgeo.io.raster import MAP_FORMATS
     from hsgeo.validate import check_navigation_covers
 
     if (dem is None) == (height_m is None):
@@ -77,7 +78,7 @@ def geocode_files(
     if not (np.isfinite(resolution_m) and resolution_m > 0):
         raise InputError(f"--resolution must be a positive number of metres, got {resolution_m}")
     inputs = (lines, trajectory, sensor, dem)
-    outs = [(output, "-o/--output")]
+    outs = [(output, "-o/--output", MAP_FORMATS)]
     if envi is not None:
         outs += [(envi, "--envi"), (str(envi) + ".hdr", "--envi (its .hdr)")]
     check_outputs(outs, inputs, overwrite=overwrite)  # before the work, not after it
