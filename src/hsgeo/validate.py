@@ -5,6 +5,8 @@
 * :func:`check_unique` — no id or row given twice (the lines and ids named);
 * :func:`check_navigation_covers` — a navigation solution covers the times it is used at,
   without gaps longer than a tolerance;
+* :func:`check_memory` — a request that cannot fit in the machine's memory is refused up
+  front, with the estimate;
 * :func:`option_number` — command-line numbers (finite, positive, in a range), as argparse
   types whose errors name the option.
 
@@ -29,6 +31,8 @@ __all__ = [
     "check_unique",
     "check_navigation_covers",
     "option_number",
+    "check_memory",
+    "physical_memory_bytes",
     "UNIT_LIMITS",
     "unit_limits",
 ]
@@ -232,3 +236,35 @@ def option_number(
 
     parse.__name__ = "number"
     return parse
+
+
+def physical_memory_bytes() -> float:
+    """The machine's physical memory in bytes (``inf`` where the system does not say)."""
+    import os
+
+    try:
+        return float(os.sysconf("SC_PAGE_SIZE")) * float(os.sysconf("SC_PHYS_PAGES"))
+    except (ValueError, OSError, AttributeError):
+        return math.inf
+
+
+def check_memory(need_bytes: float, what: str, remedy: str) -> None:
+    """Refuse up front what cannot fit in memory: :class:`~hsgeo.InputError` if ``need_bytes``
+    (a lower bound of what ``what`` will allocate) exceeds the machine's physical memory.
+
+    Parameters
+    ----------
+    need_bytes : float
+        The estimate (a lower bound: the refusal must not turn away a run that would fit).
+    what : str
+        What needs it, in the user's terms (the option and the sizes it leads to).
+    remedy : str
+        What to do (the option to change).
+    """
+    have = physical_memory_bytes()
+    if need_bytes > have:
+        gib = 2.0**30
+        raise InputError(
+            f"{what} needs at least {need_bytes / gib:.3g} GiB of memory, more than this "
+            f"machine's {have / gib:.3g} GiB; {remedy}"
+        )

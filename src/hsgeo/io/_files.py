@@ -172,13 +172,14 @@ def check_outputs(outputs, inputs: Iterable = (), *, overwrite: bool = False) ->
             _check_output(p, option, formats, inputs, seen, overwrite)
         except OSError as exc:  # a name too long, a folder without permission ...
             raise InputError(_creation_message(exc, option, p)) from None
-        out.append(p)
-    return out
+        out.append((p, option, formats))
+    for p, option, formats in out:  # after the clashes between outputs, which say more
+        if formats:
+            _check_format(p, option, formats[0])
+    return [p for p, _, _ in out]
 
 
 def _check_output(p: Path, option: str, formats, inputs, seen: dict, overwrite: bool) -> None:
-    if formats:
-        _check_format(p, option, formats[0])
     refuse_inputs(p, inputs)
     key = p.resolve()
     if key in seen:
@@ -214,7 +215,10 @@ def _check_format(p: Path, option: str, formats: dict) -> None:
     suffix = p.suffix.lower()
     if suffix in formats:
         return
-    names = ", ".join(f"{k} ({v})" for k, v in formats.items())
+    by: dict[str, list[str]] = {}
+    for k, v in formats.items():
+        by.setdefault(v, []).append(k)
+    names = "; ".join(f"{v}: {', '.join(ks)}" for v, ks in by.items())
     first = next(iter(formats))
     said = f"the extension {p.suffix!r} is not" if p.suffix else "no extension names"
     raise InputError(

@@ -58,6 +58,17 @@ def _data_lines(text: str) -> list[int]:
     return lines
 
 
+def _header(text: str) -> list[str]:
+    """The column names of a CSV's header line (the first line not blank nor a comment)."""
+    import csv
+
+    for line in text.splitlines():
+        s = line.strip()
+        if s and not s.startswith("#"):
+            return [c.strip() for c in next(csv.reader([s]))]
+    return []
+
+
 def read_table(
     path,
     columns,
@@ -136,12 +147,18 @@ def read_table(
         msg = " ".join(str(exc).split())
         raise InputError(f"{name} is not a readable {kind} table: {msg}") from None
     df.columns = [str(c).strip() for c in df.columns]
-    dup = [c for c in columns if list(df.columns).count(c) > 1]
-    if dup:
-        raise InputError(f"{name}: the header names column {dup[0]} twice; keep one")
+    header = list(df.columns) if parquet else _header(text)
+    dup = sorted({c for c in header if header.count(c) > 1}, key=header.index)
+    if dup:  # pandas would rename the second one 'zeta_px.1' and read the first silently
+        raise InputError(
+            f"{name}: the header names column {dup[0]} {header.count(dup[0])} times; keep one "
+            "(or rename the others)"
+        )
     missing = [c for c in columns if c not in df.columns]
     if missing:
-        near = {c: closest(c, df.columns) for c in missing}
+        # a suggestion only among the columns no other required name claims
+        spare = [c for c in df.columns if c not in columns]
+        near = {c: closest(c, spare) for c in missing}
         hints = "".join(f"; rename {n!r} to {c!r}?" for c, n in near.items() if n)
         found = ", ".join(df.columns)
         if len(found) > 120:

@@ -96,6 +96,7 @@ def geocode_files(
     )
     pixel = np.asarray(da["pixel"].values, dtype=float)
     pixels, pixel_kw = _line_pixels(scanner, pixel, band, sensor)
+    _check_principal_point(scanner, pixel, sensor, lines)
     _check_view_angles(scanner, pixels, pixel_kw, t_lines[0], nav, sensor)
     need = n_lines * n_px * 3 * 8.0
     if need > max_grid_gib * _GIB:
@@ -164,6 +165,22 @@ def _line_pixels(scanner, pixel, band, sensor):
             f"--band {band!r}: the camera file {str(sensor)!r} has bands 0…{n_bands - 1}"
         )
     return np.column_stack([pixel, np.zeros_like(pixel)]), {"band": int(band)}
+
+
+def _check_principal_point(scanner, pixel, sensor, lines) -> None:
+    """The principal point lies on the recorded line: between its first and last pixel."""
+    if isinstance(scanner, PushbroomCamera):
+        pp, name = scanner.x0_mm / scanner.pixel_mm, "x0_mm / pixel_mm"
+    else:
+        pp, name = float(scanner.geometry.zeta0_px), "zeta0_px"
+    lo, hi = float(np.min(pixel)), float(np.max(pixel))
+    if not lo <= pp <= hi:
+        raise InputError(
+            f"sensor file {str(sensor)!r}: the principal point ({name} = {pp:.6g} px) is off "
+            f"the line of {str(lines)!r}, whose pixels run {lo:g}…{hi:g} px; the likely causes: "
+            "a principal point of another binning or crop of the detector, the LINES pixel "
+            "coordinate counted from another origin, or a value in another unit"
+        )
 
 
 def _check_view_angles(scanner, pixels, pixel_kw, t0_s, nav, sensor):

@@ -402,6 +402,7 @@ def adjust_files(
         used=f"the observations' t_s in {str(observations)!r}",
         max_gap_s=max_nav_gap_s,
     )
+    _check_node_memory(t, node_interval_s)
     xyz, rph = traj.pose(t)
     vel, rph_rate = traj.rates(t)
     rpy = platform_rpy_from_rph(rph)  # the model's ENU platform angles (002)
@@ -455,6 +456,24 @@ def adjust_files(
     out = summary(res, nodes, ids, int(len(obs_df)), node_interval_s)
     out["_result"] = res
     return out
+
+
+def _check_node_memory(t_s, node_interval_s: float) -> None:
+    """The trajectory corrections' nodes fit in memory: their 6 unknowns each meet in the
+    reduced normal matrix, dense (8 bytes a cell, and its factor beside it).
+    """
+    from hsgeo.trajectory import SplineNodes
+    from hsgeo.validate import check_memory
+
+    span = float(np.max(t_s) - np.min(t_s))
+    n_nodes = SplineNodes(float(np.min(t_s)), float(np.max(t_s)), float(node_interval_s)).n_nodes
+    n_c = 6 * n_nodes
+    check_memory(
+        2 * 8.0 * float(n_c) ** 2,
+        f"--node-interval {node_interval_s:g} s over the observations' {span:.6g} s "
+        f"({n_nodes} nodes, a reduced normal matrix of {n_c} x {n_c})",
+        "use a longer --node-interval (002 §4: 10 s)",
+    )
 
 
 def summary(res, nodes, point_ids, n_observations_2d: int, node_interval_s: float) -> dict:
