@@ -1502,6 +1502,37 @@ case(
     files=[(F, lambda p: _bal_points_behind(p))],
 )  # fmt: skip
 
+case(
+    "adjust-pushbroom", "units", "nav-and-obs-times-in-ms", "milliseconds",
+    [("nav.csv", scale_column("t_s", 1e3)), ("obs.csv", scale_column("t_s", 1e3))],
+)  # fmt: skip
+case(
+    "adjust-pushbroom", "units", "nav-times-in-ms", "milliseconds",
+    [("nav.csv", scale_column("t_s", 1e3))],
+)  # fmt: skip
+case(
+    "geocode", "units", "nav-upside-down", "navigation's attitude",
+    [("nav.csv", lambda p: _add_to_column(p, "roll_deg", 180.0))],
+)  # fmt: skip
+case(
+    "calibrate-frame", "mismatch", "board-aruco-grid-same-dictionary", "board type other",
+    [("board.toml", text(
+        "[board]\ntype = 'aruco_grid'\ndictionary = 'DICT_6X6_250'\nmarkers_x = 5\n"
+        "markers_y = 7\nmarker_mm = 20.0\nseparation_mm = 5.0\n"))],
+)  # fmt: skip
+case(
+    "geocode", "empty", "lines-zero-lines", "length 0",
+    [("lines.nc", nc_edit(lambda ds: ds.isel(line=slice(0, 0))))],
+)  # fmt: skip
+
+
+def _add_to_column(p: Path, column: str, value: float):
+    h, rows = read_csv(p)
+    j = h.index(column)
+    for r in rows:
+        r[j] = repr(float(r[j]) + value)
+    write_csv(p, h, rows)
+
 
 def _bal_points_behind(p: Path):
     """Every point mirrored through its cameras (all of them behind every camera)."""
@@ -2039,13 +2070,29 @@ def test_interrupt_and_os_errors_are_recognised():
     assert error_line(ValueError("a bug")) is None
 
 
+def chain_edits(*fs):
+    def edit(p: Path):
+        for f in fs:
+            f(p)
+
+    return edit
+
+
 @pytest.mark.parametrize(
     "cmd,file,edit,must,must_not",
     [
         ("adjust-pushbroom", "nav.csv", drop_column("N_m"), "N_m", "rename"),
         ("geocode", "nav.csv", drop_column("U_m"), "U_m", "rename"),
+        # image coordinates in mm: the fit is poor, and the message says which units to check
+        (
+            "adjust-pushbroom",
+            "obs.csv",
+            chain_edits(scale_column("x_px", 0.0065), scale_column("y_px", 0.0065)),
+            "x_px, y_px not in pixels",
+            "GCP",
+        ),
     ],
-    ids=["pushbroom-nav-no-N_m", "geocode-nav-no-U_m"],
+    ids=["pushbroom-nav-no-N_m", "geocode-nav-no-U_m", "pushbroom-obs-in-mm"],
 )
 def test_names_the_right_cause(cmd, file, edit, must, must_not, inputs: Inputs, capsys):
     """A missing column is not 'renamed' from another required column that is present."""
@@ -2054,3 +2101,14 @@ def test_names_the_right_cause(cmd, file, edit, must, must_not, inputs: Inputs, 
     inputs.before = _sha(d)
     rc, _, err = run_cli(base_argv(cmd, d), capsys)
     assert rc == 2 and must in err and must_not not in err, err
+
+
+@pytest.mark.parametrize("cmd", ["data"])
+def test_data_twice_outside_the_repository(cmd, inputs: Inputs, capsys):
+    """A second `hsgeo data` outside the repository names the folder the user never gave as
+    the default one, not as an option they did not type."""
+    rc, _, err = run_cli(["data"], capsys)
+    assert rc == 0, err
+    rc, _, err = run_cli(["data"], capsys)
+    assert rc == 2 and "where hsgeo data writes without --out" in err, err
+    assert "--out " + str(Path.cwd()) not in err

@@ -183,8 +183,17 @@ def check_navigation_covers(
     if lo < tn[0] or hi > tn[-1]:
         raise InputError(
             f"navigation file {nav} covers t_s {tn[0]:.6g} to {tn[-1]:.6g} s but "
-            f"{used} run from {lo:.6g} to {hi:.6g} s; give the navigation of the whole "
-            "acquisition, on the same time scale"
+            f"{used} run from {lo:.6g} to {hi:.6g} s; "
+            + _time_scale_hint(tn, t)
+            + "give the navigation of the whole acquisition, on the same time scale"
+        )
+    step = float(np.median(np.diff(tn))) if tn.size > 1 else 0.0
+    if step > max_gap_s:  # most intervals "gaps": a unit or a logging rate, not a gap
+        raise InputError(
+            f"navigation file {nav}: its records are {step:.6g} s apart (the median), "
+            f"farther than {gap_option} {max_gap_s:g} everywhere; the likely causes: t_s in "
+            f"another unit than seconds (milliseconds: records {step / 1000:.6g} s apart?), "
+            f"or a navigation logged this sparsely (then allow it with {gap_option})"
         )
     # a gap matters where the navigation is interpolated across it: a time strictly between
     # two records farther apart than max_gap_s (times on a record use it as it is)
@@ -202,6 +211,15 @@ def check_navigation_covers(
             f"interpolated across for {used}, longer than {gap_option} {max_gap_s:g}; fill the "
             f"gap, or allow it with {gap_option}"
         )
+
+
+def _time_scale_hint(tn: np.ndarray, t: np.ndarray) -> str:
+    """A hint when the two time spans differ by a factor of about 1000 (ms against s)."""
+    a = float(np.ptp(tn)) if tn.size else 0.0
+    b = float(np.ptp(t)) if t.size else 0.0
+    if a > 0 and b > 0 and 300.0 < max(a / b, b / a) < 3000.0:
+        return "one of them in milliseconds? (the spans differ by a factor of about 1000); "
+    return ""
 
 
 def option_number(

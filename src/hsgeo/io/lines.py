@@ -59,6 +59,12 @@ def open_netcdf(path, variable: str, what: str, remedy: str):
             f"{role} {str(path)!r} is NetCDF-4 (HDF5): reading it needs the h5py package (pip "
             "install h5py), or save the file as NetCDF 3 classic"
         ) from None
+    except TypeError:  # scipy's reader on a dimension of length 0 (read as 'unlimited')
+        raise InputError(
+            f"{role} {str(path)!r}: not a readable NetCDF file; the likely causes: a dimension "
+            "of length 0 (no lines or no pixels recorded), a file cut short, or a file written "
+            "by a program that does not follow NetCDF 3; give a file with data"
+        ) from None
     except Exception as exc:  # noqa: BLE001 - any reader error becomes an InputError
         msg = " ".join(str(exc).split())[:200]
         raise InputError(

@@ -191,8 +191,17 @@ def _check_view_angles(scanner, pixels, pixel_kw, t0_s, nav, sensor):
             ang = np.degrees(np.arccos(np.clip(-d[:, 2], -1.0, 1.0)))
         except HsgeoError:
             ang = np.array([np.nan])
+    p = np.asarray(pixels)[..., 0] if np.ndim(pixels) == 2 else np.asarray(pixels)
+    if np.all(np.isfinite(ang)) and np.all(ang > 90.0):  # every ray looks up: the attitude
+        roll, pitch = np.degrees(nav.pose(np.array([t0_s]))[1][0, :2])
+        raise InputError(
+            f"the rays of the first line look up ({np.min(ang):.3g}…{np.max(ang):.3g}° off the "
+            f"nadir; roll {roll:.4g}°, pitch {pitch:.4g}° in the navigation); the likely "
+            "causes: the navigation's attitude in another convention (the body upside down, z "
+            f"up instead of down), the boresight of {str(sensor)!r}, or angles in radians "
+            "where degrees are expected"
+        )
     if not (np.all(np.isfinite(ang)) and np.all(ang < 80.0)):
-        p = np.asarray(pixels)[..., 0] if np.ndim(pixels) == 2 else np.asarray(pixels)
         raise InputError(
             f"sensor file {str(sensor)!r}: the pixels {p.min():g}…{p.max():g} px of the LINES "
             f"file look {np.nanmin(ang):.3g}…{np.nanmax(ang):.3g}° off the nadir (over 80°, or "

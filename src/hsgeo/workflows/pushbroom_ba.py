@@ -542,15 +542,16 @@ def fit_verdict(res, n_observations_2d: int) -> dict:
         reasons.append("σ0 is not finite: the observations do not determine the unknowns")
     elif s0 > POOR_FIT_SIGMA0_FACTOR or s0 < 1 / POOR_FIT_SIGMA0_FACTOR:
         reasons.append(
-            f"σ0 = {s0:.3g}: the model does not fit the data by a factor of {max(s0, 1 / s0):.3g}"
-            " — are the navigation angles in degrees (roll_deg, pitch_deg, heading_deg), the"
-            " camera's c_mm and pixel_mm right, and the a-priori σ of the camera file realistic?"
+            f"σ0 = {s0:.3g}: the model does not fit the data by a factor of {max(s0, 1 / s0):.3g};"
+            " the likely causes: a unit — image coordinates x_px, y_px not in pixels (in mm?),"
+            " navigation angles not in degrees, the camera's c_mm, pixel_mm or lever_arm_m in"
+            " another unit — or an a-priori σ of the camera file that is not realistic"
         )
     if share > POOR_FIT_REJECTED_SHARE:
         reasons.append(
             f"{100 * share:.1f} % of the observations were rejected as outliers (more than "
-            f"{100 * POOR_FIT_REJECTED_SHARE:.0f} %): look for a GCP or a point_id that is wrong"
-            " in the input tables"
+            f"{100 * POOR_FIT_REJECTED_SHARE:.0f} %); the likely causes: a wrong GCP or point_id in"
+            " the input tables, or observations in another unit than pixels"
         )
     return {
         "sigma0": s0,
