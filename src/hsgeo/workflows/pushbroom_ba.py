@@ -544,7 +544,8 @@ def fit_verdict(res, n_observations_2d: int) -> dict:
         reasons.append(
             f"σ0 = {s0:.3g}: the model does not fit the data by a factor of {max(s0, 1 / s0):.3g};"
             " the likely causes: a unit — image coordinates x_px, y_px not in pixels (in mm?),"
-            " navigation angles not in degrees, the camera's c_mm, pixel_mm or lever_arm_m in"
+            " navigation angles not in degrees (roll_deg, pitch_deg, heading_deg), the camera's"
+            " c_mm, pixel_mm or lever_arm_m in"
             " another unit — or an a-priori σ of the camera file that is not realistic"
         )
     if share > POOR_FIT_REJECTED_SHARE:
