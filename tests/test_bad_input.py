@@ -1887,8 +1887,16 @@ def _run_sub(argv, env_extra=None, **kwargs):
         ("mtf", {"PYTHONIOENCODING": "ascii"}),
         ("adjust-pushbroom", {"PYTHONIOENCODING": "ascii"}),
         ("geocode", {"PYTHONIOENCODING": "ascii", "LANG": "C", "LC_ALL": "C"}),
+        ("reproduce", {"PYTHONIOENCODING": "ascii"}),
     ],
-    ids=["calibrate-line-ascii", "calibrate-line-latin1", "mtf-ascii", "pushbroom-ascii", "C"],
+    ids=[
+        "calibrate-line-ascii",
+        "calibrate-line-latin1",
+        "mtf-ascii",
+        "pushbroom-ascii",
+        "C",
+        "reproduce-ascii",
+    ],
 )
 def test_reports_print_in_any_locale(cmd, env, inputs: Inputs):
     """The text report and the error line survive a terminal that cannot show Σ, σ, …, →:
@@ -1915,10 +1923,10 @@ def test_ascii_spellings_of_the_report():
 
     setup_streams()
     buf = _io.TextIOWrapper(_io.BytesIO(), encoding="ascii", errors="hsgeo-ascii")
-    buf.write("cost ½Σr² 2.5 → 1.7 px², σ0 1.03, λ 1e-5, 3 µm, é, ☃")
+    buf.write("cost ½Σr² 2.5 → 1.7 px², σ0 1.03, σ̂ 0.1, λ 1e-5, 3 µm, mm⁻⁴, é, ☃")
     buf.flush()
     assert buf.buffer.getvalue().decode() == (
-        "cost 1/2Sumr^2 2.5 -> 1.7 px^2, sigma0 1.03, lambda 1e-5, 3 um, e, ?"
+        "cost 1/2Sumr^2 2.5 -> 1.7 px^2, sigma0 1.03, sigma_hat 0.1, lambda 1e-5, 3 um, mm^-4, e, ?"
     )
 
 

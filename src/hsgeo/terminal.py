@@ -98,9 +98,12 @@ def _ascii_fallback(exc: UnicodeError):
     if not isinstance(exc, UnicodeEncodeError):
         raise exc
     out = []
-    for ch in exc.object[exc.start : exc.end]:
+    run = exc.object[exc.start : exc.end].replace("σ\u0302", "sigma_hat")  # σ̂: one symbol
+    for ch in run:
         s = ASCII_SPELLINGS.get(ch)
-        if s is None:  # an accented letter loses its accent; anything else becomes '?'
+        if s is None and unicodedata.combining(ch):
+            s = ""  # a combining accent: the letter before it stands alone
+        elif s is None:  # an accented letter loses its accent; anything else becomes '?'
             s = unicodedata.normalize("NFKD", ch).encode("ascii", "ignore").decode() or "?"
         out.append(s)
     return "".join(out), exc.end
