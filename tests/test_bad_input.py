@@ -2125,3 +2125,15 @@ def test_data_twice_outside_the_repository(cmd, inputs: Inputs, capsys):
     rc, _, err = run_cli(["data"], capsys)
     assert rc == 2 and "where hsgeo data writes without --out" in err, err
     assert "--out " + str(Path.cwd()) not in err
+
+
+@pytest.mark.parametrize("cmd", ["geocode"])
+def test_toml_from_a_pipe(cmd, inputs: Inputs):
+    """A TOML read twice (its kind, then its content) from a pipe: `--sensor /dev/stdin`."""
+    d = inputs.dir
+    argv = [x if not x.endswith("sensor.toml") else "/dev/stdin" for x in base_argv(cmd, d)]
+    inputs.before = _sha(d)
+    with open(d / "sensor.toml", "rb") as fh:
+        p = _run_sub(argv, stdin=fh)
+    assert p.returncode == 0, p.stderr
+    assert (d.parent / "out" / "ortho.nc").is_file()

@@ -109,6 +109,24 @@ def check_input_file(path, what: str) -> Path:
     return path
 
 
+#: The bytes of the pipes read so far (``/dev/stdin``, ``<(...)``), by device and inode: a pipe
+#: can be read once, and a reader that looks at a file twice (its kind, then its content) gets
+#: the same bytes the second time.
+_PIPES: dict[tuple[int, int], bytes] = {}
+
+
+def _read_bytes(path: Path) -> bytes:
+    import stat
+
+    st = path.stat()
+    if stat.S_ISREG(st.st_mode):
+        return path.read_bytes()
+    key = (st.st_dev, st.st_ino)
+    if key not in _PIPES:
+        _PIPES[key] = path.read_bytes()
+    return _PIPES[key]
+
+
 def read_text(path, what: str, kind: str) -> str:
     """The text of a UTF-8 input file (a leading byte-order mark dropped, CRLF kept).
 
@@ -117,7 +135,7 @@ def read_text(path, what: str, kind: str) -> str:
     """
     path = check_input_file(path, what)
     try:
-        data = path.read_bytes()
+        data = _read_bytes(path)
     except OSError as exc:
         raise InputError(os_error_message(exc, what)) from None
     try:

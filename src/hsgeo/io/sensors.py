@@ -197,14 +197,14 @@ def read_scanning_sensor(path):
     hsgeo.sensors.line.LineScanner or hsgeo.sensors.pushbroom.PushbroomCamera
     """
     import tomllib
-    from pathlib import Path
 
+    from hsgeo.io._files import read_text
     from hsgeo.sensors.line import LineScanner
     from hsgeo.sensors.mount import Mount
 
     try:
-        tables = set(tomllib.loads(Path(path).read_text(encoding="utf-8")))
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        tables = set(tomllib.loads(read_text(path, "sensor file", "TOML")))
+    except (InputError, tomllib.TOMLDecodeError):
         tables = {"sensor"}  # read_sensor_toml gives the one clear error
     if "camera" in tables and "sensor" not in tables:
         return read_pushbroom_camera(path)
