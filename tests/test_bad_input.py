@@ -1980,6 +1980,50 @@ def test_ctrl_c_inside_a_compiled_kernel(cmd, inputs: Inputs):
     assert sorted(inputs.dir.rglob("*")) == before
 
 
+#: The child of the Ctrl-C-while-writing test: SIGINT ``delay`` seconds after the ``n``-th
+#: temporary file is made (the first is check_outputs' probe, the second atomic_path's .part).
+_SIGINT_WRITING_CHILD = """
+import os, signal, sys, tempfile, threading
+from hsgeo import cli
+n, delay = int(sys.argv[1]), float(sys.argv[2])
+mkstemp, calls = tempfile.mkstemp, []
+def mk(*a, **k):
+    r = mkstemp(*a, **k)
+    calls.append(1)
+    if len(calls) == n:
+        threading.Timer(delay, os.kill, (os.getpid(), signal.SIGINT)).start()
+    return r
+tempfile.mkstemp = mk
+sys.exit(cli.main(sys.argv[3:]))
+"""
+
+
+@pytest.mark.parametrize("cmd", ["cube"])
+def test_ctrl_c_while_writing_leaves_nothing(cmd, inputs: Inputs):
+    """SIGINT while the cube is written chunk by chunk: one line, 130, and no output and no
+    temporary file left (atomic_path removes its .part; SIGINT is held back between making
+    the temporary file and owning it)."""
+    import subprocess
+    import sys
+
+    d = inputs.dir
+    inputs.before = _sha(d)
+    argv = base_argv(cmd, d)
+    out = d.parent / "out"
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src"), "OPENBLAS_NUM_THREADS": "1"}
+    for n, delay_s in ((2, 0.0), (2, 0.01), (2, 0.1), (1, 0.0)):
+        p = subprocess.run(
+            [sys.executable, "-c", _SIGINT_WRITING_CHILD, str(n), str(delay_s), *argv],
+            capture_output=True,
+            env=env,
+            timeout=300,
+        )
+        err = p.stderr.decode()
+        assert p.returncode == 130, (n, delay_s, err[-2000:])
+        assert err.splitlines() == [f"hsgeo {cmd}: interrupted"], err[-2000:]
+        assert sorted(x.name for x in out.iterdir()) == [], (n, delay_s)
+
+
 @pytest.mark.parametrize("cmd", ["calibrate-line"])
 def test_input_from_a_pipe(cmd, inputs: Inputs):
     """`cat obs.csv | hsgeo calibrate-line /dev/stdin ...` and a process substitution

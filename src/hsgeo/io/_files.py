@@ -216,12 +216,13 @@ def _check_output(p: Path, option: str, formats, inputs, seen: dict, overwrite: 
         )
     if p.exists() and not overwrite:
         raise InputError(f"{option} {p}: the file exists; use --overwrite to replace it")
-    try:  # the temporary file of atomic_path: can it be made there?
-        fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".part", dir=folder)
-    except OSError as exc:
-        raise InputError(_creation_message(exc, option, p)) from None
-    os.close(fd)
-    os.unlink(tmp)
+    with _no_interrupt():  # the temporary file of atomic_path: can it be made there?
+        try:
+            fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".part", dir=folder)
+        except OSError as exc:
+            raise InputError(_creation_message(exc, option, p)) from None
+        os.close(fd)
+        os.unlink(tmp)
 
 
 def _first(formats) -> str:
@@ -277,21 +278,44 @@ def atomic_path(path, inputs: Iterable = ()) -> Iterator[Path]:
     path = refuse_inputs(path, inputs)
     if not path.parent.is_dir():
         raise InputError(f"{path}: the folder {path.parent} does not exist; create it first")
+    tmp = None
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
-    except OSError as exc:
-        raise InputError(_creation_message(exc, "output", path)) from None
-    os.close(fd)
-    tmp = Path(tmp)
-    # mkstemp makes the file 0600; the output gets the mode of any new file (0666 & ~umask)
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(tmp, 0o666 & ~umask)
-    try:
+        with _no_interrupt():  # Ctrl-C cannot fall between making the file and owning it
+            try:
+                fd, name = tempfile.mkstemp(
+                    prefix=f".{path.name}.", suffix=".part", dir=path.parent
+                )
+            except OSError as exc:
+                raise InputError(_creation_message(exc, "output", path)) from None
+            tmp = Path(name)
+            os.close(fd)
+        # mkstemp makes the file 0600; the output gets the mode of any new file (0666 & ~umask)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)
         yield tmp
         os.replace(tmp, path)
     finally:
-        tmp.unlink(missing_ok=True)
+        if tmp is not None:
+            tmp.unlink(missing_ok=True)
+
+
+@contextlib.contextmanager
+def _no_interrupt():
+    """SIGINT held back for the block (main thread, POSIX), delivered right after it."""
+    import signal
+    import threading
+
+    hold = (
+        hasattr(signal, "pthread_sigmask") and threading.current_thread() is threading.main_thread()
+    )
+    if hold:
+        old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        if hold:
+            signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
 def write_text(path, text: str, *, atomic: bool = False, make_parents: bool = False) -> Path:
