@@ -153,7 +153,7 @@ def _cmd_geocode(args) -> int:
         height_m=args.height,
         resolution_m=args.resolution,
         envi=args.envi,
-        progress=not args.quiet,
+        progress=not args.quiet and sys.stderr.isatty(),  # progress on a terminal only
         overwrite=args.overwrite,
         max_grid_gib=args.max_grid_gib,
         max_nav_gap_s=args.max_nav_gap_s,
