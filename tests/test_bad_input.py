@@ -1980,20 +1980,36 @@ def test_ctrl_c_inside_a_compiled_kernel(cmd, inputs: Inputs):
     assert sorted(inputs.dir.rglob("*")) == before
 
 
-#: The child of the Ctrl-C-while-writing test: SIGINT ``delay`` seconds after the ``n``-th
-#: temporary file is made (the first is check_outputs' probe, the second atomic_path's .part).
+#: The child of the Ctrl-C-while-writing test: SIGINT at a set point of the writing, not after a
+#: time (a time depends on how busy the machine is): right after atomic_path made its .part
+#: ("part"), or at the k-th task the NetCDF writer completes ("task", k).
 _SIGINT_WRITING_CHILD = """
-import os, signal, sys, tempfile, threading
+import os, signal, sys, tempfile
 from hsgeo import cli
-n, delay = int(sys.argv[1]), float(sys.argv[2])
-mkstemp, calls = tempfile.mkstemp, []
-def mk(*a, **k):
-    r = mkstemp(*a, **k)
-    calls.append(1)
-    if len(calls) == n:
-        threading.Timer(delay, os.kill, (os.getpid(), signal.SIGINT)).start()
-    return r
-tempfile.mkstemp = mk
+import hsgeo.io.cube as cube
+where, k = sys.argv[1], int(sys.argv[2])
+def interrupt():
+    os.kill(os.getpid(), signal.SIGINT)
+if where == "part":
+    mkstemp = tempfile.mkstemp
+    def mk(*a, **kw):
+        r = mkstemp(*a, **kw)
+        if kw.get("suffix") == ".part" and mk.calls == k:
+            interrupt()
+        mk.calls += 1
+        return r
+    mk.calls = 0
+    tempfile.mkstemp = mk
+else:
+    write = cube._compute_with_progress
+    def compute(delayed, progress, n_lines):
+        calls = []
+        def tick(done, total):
+            calls.append(done)
+            if len(calls) == k:
+                interrupt()
+        return write(delayed, tick, n_lines)
+    cube._compute_with_progress = compute
 sys.exit(cli.main(sys.argv[3:]))
 """
 
@@ -2008,20 +2024,21 @@ def test_ctrl_c_while_writing_leaves_nothing(cmd, inputs: Inputs):
 
     d = inputs.dir
     inputs.before = _sha(d)
-    argv = base_argv(cmd, d)
+    argv = base_argv(cmd, d) + ["--lines-per-chunk", "2"]
     out = d.parent / "out"
     env = {**os.environ, "PYTHONPATH": str(ROOT / "src"), "OPENBLAS_NUM_THREADS": "1"}
-    for n, delay_s in ((2, 0.0), (2, 0.01), (2, 0.1), (1, 0.0)):
+    # check_outputs' probe is .part number 0, atomic_path's number 1
+    for where, k in (("part", 0), ("part", 1), ("task", 1), ("task", 5)):
         p = subprocess.run(
-            [sys.executable, "-c", _SIGINT_WRITING_CHILD, str(n), str(delay_s), *argv],
+            [sys.executable, "-c", _SIGINT_WRITING_CHILD, where, str(k), *argv],
             capture_output=True,
             env=env,
             timeout=300,
         )
         err = p.stderr.decode()
-        assert p.returncode == 130, (n, delay_s, err[-2000:])
+        assert p.returncode == 130, (where, k, err[-2000:])
         assert err.splitlines() == [f"hsgeo {cmd}: interrupted"], err[-2000:]
-        assert sorted(x.name for x in out.iterdir()) == [], (n, delay_s)
+        assert sorted(x.name for x in out.iterdir()) == [], (where, k)
 
 
 @pytest.mark.parametrize("cmd", ["calibrate-line"])
