@@ -2205,8 +2205,9 @@ def test_data_twice_outside_the_repository(cmd, inputs: Inputs, capsys):
 
 
 @pytest.mark.parametrize("cmd", ["geocode"])
-def test_toml_from_a_pipe(cmd, inputs: Inputs):
-    """A TOML read twice (its kind, then its content) from a pipe: `--sensor /dev/stdin`."""
+def test_toml_and_netcdf_from_a_pipe(cmd, inputs: Inputs):
+    """A TOML read twice (its kind, then its content) from a pipe: `--sensor /dev/stdin`; a
+    NetCDF LINES file from a pipe."""
     d = inputs.dir
     argv = [x if not x.endswith("sensor.toml") else "/dev/stdin" for x in base_argv(cmd, d)]
     inputs.before = _sha(d)
@@ -2214,3 +2215,8 @@ def test_toml_from_a_pipe(cmd, inputs: Inputs):
         p = _run_sub(argv, stdin=fh)
     assert p.returncode == 0, p.stderr
     assert (d.parent / "out" / "ortho.nc").is_file()
+    # a NetCDF from a pipe (the LINES file): read once, opened from memory
+    argv = [x if not x.endswith("lines.nc") else "/dev/stdin" for x in base_argv(cmd, d)]
+    with open(d / "lines.nc", "rb") as fh:
+        p = _run_sub([*argv, "--overwrite"], stdin=fh)
+    assert p.returncode == 0, p.stderr
