@@ -18,6 +18,7 @@ from __future__ import annotations
 import csv
 import hashlib
 import io
+import json
 import os
 import shutil
 from collections import Counter
@@ -1487,6 +1488,152 @@ def _readonly_dir(d):
     return d / "ro"
 
 
+# --- issue 24: what the operating system refuses, sizes, silent wrong answers -----------------
+# (a case per kind; the same checks serve every command through hsgeo.io / hsgeo.validate)
+LONG = "a" * 300
+
+
+def column_twice(column: str):
+    """The header names ``column`` twice (the second copy holding other numbers)."""
+
+    def edit(p: Path):
+        h, rows = read_csv(p)
+        j = h.index(column)
+        write_csv(p, [*h, column], [[*r, r[j] + "1"] for r in rows])
+
+    return edit
+
+
+def _dem_e_repeats(ds):
+    E = ds["E"].values.copy()
+    E[5] = E[4]
+    return ds.assign_coords(E=E)
+
+
+def _out(name):
+    """-o NAME, NAME under the output folder (or an absolute path as it is)."""
+    return lambda a, d: opt("-o", name if name.startswith("/") else f"{d.parent / 'out'}/{name}")(
+        a, d
+    )
+
+
+# OS refusals: a name too long (input and output), no file can be created there (/proc, /sys
+# as root), a folder where a file is meant, a DEM the interpolator refuses
+case(
+    "calibrate-line", "os", "input-name-too-long", "too long",
+    argv=replace_arg("obs.csv", lambda d: d / (LONG + ".csv")),
+)  # fmt: skip
+case("geocode", "os", "output-name-too-long", "too long", argv=_out(LONG + ".nc"))
+case("cube", "os", "output-name-too-long", "too long", argv=_out(LONG + ".nc"))
+case("geocode", "os", "output-in-proc", "no file can be created", argv=_out("/proc/o.nc"))
+case("geocode", "os", "output-in-sys", "no file can be created", argv=_out("/sys/o.nc"))
+case("cube", "os", "output-in-proc", "no file can be created", argv=_out("/proc/c.nc"))
+case("geocode", "os", "output-names-a-folder", "names a folder", argv=_out("newdir/"))
+case("geocode", "os", "output-existing-folder/", "names a folder", argv=_out("./"))
+case(
+    "geocode", "degenerate", "dem-E-repeats", "strictly increasing",
+    [("dem.nc", nc_edit(_dem_e_repeats))], argv=_dem,
+)  # fmt: skip
+# output formats by extension: refuse what is not written
+case("geocode", "output", "output-tif", "name the file o.nc", argv=_out("o.tif"))
+case("geocode", "output", "output-no-extension", "name the file o.nc", argv=_out("o"))
+# sizes a file declares, checked against the file; requests that cannot fit in memory
+case(
+    "adjust-bal", "size", "header-1e9-cameras", "header on line 1 declares",
+    files=[(F, bal_line(1, "1000000000 5 40"))],
+)  # fmt: skip
+case(
+    "adjust-bal", "size", "header-1e9-observations", "observation lines",
+    files=[(F, bal_line(1, "2 5 1000000000"))],
+)  # fmt: skip
+case(
+    "adjust-pushbroom", "size", "node-interval-1ms", "GiB of memory",
+    argv=opt("--node-interval", "0.001"),
+)  # fmt: skip
+# silent wrong answers: a column named twice in every CSV, impossible sensor values, 1e300
+for cmd, file, column in [
+    ("calibrate-line", "obs.csv", "zeta_px"),
+    ("calibrate-line", "control.csv", "x_m"),
+    ("adjust-pushbroom", "obs.csv", "x_px"),
+    ("adjust-pushbroom", "nav.csv", "roll_deg"),
+    ("adjust-pushbroom", "gcp.csv", "H_m"),
+    ("geocode", "nav.csv", "E_m"),
+    ("mtf", "profiles.csv", "intensity_dn"),
+]:
+    case(cmd, "duplicates", f"{file}-column-{column}-twice", f"{column} 2 times",
+         [(file, column_twice(column))])  # fmt: skip
+for key, value in [
+    ("zeta0_px", "900.0"),  # off the LINES file's pixels (200 ... 796), views still < 80 deg
+    ("zeta0_px", "-50.0"),
+]:
+    case("geocode", "units", f"sensor-{key}={value}-off-the-line", "principal point",
+         [("sensor.toml", toml_set("sensor", key, value))])  # fmt: skip
+for key, value in [
+    ("lever_arm_m", "[100.0, 0.0, -200.0]"),  # in mm
+    ("c_mm", "40000.0"),  # in um
+    ("x0_mm", "500.0"),
+    ("sigma_lever_m", "20.0"),
+]:
+    case("adjust-pushbroom", "units", f"cam-{key}={value}", f"{key}",
+         [("cam.toml", toml_set("camera", key, value))])  # fmt: skip
+case(
+    "adjust-bal", "range", "observation-1e300", "beyond",
+    files=[(F, bal_line(5, "0 0 1e300 2.0"))],
+)  # fmt: skip
+# messages that named the wrong cause
+case(
+    "adjust-bal", "degenerate", "all-points-behind", "behind",
+    files=[(F, lambda p: _bal_points_behind(p))],
+)  # fmt: skip
+
+case(
+    "adjust-pushbroom", "units", "nav-and-obs-times-in-ms", "milliseconds",
+    [("nav.csv", scale_column("t_s", 1e3)), ("obs.csv", scale_column("t_s", 1e3))],
+)  # fmt: skip
+case(
+    "adjust-pushbroom", "units", "nav-times-in-ms", "milliseconds",
+    [("nav.csv", scale_column("t_s", 1e3))],
+)  # fmt: skip
+case(
+    "geocode", "units", "nav-upside-down", "navigation's attitude",
+    [("nav.csv", lambda p: _add_to_column(p, "roll_deg", 180.0))],
+)  # fmt: skip
+case(
+    "calibrate-frame", "mismatch", "board-aruco-grid-same-dictionary", "board type other",
+    [("board.toml", text(
+        "[board]\ntype = 'aruco_grid'\ndictionary = 'DICT_6X6_250'\nmarkers_x = 5\n"
+        "markers_y = 7\nmarker_mm = 20.0\nseparation_mm = 5.0\n"))],
+)  # fmt: skip
+case(
+    "geocode", "empty", "lines-zero-lines", "length 0",
+    [("lines.nc", nc_edit(lambda ds: ds.isel(line=slice(0, 0))))],
+)  # fmt: skip
+
+
+def _add_to_column(p: Path, column: str, value: float):
+    h, rows = read_csv(p)
+    j = h.index(column)
+    for r in rows:
+        r[j] = repr(float(r[j]) + value)
+    write_csv(p, h, rows)
+
+
+def _bal_points_behind(p: Path):
+    """Every point mirrored through its cameras (all of them behind every camera)."""
+    from hsgeo.io.bal import read_bal
+
+    prob = read_bal(p)
+    lines = p.read_text().splitlines()
+    n = 1 + prob.n_observations + 9 * prob.n_cameras
+    C = prob.cameras
+    from hsgeo.rotations import R_from_rotvec
+
+    R = R_from_rotvec(C[:, :3])
+    centre = -np.einsum("nji,nj->ni", R, C[:, 3:6]).mean(axis=0)
+    pts = 2 * centre - prob.points
+    p.write_text("\n".join(lines[:n] + [repr(float(v)) for v in pts.ravel()]) + "\n")
+
+
 # ---------------------------------------------------------------------------------------------
 # running
 
@@ -1550,6 +1697,17 @@ def run_cli(argv, capsys) -> tuple[int, str, str]:
     return rc, cap.out, cap.err
 
 
+def _outputs(argv) -> list[str]:
+    """The files a command line asks to write (-o, --output, --envi and its .hdr)."""
+    out = []
+    for i, a in enumerate(argv[:-1]):
+        if a in ("-o", "--output", "--envi"):
+            out.append(str(argv[i + 1]))
+            if a == "--envi":
+                out.append(str(argv[i + 1]) + ".hdr")
+    return out
+
+
 @pytest.mark.parametrize("case", CASES, ids=[c.id for c in CASES])
 def test_bad_input(case: Case, inputs: Inputs, capsys):
     if "readonly" in case.name and os.geteuid() == 0:
@@ -1561,8 +1719,11 @@ def test_bad_input(case: Case, inputs: Inputs, capsys):
     if case.argv is not None:
         argv = case.argv(argv, d)
     inputs.before = _sha(d)
+    fresh = [a for a in _outputs(argv) if not os.path.lexists(a)]
     rc, out, err = run_cli(argv, capsys)
     lines = err.splitlines()
+    left = [a for a in fresh if os.path.lexists(a)]
+    assert not left, f"output left behind by a failing command: {left}"
     assert rc == 2, f"exit {rc}; stderr: {err[-2000:]}"
     assert len(lines) == 1, f"{len(lines)} lines on stderr:\n{err[-3000:]}"
     assert "Traceback" not in err
@@ -1783,3 +1944,363 @@ def test_end_to_end_in_a_subprocess(cmd, edit, expect, inputs: Inputs):
     assert p.returncode == 2
     assert p.stdout == ""
     assert len(p.stderr.splitlines()) == 1 and expect in p.stderr, p.stderr
+
+
+# --- issue 24: locales, Ctrl-C, pipes, progress, the same words in and out of the repository --
+
+
+def _run_sub(argv, env_extra=None, **kwargs):
+    import subprocess
+    import sys
+
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src"), "OPENBLAS_NUM_THREADS": "1"}
+    env.update(env_extra or {})
+    return subprocess.run(
+        [sys.executable, "-m", "hsgeo.cli", *map(str, argv)],
+        capture_output=True,
+        env=env,
+        **kwargs,
+    )
+
+
+@pytest.mark.parametrize(
+    "cmd,env",
+    [
+        ("calibrate-line", {"PYTHONIOENCODING": "ascii"}),
+        ("calibrate-line", {"PYTHONIOENCODING": "latin-1"}),
+        ("mtf", {"PYTHONIOENCODING": "ascii"}),
+        ("adjust-pushbroom", {"PYTHONIOENCODING": "ascii"}),
+        ("geocode", {"PYTHONIOENCODING": "ascii", "LANG": "C", "LC_ALL": "C"}),
+        ("reproduce", {"PYTHONIOENCODING": "ascii"}),
+    ],
+    ids=[
+        "calibrate-line-ascii",
+        "calibrate-line-latin1",
+        "mtf-ascii",
+        "pushbroom-ascii",
+        "C",
+        "reproduce-ascii",
+    ],
+)
+def test_reports_print_in_any_locale(cmd, env, inputs: Inputs):
+    """The text report and the error line survive a terminal that cannot show Σ, σ, …, →:
+    the characters are spelled in ASCII instead of ending in UnicodeEncodeError."""
+    d = inputs.dir
+    argv = base_argv(cmd, d)
+    if cmd == "adjust-pushbroom":
+        argv += ["--accept-poor-fit"]
+    inputs.before = _sha(d)
+    p = _run_sub(argv, env)
+    assert p.returncode == 0, p.stderr.decode("ascii", "replace")[-2000:]
+    assert b"UnicodeEncodeError" not in p.stderr
+    p.stdout.decode("ascii" if env["PYTHONIOENCODING"] == "ascii" else "latin-1")  # encodable
+    if cmd == "geocode":  # an error line with non-ASCII characters ('…' of a pixel range)
+        bad = d / "bad.toml"
+        bad.write_text((d / "sensor.toml").read_text().replace("486.8", "900.0"))
+        e = _run_sub(
+            [x if not x.endswith("sensor.toml") else bad for x in argv] + ["--overwrite"], env
+        )
+        assert e.returncode == 2 and len(e.stderr.splitlines()) == 1, e.stderr
+        assert b"200...796 px" in e.stderr, e.stderr
+
+
+def test_ascii_spellings_of_the_report():
+    """The spelling of the report's symbols where the terminal cannot show them."""
+    import io as _io
+
+    from hsgeo.terminal import setup_streams  # registers the error handler
+
+    setup_streams()
+    buf = _io.TextIOWrapper(_io.BytesIO(), encoding="ascii", errors="hsgeo-ascii")
+    buf.write("cost ½Σr² 2.5 → 1.7 px², σ0 1.03, σ̂ 0.1, λ 1e-5, 3 µm, mm⁻⁴, é, ☃")
+    buf.flush()
+    assert buf.buffer.getvalue().decode() == (
+        "cost 1/2Sumr^2 2.5 -> 1.7 px^2, sigma0 1.03, sigma_hat 0.1, lambda 1e-5, 3 um, mm^-4, e, ?"
+    )
+
+
+#: The child of the Ctrl-C test: ``hsgeo`` as it is, but SIGINT sent to itself ``delay`` seconds
+#: after the solver reports iteration ``k``: the signal lands while the next iteration runs,
+#: mostly inside the numba kernels (where Ctrl-C surfaces as SystemError), at a time that does
+#: not depend on how busy the machine is.
+_SIGINT_CHILD = """
+import os, signal, sys, threading
+from hsgeo import cli, terminal
+k, delay = int(sys.argv[1]), float(sys.argv[2])
+def printer(stream=None):
+    def show(info):
+        if info["iteration"] == k:
+            threading.Timer(delay, os.kill, (os.getpid(), signal.SIGINT)).start()
+    return show
+terminal.progress_printer = printer
+sys.exit(cli.main(sys.argv[3:]))
+"""
+
+
+@pytest.mark.parametrize("cmd", ["adjust-bal"])
+def test_ctrl_c_inside_a_compiled_kernel(cmd, inputs: Inputs):
+    """SIGINT while adjust-bal iterates on BAL Ladybug-49 (numba kernels, where Ctrl-C
+    surfaced as ``SystemError: CPUDispatcher(_reduced_kernel)`` about half the time): one line
+    'interrupted' and exit status 130 on every try, nothing on stdout, nothing written."""
+    import subprocess
+    import sys
+
+    ladybug = ROOT / "src/hsgeo/data/reference/bal-ladybug/problem-49-7776-pre.txt.bz2"
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src"), "OPENBLAS_NUM_THREADS": "1"}
+    before = sorted(inputs.dir.rglob("*"))
+    # on main before issue 24 these four ended in SystemError, status 1 (9 of 10 such tries)
+    for k, delay_s in ((1, 0.04), (2, 0.06), (3, 0.045), (6, 0.035)):
+        p = subprocess.run(
+            [sys.executable, "-c", _SIGINT_CHILD, str(k), str(delay_s), cmd, str(ladybug)],
+            capture_output=True,
+            env=env,
+            cwd=inputs.dir,
+            timeout=300,
+        )
+        err = p.stderr.decode()
+        assert p.returncode == 130, (k, delay_s, err[-2000:])
+        assert err.splitlines() == [f"hsgeo {cmd}: interrupted"], err[-2000:]
+        assert p.stdout == b""
+    assert sorted(inputs.dir.rglob("*")) == before
+
+
+#: The child of the Ctrl-C-while-writing test: SIGINT at a set point of the writing, not after a
+#: time (a time depends on how busy the machine is): right after atomic_path made its .part
+#: ("part"), or at the k-th task the NetCDF writer completes ("task", k).
+_SIGINT_WRITING_CHILD = """
+import os, signal, sys, tempfile
+from hsgeo import cli
+import hsgeo.io.cube as cube
+where, k = sys.argv[1], int(sys.argv[2])
+def interrupt():
+    os.kill(os.getpid(), signal.SIGINT)
+if where == "part":
+    mkstemp = tempfile.mkstemp
+    def mk(*a, **kw):
+        r = mkstemp(*a, **kw)
+        if kw.get("suffix") == ".part" and mk.calls == k:
+            interrupt()
+        mk.calls += 1
+        return r
+    mk.calls = 0
+    tempfile.mkstemp = mk
+else:
+    write = cube._compute_with_progress
+    def compute(delayed, progress, n_lines):
+        calls = []
+        def tick(done, total):
+            calls.append(done)
+            if len(calls) == k:
+                interrupt()
+        return write(delayed, tick, n_lines)
+    cube._compute_with_progress = compute
+sys.exit(cli.main(sys.argv[3:]))
+"""
+
+
+@pytest.mark.parametrize("cmd", ["cube"])
+def test_ctrl_c_while_writing_leaves_nothing(cmd, inputs: Inputs):
+    """SIGINT while the cube is written chunk by chunk: one line, 130, and no output and no
+    temporary file left (atomic_path removes its .part; SIGINT is held back between making
+    the temporary file and owning it)."""
+    import subprocess
+    import sys
+
+    d = inputs.dir
+    inputs.before = _sha(d)
+    argv = base_argv(cmd, d) + ["--lines-per-chunk", "2"]
+    out = d.parent / "out"
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src"), "OPENBLAS_NUM_THREADS": "1"}
+    # check_outputs' probe is .part number 0, atomic_path's number 1
+    for where, k in (("part", 0), ("part", 1), ("task", 1), ("task", 5)):
+        p = subprocess.run(
+            [sys.executable, "-c", _SIGINT_WRITING_CHILD, where, str(k), *argv],
+            capture_output=True,
+            env=env,
+            timeout=300,
+        )
+        err = p.stderr.decode()
+        assert p.returncode == 130, (where, k, err[-2000:])
+        assert err.splitlines() == [f"hsgeo {cmd}: interrupted"], err[-2000:]
+        assert sorted(x.name for x in out.iterdir()) == [], (where, k)
+
+
+@pytest.mark.parametrize("cmd", ["calibrate-line"])
+def test_input_from_a_pipe(cmd, inputs: Inputs):
+    """`cat obs.csv | hsgeo calibrate-line /dev/stdin ...` and a process substitution
+    (`<(cat obs.csv)`: a pipe at /dev/fd/N) read as the file itself."""
+
+    def report(out: bytes) -> list[bytes]:  # without the line that gives the seconds taken
+        return [ln for ln in out.splitlines() if b" s\n" not in ln + b"\n"]
+
+    d = inputs.dir
+    inputs.before = _sha(d)
+    want = _run_sub(base_argv(cmd, d))
+    assert want.returncode == 0, want.stderr
+    argv = base_argv(cmd, d)
+    argv[1] = "/dev/stdin"
+    with open(d / "obs.csv", "rb") as fh:
+        got = _run_sub(argv, stdin=fh)
+    assert got.returncode == 0, got.stderr
+    assert report(got.stdout) == report(want.stdout)
+    r, w = os.pipe()
+    os.write(w, (d / "obs.csv").read_bytes())  # a few kB: fits in the pipe's buffer
+    os.close(w)
+    argv[1] = f"/dev/fd/{r}"
+    try:
+        got = _run_sub(argv, pass_fds=(r,))
+    finally:
+        os.close(r)
+    assert got.returncode == 0, got.stderr
+    assert report(got.stdout) == report(want.stdout)
+
+
+@pytest.mark.parametrize("cmd", ["adjust-bal"])
+def test_bal_blank_lines_are_whitespace(cmd, inputs: Inputs, capsys):
+    """A blank line after the BAL header (or anywhere) changes nothing: the format is
+    whitespace-separated numbers. The same problem is read, and the command ends alike."""
+    from hsgeo.io.bal import read_bal
+
+    d = inputs.dir
+    p = d / "problem.txt"
+    want = read_bal(p)
+    rc, out, err = run_cli(base_argv(cmd, d), capsys)
+    lines = p.read_text().splitlines()
+    p.write_text("\n".join([lines[0], "", *lines[1:5], "   ", *lines[5:]]) + "\n\n")
+    got = read_bal(p)
+    for f in ("cameras", "points", "camera_index", "point_index", "xy_px"):
+        np.testing.assert_array_equal(getattr(got, f), getattr(want, f))
+    inputs.before = _sha(d)
+    rc2, out2, err2 = run_cli(base_argv(cmd, d), capsys)
+    assert rc2 == rc and "line" not in err2, err2
+    assert json.loads(out2 or "{}").get("final_cost") == json.loads(out or "{}").get("final_cost")
+
+
+@pytest.mark.parametrize("cmd", ["adjust-pushbroom"])
+def test_progress_only_on_a_terminal(cmd, inputs: Inputs):
+    """With stderr redirected (not a terminal) no iteration progress: a failing fit's one
+    error line is the only line on stderr; on a terminal the progress line clears itself."""
+    import io as _io
+
+    from hsgeo import terminal
+
+    d = inputs.dir
+    inputs.before = _sha(d)
+    p = _run_sub(base_argv(cmd, d))
+    err = p.stderr.decode()
+    assert "iter" not in err
+    assert len(err.splitlines()) == (1 if p.returncode == 2 else 0), err
+    assert terminal.progress_printer(_io.StringIO()) is None  # not a tty
+
+    class Tty(_io.StringIO):
+        def isatty(self):
+            return True
+
+    tty = Tty()
+    show = terminal.progress_printer(tty)
+    show({"iteration": 1, "cost": 2.0, "lambda": 1e-3, "seconds": 0.1})
+    show({"iteration": 2, "cost": 1.0, "lambda": 1e-4, "seconds": 0.2})
+    terminal.clear_progress(tty)
+    text = tty.getvalue()
+    assert "\n" not in text and text.endswith("\r\033[K") and "iter   2" in text
+
+
+@pytest.mark.parametrize("cmd", ["data"])
+def test_data_verify_out_uses_the_repository_words(cmd, inputs: Inputs, capsys):
+    """`hsgeo data --verify --out DIR` and the check in the repository: the same tolerance
+    and words (files that differ only in the last bits are not 'differ from MANIFEST')."""
+    rc, _, err = run_cli(["data", "--verify", "--out", str(inputs.dir / "gen")], capsys)
+    assert rc == 0, err
+    assert "differ from MANIFEST" not in err
+    assert "files match MANIFEST.sha256" in err.splitlines()[-1]
+
+
+def test_json_is_strict():
+    """NaN and inf are written as null: JSON has no Infinity (a BAL cost of 1e300² was)."""
+    import json
+
+    from hsgeo.terminal import json_text
+
+    d = {"cost": float("inf"), "x": [1.0, float("nan")], "a": np.array([np.inf, 2.0])}
+    assert json.loads(json_text(d)) == {"cost": None, "x": [1.0, None], "a": [None, 2.0]}
+
+
+def test_interrupt_and_os_errors_are_recognised():
+    import errno
+
+    from hsgeo.terminal import error_line, interrupted
+
+    try:
+        try:
+            raise KeyboardInterrupt
+        except KeyboardInterrupt as ki:
+            raise SystemError("CPUDispatcher(_reduced_kernel) returned a result") from ki
+    except SystemError as exc:
+        assert interrupted(exc)
+    assert not interrupted(SystemError("a bug"))
+    e = OSError(errno.ENAMETOOLONG, "File name too long", "x" * 300)
+    assert "too long" in error_line(e) and "300 characters" in error_line(e)
+    assert "memory" in error_line(MemoryError("Unable to allocate 67 GiB"))
+    assert error_line(ValueError("a bug")) is None
+
+
+def chain_edits(*fs):
+    def edit(p: Path):
+        for f in fs:
+            f(p)
+
+    return edit
+
+
+@pytest.mark.parametrize(
+    "cmd,file,edit,must,must_not",
+    [
+        ("adjust-pushbroom", "nav.csv", drop_column("N_m"), "N_m", "rename"),
+        ("geocode", "nav.csv", drop_column("U_m"), "U_m", "rename"),
+        # image coordinates in mm: the fit is poor, and the message says which units to check
+        (
+            "adjust-pushbroom",
+            "obs.csv",
+            chain_edits(scale_column("x_px", 0.0065), scale_column("y_px", 0.0065)),
+            "x_px, y_px not in pixels",
+            "GCP",
+        ),
+    ],
+    ids=["pushbroom-nav-no-N_m", "geocode-nav-no-U_m", "pushbroom-obs-in-mm"],
+)
+def test_names_the_right_cause(cmd, file, edit, must, must_not, inputs: Inputs, capsys):
+    """A missing column is not 'renamed' from another required column that is present."""
+    d = inputs.dir
+    edit(d / file)
+    inputs.before = _sha(d)
+    rc, _, err = run_cli(base_argv(cmd, d), capsys)
+    assert rc == 2 and must in err and must_not not in err, err
+
+
+@pytest.mark.parametrize("cmd", ["data"])
+def test_data_twice_outside_the_repository(cmd, inputs: Inputs, capsys):
+    """A second `hsgeo data` outside the repository names the folder the user never gave as
+    the default one, not as an option they did not type."""
+    rc, _, err = run_cli(["data"], capsys)
+    assert rc == 0, err
+    rc, _, err = run_cli(["data"], capsys)
+    assert rc == 2 and "where hsgeo data writes without --out" in err, err
+    assert "--out " + str(Path.cwd()) not in err
+
+
+@pytest.mark.parametrize("cmd", ["geocode"])
+def test_toml_and_netcdf_from_a_pipe(cmd, inputs: Inputs):
+    """A TOML read twice (its kind, then its content) from a pipe: `--sensor /dev/stdin`; a
+    NetCDF LINES file from a pipe."""
+    d = inputs.dir
+    argv = [x if not x.endswith("sensor.toml") else "/dev/stdin" for x in base_argv(cmd, d)]
+    inputs.before = _sha(d)
+    with open(d / "sensor.toml", "rb") as fh:
+        p = _run_sub(argv, stdin=fh)
+    assert p.returncode == 0, p.stderr
+    assert (d.parent / "out" / "ortho.nc").is_file()
+    # a NetCDF from a pipe (the LINES file): read once, opened from memory
+    argv = [x if not x.endswith("lines.nc") else "/dev/stdin" for x in base_argv(cmd, d)]
+    with open(d / "lines.nc", "rb") as fh:
+        p = _run_sub([*argv, "--overwrite"], stdin=fh)
+    assert p.returncode == 0, p.stderr

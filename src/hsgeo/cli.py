@@ -1,7 +1,9 @@
 """The ``hsgeo`` command: ``hsgeo reproduce``, ``hsgeo data``, ``hsgeo versions``, ...
 
-Every subcommand turns an :class:`hsgeo.HsgeoError` into a one-line message and exit status 2,
-Ctrl-C into one line and status 130, and a closed output pipe into a silent exit (status 141).
+Every subcommand turns an :class:`hsgeo.HsgeoError`, an operating system's refusal and memory
+exhausted into a one-line message and exit status 2, Ctrl-C (also inside a compiled kernel) into
+one line and status 130, and a closed output pipe into a silent exit (status 141); its text
+prints in any locale (:mod:`hsgeo.terminal`).
 """
 
 from __future__ import annotations
@@ -11,7 +13,9 @@ import io
 import os
 import sys
 
+from hsgeo import terminal
 from hsgeo.errors import ConvergenceError, HsgeoError
+from hsgeo.terminal import json_text
 
 __all__ = ["main", "EXIT_INTERRUPTED", "EXIT_BROKEN_PIPE"]
 
@@ -31,8 +35,6 @@ def _cmd_reproduce(args) -> int:
 
 
 def _cmd_calibrate_line(args) -> int:
-    import json
-
     from hsgeo.workflows.line_calibration import calibrate_files
 
     cal = calibrate_files(
@@ -44,7 +46,7 @@ def _cmd_calibrate_line(args) -> int:
         reject_k=args.reject_k,
     )
     if args.json:
-        print(json.dumps(cal.to_dict(), indent=1))
+        print(json_text(cal.to_dict()))
     else:
         stats = cal.residual_stats()
         print(cal.result.report())
@@ -84,8 +86,6 @@ def _cmd_data(args) -> int:
 
 
 def _cmd_adjust_pushbroom(args) -> int:
-    import json
-
     from hsgeo.workflows.pushbroom_ba import adjust_files
 
     out = adjust_files(
@@ -94,12 +94,12 @@ def _cmd_adjust_pushbroom(args) -> int:
         args.camera,
         args.gcp,
         node_interval_s=args.node_interval,
-        progress=True,
+        progress=terminal.progress_printer(),
         y_as_time=not args.image_y,
         max_nav_gap_s=args.max_nav_gap_s,
     )
     res = out.pop("_result")
-    print(json.dumps(out, indent=1) if args.json else res.report(max_block_size=20))
+    print(json_text(out) if args.json else res.report(max_block_size=20))
     fit = out["fit"]
     if fit["verdict"] == "poor" and not args.accept_poor_fit:
         print(
@@ -130,7 +130,7 @@ def _cmd_geocode(args) -> int:
         height_m=args.height,
         resolution_m=args.resolution,
         envi=args.envi,
-        progress=not args.quiet,
+        progress=not args.quiet and sys.stderr.isatty(),  # progress on a terminal only
         overwrite=args.overwrite,
         max_grid_gib=args.max_grid_gib,
         max_nav_gap_s=args.max_nav_gap_s,
@@ -144,13 +144,11 @@ def _cmd_geocode(args) -> int:
 
 
 def _cmd_adjust_bal(args) -> int:
-    import json
-
     from hsgeo.workflows.bal import adjust_bal_file
 
-    out = adjust_bal_file(args.file, progress=None if args.json else True)
+    out = adjust_bal_file(args.file, progress=None if args.json else terminal.progress_printer())
     if args.json:
-        print(json.dumps(out, indent=1))
+        print(json_text(out))
     else:
         print(
             f"{out['file']}: {out['n_cameras']} cameras, {out['n_points']} points, "
@@ -164,8 +162,6 @@ def _cmd_adjust_bal(args) -> int:
 
 
 def _cmd_mtf(args) -> int:
-    import json
-
     from hsgeo.workflows.mtf import bars_files
 
     out = bars_files(args.profiles, args.bars)
@@ -173,7 +169,7 @@ def _cmd_mtf(args) -> int:
         d = {"profiles": [{"row": r, **res.to_dict()} for r, res in out.items()]}
         if len(out) == 1:
             d = next(iter(d["profiles"]))
-        print(json.dumps(d, indent=1, allow_nan=False))
+        print(json_text(d))
         return 0
     for r, res in out.items():
         head = "profile" if r is None else f"row {r}"
@@ -194,15 +190,13 @@ def _cmd_mtf(args) -> int:
 
 
 def _cmd_mtf_edge(args) -> int:
-    import json
-
     import numpy as np
 
     from hsgeo.workflows.mtf import edge_file
 
     res = edge_file(args.image, args.roi)
     if args.json:
-        print(json.dumps(res.to_dict(), indent=1, allow_nan=False))
+        print(json_text(res.to_dict()))
         return 0
     print(
         f"edge at {res.edge_angle_deg:.2f} deg in ROI {res.roi}, LSF FWHM {res.lsf_fwhm_px:.2f} "
@@ -215,8 +209,6 @@ def _cmd_mtf_edge(args) -> int:
 
 
 def _cmd_asf(args) -> int:
-    import json
-
     import numpy as np
 
     from hsgeo.workflows.asf import AsfOptions, asf_files
@@ -224,7 +216,7 @@ def _cmd_asf(args) -> int:
     opts = AsfOptions(margin_m=args.margin, register=not args.no_register)
     res = asf_files(args.cross, args.along, args.runway, opts)
     if args.json:
-        print(json.dumps(res.to_dict(), indent=1, allow_nan=False))
+        print(json_text(res.to_dict()))
         return 0
     reg = res.registration
     if reg is not None:
@@ -249,8 +241,6 @@ def _cmd_asf(args) -> int:
 
 
 def _cmd_cube(args) -> int:
-    import json
-
     from hsgeo.workflows.cube import CubeOptions, cube_files
 
     opts = CubeOptions(
@@ -269,7 +259,7 @@ def _cmd_cube(args) -> int:
     )
     d = res.to_dict()
     if args.json:
-        print(json.dumps(d, indent=1))
+        print(json_text(d))
     else:
         print(
             f"reflectance cube of {d['lines']} lines x {d['samples']} samples x {d['bands']} "
@@ -292,30 +282,36 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``hsgeo`` console script."""
-    args = build_parser().parse_args(argv)
-    from hsgeo.adjust.threads import blas_threads
+    terminal.setup_streams()  # any locale: Σ, σ, … in ASCII where the terminal cannot show them
+    args = None
 
-    try:
+    def fail(msg: str, status: int = 2) -> int:
+        terminal.clear_progress()
+        msg = " ".join(msg.split())  # one line, whatever the message
+        prog = "hsgeo" if args is None else f"hsgeo {args.command}"
+        print(f"{prog}: {msg}", file=sys.stderr)
+        return status
+
+    try:  # from the first import on: Ctrl-C while numpy, pandas, numba load is Ctrl-C too
+        args = build_parser().parse_args(argv)
+        from hsgeo.adjust.threads import blas_threads
+
         # BLAS on one thread, whatever the shell says: on small dense solves a second OpenBLAS
         # thread was slower, and on a busy machine many times slower (README, "Threads");
         # the engine chooses its own kernels' threads by the size of each problem
         with blas_threads(1):
-            return int(args.func(args) or 0)
+            status = int(args.func(args) or 0)
+        terminal.clear_progress()
+        return status
     except ConvergenceError:
-        print(
-            f"hsgeo {args.command}: error: the adjustment did not converge; look for gross "
-            "errors in the input files (a wrong unit, id or coordinate) and check the initial "
-            "values given as options",
-            file=sys.stderr,
+        return fail(
+            "error: the adjustment did not converge; look for gross errors in the input files "
+            "(a wrong unit, id or coordinate) and check the initial values given as options"
         )
-        return 2
     except HsgeoError as exc:
-        msg = " ".join(str(exc).split())  # one line, whatever the message
-        print(f"hsgeo {args.command}: error: {msg}", file=sys.stderr)
-        return 2
+        return fail(f"error: {exc}")
     except KeyboardInterrupt:
-        print(f"hsgeo {args.command}: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
+        return fail("interrupted", EXIT_INTERRUPTED)
     except BrokenPipeError:
         # the reader of our output went away (`hsgeo reproduce ... --json | head -1`): stop
         # without a word; stdout goes to /dev/null so that flushing it at exit cannot fail again
@@ -326,6 +322,14 @@ def main(argv: list[str] | None = None) -> int:
         except (OSError, ValueError, io.UnsupportedOperation):
             pass
         return EXIT_BROKEN_PIPE
+    except Exception as exc:
+        # Ctrl-C inside a numba kernel arrives as SystemError caused by KeyboardInterrupt
+        if terminal.interrupted(exc):
+            return fail("interrupted", EXIT_INTERRUPTED)
+        line = terminal.error_line(exc)  # the OS refused, or memory ran out
+        if line is None:
+            raise
+        return fail(f"error: {line}")
 
 
 if __name__ == "__main__":

@@ -134,8 +134,10 @@ def intersect(origin_m, direction, terrain, *, tol_m: float = 1e-4, max_iter: in
         raise InputError("ray origins or directions contain NaN or inf")
     if np.any(d[:, 2] >= -1e-9 * np.linalg.norm(d, axis=1)):
         raise ObservationError(
-            f"{int(np.sum(d[:, 2] >= 0))} rays do not point downwards: check the attitude "
-            "(roll/pitch in radians?) and the boresight"
+            f"{int(np.sum(d[:, 2] >= 0))} rays do not point downwards; the likely causes: "
+            "an attitude of another convention (roll or pitch near 180°: the body upside down, "
+            "or z up instead of down), angles in radians where degrees are expected, or the "
+            "boresight"
         )
     h = np.full(O.shape[0], terrain.mean_height_m)
     for _ in range(max_iter):

@@ -5,6 +5,8 @@
 * :func:`check_unique` — no id or row given twice (the lines and ids named);
 * :func:`check_navigation_covers` — a navigation solution covers the times it is used at,
   without gaps longer than a tolerance;
+* :func:`check_memory` — a request that cannot fit in the machine's memory is refused up
+  front, with the estimate;
 * :func:`option_number` — command-line numbers (finite, positive, in a range), as argparse
   types whose errors name the option.
 
@@ -29,6 +31,8 @@ __all__ = [
     "check_unique",
     "check_navigation_covers",
     "option_number",
+    "check_memory",
+    "physical_memory_bytes",
     "UNIT_LIMITS",
     "unit_limits",
 ]
@@ -179,8 +183,17 @@ def check_navigation_covers(
     if lo < tn[0] or hi > tn[-1]:
         raise InputError(
             f"navigation file {nav} covers t_s {tn[0]:.6g} to {tn[-1]:.6g} s but "
-            f"{used} run from {lo:.6g} to {hi:.6g} s; give the navigation of the whole "
-            "acquisition, on the same time scale"
+            f"{used} run from {lo:.6g} to {hi:.6g} s; "
+            + _time_scale_hint(tn, t)
+            + "give the navigation of the whole acquisition, on the same time scale"
+        )
+    step = float(np.median(np.diff(tn))) if tn.size > 1 else 0.0
+    if step > max_gap_s:  # most intervals "gaps": a unit or a logging rate, not a gap
+        raise InputError(
+            f"navigation file {nav}: its records are {step:.6g} s apart (the median), "
+            f"farther than {gap_option} {max_gap_s:g} everywhere; the likely causes: t_s in "
+            f"another unit than seconds (milliseconds: records {step / 1000:.6g} s apart?), "
+            f"or a navigation logged this sparsely (then allow it with {gap_option})"
         )
     # a gap matters where the navigation is interpolated across it: a time strictly between
     # two records farther apart than max_gap_s (times on a record use it as it is)
@@ -198,6 +211,15 @@ def check_navigation_covers(
             f"interpolated across for {used}, longer than {gap_option} {max_gap_s:g}; fill the "
             f"gap, or allow it with {gap_option}"
         )
+
+
+def _time_scale_hint(tn: np.ndarray, t: np.ndarray) -> str:
+    """A hint when the two time spans differ by a factor of about 1000 (ms against s)."""
+    a = float(np.ptp(tn)) if tn.size else 0.0
+    b = float(np.ptp(t)) if t.size else 0.0
+    if a > 0 and b > 0 and 300.0 < max(a / b, b / a) < 3000.0:
+        return "one of them in milliseconds? (the spans differ by a factor of about 1000); "
+    return ""
 
 
 def option_number(
@@ -232,3 +254,35 @@ def option_number(
 
     parse.__name__ = "number"
     return parse
+
+
+def physical_memory_bytes() -> float:
+    """The machine's physical memory in bytes (``inf`` where the system does not say)."""
+    import os
+
+    try:
+        return float(os.sysconf("SC_PAGE_SIZE")) * float(os.sysconf("SC_PHYS_PAGES"))
+    except (ValueError, OSError, AttributeError):
+        return math.inf
+
+
+def check_memory(need_bytes: float, what: str, remedy: str) -> None:
+    """Refuse up front what cannot fit in memory: :class:`~hsgeo.InputError` if ``need_bytes``
+    (a lower bound of what ``what`` will allocate) exceeds the machine's physical memory.
+
+    Parameters
+    ----------
+    need_bytes : float
+        The estimate (a lower bound: the refusal must not turn away a run that would fit).
+    what : str
+        What needs it, in the user's terms (the option and the sizes it leads to).
+    remedy : str
+        What to do (the option to change).
+    """
+    have = physical_memory_bytes()
+    if need_bytes > have:
+        gib = 2.0**30
+        raise InputError(
+            f"{what} needs at least {need_bytes / gib:.3g} GiB of memory, more than this "
+            f"machine's {have / gib:.3g} GiB; {remedy}"
+        )

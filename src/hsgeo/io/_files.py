@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import tempfile
 from collections.abc import Iterable, Iterator
@@ -10,7 +11,53 @@ from pathlib import Path
 
 from hsgeo.errors import InputError
 
-__all__ = ["atomic_path", "refuse_inputs", "check_outputs", "check_input_file", "read_text"]
+__all__ = [
+    "atomic_path",
+    "refuse_inputs",
+    "check_outputs",
+    "check_input_file",
+    "read_text",
+    "os_error_message",
+]
+
+#: What to do about the operating system's refusals, by errno (the words of
+#: :func:`os_error_message`).
+_OS_REMEDY = {
+    errno.ENAMETOOLONG: "the file name is too long for the file system (255 bytes a name); "
+    "choose a shorter name",
+    errno.EACCES: "permission denied; choose a folder you can write to, or check the file's "
+    "permissions",
+    errno.EPERM: "the operating system does not allow it; choose another folder or file",
+    errno.EROFS: "the file system is read-only; choose another folder",
+    errno.ENOSPC: "no space left on the device; free some space or choose another folder",
+    errno.EDQUOT: "the disk quota is exceeded; free some space or choose another folder",
+    errno.EISDIR: "is a folder, not a file; give a file name",
+    errno.ENOTDIR: "a part of the path is a file, not a folder; check the path",
+    errno.ELOOP: "too many symbolic links; check the path",
+    errno.ENOENT: "no such file or folder (or no file can be created there); check the path",
+    errno.EIO: "input/output error of the device; check the disk or choose another folder",
+}
+
+
+def os_error_message(exc: OSError, what: str = "") -> str:
+    """One line for an operating system's refusal: the file, and what to do about it.
+
+    Parameters
+    ----------
+    exc : OSError
+        The error (its ``filename`` and ``errno`` are used; its text when the errno is not
+        one of the common ones).
+    what : str
+        The file's role or the option that named it (``"-o/--output"``,
+        ``"observation file"``), put before the file name.
+    """
+    name = exc.filename if exc.filename is not None else ""
+    name = str(name)
+    if len(name) > 80:
+        name = name[:40] + "..." + name[-30:] + f" ({len(str(exc.filename))} characters)"
+    remedy = _OS_REMEDY.get(exc.errno) or (exc.strerror or str(exc)).lower()
+    head = " ".join(x for x in (what, repr(name) if name else "") if x)
+    return f"{head}: {remedy}" if head else remedy
 
 
 def refuse_inputs(output, inputs: Iterable = ()) -> Path:
@@ -47,13 +94,37 @@ def check_input_file(path, what: str) -> Path:
     """The input file ``path`` exists and is a file; :class:`~hsgeo.InputError` otherwise.
 
     ``what`` names its role (``"observation file"``, ``"LINES file"``).
+    A pipe or a device (``/dev/stdin``, a shell's process substitution ``<(...)``) is a file
+    too: it is read once, as any input.
     """
     path = Path(path)
+    try:
+        path.stat()
+    except FileNotFoundError:
+        raise InputError(f"{what} {str(path)!r} not found; check the path") from None
+    except OSError as exc:
+        raise InputError(os_error_message(exc, what)) from None
     if path.is_dir():
         raise InputError(f"{what} {str(path)!r} is a directory, not a file; give the file")
-    if not path.is_file():
-        raise InputError(f"{what} {str(path)!r} not found; check the path")
     return path
+
+
+#: The bytes of the pipes read so far (``/dev/stdin``, ``<(...)``), by device and inode: a pipe
+#: can be read once, and a reader that looks at a file twice (its kind, then its content) gets
+#: the same bytes the second time.
+_PIPES: dict[tuple[int, int], bytes] = {}
+
+
+def _read_bytes(path: Path) -> bytes:
+    import stat
+
+    st = path.stat()
+    if stat.S_ISREG(st.st_mode):
+        return path.read_bytes()
+    key = (st.st_dev, st.st_ino)
+    if key not in _PIPES:
+        _PIPES[key] = path.read_bytes()
+    return _PIPES[key]
 
 
 def read_text(path, what: str, kind: str) -> str:
@@ -63,7 +134,10 @@ def read_text(path, what: str, kind: str) -> str:
     naming the file and the ``kind`` of text expected (``"CSV table"``, ``"TOML"``).
     """
     path = check_input_file(path, what)
-    data = path.read_bytes()
+    try:
+        data = _read_bytes(path)
+    except OSError as exc:
+        raise InputError(os_error_message(exc, what)) from None
     try:
         if b"\0" in data:
             raise UnicodeDecodeError("utf-8", data, data.index(b"\0"), len(data), "NUL byte")
@@ -79,14 +153,18 @@ def read_text(path, what: str, kind: str) -> str:
 def check_outputs(outputs, inputs: Iterable = (), *, overwrite: bool = False) -> list[Path]:
     """Check the files a command will write, before it does any work.
 
-    Each output's folder must exist and be writable, the output must not be a folder, not one
-    of the ``inputs``, not given twice, and an existing file is replaced only with
-    ``overwrite``.
+    Each output's folder must exist and a file must be creatable in it (a temporary file is
+    made and removed, as :func:`atomic_path` will: this finds a name too long, a read-only or
+    virtual file system, a folder without permission), the output must not be a folder (nor
+    end in ``/``), not one of the ``inputs``, not given twice, have one of the extensions
+    its format allows, and an existing file is replaced only with ``overwrite``.
 
     Parameters
     ----------
-    outputs : iterable of (path or None, str)
-        Each output with the option that names it (``(ortho, "-o")``); ``None`` paths skipped.
+    outputs : iterable of (path or None, str) or (path or None, str, dict)
+        Each output with the option that names it (``(ortho, "-o")``) and optionally the
+        extensions allowed, each with its format's name (``{".nc": "NetCDF"}``); ``None``
+        paths skipped.
     inputs : iterable of path
         The files the command reads.
     overwrite : bool
@@ -99,30 +177,86 @@ def check_outputs(outputs, inputs: Iterable = (), *, overwrite: bool = False) ->
     inputs = [p for p in inputs if p is not None]
     seen: dict[Path, str] = {}
     out = []
-    for p, option in outputs:
+    for p, option, *formats in outputs:
         if p is None:
             continue
+        if str(p).endswith(("/", os.sep)) or str(p) in (".", ".."):
+            raise InputError(
+                f"{option} {p}: names a folder (it ends in '/'), not a file; give a file name "
+                f"in it, e.g. {os.path.join(str(p), 'out')}{_first(formats)}"
+            )
         p = Path(p)
-        refuse_inputs(p, inputs)
-        key = p.resolve()
-        if key in seen:
-            raise InputError(
-                f"{option} {p}: the same file as {seen[key]}; give each output its own name"
-            )
-        seen[key] = option
-        if p.is_dir():
-            raise InputError(f"{option} {p}: is a directory; give a file name in it")
-        folder = p.parent
-        if not folder.is_dir():
-            raise InputError(f"{option} {p}: the folder {folder} does not exist; create it first")
-        if not os.access(folder, os.W_OK | os.X_OK):
-            raise InputError(
-                f"{option} {p}: the folder {folder} is not writable; choose another folder"
-            )
-        if p.exists() and not overwrite:
-            raise InputError(f"{option} {p}: the file exists; use --overwrite to replace it")
-        out.append(p)
-    return out
+        try:
+            _check_output(p, option, formats, inputs, seen, overwrite)
+        except OSError as exc:  # a name too long, a folder without permission ...
+            raise InputError(_creation_message(exc, option, p)) from None
+        out.append((p, option, formats))
+    for p, option, formats in out:  # after the clashes between outputs, which say more
+        if formats:
+            _check_format(p, option, formats[0])
+    return [p for p, _, _ in out]
+
+
+def _check_output(p: Path, option: str, formats, inputs, seen: dict, overwrite: bool) -> None:
+    refuse_inputs(p, inputs)
+    key = p.resolve()
+    if key in seen:
+        raise InputError(
+            f"{option} {p}: the same file as {seen[key]}; give each output its own name"
+        )
+    seen[key] = option
+    if p.is_dir():
+        raise InputError(f"{option} {p}: is a directory; give a file name in it")
+    folder = p.parent
+    if not folder.is_dir():
+        raise InputError(f"{option} {p}: the folder {folder} does not exist; create it first")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise InputError(
+            f"{option} {p}: the folder {folder} is not writable; choose another folder"
+        )
+    if p.exists() and not overwrite:
+        raise InputError(f"{option} {p}: the file exists; use --overwrite to replace it")
+    with _no_interrupt():  # the temporary file of atomic_path: can it be made there?
+        try:
+            fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".part", dir=folder)
+        except OSError as exc:
+            raise InputError(_creation_message(exc, option, p)) from None
+        os.close(fd)
+        os.unlink(tmp)
+
+
+def _first(formats) -> str:
+    return next(iter(formats[0]), "") if formats else ""
+
+
+def _check_format(p: Path, option: str, formats: dict) -> None:
+    """The extension of ``p`` is one of ``formats`` (``{".nc": "NetCDF"}``), case-insensitive."""
+    suffix = p.suffix.lower()
+    if suffix in formats:
+        return
+    by: dict[str, list[str]] = {}
+    for k, v in formats.items():
+        by.setdefault(v, []).append(k)
+    names = "; ".join(f"{v}: {', '.join(ks)}" for v, ks in by.items())
+    first = next(iter(formats))
+    said = f"the extension {p.suffix!r} is not" if p.suffix else "no extension names"
+    raise InputError(
+        f"{option} {p}: {said} a format this command writes ({names}); "
+        f"name the file {p.stem}{first}"
+    )
+
+
+def _creation_message(exc: OSError, option: str, p: Path) -> str:
+    if exc.errno == errno.ENAMETOOLONG:
+        return (
+            f"{option}: the file name is too long for the file system ({len(p.name.encode())} "
+            f"bytes; 255 a name, less the {len('..12345678.part')} of the temporary file); "
+            "choose a shorter name"
+        )
+    return (
+        f"{option} {p}: no file can be created in the folder {p.parent} "
+        f"({exc.strerror or exc}); choose another folder"
+    )
 
 
 @contextlib.contextmanager
@@ -144,18 +278,44 @@ def atomic_path(path, inputs: Iterable = ()) -> Iterator[Path]:
     path = refuse_inputs(path, inputs)
     if not path.parent.is_dir():
         raise InputError(f"{path}: the folder {path.parent} does not exist; create it first")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
-    os.close(fd)
-    tmp = Path(tmp)
-    # mkstemp makes the file 0600; the output gets the mode of any new file (0666 & ~umask)
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(tmp, 0o666 & ~umask)
+    tmp = None
     try:
+        with _no_interrupt():  # Ctrl-C cannot fall between making the file and owning it
+            try:
+                fd, name = tempfile.mkstemp(
+                    prefix=f".{path.name}.", suffix=".part", dir=path.parent
+                )
+            except OSError as exc:
+                raise InputError(_creation_message(exc, "output", path)) from None
+            tmp = Path(name)
+            os.close(fd)
+        # mkstemp makes the file 0600; the output gets the mode of any new file (0666 & ~umask)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)
         yield tmp
         os.replace(tmp, path)
     finally:
-        tmp.unlink(missing_ok=True)
+        if tmp is not None:
+            tmp.unlink(missing_ok=True)
+
+
+@contextlib.contextmanager
+def _no_interrupt():
+    """SIGINT held back for the block (main thread, POSIX), delivered right after it."""
+    import signal
+    import threading
+
+    hold = (
+        hasattr(signal, "pthread_sigmask") and threading.current_thread() is threading.main_thread()
+    )
+    if hold:
+        old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        if hold:
+            signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
 def write_text(path, text: str, *, atomic: bool = False, make_parents: bool = False) -> Path:

@@ -131,43 +131,13 @@ def _read_text(path: Path) -> str:
         ) from None
 
 
-def read_bal(path) -> BALProblem:
-    """Read a BAL problem file (plain text or ``.bz2``).
+#: The largest image coordinate a BAL observation can plausibly have (px from the image centre):
+#: no camera has a million pixels across (:data:`hsgeo.validate.UNIT_LIMITS`).
+MAX_XY_PX = 1e6
 
-    Parameters
-    ----------
-    path : str or Path
 
-    Returns
-    -------
-    BALProblem
-
-    Raises
-    ------
-    InputError
-        Unreadable file, or malformed content: the message names the file and the line
-        (a wrong count, a non-numeric value, an index out of range, NaN/inf, missing or extra
-        values).
-    """
-    path = Path(path)
-    lines = _read_text(path).splitlines()
-
-    def fail(lineno: int, what: str) -> InputError:
-        return InputError(f"{path}, line {lineno}: {what}")
-
-    if not lines:
-        raise InputError(f"{path}: empty file (expected a BAL header 'n_cameras n_points n_obs')")
-    head = lines[0].split()
-    try:
-        n_cam, n_pts, n_obs = (int(v) for v in head)
-    except ValueError:
-        raise fail(
-            1, f"expected the header 'n_cameras n_points n_observations', got {lines[0]!r}"
-        ) from None
-    if min(n_cam, n_pts, n_obs) <= 0:
-        raise fail(1, f"the counts must be positive, got {n_cam} {n_pts} {n_obs}")
-    if len(lines) < 1 + n_obs:
-        raise fail(len(lines), f"the file ends after {len(lines) - 1} of {n_obs} observation lines")
+def _read_observations(lines, n_obs: int, n_cam: int, n_pts: int, fail):
+    """The observation lines 2 … n_obs + 1 as (camera index, point index, xy px)."""
     cam = np.empty(n_obs, np.int64)
     pt = np.empty(n_obs, np.int64)
     xy = np.empty((n_obs, 2))
@@ -190,13 +160,71 @@ def read_bal(path) -> BALProblem:
             )
         if not np.isfinite(xy[i]).all():
             raise fail(2 + i, "the image coordinates are NaN or inf")
+        if np.abs(xy[i]).max() > MAX_XY_PX:
+            raise fail(
+                2 + i,
+                f"the image coordinates {xy[i, 0]:.6g} {xy[i, 1]:.6g} px are beyond "
+                f"{MAX_XY_PX:.0e} px from the image centre; correct the value or delete the "
+                "observation (and lower the header's count)",
+            )
+    return cam, pt, xy
+
+
+def read_bal(path) -> BALProblem:
+    """Read a BAL problem file (plain text or ``.bz2``).
+
+    Parameters
+    ----------
+    path : str or Path
+
+    Returns
+    -------
+    BALProblem
+
+    Raises
+    ------
+    InputError
+        Unreadable file, or malformed content: the message names the file and the line
+        (a wrong count, a non-numeric value, an index out of range, NaN/inf, missing or extra
+        values).
+    """
+    path = Path(path)
+    # whitespace-separated: blank lines carry nothing (kept out, with the file's line numbers)
+    numbered = [(i, ln) for i, ln in enumerate(_read_text(path).splitlines(), 1) if ln.strip()]
+    lines = [ln for _, ln in numbered]
+
+    def fail(k: int, what: str) -> InputError:
+        lineno = numbered[min(k, len(numbered)) - 1][0] if numbered else 1
+        return InputError(f"{path}, line {lineno}: {what}")
+
+    if not lines:
+        raise InputError(f"{path}: empty file (expected a BAL header 'n_cameras n_points n_obs')")
+    head = lines[0].split()
+    try:
+        n_cam, n_pts, n_obs = (int(v) for v in head)
+    except ValueError:
+        raise fail(
+            1, f"expected the header 'n_cameras n_points n_observations', got {lines[0]!r}"
+        ) from None
+    if min(n_cam, n_pts, n_obs) <= 0:
+        raise fail(1, f"the counts must be positive, got {n_cam} {n_pts} {n_obs}")
+    if len(lines) < 1 + n_obs:
+        raise fail(len(lines), f"the file ends after {len(lines) - 1} of {n_obs} observation lines")
     n_val = 9 * n_cam + 3 * n_pts
+    # the sizes the header declares, against the file, before allocating anything
+    n_tok = sum(len(ln.split()) for ln in lines[1 + n_obs :])
+    if n_tok < n_val:
+        raise fail(
+            len(lines),
+            f"the file ends after {n_tok} of {n_val} camera and point values ({n_cam} cameras × "
+            f"9 + {n_pts} points × 3 that the header on line 1 declares); check the header's "
+            "counts, or whether the file was cut short",
+        )
+    cam, pt, xy = _read_observations(lines, n_obs, n_cam, n_pts, fail)
     values = np.empty(n_val)
     k = 0
     for j in range(1 + n_obs, len(lines)):
         tok = lines[j].split()
-        if not tok:
-            continue
         if k + len(tok) > n_val:
             raise fail(
                 j + 1,
@@ -210,12 +238,6 @@ def read_bal(path) -> BALProblem:
             raise fail(j + 1, "a camera or point value is NaN or inf")
         values[k : k + len(vals)] = vals
         k += len(vals)
-    if k < n_val:
-        raise fail(
-            len(lines),
-            f"the file ends after {k} of {n_val} camera and point values ({n_cam} cameras × 9 "
-            f"+ {n_pts} points × 3)",
-        )
     return BALProblem(
         values[: 9 * n_cam].reshape(n_cam, 9),
         values[9 * n_cam :].reshape(n_pts, 3),

@@ -105,7 +105,10 @@ def _number(v, key: Key, where: str, problems: list) -> float | None:
         problems.append(f"{where}: must be positive, got {v!r}")
         return None
     if key.limit is not None and abs(v) > key.limit:
-        problems.append(f"{where}: {v!r} is outside [-{key.limit:g}, {key.limit:g}]")
+        problems.append(
+            f"{where}: {v!r} is outside [-{key.limit:g}, {key.limit:g}]"
+            + (f" ({key.doc}: a wrong unit?)" if key.doc else "")
+        )
         return None
     return float(v)
 

@@ -39,8 +39,18 @@ def open_netcdf(path, variable: str, what: str, remedy: str):
 
     role = f"{what.strip() or 'LINES'} file"
     path = check_input_file(path, role)
-    with open(path, "rb") as fh:
-        magic = fh.read(8)
+    src = path
+    if not path.is_file():  # a pipe (/dev/stdin, <(...)): read once, opened from memory
+        import io
+
+        from hsgeo.io._files import _read_bytes
+
+        src = io.BytesIO(_read_bytes(path))
+    if src is path:
+        with open(path, "rb") as fh:
+            magic = fh.read(8)
+    else:
+        magic = src.getvalue()[:8]
     # the engine from the file's signature, not xarray's guess (whose errors advise installing
     # packages): classic NetCDF 'CDF\x01|2|5' -> scipy, NetCDF-4 (HDF5) -> h5netcdf
     if magic[:3] == b"CDF":
@@ -53,11 +63,17 @@ def open_netcdf(path, variable: str, what: str, remedy: str):
             "HDF5 signature); give the NetCDF file"
         )
     try:
-        ds = xr.open_dataset(path, engine=engine)
+        ds = xr.open_dataset(src, engine=engine)
     except ImportError:
         raise InputError(
             f"{role} {str(path)!r} is NetCDF-4 (HDF5): reading it needs the h5py package (pip "
             "install h5py), or save the file as NetCDF 3 classic"
+        ) from None
+    except TypeError:  # scipy's reader on a dimension of length 0 (read as 'unlimited')
+        raise InputError(
+            f"{role} {str(path)!r}: not a readable NetCDF file; the likely causes: a dimension "
+            "of length 0 (no lines or no pixels recorded), a file cut short, or a file written "
+            "by a program that does not follow NetCDF 3; give a file with data"
         ) from None
     except Exception as exc:  # noqa: BLE001 - any reader error becomes an InputError
         msg = " ".join(str(exc).split())[:200]

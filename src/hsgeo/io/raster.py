@@ -11,7 +11,12 @@ from hsgeo.io._files import atomic_path, refuse_inputs
 from hsgeo.io.envi import write_envi
 from hsgeo.io.lines import open_netcdf
 
-__all__ = ["to_map_files", "read_dem"]
+__all__ = ["to_map_files", "read_dem", "MAP_FORMATS"]
+
+#: The extensions of the orthoimage written by ``-o`` (NetCDF 3 through xarray's scipy engine);
+#: a GeoTIFF needs rasterio, which hsgeo does not depend on (``--envi`` writes ENVI with map
+#: info, which GIS programs read).
+MAP_FORMATS = {".nc": "NetCDF", ".nc4": "NetCDF", ".cdf": "NetCDF", ".netcdf": "NetCDF"}
 
 
 def to_map_files(da, path_nc=None, path_envi=None, *, inputs=()) -> list:
@@ -91,6 +96,21 @@ def read_dem(path):
         )
     if h.sizes["N"] < 2 or h.sizes["E"] < 2:
         raise InputError(f"DEM file {str(path)!r}: needs at least 2 x 2 cells, got {h.shape}")
+    for c in ("N", "E"):
+        v = np.asarray(h[c].values, dtype=float)
+        step = np.diff(v)
+        if not np.all(np.isfinite(v)):
+            raise InputError(
+                f"DEM file {str(path)!r}: the coordinate {c} has NaN or infinite values; give "
+                "the cell centres in metres"
+            )
+        if not (np.all(step > 0) or np.all(step < 0)):
+            i = int(np.flatnonzero(~(step * np.sign(step[0] or 1.0) > 0))[0])
+            raise InputError(
+                f"DEM file {str(path)!r}: the coordinate {c} is not strictly increasing or "
+                f"decreasing (values {i + 1} and {i + 2}: {v[i]:.6g}, {v[i + 1]:.6g} m); give "
+                "each grid row and column once, in order"
+            )
     if not np.all(np.isfinite(h.values)):
         raise InputError(
             f"DEM file {str(path)!r}: height has {int(np.sum(~np.isfinite(h.values)))} NaN or "

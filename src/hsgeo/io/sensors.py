@@ -29,7 +29,9 @@ SENSOR_SCHEMA = {
             choices=("calibrated", "linear-ifov"),
             doc="'calibrated' (000 eq. (2)) or 'linear-ifov' (no distortion)",
         ),
-        "zeta0_px": Key("float", required=True, doc="principal point ζ0, px"),
+        "zeta0_px": Key(
+            "float", required=True, limit=1e5, doc="principal point ζ0 on the line, px"
+        ),
         "c_px": Key("float", required=True, positive=True, doc="principal distance, px"),
         "K": Key(
             "floats",
@@ -54,11 +56,18 @@ CAMERA_SCHEMA = {
         "pixel_mm": Key(
             "float", required=True, positive=True, limit=1.0, doc="pixel pitch, mm (at most 1)"
         ),
-        "c_mm": Key("float", required=True, positive=True, doc="principal distance, mm"),
-        "x0_mm": Key("float", doc="principal point x, mm"),
-        "y0_mm": Key("float", doc="principal point y, mm"),
-        "lever_arm_m": Key("floats", length=3, doc="lever arm (platform frame), m"),
-        "sigma_lever_m": Key("float", positive=True, doc="σ of the measured lever arm, m"),
+        # the limits: what no airborne line camera exceeds (physically impossible beyond)
+        "c_mm": Key(
+            "float", required=True, positive=True, limit=2000.0, doc="principal distance, mm"
+        ),
+        "x0_mm": Key("float", limit=100.0, doc="principal point x on the detector, mm"),
+        "y0_mm": Key("float", limit=100.0, doc="principal point y on the detector, mm"),
+        "lever_arm_m": Key(
+            "floats", length=3, limit=50.0, doc="lever arm (platform frame), m, not mm"
+        ),
+        "sigma_lever_m": Key(
+            "float", positive=True, limit=10.0, doc="σ of the measured lever arm, m"
+        ),
         "c_band_mm": Key(
             "floats", positive=True, doc="principal distance of each band, mm (geocoding)"
         ),
@@ -189,14 +198,14 @@ def read_scanning_sensor(path):
     hsgeo.sensors.line.LineScanner or hsgeo.sensors.pushbroom.PushbroomCamera
     """
     import tomllib
-    from pathlib import Path
 
+    from hsgeo.io._files import read_text
     from hsgeo.sensors.line import LineScanner
     from hsgeo.sensors.mount import Mount
 
     try:
-        tables = set(tomllib.loads(Path(path).read_text(encoding="utf-8")))
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        tables = set(tomllib.loads(read_text(path, "sensor file", "TOML")))
+    except (InputError, tomllib.TOMLDecodeError):
         tables = {"sensor"}  # read_sensor_toml gives the one clear error
     if "camera" in tables and "sensor" not in tables:
         return read_pushbroom_camera(path)

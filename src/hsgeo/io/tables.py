@@ -58,6 +58,17 @@ def _data_lines(text: str) -> list[int]:
     return lines
 
 
+def _header(text: str) -> list[str]:
+    """The column names of a CSV's header line (the first line not blank nor a comment)."""
+    import csv
+
+    for line in text.splitlines():
+        s = line.strip()
+        if s and not s.startswith("#"):
+            return [c.strip() for c in next(csv.reader([s]))]
+    return []
+
+
 def _parse(path, text, parquet: bool, name: str, columns, text_columns):
     """The table as pandas reads it; a parser error becomes an :class:`InputError`."""
     import pandas as pd
@@ -85,14 +96,22 @@ def _parse(path, text, parquet: bool, name: str, columns, text_columns):
     return df
 
 
-def _check_header(df, name: str, columns) -> None:
-    """Every required column once, and at least one data row."""
-    dup = [c for c in columns if list(df.columns).count(c) > 1]
+def _check_header(df, name: str, columns, header: list[str]) -> None:
+    """Every column once (``header`` as the file spells it: pandas would rename a second
+    'zeta_px' to 'zeta_px.1' and read the first silently), every required column present, and
+    at least one data row.
+    """
+    dup = sorted({c for c in header if header.count(c) > 1}, key=header.index)
     if dup:
-        raise InputError(f"{name}: the header names column {dup[0]} twice; keep one")
+        raise InputError(
+            f"{name}: the header names column {dup[0]} {header.count(dup[0])} times; keep one "
+            "(or rename the others)"
+        )
     missing = [c for c in columns if c not in df.columns]
     if missing:
-        near = {c: closest(c, df.columns) for c in missing}
+        # a suggestion only among the columns no other required name claims
+        spare = [c for c in df.columns if c not in columns]
+        near = {c: closest(c, spare) for c in missing}
         hints = "".join(f"; rename {n!r} to {c!r}?" for c, n in near.items() if n)
         found = ", ".join(df.columns)
         if len(found) > 120:
@@ -212,7 +231,7 @@ def read_table(
     parquet = path.suffix.lower() in _PARQUET
     text = None if parquet else read_text(path, f"{what} file", "CSV table")
     df = _parse(path, text, parquet, name, columns, text_columns)
-    _check_header(df, name, columns)
+    _check_header(df, name, columns, list(df.columns) if parquet else _header(text))
     lines = None if parquet else _data_lines(text)
 
     def where(row: int) -> str:

@@ -112,6 +112,7 @@ def observe_files(
             if len(d) < 4:
                 raise ObservationError(f"{p}: {_not_found(board, 'fewer than 4 ArUco targets')}")
             ids, px, obj = d.ids, d.corners_px, obj_all[d.ids]
+        _check_board_layout(p, px.reshape(-1, 2), obj.reshape(-1, 3), img.shape, board)
         rows["cube"].append(np.full(len(ids), cube))
         rows["band"].append(np.full(len(ids), band))
         rows["target"].append(ids)
@@ -130,3 +131,33 @@ def observe_files(
         size,
         pixel,
     )
+
+
+#: The largest RMS (share of the image diagonal) of a plane-to-image homography through one
+#: image's detected points that a real lens leaves: beyond it the points are not where the board
+#: description puts them.
+MAX_HOMOGRAPHY_RMS_SHARE = 0.02
+
+
+def _check_board_layout(path, uv_px, X, shape, board) -> None:
+    """The detected points lie in the image as a plane's points do (a homography fits them):
+    a board description other than the photographed one would otherwise fail later as 'did
+    not converge', which names no cause.
+    """
+    import cv2
+
+    if uv_px.shape[0] < 5 or not np.allclose(X[:, 2], 0):
+        return
+    H, _ = cv2.findHomography(X[:, :2].astype(np.float64), uv_px.astype(np.float64), 0)
+    if H is None:
+        return
+    q = cv2.perspectiveTransform(X[:, None, :2].astype(np.float64), H)[:, 0]
+    rms = float(np.sqrt(np.mean(np.sum((q - uv_px) ** 2, axis=1))))
+    if rms > MAX_HOMOGRAPHY_RMS_SHARE * float(np.hypot(*shape)):
+        raise InputError(
+            f"{path}: the detected markers do not lie as the board file places them (a "
+            f"plane-to-image fit leaves {rms:.3g} px RMS, over {MAX_HOMOGRAPHY_RMS_SHARE:.0%} of "
+            f"the image diagonal); the likely causes: a board type other than the photographed "
+            f"one (the file says {board.type}), its rows and columns swapped or miscounted, or "
+            "the marker and square sizes"
+        )

@@ -80,22 +80,24 @@ def _check_out(out: Path, *, repo: bool, overwrite: bool, default: bool) -> None
 
     from hsgeo.errors import InputError
 
+    # the folder as the user named it: --out DIR, or the default they never typed
+    name = f"{out} (where hsgeo data writes without --out)" if default else f"--out {out}"
     if out.exists() and not out.is_dir():
-        raise InputError(f"--out {out}: not a folder; give a folder")
+        raise InputError(f"{name}: not a folder; give a folder")
     if not out.exists():
         if default:  # ./data_synthetic/generated is made with its parents
             return
         if not out.parent.is_dir():
-            raise InputError(f"--out {out}: the folder {out.parent} does not exist; create it")
+            raise InputError(f"{name}: the folder {out.parent} does not exist; create it")
         if not os.access(out.parent, os.W_OK | os.X_OK):
-            raise InputError(f"--out {out}: the folder {out.parent} is not writable")
+            raise InputError(f"{name}: the folder {out.parent} is not writable")
         return
     if not os.access(out, os.W_OK | os.X_OK):
-        raise InputError(f"--out {out}: the folder is not writable; choose another folder")
+        raise InputError(f"{name}: the folder is not writable; choose another folder")
     if not repo and not overwrite and any(out.iterdir()):
         raise InputError(
-            f"--out {out}: the folder is not empty; use --overwrite to replace the generated "
-            "files in it, or choose an empty folder"
+            f"{name}: the folder is not empty; use --overwrite to replace the generated "
+            "files in it, or choose an empty folder" + (" with --out" if default else "")
         )
 
 
@@ -154,6 +156,10 @@ def generate_all(
             continue
         name = Path(p).name
         old = previous.get(name)
+        if old is None and (repo_out / name).is_file():
+            # --out elsewhere: the repository's committed copy is the reference, with the same
+            # tolerance and words as the check in the repository itself
+            old = (repo_out / name).read_text()
         if (
             old is not None
             and p in sums

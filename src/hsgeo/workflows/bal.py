@@ -161,6 +161,13 @@ def adjust_bal(
     BALFit
     """
     prob, n_dropped = prepare(problem)
+    if prob.n_observations == 0:
+        raise InputError(
+            f"every one of the {problem.n_observations} observations is of a point behind its "
+            "camera, so none is left to adjust; the likely causes: the points' or the cameras' "
+            "signs (BAL cameras look down -z), rotations given as R_world_from_cam instead of "
+            "R_cam_from_world, or points and cameras in different coordinate systems"
+        )
     block = SnavelyReprojection(prob.camera_index, prob.point_index, prob.xy_px)
     params = Parameters()
     params.add("cameras", prob.cameras, columns=CAMERA_COLUMNS)

@@ -81,6 +81,7 @@ def geocode_files(
     """
     from hsgeo.io._files import check_outputs
     from hsgeo.io.navigation import read_trajectory
+    from hsgeo.io.raster import MAP_FORMATS
     from hsgeo.validate import check_navigation_covers
 
     if (dem is None) == (height_m is None):
@@ -88,7 +89,7 @@ def geocode_files(
     if not (np.isfinite(resolution_m) and resolution_m > 0):
         raise InputError(f"--resolution must be a positive number of metres, got {resolution_m}")
     inputs = (lines, trajectory, sensor, dem)
-    outs = [(output, "-o/--output")]
+    outs = [(output, "-o/--output", MAP_FORMATS)]
     if envi is not None:
         outs += [(envi, "--envi"), (str(envi) + ".hdr", "--envi (its .hdr)")]
     check_outputs(outs, inputs, overwrite=overwrite)  # before the work, not after it
@@ -106,6 +107,7 @@ def geocode_files(
     )
     pixel = np.asarray(da["pixel"].values, dtype=float)
     pixels, pixel_kw = _line_pixels(scanner, pixel, band, sensor)
+    _check_principal_point(scanner, pixel, sensor, lines)
     _check_view_angles(scanner, pixels, pixel_kw, t_lines[0], nav, sensor)
     need = n_lines * n_px * 3 * 8.0
     if need > max_grid_gib * _GIB:
@@ -253,6 +255,22 @@ def _line_pixels(scanner, pixel, band, sensor):
     return np.column_stack([pixel, np.zeros_like(pixel)]), {"band": int(band)}
 
 
+def _check_principal_point(scanner, pixel, sensor, lines) -> None:
+    """The principal point lies on the recorded line: between its first and last pixel."""
+    if isinstance(scanner, PushbroomCamera):
+        pp, name = scanner.x0_mm / scanner.pixel_mm, "x0_mm / pixel_mm"
+    else:
+        pp, name = float(scanner.geometry.zeta0_px), "zeta0_px"
+    lo, hi = float(np.min(pixel)), float(np.max(pixel))
+    if not lo <= pp <= hi:
+        raise InputError(
+            f"sensor file {str(sensor)!r}: the principal point ({name} = {pp:.6g} px) is off "
+            f"the line of {str(lines)!r}, whose pixels run {lo:g}…{hi:g} px; the likely causes: "
+            "a principal point of another binning or crop of the detector, the LINES pixel "
+            "coordinate counted from another origin, or a value in another unit"
+        )
+
+
 def _check_view_angles(scanner, pixels, pixel_kw, t0_s, nav, sensor):
     """The rays of the first line must look down, within 80° of the nadir."""
     with np.errstate(all="ignore"):
@@ -261,8 +279,17 @@ def _check_view_angles(scanner, pixels, pixel_kw, t0_s, nav, sensor):
             ang = np.degrees(np.arccos(np.clip(-d[:, 2], -1.0, 1.0)))
         except HsgeoError:
             ang = np.array([np.nan])
+    p = np.asarray(pixels)[..., 0] if np.ndim(pixels) == 2 else np.asarray(pixels)
+    if np.all(np.isfinite(ang)) and np.all(ang > 90.0):  # every ray looks up: the attitude
+        roll, pitch = np.degrees(nav.pose(np.array([t0_s]))[1][0, :2])
+        raise InputError(
+            f"the rays of the first line look up ({np.min(ang):.3g}…{np.max(ang):.3g}° off the "
+            f"nadir; roll {roll:.4g}°, pitch {pitch:.4g}° in the navigation); the likely "
+            "causes: the navigation's attitude in another convention (the body upside down, z "
+            f"up instead of down), the boresight of {str(sensor)!r}, or angles in radians "
+            "where degrees are expected"
+        )
     if not (np.all(np.isfinite(ang)) and np.all(ang < 80.0)):
-        p = np.asarray(pixels)[..., 0] if np.ndim(pixels) == 2 else np.asarray(pixels)
         raise InputError(
             f"sensor file {str(sensor)!r}: the pixels {p.min():g}…{p.max():g} px of the LINES "
             f"file look {np.nanmin(ang):.3g}…{np.nanmax(ang):.3g}° off the nadir (over 80°, or "

@@ -517,6 +517,7 @@ def adjust_files(
     traj = read_trajectory(trajectory)
     cam = read_camera(camera)
     obs, ids = _observations(obs_df, observations, trajectory, traj, cam, max_nav_gap_s)
+    _check_node_memory(obs.t_s, node_interval_s)
     gi = gx = None
     if gcp is not None:
         gi, gx = _read_gcp(gcp, ids, observations, trajectory, traj)
@@ -601,6 +602,24 @@ def _read_gcp(gcp, ids, observations, trajectory, traj):
     return gi, gx
 
 
+def _check_node_memory(t_s, node_interval_s: float) -> None:
+    """The trajectory corrections' nodes fit in memory: their 6 unknowns each meet in the
+    reduced normal matrix, dense (8 bytes a cell, and its factor beside it).
+    """
+    from hsgeo.trajectory import SplineNodes
+    from hsgeo.validate import check_memory
+
+    span = float(np.max(t_s) - np.min(t_s))
+    n_nodes = SplineNodes(float(np.min(t_s)), float(np.max(t_s)), float(node_interval_s)).n_nodes
+    n_c = 6 * n_nodes
+    check_memory(
+        2 * 8.0 * float(n_c) ** 2,
+        f"--node-interval {node_interval_s:g} s over the observations' {span:.6g} s "
+        f"({n_nodes} nodes, a reduced normal matrix of {n_c} x {n_c})",
+        "use a longer --node-interval (002 §4: 10 s)",
+    )
+
+
 def summary(res, nodes, point_ids, n_observations_2d: int, node_interval_s: float) -> dict:
     """What ``hsgeo adjust-pushbroom`` reports of a solve: counts, σ0, the camera parameters
     (:data:`REPORTED_PARAMETERS`) with σ̂, the node corrections, the points and the fit verdict.
@@ -667,15 +686,17 @@ def fit_verdict(res, n_observations_2d: int) -> dict:
         reasons.append("σ0 is not finite: the observations do not determine the unknowns")
     elif s0 > POOR_FIT_SIGMA0_FACTOR or s0 < 1 / POOR_FIT_SIGMA0_FACTOR:
         reasons.append(
-            f"σ0 = {s0:.3g}: the model does not fit the data by a factor of {max(s0, 1 / s0):.3g}"
-            " — are the navigation angles in degrees (roll_deg, pitch_deg, heading_deg), the"
-            " camera's c_mm and pixel_mm right, and the a-priori σ of the camera file realistic?"
+            f"σ0 = {s0:.3g}: the model does not fit the data by a factor of {max(s0, 1 / s0):.3g};"
+            " the likely causes: a unit — image coordinates x_px, y_px not in pixels (in mm?),"
+            " navigation angles not in degrees (roll_deg, pitch_deg, heading_deg), the camera's"
+            " c_mm, pixel_mm or lever_arm_m in"
+            " another unit — or an a-priori σ of the camera file that is not realistic"
         )
     if share > POOR_FIT_REJECTED_SHARE:
         reasons.append(
             f"{100 * share:.1f} % of the observations were rejected as outliers (more than "
-            f"{100 * POOR_FIT_REJECTED_SHARE:.0f} %): look for a GCP or a point_id that is wrong"
-            " in the input tables"
+            f"{100 * POOR_FIT_REJECTED_SHARE:.0f} %); the likely causes: a wrong GCP or point_id in"
+            " the input tables, or observations in another unit than pixels"
         )
     return {
         "sigma0": s0,
