@@ -204,7 +204,9 @@ HEADLINE = (
 
 def unmodelled_rows(rows_on: list[Row], rows_off: list[Row], res_on, res_off) -> list[Row]:
     """The table ``"unmodelled effect"``: the headline numbers (:data:`HEADLINE`) with the EOP
-    drift across the bands on (the default) and off, same seed and noise draws.
+    drift across the bands on (the default) and off, same seed and noise draws; quantities
+    ``eop_drift_{on,off}.[per_band.|joint.]<quantity of the chapter's table>`` (``per_band``: the
+    mean ROP of 003 Table 4, ``joint``: the joint model).
     """
     out = []
     for state, rows, res in (("on", rows_on, res_on), ("off", rows_off, res_off)):
@@ -213,13 +215,14 @@ def unmodelled_rows(rows_on: list[Row], rows_off: list[Row], res_on, res_off) ->
             if q == "rms_px":
                 r = res.joint.residuals_px
                 rms = float(np.sqrt(np.mean(np.sum(r**2, axis=1))))
-                out.append(Row("unmodelled effect", f"eop_drift_{state}.joint_rms_px", "px",
+                out.append(Row("unmodelled effect", f"eop_drift_{state}.joint.rms_px", "px",
                                reproduced=rms))  # fmt: skip
                 continue
             if (t, q) not in by:
                 continue
             r = by[(t, q)]
-            name = f"eop_drift_{state}.{'joint_' if t == 'joint model' else ''}{q}"
+            ctx = {"joint model": "joint.", "003 Table 4 ROP": "per_band."}.get(t, "")
+            name = f"eop_drift_{state}.{ctx}{q}"
             out.append(
                 Row(
                     "unmodelled effect",
