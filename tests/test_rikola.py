@@ -34,7 +34,9 @@ def cfg():
 
 @pytest.fixture(scope="module")
 def truth(cfg):
-    return make_truth(cfg, np.random.default_rng([7, 0]), n_cubes=8)
+    # the estimator's own model: without the EOP drift across the bands (the unmodelled
+    # effect of the chapter, tested below)
+    return make_truth(cfg, np.random.default_rng([7, 0]), n_cubes=8, eop_drift=False)
 
 
 @pytest.fixture(scope="module")
@@ -195,7 +197,7 @@ def test_bad_inputs():
 
 
 def test_truth_and_render_deterministic(cfg, truth):
-    t2 = make_truth(cfg, np.random.default_rng([7, 0]), n_cubes=8)
+    t2 = make_truth(cfg, np.random.default_rng([7, 0]), n_cubes=8, eop_drift=False)
     np.testing.assert_array_equal(t2.poses, truth.poses)
     np.testing.assert_array_equal(t2.f_mm, truth.f_mm)
     r = Renderer(cfg, truth)
@@ -325,4 +327,139 @@ def test_chapter_parameters_are_the_scenario_and_the_paper(cfg):
     assert rop == p["rop_deg"] == tuple(RIKOLA_TABLE4_ROP_MEAN_DEG)
     assert cfg["geometry"]["n_cubes"] == p["n_cubes_paper"] == 20
     assert cfg["measure"]["sigma_px"] == p["sigma_px"]
+    assert cfg["eop_drift"]["dphi_deg_per_band"] == p["dphi_deg_per_band"]
     assert p["scale"] == 1.0 and isinstance(p["SEED"], int)
+
+
+# --- the unmodelled effect: the drift of the EOPs across the bands (003 Fig. 5) ----------------
+def _without_drift_section(cfg):
+    return {k: v for k, v in cfg.items() if k != "eop_drift"}
+
+
+def test_eop_drift_off_is_the_bench_without_it_bitwise(cfg, truth):
+    """Switched off, the drift leaves the old bench: the same truth and the same pixels as a
+    scenario without the [eop_drift] section; switched on, the same random draws."""
+    old = make_truth(_without_drift_section(cfg), np.random.default_rng([7, 0]), n_cubes=8)
+    on = make_truth(cfg, np.random.default_rng([7, 0]), n_cubes=8)
+    assert old.drift_rad is None and truth.drift_rad is None and on.drift_rad is not None
+    for t in (truth, on):
+        for f in ("f_mm", "pp_mm", "KP", "rotation_rad", "poses", "gap_model"):
+            np.testing.assert_array_equal(getattr(t, f), getattr(old, f))
+    for c, b in ((0, 5), (3, 20)):
+        np.testing.assert_array_equal(truth.band_pose(c, b), old.band_pose(c, b))
+    img_old = Renderer(_without_drift_section(cfg), old).render(1, 5, 3)
+    np.testing.assert_array_equal(Renderer(cfg, truth).render(1, 5, 3), img_old)
+    assert not np.array_equal(Renderer(cfg, on).render(1, 5, 3), img_old)
+
+
+def test_eop_drift_moves_the_rop_and_the_image_as_expected(cfg):
+    """On: (a) the ROP of a pair (k, k + 10) from the true band poses is the rigid rotation
+    plus the drift difference of the two bands, −10 × the slope in φ (small rotations add);
+    (b) a band's image of a point on the optical axis moves by f·tan(Δφ) against the rigid
+    camera, zero at the reference band."""
+    on = make_truth(cfg, np.random.default_rng([7, 0]), n_cubes=8)
+    off = make_truth(cfg, np.random.default_rng([7, 0]), n_cubes=8, eop_drift=False)
+    slope = np.deg2rad(cfg["eop_drift"]["dphi_deg_per_band"])
+    ref = cfg["eop_drift"]["reference_band"]
+    for k in (2, 5, 9):
+        for c in (0, 4):
+            ang, _ = relative_orientation(on.band_pose(c, k + 10), on.band_pose(c, k))
+            expect = on.rotation_rad + np.array([0.0, -10 * slope, 0.0])
+            np.testing.assert_allclose(ang, expect, rtol=0, atol=2e-7)  # effect: 1.4e-4 rad
+            assert abs(ang[1] - on.rotation_rad[1]) > 100 * 2e-7
+    for b in (11, ref, 20, 25):
+        pose = off.band_pose(0, b)
+        R = R_from_opk(*pose[:3])
+        X = pose[3:] + R @ np.array([0.0, 0.0, -1400.0])  # on the rigid camera's axis
+        dx = on.project(0, b, X[None]) - off.project(0, b, X[None])
+        f = on.interior(b)[0]
+        dphi = slope * (b - ref)
+        np.testing.assert_allclose(np.abs(dx[0, 0]), f * np.tan(abs(dphi)), rtol=1e-3, atol=1e-12)
+        assert abs(dx[0, 1]) < 1e-3 * max(abs(dx[0, 0]), 1e-9) + 1e-12
+
+
+def test_calibrate_rikola_is_the_steps_it_names(bench):
+    """The in-memory core gives the same per-band and joint results as calling the steps
+    (bitwise), and its to_dict is plain JSON."""
+    import json
+
+    from hsgeo.workflows.rikola import RikolaOptions, calibrate_rikola, mean_relative_orientation
+
+    obs, bands, _ = bench
+    res = calibrate_rikola(obs, RikolaOptions(scatter_mm=(0.0035, 0.0028)))
+    assert res.pairs == [(2, 12), (10, 20)]
+    for b in (5, 20):
+        np.testing.assert_array_equal(
+            res.bands[b].value("interior"), calibrate_band(obs, b).value("interior")
+        )
+    cals = {b: calibrate_band(obs, b) for b in bands}
+    m = mean_relative_orientation(cals, obs, np.arange(8), res.pairs)
+    np.testing.assert_array_equal(res.relative["rop_mean"], m["rop_mean"])
+    j = calibrate_joint(obs, init=cals, sigma_px=res.sigma_px_joint, scatter_mm=(0.0035, 0.0028))
+    np.testing.assert_array_equal(res.joint.value("sensor2_rotation"), j.value("sensor2_rotation"))
+    d = json.loads(json.dumps(res.to_dict(), allow_nan=False))
+    assert set(d["tables"]) >= {"interior band 5", "relative orientation", "joint model"}
+    assert d["tables"]["relative orientation"][1]["quantity"] == "dphi"
+
+
+# --- the common sensor face (hsgeo.sensors.mount) -------------------------------------------
+def _camera(truth, mount=None):
+    from hsgeo.sensors.mount import Mount
+    from hsgeo.sensors.rikola import RikolaCamera
+
+    return RikolaCamera(
+        tuple(truth.f_mm),
+        tuple(truth.bands["sensor"]),
+        truth.pp_mm,
+        tuple(truth.KP),
+        tuple(truth.rotation_rad),
+        (0.4, -0.3, 0.2),  # an offset, so that the sensor-II branch is exercised
+        mount=mount or Mount(),
+    )
+
+
+@pytest.mark.parametrize("with_mount", [False, True])
+def test_rikola_camera_round_trip(truth, with_mount):
+    from hsgeo.sensors.mount import Mount, Sensor
+
+    mount = (
+        Mount.from_rpy(np.deg2rad([0.4, -0.3, 0.8]), (30.0, -20.0, 50.0)) if with_mount else None
+    )
+    cam = _camera(truth, mount)
+    assert isinstance(cam, Sensor)
+    rng = np.random.default_rng(3)
+    n = 300
+    uv = np.column_stack([rng.uniform(5, 1011, n), rng.uniform(5, 642, n)])
+    view = rng.integers(0, 8, n)
+    band = rng.choice([1, 5, 10, 11, 16, 25], n)
+    o, d = cam.rays(uv, truth.poses, view, band)
+    np.testing.assert_allclose(np.linalg.norm(d, axis=1), 1.0, atol=1e-15)
+    X = o + rng.uniform(800, 2000, n)[:, None] * d
+    np.testing.assert_allclose(cam.project(X, truth.poses, view, band), uv, rtol=0, atol=1e-9)
+    with pytest.raises(InputError):
+        cam.project(X[:2], truth.poses, view[:2], 26)
+
+
+def test_rikola_camera_projects_as_the_simulator():
+    """Independent: the simulator's band poses (opk composition of R_I_from_II, its own offset)
+    and, without distortion, the pinhole by hand."""
+    cfg = load_scenario("rikola_bench")
+    t = make_truth(cfg, np.random.default_rng([2, 0]), n_cubes=3, eop_drift=False)
+    t.offset_mm = np.array([0.4, -0.3, 0.2])
+    cam = _camera(t)
+    X = Plate.from_config(cfg["plate"]).corners().reshape(-1, 3)
+    for c, b in ((0, 3), (1, 14), (2, 25)):
+        view = np.full(len(X), c)
+        ref = mm_to_pixel(t.project(c, b, X), (1017, 648), 0.0055)
+        np.testing.assert_allclose(cam.project(X, t.poses, view, b), ref, rtol=0, atol=1e-9)
+    flat = dataclasses.replace(cam, KP=(0.0,) * 5, offset_mm=(0.0, 0.0, 0.0))
+    t.offset_mm = np.zeros(3)
+    pose = t.band_pose(0, 3)
+    Xc = (X - pose[3:]) @ R_from_opk(*pose[:3])
+    xy = -t.f_mm[2] * Xc[:, :2] / Xc[:, 2:3] + t.pp_mm[1]
+    np.testing.assert_allclose(
+        flat.project(X, t.poses, np.zeros(len(X), int), 3),
+        mm_to_pixel(xy, (1017, 648), 0.0055),
+        rtol=0,
+        atol=1e-9,
+    )

@@ -119,3 +119,46 @@ def test_bad_board_files(tmp_path, capsys):
         == 2
     )
     assert "--band-regex" in capsys.readouterr().err
+
+
+def test_rikola_files_front_end_recovers_truth(tmp_path):
+    """calibrate_rikola_files: image files named by cube and band, a board file → per-band
+    interior orientation and the relative orientation of the sensors within 3.5σ̂ of the truth."""
+    import cv2
+
+    from hsgeo.measure.aruco import to_uint8
+    from hsgeo.simulate.rikola import Renderer, make_truth
+    from hsgeo.simulate.scenarios import load_scenario
+    from hsgeo.workflows.rikola import RikolaOptions, calibrate_rikola_files
+
+    cfg = load_scenario("rikola_bench")
+    truth = make_truth(cfg, np.random.default_rng([5, 0]), n_cubes=6, eop_drift=False)
+    r = Renderer(cfg, truth)
+    files = []
+    for c in range(6):
+        for b in (10, 20):
+            p = tmp_path / f"cube{c}_band{b}.png"
+            cv2.imwrite(str(p), to_uint8(r.render(c, b, 5)))
+            files.append(p)
+    board = tmp_path / "plate.toml"
+    board.write_text(
+        '[board]\ntype = "aruco_grid"\ndictionary = "DICT_4X4_100"\n'
+        "markers_x = 9\nmarkers_y = 6\nmarker_mm = 60.0\nseparation_mm = 20.0\n"
+        "[camera]\npixel_mm = 0.0055\n"
+    )
+    res = calibrate_rikola_files(
+        files,
+        board,
+        band_regex=r"band(\d+)",
+        cube_regex=r"cube(\d+)",
+        options=RikolaOptions(joint=False),
+    )
+    assert res.pairs == [(10, 20)] and res.joint is None
+    for b in (10, 20):
+        iop = res.bands[b].iop
+        for q, t in zip(("f_mm", "x0_mm", "y0_mm"), truth.interior(b), strict=True):
+            assert abs(iop[q][0] - t) < 3.5 * iop[q][1], (b, q)
+    z = (res.relative["rop_mean"] - truth.rotation_rad) / res.relative["rop_mean_sigma"]
+    assert np.all(np.abs(z) < 3.5), z
+    d = json.loads(json.dumps(res.to_dict(), allow_nan=False))
+    assert d["tables"]["relative orientation"][0]["unit"] == "deg"

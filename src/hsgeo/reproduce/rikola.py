@@ -10,9 +10,7 @@ import time
 
 import numpy as np
 
-from hsgeo.adjust import identifiability
 from hsgeo.measure.aruco import detection_rate
-from hsgeo.measure.targets import Observations
 from hsgeo.papers import (
     RIKOLA_BANDS,
     RIKOLA_TABLE3,
@@ -21,21 +19,26 @@ from hsgeo.papers import (
     RIKOLA_TABLE4_ROP_MEAN_DEG,
 )
 from hsgeo.report import Reproduction, Row
+from hsgeo.reproduce.rikola_analyses import (
+    band_identifiability,
+    corner_bias,
+    drift_reasons,
+    predict_per_band,
+    rop_transformation_test,
+    unmodelled_rows,
+)
 from hsgeo.sensors.frame import mm_to_pixel
 from hsgeo.workflows.rikola import (
-    band_problem,
-    calibrate_band,
+    RikolaOptions,
     calibrate_joint,
+    calibrate_rikola,
     detect_targets_in_images,
     gap_regression,
-    mean_relative_orientation,
     predict_band,
-    predict_per_band,
     relative_orientation,
-    rop_transformation_test,
 )
 
-__all__ = ["run", "setup", "observe", "corner_bias", "band_identifiability"]
+__all__ = ["run", "setup", "observe", "campaign", "corner_bias", "band_identifiability"]
 
 SMALL_BANDS = (1, 2, 5, 8, 10, 11, 12, 15, 16, 20)
 HELD_OUT = (8, 16)  # one band of each sensor, inside the gap range
@@ -105,51 +108,11 @@ def observe(
     return obs, obs_cmp, images, expected
 
 
-def band_identifiability(obs: Observations, band: int, truth) -> object:
-    """Rank of the per-band design at the truth (:func:`hsgeo.adjust.identifiability`)."""
-    p, blk, cubes = band_problem(obs, band, 9.0, 0.02)
-    p.set("interior", truth.interior(band))
-    p.set("distortion_mm", truth.KP)
-    p.set("poses", np.array([truth.band_pose(int(c), band) for c in cubes]))
-    return identifiability(p, blk)
-
-
-def corner_bias(obs: Observations, truth) -> dict[int, dict[str, float]]:
-    """Corner displacement with exposure (003 §3.2), per band, against the simulated truth.
-
-    Returns
-    -------
-    dict band -> ``outward_px`` (mean displacement of the detected corners away from the
-    target's centre; negative: the target looks smaller), ``scale`` (mean ratio of detected to
-    true side length, the paper's scale factor), ``centroid_mean_px`` (x, y) and
-    ``centroid_sd_px`` (x, y) of the centroid error.
+def setup(seed: int = 0, scale: float = 1.0, *, eop_drift: bool = True):
+    """Configuration, truth, cubes and bands for a seed and size; ``eop_drift``: simulate the
+    drift of the EOPs across the bands (:func:`hsgeo.simulate.rikola.eop_drift_rad`; the same
+    random draws either way).
     """
-    out = {}
-    for b in np.unique(obs.band):
-        o = obs.select(obs.band == b)
-        true = np.stack(
-            [
-                mm_to_pixel(truth.project(int(c), int(b), X), obs.image_size, obs.pixel_mm)
-                for c, X in zip(o.cube, o.corners_obj, strict=True)
-            ]
-        )
-        e = o.corners_px - true
-        centre = true.mean(axis=1, keepdims=True)
-        u = true - centre
-        u /= np.linalg.norm(u, axis=-1, keepdims=True)
-        side = lambda c: np.linalg.norm(np.roll(c, -1, axis=1) - c, axis=-1)  # noqa: E731
-        ce = o.centroids_px - true.mean(axis=1)
-        out[int(b)] = {
-            "outward_px": float(np.mean(np.sum(e * u, axis=-1))),
-            "scale": float(np.mean(side(o.corners_px) / side(true))),
-            "centroid_mean_px": ce.mean(axis=0).tolist(),
-            "centroid_sd_px": ce.std(axis=0).tolist(),
-        }
-    return out
-
-
-def setup(seed: int = 0, scale: float = 1.0):
-    """Configuration, truth, cubes and bands for a seed and size."""
     from hsgeo.simulate.rikola import make_truth
     from hsgeo.simulate.scenarios import load_scenario
 
@@ -159,14 +122,21 @@ def setup(seed: int = 0, scale: float = 1.0):
         n_cubes, bands = n_full, tuple(int(b) for b in RIKOLA_BANDS["band"])
     else:
         n_cubes, bands = max(8, int(round(n_full * scale))), SMALL_BANDS
-    truth = make_truth(cfg, np.random.default_rng([int(seed), 0]), n_cubes=n_cubes)
+    rng = np.random.default_rng([int(seed), 0])
+    truth = make_truth(cfg, rng, n_cubes=n_cubes, eop_drift=eop_drift)
     return cfg, truth, list(range(n_cubes)), list(bands)
 
 
-def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
-    """The chapter's tables; below scale 1: 8 cubes × 10 bands instead of 20 × 25."""
-    t_start = time.time()
-    cfg, truth, cubes, bands = setup(seed, scale)
+def campaign(cfg: dict, truth, seed: int, cubes, bands, *, contour: bool = True) -> dict:
+    """Render and measure the bench, then calibrate it as a user would
+    (:func:`hsgeo.workflows.rikola.calibrate_rikola`) and predict the held-out bands.
+
+    Returns
+    -------
+    dict with ``obs``, ``obs_contour`` (None without ``contour``), ``images``, ``expected``,
+    ``result`` (:class:`~hsgeo.workflows.rikola.RikolaResult`), ``held`` (RMS per held-out band
+    and route) and ``seconds``.
+    """
     sigma_px = float(cfg["measure"]["sigma_px"])
     t0 = time.time()
     obs, obs_contour, images, expected = observe(
@@ -175,35 +145,66 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
         seed,
         cubes,
         bands,
-        compare_refine="contour",
+        compare_refine="contour" if contour else None,
         keep_images=[(ROP_CUBE, b) for b in (1, 5, 20)],
     )
     t_observe = time.time() - t0
-    # 003 §3.3: every band its own camera
     t0 = time.time()
-    cals = {b: calibrate_band(obs, b, sigma_px=sigma_px) for b in bands}
-    t_bands = time.time() - t0
-    rows: list[Row] = []
-    tbl = RIKOLA_BANDS
-    # --- 003 Table 3
+    res = calibrate_rikola(obs, RikolaOptions(sigma_px=sigma_px))
+    t_cal = time.time() - t0
+    t0 = time.time()
+    held = held_out(res, obs, truth, bands)
+    return {
+        "obs": obs,
+        "obs_contour": obs_contour,
+        "images": images,
+        "expected": expected,
+        "result": res,
+        "held": held,
+        "seconds": {"observe": t_observe, "calibrate": t_cal, "held_out": time.time() - t0},
+    }
+
+
+def held_out(res, obs, truth, bands) -> dict[int, dict[str, float]]:
+    """RMS prediction error (px) of each band of :data:`HELD_OUT` left out of the joint model:
+    the joint model, the joint model with the band's true f (an oracle), the per-band route of
+    003 §3.5, and the band's own calibration.
+    """
+    cals, held = res.bands, {}
+    for h in HELD_OUT:
+        if h not in bands:
+            continue
+        jh = calibrate_joint(
+            obs,
+            exclude_bands=[h],
+            sigma_px=res.sigma_px_joint,
+            scatter_mm=res.scatter_mm,
+            init={b: c for b, c in cals.items() if b != h},
+        )
+        # the same prediction with the band's true focal length (an oracle): what is left is
+        # the error of everything but f
+        gm = jh.result.params.values()["gap_model"]
+        s_row = RIKOLA_BANDS["sensor"] - 1
+        line = gm[s_row, 0] * RIKOLA_BANDS["gap_nm"] + gm[s_row, 1]
+        held[h] = {
+            "joint": _rms(predict_band(jh, obs, h)),
+            "joint_true_f": _rms(predict_band(jh, obs, h, df_mm=truth.f_mm - line)),
+            "per_band": _rms(predict_per_band(cals, obs, h, bands)),
+            "calibrated": _rms(cals[h].residuals_px),
+        }
+    return held
+
+
+_TABLE3_TRUTH = ("f_mm", "x0_mm", "y0_mm", "K1_per_mm2", "K2_per_mm4", "K3_per_mm6")
+_TABLE3_TRUTH += ("P1_per_mm", "P2_per_mm")
+
+
+def table3_rows(cals: dict, truth) -> list[Row]:
+    """003 Table 3: the IOP of bands 5 and 20 and their σ0²."""
+    rows = []
     for b in TABLE3_BANDS:
         c = cals[b]
-        tr = dict(
-            zip(
-                (
-                    "f_mm",
-                    "x0_mm",
-                    "y0_mm",
-                    "K1_per_mm2",
-                    "K2_per_mm4",
-                    "K3_per_mm6",
-                    "P1_per_mm",
-                    "P2_per_mm",
-                ),
-                np.r_[truth.interior(b), truth.KP],
-                strict=True,
-            )
-        )
+        tr = dict(zip(_TABLE3_TRUTH, np.r_[truth.interior(b), truth.KP], strict=True))
         for q, (v, s) in c.iop.items():
             pv, ps = RIKOLA_TABLE3[b][q]
             unit = q.split("_", 1)[1] if "_" in q else ""
@@ -253,17 +254,15 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
                 provenance="chosen",
             )
         )
-    # --- 003 Table 4 (first): ROP from pairs (k, k+10). The paper uses one cube; the ROPs of
-    # one cube share that cube's systematic centroid errors (their spread understates the
-    # error), so every cube is used: rop_all[pair, cube], and σ̂ of the mean from the scatter
-    # of the per-cube means between cubes.
-    pairs = [(k, k + 10) for k in range(1, 11) if k in cals and k + 10 in cals]
-    rop_all = np.array(
-        [
-            [relative_orientation(cals[k1].pose(c), cals[k2].pose(c))[0] for c in cubes]
-            for k2, k1 in pairs
-        ]
-    )  # k2 sensor II, k1 sensor I
+    return rows
+
+
+def rop_rows(res, obs, truth) -> tuple[list[Row], dict]:
+    """003 Table 4 (first): the mean ROP over the pairs (k, k + 10) and all cubes (the paper
+    uses one cube; the ROPs of one cube share that cube's systematic centroid errors, so every
+    cube is used), cube 0 alone with its σ̂, and the transformation test of 003 §3.4.
+    """
+    cals, pairs, rel = res.bands, res.pairs, res.relative
     rop_cov = [
         relative_orientation(
             cals[k1].pose(ROP_CUBE),
@@ -273,69 +272,69 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
         )[1]
         for k2, k1 in pairs
     ]
-    m = mean_relative_orientation(cals, obs, cubes, pairs, rop_all=rop_all)
-    rop, rop_mean, rop_mean_sigma = m["rop_pairs"], m["rop_mean"], m["rop_mean_sigma"]
-    pb_clusters, deff_pairs = m["band_clusters"], m["deff_pairs"]
-    rop_cube0 = rop_all[:, cubes.index(ROP_CUBE)]
-    for i, q in enumerate(("domega_deg", "dphi_deg", "dkappa_deg")):
-        rows.append(
-            Row(
-                "003 Table 4 ROP",
-                q,
-                "deg",
-                RIKOLA_TABLE4_ROP_MEAN_DEG[i],
-                None,
-                np.rad2deg(rop_mean[i]),
-                np.rad2deg(rop_mean_sigma[i]),
-                np.rad2deg(truth.rotation_rad[i]),
-                provenance="paper",
-            )
+    rop_mean, rop_mean_sigma = rel["rop_mean"], rel["rop_mean_sigma"]
+    rows = [
+        Row(
+            "003 Table 4 ROP",
+            q,
+            "deg",
+            RIKOLA_TABLE4_ROP_MEAN_DEG[i],
+            None,
+            np.rad2deg(rop_mean[i]),
+            np.rad2deg(rop_mean_sigma[i]),
+            np.rad2deg(truth.rotation_rad[i]),
+            provenance="paper",
         )
-    # transformation test (003 §3.4): discrepancies of the sensor-II centroids from the
-    # sensor-I ones of the same cube and target, before and after applying the mean ROP
-    disc = rop_transformation_test(obs, cals, pairs, rop_mean, ROP_CUBE)
-    # --- 003 Table 4 (second): f against gap, bands 1 and 11 excluded (003 §3.5)
-    gaps, f_hat, f_sig = {}, {}, {}
-    reg, reg_truth = {}, {}
+        for i, q in enumerate(("domega_deg", "dphi_deg", "dkappa_deg"))
+    ]
+    out = {
+        "rop_cube0": rel["rop_all"][:, int(np.flatnonzero(res.cubes == ROP_CUBE)[0])],
+        "rop_cov": rop_cov,
+        # transformation test (003 §3.4): discrepancies of the sensor-II centroids from the
+        # sensor-I ones of the same cube and target, before and after applying the mean ROP
+        "disc": rop_transformation_test(obs, cals, pairs, rop_mean, ROP_CUBE),
+    }
+    return rows, out
+
+
+def gap_rows(res, truth) -> tuple[list[Row], dict]:
+    """003 Table 4 (second): f against the gap per sensor, bands 1 and 11 excluded (§3.5)."""
+    rows, reg_truth = [], {}
     for s in (1, 2):
-        bs = [b for b in bands if tbl["sensor"][b - 1] == s and b not in (1, 11)]
-        g = tbl["gap_nm"][np.array(bs) - 1]
-        fh = np.array([cals[b].value("interior")[0] for b in bs])
-        gaps[s], f_hat[s] = g, fh
-        f_sig[s] = np.array([cals[b].sigma("interior")[0] for b in bs])
-        reg[s] = gap_regression(g, fh)
-        reg_truth[s] = gap_regression(g, truth.f_mm[np.array(bs) - 1])
+        g = res.gap[s]
+        reg = g["line"]
+        reg_truth[s] = gap_regression(g["gap_nm"], truth.f_mm[np.array(g["bands"]) - 1])
         pm = RIKOLA_TABLE4_GAP_MODEL[s]
+        t = "003 Table 4 gap model"
+        tg = truth.gap_model[s - 1]
         rows += [
             Row(
-                "003 Table 4 gap model",
+                t,
                 f"a_sensor{s}_mm_per_nm",
                 "mm/nm",
-                pm["a_mm_per_nm"][0],
-                pm["a_mm_per_nm"][1],
-                reg[s]["a"],
-                reg[s]["sigma_a"],
-                truth.gap_model[s - 1, 0],
+                *pm["a_mm_per_nm"],
+                reg["a"],
+                reg["sigma_a"],
+                tg[0],
                 provenance="paper",
-            ),
+            ),  # fmt: skip
             Row(
-                "003 Table 4 gap model",
+                t,
                 f"b_sensor{s}_mm",
                 "mm",
-                pm["b_mm"][0],
-                pm["b_mm"][1],
-                reg[s]["b"],
-                reg[s]["sigma_b"],
-                truth.gap_model[s - 1, 1],
+                *pm["b_mm"],
+                reg["b"],
+                reg["sigma_b"],
+                tg[1],
                 provenance="paper",
-            ),
+            ),  # fmt: skip
             Row(
-                "003 Table 4 gap model",
+                t,
                 f"r2_sensor{s}",
                 "%",
                 pm["r2_percent"],
                 None,
-                100 * reg[s]["r2"],
+                100 * reg["r2"],
                 None,
                 100 * reg_truth[s]["r2"],
                 # the scatter of f about the gap line was chosen to give the paper's R² in
@@ -343,8 +342,12 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
                 provenance="tuned",
             ),
         ]
-    # --- 003 §3.2: corners move with exposure, centroids do not (against the truth)
-    biases = {"contour": corner_bias(obs_contour, truth), "subpix": corner_bias(obs, truth)}
+    return rows, reg_truth
+
+
+def corner_rows(biases: dict) -> list[Row]:
+    """003 §3.2: corners move with exposure, centroids do not (against the truth)."""
+    rows = []
     for name, bb in biases.items():
         o = np.array([v["outward_px"] for v in bb.values()])
         cm = np.array([v["centroid_mean_px"] for v in bb.values()])
@@ -356,224 +359,190 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
             Row(t, f"centroid_bias_max_{name}", "px", reproduced=float(np.abs(cm).max())),
             Row(t, f"centroid_sd_{name}", "px", reproduced=float(cs.mean())),
         ]
-    # --- the joint model (003 §3.5 future work); σ of a centroid from the per-band σ0
-    sigma0_pool = float(np.sqrt(np.mean([c.result.sigma0**2 for c in cals.values()])))
-    sigma_joint = sigma_px * sigma0_pool
-    f_sd = np.sqrt(np.mean(np.concatenate(list(f_sig.values())) ** 2))
-    scatter = tuple(
-        float(np.sqrt(max(reg[s]["s"] ** 2 - f_sd**2, (0.5 * f_sd) ** 2))) for s in (1, 2)
-    )
-    t0 = time.time()
-    joint = calibrate_joint(obs, sigma_px=sigma_joint, scatter_mm=scatter, init=cals)
-    t_joint = time.time() - t0
-    R = joint  # value() and sigma() with the design effect of the target clusters
-    jrows = [
+    return rows
+
+
+def joint_rows(joint, truth) -> list[Row]:
+    """The joint model (003 §3.5 future work); σ̂ with the design effect of the clusters."""
+    R, t = joint, "joint model"
+    gm, sg = R.value("gap_model"), R.sigma("gap_model")
+    rows = []
+    for i, (q, u) in enumerate(
         (
-            "a_sensor1_mm_per_nm",
-            "mm/nm",
-            R.value("gap_model")[0, 0],
-            R.sigma("gap_model")[0, 0],
-            truth.gap_model[0, 0],
-            RIKOLA_TABLE4_GAP_MODEL[1],
-        ),
-        (
-            "b_sensor1_mm",
-            "mm",
-            R.value("gap_model")[0, 1],
-            R.sigma("gap_model")[0, 1],
-            truth.gap_model[0, 1],
-            None,
-        ),
-        (
-            "a_sensor2_mm_per_nm",
-            "mm/nm",
-            R.value("gap_model")[1, 0],
-            R.sigma("gap_model")[1, 0],
-            truth.gap_model[1, 0],
-            None,
-        ),
-        (
-            "b_sensor2_mm",
-            "mm",
-            R.value("gap_model")[1, 1],
-            R.sigma("gap_model")[1, 1],
-            truth.gap_model[1, 1],
-            None,
-        ),
-    ]
-    paper_gap = {
-        "a_sensor1_mm_per_nm": RIKOLA_TABLE4_GAP_MODEL[1]["a_mm_per_nm"],
-        "b_sensor1_mm": RIKOLA_TABLE4_GAP_MODEL[1]["b_mm"],
-        "a_sensor2_mm_per_nm": RIKOLA_TABLE4_GAP_MODEL[2]["a_mm_per_nm"],
-        "b_sensor2_mm": RIKOLA_TABLE4_GAP_MODEL[2]["b_mm"],
-    }
-    for q, u, v, s, t, _ in jrows:
-        rows.append(
-            Row("joint model", q, u, paper_gap[q][0], paper_gap[q][1], v, s, t, provenance="paper")
+            ("a_sensor1_mm_per_nm", "mm/nm"),
+            ("b_sensor1_mm", "mm"),
+            ("a_sensor2_mm_per_nm", "mm/nm"),
+            ("b_sensor2_mm", "mm"),
         )
+    ):
+        s, k = divmod(i, 2)
+        paper = RIKOLA_TABLE4_GAP_MODEL[s + 1]["a_mm_per_nm" if k == 0 else "b_mm"]
+        rows.append(
+            Row(
+                t,
+                q,
+                u,
+                paper[0],
+                paper[1],
+                gm[s, k],
+                sg[s, k],
+                truth.gap_model[s, k],
+                provenance="paper",
+            )  # fmt: skip
+        )
+    pp, spp = R.value("pp_mm").ravel(), R.sigma("pp_mm").ravel()
     for i, q in enumerate(("x0_sensor1_mm", "y0_sensor1_mm", "x0_sensor2_mm", "y0_sensor2_mm")):
         paper = RIKOLA_TABLE3[20 if i < 2 else 5]["x0_mm" if i % 2 == 0 else "y0_mm"]
         rows.append(
             Row(
-                "joint model",
+                t,
                 q,
                 "mm",
                 paper[0],
                 paper[1],
-                R.value("pp_mm").ravel()[i],
-                R.sigma("pp_mm").ravel()[i],
+                pp[i],
+                spp[i],
                 truth.pp_mm.ravel()[i],
                 provenance="paper",
-            )
+            )  # fmt: skip
         )
+    KP, sKP = R.value("distortion_mm"), R.sigma("distortion_mm")
     for i, q in enumerate(("K1_per_mm2", "K2_per_mm4", "K3_per_mm6", "P1_per_mm", "P2_per_mm")):
-        rows.append(
-            Row(
-                "joint model",
-                q,
-                q.split("_", 1)[1].replace("per_", "1/"),
-                None,
-                None,
-                R.value("distortion_mm")[i],
-                R.sigma("distortion_mm")[i],
-                truth.KP[i],
-            )
-        )
+        unit = q.split("_", 1)[1].replace("per_", "1/")
+        rows.append(Row(t, q, unit, None, None, KP[i], sKP[i], truth.KP[i]))
+    rot, srot = R.value("sensor2_rotation"), R.sigma("sensor2_rotation")
     for i, q in enumerate(("domega_deg", "dphi_deg", "dkappa_deg")):
         rows.append(
             Row(
-                "joint model",
+                t,
                 q,
                 "deg",
                 RIKOLA_TABLE4_ROP_MEAN_DEG[i],
                 None,
-                np.rad2deg(R.value("sensor2_rotation")[i]),
-                np.rad2deg(R.sigma("sensor2_rotation")[i]),
+                np.rad2deg(rot[i]),
+                np.rad2deg(srot[i]),
                 np.rad2deg(truth.rotation_rad[i]),
                 provenance="paper",
-            )
+            )  # fmt: skip
         )
+    off, soff = R.value("sensor2_offset_mm"), R.sigma("sensor2_offset_mm")
     for i, q in enumerate(("tx_mm", "ty_mm", "tz_mm")):
-        rows.append(
-            Row(
-                "joint model",
-                q,
-                "mm",
-                None,
-                None,
-                R.value("sensor2_offset_mm")[i],
-                R.sigma("sensor2_offset_mm")[i],
-                truth.offset_mm[i],
-            )
+        rows.append(Row(t, q, "mm", None, None, off[i], soff[i], truth.offset_mm[i]))
+    rows.append(Row(t, "sigma0", "", None, None, R.result.sigma0, None, 1.0))
+    return rows
+
+
+def result_rows(c: dict, truth) -> tuple[list[Row], dict]:
+    """Every table of a :func:`campaign` but the corner table (which needs the contour
+    refinement), in the chapter's order; and the ROP and regression side results.
+    """
+    res = c["result"]
+    rows = table3_rows(res.bands, truth)
+    r, rop = rop_rows(res, c["obs"], truth)
+    rows += r
+    r, reg_truth = gap_rows(res, truth)
+    rows += r
+    rows += joint_rows(res.joint, truth)
+    for h, v in c["held"].items():
+        rows += [
+            Row("held-out band", f"rms_band{h}_{k}", "px", None, None, x, None, None)
+            for k, x in v.items()
+        ]
+    return rows, {"rop": rop, "regression_truth": reg_truth}
+
+
+def run(seed: int = 0, scale: float = 1.0, *, unmodelled: bool = True) -> Reproduction:
+    """The chapter's tables; below scale 1: 8 cubes × 10 bands instead of 20 × 25.
+
+    ``unmodelled``: simulate the EOP drift across the bands (the default), and add the table
+    ``"unmodelled effect"`` from a second campaign without it (same draws); False: the bench
+    without the drift and without that table.
+    """
+    t_start = time.time()
+    cfg, truth, cubes, bands = setup(seed, scale, eop_drift=unmodelled)
+    c = campaign(cfg, truth, seed, cubes, bands)
+    obs, obs_contour, res = c["obs"], c["obs_contour"], c["result"]
+    cals, joint = res.bands, res.joint
+    rows, side = result_rows(c, truth)
+    rop, reg_truth = side["rop"], side["regression_truth"]
+    biases = {"contour": corner_bias(obs_contour, truth), "subpix": corner_bias(obs, truth)}
+    i = next(k for k, r in enumerate(rows) if r.table == "joint model")
+    rows[i:i] = corner_rows(biases)  # the chapter's order: corners before the joint model
+    meta = _meta(scale, cubes, bands, c, rop)
+    if unmodelled:
+        t0 = time.time()
+        _, truth_off, _, _ = setup(seed, scale, eop_drift=False)
+        c_off = campaign(cfg, truth_off, seed, cubes, bands, contour=False)
+        rows_off, _ = result_rows(c_off, truth_off)
+        rows += unmodelled_rows(rows, rows_off, c["result"], c_off["result"])
+        c["seconds"]["unmodelled_off"] = time.time() - t0
+        slope = float(cfg["eop_drift"]["dphi_deg_per_band"])
+        meta["unmodelled_effect"] = (
+            f"the drift of the EOPs across the bands of a cube (003 Fig. 5): φ of each band's "
+            f"camera frame changes by {slope:g}° a band (chosen, rikola_bench.toml [eop_drift])"
         )
-    rows.append(Row("joint model", "sigma0", "", None, None, R.result.sigma0, None, 1.0))
-    # --- held-out bands: joint model vs the per-band route
-    t0 = time.time()
-    held = {}
-    for h in HELD_OUT:
-        if h not in bands:
-            continue
-        jh = calibrate_joint(
-            obs,
-            exclude_bands=[h],
-            sigma_px=sigma_joint,
-            scatter_mm=scatter,
-            init={b: c for b, c in cals.items() if b != h},
-        )
-        r_joint = predict_band(jh, obs, h)
-        # the same prediction with the band's true focal length (an oracle): what is left is
-        # the error of everything but f
-        vals = {k: v.copy() for k, v in jh.result.params.values().items()}
-        s_row = RIKOLA_BANDS["sensor"] - 1
-        line = vals["gap_model"][s_row, 0] * RIKOLA_BANDS["gap_nm"] + vals["gap_model"][s_row, 1]
-        r_oracle = _predict_with(jh, obs, h, vals, df=truth.f_mm - line)
-        r_perband = predict_per_band(cals, obs, h, bands)
-        held[h] = {
-            "joint": _rms(r_joint),
-            "joint_true_f": _rms(r_oracle),
-            "per_band": _rms(r_perband),
-            "calibrated": _rms(cals[h].residuals_px),
-        }
-        for k, v in held[h].items():
-            rows.append(Row("held-out band", f"rms_band{h}_{k}", "px", None, None, v, None, None))
-    t_held = time.time() - t0
-    meta = {
-        "scale": scale,
-        "n_cubes": len(cubes),
-        "bands": bands,
-        "images": len(cubes) * len(bands),
-        "targets": int(len(obs.cube)),
-        "detection_rate": detection_rate(len(obs.cube), sum(expected.values())),
-        "detection_rate_contour": detection_rate(len(obs_contour.cube), sum(expected.values())),
-        "sigma_px_apriori": sigma_px,
-        "sigma0_pooled_bands": sigma0_pool,
-        "sigma_px_joint": sigma_joint,
-        "df_prior_mm": list(scatter),
-        "rop_pairs": [list(p) for p in pairs],
-        "band_clusters": pb_clusters,
-        "rop_deff_pairs": deff_pairs,
-        "rop_pairs_deg": np.rad2deg(rop).tolist(),
-        "rop_pairs_cube0_deg": np.rad2deg(rop_cube0).tolist(),
-        "rop_cube0_mean_deg": np.rad2deg(rop_cube0.mean(axis=0)).tolist(),
-        "rop_cube0_mean_sigma_deg": np.rad2deg(
-            np.sqrt(np.diag(np.sum(rop_cov, axis=0))) / len(pairs)
-        ).tolist(),
-        "rop_discrepancy_px": disc,
-        "held_out": {str(k): v for k, v in held.items()},
-        "rms_px_per_band": _rms(np.concatenate([c.residuals_px for c in cals.values()])),
-        "rms_px_joint": _rms(joint.residuals_px),
-        "sigma0_joint": R.result.sigma0,
-        "joint_clusters": joint.clusters,
-    }
+        meta["eop_drift_dphi_deg_per_band"] = slope
+        drift_reasons(rows)
+    pairs, rel = res.pairs, res.relative
     # wall times vary from run to run: they stay out of the (bit-reproducible) JSON
     extras = {
         "cfg": cfg,
         "truth": truth,
         "obs": obs,
         "obs_contour": obs_contour,
-        "images": images,
+        "images": c["images"],
+        "result": res,
         "cals": cals,
         "joint": joint,
-        "rop": rop,
-        "rop_cube0": rop_cube0,
-        "rop_cube0_cov": np.array(rop_cov),
+        "rop": rel["rop_pairs"],
+        "rop_cube0": rop["rop_cube0"],
+        "rop_cube0_cov": np.array(rop["rop_cov"]),
         "corner_bias": biases,
-        "rop_all": rop_all,
+        "rop_all": rel["rop_all"],
         "pairs": pairs,
-        "regression": reg,
+        "regression": {s: g["line"] for s, g in res.gap.items()},
         "regression_truth": reg_truth,
-        "gaps": gaps,
-        "f_hat": f_hat,
-        "f_sigma": f_sig,
-        "seconds": {
-            "observe": t_observe,
-            "per_band": t_bands,
-            "joint": t_joint,
-            "held_out": t_held,
-            "total": time.time() - t_start,
-        },
+        "gaps": {s: g["gap_nm"] for s, g in res.gap.items()},
+        "f_hat": {s: g["f_mm"] for s, g in res.gap.items()},
+        "f_sigma": {s: g["f_sigma_mm"] for s, g in res.gap.items()},
+        "seconds": {**c["seconds"], "total": time.time() - t_start},
     }
     return Reproduction("rikola", seed, rows, meta, extras)
 
 
+def _meta(scale, cubes, bands, c, rop) -> dict:
+    obs, res, expected = c["obs"], c["result"], c["expected"]
+    rel, n_expected = res.relative, sum(expected.values())
+    rop_cube0 = rop["rop_cube0"]
+    return {
+        "scale": scale,
+        "n_cubes": len(cubes),
+        "bands": bands,
+        "images": len(cubes) * len(bands),
+        "targets": int(len(obs.cube)),
+        "detection_rate": detection_rate(len(obs.cube), n_expected),
+        "detection_rate_contour": detection_rate(len(c["obs_contour"].cube), n_expected),
+        "sigma_px_apriori": res.options.sigma_px,
+        "sigma0_pooled_bands": res.sigma0_pooled,
+        "sigma_px_joint": res.sigma_px_joint,
+        "df_prior_mm": list(res.scatter_mm),
+        "rop_pairs": [list(p) for p in res.pairs],
+        "band_clusters": rel["band_clusters"],
+        "rop_deff_pairs": rel["deff_pairs"],
+        "rop_pairs_deg": np.rad2deg(rel["rop_pairs"]).tolist(),
+        "rop_pairs_cube0_deg": np.rad2deg(rop_cube0).tolist(),
+        "rop_cube0_mean_deg": np.rad2deg(rop_cube0.mean(axis=0)).tolist(),
+        "rop_cube0_mean_sigma_deg": np.rad2deg(
+            np.sqrt(np.diag(np.sum(rop["rop_cov"], axis=0))) / len(res.pairs)
+        ).tolist(),
+        "rop_discrepancy_px": rop["disc"],
+        "held_out": {str(k): v for k, v in c["held"].items()},
+        "rms_px_per_band": _rms(np.concatenate([b.residuals_px for b in res.bands.values()])),
+        "rms_px_joint": _rms(res.joint.residuals_px),
+        "sigma0_joint": res.joint.result.sigma0,
+        "joint_clusters": res.joint.clusters,
+    }
+
+
 def _rms(r) -> float:
     return float(np.sqrt(np.mean(np.sum(np.asarray(r) ** 2, axis=1))))
-
-
-def _predict_with(joint, obs, band, values, df):
-    from hsgeo.sensors.rikola import JointCentroids
-
-    sel = (obs.band == band) & np.isin(obs.cube, joint.cubes)
-    o = obs.select(sel)
-    blk = JointCentroids(
-        np.searchsorted(joint.cubes, o.cube),
-        np.searchsorted(RIKOLA_BANDS["band"], o.band),
-        o.corners_obj,
-        o.centroids_mm,
-        1.0,
-        RIKOLA_BANDS["gap_nm"],
-        RIKOLA_BANDS["sensor"],
-    )
-    values = dict(values)
-    values["df_mm"] = np.asarray(df, float)
-    return blk.evaluate(values, False)[0].reshape(-1, 2) / obs.pixel_mm * np.array([1.0, -1.0])

@@ -33,25 +33,35 @@ Two residual blocks use it:
   per sensor, one distortion set, and the rotation ``R_I_from_II`` (ω, φ, κ; 003 eq. (1)) and
   offset ``t_I`` (mm, in sensor I's frame) of sensor II, so that
   ``X_camII = R_I_from_IIᵀ (X_camI − t_I)``.
+
+:class:`RikolaCamera` is the camera as a sensor (:mod:`hsgeo.sensors.mount`): ``project`` and
+``rays`` of any band at given poses, with a :class:`~hsgeo.sensors.mount.Mount`.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
 from types import MappingProxyType
 
 import numpy as np
 
 from hsgeo.adjust import Indexed, ResidualBlock
-from hsgeo.distortion import brown_correction_jacobian, measured_from_ideal_mm
+from hsgeo.distortion import (
+    brown_correction_jacobian,
+    ideal_from_measured_mm,
+    measured_from_ideal_mm,
+)
 from hsgeo.errors import InputError
 from hsgeo.rotations import R_from_opk, dR_dopk
-from hsgeo.sensors.frame import _dproj, camera_coordinates
+from hsgeo.sensors.frame import _dproj, camera_coordinates, mm_to_pixel, pixel_to_mm
+from hsgeo.sensors.mount import Mount, unit
 
 __all__ = [
     "project_measured_mm",
     "centroid_model",
     "TargetCentroids",
     "JointCentroids",
+    "RikolaCamera",
     "GAP_MODEL_COLUMNS",
     "ROTATION_COLUMNS",
     "OFFSET_COLUMNS",
@@ -344,3 +354,97 @@ class JointCentroids(ResidualBlock):
             nm["offset"]: d_off.reshape(2 * n, 3),
         }
         return r.ravel(), jac
+
+
+# ----------------------------------------------------------------------------------------------
+# The sensor interface (hsgeo.sensors.mount): pixels ↔ rays of a band
+# ----------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class RikolaCamera:
+    """The Rikola as a sensor: ``project`` and ``rays`` of a band at given poses.
+
+    The joint model's geometry (:class:`JointCentroids`): per band a focal length and its
+    sensor's principal point, one distortion set, sensor II rotated by ``R_I_from_II`` and
+    offset by ``offset_mm`` in sensor I's frame.
+
+    Parameters
+    ----------
+    f_mm : (n_bands,) sequence
+        Focal length of each band (rows of ``bands``).
+    sensor : (n_bands,) sequence of 1 or 2
+    pp_mm : (2, 2) sequence
+        Principal point (x0, y0) per sensor (rows I, II).
+    KP : (5,) sequence
+        (K1, K2, K3, P1, P2) of :func:`hsgeo.distortion.brown_correction`.
+    rotation_rad, offset_mm : (3,) sequence
+        (dω, dφ, dκ) of ``R_I_from_II`` and sensor II's projection centre in sensor I's frame.
+    image_size : (int, int)
+        Width and height, px.
+    pixel_mm : float
+    bands : (n_bands,) sequence of int, optional
+        Band numbers (default 1 … n_bands).
+    mount : Mount
+        Sensor I's photogrammetric camera frame (x right, y up, z backward) on the body; the
+        identity mount makes the poses sensor I's own.
+
+    The poses are rows ``(ω, φ, κ, X0, Y0, Z0)`` of the body (``R_world_from_body =
+    R_from_opk(ω, φ, κ)``), ``view`` the pose of each pixel or point, ``band`` a band number
+    (scalar or one per pixel or point); lengths in the poses' unit (mm on the bench).
+    """
+
+    f_mm: tuple
+    sensor: tuple
+    pp_mm: tuple
+    KP: tuple
+    rotation_rad: tuple = (0.0, 0.0, 0.0)
+    offset_mm: tuple = (0.0, 0.0, 0.0)
+    image_size: tuple = (1017, 648)
+    pixel_mm: float = 0.0055
+    bands: tuple | None = None
+    mount: Mount = field(default_factory=Mount)
+
+    def _band(self, band, n):
+        nums = np.arange(1, len(self.f_mm) + 1) if self.bands is None else np.asarray(self.bands)
+        b = np.broadcast_to(np.asarray(band), (n,))
+        row = np.searchsorted(nums, b)
+        if np.any(row >= nums.size) or np.any(nums[np.minimum(row, nums.size - 1)] != b):
+            raise InputError(f"band(s) {sorted(set(b.tolist()) - set(nums.tolist()))} not known")
+        two = np.asarray(self.sensor)[row] == 2
+        f = np.asarray(self.f_mm, float)[row]
+        pp = np.asarray(self.pp_mm, float)[np.asarray(self.sensor)[row] - 1]
+        return f, pp, two
+
+    def _frames(self, poses, view):
+        poses = np.atleast_2d(np.asarray(poses, dtype=float))
+        view = np.asarray(view, dtype=np.int64)
+        R = R_from_opk(poses[:, 0], poses[:, 1], poses[:, 2])[view]  # R_world_from_body
+        return poses[view, 3:6], R
+
+    def rays(self, uv_px, poses, view, band) -> tuple[np.ndarray, np.ndarray]:
+        """Origins and unit directions (world frame) of the rays of pixels ``(n, 2)``."""
+        uv = np.atleast_2d(np.asarray(uv_px, dtype=float))
+        f, pp, two = self._band(band, uv.shape[0])
+        KP = np.asarray(self.KP, float)
+        ideal = ideal_from_measured_mm(
+            pixel_to_mm(uv, self.image_size, self.pixel_mm) - pp, KP[:3], KP[3:]
+        )
+        d = np.column_stack([ideal, -f])  # the band's camera frame
+        M = R_from_opk(*self.rotation_rad)  # R_I_from_II
+        d[two] = d[two] @ M.T
+        X0, R = self._frames(poses, view)
+        o = self.mount.origins(X0, R)
+        if np.any(two):
+            t = np.broadcast_to(np.asarray(self.offset_mm, float), (int(two.sum()), 3))
+            o[two] = o[two] + self.mount.directions(R[two], t)
+        return o, unit(self.mount.directions(R, d))
+
+    def project(self, xyz_world, poses, view, band) -> np.ndarray:
+        """Pixels ``(n, 2)`` of world points seen from the poses ``view`` in ``band``."""
+        X = np.atleast_2d(np.asarray(xyz_world, dtype=float))
+        f, pp, two = self._band(band, X.shape[0])
+        X0, R = self._frames(poses, view)
+        Xc = self.mount.to_sensor(X, X0, R)  # sensor I's camera frame
+        M = R_from_opk(*self.rotation_rad)
+        Xc[two] = (Xc[two] - np.asarray(self.offset_mm, float)) @ M  # X_camII = Mᵀ (X_camI − t)
+        xy = project_measured_mm(Xc, f, pp, self.KP)
+        return mm_to_pixel(xy, self.image_size, self.pixel_mm)

@@ -36,6 +36,7 @@ __all__ = [
     "Plate",
     "RikolaTruth",
     "make_truth",
+    "eop_drift_rad",
     "band_radiometry",
     "render_band",
     "Renderer",
@@ -164,6 +165,12 @@ class RikolaTruth:
     gap_model : (2, 2) ndarray
         (a, b) per sensor (rows I, II) that generated ``f_mm``.
     scatter_mm : (2,) ndarray
+    drift_rad : (25, 3) ndarray or None
+        The drift of the exterior orientation across the bands of a cube (003 §3.4, Fig. 5):
+        per band a rotation (dω, dφ, dκ) of the band's camera frame about its projection
+        centre, ``R_world_from_band = R_rigid · R(dω, dφ, dκ)``, on top of the rigid model
+        (sensor I's pose, sensor II rotated by ``rotation_rad``). None: no drift. No
+        estimator of the chapter models it (:func:`eop_drift_rad`).
     """
 
     bands: np.ndarray
@@ -175,6 +182,7 @@ class RikolaTruth:
     poses: np.ndarray
     gap_model: np.ndarray
     scatter_mm: np.ndarray
+    drift_rad: np.ndarray | None = None
 
     def band_row(self, band: int) -> int:
         rows = np.flatnonzero(self.bands["band"] == band)
@@ -189,10 +197,15 @@ class RikolaTruth:
         """Exterior orientation (ω, φ, κ, X0, Y0, Z0) of the band's camera frame in a cube."""
         pose = self.poses[cube]
         if self.sensor(band) == 1:
-            return pose.copy()
-        R_I = R_from_opk(*pose[:3])
-        M = R_from_opk(*self.rotation_rad)  # R_I_from_II
-        return np.concatenate([opk_from_R(R_I @ M), pose[3:] + R_I @ self.offset_mm])
+            out = pose.copy()
+        else:
+            R_I = R_from_opk(*pose[:3])
+            M = R_from_opk(*self.rotation_rad)  # R_I_from_II
+            out = np.concatenate([opk_from_R(R_I @ M), pose[3:] + R_I @ self.offset_mm])
+        if self.drift_rad is not None and np.any(self.drift_rad[self.band_row(band)]):
+            D = R_from_opk(*self.drift_rad[self.band_row(band)])
+            out[:3] = opk_from_R(R_from_opk(*out[:3]) @ D)  # about the projection centre
+        return out
 
     def interior(self, band: int) -> np.ndarray:
         """(f, x0, y0) of a band in mm."""
@@ -217,7 +230,27 @@ def _look_at(C, P, roll_rad):
     return np.column_stack([x, y, z]) @ R_from_opk(0.0, 0.0, roll_rad)
 
 
-def make_truth(cfg: dict, rng, n_cubes: int | None = None) -> RikolaTruth:
+def eop_drift_rad(cfg: dict, bands) -> np.ndarray:
+    """The drift of the exterior orientation across the bands of a cube, ``(n_bands, 3)`` rad.
+
+    003 §3.4 on its Fig. 5: the EOPs of the bands of one static cube vary, "estimated values of
+    rotation φ and X0 coordinates decrease as a linear function" of the band. Here φ of each
+    band's camera frame falls linearly with the band number, zero at ``reference_band``
+    (``[eop_drift]`` of the scenario: ``dphi_deg_per_band``, ``reference_band``). The per-band
+    calibration absorbs it in each band's EOPs; the relative orientation of 003 eq. (1) and the
+    joint model, which assume one rigid rotation between the sensors and one pose per cube, do
+    not model it.
+    """
+    d = cfg.get("eop_drift", {})
+    slope = np.deg2rad(float(d.get("dphi_deg_per_band", 0.0)))
+    out = np.zeros((len(bands), 3))
+    out[:, 1] = slope * (np.asarray(bands["band"], float) - float(d.get("reference_band", 13)))
+    return out
+
+
+def make_truth(
+    cfg: dict, rng, n_cubes: int | None = None, *, eop_drift: bool = True
+) -> RikolaTruth:
     """The camera and the cube poses of a scenario (``data_synthetic/rikola_bench.toml``).
 
     Parameters
@@ -228,6 +261,9 @@ def make_truth(cfg: dict, rng, n_cubes: int | None = None) -> RikolaTruth:
         Seed of the truth (band scatter, poses).
     n_cubes : int, optional
         Fewer cubes than the configuration (the first ones of the same sequence).
+    eop_drift : bool
+        Simulate the drift of the EOPs across the bands (:func:`eop_drift_rad`; the scenario's
+        ``[eop_drift]``); it uses no random numbers, so the truth is otherwise the same.
     """
     from hsgeo.simulate import as_rng
 
@@ -286,6 +322,8 @@ def make_truth(cfg: dict, rng, n_cubes: int | None = None) -> RikolaTruth:
         if inside.sum() >= geo["min_targets"]:
             poses.append(np.concatenate([opk_from_R(R), C]))
     truth.poses = np.array(poses)
+    if eop_drift and "eop_drift" in cfg:
+        truth.drift_rad = eop_drift_rad(cfg, bands)
     return truth
 
 
