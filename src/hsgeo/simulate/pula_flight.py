@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from hsgeo.errors import InputError
 from hsgeo.geocode import PlaneTerrain
 from hsgeo.io.navigation import write_trajectory
 from hsgeo.io.tables import write_csv_array
@@ -35,6 +36,9 @@ __all__ = [
     "simulate_flight",
     "gcp_field",
     "observe_gcps",
+    "gcp_sightings",
+    "gcps_in_swath",
+    "MAX_FLIGHT_DRAWS",
     "generate",
     "airfield_scene",
     "render_line_image",
@@ -98,6 +102,9 @@ class FlightTruth:
         True height of the field, m.
     t0_s, line_rate_hz : float
         Time of line 0 (s) and line rate (Hz) of the scanner.
+    n_draws : int
+        How many draws :func:`simulate_flight` took to get a flight that images every GCP
+        within the usable swath (1: the first draw was kept).
     """
 
     true_nav: Trajectory
@@ -107,6 +114,7 @@ class FlightTruth:
     terrain_height_m: float
     t0_s: float
     line_rate_hz: float
+    n_draws: int = 1
 
 
 def gcp_field(cfg: dict) -> tuple[np.ndarray, np.ndarray]:
@@ -162,6 +170,37 @@ def _recorded(nav: Trajectory, cfg: dict, rng) -> Trajectory:
     return Trajectory(nav.t_s, pos, att)
 
 
+def gcp_sightings(nav: Trajectory, boresight_rad, gcp_enu_m) -> tuple[np.ndarray, np.ndarray]:
+    """When and under which view angle the true sensor sees each GCP (noise-free).
+
+    The time is where the GCP crosses the scan plane (sensor x = 0), found by bisection on the
+    true trajectory; the angle is the tangent y/z of the GCP in the sensor frame then. Returns
+    ``(t_s (n,), tan_angle (n,))``; ``t_s`` is NaN for a GCP that the scan plane does not cross
+    during the flight (it is ahead of the first line or behind the last).
+    """
+    R_bs = R_from_rpy(*boresight_rad)
+
+    def sensor_coords(t, X):
+        pos, _ = nav.pose(t)
+        R = nav.R_map_from_body(t) @ R_bs  # map<-sensor
+        return np.einsum("nji,nj->ni", R, X - pos)
+
+    lo = np.full(len(gcp_enu_m), nav.t_s[0])
+    hi = np.full(len(gcp_enu_m), nav.t_s[-1])
+    f_lo = sensor_coords(lo, gcp_enu_m)[:, 0]
+    crossed = np.sign(f_lo) != np.sign(sensor_coords(hi, gcp_enu_m)[:, 0])
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        f_mid = sensor_coords(mid, gcp_enu_m)[:, 0]
+        left = np.sign(f_mid) == np.sign(f_lo)
+        lo = np.where(left, mid, lo)
+        f_lo = np.where(left, f_mid, f_lo)
+        hi = np.where(left, hi, mid)
+    t = 0.5 * (lo + hi)
+    xs = sensor_coords(t, gcp_enu_m)
+    return np.where(crossed, t, np.nan), xs[:, 1] / xs[:, 2]
+
+
 def observe_gcps(
     nav: Trajectory,
     sensor: LineGeometry,
@@ -175,31 +214,30 @@ def observe_gcps(
 ):
     """Where the true sensor sees each GCP: (fractional line, ζ), with measurement noise.
 
-    The line time is where the GCP crosses the scan plane (sensor x = 0), found by bisection on
-    the true trajectory; ζ follows from the true sensor's inverse model.
+    The line time and view angle are :func:`gcp_sightings`; ζ follows from the true sensor's
+    inverse model (which raises :class:`~hsgeo.ConvergenceError` for a GCP outside its
+    calibrated field of view; :func:`simulate_flight` never asks for one).
     """
-    R_bs = R_from_rpy(*boresight_rad)
+    t, tan = gcp_sightings(nav, boresight_rad, gcp_enu_m)
+    return _measured(t, tan, sensor, t0_s, line_rate_hz, rng, sigma_line, sigma_px)
 
-    def sensor_coords(t, X):
-        pos, _ = nav.pose(t)
-        R = nav.R_map_from_body(t) @ R_bs  # map<-sensor
-        return np.einsum("nji,nj->ni", R, X - pos)
 
-    lo = np.full(len(gcp_enu_m), nav.t_s[0])
-    hi = np.full(len(gcp_enu_m), nav.t_s[-1])
-    f_lo = sensor_coords(lo, gcp_enu_m)[:, 0]
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        f_mid = sensor_coords(mid, gcp_enu_m)[:, 0]
-        left = np.sign(f_mid) == np.sign(f_lo)
-        lo = np.where(left, mid, lo)
-        f_lo = np.where(left, f_mid, f_lo)
-        hi = np.where(left, hi, mid)
-    t = 0.5 * (lo + hi)
-    xs = sensor_coords(t, gcp_enu_m)
-    zeta = sensor.zeta(xs[:, 1] / xs[:, 2])
-    line = (t - t0_s) * line_rate_hz
+def _measured(t_s, tan, sensor, t0_s, line_rate_hz, rng, sigma_line, sigma_px):
+    """The noisy (line, ζ) of GCPs seen at times ``t_s`` under tangents ``tan``."""
+    zeta = sensor.zeta(tan)
+    line = (t_s - t0_s) * line_rate_hz
     return (line + rng.normal(0, sigma_line, line.size), zeta + rng.normal(0, sigma_px, zeta.size))
+
+
+def gcps_in_swath(t_s, tan_angle, sensor: LineGeometry, half_width_px: float) -> np.ndarray:
+    """Which GCPs the scanner images: crossed during the flight (``t_s`` finite) and seen within
+    the usable swath ``|ζ − ζ0| ≤ half_width_px`` (000 Fig. 7 / 001 Fig. 8: the calibrated field
+    of view ends at 450 px). The test is on the tangent, against the forward model's tangents of
+    the swath's two edges, so a direction outside it is never inverted.
+    """
+    edges = sensor.tan_angle(sensor.zeta0_px + np.array([half_width_px, -half_width_px]))
+    tan = np.asarray(tan_angle, dtype=float)
+    return np.isfinite(t_s) & (tan >= edges.min()) & (tan <= edges.max())
 
 
 def nominal_sensor(cfg: dict) -> LinearIFOV:
@@ -214,20 +252,59 @@ def true_sensor(cfg: dict) -> CalibratedLine:
     return CalibratedLine(s["zeta0_px"], s["c_px"], tuple(s["K"]))
 
 
+#: Draws of one flight before :func:`simulate_flight` gives up on a scenario (see there).
+MAX_FLIGHT_DRAWS = 100
+
+
 def simulate_flight(cfg: dict, rng) -> tuple[FlightObservations, FlightTruth]:
-    """One flight over the field (see the module docstring): ``(observations, truth)``."""
+    """One flight over the field (see the module docstring): ``(observations, truth)``.
+
+    **Rejection.** A flight whose random attitude motion and boresight put a GCP outside the
+    usable swath (``|ζ − ζ0| > scanner.usable_half_width_px``, beyond the calibrated field of
+    view) or outside the strip is *redrawn*: 000 Tables 2–3 list every one of the ten GCPs, so
+    the paper's experiment cannot have had such a flight. The redraw continues the same random
+    stream (trajectory, navigation errors, boresight, again), so the same seed gives the same
+    bytes, and a flight accepted at the first draw is exactly the flight drawn before this rule
+    (with ``pula_flight.toml`` 2 of 43 100 flights checked were redrawn, each once: a boresight
+    roll near 4 σ on top of the roll motion; ``truth.n_draws`` says how many draws a flight
+    took). The measurement noise is drawn once, for the accepted flight.
+
+    Raises
+    ------
+    InputError
+        If none of :data:`MAX_FLIGHT_DRAWS` draws images every GCP: the scenario's field does
+        not fit its swath.
+    """
     rng = as_rng(rng)
-    nav, T, _ = _true_trajectory(cfg, rng)
-    rec = _recorded(nav, cfg, rng)
-    bs = rng.normal(0, np.deg2rad(cfg["flight"]["boresight_sigma_deg"]), 3)
     ids, enu = gcp_field(cfg)
     sensor = true_sensor(cfg)
+    nav, rec, bs, t_s, tan, n_draws = _draw_imaging_flight(cfg, rng, sensor, enu)
     rate = cfg["scanner"]["line_rate_hz"]
     m = cfg["measurement"]
-    line, zeta = observe_gcps(nav, sensor, bs, 0.0, rate, enu, rng, m["sigma_line"], m["sigma_px"])
+    line, zeta = _measured(t_s, tan, sensor, 0.0, rate, rng, m["sigma_line"], m["sigma_px"])
     h = cfg["field"]["height_m"]
     obs = FlightObservations(rec, 0.0, rate, ids, enu.copy(), line, zeta, h, nominal_sensor(cfg))
-    return obs, FlightTruth(nav, sensor, bs, enu, h, 0.0, rate)
+    return obs, FlightTruth(nav, sensor, bs, enu, h, 0.0, rate, n_draws)
+
+
+def _draw_imaging_flight(cfg: dict, rng, sensor, gcp_enu_m):
+    """Draw (true trajectory, recorded navigation, boresight) until every GCP is imaged within
+    the usable swath: ``(nav, recorded, boresight, t_s, tan, n_draws)`` (see
+    :func:`simulate_flight`, **Rejection**).
+    """
+    half = cfg["scanner"]["usable_half_width_px"]
+    for n_draws in range(1, MAX_FLIGHT_DRAWS + 1):
+        nav, _, _ = _true_trajectory(cfg, rng)
+        rec = _recorded(nav, cfg, rng)
+        bs = rng.normal(0, np.deg2rad(cfg["flight"]["boresight_sigma_deg"]), 3)
+        t_s, tan = gcp_sightings(nav, bs, gcp_enu_m)
+        if np.all(gcps_in_swath(t_s, tan, sensor, half)):
+            return nav, rec, bs, t_s, tan, n_draws
+    raise InputError(
+        f"pula_flight scenario: in {MAX_FLIGHT_DRAWS} draws no flight imaged every GCP within "
+        f"±{half:g} px of the swath; move the GCPs towards the centre ([field] across_px, "
+        "along_m) or lower [flight] attitude_motion_deg / boresight_sigma_deg"
+    )
 
 
 def generate(cfg: dict, outdir: Path) -> list[Path]:
