@@ -22,7 +22,7 @@ Shared by simulator and estimator (the chapter says so, :data:`SHARED`): the pan
 (the same :class:`~hsgeo.sensors.panoramic.PanoramicScanner` renders and geocodes), the flat
 terrain, the form of the navigation error (a constant offset per flight, exactly the shift the
 registration estimates) and the multiplicative ASF; not shared: the ground, the pixel footprint
-(2×2 rays per pixel against bilinear sampling), the BRDF, the size of the navigation error.
+(2×2 jittered rays per pixel against bilinear sampling), the BRDF, the size of the navigation error.
 
 Provenance: the truth of the ASF is chosen, except the peak-to-peak variation of channel 1,
 which was set to 004's 15 % (``tuned``: its agreement with the paper is built in).
@@ -64,9 +64,9 @@ SHARED = (
     "single shift the registration estimates) and the ASF's form (one factor per pixel that "
     "multiplies the signal, the model the ratio inverts). They do not share the ground (the "
     "runway's texture is unknown to the estimator and divides out), the pixel footprint (the "
-    "simulator averages 2×2 rays over each pixel, the estimator samples bilinearly), the BRDF "
-    "(never modelled by the estimator), or the size of the navigation error (the estimator "
-    "finds the offset between the flights from the landmarks)."
+    "simulator averages 2×2 rays jittered over each pixel, the estimator samples bilinearly), "
+    "the BRDF (never modelled by the estimator), or the size of the navigation error (the "
+    "estimator finds the offset between the flights from the landmarks)."
 )
 #: The channel whose true peak-to-peak variation was set to 004's 15 % (0-based).
 TUNED_CHANNEL = int(np.argmax(ASF_PEAK_TO_PEAK_PERCENT))
