@@ -219,8 +219,10 @@ def test_glue_value_and_figure_glue_what_the_chapter_shows(monkeypatch):
 
     glued = {}
     monkeypatch.setattr(myst_nb, "glue", lambda n, v, display=True: glued.update({n: (v, display)}))
-    assert glue_value("a", np.float64(2.5)) == 2.5 and type(glued["a"][0]) is float
-    assert glue_value("b", "text") == "text" and glued["b"] == ("text", False)
+    assert glue_value("a", np.float64(2.5)) is None  # a cell ending with it shows nothing
+    assert glued["a"] == (2.5, False) and type(glued["a"][0]) is float
+    glue_value("b", "text")
+    assert glued["b"] == ("text", False)
     fig = plt.figure()
     glue_figure("f", fig)
     assert glued["f"] == (fig, False) and not plt.fignum_exists(fig.number)  # closed

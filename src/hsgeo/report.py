@@ -518,9 +518,10 @@ def glue_text(name: str, value, sigma=None, *, unit: str = "", sig: int = 4) -> 
     return str(text)
 
 
-def glue_value(name: str, value):
+def glue_value(name: str, value) -> None:
     """Glue ``value`` as it is, hidden, for a chapter's ``{glue}`` roles and later cells (a
-    numpy scalar as the Python number it holds). Returns what was glued. Needs myst-nb.
+    numpy scalar as the Python number it holds). Returns None, as ``glue`` does, so that a cell
+    ending with it shows nothing. Needs myst-nb.
     """
     import numpy as np
     from myst_nb import glue
@@ -528,7 +529,6 @@ def glue_value(name: str, value):
     if isinstance(value, np.generic):
         value = value.item()
     glue(name, value, display=False)
-    return value
 
 
 def glue_figure(name: str, fig) -> None:
