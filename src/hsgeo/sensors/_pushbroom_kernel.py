@@ -2,9 +2,18 @@
 
 ``_lines_kernel`` (~190 lines) is kept as one function: one pass per observation (pose at the
 line time, the Newton on the crossing time, the projection and every derivative) whose
-intermediate values the derivatives reuse; split into ``@njit`` helpers they would pass a dozen
-arrays each way in the hottest loop of the pushbroom adjustment. Issue 21 left it whole because
-no ``farm-bench`` run showed a split to be neither slower nor different in the last bit.
+intermediate values the derivatives reuse. A split by stage was tried (issue 21) and gave
+different results, so it was not kept: four helpers (the pose at the trial time, the
+projection and its partials, the derivatives, their chain through the crossing time), with
+the same statements and the same scratch arrays passed in. With ``NUMBA_DISABLE_JIT=1``
+(scale 0.005, one chunk) every output of all 12 evaluations of an adjustment was bitwise the
+old kernel's, so the Python is the same; compiled it was not, both with the helpers
+``inline="always"`` and as plain ``@njit`` functions: at scale 0.005 (one chunk) the first
+evaluation differed by 5e-13 relative and the adjustment then failed with a DatumError; at
+scale 0.03 (64 parallel chunks) every x residual of the first evaluation was wrong (up to
+935 px) and the adjustment took 22 evaluations instead of 12. The cause (numba's treatment
+of the helpers under ``prange``) was not found before the deadline; a future split must show
+bitwise equal outputs compiled, at more than 6400 observations, before it replaces this.
 
 Moved out of :mod:`hsgeo.sensors.pushbroom` unchanged: one observation per iteration, the
 crossing time by Newton (the residual across the line as a time) and the derivatives; see that
