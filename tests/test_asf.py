@@ -178,3 +178,23 @@ def test_registration_shift_agrees_with_the_truth_over_seeds():
     z = np.array(z)
     assert np.all(np.abs(z.mean(axis=0)) < 1.0), z
     assert np.all(np.sum(np.abs(z) > 3, axis=0) <= 1), z
+
+
+def test_georegister_scan_uses_the_scans_own_geometry():
+    """The scan's sensor and trajectory, as the explicit call; other values keep the geometry."""
+    from hsgeo.reproduce.asf import georegister_scan
+
+    obs, _ = simulate_runway(RunwayScene(), 3, reverse=False)
+    s = obs.along
+    g = georegister_scan(s)
+    ref = georegister(s.values, s.zeta_px, s.t0_s, s.line_rate_hz, s.sensor, s.trajectory)
+    np.testing.assert_array_equal(g.E_m, ref.E_m)
+    np.testing.assert_array_equal(g.N_m, ref.N_m)
+    np.testing.assert_array_equal(g.values, s.values)
+    g2 = georegister_scan(s, values=2 * s.values)
+    np.testing.assert_array_equal(g2.values, 2 * s.values)
+    np.testing.assert_array_equal(g2.E_m, ref.E_m)
+    # the ground points lie where the sensor looks: nadir columns under the trajectory
+    sm = GroundSampler(g)
+    lp = sm.locate(g.E_m[::20, ::50].ravel(), g.N_m[::20, ::50].ravel())
+    assert np.all(np.isfinite(lp))

@@ -205,3 +205,53 @@ def test_glued_numbers_are_text_not_reprs():
     assert data["text/plain"] == "'a_b |z| 1.2'"
     assert data["text/markdown"] == r"a\_b \|z\| 1.2"
     assert "np.float64" not in data["text/plain"]
+
+
+def test_glue_value_and_figure_glue_what_the_chapter_shows(monkeypatch):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import myst_nb
+    import numpy as np
+
+    from hsgeo.report import glue_figure, glue_value
+
+    glued = {}
+    monkeypatch.setattr(myst_nb, "glue", lambda n, v, display=True: glued.update({n: (v, display)}))
+    assert glue_value("a", np.float64(2.5)) is None  # a cell ending with it shows nothing
+    assert glued["a"] == (2.5, False) and type(glued["a"][0]) is float
+    glue_value("b", "text")
+    assert glued["b"] == ("text", False)
+    fig = plt.figure()
+    glue_figure("f", fig)
+    assert glued["f"] == (fig, False) and not plt.fignum_exists(fig.number)  # closed
+
+
+def test_row_lookup_and_verdict_counts():
+    from hsgeo.errors import InputError
+
+    rows = [
+        Row("T", "a", "px", paper=1.0, reproduced=1.0, sigma=0.1, provenance="chosen"),
+        Row("T", "b", "px", paper=1.0, reproduced=5.0, sigma=0.1, provenance="chosen"),
+        Row("T", "c", "px", paper=2.0, reproduced=2.05, sigma=0.1, provenance="chosen"),
+    ]
+    rep = Reproduction("x", 0, rows)
+    assert rep.row("T", "b") is rows[1]
+    with pytest.raises(InputError, match="quantities"):
+        rep.row("T", "z")
+    assert rep.verdict_counts("T") == "2 reproduced, 1 differs"  # most frequent first
+
+
+def test_highlight_below_shades_only_the_cells_under_their_columns_limit():
+    import pandas as pd
+
+    from hsgeo.report import highlight_below
+
+    df = pd.DataFrame({"name": ["a", "b"], "LRE b": [7.0, 5.5], "LRE σ": [2.0, 3.5]})
+    html = highlight_below(df, {"LRE b": 6.0, "LRE σ": 3.0}).to_html()
+    style, tid = html.split("</style>")[0], html.split('<table id="')[1].split('"')[0]
+    # 2.0 < 3 and 5.5 < 6 shaded, no other cell
+    assert f"#{tid}_row0_col2, #{tid}_row1_col1 {{" in style and style.count("_row") == 2
+    assert style.count("background-color: #f4b6b6") == 1
+    assert ">5.5<" in html and ">7.0<" in html and ">3.5<" in html

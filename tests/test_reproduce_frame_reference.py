@@ -39,3 +39,14 @@ def test_opencv_sigmas_are_positive_and_ordered():
     s = fr.opencv_sigmas(views, size)
     assert s.shape == (9,) and (s > 0).all()
     assert s[0] > s[2]  # σ(fx) well above σ(cx) on this board (weak distance–fx separation)
+
+
+def test_largest_paper_deviation_names_the_worst_row():
+    from hsgeo.report import Reproduction, Row
+
+    rows = [
+        Row("T", "fx", "px", paper=100.0, reproduced=100.2, sigma=0.1),  # 2σ̂
+        Row("T", "k1", "1", paper=0.1, reproduced=0.07, sigma=0.01),  # −3σ̂: the largest
+        Row("T", "rms", "px", paper=0.4, reproduced=9.0),  # no σ̂: not counted
+    ]
+    assert fr.largest_paper_deviation(Reproduction("x", 0, rows), "T") == "3σ̂ (largest: k1)"

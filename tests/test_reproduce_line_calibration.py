@@ -59,3 +59,25 @@ def test_contract_and_distortion_magnitudes():
     # a residual per observation, aligned with the measured ζ (what the chapter plots)
     for row, res in rep.extras["results"].items():
         assert res.residuals(0).shape == rep.extras["sims"][row]["zeta_px"].shape
+
+
+def test_exact_pattern_bench_needs_the_side_signals_off_the_plane():
+    """000 §4.1 / the chapter's identifiability claim: with every signal in the pattern plane
+    the principal distance is undetermined (one rank short); the side signals off the plane
+    fix it. The observations are the exact projections (zero residuals at the truth)."""
+    from dataclasses import replace
+
+    from hsgeo.adjust import adjust, identifiability
+    from hsgeo.reproduce.line_calibration import exact_pattern_bench
+    from hsgeo.simulate.line_lab import LineLab
+
+    lab = LineLab()
+    K = [1.459, -0.1636, 0.00526]
+    p, blk = exact_pattern_bench(lab, K)
+    idf = identifiability(p, blk)
+    assert idf.rank == idf.n_unknowns
+    naive = identifiability(*exact_pattern_bench(replace(lab, side_offset_m=0.0), K))
+    assert naive.rank == naive.n_unknowns - 1
+    res = adjust(p, blk)
+    assert abs(float(res.value("c_px")) - 3539.0) < 1e-6
+    assert res.sigma0 < 1e-6

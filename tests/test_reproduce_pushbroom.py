@@ -101,3 +101,27 @@ def test_the_rank_check_at_the_truth_leaves_the_solve_bitwise_unchanged():
     assert np.any(before != 0)  # the solve left its crossing times there
     identifiability(res_b.params, blocks_b)
     np.testing.assert_array_equal(blocks_b[0]._dt_s, before)
+
+
+def test_factor_produces_needs_agreement_and_a_gain_over_the_base():
+    from hsgeo.report import Row
+    from hsgeo.reproduce.pushbroom_ba import factor_produces
+
+    def row(rep, sigma=0.1):
+        return Row(
+            "F", "q", "m", paper=1.0, reproduced=rep, sigma=sigma, n_runs=5, provenance="chosen"
+        )
+
+    rows = {("gauss_markov", "q"): row(1.5), ("good", "q"): row(1.05), ("same", "q"): row(1.45)}
+    rows["far", "q"] = row(3.0)
+    assert factor_produces(rows, "good", "q")  # within 3σ and 0.45 m closer than the base
+    assert not factor_produces(rows, "same", "q")  # only 0.05 m closer: less than the base's σ
+    assert not factor_produces(rows, "far", "q")  # differs from the paper
+    assert not factor_produces(rows, "gauss_markov", "q", base="gauss_markov")
+
+
+def test_interval_distribution_text_counts_each_optimum():
+    from hsgeo.reproduce.pushbroom_ba import interval_distribution_text
+
+    text = interval_distribution_text({"1.0": [0.5, 1.0, 0.5], "2": [2.0]})
+    assert text == "τ × 1: 0.5 s in 2, 1 s in 1; τ × 2: 2 s in 1"

@@ -463,3 +463,25 @@ def test_rikola_camera_projects_as_the_simulator():
         rtol=0,
         atol=1e-9,
     )
+
+
+def test_centroid_gap_of_an_affine_projection_is_zero():
+    """reproduce.rikola_analyses.centroid_gaps_px (moved out of the chapter): under an affine
+    projection the centroid of the projected corners is the image of their centroid, so every
+    gap is zero; only the images of the asked band count."""
+    import numpy as np
+
+    from hsgeo.reproduce import rikola_analyses as ra
+
+    class Flat:  # an affine "projection": the centroid of projected corners is exact
+        def project(self, cube, band, X):
+            return np.asarray(X, dtype=float)[..., :2] * 0.5
+
+    class Obs:
+        band = np.array([3, 3, 4])
+        cube = np.array([0, 1, 0])
+        image_size = (100, 80)
+        corners_obj = np.random.default_rng(0).normal(size=(3, 4, 3))
+
+    gaps = ra.centroid_gaps_px(Flat(), Obs(), 3, 0.0055)
+    assert gaps.shape == (2,) and np.all(gaps < 1e-9)

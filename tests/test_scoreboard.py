@@ -212,3 +212,19 @@ def test_asf_chapter_claims_replace_the_planned_004_rows():
     )
     rows = claims({"asf": rep})
     assert [r.quantity for r in rows] == list(ASF_004)
+
+
+def test_claims_with_reasons_lists_one_papers_claims_with_their_verdicts():
+    from hsgeo.report import Reproduction, Row
+    from hsgeo.reproduce.scoreboard import claims_with_reasons
+
+    rows = [
+        Row("000 Table 1", "c_px", "px", paper=1.0, reproduced=1.0, sigma=0.1, provenance="chosen"),
+        Row("001 Table 2", "c_px", "px", paper=1.0, reproduced=9.0, sigma=0.1, provenance="chosen"),
+        Row("000 Table 3", "dx_m", "m", paper=1.0, reproduced=5.0, sigma=0.1, provenance="chosen"),
+    ]
+    df = claims_with_reasons(Reproduction("scoreboard", 0, rows), "000")
+    assert list(df.columns) == ["claim", "verdict", "why"]
+    assert list(df.claim) == ["Table 1: c_px", "Table 3: dx_m"]
+    assert list(df.verdict) == ["reproduced", "differs"]
+    assert list(df.why) == [rows[0].judge()[1], rows[2].judge()[1]]

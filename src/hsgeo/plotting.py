@@ -272,6 +272,7 @@ def verdict_bars(ax, per_paper):
 
 # ---- chapters frame_reference and rikola (issue 13): residuals binned over the image and
 # ---- against wavelength, z-scores with ±1 bars, the relative orientation per band pair
+__all__ += ["iop_against_wavelength", "gcp_deviation_map"]
 __all__ += ["bin_residuals", "binned_residuals", "z_errorbars", "rop_per_pair", "residuals_by_band"]
 
 
@@ -537,6 +538,37 @@ def deviation_quiver(
     return ax
 
 
+def gcp_deviation_map(
+    ax,
+    track_en_m,
+    gcp_en_m,
+    gcp_ids,
+    dev_sim_en_m,
+    paper_en_m,
+    dev_paper_en_m,
+    *,
+    magnify: float,
+    sim_label: str,
+    paper_label: str,
+):
+    """The GCP deviations of a simulated flight (blue, at every GCP) and a paper's table (black,
+    at its GCPs ``paper_en_m``) drawn ``magnify`` times enlarged on the map, with the flight
+    line, the GCPs labelled by id and a 100 m scale bar (:func:`deviation_quiver`).
+    """
+    gcp = np.asarray(gcp_en_m, float)
+    ax.plot(*np.asarray(track_en_m, float).T, color="0.75", lw=1, label="flight line")
+    ax.plot(*gcp.T, "^", color="0.3", ms=5)
+    deviation_quiver(ax, gcp, dev_sim_en_m, magnify=magnify, color="C0", label=sim_label, key_m=0)
+    deviation_quiver(
+        ax, paper_en_m, dev_paper_en_m, magnify=magnify, color="k", label=paper_label, key_m=1.0
+    )
+    for g, (e, n) in zip(gcp_ids, gcp, strict=True):
+        ax.annotate(str(g), (e, n), xytext=(-12, 4), textcoords="offset points", fontsize=9)
+    scale_bar(ax, 100.0, label="100 m (map)")
+    ax.legend(loc="upper left")
+    return ax
+
+
 def displacement_vs_pixel(ax, zeta_px, displacement_m, *, label=None, color=None):
     """Median and 5–95 % band over lines of a displacement [m] against across-track pixel.
 
@@ -557,6 +589,23 @@ def displacement_vs_pixel(ax, zeta_px, displacement_m, *, label=None, color=None
 
 # ---- chapter pushbroom_ba (issue 13): 002 Tables 1-3 against the paper with ±σ̂ spread, the
 # ---- check-point heights, the per-band principal distances, the node-interval study, factors
+
+
+def iop_against_wavelength(ax, wavelength_nm, value, sigma, paper, deg: int):
+    """An interior-orientation parameter per spectral row (± σ̂) against its wavelength, the
+    paper's values (+) and a trend of degree ``deg`` fitted with weights 1/σ̂ (001 Table 2).
+    """
+    lam = np.asarray(wavelength_nm, float)
+    v, s = np.asarray(value, float), np.asarray(sigma, float)
+    ax.errorbar(lam, v, s, fmt="o", capsize=3, label="reproduced ± σ̂")
+    ax.plot(lam, paper, "k+", ms=12, mew=1.5, label="paper (001 Table 2)")
+    fit = np.polyfit(lam, v, deg, w=1 / s)
+    ll = np.linspace(lam[0], lam[-1], 50)
+    ax.plot(ll, np.polyval(fit, ll), "C1-", lw=1, label=f"weighted trend (degree {deg})")
+    ax.set_xlabel("wavelength (nm)")
+    ax.legend()
+    ax.grid(alpha=0.3)
+    return ax
 
 
 def stats_vs_paper(ax, labels, reproduced, sigma, paper, *, unit="m"):

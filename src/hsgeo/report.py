@@ -34,6 +34,9 @@ from hsgeo.errors import InputError
 from hsgeo.vocabulary import display_unit, quantity_label
 
 __all__ = [
+    "glue_figure",
+    "highlight_below",
+    "glue_value",
     "Row",
     "Reproduction",
     "VERDICTS",
@@ -417,6 +420,19 @@ def format_rows(rows: list[Row]):
 _PAD = "0.3em 0.75em"
 
 
+def highlight_below(df, limits: dict, *, fmt: str = "{:.1f}", colour: str = "#f4b6b6"):
+    """A pandas Styler of ``df`` without index: the columns named in ``limits`` formatted with
+    ``fmt``, their cells below that column's limit shaded ``colour`` (e.g. a fit whose LRE fails
+    a certification criterion).
+    """
+
+    def shade(col):
+        return [f"background-color: {colour}" if v < limits[col.name] else "" for v in col]
+
+    cols = list(limits)
+    return df.style.apply(shade, subset=cols).format(fmt, subset=cols).hide(axis="index")
+
+
 def styled(df, numeric: tuple[str, ...] = NUMERIC_COLUMNS):
     """A DataFrame of display strings as the book shows a table: a pandas Styler without index,
     class ``hsgeo-table``, every cell padded, the ``numeric`` columns right-aligned (header too,
@@ -502,6 +518,30 @@ def glue_text(name: str, value, sigma=None, *, unit: str = "", sig: int = 4) -> 
     return str(text)
 
 
+def glue_value(name: str, value) -> None:
+    """Glue ``value`` as it is, hidden, for a chapter's ``{glue}`` roles and later cells (a
+    numpy scalar as the Python number it holds). Returns None, as ``glue`` does, so that a cell
+    ending with it shows nothing. Needs myst-nb.
+    """
+    import numpy as np
+    from myst_nb import glue
+
+    if isinstance(value, np.generic):
+        value = value.item()
+    glue(name, value, display=False)
+
+
+def glue_figure(name: str, fig) -> None:
+    """Glue a matplotlib figure for a ``{glue:figure}`` directive, hidden, and close it (so the
+    cell does not show it a second time). Needs myst-nb.
+    """
+    import matplotlib.pyplot as plt
+    from myst_nb import glue
+
+    glue(name, fig, display=False)
+    plt.close(fig)
+
+
 @dataclass
 class Reproduction:
     """The rows of a chapter's tables and free-form metadata (``meta``), plus chapter objects."""
@@ -554,6 +594,23 @@ class Reproduction:
         if not rows:
             raise InputError(f"no table {name!r} in {self.chapter}; tables: {self.tables()}")
         return rows
+
+    def row(self, table: str, quantity: str) -> Row:
+        """The row of ``quantity`` in ``table`` (an error naming the table's quantities if none)."""
+        rows = self.rows_of(table)
+        for r in rows:
+            if r.quantity == quantity:
+                return r
+        raise InputError(
+            f"no quantity {quantity!r} in table {table!r}; quantities: {[r.quantity for r in rows]}"
+        )
+
+    def verdict_counts(self, table: str) -> str:
+        """The verdicts of one table counted, most frequent first: ``"3 reproduced, 1 differs"``."""
+        import pandas as pd
+
+        counts = pd.Series([r.judge()[0] for r in self.rows_of(table)]).value_counts()
+        return ", ".join(f"{n} {k}" for k, n in counts.items())
 
     def table(self, name: str | None = None):
         """The rows as a pandas DataFrame of numbers (one table, or all with a ``table`` column)."""

@@ -1,12 +1,7 @@
 """Compiled kernels of the engine's normal equations and Schur complement (numba).
 
 Kept as one file: one concern, the compiled kernels of the reduced normal equations; they
-share the row-compressed layout and the chunking described below. ``_reduced_kernel`` (~230
-lines) is kept as one function: it runs with ``fastmath`` under ``prange``, where moving its
-per-point loop into inlined ``@njit`` helpers may let LLVM reorder the sums (the results would
-no longer be bitwise those of today) and a call that is not inlined costs time in the hottest
-loop of the engine. Issue 21 left it whole because no ``farm-bench`` run showed a split to be
-neither slower nor different in the last bit.
+share the row-compressed layout and the chunking described below.
 
 The engine keeps the whitened Jacobian of the non-point unknowns *row-compressed*: every row
 ``i`` has ``K`` slots ``(cols[i, s], vals[i, s])`` (``cols = -1``: empty slot). Bundle problems
@@ -122,6 +117,194 @@ def _normal_cc_kernel(
     return out
 
 
+@njit(cache=True, inline="always")
+def _has_group(fcol, r):  # pragma: no cover - compiled
+    """Whether row r has a factored group (any of its items set)."""
+    has_f = False
+    for a in range(fcol.shape[1]):
+        if fcol[r, a] >= 0:
+            has_f = True
+    return has_f
+
+
+@njit(cache=True, inline="always")
+def _local_columns(cols, fcol, fw, order, a0, a1, grow, pos, gl):  # pragma: no cover
+    """The groups (a row of each in ``grow``) and the distinct slot columns (``gl``, their local
+    numbers in ``pos``) of the rows ``order[a0:a1]`` of one point; their counts (ng, nl).
+    """
+    Q = fcol.shape[1]
+    ng = 0
+    nl = 0
+    for rr in range(a0, a1):
+        r = order[rr]
+        if _has_group(fcol, r):
+            same = ng > 0
+            if same:
+                r0 = grow[ng - 1]
+                for a in range(Q):
+                    if fcol[r, a] != fcol[r0, a] or fw[r, a] != fw[r0, a]:
+                        same = False
+                        break
+            if not same:
+                grow[ng] = r
+                ng += 1
+        for s in range(cols.shape[1]):
+            c = cols[r, s]
+            if c >= 0 and pos[c] < 0:
+                pos[c] = nl
+                gl[nl] = c
+                nl += 1
+    return ng, nl
+
+
+@njit(cache=True, inline="always")
+def _point_normals_local(
+    cols, vals, fcol, fd, jp, order, a0, a1, grow, ng, pos, L, C, Z, li, lv
+):  # pragma: no cover - compiled
+    """``C = Yᵀ Y`` and ``Z = Yᵀ J_p`` of one point on its L local columns."""
+    K = cols.shape[1]
+    kf = fd.shape[1]
+    p = jp.shape[1]
+    for a in range(L):
+        for b in range(L):
+            C[a, b] = 0.0
+        for k in range(p):
+            Z[k, a] = 0.0
+    g = -1
+    for rr in range(a0, a1):
+        r = order[rr]
+        n = 0
+        if g + 1 < ng and grow[g + 1] == r:
+            g += 1
+        if _has_group(fcol, r):
+            for j in range(kf):
+                li[n] = g * kf + j
+                lv[n] = fd[r, j]
+                n += 1
+        for s in range(K):
+            c = cols[r, s]
+            if c >= 0 and vals[r, s] != 0.0:
+                li[n] = ng * kf + pos[c]
+                lv[n] = vals[r, s]
+                n += 1
+        for e in range(n):
+            la = li[e]
+            va = lv[e]
+            for k in range(p):
+                Z[k, la] += va * jp[r, k]
+            Crow = C[la]
+            for e2 in range(n):
+                Crow[li[e2]] += va * lv[e2]
+
+
+@njit(cache=True, inline="always")
+def _subtract_schur(C, Z, T, Vinv, i, L):  # pragma: no cover - compiled
+    """``C −= Z V_i⁻¹ Zᵀ`` on the L local columns."""
+    p = Z.shape[0]
+    for a in range(L):
+        for k in range(p):
+            acc = 0.0
+            for j in range(p):
+                acc += Z[j, a] * Vinv[i, j, k]
+            T[a, k] = acc
+    for a in range(L):
+        Crow = C[a]
+        for k in range(p):
+            t = T[a, k]
+            Zk = Z[k]
+            for b in range(L):
+                Crow[b] -= t * Zk[b]
+
+
+@njit(cache=True, inline="always")
+def _group_tiles(C, fcol, fw, grow, g, h, kf, tile_of, slot_of, tiles, R):  # pragma: no cover
+    """The block C[g, h] of groups g ≤ h added into the tiles of their items; the number of
+    tiles outside the pattern (nothing of theirs is written).
+    """
+    Q = fcol.shape[1]
+    kk = kf * kf
+    misses = 0
+    rg = grow[g]
+    rh = grow[h]
+    half = 0.5 if h == g else 1.0
+    # the block C[g, h] (kf × kf, contiguous); the tile of item a of g against item b of h is
+    # fw_g[a] fw_h[b] C[g, h]
+    for j in range(kf):
+        for l in range(kf):
+            R[j * kf + l] = C[g * kf + j, h * kf + l]
+    # items of h on consecutive tiles (spline nodes): one contiguous segment of Q·kf² values in
+    # each tile row
+    tb0 = tile_of[fcol[rh, 0]] if fcol[rh, 0] >= 0 else -1
+    run = tb0 >= 0
+    for b in range(1, Q):
+        cb = fcol[rh, b]
+        if cb < 0 or tile_of[cb] != tb0 + b:
+            run = False
+    for a in range(Q):
+        ca = fcol[rg, a]
+        if ca < 0:
+            continue
+        wa = fw[rg, a]
+        ta = tile_of[ca]
+        if run:
+            # g = h: C[g, g] is symmetric, so the tiles b < a are the transposes of a < b and
+            # follow from A + Aᵀ (the tile a = b halved)
+            b0 = a if h == g else 0
+            s0 = slot_of[ta, tb0] * kk  # the Q slots (ta, tb0 + b) follow
+            if s0 < 0:
+                misses += 1
+                continue
+            Tseg = tiles[s0 : s0 + Q * kk]
+            for b in range(b0, Q):
+                sc = wa * fw[rh, b] * (0.5 if (h == g and b == a) else 1.0)
+                # unsigned offsets: no negative-index wraparound test, which keeps the loop
+                # vectorised
+                ob = np.uint64(b * kk)
+                for e in range(kk):
+                    Tseg[ob + np.uint64(e)] += sc * R[e]
+            continue
+        for b in range(Q):
+            cb = fcol[rh, b]
+            if cb < 0:
+                continue
+            sc = half * wa * fw[rh, b]
+            s0 = slot_of[ta, tile_of[cb]] * kk
+            if s0 < 0:
+                misses += 1
+                continue
+            Tseg = tiles[s0 : s0 + kk]
+            for e in range(kk):
+                Tseg[e] += sc * R[e]
+    return misses
+
+
+@njit(cache=True, inline="always")
+def _slot_blocks(C, fcol, fw, grow, g, ng, kf, gl, nl, sc_of, A):  # pragma: no cover
+    """The block of group g against the slot columns, added into A (column ``sc_of[c]``)."""
+    rg = grow[g]
+    for a in range(fcol.shape[1]):
+        ca = fcol[rg, a]
+        if ca < 0:
+            continue
+        wa = fw[rg, a]
+        for j in range(kf):
+            Arow = A[ca + j]
+            Crow = C[g * kf + j]
+            for e in range(nl):
+                Arow[sc_of[gl[e]]] += wa * Crow[ng * kf + e]
+
+
+@njit(cache=True, inline="always")
+def _slot_slot(C, ng, kf, gl, nl, sc_of, A):  # pragma: no cover - compiled
+    """The slot columns against each other (one triangle, the diagonal halved) into A."""
+    for e in range(nl):
+        Arow = A[gl[e]]
+        Crow = C[ng * kf + e]
+        Arow[sc_of[gl[e]]] += 0.5 * Crow[ng * kf + e]
+        for e2 in range(e + 1, nl):
+            Arow[sc_of[gl[e2]]] += Crow[ng * kf + e2]
+
+
 @njit(cache=True, parallel=True, fastmath=True)
 def _reduced_kernel(
     cols,
@@ -173,7 +356,6 @@ def _reduced_kernel(
     """
     n_pts = ptr.size - 1
     K = cols.shape[1]
-    Q = fcol.shape[1]
     kf = fd.shape[1]
     p = jp.shape[1]
     Lmax = capg * kf + capc
@@ -199,155 +381,24 @@ def _reduced_kernel(
             a0, a1 = ptr[i], ptr[i + 1]
             if a1 == a0:
                 continue
-            # -- groups and slot columns of the point's rows
-            ng = 0
-            nl = 0
-            for rr in range(a0, a1):
-                r = order[rr]
-                has_f = False
-                for a in range(Q):
-                    if fcol[r, a] >= 0:
-                        has_f = True
-                if has_f:
-                    same = ng > 0
-                    if same:
-                        r0 = grow[ng - 1]
-                        for a in range(Q):
-                            if fcol[r, a] != fcol[r0, a] or fw[r, a] != fw[r0, a]:
-                                same = False
-                                break
-                    if not same:
-                        grow[ng] = r
-                        ng += 1
-                for s in range(K):
-                    c = cols[r, s]
-                    if c >= 0 and pos[c] < 0:
-                        pos[c] = nl
-                        gl[nl] = c
-                        nl += 1
+            ng, nl = _local_columns(cols, fcol, fw, order, a0, a1, grow, pos, gl)
             L = ng * kf + nl
             for e in range(nl):
                 if sc_of[gl[e]] < 0:
                     misses[ch] += 1
-            for a in range(L):
-                for b in range(L):
-                    C[a, b] = 0.0
-                for k in range(p):
-                    Z[k, a] = 0.0
-            # -- C = Yᵀ Y and Z = Yᵀ J_p on the local columns
-            g = -1
-            for rr in range(a0, a1):
-                r = order[rr]
-                n = 0
-                if g + 1 < ng and grow[g + 1] == r:
-                    g += 1
-                has_f = False
-                for a in range(Q):
-                    if fcol[r, a] >= 0:
-                        has_f = True
-                if has_f:
-                    for j in range(kf):
-                        li[n] = g * kf + j
-                        lv[n] = fd[r, j]
-                        n += 1
-                for s in range(K):
-                    c = cols[r, s]
-                    if c >= 0 and vals[r, s] != 0.0:
-                        li[n] = ng * kf + pos[c]
-                        lv[n] = vals[r, s]
-                        n += 1
-                for e in range(n):
-                    la = li[e]
-                    va = lv[e]
-                    for k in range(p):
-                        Z[k, la] += va * jp[r, k]
-                    Crow = C[la]
-                    for e2 in range(n):
-                        Crow[li[e2]] += va * lv[e2]
-            # -- C −= Z V⁻¹ Zᵀ
-            for a in range(L):
-                for k in range(p):
-                    acc = 0.0
-                    for j in range(p):
-                        acc += Z[j, a] * Vinv[i, j, k]
-                    T[a, k] = acc
-            for a in range(L):
-                Crow = C[a]
-                for k in range(p):
-                    t = T[a, k]
-                    Zk = Z[k]
-                    for b in range(L):
-                        Crow[b] -= t * Zk[b]
-            # -- expand into the global columns: group × group into the tiles
+            _point_normals_local(
+                cols, vals, fcol, fd, jp, order, a0, a1, grow, ng, pos, L, C, Z, li, lv
+            )
+            _subtract_schur(C, Z, T, Vinv, i, L)
+            # expand into the global columns: group × group into the tiles, group × slot
+            # columns and slot × slot columns into A
             for g in range(ng):
-                rg = grow[g]
                 for h in range(g, ng):
-                    rh = grow[h]
-                    half = 0.5 if h == g else 1.0
-                    # the block C[g, h] (kf × kf, contiguous); the tile of item a of g against
-                    # item b of h is fw_g[a] fw_h[b] C[g, h]
-                    for j in range(kf):
-                        for l in range(kf):
-                            R[j * kf + l] = C[g * kf + j, h * kf + l]
-                    # items of h on consecutive tiles (spline nodes): one contiguous segment
-                    # of Q·kf² values in each tile row
-                    tb0 = tile_of[fcol[rh, 0]] if fcol[rh, 0] >= 0 else -1
-                    run = tb0 >= 0
-                    for b in range(1, Q):
-                        cb = fcol[rh, b]
-                        if cb < 0 or tile_of[cb] != tb0 + b:
-                            run = False
-                    for a in range(Q):
-                        ca = fcol[rg, a]
-                        if ca < 0:
-                            continue
-                        wa = fw[rg, a]
-                        ta = tile_of[ca]
-                        if run:
-                            # g = h: C[g, g] is symmetric, so the tiles b < a are the
-                            # transposes of a < b and follow from A + Aᵀ (the tile a = b halved)
-                            b0 = a if h == g else 0
-                            s0 = slot_of[ta, tb0] * kk  # the Q slots (ta, tb0 + b) follow
-                            if s0 < 0:
-                                misses[ch] += 1
-                                continue
-                            Tseg = tiles[s0 : s0 + Q * kk]
-                            for b in range(b0, Q):
-                                sc = wa * fw[rh, b] * (0.5 if (h == g and b == a) else 1.0)
-                                # unsigned offsets: no negative-index wraparound test, which
-                                # keeps the loop vectorised
-                                ob = np.uint64(b * kk)
-                                for e in range(kk):
-                                    Tseg[ob + np.uint64(e)] += sc * R[e]
-                            continue
-                        for b in range(Q):
-                            cb = fcol[rh, b]
-                            if cb < 0:
-                                continue
-                            sc = half * wa * fw[rh, b]
-                            s0 = slot_of[ta, tile_of[cb]] * kk
-                            if s0 < 0:
-                                misses[ch] += 1
-                                continue
-                            Tseg = tiles[s0 : s0 + kk]
-                            for e in range(kk):
-                                Tseg[e] += sc * R[e]
-                for a in range(Q):
-                    ca = fcol[rg, a]
-                    if ca < 0:
-                        continue
-                    wa = fw[rg, a]
-                    for j in range(kf):
-                        Arow = A[ca + j]
-                        Crow = C[g * kf + j]
-                        for e in range(nl):
-                            Arow[sc_of[gl[e]]] += wa * Crow[ng * kf + e]
-            for e in range(nl):
-                Arow = A[gl[e]]
-                Crow = C[ng * kf + e]
-                Arow[sc_of[gl[e]]] += 0.5 * Crow[ng * kf + e]
-                for e2 in range(e + 1, nl):
-                    Arow[sc_of[gl[e2]]] += Crow[ng * kf + e2]
+                    misses[ch] += _group_tiles(
+                        C, fcol, fw, grow, g, h, kf, tile_of, slot_of, tiles, R
+                    )
+                _slot_blocks(C, fcol, fw, grow, g, ng, kf, gl, nl, sc_of, A)
+            _slot_slot(C, ng, kf, gl, nl, sc_of, A)
             for e in range(nl):
                 pos[gl[e]] = -1
     return out, out_t, misses.sum()

@@ -52,7 +52,7 @@ from hsgeo.workflows.asf import (
     peak_to_peak_percent,
 )
 
-__all__ = ["run", "asf_at_shift", "ANGLES_DEG", "SHARED", "TUNED_CHANNEL"]
+__all__ = ["run", "asf_at_shift", "georegister_scan", "ANGLES_DEG", "SHARED", "TUNED_CHANNEL"]
 
 #: Scan angles of the per-angle rows, deg.
 ANGLES_DEG = (-40.0, -20.0, 20.0, 40.0)
@@ -72,7 +72,11 @@ SHARED = (
 TUNED_CHANNEL = int(np.argmax(ASF_PEAK_TO_PEAK_PERCENT))
 
 
-def _georegister(scan, values=None) -> GeoScan:
+def georegister_scan(scan, values=None) -> GeoScan:
+    """A simulated scan (:func:`~hsgeo.simulate.asf_runway.simulate_runway`) georegistered with
+    its own sensor and trajectory (:func:`~hsgeo.workflows.asf.georegister`); ``values``: other
+    samples of the same geometry in place of the scan's.
+    """
     v = scan.values if values is None else values
     return georegister(v, scan.zeta_px, scan.t0_s, scan.line_rate_hz, scan.sensor, scan.trajectory)
 
@@ -110,7 +114,7 @@ def _noisy(gc, ga, truth, seed, i, stream=27):
 
 def _runs(obs, truth, n_runs, seed, options):
     """ASF of the crossing for ``n_runs`` noise realisations (run 0: the observations' noise)."""
-    gc, ga = _georegister(obs.cross), _georegister(obs.along)
+    gc, ga = georegister_scan(obs.cross), georegister_scan(obs.along)
     out = []
     for i in range(n_runs):
         c, a = (gc, ga) if i == 0 else _noisy(gc, ga, truth, seed, i)
@@ -267,9 +271,11 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
     res, gc, ga = _runs(obs, truth, n_runs, seed, options)
     # the BRDF switched on: the same ground, flights and noise
     obs_b, truth_b = simulate_runway(replace(scene, brdf=True), seed)
-    inp_b = AsfInputs(_georegister(obs_b.cross), _georegister(obs_b.along), obs.runway_polygon_m)
+    inp_b = AsfInputs(
+        georegister_scan(obs_b.cross), georegister_scan(obs_b.along), obs.runway_polygon_m
+    )
     res_b = asf_from_scans(inp_b, options)
-    inp_r = AsfInputs(_georegister(obs_b.reverse), inp_b.along, obs.runway_polygon_m)
+    inp_r = AsfInputs(georegister_scan(obs_b.reverse), inp_b.along, obs.runway_polygon_m)
     res_r = asf_from_scans(inp_r, options)
     combined, brdf_odd = combine_opposite_crossings(res_b.asf, res_r.asf)
     # the registration's effect: none (navigation only), and the true offset plus 1 px

@@ -28,6 +28,7 @@ __all__ = [
     "charuco_views",
     "reference_dir",
     "opencv_sigmas",
+    "largest_paper_deviation",
     "PIXEL_PITCH_MM",
 ]
 
@@ -340,3 +341,16 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
             # reference data are our chosen yardstick (issue 22: every verdict row says whence)
             r.provenance = "chosen"
     return Reproduction("frame-reference", seed, rows, meta, extras)
+
+
+def largest_paper_deviation(rep, table: str) -> str:
+    """The largest ``|reproduced − paper| / σ̂`` over the rows of ``table`` with a σ̂ and a
+    paper value (here: OpenCV's), in words: ``"0.3σ̂ (largest: k1)"``.
+    """
+    zs = [
+        (r.quantity, (r.reproduced - r.paper) / r.sigma)
+        for r in rep.rows_of(table)
+        if r.sigma and r.paper is not None
+    ]
+    q, z = max(zs, key=lambda t: abs(t[1]))
+    return f"{abs(z):.1g}σ̂ (largest: {q})"

@@ -39,6 +39,7 @@ __all__ = [
     "generate",
     "calibrate_simulated",
     "design_sigma_c",
+    "exact_pattern_bench",
     "monte_carlo",
     "IOP_NAMES",
 ]
@@ -179,6 +180,22 @@ def design_sigma_c(
                 continue
             out[i, j] = float(res.sigma("c_px")) / res.sigma0
     return out
+
+
+def exact_pattern_bench(
+    lab: LineLab, K, zeta0_px: float = 486.8, c_px: float = 3539.0, sigma_px: float = 0.1
+):
+    """The pattern seen exactly (no rendering, no noise) from the lab's stations by a sensor
+    with ``zeta0_px``, ``c_px`` and distortion ``K``: the parameters at these true values and the
+    observations, ready for :func:`~hsgeo.adjust.identifiability` or :func:`~hsgeo.adjust.adjust`.
+    """
+    xy, _ = pattern_points(lab)
+    eop = stations(lab)
+    img = np.repeat(np.arange(len(eop)), len(xy))
+    pt = np.tile(np.arange(len(xy)), len(eop))
+    z = line1d.project(xy[pt], eop[img], zeta0_px, c_px, K)
+    p = line1d.make_parameters(eop, zeta0_px, c_px, K, xy, np.ones(len(xy), bool))
+    return p, line1d.LineObservations(img, pt, z, sigma_px)
 
 
 def _precision_rows(res, mc: dict, lab: LineLab) -> list[Row]:

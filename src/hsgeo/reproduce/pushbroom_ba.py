@@ -63,6 +63,8 @@ __all__ = [
     "table_spread",
     "FACTORS",
     "study_plan",
+    "factor_produces",
+    "interval_distribution_text",
     # re-exported (hsgeo.reproduce.pushbroom_runs, hsgeo.workflows.pushbroom_ba)
     "HEIGHT_OFFSET_M",
     "SIGMA_REF_IMAGE_PX",
@@ -426,3 +428,30 @@ def run(seed: int = 0, scale: float = 1.0, progress=None, plan: dict | None = No
         "table_spread": spread,
     }
     return Reproduction("pushbroom-ba", seed, rows, meta, extras)
+
+
+def factor_produces(rows: dict, factor: str, quantity: str, base: str = "gauss_markov") -> bool:
+    """Whether the run of ``factor`` produces the paper's value of ``quantity``: within 3 spreads
+    of it (verdict "reproduced") *and* closer to it than the ``base`` run by more than that
+    run's spread (a factor whose run is as far from the paper as the base's does not produce
+    the paper's value). ``rows``: the "002 check-point factors" rows keyed by
+    ``(factor, quantity)``.
+    """
+    r, b = rows[factor, quantity], rows[base, quantity]
+    return (
+        r.judge()[0] == "reproduced"
+        and factor != base
+        and abs(r.reproduced - r.paper) < abs(b.reproduced - b.paper) - b.sigma
+    )
+
+
+def interval_distribution_text(per_seed: dict) -> str:
+    """The optimum node intervals over the seeds, per multiple of τ, as prose:
+    ``"τ × 1: 0.5 s in 3, 1 s in 2; τ × 2: …"`` (``per_seed``: τ multiple → optima, s).
+    """
+    parts = []
+    for k, v in per_seed.items():
+        vals, cnt = np.unique(v, return_counts=True)
+        dist = ", ".join(f"{a:g} s in {c}" for a, c in zip(vals, cnt, strict=True))
+        parts.append(f"τ × {float(k):g}: {dist}")
+    return "; ".join(parts)

@@ -20,7 +20,7 @@ from hsgeo.report import Row
 from hsgeo.rotations import R_from_opk
 from hsgeo.sensors.frame import mm_to_pixel
 from hsgeo.sensors.rikola import TargetCentroids, project_measured_mm
-from hsgeo.workflows.rikola import BANDS, band_problem, gap_regression
+from hsgeo.workflows.rikola import BANDS, band_problem, calibrate_band, gap_regression
 
 __all__ = [
     "track_targets",
@@ -33,6 +33,8 @@ __all__ = [
     "HEADLINE",
     "unmodelled_rows",
     "drift_reasons",
+    "centroid_gaps_px",
+    "max_pose_z",
 ]
 
 
@@ -247,3 +249,30 @@ def drift_reasons(rows: list[Row]) -> None:
                 "the bands (003 Fig. 5), which the one rigid rotation between the sensors does "
                 "not model, moves it (table 'unmodelled effect')"
             )
+
+
+def centroid_gaps_px(truth, obs: Observations, band: int, pixel_mm: float) -> np.ndarray:
+    """For every image of ``band``: how far (px) the centroid of the target's four projected
+    corners lies from the projection of its centre (perspective and the curvature of the
+    distortion move it; 003 §3.2 measures centroids).
+    """
+
+    def to_px(i, X_mm):
+        return mm_to_pixel(truth.project(obs.cube[i], obs.band[i], X_mm), obs.image_size, pixel_mm)
+
+    C = obs.corners_obj
+    return np.array(
+        [
+            np.linalg.norm(to_px(i, C[i]).mean(axis=0) - to_px(i, C[i].mean(axis=0)))
+            for i in np.flatnonzero(obs.band == band)
+        ]
+    )
+
+
+def max_pose_z(truth, obs: Observations, band: int, sigma_px: float) -> float:
+    """The largest |z| of ``band``'s calibrated camera poses against the true poses: how far a
+    centroid method's bias moves the exterior orientation in units of its σ̂.
+    """
+    c = calibrate_band(obs, band, sigma_px=sigma_px)
+    P = np.array([truth.band_pose(int(k), band) for k in c.cubes])
+    return float(np.max(np.abs((c.value("poses") - P) / c.sigma("poses"))))

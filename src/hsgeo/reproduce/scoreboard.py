@@ -31,6 +31,7 @@ from hsgeo.vocabulary import display_unit, quantity_label
 
 __all__ = [
     "PAPER_CHAPTERS",
+    "claims_with_reasons",
     "claims",
     "planned_claims",
     "run",
@@ -363,3 +364,17 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
             "paragraphs": {p: paper_paragraph(rows, p) for p in PAPERS},
         },
     )
+
+
+def claims_with_reasons(board: Reproduction, paper: str):
+    """Every claim of one paper (tables named ``"000 …"`` for ``paper="000"``) with its verdict
+    and the sentence that explains it: a DataFrame with columns claim, verdict, why.
+    """
+    import pandas as pd
+
+    recs = [
+        (f"{r.table[4:]}: {r.quantity}", *r.judge())
+        for r in board.rows
+        if r.table.startswith(paper)
+    ]
+    return pd.DataFrame(recs, columns=["claim", "verdict", "why"])

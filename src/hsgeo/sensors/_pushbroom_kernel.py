@@ -1,10 +1,12 @@
 """The compiled residual kernel of :class:`hsgeo.sensors.pushbroom.PushbroomLines` (002 eq. 2–4).
 
-``_lines_kernel`` (~190 lines) is kept as one function: one pass per observation (pose at the
-line time, the Newton on the crossing time, the projection and every derivative) whose
-intermediate values the derivatives reuse; split into ``@njit`` helpers they would pass a dozen
-arrays each way in the hottest loop of the pushbroom adjustment. Issue 21 left it whole because
-no ``farm-bench`` run showed a split to be neither slower nor different in the last bit.
+``_lines_kernel`` makes one pass per observation: the spline correction and the pose at the
+trial time (``_spline``, ``_pose``), the projection and its partials (``_image``), the Newton on
+the crossing time, the derivatives (``_derivatives``) and their chain through the crossing time
+(``_through_time``); the helpers are inlined into the kernel (``inline="always"``), so the
+compiled loop is that of one function. The values the Newton loop sets and only later lines
+read (x, y, xb, yb, gx, gy) are defined before it: left undefined there, numba lost them under
+``prange`` once the loop moved into helpers (every x residual wrong at 64 chunks).
 
 Moved out of :mod:`hsgeo.sensors.pushbroom` unchanged: one observation per iteration, the
 crossing time by Newton (the residual across the line as a time) and the derivatives; see that
@@ -33,6 +35,127 @@ T_MAX = 0.25
 #: Newton on the crossing time stops when its correction is below this (s); see the module
 #: docstring for the error this leaves in the residuals (< 1e-13 px).
 NEWTON_TOL_S = 1e-8
+
+
+@njit(cache=True, inline="always")
+def _spline(j, dt, u0, inv_dt, nodes, idx, xyz_rate, rpy_rate, w, dw, dl, rate):  # pragma: no cover
+    """The spline correction of observation j at ``t_e + dt``: its weights (w, dw), the
+    correction ``dl`` of the pose and the pose rate ``rate`` (navigation rate included).
+    """
+    bspline_weights(u0[j] + dt * inv_dt, inv_dt, w, dw)
+    for a in range(6):
+        acc = 0.0
+        acc_r = 0.0
+        for b in range(4):
+            acc += w[b] * nodes[idx[j, b], a]
+            acc_r += dw[b] * nodes[idx[j, b], a]
+        dl[a] = acc
+        rate[a] = acc_r + (xyz_rate[j, a] if a < 3 else rpy_rate[j, a - 3])
+
+
+@njit(cache=True, inline="always")
+def _pose(j, dt, P, pidx, xyz_nav, rpy_nav, xyz_rate, rpy_rate, dl, R, dR, d):  # pragma: no cover
+    """The pose of observation j at ``t_e + dt`` (navigation moved by its rates, plus ``dl``):
+    the rotation R (and ∂R in dR), and ``d = P − position``.
+    """
+    rpy_rotation(
+        rpy_nav[j, 0] + dt * rpy_rate[j, 0] + dl[3],
+        rpy_nav[j, 1] + dt * rpy_rate[j, 1] + dl[4],
+        rpy_nav[j, 2] + dt * rpy_rate[j, 2] + dl[5],
+        R,
+        dR,
+    )
+    pt = pidx[j]
+    for a in range(3):
+        d[a] = P[pt, a] - xyz_nav[j, a] - dt * xyz_rate[j, a] - dl[a]
+
+
+@njit(cache=True, inline="always")
+def _image(R, dR, d, lever, beta, c, dist, x0, y0, k_px, q, p, Jp, JpB, d6):  # pragma: no cover
+    """The image point (mm) and its partials: Jp w.r.t. the camera point (px), JpB through β,
+    d6 w.r.t. the pose (position, attitude) of the platform; returns x, y, xb, yb, gx, gy.
+    """
+    pushbroom_camera_point(R, d, lever, beta, q, p)  # 002 eq. (4)
+    xm, ym, xb, yb, iz, gx, gy = pushbroom_image_mm(
+        p[0], p[1], p[2], c, dist[0], dist[1], dist[2], dist[3]
+    )  # 002 eq. (3)
+    a_ = c * iz
+    Jp[0, 0] = gx * a_ * k_px
+    Jp[0, 1] = 0.0
+    Jp[0, 2] = -gx * xb * iz * k_px
+    Jp[1, 0] = gy * a_ * k_px
+    Jp[1, 1] = a_ * k_px
+    Jp[1, 2] = (-yb * iz - gy * xb * iz) * k_px
+    for u in range(2):
+        for a in range(3):
+            JpB[u, a] = Jp[u, 0] * beta[0, a] + Jp[u, 1] * beta[1, a] + Jp[u, 2] * beta[2, a]
+    for u in range(2):
+        for a in range(3):
+            d6[u, a] = -(JpB[u, 0] * R[a, 0] + JpB[u, 1] * R[a, 1] + JpB[u, 2] * R[a, 2])
+        for kk in range(3):
+            v = 0.0
+            for i in range(3):
+                dq = dR[kk, 0, i] * d[0] + dR[kk, 1, i] * d[1] + dR[kk, 2, i] * d[2]
+                v += JpB[u, i] * dq
+            d6[u, 3 + kk] = v
+    return xm + x0, ym + y0, xb, yb, gx, gy
+
+
+@njit(cache=True, inline="always")
+def _derivatives(
+    j, d6, Jp, JpB, dbeta, q, c, xb, yb, gx, gy, k_px, dP, dN, dB, dL, dD, dC
+):  # pragma: no cover - compiled
+    """Rows 2j, 2j+1 of the derivatives w.r.t. the point, the spline nodes (× their weights),
+    the boresight, the lever arm, the distortion and the principal distance.
+    """
+    for u in range(2):
+        row = 2 * j + u
+        for a in range(3):
+            dP[row, a] = -d6[u, a]  # dp/dP = β Rᵀ = −dp/dx
+            dN[row, a] = d6[u, a]  # × the spline weights (factored Jacobian)
+            dL[row, a] = -JpB[u, a]
+            dN[row, 3 + a] = d6[u, 3 + a]
+        for kk in range(3):
+            # boresight: dp/dbore_k = dβ_k q
+            v = 0.0
+            for i in range(3):
+                v += Jp[u, i] * (
+                    dbeta[kk, i, 0] * q[0] + dbeta[kk, i, 1] * q[1] + dbeta[kk, i, 2] * q[2]
+                )
+            dB[row, kk] = v
+    dC[2 * j, 0] = gx * xb / c * k_px
+    dC[2 * j + 1, 0] = (yb / c + gy * xb / c) * k_px
+    dD[2 * j, 0] = xb**3 * k_px
+    dD[2 * j, 1] = xb**5 * k_px
+    dD[2 * j, 2] = 3 * xb**2 * k_px
+    dD[2 * j, 3] = 0.0
+    dD[2 * j + 1, 0] = 0.0
+    dD[2 * j + 1, 1] = 0.0
+    dD[2 * j + 1, 2] = 0.0
+    dD[2 * j + 1, 3] = xb**2 * k_px
+
+
+@njit(cache=True, inline="always")
+def _through_time(j, fx, fy, dP, dN, dB, dL, dD, dC):  # pragma: no cover - compiled
+    """Rows 2j, 2j+1 through the crossing time: x(t*(θ)) takes ∂x/∂θ − fx ∂y/∂θ (fx = ẋ/ẏ),
+    ẏ_ref (t_e − t*) takes fy ∂y/∂θ (fy = ẏ_ref/ẏ).
+    """
+    rx, ry = 2 * j, 2 * j + 1
+    for a in range(3):
+        dP[rx, a] -= fx * dP[ry, a]
+        dL[rx, a] -= fx * dL[ry, a]
+        dB[rx, a] -= fx * dB[ry, a]
+        dP[ry, a] *= fy
+        dL[ry, a] *= fy
+        dB[ry, a] *= fy
+    for a in range(6):
+        dN[rx, a] -= fx * dN[ry, a]
+        dN[ry, a] *= fy
+    for a in range(4):
+        dD[rx, a] -= fx * dD[ry, a]
+        dD[ry, a] *= fy
+    dC[rx, 0] -= fx * dC[ry, 0]
+    dC[ry, 0] *= fy
 
 
 @njit(cache=True, parallel=True)
@@ -81,7 +204,6 @@ def _lines_kernel(
     (in and out): ``t* − t_e`` at which Newton starts, overwritten with this evaluation's.
     """
     m = pidx.size
-    K1, K2, P1, P2 = dist[0], dist[1], dist[2], dist[3]
     n_chunks = 64 if m > 6400 else 1
     step = (m + n_chunks - 1) // n_chunks
     for ch in prange(n_chunks):
@@ -103,57 +225,16 @@ def _lines_kernel(
             ydot = 1.0
             ey = 0.0
             n_it = n_newton if timed else 0
+            c = c_b[band[j]]
+            # defined before the Newton loop: set only inside it and read only after it, they
+            # would not survive the loop under prange
+            x = y = xb = yb = gx = gy = 0.0
             for it in range(n_it + 1):
-                bspline_weights(u0[j] + dt * inv_dt, inv_dt, w, dw)
-                for a in range(6):
-                    acc = 0.0
-                    acc_r = 0.0
-                    for b in range(4):
-                        acc += w[b] * nodes[idx[j, b], a]
-                        acc_r += dw[b] * nodes[idx[j, b], a]
-                    dl[a] = acc
-                    rate[a] = acc_r + (xyz_rate[j, a] if a < 3 else rpy_rate[j, a - 3])
-                rpy_rotation(
-                    rpy_nav[j, 0] + dt * rpy_rate[j, 0] + dl[3],
-                    rpy_nav[j, 1] + dt * rpy_rate[j, 1] + dl[4],
-                    rpy_nav[j, 2] + dt * rpy_rate[j, 2] + dl[5],
-                    R,
-                    dR,
+                _spline(j, dt, u0, inv_dt, nodes, idx, xyz_rate, rpy_rate, w, dw, dl, rate)
+                _pose(j, dt, P, pidx, xyz_nav, rpy_nav, xyz_rate, rpy_rate, dl, R, dR, d)
+                x, y, xb, yb, gx, gy = _image(
+                    R, dR, d, lever, beta, c, dist, x0, y0, k_px, q, p, Jp, JpB, d6
                 )
-                pt = pidx[j]
-                for a in range(3):
-                    d[a] = P[pt, a] - xyz_nav[j, a] - dt * xyz_rate[j, a] - dl[a]
-                pushbroom_camera_point(R, d, lever, beta, q, p)  # 002 eq. (4)
-                c = c_b[band[j]]
-                x, y, xb, yb, iz, gx, gy = pushbroom_image_mm(
-                    p[0], p[1], p[2], c, K1, K2, P1, P2
-                )  # 002 eq. (3)
-                x = x + x0
-                y = y + y0
-                a_ = c * iz
-                Jp[0, 0] = gx * a_ * k_px
-                Jp[0, 1] = 0.0
-                Jp[0, 2] = -gx * xb * iz * k_px
-                Jp[1, 0] = gy * a_ * k_px
-                Jp[1, 1] = a_ * k_px
-                Jp[1, 2] = (-yb * iz - gy * xb * iz) * k_px
-                for u in range(2):
-                    for a in range(3):
-                        JpB[u, a] = (
-                            Jp[u, 0] * beta[0, a] + Jp[u, 1] * beta[1, a] + Jp[u, 2] * beta[2, a]
-                        )
-                # d6: derivatives w.r.t. the pose (position, attitude) of the platform
-                for u in range(2):
-                    for a in range(3):
-                        d6[u, a] = -(
-                            JpB[u, 0] * R[a, 0] + JpB[u, 1] * R[a, 1] + JpB[u, 2] * R[a, 2]
-                        )
-                    for kk in range(3):
-                        v = 0.0
-                        for i in range(3):
-                            dq = dR[kk, 0, i] * d[0] + dR[kk, 1, i] * d[1] + dR[kk, 2, i] * d[2]
-                            v += JpB[u, i] * dq
-                        d6[u, 3 + kk] = v
                 if not timed:
                     break
                 # image rates (px/s) along the trajectory: ∂(x, y)/∂pose · pose rate
@@ -183,48 +264,6 @@ def _lines_kernel(
                 r[2 * j + 1] = y * k_px - xy_obs[j, 1]
             if not jac:
                 continue
-            for u in range(2):
-                row = 2 * j + u
-                for a in range(3):
-                    dP[row, a] = -d6[u, a]  # dp/dP = β Rᵀ = −dp/dx
-                    dN[row, a] = d6[u, a]  # × the spline weights (factored Jacobian)
-                    dL[row, a] = -JpB[u, a]
-                    dN[row, 3 + a] = d6[u, 3 + a]
-                for kk in range(3):
-                    # boresight: dp/dbore_k = dβ_k q
-                    v = 0.0
-                    for i in range(3):
-                        v += Jp[u, i] * (
-                            dbeta[kk, i, 0] * q[0] + dbeta[kk, i, 1] * q[1] + dbeta[kk, i, 2] * q[2]
-                        )
-                    dB[row, kk] = v
-            dC[2 * j, 0] = gx * xb / c * k_px
-            dC[2 * j + 1, 0] = (yb / c + gy * xb / c) * k_px
-            dD[2 * j, 0] = xb**3 * k_px
-            dD[2 * j, 1] = xb**5 * k_px
-            dD[2 * j, 2] = 3 * xb**2 * k_px
-            dD[2 * j, 3] = 0.0
-            dD[2 * j + 1, 0] = 0.0
-            dD[2 * j + 1, 1] = 0.0
-            dD[2 * j + 1, 2] = 0.0
-            dD[2 * j + 1, 3] = xb**2 * k_px
+            _derivatives(j, d6, Jp, JpB, dbeta, q, c, xb, yb, gx, gy, k_px, dP, dN, dB, dL, dD, dC)
             if timed:
-                # x(t*(θ)): ∂x/∂θ − (ẋ/ẏ) ∂y/∂θ; ẏ_ref (t_e − t*): (ẏ_ref/ẏ) ∂y/∂θ
-                fx = xdot / ydot
-                fy = y_rate_ref / ydot
-                rx, ry = 2 * j, 2 * j + 1
-                for a in range(3):
-                    dP[rx, a] -= fx * dP[ry, a]
-                    dL[rx, a] -= fx * dL[ry, a]
-                    dB[rx, a] -= fx * dB[ry, a]
-                    dP[ry, a] *= fy
-                    dL[ry, a] *= fy
-                    dB[ry, a] *= fy
-                for a in range(6):
-                    dN[rx, a] -= fx * dN[ry, a]
-                    dN[ry, a] *= fy
-                for a in range(4):
-                    dD[rx, a] -= fx * dD[ry, a]
-                    dD[ry, a] *= fy
-                dC[rx, 0] -= fx * dC[ry, 0]
-                dC[ry, 0] *= fy
+                _through_time(j, xdot / ydot, y_rate_ref / ydot, dP, dN, dB, dL, dD, dC)
