@@ -135,6 +135,7 @@ CONTEXTS = {
     "dem_error_off": "without DEM error",
     "ripple_on": "distortion ripple on",
     "ripple_off": "distortion ripple off",
+    "ripple_shift_z": "pseudo-true − generating value, in σ̂ (distortion ripple)",
     "calibrated": "calibrated",
     "uncalibrated": "uncalibrated",
     "gauss_markov": "Gauss–Markov trajectory error",

@@ -90,6 +90,7 @@ __all__ = [
     "TRAJECTORY_ERRORS",
     "block_length_m",
     "distortion_ripple_px",
+    "noise_free_twin",
     "gauss_markov",
     "refraction_k",
     "simulate",
@@ -562,3 +563,41 @@ def simulate(
         error_samples=err_x,
     )
     return observations, truth
+
+
+def noise_free_twin(obs: CampaignObservations, truth: CampaignTruth) -> CampaignObservations:
+    """The noise-free twin of a simulated campaign: the same observation rows (points, bands,
+    strips, registered line times) with everything random taken out and the unmodelled
+    effects (the distortion ripple, refraction) kept.
+
+    The image coordinates are the true ones at the registered line times (no key-point error,
+    no pixel quantisation, no gross errors), the navigation is the true pose (no GNSS/INS
+    error: the node corrections' truth and prior mean are zero), the GCPs and the lever arm
+    are exact. No random number is drawn: the geometry is that of ``obs`` bit for bit. Its
+    adjustment gives the pseudo-true values of the parameters (what the misspecified model
+    converges to on this geometry); with no unmodelled effect on, the truth itself.
+    """
+    cfg, names = truth.cfg, BLOCK_NAMES
+
+    def no_error(tt, rate=False):
+        return np.zeros((np.size(tt), 6))
+
+    lines = obs.lines
+    xyz, rpy, xyz_rate, rpy_rate = _navigation(cfg, truth.strips, truth.strip, lines.t_s, no_error)
+    exact = PushbroomObservations(
+        point=lines.point,
+        band=lines.band,
+        t_s=lines.t_s,
+        xy_px=truth.xy_true_px.copy(),
+        xyz_nav_m=xyz,
+        rpy_nav_rad=rpy,
+        xyz_rate_nav_m_s=xyz_rate,
+        rpy_rate_nav_rad_s=rpy_rate,
+    )
+    return replace(
+        obs,
+        lines=exact,
+        gcp_xyz_m=truth.values[names["points"]][obs.gcp_index].copy(),
+        lever_arm_m=np.array(truth.values[names["lever_arm"]]),
+        node_prior_mean=np.zeros_like(obs.node_prior_mean),
+    )

@@ -104,10 +104,12 @@ class CampaignConfig:
     cp_rays: str = "tie points"
     # -- an instrument effect the estimator does not model (issue 22): a distortion residual
     # outside 002 eq. (3), a ripple along the line of this amplitude (px) and number of periods
-    # over the line, less what the model absorbs (distortion_ripple_px). Off by default: at the
-    # paper's size even 0.1 px biases K1, K2 by more than 15σ̂ (the observations' x are not
-    # spread evenly enough for the ripple to be orthogonal to the Brown terms), so the chapter
-    # runs it as a factor (hsgeo.reproduce.pushbroom_ba.RIPPLE_PX). Not in the noise-free mode.
+    # over the line, less what the model absorbs (distortion_ripple_px). Off in the scenario's
+    # default (the tests' and studies' campaigns); the chapter's campaign switches it on
+    # (hsgeo.reproduce.pushbroom_ba.run, RIPPLE_PX) and judges the camera against its
+    # pseudo-true values (noise_free_twin; the observations' x are not spread evenly enough
+    # for the ripple to be orthogonal to the Brown terms: at the paper's size 0.1 px moves K1,
+    # K2 by more than 15σ̂). Not in the noise-free mode (noise_free_twin keeps it).
     distortion_ripple_px: float = 0.0
     distortion_ripple_periods: float = 3.0
 
