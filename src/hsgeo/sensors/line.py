@@ -24,7 +24,7 @@ from hsgeo.adjust import Parameters, ResidualBlock, adjust
 from hsgeo.errors import ObservationError
 from hsgeo.rotations import R_ENU_FROM_NED, R_from_rpy, dR_drpy
 from hsgeo.sensors import line1d
-from hsgeo.sensors.mount import Mount, line_time, unit
+from hsgeo.sensors.mount import Mount, line_time
 
 __all__ = [
     "LineGeometry",
@@ -145,17 +145,11 @@ class LineScanner:
         directions : (n, 3) ndarray, unit length
         """
         t = np.asarray(self.geometry.tan_angle(zeta_px), dtype=float).ravel()
-        pos, _ = trajectory.pose(t_s)
-        R = trajectory.R_map_from_body(t_s)
         d_s = np.stack([np.zeros_like(t), t, np.ones_like(t)], axis=1)
-        return self.mount.origins(pos, R), unit(self.mount.directions(R, d_s))
+        return self.mount.rays_along(d_s, t_s, trajectory)
 
     def _sensor_xyz(self, xyz_map_m, t_s, trajectory) -> np.ndarray:
-        pos, _ = trajectory.pose(t_s)
-        p = self.mount.to_sensor(xyz_map_m, pos, trajectory.R_map_from_body(t_s))
-        if np.any(p[:, 2] <= 0):
-            raise ObservationError("points behind the line scanner (sensor z ≤ 0)")
-        return p
+        return self.mount.sensor_points_along(xyz_map_m, t_s, trajectory, "line scanner")
 
     def project(self, xyz_map_m, t_s, trajectory) -> np.ndarray:
         """``(ζ, across_px)`` of map points seen at times ``t_s``, ``(n, 2)`` px."""

@@ -32,7 +32,7 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from hsgeo.errors import ConvergenceError, InputError
+from hsgeo.errors import ConvergenceError, InputError, ObservationError
 from hsgeo.rotations import R_from_rpy
 
 __all__ = ["Mount", "Sensor", "line_time", "unit"]
@@ -99,6 +99,25 @@ class Mount:
         d = np.atleast_2d(np.asarray(xyz_map_m, float)) - self.origins(xyz_body_m, R)
         d_body = np.einsum("nji,nj->ni", R, d)  # R_map_from_bodyᵀ d
         return d_body @ self.R_body_from_sensor  # R_body_from_sensorᵀ d_body
+
+    # ---- a sensor carried along a trajectory (line, panoramic) ---------------------------------
+    def rays_along(self, d_sensor, t_s, trajectory) -> tuple[np.ndarray, np.ndarray]:
+        """Origins (m) and unit map-frame directions of sensor-frame directions ``d_sensor``
+        ``(n, 3)`` taken at times ``t_s`` on ``trajectory`` (:class:`hsgeo.trajectory.Trajectory`).
+        """
+        pos, _ = trajectory.pose(t_s)
+        R = trajectory.R_map_from_body(t_s)
+        return self.origins(pos, R), unit(self.directions(R, d_sensor))
+
+    def sensor_points_along(self, xyz_map_m, t_s, trajectory, sensor: str = "sensor"):
+        """Map points in the sensor frame at times ``t_s`` on ``trajectory``, ``(n, 3)``; an
+        :class:`~hsgeo.errors.ObservationError` naming ``sensor`` for points behind it (z ≤ 0).
+        """
+        pos, _ = trajectory.pose(t_s)
+        p = self.to_sensor(xyz_map_m, pos, trajectory.R_map_from_body(t_s))
+        if np.any(p[:, 2] <= 0):
+            raise ObservationError(f"points behind the {sensor} (sensor z ≤ 0)")
+        return p
 
 
 def unit(d) -> np.ndarray:

@@ -25,9 +25,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from hsgeo.errors import InputError, ObservationError
+from hsgeo.errors import InputError
 from hsgeo.papers import ASF_004
-from hsgeo.sensors.mount import Mount, line_time, unit
+from hsgeo.sensors.mount import Mount, line_time
 
 __all__ = ["PanoramicScanner", "DAEDALUS_N_PX", "DAEDALUS_IFOV_DEG"]
 
@@ -114,17 +114,11 @@ class PanoramicScanner:
         directions : (n, 3) ndarray, unit length
         """
         th = np.atleast_1d(self.scan_angle_rad(zeta_px)).ravel()
-        pos, _ = trajectory.pose(t_s)
-        R = trajectory.R_map_from_body(t_s)
         d_s = np.stack([np.zeros_like(th), np.sin(th), np.cos(th)], axis=1)
-        return self.mount.origins(pos, R), unit(self.mount.directions(R, d_s))
+        return self.mount.rays_along(d_s, t_s, trajectory)
 
     def _sensor_xyz(self, xyz_map_m, t_s, trajectory) -> np.ndarray:
-        pos, _ = trajectory.pose(t_s)
-        p = self.mount.to_sensor(xyz_map_m, pos, trajectory.R_map_from_body(t_s))
-        if np.any(p[:, 2] <= 0):
-            raise ObservationError("points behind the panoramic scanner (sensor z ≤ 0)")
-        return p
+        return self.mount.sensor_points_along(xyz_map_m, t_s, trajectory, "panoramic scanner")
 
     def project(self, xyz_map_m, t_s, trajectory) -> np.ndarray:
         """``(ζ, across_px)`` of map points seen at times ``t_s``, ``(n, 2)`` px."""
