@@ -542,9 +542,10 @@ def asf_ratio(
         c_mean = np.where(w > 0, c, 0.0).sum(axis=1) / n  # 004 step 2
         a_mean = np.where(w > 0, a, 0.0).sum(axis=1) / n
         ratio = c_mean / a_mean  # 004 step 3
-        r = np.where(w > 0, c / np.where(a > 0, a, 1.0), 0.0)
-        r_mean = r.sum(axis=1, keepdims=True) / n
-        sd = np.sqrt((w * (r - r_mean) ** 2).sum(axis=1) / (n - 1))
+        # σ of a ratio of means (delta method): sd(c − ratio·a) / mean(a), over √n below
+        d = np.where(w > 0, c - ratio[:, None, :] * a, 0.0)
+        d_mean = d.sum(axis=1, keepdims=True) / n
+        sd = np.sqrt((w * (d - d_mean) ** 2).sum(axis=1) / (n - 1)) / a_mean
     usable = n >= max(min_samples, 2)
     ratio = np.where(usable, ratio, np.nan)
     sigma = np.where(usable, sd / np.sqrt(np.maximum(n, 1)), np.nan)

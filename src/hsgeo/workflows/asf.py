@@ -28,6 +28,7 @@ from scipy.spatial import cKDTree
 from hsgeo.errors import InputError
 from hsgeo.geocode import PlaneTerrain, geocode_rays
 from hsgeo.radiometry import asf_ratio
+from hsgeo.stats import nmad
 
 __all__ = [
     "GeoScan",
@@ -373,10 +374,10 @@ def register(
         )
     S = np.array(shifts)
     med = np.median(S, axis=0)
-    nmad = 1.4826 * np.median(np.abs(S - med), axis=0)
-    scatter = float(np.hypot(*nmad)) / gsd
-    se = 1.2533 / np.sqrt(len(S))  # standard error of a median, normal errors
-    return Registration(med, S, np.array(centres), scatter, se * scatter, gsd, se * nmad)
+    spread = nmad(S, axis=0)
+    scatter = float(np.hypot(*spread)) / gsd
+    se = np.sqrt(np.pi / 2) / np.sqrt(len(S))  # standard error of a median, normal errors
+    return Registration(med, S, np.array(centres), scatter, se * scatter, gsd, se * spread)
 
 
 def peak_to_peak_percent(asf, usable, smooth_px: int) -> np.ndarray:
