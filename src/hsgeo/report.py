@@ -31,6 +31,7 @@ import math
 from dataclasses import dataclass, field
 
 from hsgeo.errors import InputError
+from hsgeo.terminal import strict_values
 from hsgeo.vocabulary import display_unit, quantity_label
 
 __all__ = [
@@ -258,17 +259,6 @@ class Row:
             "provenance": self.provenance,
             "override": self.overridden,
         }
-
-
-def _strict(obj):
-    """``obj`` with every non-finite float replaced by None (strict JSON, GUIDE §5)."""
-    if isinstance(obj, dict):
-        return {k: _strict(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_strict(v) for v in obj]
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    return obj
 
 
 def agreement(z: float | None) -> str:
@@ -558,7 +548,7 @@ class Reproduction:
                 "chapter": self.chapter,
                 "seed": self.seed,
                 "rows": [r.as_dict() for r in self.rows],
-                "meta": _strict(self.meta),
+                "meta": strict_values(self.meta),
             },
             indent=1,
             allow_nan=False,

@@ -175,13 +175,11 @@ def progress_printer(stream=None):
     if not tty:
         return None
 
+    from hsgeo.adjust.solver import progress_text
+
     def show(info):
         global _progress_shown
-        text = (
-            f"  iter {info['iteration']:3d}  cost {info['cost']:.6e}  λ {info['lambda']:.1e}"
-            f"  {info['seconds']:.2f} s"
-        )
-        stream.write("\r\033[K" + text)
+        stream.write("\r\033[K" + progress_text(info))
         stream.flush()
         _progress_shown = True
 
@@ -202,19 +200,22 @@ def clear_progress(stream=None) -> None:
     _progress_shown = False
 
 
-def _finite(obj):
+def strict_values(obj):
+    """``obj`` with every NaN or infinite number as None, numpy scalars and arrays as Python
+    numbers and lists: what strict JSON holds (``Reproduction.to_json``, :func:`json_text`).
+    """
     if isinstance(obj, float):
         return obj if math.isfinite(obj) else None
     if isinstance(obj, dict):
-        return {k: _finite(v) for k, v in obj.items()}
+        return {k: strict_values(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
-        return [_finite(v) for v in obj]
+        return [strict_values(v) for v in obj]
     item = getattr(obj, "item", None)  # numpy scalars
     if item is not None and getattr(obj, "ndim", 1) == 0:
-        return _finite(item())
+        return strict_values(item())
     tolist = getattr(obj, "tolist", None)  # numpy arrays
     if tolist is not None:
-        return _finite(tolist())
+        return strict_values(tolist())
     return obj
 
 
@@ -223,4 +224,4 @@ def json_text(obj, **kwargs) -> str:
     (strict JSON: ``NaN`` and ``Infinity`` are not JSON, and most readers refuse them).
     """
     kwargs.setdefault("indent", 1)
-    return json.dumps(_finite(obj), allow_nan=False, **kwargs)
+    return json.dumps(strict_values(obj), allow_nan=False, **kwargs)

@@ -618,6 +618,17 @@ def _settled(actual: float, pred: float, new_cost: float, share: float) -> bool:
     return max(min(actual, abs(actual - pred)), 0.0) <= share * new_cost
 
 
+def progress_text(info: dict) -> str:
+    """One iteration's progress line: iteration, cost, λ, seconds and rejections (if any); the
+    solver's own ``progress=True`` and the command line's terminal progress both print it.
+    """
+    return (
+        f"  iter {info['iteration']:3d}  cost {info['cost']:.6e}  λ {info['lambda']:.1e}"
+        f"  {info['seconds']:.2f} s"
+        + (f"  rejected {info['rejected']}" if info.get("rejected") else "")
+    )
+
+
 def _progress_printer(progress):
     if progress is None or progress is False:
         return None
@@ -625,12 +636,6 @@ def _progress_printer(progress):
         return progress
 
     def show(info):
-        print(
-            f"  iter {info['iteration']:3d}  cost {info['cost']:.6e}  λ {info['lambda']:.1e}"
-            f"  {info['seconds']:.2f} s"
-            + (f"  rejected {info['rejected']}" if info.get("rejected") else ""),
-            file=sys.stderr,
-            flush=True,
-        )
+        print(progress_text(info), file=sys.stderr, flush=True)
 
     return show
