@@ -265,9 +265,10 @@ def simulate_flight(cfg: dict, rng) -> tuple[FlightObservations, FlightTruth]:
     the paper's experiment cannot have had such a flight. The redraw continues the same random
     stream (trajectory, navigation errors, boresight, again), so the same seed gives the same
     bytes, and a flight accepted at the first draw is exactly the flight drawn before this rule
-    (with ``pula_flight.toml`` 2 of 43 100 flights checked were redrawn, each once: a boresight
-    roll near 4 σ on top of the roll motion; ``truth.n_draws`` says how many draws a flight
-    took). The measurement noise is drawn once, for the accepted flight.
+    (rare with ``pula_flight.toml``: a boresight roll near 4 σ on top of the roll motion;
+    ``truth.n_draws`` says how many draws a flight took, and ``hsgeo reproduce geocoding``
+    counts the redrawn flights in ``meta["n_flights_redrawn"]``). The measurement noise is
+    drawn once, for the accepted flight.
 
     Raises
     ------
