@@ -225,6 +225,7 @@ def test_claims_with_reasons_lists_one_papers_claims_with_their_verdicts():
     ]
     df = claims_with_reasons(Reproduction("scoreboard", 0, rows), "000")
     assert list(df.columns) == ["claim", "verdict", "why"]
-    assert list(df.claim) == ["Table 1: c_px", "Table 3: dx_m"]
+    # in a reader's words, as the compact table above it (no internal key on the page)
+    assert list(df.claim) == ["principal distance c (Table 1)", "dx (Table 3)"]
     assert list(df.verdict) == ["reproduced", "differs"]
     assert list(df.why) == [rows[0].judge()[1], rows[2].judge()[1]]

@@ -75,7 +75,8 @@ VERDICT_MEANING = {
 }
 
 #: Where a row's truth comes from (GUIDE §4): ``paper`` (the paper's value used as truth),
-#: ``derived`` (computed from the paper's values), ``chosen`` (our stated assumption), ``tuned``
+#: ``derived`` (computed from the paper's values, or the pseudo-true value a misspecified model
+#: reaches on noise-free data of the same simulation), ``chosen`` (our stated assumption), ``tuned``
 #: (chosen so that an outcome meets a paper value).
 PROVENANCES = ("paper", "derived", "chosen", "tuned")
 

@@ -173,7 +173,7 @@ def _named(rows: list[Row]) -> str:
     names = [_claim_label(r) for r in rows[:NAMED]]
     if len(rows) > NAMED:
         names.append(f"{len(rows) - NAMED} more")
-    return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
+    return _listed(names)
 
 
 def _listed(parts: list[str]) -> str:
@@ -372,9 +372,5 @@ def claims_with_reasons(board: Reproduction, paper: str):
     """
     import pandas as pd
 
-    recs = [
-        (f"{r.table[4:]}: {r.quantity}", *r.judge())
-        for r in board.rows
-        if r.table.startswith(paper)
-    ]
+    recs = [(_claim_label(r), *r.judge()) for r in board.rows if r.table.startswith(paper)]
     return pd.DataFrame(recs, columns=["claim", "verdict", "why"])
