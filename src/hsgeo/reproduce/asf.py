@@ -240,12 +240,13 @@ def _leak_rows(th, asf_true, lam, brdf, brdf_rev, combined, truth_b, hw) -> list
     bc = _normalised(truth_b.brdf_cross, th, hw)
     br = _normalised(truth_b.brdf_reverse, th, hw)
     pe, po = (100 * np.max(np.abs(x - 1)) for x in even_odd_parts(bc))
+    re_, ro = (100 * np.max(np.abs(x - 1)) for x in even_odd_parts(br))
     ce, co = (100 * np.max(np.abs(x - 1)) for x in even_odd_parts(np.sqrt(bc * br)))
     rows = []
     for label, a, pred in (
         ("Lambertian, one crossing", lam, (0.0, 0.0)),
         ("BRDF, one crossing", brdf, (pe, po)),
-        ("BRDF, reverse crossing", brdf_rev, (pe, po)),
+        ("BRDF, reverse crossing", brdf_rev, (re_, ro)),  # the reverse flight's own BRDF
         ("BRDF, two opposite crossings", combined, (ce, co)),
     ):
         e, o = parts_err(a)
