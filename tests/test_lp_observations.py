@@ -120,3 +120,46 @@ def test_options_are_checked():
     ):
         with pytest.raises(InputError):
             LpOptions(**bad)
+
+
+def test_to_pushbroom_inputs_is_the_adjust_pushbroom_path(tmp_path):
+    """A table (here the pushbroom chapter's simulated observations) handed over by
+    to_pushbroom_inputs gives exactly what `hsgeo adjust-pushbroom` builds from the same table
+    written to a file; an unknown GCP is one clear error."""
+    from hsgeo.errors import ObservationError
+    from hsgeo.io.navigation import read_trajectory, write_trajectory
+    from hsgeo.io.tables import read_table
+    from hsgeo.simulate.pushbroom_campaign import simulate
+    from hsgeo.trajectory import Trajectory, rph_from_platform_rpy
+    from hsgeo.workflows.lp_observations import LpResult, to_pushbroom_inputs
+    from hsgeo.workflows.pushbroom_ba import OBS_COLUMNS, CameraPrior, _observations
+
+    obs, _ = simulate(0.001, rng=4)
+    o = obs.lines
+    table = pd.DataFrame(
+        {
+            "point_id": [f"p{v}" for v in o.point],
+            "band": o.band,
+            "t_s": o.t_s,
+            "x_px": o.xy_px[:, 0],
+            "y_px": o.xy_px[:, 1],
+        }
+    )
+    t, i = np.unique(o.t_s, return_index=True)
+    write_trajectory(
+        tmp_path / "nav.csv", Trajectory(t, o.xyz_nav_m[i], rph_from_platform_rpy(o.rpy_nav_rad[i]))
+    )
+    nav = read_trajectory(tmp_path / "nav.csv")
+    cam = CameraPrior(7)
+    res = LpResult(table, None, None, None, None, {}, {})
+    gid = [f"p{v}" for v in obs.gcp_index]
+    inp = to_pushbroom_inputs(res, nav, cam, gid, obs.gcp_xyz_m)
+    table.to_csv(tmp_path / "obs.csv", index=False, float_format="%.17g")
+    df = read_table(tmp_path / "obs.csv", OBS_COLUMNS, "observation", text_columns=("point_id",))
+    ref, ids = _observations(df, "obs.csv", "nav.csv", nav, cam, 1.0)
+    assert inp.point_ids.tolist() == ids.tolist()
+    for k in ("point", "band", "t_s", "xy_px", "xyz_nav_m", "rpy_nav_rad", "xyz_rate_nav_m_s"):
+        assert np.array_equal(getattr(inp.observations, k), getattr(ref, k)), k
+    assert [ids[g] for g in inp.gcp_index] == gid
+    with pytest.raises(ObservationError, match="nope"):
+        to_pushbroom_inputs(res, nav, cam, ["nope"], np.zeros((1, 3)))
