@@ -215,9 +215,12 @@ def match_hamming(
     if k == 2:
         second = np.array([m[1].distance if len(m) > 1 else np.inf for m in knn if m])
         keep &= dist < ratio * second
-    if cross_check:
-        back = bf.match(d2, d1)  # nearest neighbour of every desc2 in desc1
+    if cross_check and keep.any():
+        # nearest neighbour in desc1 of the desc2 that are still matched (not of all desc2:
+        # the same answer at a fraction of the brute-force cost)
+        cand = np.unique(i2[keep])
+        back = bf.match(d2[cand], d1)
         nn21 = np.full(d2.shape[0], -1, np.int64)
-        nn21[[m.queryIdx for m in back]] = [m.trainIdx for m in back]
+        nn21[cand[[m.queryIdx for m in back]]] = [m.trainIdx for m in back]
         keep &= nn21[i2] == i1
     return i1[keep], i2[keep], dist[keep]

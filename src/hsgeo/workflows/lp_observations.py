@@ -370,7 +370,7 @@ def _table(inputs, options, keys, point, square_rows):
     sq = pd.DataFrame(
         square_rows, columns=["point_id", "band", "strip", "line", "t_s", "x_px", "ok"]
     )
-    sq = sq[sq["ok"]].drop_duplicates(["point_id", "band", "strip"])
+    sq = sq.loc[sq["ok"].astype(bool)].drop_duplicates(["point_id", "band", "strip"])
     count = sq.groupby("point_id")["point_id"].transform("size")
     sq = sq[count >= options.min_square_observations].assign(y_px=0.0)
     table = pd.concat([ties, sq[list(TABLE_COLUMNS)]], ignore_index=True)
