@@ -423,6 +423,11 @@ def test_determinism():
     np.testing.assert_array_equal(r1.inliers, r2.inliers)
     np.testing.assert_array_equal(r1.F, r2.F)
     assert r1.n_iterations == r2.n_iterations
+    # exact data, the minimum number: every match is an inlier of the one model
+    e1, e2 = lp_pairs("uav-crossing", 11, np.random.default_rng(9))
+    r = ransac_lp_fundamental(e1, e2, rng=0)
+    assert r.inliers.all() and r.inliers.shape == (11,)
+    assert lp_epipolar_distance(r.F, e1, e2).max() < EXACT_TOL_PX
     f1 = ransac_frame_fundamental(a, b)
     f2 = ransac_frame_fundamental(a, b)
     np.testing.assert_array_equal(f1, f2)

@@ -421,7 +421,14 @@ def ransac_lp_fundamental(
             needed = _iterations_needed(count, n, confidence, max_iter)
     if best_F is None:
         return LpRansacResult(np.full((4, 4), np.nan), np.zeros(n, bool), done)
-    F = best_F
+    F, inliers = _refine(best_F, A_all, (L1, L2), (a, b), (T1, T2), threshold_px, deleted)
+    return LpRansacResult(F, inliers, done)
+
+
+def _refine(F0, A_all, lifted, uv, T, threshold_px, deleted):
+    """Refit on the inliers (gradient-weighted), classify again; then the deleted residuals."""
+    (L1, L2), (a, b), (T1, T2) = lifted, uv, T
+    F = F0
     d, grad = _sampson(F, L1, L2, a, b, gradient=True)
     inliers = d <= threshold_px
     for _ in range(5):  # refit on all inliers, classify again
@@ -433,7 +440,7 @@ def ransac_lp_fundamental(
         # design equals L'ᵀ F L up to one global scale, so the weights carry over.
         Aw = A_all[inliers] / grad[inliers, None]
         _, sv, Vt = np.linalg.svd(Aw, full_matrices=False)
-        if sv[-1] <= 0 or sv[10] <= _RANK_TOL * sv[0] or Vt.shape[0] < 12:
+        if Vt.shape[0] < 12 or sv[10] <= _RANK_TOL * sv[0]:
             break
         F_new = _denormalise(Vt[-1], T1, T2)
         d_new, grad_new = _sampson(F_new, L1, L2, a, b, gradient=True)
@@ -455,7 +462,7 @@ def ransac_lp_fundamental(
         Aw = A_all[inliers] / grad[inliers, None]
         F = _denormalise(np.linalg.svd(Aw, full_matrices=False)[2][-1], T1, T2)
         grad = _sampson(F, L1, L2, a, b, gradient=True)[1]
-    return LpRansacResult(F, inliers, done)
+    return F, inliers
 
 
 def _deleted_residual_px(A_all, grad, inliers, T1, T2, a, b) -> np.ndarray:
