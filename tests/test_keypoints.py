@@ -118,7 +118,7 @@ def test_square_centroid_rejects():
     uv, ok, _ = square_centroid(flat, (100, 100))
     assert not ok and np.all(np.isnan(uv))
     img = _square_image(rng, (100.0, 100.0))
-    assert not square_centroid(img, (10, 100))[1]  # window outside the scene
+    assert not square_centroid(img, (10, 100))[1]  # the window (clipped) misses the square
     big = flat.copy()
     big[80:120, 80:120] += 300  # a roof: no contrast at the square's scale in its middle
     uv, ok, _ = square_centroid(big, (100, 100), search_px=5)

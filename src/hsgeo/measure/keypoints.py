@@ -58,10 +58,17 @@ STRETCH_PERCENTILES = (0.5, 99.5)
 EDGE_MARGIN_PX = 12
 #: BRISK's FAST/AGAST score threshold (OpenCV's default 30, on the 8-bit stretch).
 BRISK_THRESHOLD = 30
-#: BRISK's scale-space octaves (OpenCV's default 3).
-BRISK_OCTAVES = 3
-#: Lowe's ratio: a match is kept when best / second-best Hamming distance is below it.
-RATIO = 0.8
+#: BRISK's scale-space octaves. 0: the full-resolution layer only (OpenCV's default is 3). The
+#: scenes of one campaign differ in scale by at most the ratio of its flying heights (002: 2500 /
+#: 1875 m = 1.33), which BRISK's descriptor tolerates, and a key point found on a coarser octave
+#: is located to a fraction of *that* octave's pixel: on the rendered campaign of
+#: :mod:`hsgeo.simulate.lp_campaign` (scale 0.1, seed 0) 80 % of the observations were within
+#: 1 px of their true image position with 3 octaves, 94 % with 0.
+BRISK_OCTAVES = 0
+#: Lowe's ratio: a match is kept when best / second-best Hamming distance is below it. 0.7
+#: rather than Lowe's 0.8: on the same campaign it took the share within 1 px from 94 % to 96 %
+#: and gave more tie points (fewer components joined through an ambiguous match).
+RATIO = 0.7
 
 
 @dataclass(frozen=True)
@@ -149,7 +156,8 @@ def detect_brisk(
     band : (rows, cols) array_like
         DN; NaN outside the scene (no key point within :data:`EDGE_MARGIN_PX` of it).
     threshold, octaves : int
-        BRISK's detection threshold and octaves (OpenCV's defaults).
+        BRISK's detection threshold and octaves (:data:`BRISK_THRESHOLD`,
+        :data:`BRISK_OCTAVES`).
     percentiles : (float, float)
         The 8-bit stretch (:func:`to_uint8`).
 

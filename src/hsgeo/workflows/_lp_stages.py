@@ -14,6 +14,7 @@ import numpy as np
 
 from hsgeo.measure.keypoints import detect_brisk, match_hamming
 from hsgeo.workflows import _lp_geometry as geo
+from hsgeo.workflows import _lp_squares as sq
 
 __all__ = ["Keys", "strip_scenes", "match_all", "MIN_MATCHES"]
 
@@ -26,7 +27,8 @@ class Keys:
 
     def __init__(self):
         self.parts: dict[str, list] = {
-            k: [] for k in ("strip", "scene", "band", "uv", "line", "x", "t", "ground", "desc")
+            k: []
+            for k in ("strip", "scene", "band", "uv", "line", "x", "t", "ground", "desc", "size")
         }
         self.slices: dict[tuple[int, int], slice] = {}
         self.n = 0
@@ -45,6 +47,7 @@ class Keys:
             ("t", t),
             ("ground", ground),
             ("desc", kp.descriptors),
+            ("size", kp.size_px),
         ):
             self.parts[k].append(np.asarray(v))
 
@@ -71,7 +74,8 @@ def strip_scenes(strip, si, inputs, options, bands, height, keys, rows, timings)
     scenes = make_scenes(strip, nav, cam, options.n_lines_per_scene, inputs.n_px_full)
     timings["scenes"] += time.perf_counter() - t0
     t_s = np.asarray(strip.t_s, float)
-    squares = _predict_squares(strip, inputs, height) if len(inputs.square_ids) else None
+    squares = sq.predict(strip, inputs, height) if len(inputs.square_ids) else None
+    candidates = []
     out = []
     for sc in scenes:
         t0 = time.perf_counter()
@@ -90,7 +94,9 @@ def strip_scenes(strip, si, inputs, options, bands, height, keys, rows, timings)
             "dx_max_px": float(np.nanmax(np.abs(dx))),
         }
         for b in bands:
-            kp = detect_brisk(sc.image[:, :, b])
+            kp = detect_brisk(
+                sc.image[:, :, b], threshold=options.brisk_threshold, octaves=options.brisk_octaves
+            )
             if kp.n:
                 line, x = scene_to_line(sc, kp.uv)
                 line = np.asarray(line, np.int64)
@@ -110,58 +116,12 @@ def strip_scenes(strip, si, inputs, options, bands, height, keys, rows, timings)
         timings["detection"] += time.perf_counter() - t0
         if squares is not None:
             t0 = time.perf_counter()
-            rows["squares"] += _measure_squares(sc, strip, squares, inputs, options, bands)
+            candidates += sq.candidates(sc, squares, inputs, options, bands)
             timings["squares"] += time.perf_counter() - t0
-    return out
-
-
-def _predict_squares(strip, inputs, height):
-    """Each square's predicted fractional line and x in this strip, and the strip's GSD."""
-    t_s = np.asarray(strip.t_s, float)
-    line, x = geo.crossing_lines(inputs.camera, inputs.square_xyz_m, t_s, inputs.navigation)
-    z = inputs.navigation.pose(t_s[t_s.size // 2])[0][0, 2]
-    c = float(np.atleast_1d(inputs.camera.c_mm)[0])
-    gsd_m = (z - height) * inputs.camera.pixel_mm / c
-    return line, x, gsd_m
-
-
-def _measure_squares(sc, strip, predicted, inputs, options, bands) -> list:
-    """The squares predicted in this scene, measured in every band (their centroids)."""
-    from hsgeo.measure.lp_scenes import scene_to_line
-    from hsgeo.measure.targets_lp import square_centroid
-
-    line, x, gsd_m = predicted
-    n = sc.image.shape[0]
-    box = max(2, int(np.ceil(options.square_size_m / gsd_m)))
-    h_px = (inputs.n_px_full - 1) / 2
-    t_s = np.asarray(strip.t_s, float)
-    out = []
-    for k in np.flatnonzero(np.isfinite(line)):
-        u0 = line[k] - sc.line0
-        if not (0 <= u0 <= n - 1):
-            continue
-        v0 = x[k] + h_px - sc.col0  # the compensation's shift is inside the search window
-        for b in bands:
-            uv, ok, snr = square_centroid(
-                sc.image[:, :, b], (u0, v0), box_px=box, search_px=options.square_search_px
-            )
-            ln, xx = (np.zeros(1, int), np.full(1, np.nan))
-            if ok:
-                ln, xx = scene_to_line(sc, uv[None, :])
-            out.append(
-                {
-                    "point_id": str(inputs.square_ids[k]),
-                    "band": int(b),
-                    "strip": str(strip.strip_id),
-                    "line": int(ln[0]),
-                    "t_s": float(t_s[int(ln[0])]) if ok else float("nan"),
-                    "x_px": float(xx[0]),
-                    "u": float(uv[0]),
-                    "v": float(uv[1]),
-                    "snr": float(snr),
-                    "ok": bool(ok),
-                }
-            )
+    if squares is not None:
+        t0 = time.perf_counter()
+        rows["squares"] += sq.choose(candidates, strip, squares, inputs, options)
+        timings["squares"] += time.perf_counter() - t0
     return out
 
 

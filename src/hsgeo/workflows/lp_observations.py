@@ -39,8 +39,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from hsgeo.errors import InputError, ObservationError
-from hsgeo.measure.keypoints import RATIO
+from hsgeo.measure.keypoints import BRISK_OCTAVES, BRISK_THRESHOLD, RATIO
+from hsgeo.measure.targets_lp import SEARCH_PX
 from hsgeo.measure.tie_points import link_tie_points
+from hsgeo.workflows import _lp_squares as sq
 from hsgeo.workflows._lp_stages import MIN_MATCHES, Keys, match_all, strip_scenes
 
 __all__ = [
@@ -112,6 +114,8 @@ class LpOptions:
         sub-pixel position.
     ratio : float
         Lowe's ratio of the matching.
+    brisk_threshold, brisk_octaves : int
+        BRISK's detection threshold and scale-space octaves.
     overlap_margin_m : float
         Key points predicted this far outside the other scene's footprint are still matched
         (the a-priori boresight's error on the ground).
@@ -135,9 +139,11 @@ class LpOptions:
     bands: tuple | None = None
     x_at: str = "pixel_centre"
     ratio: float = RATIO
+    brisk_threshold: int = BRISK_THRESHOLD
+    brisk_octaves: int = BRISK_OCTAVES
     overlap_margin_m: float = 30.0
     square_size_m: float = 1.2
-    square_search_px: int = 40
+    square_search_px: int = SEARCH_PX
     min_square_observations: int = 2
     max_nav_gap_s: float = 1.0
     rng: int = 0
@@ -365,6 +371,7 @@ def _table(inputs, options, keys, point, square_rows):
             "y_px": np.zeros(obs.size),
             "strip": ids[keys.strip[obs]],
             "line": keys.line[obs],
+            "size_px": keys.size[obs],
         }
     )
     sq = pd.DataFrame(
@@ -456,7 +463,7 @@ def _result(inputs, options, bands, keys, point, link, table, matches, rows, tim
         scenes=pd.DataFrame(rows["scenes"]),
         squares=pd.DataFrame(
             rows["squares"],
-            columns=["point_id", "band", "strip", "line", "t_s", "x_px", "u", "v", "snr", "ok"],
+            columns=sq.COLUMNS,
         ),
         counts=counts,
         timings_s=timings,
