@@ -10,13 +10,14 @@ is not said; ours, :func:`square_centroid`, for one square in one band of a scen
    minus the mean over the ring around it out to ``3 box_px`` (both by cumulative sums); its
    local maxima are the candidates (:func:`square_candidates`), the largest is the square
    (:func:`square_centroid`; where several squares may share a window, the caller chooses
-   among the candidates, as :mod:`hsgeo.workflows.lp_observations` does). A square brighter than its surroundings
-   by a few times the window's noise (its NMAD) is found; a large bright area (a roof, a road)
-   has no contrast to its own surroundings at the square's scale.
-3. **Intensity-weighted centroid** (:func:`blob_centroid`): in a ``(4 box_px + 1)``-pixel window around the detection,
-   the background (median of that window's border) is subtracted; the pixels above half the
-   peak that are 8-connected to it, grown by one pixel (the partly covered edge pixels), are
-   the blob, and its centroid weighted by the background-subtracted DN (negative values as 0)
+   among the candidates, as :mod:`hsgeo.workflows.lp_observations` does). A square brighter
+   than its surroundings by a few times the window's noise (its NMAD) is found; a large bright
+   area (a roof, a road) has no contrast to its own surroundings at the square's scale.
+3. **Intensity-weighted centroid** (:func:`blob_centroid`): in a ``(4 box_px + 1)``-pixel
+   window around the detection, the background (median of that window's border) is
+   subtracted; the pixels above half the peak that are 8-connected to it, grown by one pixel
+   (the partly covered edge pixels), are the blob, and its centroid weighted by the
+   background-subtracted DN (negative values as 0)
    is the centre, in scene coordinates ``(u, v)`` (sub-pixel).
 
 Rejected (``ok = False``): a contrast below ``min_snr`` times the noise, a blob touching the
