@@ -74,13 +74,13 @@ def box_contrast(image, box_px: int) -> np.ndarray:
         # sum over rows r-h_lo … r+h_hi (and columns alike) for every r, c where it fits
         n0, n1 = a.shape
         out = np.full(a.shape, np.nan)
-        r = np.arange(h_lo, n0 - h_hi)
-        c = np.arange(h_lo, n1 - h_hi)
-        if r.size == 0 or c.size == 0:
+        m0, m1 = n0 - h_lo - h_hi, n1 - h_lo - h_hi
+        if m0 <= 0 or m1 <= 0:
             return out
-        R0, C0 = np.meshgrid(r - h_lo, c - h_lo, indexing="ij")
-        R1, C1 = np.meshgrid(r + h_hi + 1, c + h_hi + 1, indexing="ij")
-        out[np.ix_(r, c)] = S[R1, C1] - S[R0, C1] - S[R1, C0] + S[R0, C0]
+        w = h_lo + h_hi + 1
+        out[h_lo : n0 - h_hi, h_lo : n1 - h_hi] = (
+            S[w : w + m0, w : w + m1] - S[:m0, w : w + m1] - S[w : w + m0, :m1] + S[:m0, :m1]
+        )
         return out
 
     lo = (box_px - 1) // 2
