@@ -26,7 +26,14 @@ import numpy as np
 
 from hsgeo.errors import InputError
 
-__all__ = ["LocalFrame", "SITE_AAS", "ETRS89_GEOGRAPHIC_3D", "ETRS89_UTM32N"]
+__all__ = [
+    "LocalFrame",
+    "SITE_AAS",
+    "ETRS89_GEOGRAPHIC_3D",
+    "ETRS89_UTM32N",
+    "lonlat_to_crs",
+    "same_crs",
+]
 
 #: ETRS89 geographic 3D (longitude, latitude, ellipsoidal height).
 ETRS89_GEOGRAPHIC_3D = 4937
@@ -81,6 +88,16 @@ class LocalFrame:
         except CRSError as exc:
             raise InputError(f"EPSG:{self.map_epsg} is not a CRS pyproj knows ({exc})") from exc
 
+    def local_crs(self) -> str:
+        """The local frame's horizontal plane as a CRS: PROJ's ellipsoidal orthographic projection
+        about the origin (E, N of the foot of each point on the GRS80 ellipsoid; for points at
+        ellipsoidal height h, distance d from the origin, within h·d/R of the topocentric E, N).
+        """
+        return (
+            f"+proj=ortho +lat_0={self.lat_deg!r} +lon_0={self.lon_deg!r} +ellps=GRS80 "
+            "+units=m +no_defs +type=crs"
+        )
+
     def pipeline(self) -> str:
         """The PROJ pipeline ENU (m) → ETRS89 longitude, latitude (degrees), height (m)."""
         return (
@@ -115,7 +132,9 @@ class LocalFrame:
         """ENU (m) of ETRS89 longitude, latitude (degrees) and ellipsoidal height (m)."""
         from pyproj.enums import TransformDirection
 
-        lon, lat, h = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (lon_deg, lat_deg, h_m)))
+        lon, lat, h = np.broadcast_arrays(
+            *(np.asarray(v, dtype=float) for v in (lon_deg, lat_deg, h_m))
+        )
         E, N, U = self._transformers()[0].transform(
             lon, lat, h, direction=TransformDirection.INVERSE
         )
@@ -149,3 +168,23 @@ class LocalFrame:
 
 #: The 002 site, Ås (Norway): 59.665° N, 10.775° E (002 §2), map CRS ETRS89 / UTM 32N.
 SITE_AAS = LocalFrame(59.665, 10.775, 0.0, ETRS89_UTM32N)
+
+
+def lonlat_to_crs(crs: str, lon_deg, lat_deg):
+    """Coordinates in ``crs`` (any CRS pyproj reads) of ETRS89 longitudes and latitudes."""
+    cache = getattr(_local, "to_crs", None)
+    if cache is None:
+        cache = _local.to_crs = {}
+    if crs not in cache:
+        from pyproj import Transformer
+
+        cache[crs] = Transformer.from_crs(4258, crs, always_xy=True)
+    x, y = cache[crs].transform(np.asarray(lon_deg, float), np.asarray(lat_deg, float))
+    return np.asarray(x), np.asarray(y)
+
+
+def same_crs(a, b) -> bool:
+    """Whether two CRS (anything :class:`pyproj.CRS` reads) are the same."""
+    from pyproj import CRS
+
+    return CRS.from_user_input(a) == CRS.from_user_input(b)

@@ -55,8 +55,9 @@ class MapGrid:
         Cell size.
     width, height : int
         Columns (east) and rows (south).
-    epsg : int
-        The CRS (default 25832, ETRS89 / UTM 32N).
+    crs : str
+        The CRS, anything :class:`pyproj.CRS` reads (default ``"EPSG:25832"``, ETRS89 /
+        UTM 32N; :meth:`hsgeo.crs.LocalFrame.local_crs` for the local frame).
     """
 
     x_min_m: float
@@ -64,25 +65,33 @@ class MapGrid:
     resolution_m: float
     width: int
     height: int
-    epsg: int = 25832
+    crs: str = "EPSG:25832"
 
     def __post_init__(self):
         if not (np.isfinite(self.resolution_m) and self.resolution_m > 0):
-            raise InputError(f"the resolution must be a positive number of metres, got {self.resolution_m}")
+            raise InputError(
+                f"the resolution must be a positive number of metres, got {self.resolution_m}"
+            )
         if self.width < 1 or self.height < 1:
             raise InputError(f"the grid needs at least one cell, got {self.width} x {self.height}")
 
     @classmethod
-    def covering(cls, x_range_m, y_range_m, resolution_m: float, epsg: int = 25832) -> MapGrid:
+    def covering(
+        cls, x_range_m, y_range_m, resolution_m: float, crs: str = "EPSG:25832"
+    ) -> MapGrid:
         """The grid of cells on multiples of ``resolution_m`` that covers the ranges."""
         r = float(resolution_m)
         if not (np.isfinite(r) and r > 0):
-            raise InputError(f"--resolution must be a positive number of metres, got {resolution_m}")
+            raise InputError(
+                f"--resolution must be a positive number of metres, got {resolution_m}"
+            )
         x0 = np.floor(min(x_range_m) / r) * r
         x1 = np.ceil(max(x_range_m) / r) * r
         y0 = np.floor(min(y_range_m) / r) * r
         y1 = np.ceil(max(y_range_m) / r) * r
-        return cls(float(x0), float(y1), r, max(1, round((x1 - x0) / r)), max(1, round((y1 - y0) / r)), epsg)
+        return cls(
+            float(x0), float(y1), r, max(1, round((x1 - x0) / r)), max(1, round((y1 - y0) / r)), crs
+        )
 
     @property
     def transform(self):
@@ -106,20 +115,32 @@ class MapGrid:
     def extent_m(self) -> tuple:
         """``(x_min, y_min, x_max, y_max)`` of the cell edges, m."""
         r = self.resolution_m
-        return (self.x_min_m, self.y_max_m - self.height * r, self.x_min_m + self.width * r, self.y_max_m)
+        return (
+            self.x_min_m,
+            self.y_max_m - self.height * r,
+            self.x_min_m + self.width * r,
+            self.y_max_m,
+        )
 
     def window(self, row0: int, row1: int, col0: int, col1: int) -> MapGrid:
         """The sub-grid of rows ``row0:row1`` and columns ``col0:col1``."""
         r = self.resolution_m
-        return MapGrid(self.x_min_m + col0 * r, self.y_max_m - row0 * r, r, col1 - col0, row1 - row0, self.epsg)
+        return MapGrid(
+            self.x_min_m + col0 * r, self.y_max_m - row0 * r, r, col1 - col0, row1 - row0, self.crs
+        )
 
     def area_definition(self):
         """The grid as a :class:`pyresample.geometry.AreaDefinition`."""
         from pyresample.geometry import AreaDefinition
 
         return AreaDefinition(
-            "hsgeo_grid", "hsgeo map grid", f"EPSG:{self.epsg}", f"EPSG:{self.epsg}",
-            self.width, self.height, self.extent_m,
+            "hsgeo_grid",
+            "hsgeo map grid",
+            "hsgeo_crs",
+            self.crs,
+            self.width,
+            self.height,
+            self.extent_m,
         )
 
 
@@ -206,38 +227,38 @@ def geolocate_lines(strip: Strip, terrain, frame, lines=slice(None), columns=sli
     return X.reshape(m, k, 3), np.stack([lon, lat], -1).reshape(m, k, 2), off.reshape(m, k)
 
 
-def strip_footprints(strip: Strip, terrain, frame, lines_per_block: int):
-    """Map bounding boxes of a strip's line blocks and its largest ground pixel spacing.
+def strip_footprints(strip: Strip, terrain, frame, lines_per_block: int, crs: str):
+    """Bounding boxes in ``crs`` of a strip's line blocks and its largest ground pixel spacing.
 
     Geolocates the perimeter of each block of ``lines_per_block`` lines (its first and last
-    line, its first and last pixel of every line) and, for the spacing, every pixel of the
-    first and last line.
+    line, its first and last pixel of every line).
 
     Returns
     -------
     blocks : list of (line0, line1)
     bbox_m : (n_blocks, 4) ndarray
-        ``x_min, y_min, x_max, y_max`` in the map CRS, m.
+        ``x_min, y_min, x_max, y_max`` in ``crs``, m.
     spacing_m : float
         Largest distance between neighbouring pixels along a line or between lines, m.
     """
+    from hsgeo.crs import lonlat_to_crs
+
     n = strip.n_lines
     blocks = [(a, min(n, a + lines_per_block)) for a in range(0, n, lines_per_block)]
     bbox = np.empty((len(blocks), 4))
-    tr = frame._transformers()[1]
     spacing = 0.0
     for i, (a, b) in enumerate(blocks):
-        rows = np.unique([a, b - 1])
-        e1, _, _ = geolocate_lines(strip, terrain, frame, rows)
-        e2, _, _ = geolocate_lines(strip, terrain, frame, slice(a, b), [0, -1])
-        pts = np.concatenate([e1.reshape(-1, 3), e2.reshape(-1, 3)])
-        lon, lat, h = frame.enu_to_lonlat(pts[:, 0], pts[:, 1], pts[:, 2])
-        x, y, _ = tr.transform(lon, lat, h)
+        e1, l1, _ = geolocate_lines(strip, terrain, frame, np.unique([a, b - 1]))
+        e2, l2, _ = geolocate_lines(strip, terrain, frame, slice(a, b), [0, -1])
+        ll = np.concatenate([l1.reshape(-1, 2), l2.reshape(-1, 2)])
+        x, y = lonlat_to_crs(crs, ll[:, 0], ll[:, 1])
         bbox[i] = np.min(x), np.min(y), np.max(x), np.max(y)
         if e1.shape[1] > 1:
-            spacing = max(spacing, float(np.linalg.norm(np.diff(e1[..., :2], axis=1), axis=-1).max()))
+            step = np.linalg.norm(np.diff(e1[..., :2], axis=1), axis=-1)
+            spacing = max(spacing, float(step.max()))
         if b - a > 1:
-            spacing = max(spacing, float(np.linalg.norm(np.diff(e2[..., :2], axis=0), axis=-1).max()))
+            step = np.linalg.norm(np.diff(e2[..., :2], axis=0), axis=-1)
+            spacing = max(spacing, float(step.max()))
     return blocks, bbox, spacing
 
 
@@ -303,7 +324,9 @@ def mosaic_tile(grid: MapGrid, parts, terrain, frame, radius_m: float, n_bands: 
             ll.append(lonlat.reshape(-1, 2))
             vals.append(np.asarray(v, dtype=np.float32).reshape(-1, n_bands))
             ranks.append(off.ravel())
-        v, r = resample_swath(np.concatenate(ll), np.concatenate(vals), np.concatenate(ranks), grid, radius_m)
+        v, r = resample_swath(
+            np.concatenate(ll), np.concatenate(vals), np.concatenate(ranks), grid, radius_m
+        )
         win = r < best_rank  # 002 mosaic rule here: the ray nearest to nadir
         best[:, win] = v[:, win]
         best_rank[win] = r[win]
@@ -312,10 +335,12 @@ def mosaic_tile(grid: MapGrid, parts, terrain, frame, radius_m: float, n_bands: 
 
 def orthomosaic(
     strips,
-    grid: MapGrid,
     terrain,
     frame,
     *,
+    grid: MapGrid | None = None,
+    resolution_m: float | None = None,
+    crs: str | None = None,
     band_names=None,
     wavelength_nm=None,
     tile_px: int = 512,
@@ -328,10 +353,11 @@ def orthomosaic(
     ----------
     strips : sequence of Strip
         Their ``values`` all with the same bands (select the bands before, e.g. true colour).
-    grid : MapGrid
-        The output grid (its CRS must be the frame's map CRS).
     terrain : ``height(E, N)`` in the local frame (PlaneTerrain, DemTerrain, MapTerrain)
     frame : hsgeo.crs.LocalFrame
+    grid : MapGrid, optional
+        The output grid; default: the cells of ``resolution_m`` in ``crs`` (default the
+        frame's map CRS) that cover every strip's footprint.
     band_names : sequence of str, optional
     wavelength_nm : sequence of float, optional
     tile_px : int
@@ -346,34 +372,45 @@ def orthomosaic(
     -------
     xarray.DataArray
         ``(band, y, x)`` float32, chunks ``(n_bands, tile_px, tile_px)``, coordinates of the
-        cell centres in the map CRS, ``band`` names and ``wavelength_nm``; CRS and transform
-        written by rioxarray (``da.rio.crs``, ``da.rio.transform()``).
+        cell centres, ``band`` names and ``wavelength_nm``; CRS and transform written by
+        rioxarray (``da.rio.crs``, ``da.rio.transform()``).
     """
-    import dask
-    import dask.array as dsa
-    import xarray as xr
-    import rioxarray  # noqa: F401  (the .rio accessor)
-
     strips = list(strips)
     if not strips:
         raise InputError("no strips to mosaic")
-    if grid.epsg != frame.map_epsg:
-        raise InputError(
-            f"the output grid is in EPSG:{grid.epsg}, the local frame's map CRS is "
-            f"EPSG:{frame.map_epsg}: give both the same CRS"
-        )
     n_bands = strips[0].n_bands
     if any(s.n_bands != n_bands for s in strips):
         raise InputError(f"strips with different band counts: {[s.n_bands for s in strips]}")
+    crs = grid.crs if grid is not None else (crs or f"EPSG:{frame.map_epsg}")
     foot, spacing = [], 0.0
     for s in strips:
-        blocks, bbox, sp = strip_footprints(s, terrain, frame, lines_per_block)
+        blocks, bbox, sp = strip_footprints(s, terrain, frame, lines_per_block, crs)
         foot.append((blocks, bbox))
         spacing = max(spacing, sp)
+    if grid is None:
+        if resolution_m is None:
+            raise InputError("give the output grid or its resolution_m")
+        allb = np.concatenate([f[1] for f in foot])
+        grid = MapGrid.covering(allb[:, [0, 2]].ravel(), allb[:, [1, 3]].ravel(), resolution_m, crs)
     if radius_m is None:
         radius_m = 0.55 * np.hypot(spacing, spacing) + 0.5 * grid.resolution_m
+    data = _mosaic_array(strips, foot, grid, terrain, frame, radius_m, tile_px, lines_per_block)
+    return _as_dataarray(data, grid, strips, band_names, wavelength_nm, radius_m)
+
+
+def _mosaic_array(strips, foot, grid, terrain, frame, radius_m, tile_px, lines_per_block):
+    """The Dask array ``(n_bands, height, width)``: one task per tile (:func:`mosaic_tile`)."""
+    import dask
+    import dask.array as dsa
+
+    n_bands = strips[0].n_bands
     g_terrain, g_frame = dask.delayed(terrain, pure=True), dask.delayed(frame, pure=True)
-    values = [s.values if isinstance(s.values, dsa.Array) else dsa.from_array(np.asarray(s.values), chunks=(lines_per_block, -1, -1)) for s in strips]
+    values = [
+        s.values
+        if isinstance(s.values, dsa.Array)
+        else dsa.from_array(np.asarray(s.values), chunks=(lines_per_block, -1, -1))
+        for s in strips
+    ]
     rows = []
     for r0 in range(0, grid.height, tile_px):
         r1 = min(grid.height, r0 + tile_px)
@@ -384,19 +421,35 @@ def orthomosaic(
             x0, y0, x1, y1 = tile.extent_m
             parts = []
             for s, v, (blocks, bbox) in zip(strips, values, foot, strict=True):
-                hit = (bbox[:, 0] - radius_m < x1) & (bbox[:, 2] + radius_m > x0) & (bbox[:, 1] - radius_m < y1) & (bbox[:, 3] + radius_m > y0)
-                sel = [(blocks[i][0], blocks[i][1], v[blocks[i][0] : blocks[i][1]]) for i in np.flatnonzero(hit)]
+                hit = (
+                    (bbox[:, 0] - radius_m < x1)
+                    & (bbox[:, 2] + radius_m > x0)
+                    & (bbox[:, 1] - radius_m < y1)
+                    & (bbox[:, 3] + radius_m > y0)
+                )
+                sel = [
+                    (blocks[i][0], blocks[i][1], v[blocks[i][0] : blocks[i][1]])
+                    for i in np.flatnonzero(hit)
+                ]
                 if sel:
                     parts.append((s, sel))
             shape = (n_bands, r1 - r0, c1 - c0)
             if parts:
-                task = dask.delayed(mosaic_tile, pure=True)(tile, parts, g_terrain, g_frame, radius_m, n_bands)
+                task = dask.delayed(mosaic_tile, pure=True)(
+                    tile, parts, g_terrain, g_frame, radius_m, n_bands
+                )
                 row.append(dsa.from_delayed(task, shape, dtype=np.float32))
             else:
-                row.append(dsa.full(shape, np.nan, dtype=np.float32))
+                row.append(dsa.full(shape, np.nan, dtype=np.float32, chunks=shape))
         rows.append(row)
-    data = dsa.block([[blk for blk in row] for row in rows]) if rows else None
-    data = data.rechunk((n_bands, tile_px, tile_px))
+    return dsa.block(rows)
+
+
+def _as_dataarray(data, grid, strips, band_names, wavelength_nm, radius_m):
+    import rioxarray  # noqa: F401  (the .rio accessor)
+    import xarray as xr
+
+    n_bands = data.shape[0]
     names = [str(b) for b in (band_names if band_names is not None else range(n_bands))]
     coords = {"band": names, "y": grid.y_m, "x": grid.x_m}
     if wavelength_nm is not None:
@@ -414,8 +467,9 @@ def orthomosaic(
             "strips": ",".join(s.name for s in strips),
         },
     )
-    da = da.rio.write_crs(f"EPSG:{grid.epsg}").rio.write_transform(grid.transform)
-    return da
+    da["x"].attrs.update(units="m", long_name="easting")
+    da["y"].attrs.update(units="m", long_name="northing")
+    return da.rio.write_crs(grid.crs).rio.write_transform(grid.transform)
 
 
 class MapTerrain:
@@ -441,17 +495,28 @@ class MapTerrain:
 
         z = np.asarray(height_m, dtype=float)
         if z.shape != (grid.height, grid.width):
-            raise InputError(f"{source}: heights {z.shape} do not match the grid {(grid.height, grid.width)}")
-        if not np.all(np.isfinite(z)):
-            raise InputError(f"{source}: {int(np.sum(~np.isfinite(z)))} cells without a height (nodata or NaN): fill them")
-        if grid.epsg != frame.map_epsg:
             raise InputError(
-                f"{source} is in EPSG:{grid.epsg}, the mosaic in EPSG:{frame.map_epsg}: "
-                "reproject the DSM (gdalwarp -t_srs) or give a DSM in the mosaic's CRS"
+                f"{source}: heights {z.shape} do not match the grid {(grid.height, grid.width)}"
+            )
+        if not np.all(np.isfinite(z)):
+            raise InputError(
+                f"{source}: {int(np.sum(~np.isfinite(z)))} cells without a height (nodata or "
+                "NaN): fill them (gdal_fillnodata.py) or crop the DSM to its data"
+            )
+        from hsgeo.crs import same_crs
+
+        if not same_crs(grid.crs, f"EPSG:{frame.map_epsg}"):
+            raise InputError(
+                f"{source} is in {grid.crs}, the mosaic in EPSG:{frame.map_epsg}: reproject "
+                "the DSM (gdalwarp -t_srs EPSG:25832) or give a DSM in the mosaic's CRS"
             )
         self.grid, self.frame, self.source = grid, frame, source
         self._f = RegularGridInterpolator(
-            (grid.y_m[::-1], grid.x_m), z[::-1], method="linear", bounds_error=False, fill_value=np.nan
+            (grid.y_m[::-1], grid.x_m),
+            z[::-1],
+            method="linear",
+            bounds_error=False,
+            fill_value=np.nan,
         )
         c = frame.map_to_enu(grid.x_m[[0, -1]].mean(), grid.y_m[[0, -1]].mean(), float(z.mean()))
         self.mean_height_m = float(c[2])
@@ -469,7 +534,7 @@ class MapTerrain:
                 x0, y0, x1, y1 = self.grid.extent_m
                 raise ObservationError(
                     f"{int(np.sum(~np.isfinite(h)))} rays reach the ground outside {self.source} "
-                    f"(x {x0:.0f}…{x1:.0f}, y {y0:.0f}…{y1:.0f} m in EPSG:{self.grid.epsg}): "
+                    f"(x {x0:.0f}…{x1:.0f}, y {y0:.0f}…{y1:.0f} m in {self.grid.crs}): "
                     "give a DSM that covers the lines"
                 )
             U = self.frame.map_to_enu(x, y, h)[2]

@@ -31,6 +31,7 @@ __all__ = [
     "interrupted",
     "error_line",
     "progress_printer",
+    "progress_counter",
     "clear_progress",
     "json_text",
 ]
@@ -180,6 +181,28 @@ def progress_printer(stream=None):
     def show(info):
         global _progress_shown
         stream.write("\r\033[K" + progress_text(info))
+        stream.flush()
+        _progress_shown = True
+
+    return show
+
+
+def progress_counter(what: str, stream=None):
+    """A ``progress(done, total)`` callback for long work in parts (tiles, lines): ``what
+    done/total (percent)`` on one self-clearing line of an interactive terminal, erased by
+    :func:`clear_progress`; ``None`` when ``stream`` (default stderr) is not a terminal.
+    """
+    stream = sys.stderr if stream is None else stream
+    try:
+        tty = stream.isatty()
+    except (ValueError, AttributeError):
+        tty = False
+    if not tty:
+        return None
+
+    def show(done: int, total: int):
+        global _progress_shown
+        stream.write(f"\r\033[K{what} {done}/{total} ({100.0 * done / max(1, total):.0f} %)")
         stream.flush()
         _progress_shown = True
 

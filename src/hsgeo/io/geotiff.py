@@ -73,7 +73,11 @@ def write_cog(
     crs, transform = da.rio.crs, da.rio.transform()
     if crs is None:
         raise InputError("the raster has no CRS: write one with da.rio.write_crs")
-    data = da.data if isinstance(da.data, dsa.Array) else dsa.from_array(np.asarray(da.values), chunks=(-1, 512, 512))
+    data = (
+        da.data
+        if isinstance(da.data, dsa.Array)
+        else dsa.from_array(np.asarray(da.values), chunks=(-1, 512, 512))
+    )
     n_b, ny, nx = data.shape
     r_off = np.concatenate([[0], np.cumsum(data.chunks[1])])
     c_off = np.concatenate([[0], np.cumsum(data.chunks[2])])
@@ -84,8 +88,17 @@ def write_cog(
     os.close(fd)
     try:
         profile = dict(
-            driver="GTiff", width=nx, height=ny, count=n_b, dtype="float32", crs=crs,
-            transform=transform, nodata=np.nan, tiled=True, blockxsize=512, blockysize=512,
+            driver="GTiff",
+            width=nx,
+            height=ny,
+            count=n_b,
+            dtype="float32",
+            crs=crs,
+            transform=transform,
+            nodata=np.nan,
+            tiled=True,
+            blockxsize=512,
+            blockysize=512,
             BIGTIFF="IF_SAFER",
         )
         with rasterio.open(stage, "w", **profile) as dst:
@@ -106,15 +119,24 @@ def write_cog(
                 dst.update_tags(wavelength_nm=",".join(f"{float(w):.6g}" for w in wl))
         with atomic_path(path, inputs) as tmp:
             rasterio.shutil.copy(
-                stage, tmp, driver="COG", COMPRESS="DEFLATE", PREDICTOR="YES", BLOCKSIZE=512,
-                OVERVIEWS="AUTO", OVERVIEW_RESAMPLING=overview_resampling, BIGTIFF="IF_SAFER",
+                stage,
+                tmp,
+                driver="COG",
+                COMPRESS="DEFLATE",
+                PREDICTOR="YES",
+                BLOCKSIZE=512,
+                OVERVIEWS="AUTO",
+                OVERVIEW_RESAMPLING=overview_resampling,
+                BIGTIFF="IF_SAFER",
             )
     finally:
         Path(stage).unlink(missing_ok=True)
     return path
 
 
-def write_geotiff(path, values, transform, epsg: int, *, overwrite: bool = False, inputs=(), nodata=None) -> Path:
+def write_geotiff(
+    path, values, transform, epsg: int, *, overwrite: bool = False, inputs=(), nodata=None
+) -> Path:
     """A single-band GeoTIFF (a DSM), atomically. ``values``: ``(rows, cols)``, north first."""
     import rasterio
 
@@ -123,8 +145,16 @@ def write_geotiff(path, values, transform, epsg: int, *, overwrite: bool = False
     v = np.asarray(values, dtype=np.float32)
     with atomic_path(path, inputs) as tmp:
         with rasterio.open(
-            tmp, "w", driver="GTiff", width=v.shape[1], height=v.shape[0], count=1,
-            dtype="float32", crs=f"EPSG:{epsg}", transform=transform, nodata=nodata,
+            tmp,
+            "w",
+            driver="GTiff",
+            width=v.shape[1],
+            height=v.shape[0],
+            count=1,
+            dtype="float32",
+            crs=f"EPSG:{epsg}",
+            transform=transform,
+            nodata=nodata,
         ) as dst:
             dst.write(v, 1)
     return path
@@ -159,7 +189,7 @@ def read_dsm(path, option: str = "--dsm"):
                     f"transform {tuple(t)[:6]}; warp it (gdalwarp)"
                 )
             z = src.read(1, masked=True).astype(float).filled(np.nan)
-            grid = MapGrid(t.c, t.f, t.a, src.width, src.height, int(src.crs.to_epsg()))
+            grid = MapGrid(t.c, t.f, t.a, src.width, src.height, f"EPSG:{src.crs.to_epsg()}")
     except RasterioIOError as exc:
         raise InputError(f"{option} {p}: not a raster GDAL can read ({exc})") from None
     return z, grid

@@ -67,17 +67,32 @@ def lazy_cube(strip: Strip, scene: SquaresScene, terrain, frame, lines_per_chunk
     import dask.array as dsa
 
     n, n_px, nb = strip.n_lines, strip.pixels.shape[0], len(scene.band_gain)
-    chunks = (tuple(min(lines_per_chunk, n - a) for a in range(0, n, lines_per_chunk)), (n_px,), (nb,))
+    chunks = (
+        tuple(min(lines_per_chunk, n - a) for a in range(0, n, lines_per_chunk)),
+        (n_px,),
+        (nb,),
+    )
 
     def _render(block_info=None):
         a, b = block_info[None]["array-location"][0]
         return render_lines(strip, scene, terrain, frame, slice(a, b))
 
-    return dsa.map_blocks(_render, chunks=chunks, dtype=np.float32, meta=np.empty((0, 0, 0), np.float32))
+    return dsa.map_blocks(
+        _render, chunks=chunks, dtype=np.float32, meta=np.empty((0, 0, 0), np.float32)
+    )
 
 
-def straight_flight(frame, *, start_xy_m, heading_deg: float, speed_m_s: float, height_m: float,
-                    duration_s: float, rate_hz: float = 50.0, roll_amp_deg: float = 0.0):
+def straight_flight(
+    frame,
+    *,
+    start_xy_m,
+    heading_deg: float,
+    speed_m_s: float,
+    height_m: float,
+    duration_s: float,
+    rate_hz: float = 50.0,
+    roll_amp_deg: float = 0.0,
+):
     """A straight, level flight in the local frame of ``frame`` (a :class:`Trajectory`).
 
     Starts above map point ``start_xy_m`` at ``height_m`` above the ellipsoid's local U = 0,
