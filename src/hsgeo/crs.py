@@ -109,6 +109,11 @@ class LocalFrame:
         )
 
     def _transformers(self):
+        """(ENU → geographic, geographic → map, ENU → map or None), built once per thread.
+
+        ENU → map is one PROJ pipeline (the frame's steps followed by those of the geographic →
+        map conversion, when PROJ states that as a pipeline): half the work of two transforms.
+        """
         key = (self.lat_deg, self.lon_deg, self.h_m, self.map_epsg)
         cache = getattr(_local, "cache", None)
         if cache is None:
@@ -118,7 +123,12 @@ class LocalFrame:
 
             enu_geo = Transformer.from_pipeline(self.pipeline())
             geo_map = Transformer.from_crs(ETRS89_GEOGRAPHIC_3D, self.crs, always_xy=True)
-            cache[key] = (enu_geo, geo_map)
+            steps = geo_map.definition.split()
+            enu_map = None
+            if steps and steps[0] == "proj=pipeline":
+                tail = " ".join("+" + s for s in steps[1:])
+                enu_map = Transformer.from_pipeline(f"{self.pipeline()} {tail}")
+            cache[key] = (enu_geo, geo_map, enu_map)
         return cache[key]
 
     # ---- ENU <-> geographic ------------------------------------------------------------------
@@ -143,8 +153,13 @@ class LocalFrame:
     # ---- ENU <-> map CRS ---------------------------------------------------------------------
     def enu_to_map(self, E_m, N_m, U_m):
         """Map coordinates (x east, y north in m; z the ellipsoidal height) of ENU points."""
-        lon, lat, h = self.enu_to_lonlat(E_m, N_m, U_m)
-        x, y, z = self._transformers()[1].transform(lon, lat, h)
+        enu_map = self._transformers()[2]
+        if enu_map is None:
+            lon, lat, h = self.enu_to_lonlat(E_m, N_m, U_m)
+            x, y, z = self._transformers()[1].transform(lon, lat, h)
+        else:
+            E, N, U = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (E_m, N_m, U_m)))
+            x, y, z = enu_map.transform(E, N, U)
         return np.asarray(x), np.asarray(y), np.asarray(z)
 
     def map_to_enu(self, x_m, y_m, z_m):
@@ -152,9 +167,12 @@ class LocalFrame:
         from pyproj.enums import TransformDirection
 
         x, y, z = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (x_m, y_m, z_m)))
-        lon, lat, h = self._transformers()[1].transform(
-            x, y, z, direction=TransformDirection.INVERSE
-        )
+        inv = TransformDirection.INVERSE
+        enu_map = self._transformers()[2]
+        if enu_map is not None:
+            E, N, U = enu_map.transform(x, y, z, direction=inv)
+            return np.asarray(E), np.asarray(N), np.asarray(U)
+        lon, lat, h = self._transformers()[1].transform(x, y, z, direction=inv)
         return self.lonlat_to_enu(lon, lat, h)
 
     def map_to_lonlat(self, x_m, y_m):

@@ -526,19 +526,25 @@ class MapTerrain:
 
     def height(self, E, N):
         E, N = np.broadcast_arrays(np.asarray(E, float), np.asarray(N, float))
-        U = np.full(E.shape, self.mean_height_m)
-        for _ in range(2):
-            x, y, _ = self.frame.enu_to_map(E, N, U)
-            h = self._f(np.stack([np.ravel(y), np.ravel(x)], axis=1)).reshape(E.shape)
-            if np.any(~np.isfinite(h)):
-                x0, y0, x1, y1 = self.grid.extent_m
-                raise ObservationError(
-                    f"{int(np.sum(~np.isfinite(h)))} rays reach the ground outside {self.source} "
-                    f"(x {x0:.0f}…{x1:.0f}, y {y0:.0f}…{y1:.0f} m in {self.grid.crs}): "
-                    "give a DSM that covers the lines"
-                )
-            U = self.frame.map_to_enu(x, y, h)[2]
+        U0 = np.full(E.shape, self.mean_height_m)
+        U = self._surface_u(E, N, U0)
+        # the map position of (E, N) moves with U by about ΔU·d/R: a second pass where > 1 mm
+        redo = np.abs(U - U0) * np.hypot(E, N) / 6.37e6 > 1e-3
+        if np.any(redo):
+            U[redo] = self._surface_u(E[redo], N[redo], U[redo])
         return U
+
+    def _surface_u(self, E, N, U):
+        x, y, _ = self.frame.enu_to_map(E, N, U)
+        h = self._f(np.stack([np.ravel(y), np.ravel(x)], axis=1)).reshape(E.shape)
+        if np.any(~np.isfinite(h)):
+            x0, y0, x1, y1 = self.grid.extent_m
+            raise ObservationError(
+                f"{int(np.sum(~np.isfinite(h)))} rays reach the ground outside {self.source} "
+                f"(x {x0:.0f}…{x1:.0f}, y {y0:.0f}…{y1:.0f} m in {self.grid.crs}): "
+                "give a DSM that covers the lines"
+            )
+        return self.frame.map_to_enu(x, y, h)[2]
 
 
 def _rebuild_map_terrain(z, grid, frame, source):
