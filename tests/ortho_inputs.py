@@ -64,29 +64,29 @@ class Flight:
     trajectories: tuple
 
 
-def flight_trajectories(length_m: float = 240.0, lateral_m: float = 60.0, roll_amp_deg=0.05):
+def flight_trajectory(length_m: float = 240.0, lateral_m: float = 60.0, roll_amp_deg=0.05):
+    """One navigation: strip 1 northwards, a turn of 20 s, strip 2 southwards, 60 m apart.
+
+    Returns the :class:`Trajectory` and the two strips' line times (s).
+    """
+    from hsgeo.trajectory import Trajectory
+
     x0, y0 = origin_xy()
     dur = length_m / SPEED_M_S + 2.0
     half = length_m / 2 + SPEED_M_S
-    t1 = straight_flight(
-        FRAME,
-        start_xy_m=(x0 - lateral_m / 2, y0 - half),
-        heading_deg=0.0,
-        speed_m_s=SPEED_M_S,
-        height_m=HEIGHT_M + 100.0,
-        duration_s=dur,
-        roll_amp_deg=roll_amp_deg,
+    kw = dict(
+        speed_m_s=SPEED_M_S, height_m=HEIGHT_M + 100.0, duration_s=dur, roll_amp_deg=roll_amp_deg
     )
-    t2 = straight_flight(
-        FRAME,
-        start_xy_m=(x0 + lateral_m / 2, y0 + half),
-        heading_deg=180.0,
-        speed_m_s=SPEED_M_S,
-        height_m=HEIGHT_M + 100.0,
-        duration_s=dur,
-        roll_amp_deg=roll_amp_deg,
+    t1 = straight_flight(FRAME, start_xy_m=(x0 - lateral_m / 2, y0 - half), heading_deg=0.0, **kw)
+    t2 = straight_flight(FRAME, start_xy_m=(x0 + lateral_m / 2, y0 + half), heading_deg=180.0, **kw)
+    off = t1.t_s[-1] + 20.0
+    nav = Trajectory(
+        np.concatenate([t1.t_s, t2.t_s + off]),
+        np.concatenate([t1.xyz_m, t2.xyz_m]),
+        np.concatenate([t1.roll_pitch_heading_rad, t2.roll_pitch_heading_rad]),
     )
-    return t1, t2
+    lt = line_times(length_m)
+    return nav, (lt, lt + off)
 
 
 def line_times(length_m: float = 240.0):
@@ -106,13 +106,14 @@ def line_scanner(n_px: int = 300):
     return LineScanner(LinearIFOV(zeta0_px=(n_px - 1) / 2, c_px=40.0 / 0.0065))
 
 
-def flight(sensor="lp", lazy=False, length_m=240.0, render_trajectories=None, nav=None):
-    """Two rendered strips of the LP camera ("lp") or the 000 line scanner ("line")."""
+def flight(sensor="lp", lazy=False, length_m=240.0, render_nav=None, nav=None):
+    """Two rendered strips of the LP camera ("lp") or the 000 line scanner ("line"), rendered
+    along ``render_nav`` (default the navigation) and mosaicked along ``nav``."""
     z, g = dsm()
     terrain = MapTerrain(z, g, FRAME)
-    trajs = flight_trajectories(length_m)
-    rtrajs = render_trajectories or trajs
-    t = line_times(length_m)
+    nav0, times = flight_trajectory(length_m)
+    nav = nav or nav0
+    rnav = render_nav or nav0
     sc = scene()
     if sensor == "lp":
         sen, px, kw = lp_camera(), lp_pixels(), {"band": 0}
@@ -120,12 +121,92 @@ def flight(sensor="lp", lazy=False, length_m=240.0, render_trajectories=None, na
         n = 300
         sen, px, kw = line_scanner(n), np.arange(n, dtype=float), {}
     strips = []
-    for i, (tr, rtr) in enumerate(zip(nav or trajs, rtrajs, strict=True)):
-        shell = Strip(sen, rtr, t, px, np.zeros((t.size, px.shape[0], 4), np.float32), kw, f"s{i}")
+    for i, t in enumerate(times):
+        shell = Strip(sen, rnav, t, px, np.zeros((t.size, px.shape[0], 4), np.float32), kw)
         vals = (
             lazy_cube(shell, sc, terrain, FRAME, 64)
             if lazy
             else render_lines(shell, sc, terrain, FRAME)
         )
-        strips.append(Strip(sen, tr, t, px, vals, kw, f"s{i + 1}"))
-    return Flight(tuple(strips), terrain, tuple(nav or trajs))
+        strips.append(Strip(sen, nav, t, px, vals, kw, f"s{i + 1}"))
+    return Flight(tuple(strips), terrain, (nav, nav))
+
+
+def node_corrections(nav):
+    """A known adjustment: node corrections of 1.2 m east, -0.9 m north, 0.3 m up and a few
+    hundredths of a degree (the recorded navigation lacks them)."""
+    from hsgeo.trajectory import SplineNodes
+
+    nodes = SplineNodes(float(nav.t_s[0]), float(nav.t_s[-1]), 10.0)
+    k = np.arange(nodes.n_nodes)[:, None]
+    v = np.hstack(
+        [
+            np.full((nodes.n_nodes, 1), 1.2),
+            np.full((nodes.n_nodes, 1), -0.9),
+            np.full((nodes.n_nodes, 1), 0.3),
+            np.radians(0.02) * np.cos(k + [0, 1, 2]),
+        ]
+    )
+    return nodes, v
+
+
+def adjustment_json(nodes, v) -> str:
+    import json
+
+    from hsgeo.trajectory import CORRECTION_COLUMNS
+
+    par = {
+        "boresight_deg": [0.0, 0.0, 0.0],
+        "lever_arm_m": [0.0, 0.0, 0.0],
+        "distortion": [0.0, 0.0, 0.0, 0.0],
+        "c_mm": [40.0],
+    }
+    return json.dumps(
+        {
+            "converged": True,
+            "parameters": {k: {"value": x, "sigma": [0.0] * len(x)} for k, x in par.items()},
+            "nodes": {
+                "t_s": nodes.t_nodes_s.tolist(),
+                "value": v.tolist(),
+                "sigma": np.zeros_like(v).tolist(),
+                "columns": list(CORRECTION_COLUMNS),
+            },
+        }
+    )
+
+
+def write_ortho_inputs(d, *, adjusted: bool = False, lazy: bool = False) -> dict:
+    """LP line files, NAV, camera TOML, DSM GeoTIFF (and RESULT.json) under ``d``.
+
+    With ``adjusted``, the lines are rendered along the true trajectory and the navigation file
+    lacks the corrections of :func:`node_corrections`, which RESULT.json carries.
+    """
+    from pathlib import Path
+
+    from hsgeo.io.geotiff import write_geotiff
+    from hsgeo.io.lp_strips import write_lp_strip
+    from hsgeo.io.navigation import write_trajectory
+    from hsgeo.trajectory import corrected_trajectory
+
+    d = Path(d)
+    true_nav, _ = flight_trajectory()
+    files = {}
+    if adjusted:
+        nodes, v = node_corrections(true_nav)
+        nav = corrected_trajectory(true_nav, nodes, -v)
+        files["adjustment"] = d / "result.json"
+        files["adjustment"].write_text(adjustment_json(nodes, v))
+    else:
+        nav = true_nav
+    fl = flight("lp", lazy=lazy, render_nav=true_nav, nav=nav)
+    files["lines"] = []
+    for s in fl.strips:
+        p = d / f"{s.name}.nc"
+        write_lp_strip(p, s.values, s.t_s, WAVELENGTH_NM, strip_id=s.name)
+        files["lines"].append(p)
+    files["nav"] = write_trajectory(d / "nav.csv", nav)
+    files["camera"] = d / "camera.toml"
+    files["camera"].write_text("[camera]\nn_bands = 4\npixel_mm = 0.0065\nc_mm = 40.0\n")
+    z, g = dsm()
+    files["dsm"] = write_geotiff(d / "dsm.tif", z, g.transform, 25832)
+    return files

@@ -91,8 +91,8 @@ def test_nearest_to_nadir_rule():
     v = m.values[0]
     X, Y = np.meshgrid(m["x"].values, m["y"].values)
     E, N, _ = FRAME.map_to_enu(X, Y, 100.0)
-    e1 = fl.trajectories[0].xyz_m[0, 0]
-    e2 = fl.trajectories[1].xyz_m[0, 0]  # the flight lines (true north in the local frame)
+    e1 = fl.trajectories[0].pose(fl.strips[0].t_s[0])[0][0, 0]
+    e2 = fl.trajectories[0].pose(fl.strips[1].t_s[0])[0][0, 0]  # the lines (true north, local)
     both = np.isfinite(v) & (np.abs(N) < 100)  # both strips' lines span N = ±120 m
     # the overlap is ±16 m about the middle; the ±0.05° roll moves a nadir by < 2 m
     d1, d2 = np.abs(E - e1), np.abs(E - e2)

@@ -26,6 +26,8 @@ from hsgeo.io._files import atomic_path, check_input_file, check_outputs
 __all__ = ["write_cog", "read_dsm", "write_geotiff", "GEOTIFF_FORMATS"]
 
 GEOTIFF_FORMATS = {".tif": "GeoTIFF", ".tiff": "GeoTIFF"}
+#: GDAL's block cache while writing, MiB (its default, 5 % of the RAM, would grow with it).
+GDAL_CACHE_MB = 64
 
 
 def write_cog(
@@ -86,7 +88,9 @@ def write_cog(
     wl = da["wavelength_nm"].values if "wavelength_nm" in da.coords else None
     fd, stage = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".stage.tif", dir=path.parent)
     os.close(fd)
+    env = rasterio.Env(GDAL_CACHEMAX=GDAL_CACHE_MB * 2**20)  # GDAL's block cache: bounded
     try:
+        env.__enter__()
         profile = dict(
             driver="GTiff",
             width=nx,
@@ -130,6 +134,7 @@ def write_cog(
                 BIGTIFF="IF_SAFER",
             )
     finally:
+        env.__exit__(None, None, None)
         Path(stage).unlink(missing_ok=True)
     return path
 

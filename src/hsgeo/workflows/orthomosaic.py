@@ -31,6 +31,8 @@ __all__ = [
     "orthomosaic_files",
 ]
 
+#: How long ``--scheduler`` waits for the scheduler to answer, s.
+SCHEDULER_TIMEOUT_S = 10.0
 #: The true-colour bands' wavelengths (R, G, B), nm: the default ``--bands``.
 TRUE_COLOUR_NM = (640.0, 550.0, 460.0)
 
@@ -235,7 +237,7 @@ def _client(scheduler):
     from distributed import Client
 
     try:
-        return Client(scheduler, timeout="10s", set_as_default=True)
+        return Client(scheduler, timeout=f"{SCHEDULER_TIMEOUT_S}s", set_as_default=True)
     except (OSError, TimeoutError, ValueError) as exc:
         raise InputError(
             f"--scheduler {scheduler}: no dask scheduler answers there ({type(exc).__name__}); "
