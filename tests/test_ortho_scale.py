@@ -33,9 +33,11 @@ t = 1.0 + np.arange(n_lines) * GSD_M / SPEED_M_S
 scene = SquaresScene(np.array([[x0, y0 + 500.0]]), band_gain=tuple(np.linspace(1.0, 0.2, n_bands)))
 terrain = PlaneTerrain(100.0)
 cam = lp_camera(1)
-shell = Strip(cam, nav, t, lp_pixels(n_px), np.zeros((n_lines, n_px, n_bands), np.float32), {{"band": 0}})
+zeros = np.zeros((n_lines, n_px, n_bands), np.float32)  # untouched pages: never resident
+shell = Strip(cam, nav, t, lp_pixels(n_px), zeros, {{"band": 0}})
 cube = lazy_cube(shell, scene, terrain, FRAME, 32)
-strip = Strip(cam, nav, t, lp_pixels(n_px), cube[:, :, [0, n_bands // 2, n_bands - 1]], {{"band": 0}}, "big")
+rgb = cube[:, :, [0, n_bands // 2, n_bands - 1]]
+strip = Strip(cam, nav, t, lp_pixels(n_px), rgb, {{"band": 0}}, "big")
 dask.config.set(num_workers=2)
 # warm-up: GDAL, PROJ and pykdtree loaded (their code pages count in the RSS) on a small strip
 small = Strip(cam, nav, t[:64], lp_pixels(n_px), cube[:64, :, :3], {{"band": 0}}, "small")
@@ -51,8 +53,8 @@ print(json.dumps({{"cube_bytes": int(cube.nbytes), "base_rss": base, "peak_rss":
 
 @pytest.mark.slow
 def test_mosaic_of_a_cube_4x_larger_than_the_memory_limit(tmp_path):
-    """A 1.6 GB cube (4.8x the limit), rendered lazily chunk by chunk, mosaicked (3 of its 192 bands) into a COG
-    while the process grows by less than LIMIT_MIB (peak RSS, measured in a fresh process, over
+    """A 1.6 GB cube (4.8x the limit), rendered lazily chunk by chunk, mosaicked (3 of its 192
+    bands) into a COG while the process grows by less than LIMIT_MIB (peak RSS, measured in a fresh process, over
     its resident size after a small mosaic has loaded GDAL, PROJ and pykdtree). Measured
     2026-11-27: +245 MiB (threads' malloc arenas ~100 MiB, GDAL's block cache up to
     GDAL_CACHE_MB, the COG copy with its overviews ~100 MiB; none grows with the cube)."""
