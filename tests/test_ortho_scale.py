@@ -54,7 +54,8 @@ print(json.dumps({{"cube_bytes": int(cube.nbytes), "base_rss": base, "peak_rss":
 @pytest.mark.slow
 def test_mosaic_of_a_cube_4x_larger_than_the_memory_limit(tmp_path):
     """A 1.6 GB cube (4.8x the limit), rendered lazily chunk by chunk, mosaicked (3 of its 192
-    bands) into a COG while the process grows by less than LIMIT_MIB (peak RSS, measured in a fresh process, over
+    bands) into a COG while the process grows by less than LIMIT_MIB (peak RSS, measured in a
+    fresh process, over
     its resident size after a small mosaic has loaded GDAL, PROJ and pykdtree). Measured
     2026-11-27: +245 MiB (threads' malloc arenas ~100 MiB, GDAL's block cache up to
     GDAL_CACHE_MB, the COG copy with its overviews ~100 MiB; none grows with the cube)."""
