@@ -167,6 +167,7 @@ def _cmd_geocode(args) -> int:
         max_grid_gib=args.max_grid_gib,
         max_nav_gap_s=args.max_nav_gap_s,
         band=args.band,
+        site=args.site,
     )
     print(
         f"orthorectified {ortho.sizes['band']} band(s) onto {ortho.sizes['N']} x "

@@ -214,8 +214,30 @@ def add_geocode(sub) -> argparse.ArgumentParser:
         default=0,
         help="band of a pushbroom camera file whose geometry is used (default 0)",
     )
+    p.add_argument(
+        "--site",
+        type=_site,
+        metavar="LAT,LON[,H]",
+        help="ETRS89 latitude, longitude (degrees) and ellipsoidal height (m) of the origin of "
+        "the navigation's east-north-up frame: the output's CRS (default the 002 site, "
+        "59.665,10.775,0)",
+    )
     p.add_argument("--quiet", action="store_true", help="no progress display")
     return p
+
+
+def _site(text: str) -> tuple:
+    """``--site LAT,LON[,H]``."""
+    try:
+        v = tuple(float(x) for x in text.split(","))
+    except ValueError:
+        v = ()
+    if len(v) not in (2, 3) or not (-90 < v[0] < 90 and -180 <= v[1] <= 180):
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: give LAT,LON or LAT,LON,H (degrees north and east, metres), e.g. "
+            "59.665,10.775,0"
+        )
+    return v
 
 
 def _wavelengths(text: str) -> tuple:

@@ -37,6 +37,7 @@ __all__ = [
     "resample_swath",
     "orthomosaic",
     "mosaic_tile",
+    "grid_swath",
     "OFF_NADIR_NAME",
 ]
 
@@ -284,9 +285,13 @@ def resample_swath(lonlat_deg, values, rank, grid: MapGrid, radius_m: float):
     from pyresample.geometry import SwathDefinition
     from pyresample.kd_tree import get_neighbour_info
 
+    from hsgeo.crs import lonlat_to_crs
+
     swath = SwathDefinition(lons=lonlat_deg[:, 0], lats=lonlat_deg[:, 1])
+    # pyresample measures on a sphere of 6370997 m (0.3 % short of the ellipsoid's radii of
+    # curvature at 60° N): search a little wider, then keep the radius in the grid's metres
     vin, vout, idx, _ = get_neighbour_info(
-        swath, grid.area_definition(), radius_m, neighbours=1, nprocs=1
+        swath, grid.area_definition(), 1.01 * radius_m, neighbours=1, nprocs=1
     )
     n_cells = grid.width * grid.height
     src = np.flatnonzero(vin)
@@ -294,11 +299,61 @@ def resample_swath(lonlat_deg, values, rank, grid: MapGrid, radius_m: float):
     ok = idx < src.size
     cell = out_cells[ok]
     pix = src[idx[ok]]
+    px, py = lonlat_to_crs(grid.crs, lonlat_deg[pix, 0], lonlat_deg[pix, 1])
+    r_, c_ = np.divmod(cell, grid.width)
+    near = np.hypot(px - grid.x_m[c_], py - grid.y_m[r_]) <= radius_m
+    cell, pix = cell[near], pix[near]
     out = np.full((values.shape[1], n_cells), np.nan, dtype=np.float32)
     out[:, cell] = values[pix].T
     r = np.full(n_cells, np.inf)
     r[cell] = rank[pix]
     return out.reshape(-1, grid.height, grid.width), r.reshape(grid.height, grid.width)
+
+
+def grid_swath(image, ground_enu_m, frame, *, resolution_m: float, crs=None, radius_m=None):
+    """One geolocated swath onto a grid, in memory (``hsgeo geocode``): the resampling of
+    :func:`mosaic_tile` (pyresample, nearest neighbour within ``radius_m``) without Dask.
+
+    Parameters
+    ----------
+    image : (n_bands, n_lines, n_px) ndarray
+    ground_enu_m : (n_lines, n_px, 3) ndarray
+        Every pixel's ground point in the local frame (:func:`hsgeo.geocode.geocode_image`).
+    frame : hsgeo.crs.LocalFrame
+    resolution_m : float
+    crs : str, optional
+        The grid's CRS; default the local frame's own (:meth:`~hsgeo.crs.LocalFrame.local_crs`:
+        E, N of the frame within h·d/R).
+    radius_m : float, optional
+        Default: 0.55 × the diagonal of the largest pixel spacings along and across the line
+        plus half a cell.
+
+    Returns
+    -------
+    values : (n_bands, height, width) float32 ndarray
+    grid : MapGrid
+    radius_m : float
+    """
+    from hsgeo.crs import lonlat_to_crs
+
+    g = np.asarray(ground_enu_m, dtype=float)
+    crs = crs or frame.local_crs()
+    lon, lat, _ = frame.enu_to_lonlat(g[..., 0], g[..., 1], g[..., 2])
+    x, y = lonlat_to_crs(crs, lon, lat)
+    grid = MapGrid.covering((x.min(), x.max()), (y.min(), y.max()), resolution_m, crs)
+    if radius_m is None:
+        along = (
+            np.linalg.norm(np.diff(g[..., :2], axis=0), axis=-1).max() if g.shape[0] > 1 else 0.0
+        )
+        across = (
+            np.linalg.norm(np.diff(g[..., :2], axis=1), axis=-1).max() if g.shape[1] > 1 else 0.0
+        )
+        radius_m = 0.55 * float(np.hypot(along, across)) + 0.5 * resolution_m
+    img = np.asarray(image)
+    vals = img.reshape(img.shape[0], -1).T
+    ll = np.column_stack([lon.ravel(), lat.ravel()])
+    out, _ = resample_swath(ll, vals, np.zeros(ll.shape[0]), grid, radius_m)
+    return out, grid, float(radius_m)
 
 
 def mosaic_tile(grid: MapGrid, parts, terrain, frame, radius_m: float, n_bands: int):
