@@ -35,8 +35,13 @@ import numpy as np
 
 HERE = Path(__file__).parent
 PATHS = ("in_memory", "chunked_1", "chunked_threads_2", "distributed_2", "ckdtree_handwritten")
-CORES = {"in_memory": 1, "chunked_1": 1, "chunked_threads_2": 2, "distributed_2": 2,
-         "ckdtree_handwritten": 1}
+CORES = {
+    "in_memory": 1,
+    "chunked_1": 1,
+    "chunked_threads_2": 2,
+    "distributed_2": 2,
+    "ckdtree_handwritten": 1,
+}
 
 
 def scene(n_lines: int, n_px: int = 900):
@@ -58,12 +63,20 @@ def scene(n_lines: int, n_px: int = 900):
     strips = []
     for i, (dx, hd) in enumerate(((-75.0, 0.0), (75.0, 180.0))):
         sy = y0 - length / 2 - v if hd == 0 else y0 + length / 2 + v
-        nav = straight_flight(F, start_xy_m=(x0 + dx, sy), heading_deg=hd, speed_m_s=v,
-                              height_m=1975.0, duration_s=length / v + 3.0, roll_amp_deg=0.05)
+        nav = straight_flight(
+            F,
+            start_xy_m=(x0 + dx, sy),
+            heading_deg=hd,
+            speed_m_s=v,
+            height_m=1975.0,
+            duration_s=length / v + 3.0,
+            roll_amp_deg=0.05,
+        )
         t = 1.0 + np.arange(n_lines) * gsd / v
         shell = Strip(cam, nav, t, px, np.zeros((n_lines, n_px, 3), np.float32), {"band": 0})
-        strips.append(Strip(cam, nav, t, px, render_lines(shell, sq, terrain, F), {"band": 0},
-                            f"s{i + 1}"))
+        strips.append(
+            Strip(cam, nav, t, px, render_lines(shell, sq, terrain, F), {"band": 0}, f"s{i + 1}")
+        )
     return strips, terrain, F
 
 
@@ -71,19 +84,38 @@ def _in_memory(strips, terrain, frame):
     from hsgeo.geocode import geocode_image
     from hsgeo.ortho import MapGrid, resample_swath, strip_footprints
 
-    allb = np.concatenate([strip_footprints(s, terrain, frame, 256, "EPSG:25832")[1] for s in strips])
+    allb = np.concatenate(
+        [strip_footprints(s, terrain, frame, 256, "EPSG:25832")[1] for s in strips]
+    )
     grid = MapGrid.covering(allb[:, [0, 2]].ravel(), allb[:, [1, 3]].ravel(), 0.3)
     best = np.full((3, grid.height, grid.width), np.nan, np.float32)
     rank = np.full((grid.height, grid.width), np.inf)
     for s in strips:
-        g = geocode_image(s.trajectory, s.sensor, s.n_lines, s.pixels, t0_s=s.t_s[0],
-                          line_rate_hz=1.0 / (s.t_s[1] - s.t_s[0]), terrain=terrain, band=0)
+        g = geocode_image(
+            s.trajectory,
+            s.sensor,
+            s.n_lines,
+            s.pixels,
+            t0_s=s.t_s[0],
+            line_rate_hz=1.0 / (s.t_s[1] - s.t_s[0]),
+            terrain=terrain,
+            band=0,
+        )
         lon, lat, _ = frame.enu_to_lonlat(g[..., 0], g[..., 1], g[..., 2])
-        o, d = s.sensor.rays(np.tile(s.pixels, (s.n_lines, 1)), np.repeat(s.t_s, s.pixels.shape[0]),
-                             s.trajectory, band=0)
+        o, d = s.sensor.rays(
+            np.tile(s.pixels, (s.n_lines, 1)),
+            np.repeat(s.t_s, s.pixels.shape[0]),
+            s.trajectory,
+            band=0,
+        )
         off = np.degrees(np.arccos(-d[:, 2]))
-        v, r = resample_swath(np.column_stack([lon.ravel(), lat.ravel()]),
-                              np.asarray(s.values).reshape(-1, 3), off, grid, 0.55 * np.hypot(0.31, 0.31) + 0.15)
+        v, r = resample_swath(
+            np.column_stack([lon.ravel(), lat.ravel()]),
+            np.asarray(s.values).reshape(-1, 3),
+            off,
+            grid,
+            0.55 * np.hypot(0.31, 0.31) + 0.15,
+        )
         win = r < rank
         best[:, win], rank[win] = v[:, win], r[win]
     return best.shape[1] * best.shape[2]
@@ -96,12 +128,20 @@ def _chunked(strips, terrain, frame, scheduler):
     if scheduler == "distributed":
         from distributed import Client, LocalCluster
 
-        with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                          dashboard_address=None) as c, Client(c) as cl:
+        with (
+            LocalCluster(
+                n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+            ) as c,
+            Client(c) as cl,
+        ):
             t0 = time.perf_counter()
             cl.compute(m.data).result()
             return m.shape[1] * m.shape[2], time.perf_counter() - t0
-    kw = {"scheduler": "synchronous"} if scheduler == "sync" else {"scheduler": "threads", "num_workers": 2}
+    kw = (
+        {"scheduler": "synchronous"}
+        if scheduler == "sync"
+        else {"scheduler": "threads", "num_workers": 2}
+    )
     m.compute(**kw)
     return m.shape[1] * m.shape[2], None
 
@@ -111,8 +151,16 @@ def _ckdtree(strips, terrain):
 
     cells = 0
     for s in strips:
-        g = geocode_image(s.trajectory, s.sensor, s.n_lines, s.pixels, t0_s=s.t_s[0],
-                          line_rate_hz=1.0 / (s.t_s[1] - s.t_s[0]), terrain=terrain, band=0)
+        g = geocode_image(
+            s.trajectory,
+            s.sensor,
+            s.n_lines,
+            s.pixels,
+            t0_s=s.t_s[0],
+            line_rate_hz=1.0 / (s.t_s[1] - s.t_s[0]),
+            terrain=terrain,
+            band=0,
+        )
         da = orthorectify(np.moveaxis(np.asarray(s.values), -1, 0), g, resolution_m=0.3)
         cells += da.sizes["N"] * da.sizes["E"]
     return cells
@@ -128,15 +176,24 @@ def one(path: str, n_lines: int) -> dict:
     elif path == "ckdtree_handwritten":
         cells = _ckdtree(strips, terrain)
     else:
-        sched = {"chunked_1": "sync", "chunked_threads_2": "threads", "distributed_2": "distributed"}
+        sched = {
+            "chunked_1": "sync",
+            "chunked_threads_2": "threads",
+            "distributed_2": "distributed",
+        }
         cells, wall_cluster = _chunked(strips, terrain, frame, sched[path])
     wall, cpu = time.perf_counter() - w0, time.process_time() - c0
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
     w = wall_cluster or wall
     return {
-        "path": path, "cores": CORES[path], "output_pixels": int(cells), "wall_s": w,
-        "client_cpu_s": cpu, "output_px_per_s_per_core": cells / w / CORES[path],
-        "peak_rss_mib": peak / 2**20, "peak_rss_over_inputs_mib": (peak - base) / 2**20,
+        "path": path,
+        "cores": CORES[path],
+        "output_pixels": int(cells),
+        "wall_s": w,
+        "client_cpu_s": cpu,
+        "output_px_per_s_per_core": cells / w / CORES[path],
+        "peak_rss_mib": peak / 2**20,
+        "peak_rss_over_inputs_mib": (peak - base) / 2**20,
         "input_mib": sum(np.asarray(s.values).nbytes for s in strips) / 2**20,
     }
 
@@ -152,16 +209,28 @@ def main(argv=None) -> int:
     rows = []
     env = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}
     for p in PATHS:
-        r = subprocess.run([sys.executable, __file__, "--one", p, "--lines", str(args.lines)],
-                           capture_output=True, text=True, env=env, check=True)
+        r = subprocess.run(
+            [sys.executable, __file__, "--one", p, "--lines", str(args.lines)],
+            capture_output=True,
+            text=True,
+            env=env,
+            check=True,
+        )
         rows.append(json.loads(r.stdout.strip().splitlines()[-1]))
         print(json.dumps(rows[-1]), flush=True)
     by = {r["path"]: r for r in rows}
     out = {
-        "n_lines_per_strip": args.lines, "n_strips": 2, "n_px": 900, "n_bands": 3,
-        "resolution_m": 0.3, "crs": "EPSG:25832", "rows": rows,
-        "speedup_chunked_threads_2_over_chunked_1": by["chunked_1"]["wall_s"] / by["chunked_threads_2"]["wall_s"],
-        "speedup_distributed_2_over_chunked_1": by["chunked_1"]["wall_s"] / by["distributed_2"]["wall_s"],
+        "n_lines_per_strip": args.lines,
+        "n_strips": 2,
+        "n_px": 900,
+        "n_bands": 3,
+        "resolution_m": 0.3,
+        "crs": "EPSG:25832",
+        "rows": rows,
+        "speedup_chunked_threads_2_over_chunked_1": by["chunked_1"]["wall_s"]
+        / by["chunked_threads_2"]["wall_s"],
+        "speedup_distributed_2_over_chunked_1": by["chunked_1"]["wall_s"]
+        / by["distributed_2"]["wall_s"],
         "pyresample_in_memory_over_ckdtree_px_per_s": by["in_memory"]["output_px_per_s_per_core"]
         / by["ckdtree_handwritten"]["output_px_per_s_per_core"],
         "machine": {"cpus": os.cpu_count(), "python": platform.python_version()},

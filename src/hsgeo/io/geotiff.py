@@ -177,7 +177,7 @@ def read_dsm(path, option: str = "--dsm"):
     import rasterio
     from rasterio.errors import RasterioIOError
 
-    from hsgeo.ortho import MapGrid
+    from hsgeo.mapgrid import MapGrid
 
     p = check_input_file(path, f"{option} DSM")
     try:
