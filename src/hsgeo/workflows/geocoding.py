@@ -286,7 +286,8 @@ def _to_grid(da, ground, options, attrs):
     )
     ortho["E"].attrs.update(units="m", long_name="easting")
     ortho["N"].attrs.update(units="m", long_name="northing")
-    return ortho.rio.set_spatial_dims("E", "N").rio.write_crs(grid.crs)
+    ortho = ortho.rio.set_spatial_dims("E", "N").rio.write_crs(grid.crs)
+    return ortho.rio.write_transform(grid.transform)
 
 
 def _line_pixels(scanner, pixel, band, sensor):
