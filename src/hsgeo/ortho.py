@@ -22,7 +22,7 @@ and the same graph runs on the threaded scheduler or on a ``dask.distributed`` c
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -60,8 +60,8 @@ class Strip:
     pixels : (n_px,) or (n_px, 2) ndarray
         One line's pixel coordinates in the sensor's convention (ζ of the 000 line scanner,
         ``(x, y = 0)`` px of the 002 LP camera), the same in every line.
-    values : (n_lines, n_px, n_bands) array_like
-        Radiance or reflectance; a Dask array is never loaded whole.
+    values : (n_lines, n_px, n_bands) array_like or None
+        Radiance or reflectance; a Dask array is never loaded whole (None: the geometry only).
     pixel_kw : dict
         What else ``rays`` takes per pixel (``band=`` of a pushbroom camera).
     name : str
@@ -79,8 +79,8 @@ class Strip:
     def __post_init__(self):
         t = np.asarray(self.t_s, dtype=float)
         px = np.asarray(self.pixels, dtype=float)
-        shape = tuple(np.shape(self.values))
-        if len(shape) != 3 or shape[:2] != (t.size, px.shape[0]):
+        shape = tuple(np.shape(self.values)) if self.values is not None else None
+        if shape is not None and (len(shape) != 3 or shape[:2] != (t.size, px.shape[0])):
             raise InputError(
                 f"strip {self.name!r}: values must be (n_lines, n_px, n_bands) = ({t.size}, "
                 f"{px.shape[0]}, …), got {shape}"
@@ -95,6 +95,12 @@ class Strip:
     @property
     def n_bands(self) -> int:
         return int(np.shape(self.values)[2])
+
+    def geometry(self) -> Strip:
+        """The strip without its values (``values=None``): what a tile's task needs besides
+        the line blocks it reads, so that a task never depends on the whole cube.
+        """
+        return replace(self, values=None)
 
 
 def geolocate_lines(strip: Strip, terrain, frame, lines=slice(None), columns=slice(None)):
@@ -265,7 +271,8 @@ def mosaic_tile(grid: MapGrid, parts, terrain, frame, radius_m: float, n_bands: 
     grid : MapGrid
         The tile.
     parts : list of (Strip, [(line0, line1, values_block), ...])
-        Per strip the line blocks that meet the tile and their values ``(m, n_px, n_bands)``.
+        Per strip (its geometry) the line blocks that meet the tile and their values
+        ``(m, n_px, n_bands)``.
 
     Returns
     -------
@@ -283,10 +290,22 @@ def mosaic_tile(grid: MapGrid, parts, terrain, frame, radius_m: float, n_bands: 
         v, r = resample_swath(
             np.concatenate(ll), np.concatenate(vals), np.concatenate(ranks), grid, radius_m
         )
-        win = r < best_rank  # 002 mosaic rule here: the ray nearest to nadir
+        win = r < best_rank  # the mosaic rule: the ray nearest to nadir
         best[:, win] = v[:, win]
         best_rank[win] = r[win]
     return best
+
+
+def _tile_task(grid, layout, terrain, frame, radius_m, n_bands, *arrays):
+    """:func:`mosaic_tile` with flat arguments (``layout``: per strip its number of blocks and
+    their line ranges; ``arrays``: per strip its geometry, then its blocks' values).
+    """
+    parts, k = [], 0
+    for ranges in layout:
+        geom, vals = arrays[k], arrays[k + 1 : k + 1 + len(ranges)]
+        parts.append((geom, [(a, b, v) for (a, b), v in zip(ranges, vals, strict=True)]))
+        k += 1 + len(ranges)
+    return mosaic_tile(grid, parts, terrain, frame, radius_m, n_bands)
 
 
 def orthomosaic(
@@ -361,6 +380,9 @@ def _mosaic_array(strips, foot, grid, terrain, frame, radius_m, tile_px, lines_p
 
     n_bands = strips[0].n_bands
     g_terrain, g_frame = dask.delayed(terrain, pure=True), dask.delayed(frame, pure=True)
+    # one key per strip's geometry, shared by the tiles (dask would unpack a Strip dataclass
+    # with its values and make every tile depend on every chunk of the cube)
+    g_strips = [dask.delayed(s.geometry(), pure=True) for s in strips]
     values = [
         s.values
         if isinstance(s.values, dsa.Array)
@@ -375,24 +397,22 @@ def _mosaic_array(strips, foot, grid, terrain, frame, radius_m, tile_px, lines_p
             c1 = min(grid.width, c0 + tile_px)
             tile = grid.window(r0, r1, c0, c1)
             x0, y0, x1, y1 = tile.extent_m
-            parts = []
-            for s, v, (blocks, bbox) in zip(strips, values, foot, strict=True):
+            layout, args = [], []
+            for s, v, (blocks, bbox) in zip(g_strips, values, foot, strict=True):
                 hit = (
                     (bbox[:, 0] - radius_m < x1)
                     & (bbox[:, 2] + radius_m > x0)
                     & (bbox[:, 1] - radius_m < y1)
                     & (bbox[:, 3] + radius_m > y0)
                 )
-                sel = [
-                    (blocks[i][0], blocks[i][1], v[blocks[i][0] : blocks[i][1]])
-                    for i in np.flatnonzero(hit)
-                ]
-                if sel:
-                    parts.append((s, sel))
+                ranges = [blocks[i] for i in np.flatnonzero(hit)]
+                if ranges:
+                    layout.append(ranges)
+                    args += [s, *(v[a:b] for a, b in ranges)]
             shape = (n_bands, r1 - r0, c1 - c0)
-            if parts:
-                task = dask.delayed(mosaic_tile, pure=True)(
-                    tile, parts, g_terrain, g_frame, radius_m, n_bands
+            if layout:
+                task = dask.delayed(_tile_task, pure=True)(
+                    tile, layout, g_terrain, g_frame, radius_m, n_bands, *args
                 )
                 row.append(dsa.from_delayed(task, shape, dtype=np.float32))
             else:
