@@ -336,3 +336,54 @@ def test_geocode_command_takes_the_002_camera_file(tmp_path):
 
     np.testing.assert_allclose(swath_m(d0) / swath_m(ds), 40.0 / 36.0, rtol=0.02)
     assert main(args + ["-o", str(tmp_path / "x.nc"), "--band", "2"]) == 2
+
+
+def test_geocode_outputs_carry_the_local_frame_crs(tmp_path):
+    """``hsgeo geocode`` (on the orthomosaic's path): the NetCDF and the ENVI file carry a real
+    CRS, the local frame's plane about ``--site``; GDAL reads it from both, and a cell's E, N
+    are its position in that CRS (pyproj: the ENU point of a cell centre has the same E, N)."""
+    import rasterio
+
+    from hsgeo.cli import main
+    from hsgeo.crs import LocalFrame, lonlat_to_crs
+
+    nav = straight_nav(heading_deg=0.0, T=10.0)
+    write_trajectory(tmp_path / "nav.csv", nav)
+    zeta = np.arange(200.0, 800.0, 2.0)
+    g = geocode_image(nav, CAL, 40, zeta, t0_s=0.0, line_rate_hz=8.0, terrain=PlaneTerrain(3.0))
+    write_lines(tmp_path / "lines.nc", g[..., 0], zeta, t0_s=0.0, line_rate_hz=8.0)
+    (tmp_path / "sensor.toml").write_text(
+        "[sensor]\nmodel = 'calibrated'\nzeta0_px = 486.8\nc_px = 3539.0\n"
+        "K = [1.459, -0.1636, 0.00526]\n"
+    )
+    argv = [
+        "geocode",
+        str(tmp_path / "lines.nc"),
+        "--trajectory",
+        str(tmp_path / "nav.csv"),
+        "--sensor",
+        str(tmp_path / "sensor.toml"),
+        "--height",
+        "3",
+        "-o",
+        str(tmp_path / "o.nc"),
+        "--envi",
+        str(tmp_path / "o_envi"),
+        "--quiet",
+        "--site",
+        "45.0,13.9,20",
+    ]
+    assert main(argv) == 0
+    frame = LocalFrame(45.0, 13.9, 20.0)
+    from pyproj import CRS
+
+    ds = xr.open_dataset(tmp_path / "o.nc")
+    corner = (float(ds["E"].values[0]) - 0.25, float(ds["N"].values[0]) + 0.25)
+    for path in (f"netcdf:{tmp_path / 'o.nc'}:radiance", str(tmp_path / "o_envi")):
+        with rasterio.open(path) as src:
+            assert CRS.from_wkt(src.crs.to_wkt()) == CRS.from_user_input(frame.local_crs())
+            np.testing.assert_allclose((src.transform.c, src.transform.f), corner)
+            assert (src.transform.a, src.transform.e) == (0.5, -0.5)
+    E, N = float(ds["E"].values[3]), float(ds["N"].values[5])
+    lon, lat, _ = frame.enu_to_lonlat(E, N, 3.0)
+    np.testing.assert_allclose(lonlat_to_crs(frame.local_crs(), lon, lat), (E, N), atol=1e-3)
