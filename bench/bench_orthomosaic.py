@@ -219,6 +219,8 @@ def one(path: str, n_lines: int) -> dict:
         "wall_s": w,
         "client_cpu_s": cpu,
         "output_px_per_s_per_core": cells / w / CORES[path],
+        # the work this process did, per CPU second (a distributed run's is on its workers)
+        "output_px_per_cpu_s": None if path == "distributed_2" else cells / cpu,
         "peak_rss_mib": rss.peak / 2**20,
         "peak_rss_over_start_mib": (rss.peak - rss.start) / 2**20,
         "input_mib": sum(np.asarray(s.values).nbytes for s in strips) / 2**20,
@@ -260,7 +262,17 @@ def main(argv=None) -> int:
         / by["distributed_2"]["wall_s"],
         "pyresample_in_memory_over_ckdtree_px_per_s": by["in_memory"]["output_px_per_s_per_core"]
         / by["ckdtree_handwritten"]["output_px_per_s_per_core"],
-        "machine": {"cpus": os.cpu_count(), "python": platform.python_version()},
+        "pyresample_in_memory_over_ckdtree_px_per_cpu_s": by["in_memory"]["output_px_per_cpu_s"]
+        / by["ckdtree_handwritten"]["output_px_per_cpu_s"],
+        "chunked_1_over_in_memory_px_per_cpu_s": by["chunked_1"]["output_px_per_cpu_s"]
+        / by["in_memory"]["output_px_per_cpu_s"],
+        "machine": {
+            "cpus": os.cpu_count(),
+            "python": platform.python_version(),
+            "load_average_1_5_15": list(os.getloadavg()),
+            "note": "a shared 2-core machine: wall times (px/s/core) move with the other jobs, "
+            "CPU seconds much less",
+        },
         "note": "ckdtree_handwritten grids each strip alone in the local frame (no mosaic, no "
         "CRS): its output pixels are the sum of the two strips' grids",
     }
