@@ -13,7 +13,7 @@ LIMIT_MIB = 320
 N_LINES, N_PX, N_BANDS = 7000, 300, 192
 
 _SCRIPT = r"""
-import json, resource, sys
+import json, sys
 sys.path[:0] = [{tests!r}]
 import numpy as np, psutil
 import dask
@@ -44,7 +44,9 @@ write_cog(orthomosaic([small], terrain, FRAME, resolution_m=0.3), {out!r} + ".wa
 base = psutil.Process().memory_info().rss
 m = orthomosaic([strip], terrain, FRAME, resolution_m=0.3, tile_px=512, lines_per_block=32)
 write_cog(m, {out!r}, batch_tiles=2)
-peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+# VmHWM: this process's own peak (ru_maxrss would also hold the parent's resident size at the
+# fork + exec that started it: the whole test session's, in `make test`)
+peak = [int(s.split()[1]) * 1024 for s in open("/proc/self/status") if s.startswith("VmHWM:")][0]
 print(json.dumps({{"cube_bytes": int(cube.nbytes), "base_rss": base, "peak_rss": peak,
                    "shape": list(m.shape)}}))
 """
