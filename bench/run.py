@@ -1,7 +1,8 @@
 """``make bench``: run every ``bench/bench_*.py`` (each writes ``bench/results/<name>.json``).
 
 ``python bench/run.py [NAME ...]`` runs only the named ones (``engine``, ``pushbroom_ba``,
-``pushbroom_scaling``, ``bal``, ``nist_strd``, ``mtf``, ``cube``, ``busy_machine``); each
+``pushbroom_scaling``, ``bal``, ``nist_strd``, ``mtf``, ``cube``, ``busy_machine``,
+``lp_ransac``); each
 script also runs on its own with its options (``python bench/bench_pushbroom_ba.py --help``).
 ``pushbroom_scaling`` is ``bench_pushbroom_ba.py --scaling …``, run after the pushbroom
 benchmark (issue 14).

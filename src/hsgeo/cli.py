@@ -111,6 +111,44 @@ def _cmd_adjust_pushbroom(args) -> int:
     return 0
 
 
+def _cmd_lp_observations(args) -> int:
+    from hsgeo.workflows.lp_observations import LpOptions, lp_observation_files
+
+    opts = LpOptions(
+        n_lines_per_scene=args.scene_lines,
+        ransac=args.ransac,
+        threshold_px=args.threshold_px,
+        bands=args.bands,
+        x_at="subpixel" if args.subpixel_x else "pixel_centre",
+        max_nav_gap_s=args.max_nav_gap_s,
+    )
+    res = lp_observation_files(
+        args.scenes,
+        args.trajectory,
+        args.camera,
+        args.output,
+        squares=args.squares,
+        height_m=args.height,
+        options=opts,
+        overwrite=args.overwrite,
+        progress=terminal.stage_printer(),
+        n_px_full=args.line_pixels,
+    )
+    terminal.clear_progress()
+    d = res.to_dict()
+    if args.json:
+        print(json_text(d))
+        return 0
+    c = d["counts"]["all"]
+    print(
+        f"{d['n_observations']} observations of {d['n_tie_points']} tie points and "
+        f"{d['n_squares']} squares from {c['scenes']} scenes in {len(args.scenes)} strips: "
+        f"{c['keypoints']} key points, {c['matches']} matches, {c['inliers_lp']} LP-F and "
+        f"{c['inliers_frame']} frame-F RANSAC inliers -> {args.output}"
+    )
+    return 0
+
+
 def _cmd_versions(args) -> int:
     from hsgeo import show_versions
 

@@ -271,6 +271,99 @@ def add_adjust_pushbroom(sub) -> argparse.ArgumentParser:
     return p
 
 
+def add_lp_observations(sub) -> argparse.ArgumentParser:
+    """``hsgeo lp-observations``."""
+    p = sub.add_parser(
+        "lp-observations",
+        help="tie-point observations from LP image lines: rotation-compensated scenes, BRISK, "
+        "RANSAC on the LP fundamental matrix (002 §3.1)",
+        description="Retrieve the observations of hsgeo adjust-pushbroom from the pixels of "
+        "LP strips (002 §3.1, §4): scenes of N lines rotation-compensated in x (002 eq. 1), "
+        "BRISK key points matched within each band between scenes of different strips whose "
+        "footprints overlap, RANSAC on the Gupta-Hartley LP fundamental matrix (or the frame "
+        "camera's), tie points seen in >= 3 lines of >= 3 strips, each observation at the "
+        "centre of its original pixel. SCENES: LP line files, one strip each (NetCDF, see "
+        "hsgeo.io.lp_lines: lines(line, column, band) DN, t_s(line), wavelength_nm(band), "
+        "attributes col0 and strip_id). NAV: the navigation file of every command, CSV or "
+        "Parquet with t_s, E_m, N_m, U_m, roll_deg, pitch_deg, heading_deg (see "
+        "hsgeo.io.navigation). CAMERA: the camera TOML of hsgeo adjust-pushbroom (one band "
+        "per band of the line files; c_band_mm, boresight_deg as known a priori). SQUARES: "
+        "CSV or Parquet point_id, E_m, N_m, H_m of the reference squares: their centres are "
+        "measured in the images and written with their ids (give the GCPs among them to "
+        "adjust-pushbroom --gcp). OUT: the observation table point_id, band, t_s, x_px, y_px "
+        "(+ strip, line), .parquet or .csv: it feeds hsgeo adjust-pushbroom unchanged.",
+    )
+    p.add_argument("scenes", nargs="+", metavar="SCENES", help="LP line files (NetCDF)")
+    p.add_argument("--trajectory", required=True, metavar="NAV", help="navigation file (see above)")
+    p.add_argument("--camera", required=True, metavar="CAMERA.toml", help="camera (TOML)")
+    p.add_argument("-o", "--output", required=True, metavar="OUT.parquet")
+    p.add_argument(
+        "--scene-lines",
+        type=option_number(integer=True, lo=8, hi=100000),
+        default=200,
+        help="lines per scene (default 200, 002 §4)",
+    )
+    p.add_argument(
+        "--ransac",
+        choices=("lp", "frame"),
+        default="lp",
+        help="RANSAC model: the LP fundamental matrix (default, 002) or the frame camera's",
+    )
+    p.add_argument(
+        "--threshold-px",
+        type=_POSITIVE,
+        default=1.0,
+        help="RANSAC inlier threshold, px (default 1)",
+    )
+    p.add_argument("--squares", metavar="SQUARES.csv", help="reference squares (see above)")
+    p.add_argument(
+        "--height",
+        type=option_number(lo=-1e4, hi=1e4),
+        metavar="H",
+        help="mean terrain height, m (default: the squares' mean height)",
+    )
+    p.add_argument(
+        "--bands",
+        type=_band_list,
+        help="bands to use, 0-based, comma-separated (default all)",
+    )
+    p.add_argument(
+        "--subpixel-x",
+        action="store_true",
+        help="x at the key point's sub-pixel position (default: the pixel centre, 002 §3.1)",
+    )
+    p.add_argument(
+        "--line-pixels",
+        type=option_number(integer=True, lo=1, hi=100000),
+        default=1800,
+        help="pixels of a full line (default 1800, 002 §4)",
+    )
+    p.add_argument(
+        "--max-nav-gap-s",
+        type=_POSITIVE,
+        default=1.0,
+        help="longest gap between navigation records interpolated across, s (default 1)",
+    )
+    p.add_argument(
+        "--overwrite", action="store_true", help="replace an existing output (default: refuse)"
+    )
+    p.add_argument("--json", action="store_true", help="a JSON summary instead of text")
+    return p
+
+
+def _band_list(text: str) -> tuple:
+    """``--bands 0,2,5`` → (0, 2, 5)."""
+    try:
+        out = tuple(int(v) for v in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is not a comma-separated list of band numbers (e.g. 0,2,5)"
+        ) from None
+    if not out or min(out) < 0:
+        raise argparse.ArgumentTypeError(f"{text!r}: bands are numbered from 0")
+    return out
+
+
 def add_adjust_bal(sub) -> argparse.ArgumentParser:
     """``hsgeo adjust-bal``."""
     p = sub.add_parser(
@@ -421,6 +514,7 @@ SUBCOMMANDS = (
     ("_cmd_data", add_data),
     ("_cmd_geocode", add_geocode),
     ("_cmd_adjust_pushbroom", add_adjust_pushbroom),
+    ("_cmd_lp_observations", add_lp_observations),
     ("_cmd_adjust_bal", add_adjust_bal),
     ("_cmd_mtf", add_mtf),
     ("_cmd_mtf_edge", add_mtf_edge),

@@ -29,6 +29,7 @@ __all__ = [
     "deviation_quiver",
     "displacement_vs_pixel",
     "solver_scaling",
+    "plot_lp_compensation",
 ]
 
 
@@ -738,4 +739,45 @@ def solver_scaling(axes, rows, *, goals=None, reference_scale: float = 1.0):
         ax.legend(fontsize=8)
     ax_t.set_ylabel("solver time (s)")
     ax_m.set_ylabel("peak memory (MB)")
+    return axes
+
+
+# ---- 002 LP observations (Fig. 3)
+def plot_lp_compensation(axes, strip, scene, *, band: int = 0, columns=None, vmax=None):
+    """002 Fig. 3: a subset of an LP scene before (the original lines) and after the rotation
+    compensation in x (:func:`hsgeo.measure.lp_scenes.make_scenes`).
+
+    Parameters
+    ----------
+    axes : two matplotlib Axes
+        Before, after.
+    strip : hsgeo.io.lp_lines.LpStrip
+        The strip the scene was cut from.
+    scene : hsgeo.measure.lp_scenes.LpScene
+    band : int
+    columns : slice, optional
+        Columns of the scene to show (default: all).
+    vmax : float, optional
+        Upper end of the grey scale (default: the 99.5th percentile of the shown scene).
+
+    Returns
+    -------
+    the two Axes. The platform moves downwards in both (rows are lines in time order).
+    """
+    cols = columns if columns is not None else slice(None)
+    rows = slice(scene.line0, scene.line0 + scene.n_lines)
+    before = strip.lines[rows, cols, band]
+    after = scene.image[:, cols, band]
+    hi = vmax if vmax is not None else float(np.percentile(after, 99.5))
+    lo = float(np.percentile(after, 0.5))
+    c0 = (cols.start or 0) if isinstance(cols, slice) else 0
+    extent = (c0 - 0.5, c0 + after.shape[1] - 0.5, scene.n_lines - 0.5, -0.5)
+    for ax, img, title in (
+        (axes[0], before, "(a) original LP lines"),
+        (axes[1], after, "(b) rotation-compensated in x"),
+    ):
+        ax.imshow(img, cmap="gray", vmin=lo, vmax=hi, extent=extent, interpolation="nearest")
+        ax.set_title(title, fontsize=9)
+        ax.set_xlabel("scene column v (px)")
+    axes[0].set_ylabel("scene row u (line)")
     return axes

@@ -31,6 +31,7 @@ __all__ = [
     "interrupted",
     "error_line",
     "progress_printer",
+    "stage_printer",
     "clear_progress",
     "json_text",
 ]
@@ -180,6 +181,28 @@ def progress_printer(stream=None):
     def show(info):
         global _progress_shown
         stream.write("\r\033[K" + progress_text(info))
+        stream.flush()
+        _progress_shown = True
+
+    return show
+
+
+def stage_printer(stream=None):
+    """A ``progress(done, total, stage)`` callback for work in steps (strips, files): ``stage
+    done/total`` on one self-clearing line of an interactive terminal (:func:`clear_progress`
+    erases it); ``None`` when ``stream`` (default stderr) is not a terminal.
+    """
+    stream = sys.stderr if stream is None else stream
+    try:
+        tty = stream.isatty()
+    except (ValueError, AttributeError):
+        tty = False
+    if not tty:
+        return None
+
+    def show(done: int, total: int, stage: str) -> None:
+        global _progress_shown
+        stream.write(f"\r\033[K{stage}: {done}/{total}")
         stream.flush()
         _progress_shown = True
 

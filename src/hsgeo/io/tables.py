@@ -17,7 +17,14 @@ from hsgeo.errors import InputError
 from hsgeo.io._files import check_input_file, read_text
 from hsgeo.io.config import closest
 
-__all__ = ["read_table", "write_csv_array", "write_csv_lines", "UNIT_SUFFIXES"]
+__all__ = [
+    "read_table",
+    "write_table",
+    "write_csv_array",
+    "write_csv_lines",
+    "UNIT_SUFFIXES",
+    "TABLE_FORMATS",
+]
 
 #: Column-name endings that mark a physical quantity (the column must be numeric and finite).
 UNIT_SUFFIXES = (
@@ -290,3 +297,28 @@ def write_csv_lines(path, header: str, lines) -> object:
         for line in lines:
             fh.write(line + "\n")
     return Path(path)
+
+
+#: The formats :func:`write_table` writes, by suffix (for ``check_outputs``).
+TABLE_FORMATS = {".parquet": "Parquet", ".pq": "Parquet", ".csv": "CSV"}
+
+
+def write_table(path, df, *, inputs=()) -> Path:
+    """Write a table (a pandas DataFrame) as Parquet (``.parquet``, ``.pq``) or CSV, atomically.
+
+    CSV floats are written with 17 significant digits (they read back to the same bits);
+    an input of the command is never overwritten (``inputs``, :func:`~hsgeo.io.atomic_path`).
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    from hsgeo.io._files import atomic_path
+
+    path = Path(path)
+    with atomic_path(path, inputs) as tmp:
+        if path.suffix.lower() in _PARQUET:
+            df.to_parquet(tmp, index=False)
+        else:
+            df.to_csv(tmp, index=False, float_format="%.17g")
+    return path

@@ -50,6 +50,9 @@ __all__ = [
     "PushbroomOptions",
     "PushbroomResult",
     "adjust_pushbroom",
+    "observations_from_table",
+    "OBS_COLUMNS",
+    "GCP_COLUMNS",
 ]
 
 
@@ -532,6 +535,27 @@ def adjust_files(
     out = r.to_dict()
     out["_result"] = r.result
     return out
+
+
+def observations_from_table(
+    obs_df,
+    traj,
+    cam: CameraPrior,
+    *,
+    source: str = "observation table",
+    nav: str = "navigation",
+    max_nav_gap_s: float = 1.0,
+):
+    """An observation table (``point_id, band, t_s, x_px, y_px``, a DataFrame) with the
+    navigation at its line times: ``(PushbroomObservations, point_ids)``.
+
+    The one path from a table to the adjustment's observations: ``hsgeo adjust-pushbroom``
+    (:func:`adjust_files`) and the LP observations retrieved from pixels
+    (:func:`hsgeo.workflows.lp_observations.to_pushbroom_inputs`) both go through it, with its
+    checks (bands of the camera, points seen twice, the navigation covering the lines).
+    ``source`` and ``nav`` name the table and the navigation in messages.
+    """
+    return _observations(obs_df, source, nav, traj, cam, max_nav_gap_s)
 
 
 def _observations(obs_df, observations, trajectory, traj, cam: CameraPrior, max_nav_gap_s):

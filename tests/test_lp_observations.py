@@ -1,0 +1,165 @@
+"""LP observations from pixels (hsgeo.workflows.lp_observations and its parts): tie-point
+linking on hand-made match graphs, footprints and crossings, the table path to the adjustment;
+end to end on a tiny rendered campaign (hsgeo.simulate.lp_campaign) against the truth."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from hsgeo.errors import InputError
+from hsgeo.measure.tie_points import components, link_tie_points
+from hsgeo.workflows import _lp_geometry as geo
+from hsgeo.workflows.lp_observations import LpOptions
+
+
+# ---------------------------------------------------------------------------------------------
+# tie points on a hand-made match graph
+def test_components_union_find():
+    lab = components(7, [0, 1, 3, 5], [1, 2, 4, 5])
+    assert lab[0] == lab[1] == lab[2]
+    assert lab[3] == lab[4] != lab[0]
+    assert len({lab[5], lab[6], lab[0], lab[3]}) == 4
+    with pytest.raises(InputError):
+        components(3, [0], [3])
+
+
+def test_link_tie_points_filters_as_002():
+    """Nodes (key points) with their strip, line and x; a graph of:
+    A: a chain over strips 0-1-2-3 (kept, 4 observations);
+    B: strips 0-1 only (dropped: 2 strips < 3);
+    C: strips 0-1-2 plus a second key point of strip 2 at the same line and x (a duplicate:
+       kept once, 3 observations);
+    D: strips 0-1-2 plus a second key point of strip 1 ten lines away (a contradiction: the
+       whole component is dropped);
+    E: strips 0-1-2 with a 4th node of strip 3 linked only through an edge not given (stays
+       alone: unmatched)."""
+    strip = [0, 1, 2, 3, 0, 1, 0, 1, 2, 2, 0, 1, 2, 1, 0, 1, 2, 3]
+    line = [10, 20, 30, 40, 11, 21, 50, 60, 70, 70, 80, 90, 95, 100, 5, 6, 7, 8]
+    x = [1.0, 2, 3, 4, 5, 6, 7, 8, 9, 9.4, 10, 11, 12, 11, 13, 14, 15, 16]
+    edges = [
+        (0, 1),
+        (1, 2),
+        (2, 3),  # A
+        (4, 5),  # B
+        (6, 7),
+        (7, 8),
+        (8, 9),  # C
+        (10, 11),
+        (11, 12),
+        (12, 13),  # D
+        (14, 15),
+        (15, 16),  # E (node 17 unmatched)
+    ]
+    a, b = np.array(edges).T
+    point, st = link_tie_points(len(strip), a, b, strip, line, x)
+    assert st == {"n_components": 5, "n_contradictory": 1, "n_too_few": 1, "n_points": 3}
+    assert point.tolist() == [0, 0, 0, 0, -1, -1, 1, 1, 1, -1, -1, -1, -1, -1, 2, 2, 2, -1]
+    # stricter: ≥ 4 strips keeps A only
+    point, st = link_tie_points(len(strip), a, b, strip, line, x, min_strips=4, min_lines=4)
+    assert st["n_points"] == 1 and np.flatnonzero(point >= 0).tolist() == [0, 1, 2, 3]
+    with pytest.raises(InputError):
+        link_tie_points(3, [0], [1], [0, 1], [0, 1, 2], [0.0, 1, 2])
+
+
+# ---------------------------------------------------------------------------------------------
+# footprints and crossings
+def test_convex_overlap_and_inside():
+    sq = np.array([[0.0, 0], [10, 0], [10, 10], [0, 10]])
+    assert geo.convex_overlap(sq, sq + [5, 5])
+    assert not geo.convex_overlap(sq, sq + [11, 0])
+    assert geo.convex_overlap(sq, sq + [11, 0], margin_m=2.0)
+    diamond = np.array([[15.0, 5], [20, 0], [25, 5], [20, 10]])
+    assert not geo.convex_overlap(sq, diamond)
+    assert geo.convex_overlap(sq[::-1], sq + [9, 9])  # clockwise input
+    pts = np.array([[5.0, 5], [11, 5], [-0.5, 5]])
+    assert geo.inside_convex(pts, sq).tolist() == [True, False, False]
+    assert geo.inside_convex(pts, sq, margin_m=1).tolist() == [True, True, True]
+
+
+def _flight(t, heading_deg=90.0, E0=0.0, N0=0.0, speed=67.0, H=1965.0):
+    from hsgeo.trajectory import Trajectory
+
+    h = np.deg2rad(heading_deg)
+    d = np.array([np.sin(h), np.cos(h)])
+    EN = np.array([E0, N0]) + np.outer(speed * (t - t[0]), d)
+    xyz = np.column_stack([EN, np.full(t.size, H)])
+    rph = np.column_stack([np.zeros(t.size), np.zeros(t.size), np.full(t.size, h)])
+    return Trajectory(t, xyz, rph)
+
+
+def test_crossing_lines_and_footprint():
+    """A point on the ground is swept by the line whose image y changes sign; its x there is
+    the projection's, and the footprint of the lines around it contains its ground point."""
+    from hsgeo.sensors.pushbroom import PushbroomCamera
+
+    cam = PushbroomCamera((40.0,), 0.0065)
+    t = np.arange(0, 4.0, 1 / 200)
+    nav = _flight(t)
+    P = np.array([[120.3, 40.0, 90.0], [50.0, -200.0, 90.0], [1e4, 0, 90]])
+    line, x = geo.crossing_lines(cam, P, t, nav)
+    assert np.isnan(line[2]) and np.isnan(x[2])
+    for k in range(2):
+        j = int(np.floor(line[k]))
+        tk = t[j] + (line[k] - j) / 200
+        xy = cam.project(P[k : k + 1], [tk], nav)[0]
+        assert abs(xy[1]) < 0.05 and abs(xy[0] - x[k]) < 0.05
+    fp = geo.footprint(cam, (-899.5, 899.5), (t[0], t[-1]), nav, 90.0)
+    assert geo.inside_convex(P[:2, :2], fp).all()
+    g = geo.ground_points(cam, [0.0], [1.0], nav, 0, 90.0)
+    assert np.allclose(g[0], [67.0, 0.0, 90.0], atol=1e-6)
+
+
+# ---------------------------------------------------------------------------------------------
+# options and the table path to the adjustment
+def test_options_are_checked():
+    for bad in (
+        {"ransac": "homography"},
+        {"x_at": "corner"},
+        {"n_lines_per_scene": 3},
+        {"threshold_px": 0.0},
+    ):
+        with pytest.raises(InputError):
+            LpOptions(**bad)
+
+
+def test_to_pushbroom_inputs_is_the_adjust_pushbroom_path(tmp_path):
+    """A table (here the pushbroom chapter's simulated observations) handed over by
+    to_pushbroom_inputs gives exactly what `hsgeo adjust-pushbroom` builds from the same table
+    written to a file; an unknown GCP is one clear error."""
+    from hsgeo.errors import ObservationError
+    from hsgeo.io.navigation import read_trajectory, write_trajectory
+    from hsgeo.io.tables import read_table
+    from hsgeo.simulate.pushbroom_campaign import simulate
+    from hsgeo.trajectory import Trajectory, rph_from_platform_rpy
+    from hsgeo.workflows.lp_observations import LpResult, to_pushbroom_inputs
+    from hsgeo.workflows.pushbroom_ba import OBS_COLUMNS, CameraPrior, _observations
+
+    obs, _ = simulate(0.001, rng=4)
+    o = obs.lines
+    table = pd.DataFrame(
+        {
+            "point_id": [f"p{v}" for v in o.point],
+            "band": o.band,
+            "t_s": o.t_s,
+            "x_px": o.xy_px[:, 0],
+            "y_px": o.xy_px[:, 1],
+        }
+    )
+    t, i = np.unique(o.t_s, return_index=True)
+    write_trajectory(
+        tmp_path / "nav.csv", Trajectory(t, o.xyz_nav_m[i], rph_from_platform_rpy(o.rpy_nav_rad[i]))
+    )
+    nav = read_trajectory(tmp_path / "nav.csv")
+    cam = CameraPrior(7)
+    res = LpResult(table, None, None, None, None, {}, {})
+    gid = [f"p{v}" for v in obs.gcp_index]
+    inp = to_pushbroom_inputs(res, nav, cam, gid, obs.gcp_xyz_m)
+    table.to_csv(tmp_path / "obs.csv", index=False, float_format="%.17g")
+    df = read_table(tmp_path / "obs.csv", OBS_COLUMNS, "observation", text_columns=("point_id",))
+    ref, ids = _observations(df, "obs.csv", "nav.csv", nav, cam, 1.0)
+    assert inp.point_ids.tolist() == ids.tolist()
+    for k in ("point", "band", "t_s", "xy_px", "xyz_nav_m", "rpy_nav_rad", "xyz_rate_nav_m_s"):
+        assert np.array_equal(getattr(inp.observations, k), getattr(ref, k)), k
+    assert [ids[g] for g in inp.gcp_index] == gid
+    with pytest.raises(ObservationError, match="nope"):
+        to_pushbroom_inputs(res, nav, cam, ["nope"], np.zeros((1, 3)))
