@@ -8,7 +8,7 @@ import pytest
 from hsgeo.errors import InputError
 from hsgeo.geocode import intersect
 from hsgeo.simulate import lp_campaign as L
-from hsgeo.simulate._lp_ground import render_rays
+from hsgeo.simulate._lp_render import render_rays
 
 SCALE = 0.1
 
