@@ -85,8 +85,9 @@ class LpConfig:
     # TUNED (provenance "tuned"): amplitude of the mount's residual attitude motion (the shape
     # of pushbroom_campaign._mount_motion, sines of 0.3–2.3 Hz), chosen so that |δx| of 002
     # eq. (1) over the 200-line scenes of the whole block (scale 1, first line as reference)
-    # has 002 §4's RMS of 0.91 px: 0.908 px (100 / 300 lines: 0.73 / 0.84 px). Its max is then
-    # 2.4 px against 002's 4.43 px: a few sines have a smaller crest factor than real motion.
+    # has 002 §4's RMS of 0.91 px: 0.911 px (100 / 300 lines: 0.73 / 0.86 px). Its max is then
+    # 2.46 px against 002's 4.43 px: a few sines have a smaller crest factor than a real
+    # mount's motion.
     mount_motion_rad: float = 0.0108 * DEG
     # -- ground (ours)
     ground_cell_m: float = 0.15  # reflectance raster: half the 0.30 m GSD at 1875 m
