@@ -59,7 +59,7 @@ from hsgeo.errors import InputError
 from hsgeo.io.lp_lines import LpStrip
 from hsgeo.sensors.pushbroom import BLOCK_NAMES, PushbroomCamera
 from hsgeo.simulate._lp_ground import make_ground
-from hsgeo.simulate._lp_render import Ground, render_lines
+from hsgeo.simulate._lp_render import Ground, render_lines, render_rays
 from hsgeo.simulate.pushbroom_campaign import (
     REFERENCE_EN_M,
     _camera_truth,
@@ -181,6 +181,30 @@ class LpTruth:
     strip_index: np.ndarray
     nav_error: object = None
 
+    def ground_points(self, t_s, x_px, band) -> np.ndarray:
+        """True ground point (E, N, U, m) seen by pixels ``x_px`` of the lines at ``t_s``.
+
+        The true ray (:meth:`PushbroomCamera.rays` of :attr:`camera` on :attr:`trajectory`)
+        meets the DSM where the renderer sampled it: for judging a retrieved observation
+        against its true image position (project the point with ``camera.project``).
+
+        Parameters
+        ----------
+        t_s, x_px : (m,) array_like
+            Line times (s) and x along the line (px from the full line's centre).
+        band : int or (m,) int array_like
+
+        Returns
+        -------
+        (m, 3) ndarray
+        """
+        x = np.atleast_1d(np.asarray(x_px, dtype=np.float64))
+        o, d = self.camera.rays(
+            np.column_stack([x, np.zeros(x.size)]), np.atleast_1d(t_s), self.trajectory, band
+        )
+        en, _ = render_rays(o, d, self.ground)
+        return np.column_stack([en, self.terrain.height(en[:, 0], en[:, 1])])
+
 
 def _line_times(cfg: CampaignConfig, plan) -> list[np.ndarray]:
     """Every line's exposure time of each strip: ``t_start + k / line_rate``."""
@@ -268,6 +292,12 @@ def _checked(scale, cfg):
             f"scale must be in (0, 1] (the share of 002's 600 m block side rendered), got {scale}"
         )
     cfg = cfg or LpConfig()
+    for name in ("ground_cell_m", "dsm_cell_m", "field_size_m", "dn_max", "electrons_per_dn"):
+        v = getattr(cfg, name)
+        if not (np.isfinite(v) and v > 0):
+            raise InputError(f"LpConfig.{name} must be a positive number, got {v!r}")
+    if not (cfg.psf_sigma_m >= 0 and cfg.read_noise_dn >= 0 and cfg.mount_motion_rad >= 0):
+        raise InputError("LpConfig: psf_sigma_m, read_noise_dn and mount_motion_rad must be ≥ 0")
     nb = len(cfg.campaign.c_offsets_um)
     if len(cfg.dn_per_reflectance) < nb or len(cfg.campaign.wavelengths_nm) != nb:
         raise InputError(
