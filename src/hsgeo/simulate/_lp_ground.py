@@ -17,8 +17,12 @@ The reflectance of each material in each band is :data:`SPECTRA` (ours, typical 
 vegetation dark in the visible and bright above the red edge at ~750 nm, 002 §5.3), at the
 campaign's seven wavelengths; other wavelengths interpolate it.
 
-The point-spread function is a Gaussian blur of the raster (``psf_sigma_m``), applied once per
-band; a ray samples the blurred raster bilinearly where it meets the DSM.
+The point-spread function is a Gaussian blur of the raster (``psf_sigma_m``) and, for the
+motion blur of a line's integration (``motion_blur_m``: the ground the platform passes while the
+line integrates, 002 §4 names it among the unmodelled effects), a box along north — every strip
+flies north or south, so one raster serves all; the exposure's time stamp is its middle, so
+the box is centred and moves no centroid. Both are applied once per band; a ray samples the
+blurred raster bilinearly where it meets the DSM.
 
 The rendering (the ray–DSM intersection and the sampling) is :mod:`hsgeo.simulate._lp_render`.
 """
@@ -262,12 +266,25 @@ def _buildings(cfg, r: _Raster, dsm, ext, squares_en, rng) -> None:
             dsm[sl][m] += h
 
 
+def _box_weights(width_cells: float) -> np.ndarray:
+    """Weights of a centred box ``width_cells`` wide on a grid of unit cells (each the overlap
+    of its cell with the box), summing to one.
+    """
+    k = int(np.ceil(width_cells / 2 + 0.5))
+    x = np.arange(-k, k + 1)
+    w = np.clip(
+        np.minimum(x + 0.5, width_cells / 2) - np.maximum(x - 0.5, -width_cells / 2), 0, None
+    )
+    return w / w.sum()
+
+
 def _reflectance(cfg, r: _Raster, squares_en, wavelengths_nm, rng) -> np.ndarray:
     """Blurred reflectance per band, ``(n_bands, n, n)`` float32: material spectra × brightness
     × (1 + texture), the white squares mixed in by their exact coverage, then the PSF.
     """
-    from scipy.ndimage import gaussian_filter
+    from scipy.ndimage import convolve1d, gaussian_filter
 
+    box = _box_weights(cfg.motion_blur_m / r.cell) if cfg.motion_blur_m > 0 else None
     tex = _texture(r.shape, r.cell, rng)
     spectra = _spectra(wavelengths_nm)
     mod = np.clip(r.bright * (1 + _TEXTURE[r.material] * tex), 0.05, 3.0)
@@ -287,7 +304,10 @@ def _reflectance(cfg, r: _Raster, squares_en, wavelengths_nm, rng) -> np.ndarray
     for b in range(refl.shape[0]):
         r_b = spectra[:, b].astype(np.float32)[r.material] * mod
         r_b = (1 - cov) * r_b + cov * np.float32(white[b])
-        refl[b] = gaussian_filter(r_b, cfg.psf_sigma_m / r.cell, mode="nearest")
+        r_b = gaussian_filter(r_b, cfg.psf_sigma_m / r.cell, mode="nearest")
+        if box is not None:
+            r_b = convolve1d(r_b, box, axis=0, mode="nearest")
+        refl[b] = r_b
     return refl
 
 

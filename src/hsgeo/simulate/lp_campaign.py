@@ -103,6 +103,10 @@ class LpConfig:
     # a Gaussian PSF of σ 0.15 m (FWHM 0.35 m ≈ the pixel footprint, 0.30–0.41 m at
     # 1875–2500 m AGL), applied to the ground raster
     psf_sigma_m: float = 0.15
+    # motion blur: the ground passed during a line's integration (ours: integration = the line
+    # period 1/200 s, time stamp at mid-exposure: 67 m/s / 200 = 0.335 m along track); 0: off.
+    # Not in the pinhole model of 002 eq. (2) (002 §4 lists it among the unmodelled effects)
+    motion_blur_m: float = 67.0 / 200.0
     # -- radiometry (ours): DN per unit reflectance per band, one integration time; vegetation
     # (ρ ≈ 0.48) reaches ~90 % of dn_max above the red edge (002 §5.3: "close to saturation")
     dn_max: float = 4095.0
@@ -296,8 +300,13 @@ def _checked(scale, cfg):
         v = getattr(cfg, name)
         if not (np.isfinite(v) and v > 0):
             raise InputError(f"LpConfig.{name} must be a positive number, got {v!r}")
-    if not (cfg.psf_sigma_m >= 0 and cfg.read_noise_dn >= 0 and cfg.mount_motion_rad >= 0):
-        raise InputError("LpConfig: psf_sigma_m, read_noise_dn and mount_motion_rad must be ≥ 0")
+    if not all(
+        getattr(cfg, k) >= 0
+        for k in ("psf_sigma_m", "motion_blur_m", "read_noise_dn", "mount_motion_rad")
+    ):
+        raise InputError(
+            "LpConfig: psf_sigma_m, motion_blur_m, read_noise_dn and mount_motion_rad must be ≥ 0"
+        )
     nb = len(cfg.campaign.c_offsets_um)
     if len(cfg.dn_per_reflectance) < nb or len(cfg.campaign.wavelengths_nm) != nb:
         raise InputError(
