@@ -105,6 +105,8 @@ def test_bad_config():
         L.simulate(0.05, cfg=replace(L.LpConfig(), ground_cell_m=0.0))
     with pytest.raises(InputError, match="psf_sigma_m"):
         L.simulate(0.05, cfg=replace(L.LpConfig(), psf_sigma_m=-1.0))
+    with pytest.raises(InputError, match="rng"):
+        L.simulate(0.05, rng=-1)
 
 
 def test_campaign_structure(campaign):

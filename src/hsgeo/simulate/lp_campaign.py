@@ -58,6 +58,7 @@ import numpy as np
 from hsgeo.errors import InputError
 from hsgeo.io.lp_lines import LpStrip
 from hsgeo.sensors.pushbroom import BLOCK_NAMES, PushbroomCamera
+from hsgeo.simulate import as_rng
 from hsgeo.simulate._lp_ground import make_ground
 from hsgeo.simulate._lp_render import Ground, render_lines, render_rays
 from hsgeo.simulate.pushbroom_campaign import (
@@ -337,7 +338,7 @@ def simulate(
     from hsgeo.geocode import DemTerrain
 
     cfg = _checked(scale, cfg)
-    rng = np.random.default_rng(rng)
+    rng = as_rng(rng)
     c = replace(cfg.campaign, mount_motion_rad=cfg.mount_motion_rad)
     plan = _strip_plan(c)
     t_end = plan[-1][1]
