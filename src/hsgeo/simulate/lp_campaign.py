@@ -69,7 +69,12 @@ from hsgeo.simulate.pushbroom_campaign import (
     _true_pose,
 )
 from hsgeo.simulate.pushbroom_campaign_types import CampaignConfig
-from hsgeo.trajectory import SplineNodes, Trajectory, rph_from_platform_rpy
+from hsgeo.trajectory import (
+    R_BODY_FROM_PLATFORM,
+    SplineNodes,
+    Trajectory,
+    rph_from_platform_rpy,
+)
 
 __all__ = ["LpConfig", "LpObservations", "LpTruth", "simulate", "MIN_COLUMNS"]
 
@@ -242,7 +247,7 @@ def _window(camera, traj, t, n_px, half_m, h_mean, agl):
     x = np.arange(n_px) - (n_px - 1) / 2
     tm = t[t.size // 2]
     pos, _ = traj.pose(np.full(n_px, tm))
-    R = traj.R_map_from_body(np.full(n_px, tm)) @ np.diag([1.0, -1.0, -1.0])
+    R = traj.R_map_from_body(np.full(n_px, tm)) @ R_BODY_FROM_PLATFORM
     o, d = camera.rays_at(np.column_stack([x, np.zeros(n_px)]), 0, pos, R)
     s = (h_mean - o[:, 2]) / d[:, 2]
     E = o[:, 0] + s * d[:, 0]
@@ -270,17 +275,16 @@ def _render_strip(cfg: LpConfig, camera, traj, t, cols, ground: Ground, rng) -> 
     c = cfg.campaign
     n_px = c.pixels_per_line
     x = cols - (n_px - 1) / 2
-    nl, nc = t.size, x.size
+    nc = x.size
     nb = len(camera.c_mm)
     pos, _ = traj.pose(t)
-    R = traj.R_map_from_body(t) @ np.diag([1.0, -1.0, -1.0])  # map from platform
+    R = traj.R_map_from_body(t) @ R_BODY_FROM_PLATFORM  # map from platform
     o_plat, _ = camera.rays_at(np.zeros((1, 2)), 0, np.zeros((1, 3)), np.eye(3)[None])
     origins_line = pos + R @ o_plat[0]  # (nl, 3): x + R l^p
-    out = np.empty((nl, nc, nb), np.float32)
     xy = np.column_stack([x, np.zeros(nc)])
-    for b in range(nb):
-        _, d_plat = camera.rays_at(xy, b, np.zeros((nc, 3)), np.broadcast_to(np.eye(3), (nc, 3, 3)))
-        out[:, :, b] = render_lines(R, origins_line, d_plat, ground, b)
+    eye = np.broadcast_to(np.eye(3), (nc, 3, 3))
+    d_plat = np.stack([camera.rays_at(xy, b, np.zeros((nc, 3)), eye)[1] for b in range(nb)])
+    out = render_lines(R, origins_line, d_plat, ground)
     # radiometry: DN, shot and read noise, quantisation, saturation
     dn = out * np.asarray(cfg.dn_per_reflectance[:nb], np.float32)
     sigma = np.sqrt(dn / np.float32(cfg.electrons_per_dn) + np.float32(cfg.read_noise_dn) ** 2)
