@@ -37,12 +37,14 @@ at the corners, 13 check points, :data:`~hsgeo.simulate.pushbroom_campaign.REFER
 moved by up to ±20 m) shrunk with the block, ``scale ·`` their positions, so that every scale
 has its GCPs and check points.
 
-Sizes and cost (measured 2026-11-27 on the shared 2-core machine under a load of ~5): at scale
-1 the 24 strips hold 3.9·10⁸ pixel-bands (1.56 GB as float32; peak memory 2.6 GB with the
-ground raster) and render in 106 s, 0.27 s per million pixel-bands (the ray–DSM intersection
-and sampling, :mod:`hsgeo.simulate._lp_render`, ≈ 90 % of it); the work and the memory scale
-with ``scale²``. The default, 0.35, renders 12 % of the campaign (≈ 4.8·10⁷ pixel-bands, ≈ 13 s),
-leaving the chapter's detection, matching and adjustment most of its 3-minute budget.
+Sizes and cost (measured 2026-11-27 on the shared 2-core machine under a load of 4–6 from other
+sessions, so the times are upper bounds): at scale 1 the 24 strips hold 3.9·10⁸ pixel-bands
+(1.56 GB as float32; peak memory 2.6 GB with the ground raster) and :func:`simulate` takes 92 s,
+0.24 s per million pixel-bands (a strip alone renders at 0.17 s per million, the compiled
+ray–DSM intersection and sampling, :mod:`hsgeo.simulate._lp_render`, being most of it; on a
+quiet machine 0.06). Work and memory scale with ``scale²``. The default, 0.35, renders 12 % of
+the campaign (≈ 4.8·10⁷ pixel-bands, ≈ 10 s), leaving the chapter's detection, matching and
+adjustment most of its 3-minute budget.
 
 References
 ----------
