@@ -161,7 +161,7 @@ def test_same_seed_same_bytes():
     assert a.strips[0].lines.tobytes() != c.strips[0].lines.tobytes()
 
 
-@pytest.mark.parametrize("scale", [0, -1, 1.5, float("nan"), "big"])
+@pytest.mark.parametrize("scale", [0, 0.01, -1, 1.5, float("nan"), "big"])
 def test_bad_scale(scale):
     with pytest.raises(InputError, match="scale"):
         L.simulate(scale=scale)

@@ -28,7 +28,7 @@ band, no distortion, zero boresight, the tape-measured lever arm, the calibrated
 
 Scale
 -----
-``scale`` ∈ (0, 1] renders the central ``600·scale`` m × ``600·scale`` m of 002's 600 m × 600 m
+``scale`` ∈ [0.05, 1] renders the central ``600·scale`` m × ``600·scale`` m of 002's 600 m × 600 m
 block, i.e. the fraction ``scale²`` of the campaign's area and (within a few per cent) of its
 pixels: every strip keeps 002's flight line, height and speed, and stores only the lines and
 columns whose ground lies over the rendered block (``col0``; a strip that sees fewer than
@@ -78,9 +78,11 @@ from hsgeo.trajectory import (
     rph_from_platform_rpy,
 )
 
-__all__ = ["LpConfig", "LpObservations", "LpTruth", "simulate", "MIN_COLUMNS"]
+__all__ = ["LpConfig", "LpObservations", "LpTruth", "simulate", "MIN_COLUMNS", "MIN_SCALE"]
 
 DEG = np.pi / 180
+#: The smallest scale: a 30 m block (the 17 squares, 1.2 m each, still ≥ 7 m apart).
+MIN_SCALE = 0.05
 #: A strip that sees fewer columns of the rendered block is left out.
 MIN_COLUMNS = 64
 
@@ -298,9 +300,10 @@ def _render_strip(cfg: LpConfig, camera, traj, t, cols, ground: Ground, rng) -> 
 def _checked(scale, cfg):
     if not (isinstance(scale, (int, float, np.floating)) and np.isfinite(scale)):
         raise InputError(f"scale must be a number in (0, 1], got {scale!r}")
-    if not 0 < scale <= 1:
+    if not MIN_SCALE <= scale <= 1:
         raise InputError(
-            f"scale must be in (0, 1] (the share of 002's 600 m block side rendered), got {scale}"
+            f"scale must be in [{MIN_SCALE}, 1] (the share of 002's 600 m block side rendered; "
+            f"below {MIN_SCALE} the 17 squares crowd a block of under 30 m), got {scale}"
         )
     cfg = cfg or LpConfig()
     for name in ("ground_cell_m", "dsm_cell_m", "field_size_m", "dn_max", "electrons_per_dn"):
@@ -329,7 +332,7 @@ def simulate(
 
     Parameters
     ----------
-    scale : float in (0, 1]
+    scale : float in [MIN_SCALE, 1]
         Side of the rendered block as a share of 002's 600 m (area and pixels ∝ ``scale²``).
     rng : int or numpy.random.Generator
     cfg : LpConfig, optional
