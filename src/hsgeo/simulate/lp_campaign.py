@@ -17,7 +17,8 @@ the line's exposure time, which includes the high-frequency attitude motion of t
 mount (:func:`~hsgeo.simulate.pushbroom_campaign._mount_motion`, amplitude
 :attr:`LpConfig.mount_motion_rad`, tuned to 002's |δx|); per band with its own principal
 distance: each pixel's ray (:meth:`hsgeo.sensors.pushbroom.PushbroomCamera.rays_at`) meets the
-DSM and samples the blurred reflectance there (a Gaussian PSF of about a pixel's footprint). The
+DSM and samples the blurred reflectance there (a Gaussian PSF of about a pixel's footprint, and
+the motion blur of the line's integration along track, :attr:`LpConfig.motion_blur_m`). The
 reflectance becomes DN with a band-dependent responsivity (vegetation close to saturation above
 the red edge, 002 §5.3), shot and read noise, rounding and clipping at ``dn_max``.
 
@@ -25,6 +26,11 @@ The navigation a user has is the truth minus the Gauss–Markov error, sampled a
 of every strip (a :class:`~hsgeo.trajectory.Trajectory`; between strips it interpolates across
 the turns, where no line is exposed). The a-priori camera is the nominal one (c = 40 mm in every
 band, no distortion, zero boresight, the tape-measured lever arm, the calibrated principal point).
+
+What the renderer shares with the estimator: the camera model itself (002 eq. (2)–(4), the
+same :class:`~hsgeo.sensors.pushbroom.PushbroomCamera`) maps the ground to the pixels. What the
+estimator does not model: the PSF and the motion blur, the DSM's occlusions, the texture's
+effect on where a key point is found, the noise and saturation of the DN.
 
 Scale
 -----
@@ -40,11 +46,11 @@ has its GCPs and check points.
 Sizes and cost (measured 2026-11-27 on the shared 2-core machine under a load of 4–6 from other
 sessions, so the times are upper bounds): at scale 1 the 24 strips hold 3.9·10⁸ pixel-bands
 (1.56 GB as float32; peak memory 2.6 GB with the ground raster) and :func:`simulate` takes 92 s,
-0.24 s per million pixel-bands (a strip alone renders at 0.17 s per million, the compiled
-ray–DSM intersection and sampling, :mod:`hsgeo.simulate._lp_render`, being most of it; on a
-quiet machine 0.06). Work and memory scale with ``scale²``. The default, 0.35, renders 12 % of
-the campaign (≈ 4.8·10⁷ pixel-bands, ≈ 10 s), leaving the chapter's detection, matching and
-adjustment most of its 3-minute budget.
+0.24 s per million pixel-bands (a strip alone renders at 0.17 s per million; the compiled
+ray–DSM intersection and sampling, :mod:`hsgeo.simulate._lp_render`, is most of it, measured
+between 0.04 and 0.13 s per million as the load varied). Work and memory scale with
+``scale²``. The default, 0.35, renders 12 % of the campaign (≈ 4.8·10⁷ pixel-bands, ≈ 10 s),
+leaving the chapter's detection, matching and adjustment most of its 3-minute budget.
 
 References
 ----------
