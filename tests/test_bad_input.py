@@ -110,6 +110,32 @@ def _geocode(d: Path) -> None:
     ).to_netcdf(d / "dem.nc", engine="scipy")
 
 
+def _lp(d: Path) -> None:
+    """Four strips of the rendered LP campaign (scale 0.1) as LP line files, the navigation,
+    the a-priori camera and the reference squares."""
+    import pandas as pd
+
+    from hsgeo.io.lp_lines import write_lp_lines
+    from hsgeo.io.navigation import write_trajectory
+    from hsgeo.simulate.lp_campaign import simulate
+
+    d.mkdir()
+    obs, _ = simulate(scale=0.1, rng=2)
+    for i, k in enumerate((0, 2, 4, 12)):
+        write_lp_lines(d / f"s{i}.nc", obs.strips[k])
+    write_trajectory(d / "nav.csv", obs.navigation)
+    cam = obs.camera
+    la = ", ".join(f"{v:.6f}" for v in cam.lever_arm_m)
+    (d / "cam.toml").write_text(
+        f"[camera]\nn_bands = {len(cam.c_mm)}\npixel_mm = {cam.pixel_mm}\nc_mm = {cam.c_mm[0]}\n"
+        f"x0_mm = {cam.x0_mm}\nlever_arm_m = [{la}]\n"
+    )
+    xyz = obs.square_xyz_m
+    pd.DataFrame(
+        {"point_id": list(obs.square_ids), "E_m": xyz[:, 0], "N_m": xyz[:, 1], "H_m": xyz[:, 2]}
+    ).to_csv(d / "squares.csv", index=False, float_format="%.17g")
+
+
 def _frame(d: Path) -> None:
     d.mkdir()
     for p in sorted((CHARUCO / "images").glob("*.jpg"))[:3]:
@@ -187,6 +213,7 @@ def build_valid(root: Path) -> Path:
     _pushbroom(root / "adjust-pushbroom")
     _geocode(root / "geocode")
     _frame(root / "calibrate-frame")
+    _lp(root / "lp-observations")
     return root
 
 
@@ -224,6 +251,21 @@ def base_argv(cmd: str, d: Path) -> list[str]:
         ]
     if cmd == "calibrate-frame":
         return [cmd, *(s(d / f"img_0{i}.jpg") for i in range(3)), "--board", s(d / "board.toml")]
+    if cmd == "lp-observations":
+        out = d.parent / "out"
+        out.mkdir(exist_ok=True)
+        return [
+            cmd,
+            *(s(d / f"s{i}.nc") for i in range(4)),
+            "--trajectory",
+            s(d / "nav.csv"),
+            "--camera",
+            s(d / "cam.toml"),
+            "--squares",
+            s(d / "squares.csv"),
+            "-o",
+            s(out / "obs.parquet"),
+        ]
     if cmd == "adjust-bal":
         return [cmd, s(d / "problem.txt"), "--json"]
     if cmd == "mtf":
@@ -647,6 +689,94 @@ for o, vals in {"--node-interval": ["0", "-10", "nan", "inf", "abc"]}.items():
 case(C, "options", "--max-nav-gap-s=0", "--max-nav-gap-s", argv=opt("--max-nav-gap-s", "0"))
 case(C, "options", "no-camera", "--camera", argv=opt("--camera"))
 case(C, "options", "no-trajectory", "--trajectory", argv=opt("--trajectory"))
+
+# --- lp-observations -----------------------------------------------------------------------
+C = "lp-observations"
+SQUARES = ["point_id", "E_m", "N_m", "H_m"]
+table_file_cases(C, "nav.csv", "navigation", NAV, "squares.csv")
+table_file_cases(C, "squares.csv", "squares", SQUARES, "nav.csv")
+case(C, "duplicates", "squares-same-id-twice", "point_id", [("squares.csv", duplicate_row(0))])
+case(C, "degenerate", "nav-not-covering", "navigation", [("nav.csv", keep_rows(60))])
+case(C, "degenerate", "nav-times-decreasing", "t_s", [("nav.csv", swap_rows(5, 6))])
+case(C, "units", "nav-east-in-mm", "jumps", [("nav.csv", scale_column("E_m", 1000.0))])
+
+
+def _lp_noise(p: Path) -> None:
+    """The strip's lines replaced by noise: nothing to match."""
+    from dataclasses import replace
+
+    from hsgeo.io.lp_lines import read_lp_lines, write_lp_lines
+
+    s = read_lp_lines(p)
+    rng = np.random.default_rng(int(p.stem[1:]))  # each strip its own noise
+    write_lp_lines(
+        p, replace(s, lines=rng.normal(1000, 30, s.lines.shape).astype(np.float32)), overwrite=True
+    )
+
+
+def _lp_drop(var: str):
+    def edit(p: Path) -> None:
+        import xarray as xr
+
+        with xr.open_dataset(p, engine="h5netcdf") as ds:
+            new = ds.load().drop_vars(var)
+        p.unlink()
+        new.to_netcdf(p, engine="h5netcdf")
+
+    return edit
+
+
+for f in ("s0.nc", "s3.nc"):
+    case(C, "missing", f"{f}-missing", f, [(f, remove)])
+    case(C, "missing", f"{f}-directory", f, [(f, make_dir)])
+    case(C, "empty", f"{f}-empty", f, [(f, text(""))])
+    case(C, "garbage", f"{f}-text", f, [(f, text("hello world\n"))])
+    case(C, "binary", f"{f}-binary", f, [(f, text(BINARY))])
+    case(C, "mistyped", f"{f}-a-csv", f, [(f, copy_from("nav.csv"))])
+    case(C, "mistyped", f"{f}-no-t_s", "t_s", [(f, _lp_drop("t_s"))])
+    case(C, "mistyped", f"{f}-no-lines", "lines", [(f, _lp_drop("lines"))])
+case(C, "degenerate", "noise-only", "11 matches", [(f"s{i}.nc", _lp_noise) for i in range(4)])
+case(C, "degenerate", "two-strips", "strip(s) given", argv=lambda a, d: [a[0], a[1], a[2], *a[5:]])
+case(C, "duplicates", "strip-twice", "twice", argv=lambda a, d: [a[0], a[1], *a[1:]])
+case(C, "missing", "cam-missing", "cam.toml", [("cam.toml", remove)])
+case(C, "garbage", "cam-garbage", "cam.toml", [("cam.toml", text("[camera\nn_bands = \n"))])
+case(C, "mismatch", "cam-3-bands", "n_bands", [("cam.toml", toml_set("camera", "n_bands", "3"))])
+case(
+    C,
+    "range",
+    "cam-pixel-negative",
+    "pixel_mm",
+    [("cam.toml", toml_set("camera", "pixel_mm", "-6.5"))],
+)
+case(C, "options", "bands-9", "band(s) [9]", argv=flag("--bands", "0,9"))
+case(C, "options", "bands-text", "--bands", argv=flag("--bands", "red"))
+case(C, "options", "bands-negative", "--bands", argv=flag("--bands", "-1"))
+case(C, "options", "scene-lines-2", "--scene-lines", argv=flag("--scene-lines", "2"))
+case(C, "options", "scene-lines-text", "--scene-lines", argv=flag("--scene-lines", "many"))
+case(C, "options", "ransac-homography", "--ransac", argv=flag("--ransac", "homography"))
+case(C, "options", "threshold-0", "--threshold-px", argv=flag("--threshold-px", "0"))
+case(C, "options", "height-nan", "--height", argv=flag("--height", "nan"))
+case(C, "options", "no-trajectory", "--trajectory", argv=opt("--trajectory"))
+case(C, "options", "no-output", "-o", argv=opt("-o"))
+case(C, "options", "no-height-no-squares", "--height", argv=opt("--squares"))
+case(C, "output", "output-is-nav", "nav.csv", argv=lambda a, d: opt("-o", str(d / "nav.csv"))(a, d))
+case(C, "output", "output-is-strip", "s0.nc", argv=lambda a, d: opt("-o", str(d / "s0.nc"))(a, d))
+case(C, "output", "output-txt", ".txt", argv=lambda a, d: opt("-o", str(d.parent / "o.txt"))(a, d))
+case(
+    C,
+    "output",
+    "output-folder-missing",
+    "does not exist",
+    argv=lambda a, d: opt("-o", str(d / "no" / "o.parquet"))(a, d),
+)
+case(
+    C,
+    "outputs",
+    "output-exists",
+    "--overwrite",
+    argv=lambda a, d: _touch_output(a, d),
+)
+
 
 # --- geocode -------------------------------------------------------------------------------
 C = "geocode"

@@ -297,7 +297,8 @@ def retrieve(inputs: LpInputs, options: LpOptions = LpOptions(), progress=None) 
         Fewer strips than ``min_strips``, bands missing or unlike the camera's, a navigation
         that does not cover the lines, no terrain height, no two strips' scenes overlapping.
     ObservationError
-        No scene pair with 11 matches (the LP fundamental matrix's minimum).
+        No scene pair with 11 matches (the LP fundamental matrix's minimum), or no tie point
+        seen in enough lines and strips.
     """
     bands, height = _check(inputs, options)
     timings = {k: 0.0 for k in ("scenes", "detection", "matching", "ransac", "squares")}
@@ -342,6 +343,13 @@ def retrieve(inputs: LpInputs, options: LpOptions = LpOptions(), progress=None) 
         min_strips=options.min_strips,
     )
     timings["tie_points"] = time.perf_counter() - t0
+    if link["n_points"] == 0:
+        raise ObservationError(
+            f"no tie point is seen in ≥ {options.min_lines} lines of ≥ {options.min_strips} "
+            f"strips (002 §4): RANSAC kept {int(kept.sum())} of {kept.size} matches in "
+            f"{len(rows['pairs'])} scene pairs; give more overlapping strips, or scenes with "
+            "texture in these bands (--bands)"
+        )
     table = _table(inputs, options, keys, point, rows["squares"])
     matches = _matches_frame(inputs, keys, m, kept, point)
     return _result(inputs, options, bands, keys, point, link, table, matches, rows, timings)
