@@ -21,7 +21,7 @@ def test_error_histogram_is_a_density_with_the_share_beyond():
     # a step histogram of density: the total area is 1 (beyond-limit values in the last bin)
     xy = patch.get_xy()
     heights = xy[1:-1:2, 1]
-    assert np.isclose(np.sum(heights[: 30] * 0.1), 1.0)
+    assert np.isclose(np.sum(heights[:30] * 0.1), 1.0)
     plt.close(fig)
 
 

@@ -50,7 +50,7 @@ def error_histogram(ax, errors_px: dict, *, limit_px: float = 3.0, bins: int = 6
     ax.set_xlim(0.0, limit_px)
     ax.set_xlabel("distance from the true image position (px)")
     ax.set_ylabel("density (1/px)")
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.2))
     return ax
 
 
@@ -77,11 +77,20 @@ def band_counts(ax, wavelength_nm, counts: dict, *, red_edge_nm: float = 750.0, 
     step = float(np.min(np.diff(wl))) if wl.size > 1 else 50.0
     w = 0.8 * step / max(k, 1)
     for i, (label, c) in enumerate(counts.items()):
-        ax.bar(wl + (i - (k - 1) / 2) * w, np.asarray(c, float), width=w, label=label, color=f"C{i}")
+        ax.bar(
+            wl + (i - (k - 1) / 2) * w, np.asarray(c, float), width=w, label=label, color=f"C{i}"
+        )
     ax.axvspan(red_edge_nm, wl.max() + step, color="C2", alpha=0.08, lw=0)
     ax.axvline(red_edge_nm, color="C2", lw=0.8, ls="--")
-    ax.text(red_edge_nm + 0.02 * step, 0.97, "above the red edge", transform=ax.get_xaxis_transform(),
-            va="top", fontsize=7, color="C2")
+    ax.text(
+        red_edge_nm + 0.02 * step,
+        0.97,
+        "above the red edge",
+        transform=ax.get_xaxis_transform(),
+        va="top",
+        fontsize=7,
+        color="C2",
+    )
     if log:
         ax.set_yscale("log")
     ax.set_xlim(wl.min() - step / 2, wl.max() + step / 2)

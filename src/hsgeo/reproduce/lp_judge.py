@@ -43,7 +43,8 @@ OUTLIER_PX = 2.0
 
 def _transfer_px(truth, t_from, x_from, t_to, x_to, band) -> np.ndarray:
     """Distance (px) of the projection at ``t_to`` of the ground point seen at ``(t_from,
-    x_from)`` from ``(x_to, 0)``."""
+    x_from)`` from ``(x_to, 0)``.
+    """
     g = truth.ground_points(t_from, x_from, band)
     p = truth.camera.project(g, np.asarray(t_to, float), truth.trajectory, band)
     return np.hypot(p[:, 0] - np.asarray(x_to, float), p[:, 1])
@@ -114,7 +115,10 @@ def observation_errors_px(table, truth, square_ids=(), square_xyz_m=None) -> np.
         order = np.argsort(inv, kind="stable")
         starts = np.r_[0, np.flatnonzero(np.diff(inv[order])) + 1]
         med = np.array(
-            [np.median(g[order[a:b]], axis=0) for a, b in zip(starts, np.r_[starts[1:], tie.size])]
+            [
+                np.median(g[order[a:b]], axis=0)
+                for a, b in zip(starts, np.r_[starts[1:], tie.size], strict=True)
+            ]
         )
         P[tie] = med[inv]
     p = truth.camera.project(P, t, truth.trajectory, band)
@@ -125,7 +129,8 @@ def observation_errors_px(table, truth, square_ids=(), square_xyz_m=None) -> np.
 
 def within_fractions(err_px, limits=(1.0, 0.5)) -> dict:
     """Share of errors within each limit (px): ``{limit: share}``; ``err_px`` is ``(n,)``
-    distances or ``(n, 2)`` components (their length is taken). NaN for no errors."""
+    distances or ``(n, 2)`` components (their length is taken). NaN for no errors.
+    """
     e = np.asarray(err_px, float)
     if e.ndim == 2:
         e = np.hypot(e[:, 0], e[:, 1])

@@ -74,7 +74,8 @@ def sim_scale(scale: float) -> float:
 
 def _dx(scenes, n_cols: dict) -> tuple[float, float, float]:
     """|δx| RMS over every pixel of every scene, its max, and the RMS's standard error from the
-    spread of the scenes' RMS (px); ``n_cols``: strip id -> its columns."""
+    spread of the scenes' RMS (px); ``n_cols``: strip id -> its columns.
+    """
     cols = np.array([n_cols[str(v)] for v in scenes["strip"]], float)
     w = scenes["n_lines"].to_numpy(float) * cols
     ms = scenes["dx_rms_px"].to_numpy(float) ** 2
@@ -198,7 +199,7 @@ def _accuracy_rows(ev: dict) -> list[Row]:
 def _band_rows(res, wavelengths_nm) -> list[Row]:
     T = "observations per band"
     rows = []
-    for b, wl in enumerate(wavelengths_nm):
+    for b in range(len(wavelengths_nm)):
         c = res.counts.get(f"band{b}")
         if c is None:
             continue
@@ -222,7 +223,8 @@ def _band_rows(res, wavelengths_nm) -> list[Row]:
 def stat_sigma(cov_m2: np.ndarray, rng, n_draws: int = _N_DRAWS) -> np.ndarray:
     """σ̂ of each statistic of :data:`P002_STATS` of check-point errors drawn from their
     a-posteriori covariance ``(k, 3, 3)`` (m²): ``(3, 6)`` (E, N, H × statistic), the spread
-    over ``n_draws`` draws. The adjustment's own precision, not a spread over campaigns."""
+    over ``n_draws`` draws. The adjustment's own precision, not a spread over campaigns.
+    """
     k = cov_m2.shape[0]
     if k < 2:
         return np.full((3, len(P002_STATS)), np.nan)
@@ -357,8 +359,7 @@ def _meta(s, obs, truth, ev, lengths, T, off) -> dict:
         "mount_motion_deg": float(np.rad2deg(cfg.mount_motion_rad)),
         "unmodelled_effect": "motion blur of the line's integration along track "
         f"({cfg.motion_blur_m:.3f} m box), not in 002 eq. (2); on in every run, off in the "
-        "table's 'off' rows (the same campaign rendered again)"
-        + ("" if off else " (not run)"),
+        "table's 'off' rows (the same campaign rendered again)" + ("" if off else " (not run)"),
         "timings_s": T,
         "retrieval_timings_s": {
             k: (float(np.sum(v)) if isinstance(v, list) else float(v))

@@ -1,4 +1,4 @@
-"""One LP campaign from pixels, retrieved, adjusted and judged (``hsgeo reproduce lp-observations``).
+"""One LP campaign from pixels: retrieved, adjusted, judged (``hsgeo reproduce lp-observations``).
 
 :func:`evaluate` runs the user's pipeline on a rendered campaign
 (:func:`hsgeo.simulate.lp_campaign.simulate`): the observations are retrieved from the pixels
@@ -51,7 +51,8 @@ def camera_prior(obs, cfg) -> CameraPrior:
     """What the operator knows of the camera and the GNSS/INS (the pushbroom chapter's priors):
     the nominal c, pixel pitch and principal point, the tape-measured lever arm, the a-priori σ
     of the campaign (:class:`hsgeo.simulate.pushbroom_campaign_types.CampaignConfig`; 002 §4's
-    ½ px for the observations)."""
+    ½ px for the observations).
+    """
     c = cfg.campaign
     return CameraPrior(
         n_bands=len(obs.camera.c_mm),
@@ -70,7 +71,8 @@ def camera_prior(obs, cfg) -> CameraPrior:
 
 def retrieval_inputs(obs, squares: bool = True) -> LpInputs:
     """The retrieval's inputs from the operator's side of a campaign; without ``squares`` the
-    mean terrain height is taken from the squares' surveyed heights and no square is measured."""
+    mean terrain height is taken from the squares' surveyed heights and no square is measured.
+    """
     if squares:
         return LpInputs(
             tuple(obs.strips),
@@ -87,7 +89,8 @@ def retrieval_inputs(obs, squares: bool = True) -> LpInputs:
 
 def parameter_z(result, camera_true) -> dict:
     """Estimate, σ̂, truth and z of every reported camera parameter (:data:`REPORTED_PARAMETERS`)
-    against the true camera: ``{block: (labels, value, sigma, truth)}`` in the model's units."""
+    against the true camera: ``{block: (labels, value, sigma, truth)}`` in the model's units.
+    """
     out = {}
     for name, _, _ in REPORTED_PARAMETERS:
         t = np.asarray(getattr(camera_true, name), float).ravel()
@@ -204,11 +207,14 @@ def evaluate(obs, truth, seed: int, *, nogcp: bool = True, progress=None) -> dic
 
 def scene_length_counts(obs, lengths, seed: int, progress=None) -> dict:
     """Retrieve the tie points with scenes of each number of lines (no squares measured):
-    ``{n_lines: LpResult}`` (002 §4: 100, 200 and 300 lines)."""
+    ``{n_lines: LpResult}`` (002 §4: 100, 200 and 300 lines).
+    """
     inp = retrieval_inputs(obs, squares=False)
     out = {}
     for n in lengths:
-        out[int(n)] = retrieve(inp, LpOptions(n_lines_per_scene=int(n), rng=seed), progress=progress)
+        out[int(n)] = retrieve(
+            inp, LpOptions(n_lines_per_scene=int(n), rng=seed), progress=progress
+        )
     return out
 
 
