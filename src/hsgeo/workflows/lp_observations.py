@@ -277,6 +277,28 @@ def _check(inputs: LpInputs, options: LpOptions) -> tuple[tuple, float]:
     return bands, float(h)
 
 
+def _check_overlap(inputs: LpInputs, options: LpOptions, height: float) -> None:
+    """Some two strips' footprints overlap (before any work; scenes are checked again)."""
+    from hsgeo.workflows._lp_geometry import convex_overlap, footprint
+
+    h_px = (inputs.n_px_full - 1) / 2
+    fps = []
+    for s in inputs.strips:
+        x = (s.col0 - h_px, s.col0 + s.lines.shape[1] - 1 - h_px)
+        t = (float(s.t_s[0]), float(s.t_s[-1]))
+        fps.append(footprint(inputs.camera, x, t, inputs.navigation, height))
+    m = options.overlap_margin_m
+    if not any(
+        convex_overlap(fps[i], fps[j], m) for i in range(len(fps)) for j in range(i + 1, len(fps))
+    ):
+        raise InputError(
+            f"no two strips overlap on the ground (footprints from the navigation and the "
+            f"camera on the plane at {height:.6g} m): give overlapping strips, the navigation "
+            "of these lines (the same time scale), and the terrain height (--height) or the "
+            "squares (--squares)"
+        )
+
+
 def retrieve(inputs: LpInputs, options: LpOptions = LpOptions(), progress=None) -> LpResult:
     """Observations of tie points (and reference squares) from LP strips (module docstring).
 
@@ -301,6 +323,7 @@ def retrieve(inputs: LpInputs, options: LpOptions = LpOptions(), progress=None) 
         seen in enough lines and strips.
     """
     bands, height = _check(inputs, options)
+    _check_overlap(inputs, options, height)
     timings = {k: 0.0 for k in ("scenes", "detection", "matching", "ransac", "squares")}
     timings["ransac_per_strip"] = []
     keys = Keys()
@@ -379,7 +402,6 @@ def _table(inputs, options, keys, point, square_rows):
             "y_px": np.zeros(obs.size),
             "strip": ids[keys.strip[obs]],
             "line": keys.line[obs],
-            "size_px": keys.size[obs],
         }
     )
     sq = pd.DataFrame(
