@@ -331,7 +331,7 @@ P002 = {
     "n_unknowns": 342407,  # 002 §4: "A total of 342407 unknowns"
     "n_observations_2d": 441587,  # 002 §4: "441 587 2D observations"
     # 002 §4: observation retrieval from LP image scenes (§3.1)
-    "scene_lines": 200,  # 002 §4: "LP image scenes were created from sequences of 200 LP image lines"
+    "scene_lines": 200,  # 002 §4: "created from sequences of 200 LP image lines"
     "dx_rms_px": 0.91,  # 002 §4: "|δx| with root mean square (RMS) of 0.91 pixels"
     "dx_max_px": 4.43,  # 002 §4: "and a maximum of 4.43 pixels"
     "observations_by_scene_lines": {  # 002 §4: 2D observations from scenes of 100/200/300 lines
