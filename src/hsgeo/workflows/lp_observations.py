@@ -12,6 +12,10 @@ The user's pipeline, truth-free (002 §3.1 steps 2–3, and the reference square
 3. **Candidate pairs**: scenes of different strips whose footprints (the four corner rays on
    that plane) overlap; in each pair and band only the key points predicted inside the other
    scene's footprint (with ``overlap_margin_m``) are matched (Hamming, cross-check and ratio).
+   This search region and the strict ratio leave few gross errors for RANSAC (on the rendered
+   campaign 0.0–0.5 % of the matches were more than 1 m apart on the ground before RANSAC);
+   ``overlap_margin_m=np.inf`` and ``ratio=0.8`` match as an unguided pipeline would, for a
+   harder test of the two RANSAC models.
 4. **RANSAC** on each pair's matches, with 002's LP fundamental matrix (Gupta & Hartley 1997,
    ≥ 11 correspondences; :mod:`hsgeo.measure.lp_ransac`) or, for comparison, the frame
    camera's (``cv2.findFundamentalMat``); both are run on the same matches and kept as
