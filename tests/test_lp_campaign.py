@@ -8,7 +8,7 @@ import pytest
 from hsgeo.errors import InputError
 from hsgeo.geocode import intersect
 from hsgeo.simulate import lp_campaign as L
-from hsgeo.simulate._lp_ground import render_rays
+from hsgeo.simulate._lp_render import render_rays
 
 SCALE = 0.1
 
@@ -86,6 +86,29 @@ def test_rays_meet_the_dsm_where_geocode_does(campaign):
     assert np.max(np.abs(ref[:, :2] - en[flat])) < 1e-4
 
 
+def test_ground_points_project_back_onto_their_pixels(campaign):
+    obs, truth = campaign
+    s = obs.strips[-1]
+    rng = np.random.default_rng(2)
+    li = rng.integers(0, s.n_lines, 200)
+    x = s.x_px(obs.n_px_full)[0] + rng.uniform(0, s.n_cols - 1, 200)
+    band = rng.integers(0, 7, 200)
+    P = truth.ground_points(s.t_s[li], x, band)
+    xy = truth.camera.project(P, s.t_s[li], truth.trajectory, band=band)
+    assert np.max(np.abs(xy[:, 0] - x)) < 1e-6 and np.max(np.abs(xy[:, 1])) < 1e-6
+
+
+def test_bad_config():
+    from dataclasses import replace
+
+    with pytest.raises(InputError, match="ground_cell_m"):
+        L.simulate(0.05, cfg=replace(L.LpConfig(), ground_cell_m=0.0))
+    with pytest.raises(InputError, match="psf_sigma_m"):
+        L.simulate(0.05, cfg=replace(L.LpConfig(), psf_sigma_m=-1.0))
+    with pytest.raises(InputError, match="rng"):
+        L.simulate(0.05, rng=-1)
+
+
 def test_campaign_structure(campaign):
     obs, truth = campaign
     c = truth.cfg.campaign
@@ -138,7 +161,7 @@ def test_same_seed_same_bytes():
     assert a.strips[0].lines.tobytes() != c.strips[0].lines.tobytes()
 
 
-@pytest.mark.parametrize("scale", [0, -1, 1.5, float("nan"), "big"])
+@pytest.mark.parametrize("scale", [0, 0.01, -1, 1.5, float("nan"), "big"])
 def test_bad_scale(scale):
     with pytest.raises(InputError, match="scale"):
         L.simulate(scale=scale)

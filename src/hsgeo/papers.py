@@ -330,6 +330,21 @@ P002 = {
     "chromatic_shift_px": 0.27,  # 002 §5: "maximum absolute shift ≤ 0.27 pixels"
     "n_unknowns": 342407,  # 002 §4: "A total of 342407 unknowns"
     "n_observations_2d": 441587,  # 002 §4: "441 587 2D observations"
+    # 002 §4: observation retrieval from LP image scenes (§3.1)
+    "scene_lines": 200,  # 002 §4: "created from sequences of 200 LP image lines"
+    "dx_rms_px": 0.91,  # 002 §4: "|δx| with root mean square (RMS) of 0.91 pixels"
+    "dx_max_px": 4.43,  # 002 §4: "and a maximum of 4.43 pixels"
+    "observations_by_scene_lines": {  # 002 §4: 2D observations from scenes of 100/200/300 lines
+        100: 352431,  # 002 §4: "100 and 300 LP image lines ... 352 431 and 385 166"
+        200: 441587,  # 002 §4: "441 587 2D observations"
+        300: 385166,
+    },
+    "min_ransac_correspondences": 11,  # 002 §3.1: "at least 11 key-point correspondences"
+    "n_tie_points": 113758,  # 002 §4: "113758 used tie points"
+    "gsd_m": (0.3, 0.4),  # 002 §4: "ground sampling distances of 0.3 and 0.4 m"
+    # 002 Fig. 9: orthomosaic of the 1875 m AGL acquisition at 30 cm on a 20 cm DSM (§5.1)
+    "fig9_pixel_m": 0.3,  # 002 Fig. 9 caption: "with a pixel size of 30 cm"
+    "fig9_dsm_m": 0.2,  # 002 §5.1: "created using a 20 cm digital surface model"
 }
 
 __all__ += ["P002_STATS", "P002"]

@@ -11,6 +11,8 @@ One module per format:
 * :mod:`hsgeo.io.navigation` — the one navigation file of every command (GNSS/INS
   trajectory, :class:`~hsgeo.trajectory.Trajectory`);
 * :mod:`hsgeo.io.lines` — recorded flight lines (NetCDF);
+* :mod:`hsgeo.io.lp_lines` — the LP image lines of one strip (:class:`LpStrip`, NetCDF-4) of
+  ``hsgeo lp-observations``;
 * :mod:`hsgeo.io.raster` — orthoimages (NetCDF and ENVI) and DEMs (NetCDF);
 * :mod:`hsgeo.io.envi` — ENVI BSQ/BIL/BIP + ``.hdr``, also written in blocks of lines;
 * :mod:`hsgeo.io.frames` — folders of raw ImSpector frames (16-bit TIFF or ``.npy``) with their
@@ -31,6 +33,7 @@ from hsgeo.io.boards import Board, read_board
 from hsgeo.io.config import Key, read_config, read_toml
 from hsgeo.io.envi import read_envi, write_envi
 from hsgeo.io.lines import read_lines, write_lines
+from hsgeo.io.lp_lines import LpStrip, read_lp_lines, write_lp_lines
 from hsgeo.io.navigation import NAV_COLUMNS, read_trajectory, write_trajectory
 from hsgeo.io.nist_strd import read_nist_strd
 from hsgeo.io.opencv import read_opencv_storage
@@ -47,6 +50,9 @@ from hsgeo.io.tables import read_table, write_csv_array, write_csv_lines
 
 __all__ = [
     "atomic_path",
+    "LpStrip",
+    "read_lp_lines",
+    "write_lp_lines",
     "refuse_inputs",
     "read_table",
     "write_csv_array",

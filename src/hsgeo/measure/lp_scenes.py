@@ -133,7 +133,10 @@ def rotation_compensation_px(x_px, t_lines_s, t_ref_s, trajectory, camera, band=
     x_mm = np.column_stack([x * camera.pixel_mm - camera.x0_mm, np.zeros(x.size)])
     if any(camera.distortion):
         x_mm = undistort_pushbroom_line(x_mm, camera.distortion)
-    c = float(camera._band_c(band, 1)[0])
+    c_all = np.atleast_1d(np.asarray(camera.c_mm, dtype=np.float64))
+    if int(band) != band or not 0 <= band < c_all.size:
+        raise InputError(f"band {band!r} not in the camera's bands 0…{c_all.size - 1}")
+    c = float(c_all[int(band)])
     v = np.column_stack([x_mm[:, 0], np.zeros(x.size), np.full(x.size, c)])  # (n_x, 3)
     R_ref = _R_map_from_camera(trajectory, camera, np.array([float(t_ref_s)]))[0]
     R_e = _R_map_from_camera(trajectory, camera, t)  # (n_lines, 3, 3)

@@ -27,6 +27,7 @@ CHAPTERS: dict[str, str] = {
     "geocoding": "geocoding",
     "rikola": "rikola",
     "pushbroom-ba": "pushbroom_ba",
+    "lp-observations": "lp_observations",
     "mtf": "mtf",
     "cube": "cube",
     "asf": "asf",

@@ -48,7 +48,16 @@ __all__ = [
 ]
 
 #: The chapters whose tables hold claims of the papers.
-PAPER_CHAPTERS = ("line-calibration", "geocoding", "pushbroom-ba", "rikola", "mtf", "cube", "asf")
+PAPER_CHAPTERS = (
+    "line-calibration",
+    "geocoding",
+    "pushbroom-ba",
+    "lp-observations",
+    "rikola",
+    "mtf",
+    "cube",
+    "asf",
+)
 
 #: The papers as the scoreboard names them (../shared/papers/README.md).
 PAPERS = {
@@ -68,6 +77,7 @@ CHAPTER_DOCS = {
     "line-calibration": "chapters/line_calibration",
     "geocoding": "chapters/geocoding",
     "pushbroom-ba": "chapters/pushbroom_ba",
+    "lp-observations": "chapters/lp_observations",
     "rikola": "chapters/rikola",
     "mtf": "chapters/mtf",
     "cube": "chapters/cube",

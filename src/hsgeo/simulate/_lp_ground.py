@@ -17,16 +17,14 @@ The reflectance of each material in each band is :data:`SPECTRA` (ours, typical 
 vegetation dark in the visible and bright above the red edge at ~750 nm, 002 §5.3), at the
 campaign's seven wavelengths; other wavelengths interpolate it.
 
-The point-spread function is a Gaussian blur of the raster (``psf_sigma_m``), applied once per
-band; a ray samples the blurred raster bilinearly where it meets the DSM.
+The point-spread function is a Gaussian blur of the raster (``psf_sigma_m``) and, for the
+motion blur of a line's integration (``motion_blur_m``: the ground the platform passes while the
+line integrates, 002 §4 names it among the unmodelled effects), a box along north — every strip
+flies north or south, so one raster serves all; the exposure's time stamp is its middle, so
+the box is centred and moves no centroid. Both are applied once per band; a ray samples the
+blurred raster bilinearly where it meets the DSM.
 
-The intersection (:func:`render_rays`) is our own compiled kernel rather than
-:func:`hsgeo.geocode.intersect`: the latter's fixed-point iteration on the height diverges where
-a building's wall is steeper than the ray's cotangent (slope × tan(view angle) > 1 near the
-swath's edge), and evaluates scipy's interpolator on every ray each iteration. Ours marches
-down the ray from the DSM's highest point in steps of at most half a DSM cell horizontally and
-``0.5 m`` vertically, then bisects the first crossing to 1e-6 m: robust on walls, with the same
-bilinear DSM as :class:`hsgeo.geocode.DemTerrain` (checked against it in the tests).
+The rendering (the ray–DSM intersection and the sampling) is :mod:`hsgeo.simulate._lp_render`.
 """
 
 from __future__ import annotations
@@ -36,15 +34,9 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit, prange
 
-__all__ = [
-    "Ground",
-    "MATERIALS",
-    "SPECTRA",
-    "make_ground",
-    "render_rays",
-    "render_lines",
-    "dsm_height",
-]
+from hsgeo.simulate._lp_render import Ground, _bilinear, dsm_height
+
+__all__ = ["Ground", "MATERIALS", "SPECTRA", "make_ground"]
 
 #: Materials of the ground, by index of the material raster.
 MATERIALS = ("grass", "crop", "soil", "stubble", "tree", "asphalt", "roof", "white")
@@ -70,200 +62,7 @@ _TEXTURE = np.array([0.10, 0.14, 0.18, 0.16, 0.25, 0.06, 0.08, 0.0])
 _ROWS = np.array([0.04, 0.30, 0.12, 0.22])
 
 
-@dataclass(frozen=True)
-class Ground:
-    """The rasterised ground.
-
-    Attributes
-    ----------
-    e0_m, n0_m : float
-        Map E, N of the centre of raster cell (0, 0) (rows increase northward).
-    cell_m : float
-        Cell size of the reflectance raster.
-    reflectance : (n_bands, n_rows, n_cols) float32
-        Blurred reflectance per band.
-    material : (n_rows, n_cols) uint8
-        Index into :data:`MATERIALS` (for figures).
-    dsm : (n_rows_dsm, n_cols_dsm) float64
-        Surface heights (m) on a grid of ``dsm_cell_m`` starting at ``(e0_m, n0_m)``.
-    dsm_cell_m : float
-    """
-
-    e0_m: float
-    n0_m: float
-    cell_m: float
-    reflectance: np.ndarray
-    material: np.ndarray
-    dsm: np.ndarray
-    dsm_cell_m: float
-
-    def dsm_dataarray(self):
-        """The DSM as an ``xarray.DataArray`` with coordinates ``N``, ``E`` (m)."""
-        import xarray as xr
-
-        n, m = self.dsm.shape
-        return xr.DataArray(
-            self.dsm,
-            dims=("N", "E"),
-            coords={
-                "N": self.n0_m + self.dsm_cell_m * np.arange(n),
-                "E": self.e0_m + self.dsm_cell_m * np.arange(m),
-            },
-            name="height_m",
-        )
-
-
 # ------------------------------------------------------------------------------ compiled cores
-@njit(cache=True, inline="always")
-def _bilinear(a, u, v):  # pragma: no cover - compiled
-    """Bilinear value of ``a[row, col]`` at fractional (row ``v``, col ``u``), clamped."""
-    nr, nc = a.shape
-    if u < 0.0:
-        u = 0.0
-    if v < 0.0:
-        v = 0.0
-    if u > nc - 1.000001:
-        u = nc - 1.000001
-    if v > nr - 1.000001:
-        v = nr - 1.000001
-    j = int(u)
-    i = int(v)
-    fu = u - j
-    fv = v - i
-    return (1.0 - fv) * ((1.0 - fu) * a[i, j] + fu * a[i, j + 1]) + fv * (
-        (1.0 - fu) * a[i + 1, j] + fu * a[i + 1, j + 1]
-    )
-
-
-@njit(cache=True)
-def _hit(ox, oy, oz, dx, dy, dz, dsm, e0, n0, dcell, hmax, hmin, bcell, hmid):  # pragma: no cover
-    """Ray parameter ``s`` of the first crossing of ``O + s D`` with the bilinear DSM.
-
-    The local height bounds ``hmax``/``hmin`` (per block of ``bcell`` m, dilated by one block)
-    bracket the crossing; the ray is marched down from the upper bound in steps of at most
-    half a DSM cell horizontally and 0.5 m vertically, and the first sign change is refined by
-    the Illinois variant of regula falsi to 1e-7 m.
-    """
-    # the block under the ray where it passes the DSM's mean level (its horizontal travel over
-    # the whole height range is far below a block: tan(view angle) · range ≲ 2 m)
-    nb_r, nb_c = hmax.shape
-    s_mid = (hmid - oz) / dz
-    bj = int((ox + s_mid * dx - e0) / bcell)
-    bi = int((oy + s_mid * dy - n0) / bcell)
-    bj = min(max(bj, 0), nb_c - 1)
-    bi = min(max(bi, 0), nb_r - 1)
-    s_top = (hmax[bi, bj] + 0.01 - oz) / dz
-    s_bot = (hmin[bi, bj] - 0.01 - oz) / dz
-    horiz = np.sqrt(dx * dx + dy * dy) * (s_bot - s_top)
-    vert = (s_bot - s_top) * (-dz)
-    n_steps = int(max(horiz / (0.5 * dcell), vert / 0.5)) + 1
-    ds = (s_bot - s_top) / n_steps
-    a = s_top
-    fa = oz + a * dz - _bilinear(dsm, (ox + a * dx - e0) / dcell, (oy + a * dy - n0) / dcell)
-    b = s_bot
-    fb = -1.0
-    for _ in range(n_steps):
-        s = a + ds
-        f = oz + s * dz - _bilinear(dsm, (ox + s * dx - e0) / dcell, (oy + s * dy - n0) / dcell)
-        if f <= 0.0:
-            b = s
-            fb = f
-            break
-        a = s
-        fa = f
-    side = 0
-    for _ in range(60):  # Illinois regula falsi on the bracket [a, b]
-        if fa - fb == 0.0 or (b - a) * (-dz) < 1e-7:
-            break
-        s = (a * fb - b * fa) / (fb - fa)
-        f = oz + s * dz - _bilinear(dsm, (ox + s * dx - e0) / dcell, (oy + s * dy - n0) / dcell)
-        if abs(f) < 1e-7:
-            return s
-        if f > 0.0:
-            a = s
-            fa = f
-            if side == 1:
-                fb *= 0.5
-            side = 1
-        else:
-            b = s
-            fb = f
-            if side == -1:
-                fa *= 0.5
-            side = -1
-    return 0.5 * (a + b)
-
-
-@njit(cache=True, parallel=True)
-def _render_kernel(
-    O, D, dsm, e0, n0, dcell, hmax, hmin, bcell, hmid, refl, gcell, out_en, out_v
-):  # pragma: no cover
-    for k in prange(O.shape[0]):
-        s = _hit(
-            O[k, 0],
-            O[k, 1],
-            O[k, 2],
-            D[k, 0],
-            D[k, 1],
-            D[k, 2],
-            dsm,
-            e0,
-            n0,
-            dcell,
-            hmax,
-            hmin,
-            bcell,
-            hmid,
-        )
-        E = O[k, 0] + s * D[k, 0]
-        N = O[k, 1] + s * D[k, 1]
-        out_en[k, 0] = E
-        out_en[k, 1] = N
-        if refl.shape[0] > 0:
-            out_v[k] = _bilinear(refl, (E - e0) / gcell, (N - n0) / gcell)
-
-
-@njit(cache=True, parallel=True)
-def _render_lines_kernel(
-    R, O, d_plat, dsm, e0, n0, dcell, hmax, hmin, bcell, hmid, refl, gcell, out
-):  # pragma: no cover
-    """``out[l, c]``: reflectance where the ray of column ``c`` of line ``l`` meets the DSM,
-    the ray being ``O[l] + s R[l] d_plat[c]``.
-    """
-    nl = R.shape[0]
-    nc = d_plat.shape[0]
-    for li in prange(nl):
-        for c in range(nc):
-            dx = (
-                R[li, 0, 0] * d_plat[c, 0] + R[li, 0, 1] * d_plat[c, 1] + R[li, 0, 2] * d_plat[c, 2]
-            )
-            dy = (
-                R[li, 1, 0] * d_plat[c, 0] + R[li, 1, 1] * d_plat[c, 1] + R[li, 1, 2] * d_plat[c, 2]
-            )
-            dz = (
-                R[li, 2, 0] * d_plat[c, 0] + R[li, 2, 1] * d_plat[c, 1] + R[li, 2, 2] * d_plat[c, 2]
-            )
-            s = _hit(
-                O[li, 0],
-                O[li, 1],
-                O[li, 2],
-                dx,
-                dy,
-                dz,
-                dsm,
-                e0,
-                n0,
-                dcell,
-                hmax,
-                hmin,
-                bcell,
-                hmid,
-            )
-            E = O[li, 0] + s * dx
-            N = O[li, 1] + s * dy
-            out[li, c] = _bilinear(refl, (E - e0) / gcell, (N - n0) / gcell)
-
-
 @njit(cache=True)
 def _voronoi(nr, nc, cell, e0, n0, seeds, spacing):  # pragma: no cover - compiled
     """Index of the nearest jittered-grid seed (``seeds[a, b] = (E, N)``) of every cell."""
@@ -294,117 +93,6 @@ def _upsample_add(out, coarse, step, weight):  # pragma: no cover - compiled
     for i in prange(nr):
         for j in range(nc):
             out[i, j] += weight * _bilinear(coarse, j * step, i * step)
-
-
-# ------------------------------------------------------------------------------ the numpy faces
-def render_rays(origins_m, directions, ground: Ground, band: int | None = None):
-    """Where rays meet the DSM, and the blurred reflectance of ``band`` there.
-
-    Parameters
-    ----------
-    origins_m, directions : (n, 3) ndarray
-        Ray origins (E, N, U, m) and directions (map frame, pointing down).
-    ground : Ground
-    band : int, optional
-        Band of :attr:`Ground.reflectance` to sample (None: intersection only).
-
-    Returns
-    -------
-    en_m : (n, 2) ndarray
-        Ground E, N of each ray.
-    value : (n,) ndarray or None
-        The reflectance there.
-    """
-    O = np.ascontiguousarray(origins_m, dtype=np.float64)
-    D = np.ascontiguousarray(directions, dtype=np.float64)
-    refl = ground.reflectance[band] if band is not None else np.zeros((0, 0), np.float32)
-    en = np.empty((O.shape[0], 2))
-    val = np.empty(O.shape[0])
-    _render_kernel(
-        O,
-        D,
-        ground.dsm,
-        ground.e0_m,
-        ground.n0_m,
-        ground.dsm_cell_m,
-        *_bounds(ground),
-        refl,
-        ground.cell_m,
-        en,
-        val,
-    )
-    return en, (val if band is not None else None)
-
-
-#: DSM cells per block of the local height bounds of :func:`_bounds`.
-BLOCK_CELLS = 16
-
-
-def _bounds(ground: Ground):
-    """Local height bounds for the intersection: ``(hmax, hmin, block_m)``, the max and min of
-    the DSM over blocks of :data:`BLOCK_CELLS` cells, each dilated by one block (cached).
-    """
-    cached = getattr(ground, "_bounds_cache", None)
-    if cached is not None:
-        return cached
-    from scipy.ndimage import maximum_filter, minimum_filter
-
-    B = BLOCK_CELLS
-    z = ground.dsm
-    nr, nc = -(-z.shape[0] // B) * B, -(-z.shape[1] // B) * B
-    zp = np.pad(z, ((0, nr - z.shape[0]), (0, nc - z.shape[1])), mode="edge")
-    blocks = zp.reshape(nr // B, B, nc // B, B)
-    hmax = maximum_filter(blocks.max(axis=(1, 3)), size=3, mode="nearest")
-    hmin = minimum_filter(blocks.min(axis=(1, 3)), size=3, mode="nearest")
-    out = (
-        np.ascontiguousarray(hmax),
-        np.ascontiguousarray(hmin),
-        B * ground.dsm_cell_m,
-        float(0.5 * (z.max() + z.min())),
-    )
-    object.__setattr__(ground, "_bounds_cache", out)
-    return out
-
-
-def render_lines(
-    R_map_from_platform, origins_m, d_platform, ground: Ground, band: int
-) -> np.ndarray:
-    """Reflectance of ``band`` seen by each column of each line: ``(n_lines, n_cols)`` float32.
-
-    The ray of column ``c`` of line ``l`` is ``origins_m[l] + s R[l] d_platform[c]`` (the
-    factored form of :meth:`hsgeo.sensors.pushbroom.PushbroomCamera.rays_at`).
-    """
-    R = np.ascontiguousarray(R_map_from_platform, dtype=np.float64)
-    O = np.ascontiguousarray(origins_m, dtype=np.float64)
-    d = np.ascontiguousarray(d_platform, dtype=np.float64)
-    out = np.empty((R.shape[0], d.shape[0]), np.float32)
-    _render_lines_kernel(
-        R,
-        O,
-        d,
-        ground.dsm,
-        ground.e0_m,
-        ground.n0_m,
-        ground.dsm_cell_m,
-        *_bounds(ground),
-        ground.reflectance[band],
-        ground.cell_m,
-        out,
-    )
-    return out
-
-
-def dsm_height(ground: Ground, e_m, n_m) -> np.ndarray:
-    """Bilinear DSM height (m) at map E, N (as :class:`~hsgeo.geocode.DemTerrain`)."""
-    u = (np.asarray(e_m, float) - ground.e0_m) / ground.dsm_cell_m
-    v = (np.asarray(n_m, float) - ground.n0_m) / ground.dsm_cell_m
-    j = np.clip(np.floor(u).astype(int), 0, ground.dsm.shape[1] - 2)
-    i = np.clip(np.floor(v).astype(int), 0, ground.dsm.shape[0] - 2)
-    fu, fv = u - j, v - i
-    a = ground.dsm
-    return (1 - fv) * ((1 - fu) * a[i, j] + fu * a[i, j + 1]) + fv * (
-        (1 - fu) * a[i + 1, j] + fu * a[i + 1, j + 1]
-    )
 
 
 def _spectra(wavelengths_nm) -> np.ndarray:
@@ -466,6 +154,163 @@ def _square_coverage(E, N, cell, centre, side):
     return overlap(N, centre[1])[:, None] * overlap(E, centre[0])[None, :]
 
 
+@dataclass
+class _Raster:
+    """The raster being drawn: cell centres, material and brightness (mutable while drawing)."""
+
+    E: np.ndarray
+    N: np.ndarray
+    cell: float
+    material: np.ndarray
+    bright: np.ndarray
+
+    @property
+    def shape(self):
+        return self.material.shape
+
+    def cells(self, fn, bbox):
+        """``(slices, mask)`` of the cells of ``bbox`` where ``fn(E, N)``, or None."""
+        return _cells_within(self.E, self.N, fn, bbox, self.cell, self.E[0], self.N[0], self.shape)
+
+    def paint(self, fn, bbox, material, bright):
+        hit = self.cells(fn, bbox)
+        if hit is not None:
+            sl, m = hit
+            self.material[sl][m] = material
+            self.bright[sl][m] = bright if np.ndim(bright) == 0 else bright[m]
+
+
+def _field_raster(cfg, ext, rng) -> _Raster:
+    """Fields (material, brightness, row pattern) over ``[-ext, ext]²``."""
+    cell = cfg.ground_cell_m
+    n = int(np.ceil(2 * ext / cell)) + 1
+    E = -ext + cell * np.arange(n)
+    N = -ext + cell * np.arange(n)
+    idx, fmat, fbright, ftheta, fper = _fields(cfg, (n, n), -ext, -ext, rng)
+    material = fmat[idx]
+    bright = fbright[idx].astype(np.float32)
+    for i0 in range(0, n, 512):  # rows in blocks: the row pattern's temporaries stay small
+        rs = slice(i0, min(i0 + 512, n))
+        k = idx[rs]
+        phase = (E[None, :] * np.cos(ftheta[k]) + N[rs, None] * np.sin(ftheta[k])) / fper[k]
+        bright[rs] *= (1 + _ROWS[fmat[k]] * np.sin(2 * np.pi * phase)).astype(np.float32)
+    return _Raster(E, N, cell, material, bright)
+
+
+def _trees_and_roads(cfg, r: _Raster, ext, rng) -> None:
+    """Tree crowns (discs) and straight roads, painted on the raster."""
+    area_km2 = (2 * ext) ** 2 / 1e6
+    n_trees = rng.poisson(cfg.trees_per_km2 * area_km2)
+    for (te, tn), rad, b in zip(
+        rng.uniform(-ext, ext, (n_trees, 2)),
+        rng.uniform(1.5, 4.0, n_trees),
+        rng.uniform(0.8, 1.2, n_trees),
+        strict=True,
+    ):
+        r.paint(
+            lambda e, nn, te=te, tn=tn, rad=rad: (e - te) ** 2 + (nn - tn) ** 2 < rad * rad,
+            (te - rad, te + rad, tn - rad, tn + rad),
+            MATERIALS.index("tree"),
+            b,
+        )
+    n_roads = max(1, rng.poisson(cfg.roads_per_km * 2 * ext / 1e3))
+    for _ in range(n_roads):
+        p = rng.uniform(-ext / 2, ext / 2, 2)
+        a = rng.uniform(0, np.pi)
+        w = rng.uniform(4.0, 8.0)
+        ca, sa = np.cos(a), np.sin(a)
+        r.paint(
+            lambda e, nn, p=p, ca=ca, sa=sa, w=w: (
+                np.abs(-(e - p[0]) * sa + (nn - p[1]) * ca) < w / 2
+            ),
+            (-ext, ext, -ext, ext),
+            MATERIALS.index("asphalt"),
+            1.0,
+        )
+
+
+def _buildings(cfg, r: _Raster, dsm, ext, squares_en, rng) -> None:
+    """Buildings: rotated rectangles with a two-tone gabled roof, raised on the DSM."""
+    dcell = cfg.dsm_cell_m
+    De = -ext + dcell * np.arange(dsm.shape[1])
+    Dn = -ext + dcell * np.arange(dsm.shape[0])
+    n_bld = rng.poisson(cfg.buildings_per_km2 * (2 * ext) ** 2 / 1e6)
+    for _ in range(n_bld):
+        c = rng.uniform(-ext, ext, 2)
+        L, W = rng.uniform(8, 25), rng.uniform(6, 14)
+        a = rng.uniform(0, np.pi)
+        h = rng.uniform(*cfg.building_height_m)
+        tone = rng.uniform(0.7, 1.3)
+        if len(squares_en) and np.min(np.hypot(*(squares_en - c).T)) < 30:
+            continue  # the squares lie on open grass
+        ca, sa = np.cos(a), np.sin(a)
+        half_diag = np.hypot(L, W) / 2
+        bbox = (c[0] - half_diag, c[0] + half_diag, c[1] - half_diag, c[1] + half_diag)
+
+        def local(e, nn, c=c, ca=ca, sa=sa):
+            return (e - c[0]) * ca + (nn - c[1]) * sa, -(e - c[0]) * sa + (nn - c[1]) * ca
+
+        def inside(e, nn, L=L, W=W, local=local):
+            x, y = local(e, nn)
+            return (np.abs(x) < L / 2) & (np.abs(y) < W / 2)
+
+        hit = r.cells(inside, bbox)
+        if hit is not None:
+            sl, m = hit
+            y = local(r.E[sl[1]][None, :], r.N[sl[0]][:, None])[1]
+            r.material[sl][m] = MATERIALS.index("roof")
+            r.bright[sl][m] = (tone * np.where(y > 0, 1.0, 0.6))[m]
+        hit = _cells_within(De, Dn, inside, bbox, dcell, -ext, -ext, dsm.shape)
+        if hit is not None:
+            sl, m = hit
+            dsm[sl][m] += h
+
+
+def _box_weights(width_cells: float) -> np.ndarray:
+    """Weights of a centred box ``width_cells`` wide on a grid of unit cells (each the overlap
+    of its cell with the box), summing to one.
+    """
+    k = int(np.ceil(width_cells / 2 + 0.5))
+    x = np.arange(-k, k + 1)
+    w = np.clip(
+        np.minimum(x + 0.5, width_cells / 2) - np.maximum(x - 0.5, -width_cells / 2), 0, None
+    )
+    return w / w.sum()
+
+
+def _reflectance(cfg, r: _Raster, squares_en, wavelengths_nm, rng) -> np.ndarray:
+    """Blurred reflectance per band, ``(n_bands, n, n)`` float32: material spectra × brightness
+    × (1 + texture), the white squares mixed in by their exact coverage, then the PSF.
+    """
+    from scipy.ndimage import convolve1d, gaussian_filter
+
+    box = _box_weights(cfg.motion_blur_m / r.cell) if cfg.motion_blur_m > 0 else None
+    tex = _texture(r.shape, r.cell, rng)
+    spectra = _spectra(wavelengths_nm)
+    mod = np.clip(r.bright * (1 + _TEXTURE[r.material] * tex), 0.05, 3.0)
+    del tex
+    cov = np.zeros(r.shape, np.float32)
+    s = cfg.square_side_m
+    for c in squares_en:
+        hit = r.cells(
+            lambda e, nn: np.ones(np.broadcast(e, nn).shape, bool),
+            (c[0] - s, c[0] + s, c[1] - s, c[1] + s),
+        )
+        if hit is not None:
+            sl, _ = hit
+            cov[sl] = np.maximum(cov[sl], _square_coverage(r.E[sl[1]], r.N[sl[0]], r.cell, c, s))
+    white = spectra[MATERIALS.index("white")]
+    refl = np.empty((spectra.shape[1],) + r.shape, np.float32)
+    for b in range(refl.shape[0]):
+        r_b = spectra[:, b].astype(np.float32)[r.material] * mod
+        r_b = (1 - cov) * r_b + cov * np.float32(white[b])
+        r_b = gaussian_filter(r_b, cfg.psf_sigma_m / r.cell, mode="nearest")
+        if box is not None:
+            r_b = convolve1d(r_b, box, axis=0, mode="nearest")
+        refl[b] = r_b
+    return refl
+
+
 def make_ground(cfg, half_m: float, squares_en_m, wavelengths_nm, rng) -> tuple[Ground, np.ndarray]:
     """Draw and rasterise the ground over ``[-half_m, half_m]²`` (plus ``cfg.ground_margin_m``).
 
@@ -487,140 +332,23 @@ def make_ground(cfg, half_m: float, squares_en_m, wavelengths_nm, rng) -> tuple[
     squares_h_m : (k,) ndarray
         DSM height at each square's centre (flat grass there).
     """
-    from scipy.ndimage import gaussian_filter
-
-    cell, dcell = cfg.ground_cell_m, cfg.dsm_cell_m
     ext = half_m + cfg.ground_margin_m
-    e0 = n0 = -ext
-    n = int(np.ceil(2 * ext / cell)) + 1
-    shape = (n, n)
-    E = e0 + cell * np.arange(n)
-    N = n0 + cell * np.arange(n)
-    area_km2 = (2 * ext) ** 2 / 1e6
     sq = np.asarray(squares_en_m, dtype=float).reshape(-1, 2)
-
-    # fields: material, brightness and row pattern
-    idx, fmat, fbright, ftheta, fper = _fields(cfg, shape, e0, n0, rng)
-    material = fmat[idx]
-    bright = fbright[idx].astype(np.float32)
-    for i0 in range(0, n, 512):  # rows in blocks: the row pattern's temporaries stay small
-        rs = slice(i0, min(i0 + 512, n))
-        k = idx[rs]
-        phase = (E[None, :] * np.cos(ftheta[k]) + N[rs, None] * np.sin(ftheta[k])) / fper[k]
-        bright[rs] *= (1 + _ROWS[fmat[k]] * np.sin(2 * np.pi * phase)).astype(np.float32)
-    del idx
-    # trees: discs of crowns
-    n_trees = rng.poisson(cfg.trees_per_km2 * area_km2)
-    for (te, tn), r, b in zip(
-        rng.uniform(-ext, ext, (n_trees, 2)),
-        rng.uniform(1.5, 4.0, n_trees),
-        rng.uniform(0.8, 1.2, n_trees),
-        strict=True,
-    ):
-        hit = _cells_within(
-            E,
-            N,
-            lambda e, nn, te=te, tn=tn, r=r: (e - te) ** 2 + (nn - tn) ** 2 < r * r,
-            (te - r, te + r, tn - r, tn + r),
-            cell,
-            e0,
-            n0,
-            shape,
-        )
-        if hit is not None:
-            sl, m = hit
-            material[sl][m] = 4
-            bright[sl][m] = b
-    # roads: straight lines across the block
-    n_roads = max(1, rng.poisson(cfg.roads_per_km * 2 * ext / 1e3))
-    for _ in range(n_roads):
-        p = rng.uniform(-ext / 2, ext / 2, 2)
-        a = rng.uniform(0, np.pi)
-        w = rng.uniform(4.0, 8.0)
-        ca, sa = np.cos(a), np.sin(a)
-        for i0 in range(0, n, 512):
-            rs = slice(i0, min(i0 + 512, n))
-            d = np.abs(-(E[None, :] - p[0]) * sa + (N[rs, None] - p[1]) * ca)
-            m = d < w / 2
-            material[rs][m] = 5
-            bright[rs][m] = 1.0
-    # buildings: rotated rectangles with a gabled roof (two tones), on the DSM
-    nd = int(np.ceil(2 * ext / dcell)) + 1
-    De = e0 + dcell * np.arange(nd)
-    Dn = n0 + dcell * np.arange(nd)
-    dsm = _terrain(cfg, De, Dn, rng)
-    n_bld = rng.poisson(cfg.buildings_per_km2 * area_km2)
-    for _ in range(n_bld):
-        c = rng.uniform(-ext, ext, 2)
-        if len(sq) and np.min(np.hypot(*(sq - c).T)) < 30:
-            continue  # the squares lie on open grass
-        L, W = rng.uniform(8, 25), rng.uniform(6, 14)
-        a = rng.uniform(0, np.pi)
-        h = rng.uniform(*cfg.building_height_m)
-        tone = rng.uniform(0.7, 1.3)
-        ca, sa = np.cos(a), np.sin(a)
-        r = np.hypot(L, W) / 2
-
-        def inside(e, nn, c=c, ca=ca, sa=sa, L=L, W=W):
-            x = (e - c[0]) * ca + (nn - c[1]) * sa
-            y = -(e - c[0]) * sa + (nn - c[1]) * ca
-            return (np.abs(x) < L / 2) & (np.abs(y) < W / 2), y
-
-        bbox = (c[0] - r, c[0] + r, c[1] - r, c[1] + r)
-        hit = _cells_within(E, N, lambda e, nn: inside(e, nn)[0], bbox, cell, e0, n0, shape)
-        if hit is not None:
-            sl, m = hit
-            y = inside(E[sl[1]][None, :], N[sl[0]][:, None])[1]
-            material[sl][m] = 6
-            bright[sl][m] = (tone * np.where(y > 0, 1.0, 0.6))[m]
-        hit = _cells_within(De, Dn, lambda e, nn: inside(e, nn)[0], bbox, dcell, e0, n0, dsm.shape)
-        if hit is not None:
-            sl, m = hit
-            dsm[sl][m] += h
-    # the squares: a grass patch, then the white square with its exact coverage
-    for c in sq:
-        hit = _cells_within(
-            E,
-            N,
+    r = _field_raster(cfg, ext, rng)
+    _trees_and_roads(cfg, r, ext, rng)
+    nd = int(np.ceil(2 * ext / cfg.dsm_cell_m)) + 1
+    grid = -ext + cfg.dsm_cell_m * np.arange(nd)
+    dsm = _terrain(cfg, grid, grid, rng)
+    _buildings(cfg, r, dsm, ext, sq, rng)
+    for c in sq:  # the squares lie on a grass patch of 6 m radius
+        r.paint(
             lambda e, nn, c=c: (e - c[0]) ** 2 + (nn - c[1]) ** 2 < 36.0,
             (c[0] - 6, c[0] + 6, c[1] - 6, c[1] + 6),
-            cell,
-            e0,
-            n0,
-            shape,
+            MATERIALS.index("grass"),
+            1.0,
         )
-        if hit is not None:
-            sl, m = hit
-            material[sl][m] = 0
-            bright[sl][m] = 1.0
-    tex = _texture(shape, cell, rng)
-    spectra = _spectra(wavelengths_nm)
-    strength = _TEXTURE[material]
-    refl = np.empty((len(spectra[0]),) + shape, np.float32)
-    cov = np.zeros(shape, np.float32)
-    for c in sq:
-        s = cfg.square_side_m
-        hit = _cells_within(
-            E,
-            N,
-            lambda e, nn: np.ones(np.broadcast(e, nn).shape, bool),
-            (c[0] - s, c[0] + s, c[1] - s, c[1] + s),
-            cell,
-            e0,
-            n0,
-            shape,
-        )
-        if hit is not None:
-            sl, _ = hit
-            cov[sl] = np.maximum(cov[sl], _square_coverage(E[sl[1]], N[sl[0]], cell, c, s))
-    mod = np.clip(bright * (1 + strength * tex), 0.05, 3.0)
-    del tex, strength, bright
-    white = spectra[MATERIALS.index("white")]
-    for b in range(refl.shape[0]):
-        r_b = spectra[:, b].astype(np.float32)[material] * mod
-        r_b = (1 - cov) * r_b + cov * np.float32(white[b])
-        refl[b] = gaussian_filter(r_b, cfg.psf_sigma_m / cell, mode="nearest")
-    ground = Ground(float(e0), float(n0), float(cell), refl, material, dsm, float(dcell))
+    refl = _reflectance(cfg, r, sq, wavelengths_nm, rng)
+    ground = Ground(-ext, -ext, r.cell, refl, r.material, dsm, float(cfg.dsm_cell_m))
     squares_h = dsm_height(ground, sq[:, 0], sq[:, 1]) if len(sq) else np.zeros(0)
     return ground, squares_h
 

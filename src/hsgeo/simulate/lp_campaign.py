@@ -17,7 +17,8 @@ the line's exposure time, which includes the high-frequency attitude motion of t
 mount (:func:`~hsgeo.simulate.pushbroom_campaign._mount_motion`, amplitude
 :attr:`LpConfig.mount_motion_rad`, tuned to 002's |δx|); per band with its own principal
 distance: each pixel's ray (:meth:`hsgeo.sensors.pushbroom.PushbroomCamera.rays_at`) meets the
-DSM and samples the blurred reflectance there (a Gaussian PSF of about a pixel's footprint). The
+DSM and samples the blurred reflectance there (a Gaussian PSF of about a pixel's footprint, and
+the motion blur of the line's integration along track, :attr:`LpConfig.motion_blur_m`). The
 reflectance becomes DN with a band-dependent responsivity (vegetation close to saturation above
 the red edge, 002 §5.3), shot and read noise, rounding and clipping at ``dn_max``.
 
@@ -26,17 +27,30 @@ of every strip (a :class:`~hsgeo.trajectory.Trajectory`; between strips it inter
 the turns, where no line is exposed). The a-priori camera is the nominal one (c = 40 mm in every
 band, no distortion, zero boresight, the tape-measured lever arm, the calibrated principal point).
 
+What the renderer shares with the estimator: the camera model itself (002 eq. (2)–(4), the
+same :class:`~hsgeo.sensors.pushbroom.PushbroomCamera`) maps the ground to the pixels. What the
+estimator does not model: the PSF and the motion blur, the DSM's occlusions, the texture's
+effect on where a key point is found, the noise and saturation of the DN.
+
 Scale
 -----
-``scale`` ∈ (0, 1] renders the central ``600·scale`` m × ``600·scale`` m of 002's 600 m × 600 m
+``scale`` ∈ [0.05, 1] renders the central ``600·scale`` m × ``600·scale`` m of 002's 600 m × 600 m
 block, i.e. the fraction ``scale²`` of the campaign's area and (within a few per cent) of its
 pixels: every strip keeps 002's flight line, height and speed, and stores only the lines and
 columns whose ground lies over the rendered block (``col0``; a strip that sees fewer than
 :data:`MIN_COLUMNS` columns of it is left out). The seventeen squares keep 002's layout (4 GCPs
 at the corners, 13 check points, :data:`~hsgeo.simulate.pushbroom_campaign.REFERENCE_EN_M`, each
 moved by up to ±20 m) shrunk with the block, ``scale ·`` their positions, so that every scale
-has its GCPs and check points. At scale 1 the 24 strips hold ≈ 6·10⁸ pixel-bands (2.3 GB as
-float32).
+has its GCPs and check points.
+
+Sizes and cost (measured 2026-11-27 on the shared 2-core machine under a load of 4–6 from other
+sessions, so the times are upper bounds): at scale 1 the 24 strips hold 3.9·10⁸ pixel-bands
+(1.56 GB as float32; peak memory 2.6 GB with the ground raster) and :func:`simulate` takes 92 s,
+0.24 s per million pixel-bands (a strip alone renders at 0.17 s per million; the compiled
+ray–DSM intersection and sampling, :mod:`hsgeo.simulate._lp_render`, is most of it, measured
+between 0.04 and 0.13 s per million as the load varied). Work and memory scale with
+``scale²``. The default, 0.35, renders 12 % of the campaign (5.3·10⁷ pixel-bands, 12 s, 0.7 GB),
+leaving the chapter's detection, matching and adjustment most of its 3-minute budget.
 
 References
 ----------
@@ -52,7 +66,9 @@ import numpy as np
 from hsgeo.errors import InputError
 from hsgeo.io.lp_lines import LpStrip
 from hsgeo.sensors.pushbroom import BLOCK_NAMES, PushbroomCamera
-from hsgeo.simulate._lp_ground import Ground, make_ground, render_lines
+from hsgeo.simulate import as_rng
+from hsgeo.simulate._lp_ground import make_ground
+from hsgeo.simulate._lp_render import Ground, render_lines, render_rays
 from hsgeo.simulate.pushbroom_campaign import (
     REFERENCE_EN_M,
     _camera_truth,
@@ -61,11 +77,18 @@ from hsgeo.simulate.pushbroom_campaign import (
     _true_pose,
 )
 from hsgeo.simulate.pushbroom_campaign_types import CampaignConfig
-from hsgeo.trajectory import SplineNodes, Trajectory, rph_from_platform_rpy
+from hsgeo.trajectory import (
+    R_BODY_FROM_PLATFORM,
+    SplineNodes,
+    Trajectory,
+    rph_from_platform_rpy,
+)
 
-__all__ = ["LpConfig", "LpObservations", "LpTruth", "simulate", "MIN_COLUMNS"]
+__all__ = ["LpConfig", "LpObservations", "LpTruth", "simulate", "MIN_COLUMNS", "MIN_SCALE"]
 
 DEG = np.pi / 180
+#: The smallest scale: a 30 m block (the 17 squares, 1.2 m each, still ≥ 7 m apart).
+MIN_SCALE = 0.05
 #: A strip that sees fewer columns of the rendered block is left out.
 MIN_COLUMNS = 64
 
@@ -78,8 +101,9 @@ class LpConfig:
     # TUNED (provenance "tuned"): amplitude of the mount's residual attitude motion (the shape
     # of pushbroom_campaign._mount_motion, sines of 0.3–2.3 Hz), chosen so that |δx| of 002
     # eq. (1) over the 200-line scenes of the whole block (scale 1, first line as reference)
-    # has 002 §4's RMS of 0.91 px: 0.908 px (100 / 300 lines: 0.73 / 0.84 px). Its max is then
-    # 2.4 px against 002's 4.43 px: a few sines have a smaller crest factor than real motion.
+    # has 002 §4's RMS of 0.91 px: 0.911 px (100 / 300 lines: 0.73 / 0.86 px). Its max is then
+    # 2.46 px against 002's 4.43 px: a few sines have a smaller crest factor than a real
+    # mount's motion.
     mount_motion_rad: float = 0.0108 * DEG
     # -- ground (ours)
     ground_cell_m: float = 0.15  # reflectance raster: half the 0.30 m GSD at 1875 m
@@ -95,6 +119,10 @@ class LpConfig:
     # a Gaussian PSF of σ 0.15 m (FWHM 0.35 m ≈ the pixel footprint, 0.30–0.41 m at
     # 1875–2500 m AGL), applied to the ground raster
     psf_sigma_m: float = 0.15
+    # motion blur: the ground passed during a line's integration (ours: integration = the line
+    # period 1/200 s, time stamp at mid-exposure: 67 m/s / 200 = 0.335 m along track); 0: off.
+    # Not in the pinhole model of 002 eq. (2) (002 §4 lists it among the unmodelled effects)
+    motion_blur_m: float = 67.0 / 200.0
     # -- radiometry (ours): DN per unit reflectance per band, one integration time; vegetation
     # (ρ ≈ 0.48) reaches ~90 % of dn_max above the red edge (002 §5.3: "close to saturation")
     dn_max: float = 4095.0
@@ -173,6 +201,30 @@ class LpTruth:
     strip_index: np.ndarray
     nav_error: object = None
 
+    def ground_points(self, t_s, x_px, band) -> np.ndarray:
+        """True ground point (E, N, U, m) seen by pixels ``x_px`` of the lines at ``t_s``.
+
+        The true ray (:meth:`PushbroomCamera.rays` of :attr:`camera` on :attr:`trajectory`)
+        meets the DSM where the renderer sampled it: for judging a retrieved observation
+        against its true image position (project the point with ``camera.project``).
+
+        Parameters
+        ----------
+        t_s, x_px : (m,) array_like
+            Line times (s) and x along the line (px from the full line's centre).
+        band : int or (m,) int array_like
+
+        Returns
+        -------
+        (m, 3) ndarray
+        """
+        x = np.atleast_1d(np.asarray(x_px, dtype=np.float64))
+        o, d = self.camera.rays(
+            np.column_stack([x, np.zeros(x.size)]), np.atleast_1d(t_s), self.trajectory, band
+        )
+        en, _ = render_rays(o, d, self.ground)
+        return np.column_stack([en, self.terrain.height(en[:, 0], en[:, 1])])
+
 
 def _line_times(cfg: CampaignConfig, plan) -> list[np.ndarray]:
     """Every line's exposure time of each strip: ``t_start + k / line_rate``."""
@@ -205,7 +257,7 @@ def _window(camera, traj, t, n_px, half_m, h_mean, agl):
     x = np.arange(n_px) - (n_px - 1) / 2
     tm = t[t.size // 2]
     pos, _ = traj.pose(np.full(n_px, tm))
-    R = traj.R_map_from_body(np.full(n_px, tm)) @ np.diag([1.0, -1.0, -1.0])
+    R = traj.R_map_from_body(np.full(n_px, tm)) @ R_BODY_FROM_PLATFORM
     o, d = camera.rays_at(np.column_stack([x, np.zeros(n_px)]), 0, pos, R)
     s = (h_mean - o[:, 2]) / d[:, 2]
     E = o[:, 0] + s * d[:, 0]
@@ -233,17 +285,16 @@ def _render_strip(cfg: LpConfig, camera, traj, t, cols, ground: Ground, rng) -> 
     c = cfg.campaign
     n_px = c.pixels_per_line
     x = cols - (n_px - 1) / 2
-    nl, nc = t.size, x.size
+    nc = x.size
     nb = len(camera.c_mm)
     pos, _ = traj.pose(t)
-    R = traj.R_map_from_body(t) @ np.diag([1.0, -1.0, -1.0])  # map from platform
+    R = traj.R_map_from_body(t) @ R_BODY_FROM_PLATFORM  # map from platform
     o_plat, _ = camera.rays_at(np.zeros((1, 2)), 0, np.zeros((1, 3)), np.eye(3)[None])
     origins_line = pos + R @ o_plat[0]  # (nl, 3): x + R l^p
-    out = np.empty((nl, nc, nb), np.float32)
     xy = np.column_stack([x, np.zeros(nc)])
-    for b in range(nb):
-        _, d_plat = camera.rays_at(xy, b, np.zeros((nc, 3)), np.broadcast_to(np.eye(3), (nc, 3, 3)))
-        out[:, :, b] = render_lines(R, origins_line, d_plat, ground, b)
+    eye = np.broadcast_to(np.eye(3), (nc, 3, 3))
+    d_plat = np.stack([camera.rays_at(xy, b, np.zeros((nc, 3)), eye)[1] for b in range(nb)])
+    out = render_lines(R, origins_line, d_plat, ground)
     # radiometry: DN, shot and read noise, quantisation, saturation
     dn = out * np.asarray(cfg.dn_per_reflectance[:nb], np.float32)
     sigma = np.sqrt(dn / np.float32(cfg.electrons_per_dn) + np.float32(cfg.read_noise_dn) ** 2)
@@ -255,11 +306,23 @@ def _render_strip(cfg: LpConfig, camera, traj, t, cols, ground: Ground, rng) -> 
 def _checked(scale, cfg):
     if not (isinstance(scale, (int, float, np.floating)) and np.isfinite(scale)):
         raise InputError(f"scale must be a number in (0, 1], got {scale!r}")
-    if not 0 < scale <= 1:
+    if not MIN_SCALE <= scale <= 1:
         raise InputError(
-            f"scale must be in (0, 1] (the share of 002's 600 m block side rendered), got {scale}"
+            f"scale must be in [{MIN_SCALE}, 1] (the share of 002's 600 m block side rendered; "
+            f"below {MIN_SCALE} the 17 squares crowd a block of under 30 m), got {scale}"
         )
     cfg = cfg or LpConfig()
+    for name in ("ground_cell_m", "dsm_cell_m", "field_size_m", "dn_max", "electrons_per_dn"):
+        v = getattr(cfg, name)
+        if not (np.isfinite(v) and v > 0):
+            raise InputError(f"LpConfig.{name} must be a positive number, got {v!r}")
+    if not all(
+        getattr(cfg, k) >= 0
+        for k in ("psf_sigma_m", "motion_blur_m", "read_noise_dn", "mount_motion_rad")
+    ):
+        raise InputError(
+            "LpConfig: psf_sigma_m, motion_blur_m, read_noise_dn and mount_motion_rad must be ≥ 0"
+        )
     nb = len(cfg.campaign.c_offsets_um)
     if len(cfg.dn_per_reflectance) < nb or len(cfg.campaign.wavelengths_nm) != nb:
         raise InputError(
@@ -269,13 +332,13 @@ def _checked(scale, cfg):
 
 
 def simulate(
-    scale: float = 0.25, rng=0, cfg: LpConfig | None = None, progress=None
+    scale: float = 0.35, rng=0, cfg: LpConfig | None = None, progress=None
 ) -> tuple[LpObservations, LpTruth]:
     """Render the LP campaign's strips over the central ``600·scale`` m block (module docstring).
 
     Parameters
     ----------
-    scale : float in (0, 1]
+    scale : float in [MIN_SCALE, 1]
         Side of the rendered block as a share of 002's 600 m (area and pixels ∝ ``scale²``).
     rng : int or numpy.random.Generator
     cfg : LpConfig, optional
@@ -290,7 +353,7 @@ def simulate(
     from hsgeo.geocode import DemTerrain
 
     cfg = _checked(scale, cfg)
-    rng = np.random.default_rng(rng)
+    rng = as_rng(rng)
     c = replace(cfg.campaign, mount_motion_rad=cfg.mount_motion_rad)
     plan = _strip_plan(c)
     t_end = plan[-1][1]
