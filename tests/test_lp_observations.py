@@ -204,7 +204,7 @@ def true_image_errors(table, truth, square_ids):
     ground point is the median of where the observations' true rays (true camera, true
     trajectory) meet the DSM, a square's its surveyed centre; it is projected with the true
     camera into the observing line (y = 0 is the line)."""
-    from hsgeo.simulate._lp_ground import dsm_height, render_rays
+    from hsgeo.simulate._lp_render import dsm_height, render_rays
 
     t = table["t_s"].to_numpy(float)
     b = table["band"].to_numpy()
