@@ -64,7 +64,7 @@ from hsgeo.adjust.schur import (
     _reduced_inverse,
     _step,
 )
-from hsgeo.adjust.system import _evaluate, _Layout, _NonFinite, _System
+from hsgeo.adjust.system import _Clock, _evaluate, _Layout, _NonFinite, _System
 from hsgeo.adjust.threads import engine_threads
 from hsgeo.errors import ConvergenceError, DatumError, InputError, ObservationError
 
@@ -229,14 +229,26 @@ class _Solve:
         self.each = options.reject_k is not None and options.reject_every_iteration
         self.D_max: np.ndarray | None = None  # damping_diagonal="max": the running maximum
         self.hold_count: dict[int, int] = {}  # times each point was held (at most HOLD_MAX)
+        self.clock = _Clock()  # AdjustmentResult.seconds_split
+        #: SolverOptions.robust_start: the loss until the first settled iterate, and the
+        #: scales of the last linearisation (the trial steps are costed with the same)
+        self.loss_on = options.robust_start is not None
+        self.loss_c: dict | None = None
 
     # -- the linearised system -------------------------------------------------------------
     def linearise(self, check_redundancy: bool = False) -> tuple[_System, _Normal]:
         """The whitened system and its normal equations at the current values."""
-        layout = self.layout
+        layout, opts = self.layout, self.options
         sy = _evaluate(
-            layout, self.blocks, self.masks, jacobian=True, compiled=self.options.compiled
+            layout,
+            self.blocks,
+            self.masks,
+            jacobian=True,
+            compiled=opts.compiled,
+            clock=self.clock,
+            loss=(opts.robust_start, opts.robust_start_k, None) if self.loss_on else None,
         )
+        self.loss_c = sy.loss_c
         if check_redundancy:
             dof = sy.r.size - layout.n_unknowns
             if dof < 0 or (dof == 0 and sy.n_obs_rows < layout.n_unknowns):
@@ -245,11 +257,24 @@ class _Solve:
                     f"unknowns ({layout.n_unknowns}): add observations, fix parameters or add "
                     "priors"
                 )
-        return sy, _normal(layout, sy, self.options, self.orders)
+        return sy, _normal(layout, sy, self.options, self.orders, self.clock)
+
+    def trial(self) -> _System:
+        """The residuals at the current values (no Jacobian), under the loss of the last
+        linearisation if the robust start is on; raises ``_NonFinite``.
+        """
+        opts = self.options
+        loss = None
+        if self.loss_on and self.loss_c is not None:
+            loss = (opts.robust_start, opts.robust_start_k, self.loss_c)
+        return _evaluate(
+            self.layout, self.blocks, self.masks, False, opts.compiled, self.clock, loss
+        )
 
     def reject(self, residuals: _System, sy: _System, ne: _Normal) -> bool:
         """Test the residuals of ``residuals`` (leverages from ``sy``, ``ne``); see robust."""
-        return _reject(
+        t0 = time.perf_counter()
+        out = _reject(
             self.blocks,
             self.masks,
             residuals,
@@ -257,6 +282,8 @@ class _Solve:
             self.layout.row_point,
             _leverage(ne, sy),
         )
+        self.clock.add("rejection", t0)
+        return out
 
     # -- one pass of the Levenberg–Marquardt loop -------------------------------------------
     def minimise(self, tol: float, check_datum: bool = False):
@@ -270,7 +297,9 @@ class _Solve:
         sy, ne = self.linearise(check_redundancy=True)
         self._damping_diagonal(ne)
         if check_datum:
+            t0 = time.perf_counter()
             _check_datum(self.layout, ne, opts.rank_rtol)
+            self.clock.add("datum", t0)
         lam, nu = opts.lambda0, 2.0
         cost = sy.cost
         self.history.append(cost)
@@ -278,10 +307,19 @@ class _Solve:
         tested = False  # each-iteration mode: the current point passed the rejection test
         n_iter = 0
         while True:
-            if cost <= opts.atol * sy.r.size:
+            if cost <= opts.atol * sy.r.size and not self.loss_on:
                 return _Outcome(True, "cost below atol (noise-free data)"), sy, ne
             dc, dp, pred = self._gauss_newton_step(ne, lam, tol, cost)
-            if self._converged(ne, lam, pred, tol, cost) and self._small_step(dc, dp):
+            converged = self._converged(ne, lam, pred, tol, cost) and self._small_step(dc, dp)
+            if self.loss_on and converged:
+                # the robust start ends at its own minimum: least squares from here on
+                self.loss_on = False
+                sy = ne = None
+                sy, ne = self.linearise()
+                self._damping_diagonal(ne)
+                cost = sy.cost
+                continue
+            if converged:
                 # converged before any rejection test (e.g. at the initial values)
                 if self.each and not tested and self.reject(sy, sy, ne):
                     return _Outcome(False, "", rejected=True), sy, ne
@@ -298,6 +336,13 @@ class _Solve:
             self.total_iter += 1
             step = self._damped_step(ne, cost, lam, nu, dc, dp, pred, sy)
             lam, nu = step.lam, step.nu
+            if lam > opts.lambda_max and self.loss_on:
+                self.loss_on = False  # the robust start ends here: least squares from here on
+                sy = ne = step = None
+                sy, ne = self.linearise()
+                self._damping_diagonal(ne)
+                lam, nu, cost = opts.lambda0, 2.0, sy.cost
+                continue
             if lam > opts.lambda_max:
                 # no step decreases the cost: we are at the minimum to machine precision
                 ok = step.pred <= 1e3 * tol * max(cost, 1e-300) or cost <= opts.atol * sy.r.size
@@ -315,6 +360,13 @@ class _Solve:
             self.history.append(new_cost)
             tested = False
             settled = _settled(step.actual, step.pred, new_cost, opts.settled)
+            switched = self.loss_on and settled
+            if switched:
+                # the robust start ends at the first settled iterate: from here on least
+                # squares, and the rejection tests the plain residuals
+                self.loss_on = False
+                step.system = self.trial()
+                self.history[-1] = new_cost = step.system.cost
             if self.each and (rejecting or settled):
                 # 002 §3.4: outliers are rejected in each iteration, on the residuals at the
                 # new point, from the first settled iterate: before that, residuals reflect
@@ -328,7 +380,7 @@ class _Solve:
             # where the convergence test passes, or when a chord step fails
             chord = (
                 ne.reduced0[0]
-                if settled and ne.compiled_schur and ne.reduced0 is not None
+                if settled and not switched and ne.compiled_schur and ne.reduced0 is not None
                 else None
             )
             sy = ne = step = None  # free the old Jacobian before forming the new one
@@ -461,9 +513,7 @@ class _Solve:
                 dc, pred = acc
             layout.apply(dc, dp)
             try:
-                trial = _evaluate(
-                    layout, self.blocks, self.masks, jacobian=False, compiled=self.options.compiled
-                )
+                trial = self.trial()
             except _NonFinite:
                 # the step left the model's domain (an overflow, a log of a negative): a step
                 # that does not decrease the cost, refused like one
@@ -534,7 +584,7 @@ class _Solve:
         layout.set_state(state)
         layout.apply(dc, dp_h)
         try:
-            trial = _evaluate(layout, self.blocks, self.masks, False, self.options.compiled)
+            trial = self.trial()
         except _NonFinite:
             layout.set_state(state)
             return None
@@ -563,11 +613,11 @@ class _Solve:
     def result(self, sy: _System, ne: _Normal, outcome: _Outcome, rounds: int) -> AdjustmentResult:
         """σ0, covariance and residuals at the final iterate, as an :class:`AdjustmentResult`."""
         layout, blocks = self.layout, self.blocks
-        seconds = time.perf_counter() - self.t0
         n_unk = layout.n_unknowns
         dof = int(sy.r.size - n_unk)
         vtpv = float(sy.r @ sy.r)
         sigma0 = float(np.sqrt(vtpv / dof)) if dof > 0 else float("nan")
+        t_cov = time.perf_counter()
         try:
             S_inv = _reduced_inverse(layout, ne)
         except (np.linalg.LinAlgError, sla.LinAlgError) as exc:
@@ -576,6 +626,7 @@ class _Solve:
                 "computed (a datum defect that appeared during the iteration?)",
                 layout.labels_c,
             ) from exc
+        self.clock.add("covariance", t_cov)
         s2 = sigma0**2 if np.isfinite(sigma0) else 1.0
         full = _evaluate(layout, blocks, [np.ones(b.m, dtype=bool) for b in blocks], False)
         residuals, off = {}, 0
@@ -585,6 +636,9 @@ class _Solve:
         cofactors = None
         if self.options.keep_jacobian and layout.pblock is not None:
             cofactors = _point_cofactor_function(ne, S_inv)
+        seconds = time.perf_counter() - self.t0
+        split = dict(self.clock.seconds)
+        split["other"] = max(seconds - sum(split.values()), 0.0)
         return AdjustmentResult(
             params=layout.params,
             converged=outcome.converged,
@@ -604,6 +658,7 @@ class _Solve:
             _masks=[m.copy() for m in self.masks],
             _residuals=residuals,
             _point_cofactors=cofactors,
+            seconds_split=split,
         )
 
 

@@ -11,6 +11,7 @@ path (:mod:`hsgeo.adjust._fast`).
 
 from __future__ import annotations
 
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -22,6 +23,21 @@ from hsgeo.adjust.residuals import Indexed, ResidualBlock
 from hsgeo.errors import InputError
 
 __all__: list[str] = []
+
+
+class _Clock:
+    """Seconds spent in each phase of one adjustment (``AdjustmentResult.seconds_split``).
+
+    ``t = clock.add("model", t)`` adds the seconds since ``t`` to ``"model"`` and returns now.
+    """
+
+    def __init__(self) -> None:
+        self.seconds: dict[str, float] = {}
+
+    def add(self, key: str, t0: float) -> float:
+        now = time.perf_counter()
+        self.seconds[key] = self.seconds.get(key, 0.0) + (now - t0)
+        return now
 
 
 class _Layout:
@@ -170,9 +186,15 @@ class _System:
     pidx: np.ndarray | None  # (M,) point touched by each row (-1: none)
     Jp: np.ndarray | None  # (M, p)
     n_obs_rows: int  # rows that are observations (the rest are priors)
+    #: under a robust loss (see :mod:`hsgeo.adjust.loss`): its scale per block index, and,
+    #: at a linearisation (rows scaled by √ρ′), the robust cost ½ Σ ρ (None: ½ ‖r‖²)
+    loss_c: dict | None = None
+    robust_cost: float | None = None
 
     @property
     def cost(self) -> float:
+        if self.robust_cost is not None:
+            return self.robust_cost
         with np.errstate(over="ignore"):  # finite residuals too large to square: cost inf
             return 0.5 * float(self.r @ self.r)
 
@@ -409,23 +431,44 @@ def _assemble(layout: _Layout, slot_parts, pidx_parts, jp_parts, M: int, factore
 
 
 def _evaluate(
-    layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian: bool, compiled: bool = True
+    layout: _Layout,
+    blocks: Sequence[ResidualBlock],
+    masks,
+    jacobian: bool,
+    compiled: bool = True,
+    clock: _Clock | None = None,
+    loss: tuple | None = None,
 ) -> _System:
     """Whitened residuals (and with ``jacobian`` the row-compressed Jacobian) at the current
     values of ``layout.params``; rows of ``masks[i] == False`` are left out. ``compiled``
-    keeps factored Jacobians factored (the compiled kernels' form).
+    keeps factored Jacobians factored (the compiled kernels' form). ``clock`` takes the
+    seconds of the blocks' own evaluation (``model``) and of the assembly (``jacobian``).
+
+    ``loss = (kind, k, scales)``: the observation rows under a robust loss
+    (:mod:`hsgeo.adjust.loss`), with the scale of each block index in ``scales`` (None: ``k``
+    robust σ of the residuals here); with ``jacobian`` rows are scaled by ``√ρ′`` and the
+    system carries the robust cost, otherwise by ``√(ρ/s)`` (``½ ‖r‖²`` is that cost).
     """
+    clock = clock or _Clock()
+    t = time.perf_counter()
     values = layout.params.values()
     r_parts, slot_parts, pidx_parts, jp_parts = [], [], [], []
     factored_k = None  # width k of the factored Jacobians (one per row, one k for all)
     offset = 0
     pname = layout.pblock.name if layout.pblock is not None else None
+    loss_c, rho_sum = {}, 0.0
     for ib, (blk, keep) in enumerate(zip(blocks, masks, strict=True)):
+        t = clock.add("jacobian", t)
         r, jac = _block_residuals(blk, values, jacobian)
+        t = clock.add("model", t)
         w = 1.0 / blk.sigma
         rows_kept = np.flatnonzero(keep)
         all_kept = rows_kept.size == blk.m
-        r_parts.append(r * w if all_kept else r.take(rows_kept) * w.take(rows_kept))
+        rw = r * w if all_kept else r.take(rows_kept) * w.take(rows_kept)
+        if loss is not None:
+            w, rw, loss_c[ib], part = _robust_rows(loss, ib, blk, w, rw, keep, jacobian)
+            rho_sum += part
+        r_parts.append(rw)
         if jacobian:
             pidx = np.full(rows_kept.size, -1, dtype=np.int64)
             jp = np.zeros((rows_kept.size, layout.p))
@@ -459,10 +502,31 @@ def _evaluate(
     n_obs_rows = offset
     offset += _prior_rows(layout, jacobian, r_parts, slot_parts, pidx_parts, jp_parts)
     r_all = np.concatenate(r_parts) if r_parts else np.zeros(0)
+    robust = None
+    if loss is not None and jacobian:
+        prior = r_all[n_obs_rows:]
+        robust = 0.5 * (rho_sum + float(prior @ prior))
+    lc = loss_c if loss is not None else None
     if not jacobian:
-        return _System(r_all, None, None, None, n_obs_rows)
+        clock.add("model", t)
+        return _System(r_all, None, None, None, n_obs_rows, lc)
     Jrc, pidx, Jp = _assemble(layout, slot_parts, pidx_parts, jp_parts, offset, factored_k)
-    return _System(r_all, Jrc, pidx, Jp, n_obs_rows)
+    clock.add("jacobian", t)
+    return _System(r_all, Jrc, pidx, Jp, n_obs_rows, lc, robust)
+
+
+def _robust_rows(loss, ib: int, blk: ResidualBlock, w, rw, keep, jacobian: bool):
+    """One block's rows under the robust loss ``loss = (kind, k, scales)``: the row weights
+    ``w`` (all rows) and the kept whitened residuals ``rw`` scaled, the scale, and ``Σ ρ``.
+    """
+    from hsgeo.adjust.loss import scale, weigh
+
+    kind, k, scales = loss
+    c = scales[ib] if scales is not None else scale(rw, k)
+    f, part = weigh(kind, rw, blk.group_size, c, jacobian)
+    w_all = np.broadcast_to(np.asarray(w, dtype=np.float64), (blk.m,)).copy()
+    w_all[keep] *= f  # the Jacobian's rows are whitened with w (see _Slots)
+    return w_all, rw * f, c, part
 
 
 def _merge_tied_columns(cols: np.ndarray, vals: np.ndarray) -> None:
