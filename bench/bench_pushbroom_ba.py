@@ -39,7 +39,8 @@ HERE = Path(__file__).resolve().parent
 def _problem(scale, seed, with_gcp=True, keep=None):
     """The chapter's problem at ``scale``: ``(obs, params, blocks)``. With a dict ``keep``,
     the check points' rows and true coordinates are put in it (``cp_index``, ``cp_xyz_m``)
-    before the truth is dropped."""
+    and which observations carry a simulated gross error (``gross``) before the truth is
+    dropped."""
     from hsgeo.reproduce.pushbroom_ba import Y_AS_TIME, camera_prior
     from hsgeo.simulate.pushbroom_campaign import CampaignConfig, simulate
     from hsgeo.workflows.pushbroom_ba import build_problem
@@ -49,6 +50,7 @@ def _problem(scale, seed, with_gcp=True, keep=None):
     if keep is not None:
         keep["cp_index"] = truth.cp_index.copy()
         keep["cp_xyz_m"] = truth.values["points_m"][truth.cp_index].copy()
+        keep["gross"] = truth.outlier.copy()
     del truth
     p, blocks, _ = build_problem(
         obs.lines,
@@ -66,25 +68,22 @@ def _load_compiled_kernels(seed):
     """Adjust a tiny campaign once: numba loads the compiled kernels from its on-disk cache on
     their first call in a process (a fixed ≈ 0.3–0.8 s, whatever the problem size). Returns
     the seconds it took, which are reported as ``jit_load_seconds``, apart from the solve."""
-    from hsgeo.adjust import adjust
-    from hsgeo.reproduce.pushbroom_ba import FTOL, REJECT_K
+    from hsgeo.workflows.pushbroom_ba import solve
 
     _, p, blocks = _problem(0.005, seed)
     t0 = time.perf_counter()
-    adjust(p, blocks, reject_k=REJECT_K, ftol=FTOL, reject_every_iteration=True)
+    solve(p, blocks)
     return time.perf_counter() - t0
 
 
 def case_ours(scale, seed, reject):
-    from hsgeo.adjust import adjust
-    from hsgeo.reproduce.pushbroom_ba import FTOL, REJECT_K
+    from hsgeo.reproduce.pushbroom_ba import REJECT_K
+    from hsgeo.workflows.pushbroom_ba import solve
 
     obs, p, blocks = _problem(scale, seed)
     jit = _load_compiled_kernels(seed)
     t0 = time.perf_counter()
-    res = adjust(
-        p, blocks, reject_k=REJECT_K if reject else None, ftol=FTOL, reject_every_iteration=True
-    )
+    res = solve(p, blocks, reject_k=REJECT_K if reject else None)
     wall = time.perf_counter() - t0
     return {
         "n_observations": obs.lines.n,
@@ -167,7 +166,8 @@ def _check_point_nmad(res, cp):
 
 
 def case_scaling(scale, seed, robust_start=None):
-    """One row of the scaling benchmark: the chapter's adjustment (outlier rejection) at
+    """One row of the scaling benchmark: the chapter's adjustment (:func:`~hsgeo.workflows.
+    pushbroom_ba.solve`, outlier rejection) at
     ``scale`` (beyond 1: the longer block of :func:`~hsgeo.simulate.pushbroom_campaign.simulate`).
 
     Times ``simulate()`` inside :func:`_problem` (wrapped, not changed), frees everything the
@@ -178,8 +178,7 @@ def case_scaling(scale, seed, robust_start=None):
     import gc
 
     import hsgeo.simulate.pushbroom_campaign as campaign
-    from hsgeo.adjust import adjust
-    from hsgeo.reproduce.pushbroom_ba import FTOL, REJECT_K
+    from hsgeo.workflows.pushbroom_ba import solve
 
     simulate, timing = campaign.simulate, {}
 
@@ -203,14 +202,7 @@ def case_scaling(scale, seed, robust_start=None):
     jit = _load_compiled_kernels(seed)
     rss_before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     t0 = time.perf_counter()
-    res = adjust(
-        p,
-        blocks,
-        reject_k=REJECT_K,
-        ftol=FTOL,
-        reject_every_iteration=True,
-        robust_start=robust_start,
-    )
+    res = solve(p, blocks, robust_start=robust_start)  # the chapter's settings
     wall = time.perf_counter() - t0
     return {
         "scale": scale,
@@ -224,6 +216,9 @@ def case_scaling(scale, seed, robust_start=None):
         "sigma0": res.sigma0,
         "rejected_share": float(res.outliers(0).mean()),
         "check_point_nmad_enh_m": _check_point_nmad(res, cp),
+        "simulated_gross_errors": int(cp["gross"].sum()),
+        "gross_errors_rejected": int((res.outliers(0) & cp["gross"]).sum()),
+        "good_observations_rejected": int((res.outliers(0) & ~cp["gross"]).sum()),
         "seconds_split": {k: float(v) for k, v in sorted(res.seconds_split.items())},
         "cost_history": [float(c) for c in res.cost_history],
         "simulate_seconds": timing["simulate_seconds"],
