@@ -6,7 +6,7 @@ generic paths)."""
 import numpy as np
 import pytest
 from test_engine import _bearing_params, line_data
-from toy_models import Line, bearing_scene
+from toy_models import Bearings, Line, bearing_scene
 
 from hsgeo.adjust import Parameters, SolverOptions, adjust
 from hsgeo.adjust.loss import rho, scale, weigh
@@ -103,3 +103,43 @@ def test_seconds_split_adds_up_and_options_are_checked():
         SolverOptions(robust_start="tukey")
     with pytest.raises(InputError, match="robust_start_k"):
         SolverOptions(robust_start_k=0.0)
+
+
+def test_an_accepted_step_that_threw_a_point_is_taken_with_it_held():
+    """An accepted step whose excess over the linear prediction sits on one point (a point
+    thrown where its model is far from linear, as Gauss–Newton steps from poor initial values
+    do to weakly intersected pushbroom tie points, issue 29) is taken with that point held:
+    the point stays where it was, every other point takes its step, and the cost is that of
+    the held step. The throw is simulated by inflating the point's residuals in the trial."""
+    from hsgeo.adjust.options import SolverOptions as SO
+    from hsgeo.adjust.schur import _predicted_decrease, _step
+    from hsgeo.adjust.solver import _Solve
+
+    S, P, st, pt, th = bearing_scene(0, n_stations=6, n_points=40, coverage=4)
+    P0 = P + np.random.default_rng(1).normal(0, 3.0, P.shape)
+    p = Parameters()
+    p.add("stations", S.copy())
+    p.add("points", P0.copy(), points=True)
+    p.fix("stations")
+    solve = _Solve(p, [Bearings(st, pt, th, 1e-3)], SO(), None)
+    sy, ne = solve.linearise()
+    cost = sy.cost
+    dc, dp = _step(solve.layout, ne, 0.0)
+    pred = _predicted_decrease(solve.layout, ne, 0.0, dc, dp)
+    state = solve.layout.get_state()
+    solve.layout.apply(dc, dp)
+    good = solve.trial()
+    # a step that threw nothing is taken as it is, the parameters at it
+    same = solve._hold_thrown(sy, ne, good, state, cost, dc, dp, (good, 0, pred, 1))
+    assert same[0] is good
+    np.testing.assert_allclose(solve.layout.pblock.value, P0 + dp, rtol=1e-12)
+    thrown = type(good)(good.r.copy(), None, None, None, good.n_obs_rows)
+    thrown.r[pt == 7] = 50.0  # point 7's rays far off: 5000 against the step's ~40
+    assert thrown.cost < cost  # (still a decrease: the step is accepted)
+    out = solve._hold_thrown(sy, ne, thrown, state, cost, dc, dp, (thrown, 0, pred, 1))
+    pts = solve.layout.pblock.value
+    np.testing.assert_array_equal(pts[7], P0[7])  # held where it was
+    others = np.arange(40) != 7
+    np.testing.assert_allclose(pts[others], (P0 + dp)[others], rtol=1e-12)
+    assert out[0].cost < thrown.cost
+    np.testing.assert_allclose(out[0].cost, solve.trial().cost, rtol=1e-12)

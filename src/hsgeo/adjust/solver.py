@@ -177,6 +177,10 @@ def _adjust(params, blocks, opts: SolverOptions, progress) -> AdjustmentResult:
 
 #: Most times one point is held in place to save a refused step (see _Solve._hold_points).
 HOLD_MAX = 3
+#: An accepted step before the first settled iterate is tried again with a few points held
+#: when their rows' excess over the linear prediction is at least this share of its cost
+#: (see _Solve._hold_thrown).
+THROWN_SHARE = 0.5
 
 
 @dataclass(frozen=True)
@@ -229,6 +233,7 @@ class _Solve:
         self.each = options.reject_k is not None and options.reject_every_iteration
         self.D_max: np.ndarray | None = None  # damping_diagonal="max": the running maximum
         self.hold_count: dict[int, int] = {}  # times each point was held (at most HOLD_MAX)
+        self.settled_seen = False  # an iterate was settled (accepted steps no longer held)
         self.clock = _Clock()  # AdjustmentResult.seconds_split
         #: SolverOptions.robust_start: the loss until the first settled iterate, and the
         #: scales of the last linearisation (the trial steps are costed with the same)
@@ -360,6 +365,7 @@ class _Solve:
             self.history.append(new_cost)
             tested = False
             settled = _settled(step.actual, step.pred, new_cost, opts.settled)
+            self.settled_seen = self.settled_seen or settled
             switched = self.loss_on and settled
             if switched:
                 # the robust start ends at the first settled iterate: from here on least
@@ -528,6 +534,17 @@ class _Solve:
                 held = self._hold_points(sy, ne, trial, state, cost, dc, dp)
                 if held is not None:
                     trial, actual, pred, rho = held
+            if (
+                rho > 0
+                and np.isfinite(trial.cost)
+                and sy is not None
+                and self.options.hold_points
+                and not self.settled_seen
+                and ne.S_chord is None
+            ):
+                trial, actual, pred, rho = self._hold_thrown(
+                    sy, ne, trial, state, cost, dc, dp, (trial, actual, pred, rho)
+                )
             if rho > 0 and np.isfinite(trial.cost):
                 lam *= max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3)
                 nu = 2.0
@@ -543,7 +560,27 @@ class _Solve:
             dc, dp = _step(layout, ne, lam)
             pred = _predicted_decrease(layout, ne, lam, dc, dp)
 
-    def _hold_points(self, sy: _System, ne: _Normal, trial: _System, state, cost, dc, dp):
+    def _hold_thrown(self, sy, ne, trial, state, cost, dc, dp, accepted):
+        """An accepted step that threw a few points: the same step with them held, if that
+        costs less (see :meth:`_hold_points`; ``THROWN_SHARE``). Returns ``(trial, actual,
+        pred, rho)`` of the step taken, the parameters at it.
+
+        Before the first settled iterate a Gauss–Newton step from poor initial values can
+        decrease the cost by orders of magnitude and still throw a few weakly intersected
+        points far off (at 7× the paper's pushbroom block: a cost 15 times the next
+        iterate's); the following steps are then refused because of them, the damping grows
+        by orders of magnitude and decays over many iterations (issue 29).
+        """
+        held = self._hold_points(sy, ne, trial, state, cost, dc, dp, min_share=THROWN_SHARE)
+        if held is not None and held[0].cost < trial.cost:
+            return held
+        self.layout.set_state(state)
+        self.layout.apply(dc, dp)  # back at the accepted step
+        return accepted
+
+    def _hold_points(
+        self, sy: _System, ne: _Normal, trial: _System, state, cost, dc, dp, min_share=None
+    ):
         """Retry a refused step with the few points that refused it held where they are.
 
         A Gauss–Newton step can throw one weakly intersected point far off (a tie point with a
@@ -568,6 +605,8 @@ class _Solve:
         pos = np.sort(per_pt[per_pt > 0])[::-1]
         if not pos.size:
             return None
+        if min_share is not None and pos.sum() < min_share * trial.cost:
+            return None  # (an accepted step: its excess is not where its cost is)
         k = int(np.searchsorted(np.cumsum(pos), 0.9 * pos.sum())) + 1
         if k > max(1, dp.shape[0] // 1000):
             return None  # the model fails broadly: more damping, as usual
