@@ -178,9 +178,12 @@ def _adjust(params, blocks, opts: SolverOptions, progress) -> AdjustmentResult:
 #: Most times one point is held in place to save a refused step (see _Solve._hold_points).
 HOLD_MAX = 3
 #: An accepted step before the first settled iterate is tried again with a few points held
-#: when their rows' excess over the linear prediction is at least this share of its cost
-#: (see _Solve._hold_thrown).
-THROWN_SHARE = 0.5
+#: (at most 0.1 % of them) when their rows' excess over the linear prediction exceeds
+#: THROWN_RATIO times the points' median excess and sums to at least THROWN_SHARE of the
+#: step's cost (see _Solve._hold_thrown; at 7× the paper's pushbroom block two points carried
+#: 1.2e8 of a 7.2e7 cost, the median point 3; at 1× no point passes 1000 times the median).
+THROWN_SHARE = 0.25
+THROWN_RATIO = 1000.0
 
 
 @dataclass(frozen=True)
@@ -605,9 +608,17 @@ class _Solve:
         pos = np.sort(per_pt[per_pt > 0])[::-1]
         if not pos.size:
             return None
-        if min_share is not None and pos.sum() < min_share * trial.cost:
-            return None  # (an accepted step: its excess is not where its cost is)
-        k = int(np.searchsorted(np.cumsum(pos), 0.9 * pos.sum())) + 1
+        if min_share is not None:
+            # an accepted step: the points whose excess stands out from the points' typical
+            # excess by THROWN_RATIO, if they carry min_share of the new cost (the spread
+            # excess of every point's curvature can be as large as the thrown points' at a
+            # long block's first step: a share of the total would then name them all)
+            big = pos[pos > THROWN_RATIO * float(np.median(pos))]
+            k = big.size
+            if not k or big.sum() < min_share * trial.cost:
+                return None
+        else:
+            k = int(np.searchsorted(np.cumsum(pos), 0.9 * pos.sum())) + 1
         if k > max(1, dp.shape[0] // 1000):
             return None  # the model fails broadly: more damping, as usual
         held = np.argsort(-per_pt, kind="stable")[:k]
