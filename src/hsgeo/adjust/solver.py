@@ -21,6 +21,12 @@ Gauss–Newton with Levenberg–Marquardt damping on the whitened observation eq
   every iteration from a settled iterate on (``reject_every_iteration``, as 002 §3.4 does);
 * from a settled iterate on, the compiled path takes chord steps (the last reduced matrix
   reused) and forms the matrix again at the final iterate;
+* a refused step is retried with the few points that refused it held; before the first
+  settled iterate, an accepted step that threw a few points far off is taken with them held
+  when that costs less (:meth:`_Solve._hold_thrown`);
+* optionally a robust loss until the first settled iterate (``robust_start``,
+  :mod:`hsgeo.adjust.loss`), least squares after it;
+* the seconds of each phase are in ``AdjustmentResult.seconds_split``;
 * the a-posteriori σ0 and the covariance of the non-point parameters (points on request) are in
   the :class:`~hsgeo.adjust.result.AdjustmentResult`.
 
