@@ -112,6 +112,12 @@ class SolverOptions:
         Form the normal equations with the compiled row-compressed kernels
         (:mod:`hsgeo.adjust._fast`); ``False``: the generic scipy.sparse path (same equations,
         no chord steps; for tests and debugging).
+    fused : bool, default True
+        On the compiled path, let residual blocks that can (``ResidualBlock.evaluate_into``,
+        e.g. :class:`~hsgeo.sensors.pushbroom.PushbroomLines`) write their whitened
+        derivatives straight into the engine's row-compressed arrays instead of returning a
+        Jacobian the engine copies; ``False``: every block through its ``evaluate`` (the
+        reference the tests compare against; same equations).
     keep_jacobian : bool, default False
         Keep the Jacobian of the final iterate in the result, which
         :meth:`~hsgeo.adjust.AdjustmentResult.point_covariance` (and ``sigma`` of the points)
@@ -155,6 +161,7 @@ class SolverOptions:
     rank_rtol: float = 1e-11
     raise_on_failure: bool = True
     compiled: bool = True
+    fused: bool = True
     keep_jacobian: bool = False
     threads: int | str = "auto"
     blas_threads: int = 1
@@ -220,6 +227,7 @@ class SolverOptions:
             "check_datum",
             "raise_on_failure",
             "compiled",
+            "fused",
             "keep_jacobian",
             "hold_points",
         ):

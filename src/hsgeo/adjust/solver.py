@@ -261,6 +261,7 @@ class _Solve:
             compiled=opts.compiled,
             clock=self.clock,
             loss=(opts.robust_start, opts.robust_start_k, None) if self.loss_on else None,
+            fused=opts.fused,
         )
         self.loss_c = sy.loss_c
         if check_redundancy:

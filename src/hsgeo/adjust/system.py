@@ -392,23 +392,40 @@ def _prior_rows(layout: _Layout, jacobian: bool, r_parts, slot_parts, pidx_parts
     return n
 
 
-def _assemble(layout: _Layout, slot_parts, pidx_parts, jp_parts, M: int, factored_k):
+def _assemble(
+    layout: _Layout, slot_parts, pidx_parts, jp_parts, M: int, factored_k, values=None, clock=None
+):
     """One (M, K) row-compressed matrix: each part's slots side by side, padded to the widest;
-    returns ``(Jrc, pidx, Jp)``.
+    returns ``(Jrc, pidx, Jp)``. A :class:`_FusedPart` is evaluated here, into its rows.
     """
-    K = max([sum(sl.width for sl in part) for part in slot_parts] + [1])
+    from hsgeo.adjust._fused import _FusedPart
+
+    def parts_of(part):
+        return [part] if isinstance(part, _FusedPart) else part
+
+    K = max([sum(sl.width for sl in parts_of(part)) for part in slot_parts] + [1])
     itype = np.int32 if layout.n_c < 2**31 else np.int64
     cols_all = np.empty((M, K), dtype=itype)
     vals_all = np.empty((M, K))
-    Q = max([sl.qk[0] for part in slot_parts for sl in part if sl.factored] + [0])
+    Q = max([sl.qk[0] for part in slot_parts for sl in parts_of(part) if sl.factored] + [0])
     Kf = factored_k if Q else 0
     fcol = np.full((M, Q), -1, dtype=itype)
     fw = np.zeros((M, Q))
     fd = np.zeros((M, Kf))
+    pidx = np.empty(M, dtype=np.int64)
+    Jp = np.empty((M, layout.p))
     row0 = 0
-    for part, pi in zip(slot_parts, pidx_parts, strict=True):
+    for part, pi, jp in zip(slot_parts, pidx_parts, jp_parts, strict=True):
         n = pi.size
+        rs = slice(row0, row0 + n)
+        pidx[rs] = pi
         k0 = 0
+        if isinstance(part, _FusedPart):
+            part.fill(values, cols_all[rs], vals_all[rs], fcol[rs], fw[rs], fd[rs], Jp[rs], clock)
+            k0 = part.width
+            part = []
+        else:
+            Jp[rs] = jp
         for sl in part:
             if sl.factored:
                 sl.fill_factored(fcol[row0 : row0 + n], fw[row0 : row0 + n], fd[row0 : row0 + n])
@@ -424,8 +441,6 @@ def _assemble(layout: _Layout, slot_parts, pidx_parts, jp_parts, M: int, factore
         row0 += n
     if layout.tie_blocks:
         _merge_tied_columns(cols_all, vals_all)
-    pidx = np.concatenate(pidx_parts) if pidx_parts else np.full(M, -1)
-    Jp = np.concatenate(jp_parts) if jp_parts else np.zeros((M, layout.p))
     Jrc = _RowJac(cols_all, vals_all, layout.n_c, *((fcol, fw, fd) if Q else ()))
     return Jrc, pidx, Jp
 
@@ -438,6 +453,7 @@ def _evaluate(
     compiled: bool = True,
     clock: _Clock | None = None,
     loss: tuple | None = None,
+    fused: bool = True,
 ) -> _System:
     """Whitened residuals (and with ``jacobian`` the row-compressed Jacobian) at the current
     values of ``layout.params``; rows of ``masks[i] == False`` are left out. ``compiled``
@@ -448,7 +464,12 @@ def _evaluate(
     (:mod:`hsgeo.adjust.loss`), with the scale of each block index in ``scales`` (None: ``k``
     robust σ of the residuals here); with ``jacobian`` rows are scaled by ``√ρ′`` and the
     system carries the robust cost, otherwise by ``√(ρ/s)`` (``½ ‖r‖²`` is that cost).
+
+    ``fused`` (compiled, no loss): blocks with ``evaluate_into`` write their rows themselves
+    (:class:`_FusedPart`), evaluated in :func:`_assemble`.
     """
+    from hsgeo.adjust._fused import _FusedPart
+
     clock = clock or _Clock()
     t = time.perf_counter()
     values = layout.params.values()
@@ -459,6 +480,18 @@ def _evaluate(
     loss_c, rho_sum = {}, 0.0
     for ib, (blk, keep) in enumerate(zip(blocks, masks, strict=True)):
         t = clock.add("jacobian", t)
+        spec = None
+        if jacobian and fused and compiled and loss is None:
+            spec = _FusedPart.spec_of(layout, blk, keep, factored_k)
+        if spec is not None:
+            part = _FusedPart(layout, blk, ib, keep, 1.0 / blk.sigma, spec)
+            factored_k = part.qk[1]
+            r_parts.append(part.r_kept)
+            slot_parts.append(part)
+            pidx_parts.append(part.pidx)
+            jp_parts.append(None)
+            offset += part.rows.size
+            continue
         r, jac = _block_residuals(blk, values, jacobian)
         t = clock.add("model", t)
         w = 1.0 / blk.sigma
@@ -501,16 +534,24 @@ def _evaluate(
         offset += rows_kept.size
     n_obs_rows = offset
     offset += _prior_rows(layout, jacobian, r_parts, slot_parts, pidx_parts, jp_parts)
-    r_all = np.concatenate(r_parts) if r_parts else np.zeros(0)
-    robust = None
-    if loss is not None and jacobian:
-        prior = r_all[n_obs_rows:]
-        robust = 0.5 * (rho_sum + float(prior @ prior))
     lc = loss_c if loss is not None else None
     if not jacobian:
+        r_all = np.concatenate(r_parts) if r_parts else np.zeros(0)
         clock.add("model", t)
         return _System(r_all, None, None, None, n_obs_rows, lc)
-    Jrc, pidx, Jp = _assemble(layout, slot_parts, pidx_parts, jp_parts, offset, factored_k)
+    model0 = clock.seconds.get("model", 0.0)
+    Jrc, pidx, Jp = _assemble(
+        layout, slot_parts, pidx_parts, jp_parts, offset, factored_k, values, clock
+    )
+    # the fused parts' evaluation went to "model": not the assembly's too
+    clock.seconds["jacobian"] = clock.seconds.get("jacobian", 0.0) - (
+        clock.seconds.get("model", 0.0) - model0
+    )
+    r_all = np.concatenate(r_parts) if r_parts else np.zeros(0)  # after the fused parts
+    robust = None
+    if loss is not None:
+        prior = r_all[n_obs_rows:]
+        robust = 0.5 * (rho_sum + float(prior @ prior))
     clock.add("jacobian", t)
     return _System(r_all, Jrc, pidx, Jp, n_obs_rows, lc, robust)
 
