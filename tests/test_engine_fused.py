@@ -58,6 +58,10 @@ def test_fused_system_equals_generic(tiny, y_as_time, share, fixed):
     np.testing.assert_array_equal(a.pidx, b.pidx)
     np.testing.assert_array_equal(a.r, b.r)
     assert a.n_obs_rows == b.n_obs_rows
+    # the gradient and diagonal accumulated in the block's pass against a pass over the rows
+    assert a.gd_parts and not b.gd_parts
+    for x, y in zip(a.gradient_diag(), b.gradient_diag(), strict=True):
+        np.testing.assert_allclose(x, y, rtol=1e-12, atol=1e-12 * np.max(np.abs(y)))
     if fixed:
         assert (a.Jrc.cols == -1).any() and np.all(a.Jrc.vals[a.Jrc.cols < 0] == 0.0)
 

@@ -17,7 +17,6 @@ import time
 import numpy as np
 
 from hsgeo.adjust.residuals import ResidualBlock
-from hsgeo.adjust.system import _Clock, _Layout, _NonFinite
 
 __all__: list[str] = []
 
@@ -33,7 +32,7 @@ class _FusedPart:
     indices are the engine's (from the layout), as on the generic path.
     """
 
-    def __init__(self, layout: _Layout, blk: ResidualBlock, ib: int, keep, w, spec: dict):
+    def __init__(self, layout, blk: ResidualBlock, ib: int, keep, w, spec: dict):
         self.blk, self.spec, self.layout = blk, spec, layout
         pair = keep[0::2]
         self.dst = np.where(pair, np.cumsum(pair) - 1, -1).astype(np.int64)
@@ -49,9 +48,13 @@ class _FusedPart:
         layout.row_point[ib] = pidx
         self.pidx = pidx.take(self.rows)
         self.r_kept = np.empty(self.rows.size)  # filled by fill (the _System's residuals)
+        #: after fill: the gradient and diagonal of the non-point unknowns over these rows,
+        #: accumulated by the block's pass (see _System.gd_parts), and the rows' range
+        self.g = self.d = None
+        self.row_range = (0, 0)
 
     @staticmethod
-    def spec_of(layout: _Layout, blk: ResidualBlock, keep, factored_k) -> dict | None:
+    def spec_of(layout, blk: ResidualBlock, keep, factored_k) -> dict | None:
         """The block's ``fused_spec()`` if the fused path applies to it here, else None."""
         if not hasattr(blk, "evaluate_into") or blk.group_size != 2:
             return None
@@ -74,18 +77,28 @@ class _FusedPart:
             return None
         return spec
 
-    def fill(self, values, cols, vals, fcol, fw, fd, jp, clock: _Clock) -> None:
+    def fill(self, values, cols, vals, fcol, fw, fd, jp, clock) -> None:
         """Evaluate the block into the part's rows of the arrays (see :func:`_assemble`)."""
         t = time.perf_counter()
         blk, layout = self.blk, self.layout
         r = np.empty(blk.m)
         w = self.width
         q, k = self.qk
-        blk.evaluate_into(values, self.dst, self.w, r, jp, vals[:, :w], fw[:, :q], fd[:, :k])
+        dense = [layout.colmap[nm] for nm, index in self.spec["slots"] if index is None]
+        indexed = [layout.colmap[nm] for nm, index in self.spec["slots"] if index is not None]
+        cols_of = (
+            np.concatenate(dense).astype(np.int64),
+            indexed[0].astype(np.int64),
+            int(layout.colmap[self.spec["factored"][0]][0]),
+        )
+        gd = np.zeros((2, 64 if blk.m > 12800 else 1, layout.n_c))
+        blk.evaluate_into(
+            values, self.dst, self.w, r, jp, vals[:, :w], fw[:, :q], fd[:, :k], gd, cols_of
+        )
+        # the chunks summed in a fixed order: the same bits for any number of threads
+        self.g, self.d = gd.sum(axis=1)
         clock.add("model", t)  # (the rest is the caller's "jacobian")
-        if not np.all(np.isfinite(r)):
-            bad = np.flatnonzero(~np.isfinite(r))[:5].tolist()
-            raise _NonFinite(f"residual block {blk.name!r} produced non-finite residuals at {bad}")
+        self.nonfinite = np.flatnonzero(~np.isfinite(r))[:5]  # checked by system._assemble
         np.multiply(r.take(self.rows), self.w.take(self.rows), out=self.r_kept)
         fname, fidx, _ = self.spec["factored"]
         fi = fidx.take(self.rows, axis=0)

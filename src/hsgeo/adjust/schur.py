@@ -193,7 +193,7 @@ def _normal_equations(layout, sy, options, orders) -> _Normal:
         orders = orders or _OrderCache()
         order, ptr, row_order, pt_order = orders.get(layout, sy)
         Jrc = sy.Jrc
-        gc, diag_cc = Jrc.rmatvec(sy.r, diag=True)
+        gc, diag_cc = sy.gradient_diag()  # (accumulated by the fused blocks' pass)
         if layout.pblock is None:
             Ncc = normal_cc(Jrc.arrays, layout.n_c, row_order)
             return _Normal(Ncc, gc, None, None, diag_cc=diag_cc, options=options)

@@ -190,6 +190,33 @@ class _System:
     #: at a linearisation (rows scaled by √ρ′), the robust cost ½ Σ ρ (None: ½ ‖r‖²)
     loss_c: dict | None = None
     robust_cost: float | None = None
+    #: ``(row0, row1, g, d)`` of rows whose gradient ``Jᵀ r`` and diagonal ``diag(JᵀJ)`` of
+    #: the non-point unknowns the fused path accumulated already (see :meth:`gradient_diag`)
+    gd_parts: list | None = None
+
+    def gradient_diag(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(J_cᵀ r, diag(J_cᵀ J_c))`` (compiled path): the fused parts' sums, the other rows
+        by one pass over them.
+        """
+        if not self.gd_parts:
+            return self.Jrc.rmatvec(self.r, diag=True)
+        from hsgeo.adjust._fast import rmatvec_diag
+
+        n_c = self.Jrc.n_cols
+        g, d = np.zeros(n_c), np.zeros(n_c)
+        row = 0
+        spans = sorted(self.gd_parts, key=lambda x: x[0])
+        for r0, r1, gp, dp in [*spans, (self.r.size, self.r.size, None, None)]:
+            if r0 > row:  # rows between the fused parts
+                arr = [a[row:r0] for a in self.Jrc.arrays]
+                gr, dr = rmatvec_diag(*arr, np.ascontiguousarray(self.r[row:r0]), n_c, True)
+                g += gr
+                d += dr
+            if gp is not None:
+                g += gp
+                d += dp
+            row = r1
+        return g, d
 
     @property
     def cost(self) -> float:
@@ -421,7 +448,13 @@ def _assemble(
         pidx[rs] = pi
         k0 = 0
         if isinstance(part, _FusedPart):
+            part.row_range = (row0, row0 + n)
             part.fill(values, cols_all[rs], vals_all[rs], fcol[rs], fw[rs], fd[rs], Jp[rs], clock)
+            if part.nonfinite.size:
+                raise _NonFinite(
+                    f"residual block {part.blk.name!r} produced non-finite residuals at rows "
+                    f"{part.nonfinite.tolist()}"
+                )
             k0 = part.width
             part = []
         else:
@@ -552,8 +585,9 @@ def _evaluate(
     if loss is not None:
         prior = r_all[n_obs_rows:]
         robust = 0.5 * (rho_sum + float(prior @ prior))
+    gd_parts = [(*sl.row_range, sl.g, sl.d) for sl in slot_parts if isinstance(sl, _FusedPart)]
     clock.add("jacobian", t)
-    return _System(r_all, Jrc, pidx, Jp, n_obs_rows, lc, robust)
+    return _System(r_all, Jrc, pidx, Jp, n_obs_rows, lc, robust, gd_parts)
 
 
 def _robust_rows(loss, ib: int, blk: ResidualBlock, w, rw, keep, jacobian: bool):

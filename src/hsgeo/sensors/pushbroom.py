@@ -258,6 +258,10 @@ class PushbroomObservations:
         return self.xyz_rate_nav_m_s is not None
 
 
+#: ``cols`` of PushbroomLines._kernel when no gradient is accumulated
+_NO_COLS = (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), 0)
+
+
 class PushbroomLines(ResidualBlock):
     """Image observations of tie points in LP lines (002 eq. 2–4) as a residual block.
 
@@ -536,7 +540,7 @@ class PushbroomLines(ResidualBlock):
             ],
         }
 
-    def evaluate_into(self, values, dst, w_row, r, jp, vals, fw, fd) -> None:
+    def evaluate_into(self, values, dst, w_row, r, jp, vals, fw, fd, gd=None, cols=None):
         """:meth:`evaluate` writing the whitened derivatives straight into the engine's arrays.
 
         Parameters
@@ -561,12 +565,20 @@ class PushbroomLines(ResidualBlock):
         fd : (n, 6) ndarray
             Out: whitened derivatives w.r.t. the trajectory correction at the crossing time;
             the node columns are ``fw × fd``.
+        gd : (2, n_chunks, n_c) ndarray, optional
+            Out (zeroed by the caller): per chunk of observations, the gradient ``Jᵀ r``
+            (``gd[0]``) and the diagonal ``diag(JᵀJ)`` (``gd[1]``) of the engine's non-point
+            unknowns over the rows written, accumulated in the same pass.
+        cols : tuple, optional
+            With ``gd``: ``(cam_cols (10,), c_cols (n_bands,), node_c0)``, the engine's
+            columns of the boresight, lever arm and distortion entries, of each band's
+            principal distance (-1: fixed) and of the first node entry.
         """
         m = self.point.size
         derivs = (jp, fd, vals[:, 0:3], vals[:, 3:6], vals[:, 6:10], vals[:, 10:11])
-        self._kernel(values, True, r, np.empty((m, 4)), derivs, dst, w_row, fw)
+        self._kernel(values, True, r, np.empty((m, 4)), derivs, dst, w_row, fw, gd, cols)
 
-    def _kernel(self, values, jacobian, r, w_out, derivs, dst, w_row, fw) -> None:
+    def _kernel(self, values, jacobian, r, w_out, derivs, dst, w_row, fw, gd=None, cols=None):
         """One call of the compiled kernel (see ``_pushbroom_kernel._lines_kernel``)."""
         nm = self.blocks
         idx = self._basis[0]
@@ -605,6 +617,8 @@ class PushbroomLines(ResidualBlock):
             dst,
             w_row,
             fw,
+            np.zeros((2, 0, 0)) if gd is None else gd,
+            *(_NO_COLS if cols is None else cols),
         )
 
 
