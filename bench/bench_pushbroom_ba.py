@@ -277,15 +277,37 @@ def scaling(scales, seed, out_path, timeout=3600, robust_start=None):
         "peak_rss_mb is the process peak, peak_rss_mb_before_solve the peak of the simulation "
         "and the problem set-up (the observations and the truth freed before the solve); "
         "seconds_split: where solver_seconds went (AdjustmentResult.seconds_split: model = "
-        "the LP block's own evaluation, jacobian = whitening into the row-compressed arrays, "
+        "the LP block's own evaluation, on the fused path with the whitened derivatives "
+        "written into the engine's arrays and their gradient and diagonal; jacobian = the rest "
+        "of the row-compressed arrays (column indices, priors), "
         "formation = gradient, diagonal, point blocks and reduced matrix, solve = Cholesky "
         "and back-substitution); check_point_nmad_enh_m: NMAD of the 13 check points' "
         "errors E, N, H (m); *_per_1x: ratios to this run's scale-1 row",
         "machine": _machine(load0),
         "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
         "seed": seed,
+        "commit": _commit(),
     }
     return _write(out, out_path)
+
+
+def _commit() -> str | None:
+    """The checkout's commit (with ``+`` if it has uncommitted changes), None outside git."""
+    try:
+        head = subprocess.run(
+            ["git", "rev-parse", "--short", "HEAD"], cwd=HERE, capture_output=True, text=True
+        )
+        dirty = subprocess.run(
+            ["git", "status", "--porcelain", "--untracked-files=no"],
+            cwd=HERE,
+            capture_output=True,
+            text=True,
+        )
+    except OSError:
+        return None
+    if head.returncode:
+        return None
+    return head.stdout.strip() + ("+" if dirty.stdout.strip() else "")
 
 
 def _machine(load0):

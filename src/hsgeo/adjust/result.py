@@ -50,7 +50,9 @@ class AdjustmentResult:
         (flattened; -1 where fixed).
     seconds_split : dict of str to float
         Where ``seconds`` went: ``model`` (the residual blocks' own evaluation, residuals and
-        derivatives), ``jacobian`` (whitening them into the engine's row-compressed arrays),
+        derivatives; on the fused path, ``SolverOptions.fused``, also their whitening into the
+        engine's arrays and the gradient and diagonal of those rows), ``jacobian`` (whitening
+        the other blocks' derivatives into the engine's row-compressed arrays, the columns),
         ``formation`` (gradient, diagonal, point blocks and the reduced matrix), ``solve``
         (its factorisation and the back-substitution), ``rejection`` (outlier tests),
         ``datum`` (the rank check) and ``covariance`` (``S⁻¹`` at the solution); the rest is

@@ -26,6 +26,8 @@ Gauss–Newton with Levenberg–Marquardt damping on the whitened observation eq
   when that costs less (:meth:`_Solve._hold_thrown`);
 * optionally a robust loss until the first settled iterate (``robust_start``,
   :mod:`hsgeo.adjust.loss`), least squares after it;
+* blocks that can write their whitened rows themselves (``fused``, :mod:`hsgeo.adjust._fused`)
+  do so, with the gradient and diagonal of those rows, in their own pass;
 * the seconds of each phase are in ``AdjustmentResult.seconds_split``;
 * the a-posteriori σ0 and the covariance of the non-point parameters (points on request) are in
   the :class:`~hsgeo.adjust.result.AdjustmentResult`.
