@@ -714,8 +714,8 @@ def test_points_held_to_save_a_refused_step(monkeypatch):
 
     counts = []
 
-    def spy(self, *a):
-        out = orig(self, *a)
+    def spy(self, *a, **kw):
+        out = orig(self, *a, **kw)
         held.append(out is not None)
         counts.append(max(self.hold_count.values(), default=0))
         return out

@@ -48,6 +48,15 @@ class AdjustmentResult:
     columns : dict of str to ndarray
         For each non-point block, the index in ``labels``/``covariance`` of each entry
         (flattened; -1 where fixed).
+    seconds_split : dict of str to float
+        Where ``seconds`` went: ``model`` (the residual blocks' own evaluation, residuals and
+        derivatives; on the fused path, ``SolverOptions.fused``, also their whitening into the
+        engine's arrays and the gradient and diagonal of those rows), ``jacobian`` (whitening
+        the other blocks' derivatives into the engine's row-compressed arrays, the columns),
+        ``formation`` (gradient, diagonal, point blocks and the reduced matrix), ``solve``
+        (its factorisation and the back-substitution), ``rejection`` (outlier tests),
+        ``datum`` (the rank check) and ``covariance`` (``S⁻¹`` at the solution); the rest is
+        ``other``.
     """
 
     params: Parameters
@@ -70,6 +79,7 @@ class AdjustmentResult:
     #: ``f(points, chunk)`` → the points' cofactor blocks (None: the Jacobian was not kept)
     _point_cofactors: Callable | None = field(default=None, repr=False)
     _point_cov: np.ndarray | None = field(default=None, repr=False)
+    seconds_split: dict = field(default_factory=dict, repr=False)
 
     # -- estimates and their σ ----------------------------------------------------------------
     def value(self, name: str) -> np.ndarray:

@@ -14,6 +14,7 @@ Two paths form the same equations: the compiled row-compressed kernels
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
@@ -24,7 +25,7 @@ import scipy.sparse as sp
 from scipy.linalg import lapack
 
 from hsgeo.adjust.options import SolverOptions
-from hsgeo.adjust.system import _Layout, _System
+from hsgeo.adjust.system import _Clock, _Layout, _System
 
 __all__: list[str] = []
 
@@ -48,6 +49,7 @@ class _Normal:
     D_c: np.ndarray | None = None  # damping diagonal of the non-point unknowns (None: diag N_cc)
     options: SolverOptions = SolverOptions()  # compiled path, lambda_points_min
     orders: _OrderCache | None = None  # keeps the Schur kernel's pattern between formations
+    clock: _Clock | None = None  # seconds of the formation and the solve (see _step)
 
     @property
     def compiled_schur(self) -> bool:
@@ -162,12 +164,27 @@ class _OrderCache:
 
 
 def _normal(
-    layout: _Layout, sy: _System, options: SolverOptions, orders: _OrderCache | None = None
+    layout: _Layout,
+    sy: _System,
+    options: SolverOptions,
+    orders: _OrderCache | None = None,
+    clock: _Clock | None = None,
 ) -> _Normal:
     """The normal equations at ``sy`` (compiled or generic path, see ``options.compiled``).
 
-    ``orders`` carries the processing orders from one call to the next (a new cache if None).
+    ``orders`` carries the processing orders from one call to the next (a new cache if None);
+    ``clock`` takes the seconds (``formation``) and goes with the result to :func:`_step`.
     """
+    clock = clock or _Clock()
+    t0 = time.perf_counter()
+    ne = _normal_equations(layout, sy, options, orders)
+    ne.clock = clock
+    clock.add("formation", t0)
+    return ne
+
+
+def _normal_equations(layout, sy, options, orders) -> _Normal:
+    """:func:`_normal` without the clock."""
     order = ptr = pt_order = None
     compiled = options.compiled
     if compiled:
@@ -176,7 +193,7 @@ def _normal(
         orders = orders or _OrderCache()
         order, ptr, row_order, pt_order = orders.get(layout, sy)
         Jrc = sy.Jrc
-        gc, diag_cc = Jrc.rmatvec(sy.r, diag=True)
+        gc, diag_cc = sy.gradient_diag()  # (accumulated by the fused blocks' pass)
         if layout.pblock is None:
             Ncc = normal_cc(Jrc.arrays, layout.n_c, row_order)
             return _Normal(Ncc, gc, None, None, diag_cc=diag_cc, options=options)
@@ -352,7 +369,13 @@ def _reduced(layout: _Layout, ne: _Normal, lam: float):
 
 
 def _step(layout: _Layout, ne: _Normal, lam: float):
+    """The damped step ``(dc, dp)`` at λ (the reduced matrix formed or taken from the cache,
+    factorised, and the points back-substituted); its seconds go to ``ne.clock``.
+    """
+    clock = ne.clock or _Clock()
+    t = time.perf_counter()
     S, rhs, Vinv, _ = _reduced(layout, ne, lam)
+    t = clock.add("formation", t)
     if layout.n_c:
         try:
             dc = -sla.cho_solve(sla.cho_factor(S, check_finite=False), rhs, check_finite=False)
@@ -364,6 +387,7 @@ def _step(layout: _Layout, ne: _Normal, lam: float):
     if Vinv is not None:
         b = ne.gp + ne.Wt_dot(dc)
         dp = -np.einsum("nij,nj->ni", Vinv, b)
+    clock.add("solve", t)
     return dc, dp
 
 

@@ -21,6 +21,14 @@ Gauss–Newton with Levenberg–Marquardt damping on the whitened observation eq
   every iteration from a settled iterate on (``reject_every_iteration``, as 002 §3.4 does);
 * from a settled iterate on, the compiled path takes chord steps (the last reduced matrix
   reused) and forms the matrix again at the final iterate;
+* a refused step is retried with the few points that refused it held; before the first
+  settled iterate, an accepted step that threw a few points far off is taken with them held
+  when that costs less (:meth:`_Solve._hold_thrown`);
+* optionally a robust loss until the first settled iterate (``robust_start``,
+  :mod:`hsgeo.adjust.loss`), least squares after it;
+* blocks that can write their whitened rows themselves (``fused``, :mod:`hsgeo.adjust._fused`)
+  do so, with the gradient and diagonal of those rows, in their own pass;
+* the seconds of each phase are in ``AdjustmentResult.seconds_split``;
 * the a-posteriori σ0 and the covariance of the non-point parameters (points on request) are in
   the :class:`~hsgeo.adjust.result.AdjustmentResult`.
 
@@ -64,7 +72,7 @@ from hsgeo.adjust.schur import (
     _reduced_inverse,
     _step,
 )
-from hsgeo.adjust.system import _evaluate, _Layout, _NonFinite, _System
+from hsgeo.adjust.system import _Clock, _evaluate, _Layout, _NonFinite, _System
 from hsgeo.adjust.threads import engine_threads
 from hsgeo.errors import ConvergenceError, DatumError, InputError, ObservationError
 
@@ -177,6 +185,13 @@ def _adjust(params, blocks, opts: SolverOptions, progress) -> AdjustmentResult:
 
 #: Most times one point is held in place to save a refused step (see _Solve._hold_points).
 HOLD_MAX = 3
+#: An accepted step before the first settled iterate is tried again with a few points held
+#: (at most 0.1 % of them) when their rows' excess over the linear prediction exceeds
+#: THROWN_RATIO times the points' median excess and sums to at least THROWN_SHARE of the
+#: step's cost (see _Solve._hold_thrown; at 7× the paper's pushbroom block two points carried
+#: 1.2e8 of a 7.2e7 cost, the median point 3; at 1× no point passes 1000 times the median).
+THROWN_SHARE = 0.25
+THROWN_RATIO = 1000.0
 
 
 @dataclass(frozen=True)
@@ -229,14 +244,28 @@ class _Solve:
         self.each = options.reject_k is not None and options.reject_every_iteration
         self.D_max: np.ndarray | None = None  # damping_diagonal="max": the running maximum
         self.hold_count: dict[int, int] = {}  # times each point was held (at most HOLD_MAX)
+        self.settled_seen = False  # an iterate was settled (accepted steps no longer held)
+        self.clock = _Clock()  # AdjustmentResult.seconds_split
+        #: SolverOptions.robust_start: the loss until the first settled iterate, and the
+        #: scales of the last linearisation (the trial steps are costed with the same)
+        self.loss_on = options.robust_start is not None
+        self.loss_c: dict | None = None
 
     # -- the linearised system -------------------------------------------------------------
     def linearise(self, check_redundancy: bool = False) -> tuple[_System, _Normal]:
         """The whitened system and its normal equations at the current values."""
-        layout = self.layout
+        layout, opts = self.layout, self.options
         sy = _evaluate(
-            layout, self.blocks, self.masks, jacobian=True, compiled=self.options.compiled
+            layout,
+            self.blocks,
+            self.masks,
+            jacobian=True,
+            compiled=opts.compiled,
+            clock=self.clock,
+            loss=(opts.robust_start, opts.robust_start_k, None) if self.loss_on else None,
+            fused=opts.fused,
         )
+        self.loss_c = sy.loss_c
         if check_redundancy:
             dof = sy.r.size - layout.n_unknowns
             if dof < 0 or (dof == 0 and sy.n_obs_rows < layout.n_unknowns):
@@ -245,11 +274,24 @@ class _Solve:
                     f"unknowns ({layout.n_unknowns}): add observations, fix parameters or add "
                     "priors"
                 )
-        return sy, _normal(layout, sy, self.options, self.orders)
+        return sy, _normal(layout, sy, self.options, self.orders, self.clock)
+
+    def trial(self) -> _System:
+        """The residuals at the current values (no Jacobian), under the loss of the last
+        linearisation if the robust start is on; raises ``_NonFinite``.
+        """
+        opts = self.options
+        loss = None
+        if self.loss_on and self.loss_c is not None:
+            loss = (opts.robust_start, opts.robust_start_k, self.loss_c)
+        return _evaluate(
+            self.layout, self.blocks, self.masks, False, opts.compiled, self.clock, loss
+        )
 
     def reject(self, residuals: _System, sy: _System, ne: _Normal) -> bool:
         """Test the residuals of ``residuals`` (leverages from ``sy``, ``ne``); see robust."""
-        return _reject(
+        t0 = time.perf_counter()
+        out = _reject(
             self.blocks,
             self.masks,
             residuals,
@@ -257,6 +299,8 @@ class _Solve:
             self.layout.row_point,
             _leverage(ne, sy),
         )
+        self.clock.add("rejection", t0)
+        return out
 
     # -- one pass of the Levenberg–Marquardt loop -------------------------------------------
     def minimise(self, tol: float, check_datum: bool = False):
@@ -270,7 +314,9 @@ class _Solve:
         sy, ne = self.linearise(check_redundancy=True)
         self._damping_diagonal(ne)
         if check_datum:
+            t0 = time.perf_counter()
             _check_datum(self.layout, ne, opts.rank_rtol)
+            self.clock.add("datum", t0)
         lam, nu = opts.lambda0, 2.0
         cost = sy.cost
         self.history.append(cost)
@@ -278,10 +324,19 @@ class _Solve:
         tested = False  # each-iteration mode: the current point passed the rejection test
         n_iter = 0
         while True:
-            if cost <= opts.atol * sy.r.size:
+            if cost <= opts.atol * sy.r.size and not self.loss_on:
                 return _Outcome(True, "cost below atol (noise-free data)"), sy, ne
             dc, dp, pred = self._gauss_newton_step(ne, lam, tol, cost)
-            if self._converged(ne, lam, pred, tol, cost) and self._small_step(dc, dp):
+            converged = self._converged(ne, lam, pred, tol, cost) and self._small_step(dc, dp)
+            if self.loss_on and converged:
+                # the robust start ends at its own minimum: least squares from here on
+                self.loss_on = False
+                sy = ne = None
+                sy, ne = self.linearise()
+                self._damping_diagonal(ne)
+                cost = sy.cost
+                continue
+            if converged:
                 # converged before any rejection test (e.g. at the initial values)
                 if self.each and not tested and self.reject(sy, sy, ne):
                     return _Outcome(False, "", rejected=True), sy, ne
@@ -298,6 +353,13 @@ class _Solve:
             self.total_iter += 1
             step = self._damped_step(ne, cost, lam, nu, dc, dp, pred, sy)
             lam, nu = step.lam, step.nu
+            if lam > opts.lambda_max and self.loss_on:
+                self.loss_on = False  # the robust start ends here: least squares from here on
+                sy = ne = step = None
+                sy, ne = self.linearise()
+                self._damping_diagonal(ne)
+                lam, nu, cost = opts.lambda0, 2.0, sy.cost
+                continue
             if lam > opts.lambda_max:
                 # no step decreases the cost: we are at the minimum to machine precision
                 ok = step.pred <= 1e3 * tol * max(cost, 1e-300) or cost <= opts.atol * sy.r.size
@@ -315,6 +377,14 @@ class _Solve:
             self.history.append(new_cost)
             tested = False
             settled = _settled(step.actual, step.pred, new_cost, opts.settled)
+            self.settled_seen = self.settled_seen or settled
+            switched = self.loss_on and settled
+            if switched:
+                # the robust start ends at the first settled iterate: from here on least
+                # squares, and the rejection tests the plain residuals
+                self.loss_on = False
+                step.system = self.trial()
+                self.history[-1] = new_cost = step.system.cost
             if self.each and (rejecting or settled):
                 # 002 §3.4: outliers are rejected in each iteration, on the residuals at the
                 # new point, from the first settled iterate: before that, residuals reflect
@@ -328,7 +398,7 @@ class _Solve:
             # where the convergence test passes, or when a chord step fails
             chord = (
                 ne.reduced0[0]
-                if settled and ne.compiled_schur and ne.reduced0 is not None
+                if settled and not switched and ne.compiled_schur and ne.reduced0 is not None
                 else None
             )
             sy = ne = step = None  # free the old Jacobian before forming the new one
@@ -461,9 +531,7 @@ class _Solve:
                 dc, pred = acc
             layout.apply(dc, dp)
             try:
-                trial = _evaluate(
-                    layout, self.blocks, self.masks, jacobian=False, compiled=self.options.compiled
-                )
+                trial = self.trial()
             except _NonFinite:
                 # the step left the model's domain (an overflow, a log of a negative): a step
                 # that does not decrease the cost, refused like one
@@ -478,6 +546,17 @@ class _Solve:
                 held = self._hold_points(sy, ne, trial, state, cost, dc, dp)
                 if held is not None:
                     trial, actual, pred, rho = held
+            if (
+                rho > 0
+                and np.isfinite(trial.cost)
+                and sy is not None
+                and self.options.hold_points
+                and not self.settled_seen
+                and ne.S_chord is None
+            ):
+                trial, actual, pred, rho = self._hold_thrown(
+                    sy, ne, trial, state, cost, dc, dp, (trial, actual, pred, rho)
+                )
             if rho > 0 and np.isfinite(trial.cost):
                 lam *= max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3)
                 nu = 2.0
@@ -493,7 +572,27 @@ class _Solve:
             dc, dp = _step(layout, ne, lam)
             pred = _predicted_decrease(layout, ne, lam, dc, dp)
 
-    def _hold_points(self, sy: _System, ne: _Normal, trial: _System, state, cost, dc, dp):
+    def _hold_thrown(self, sy, ne, trial, state, cost, dc, dp, accepted):
+        """An accepted step that threw a few points: the same step with them held, if that
+        costs less (see :meth:`_hold_points`; ``THROWN_SHARE``). Returns ``(trial, actual,
+        pred, rho)`` of the step taken, the parameters at it.
+
+        Before the first settled iterate a Gauss–Newton step from poor initial values can
+        decrease the cost by orders of magnitude and still throw a few weakly intersected
+        points far off (at 7× the paper's pushbroom block: a cost 15 times the next
+        iterate's); the following steps are then refused because of them, the damping grows
+        by orders of magnitude and decays over many iterations (issue 29).
+        """
+        held = self._hold_points(sy, ne, trial, state, cost, dc, dp, min_share=THROWN_SHARE)
+        if held is not None and held[0].cost < trial.cost:
+            return held
+        self.layout.set_state(state)
+        self.layout.apply(dc, dp)  # back at the accepted step
+        return accepted
+
+    def _hold_points(
+        self, sy: _System, ne: _Normal, trial: _System, state, cost, dc, dp, min_share=None
+    ):
         """Retry a refused step with the few points that refused it held where they are.
 
         A Gauss–Newton step can throw one weakly intersected point far off (a tie point with a
@@ -518,7 +617,17 @@ class _Solve:
         pos = np.sort(per_pt[per_pt > 0])[::-1]
         if not pos.size:
             return None
-        k = int(np.searchsorted(np.cumsum(pos), 0.9 * pos.sum())) + 1
+        if min_share is not None:
+            # an accepted step: the points whose excess stands out from the points' typical
+            # excess by THROWN_RATIO, if they carry min_share of the new cost (the spread
+            # excess of every point's curvature can be as large as the thrown points' at a
+            # long block's first step: a share of the total would then name them all)
+            big = pos[pos > THROWN_RATIO * float(np.median(pos))]
+            k = big.size
+            if not k or big.sum() < min_share * trial.cost:
+                return None
+        else:
+            k = int(np.searchsorted(np.cumsum(pos), 0.9 * pos.sum())) + 1
         if k > max(1, dp.shape[0] // 1000):
             return None  # the model fails broadly: more damping, as usual
         held = np.argsort(-per_pt, kind="stable")[:k]
@@ -534,7 +643,7 @@ class _Solve:
         layout.set_state(state)
         layout.apply(dc, dp_h)
         try:
-            trial = _evaluate(layout, self.blocks, self.masks, False, self.options.compiled)
+            trial = self.trial()
         except _NonFinite:
             layout.set_state(state)
             return None
@@ -563,11 +672,11 @@ class _Solve:
     def result(self, sy: _System, ne: _Normal, outcome: _Outcome, rounds: int) -> AdjustmentResult:
         """σ0, covariance and residuals at the final iterate, as an :class:`AdjustmentResult`."""
         layout, blocks = self.layout, self.blocks
-        seconds = time.perf_counter() - self.t0
         n_unk = layout.n_unknowns
         dof = int(sy.r.size - n_unk)
         vtpv = float(sy.r @ sy.r)
         sigma0 = float(np.sqrt(vtpv / dof)) if dof > 0 else float("nan")
+        t_cov = time.perf_counter()
         try:
             S_inv = _reduced_inverse(layout, ne)
         except (np.linalg.LinAlgError, sla.LinAlgError) as exc:
@@ -576,6 +685,7 @@ class _Solve:
                 "computed (a datum defect that appeared during the iteration?)",
                 layout.labels_c,
             ) from exc
+        self.clock.add("covariance", t_cov)
         s2 = sigma0**2 if np.isfinite(sigma0) else 1.0
         full = _evaluate(layout, blocks, [np.ones(b.m, dtype=bool) for b in blocks], False)
         residuals, off = {}, 0
@@ -585,6 +695,9 @@ class _Solve:
         cofactors = None
         if self.options.keep_jacobian and layout.pblock is not None:
             cofactors = _point_cofactor_function(ne, S_inv)
+        seconds = time.perf_counter() - self.t0
+        split = dict(self.clock.seconds)
+        split["other"] = max(seconds - sum(split.values()), 0.0)
         return AdjustmentResult(
             params=layout.params,
             converged=outcome.converged,
@@ -604,6 +717,7 @@ class _Solve:
             _masks=[m.copy() for m in self.masks],
             _residuals=residuals,
             _point_cofactors=cofactors,
+            seconds_split=split,
         )
 
 

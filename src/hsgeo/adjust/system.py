@@ -11,6 +11,7 @@ path (:mod:`hsgeo.adjust._fast`).
 
 from __future__ import annotations
 
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -22,6 +23,21 @@ from hsgeo.adjust.residuals import Indexed, ResidualBlock
 from hsgeo.errors import InputError
 
 __all__: list[str] = []
+
+
+class _Clock:
+    """Seconds spent in each phase of one adjustment (``AdjustmentResult.seconds_split``).
+
+    ``t = clock.add("model", t)`` adds the seconds since ``t`` to ``"model"`` and returns now.
+    """
+
+    def __init__(self) -> None:
+        self.seconds: dict[str, float] = {}
+
+    def add(self, key: str, t0: float) -> float:
+        now = time.perf_counter()
+        self.seconds[key] = self.seconds.get(key, 0.0) + (now - t0)
+        return now
 
 
 class _Layout:
@@ -170,9 +186,42 @@ class _System:
     pidx: np.ndarray | None  # (M,) point touched by each row (-1: none)
     Jp: np.ndarray | None  # (M, p)
     n_obs_rows: int  # rows that are observations (the rest are priors)
+    #: under a robust loss (see :mod:`hsgeo.adjust.loss`): its scale per block index, and,
+    #: at a linearisation (rows scaled by √ρ′), the robust cost ½ Σ ρ (None: ½ ‖r‖²)
+    loss_c: dict | None = None
+    robust_cost: float | None = None
+    #: ``(row0, row1, g, d)`` of rows whose gradient ``Jᵀ r`` and diagonal ``diag(JᵀJ)`` of
+    #: the non-point unknowns the fused path accumulated already (see :meth:`gradient_diag`)
+    gd_parts: list | None = None
+
+    def gradient_diag(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(J_cᵀ r, diag(J_cᵀ J_c))`` (compiled path): the fused parts' sums, the other rows
+        by one pass over them.
+        """
+        if not self.gd_parts:
+            return self.Jrc.rmatvec(self.r, diag=True)
+        from hsgeo.adjust._fast import rmatvec_diag
+
+        n_c = self.Jrc.n_cols
+        g, d = np.zeros(n_c), np.zeros(n_c)
+        row = 0
+        spans = sorted(self.gd_parts, key=lambda x: x[0])
+        for r0, r1, gp, dp in [*spans, (self.r.size, self.r.size, None, None)]:
+            if r0 > row:  # rows between the fused parts
+                arr = [a[row:r0] for a in self.Jrc.arrays]
+                gr, dr = rmatvec_diag(*arr, np.ascontiguousarray(self.r[row:r0]), n_c, True)
+                g += gr
+                d += dr
+            if gp is not None:
+                g += gp
+                d += dp
+            row = r1
+        return g, d
 
     @property
     def cost(self) -> float:
+        if self.robust_cost is not None:
+            return self.robust_cost
         with np.errstate(over="ignore"):  # finite residuals too large to square: cost inf
             return 0.5 * float(self.r @ self.r)
 
@@ -370,23 +419,46 @@ def _prior_rows(layout: _Layout, jacobian: bool, r_parts, slot_parts, pidx_parts
     return n
 
 
-def _assemble(layout: _Layout, slot_parts, pidx_parts, jp_parts, M: int, factored_k):
+def _assemble(
+    layout: _Layout, slot_parts, pidx_parts, jp_parts, M: int, factored_k, values=None, clock=None
+):
     """One (M, K) row-compressed matrix: each part's slots side by side, padded to the widest;
-    returns ``(Jrc, pidx, Jp)``.
+    returns ``(Jrc, pidx, Jp)``. A :class:`_FusedPart` is evaluated here, into its rows.
     """
-    K = max([sum(sl.width for sl in part) for part in slot_parts] + [1])
+    from hsgeo.adjust._fused import _FusedPart
+
+    def parts_of(part):
+        return [part] if isinstance(part, _FusedPart) else part
+
+    K = max([sum(sl.width for sl in parts_of(part)) for part in slot_parts] + [1])
     itype = np.int32 if layout.n_c < 2**31 else np.int64
     cols_all = np.empty((M, K), dtype=itype)
     vals_all = np.empty((M, K))
-    Q = max([sl.qk[0] for part in slot_parts for sl in part if sl.factored] + [0])
+    Q = max([sl.qk[0] for part in slot_parts for sl in parts_of(part) if sl.factored] + [0])
     Kf = factored_k if Q else 0
     fcol = np.full((M, Q), -1, dtype=itype)
     fw = np.zeros((M, Q))
     fd = np.zeros((M, Kf))
+    pidx = np.empty(M, dtype=np.int64)
+    Jp = np.empty((M, layout.p))
     row0 = 0
-    for part, pi in zip(slot_parts, pidx_parts, strict=True):
+    for part, pi, jp in zip(slot_parts, pidx_parts, jp_parts, strict=True):
         n = pi.size
+        rs = slice(row0, row0 + n)
+        pidx[rs] = pi
         k0 = 0
+        if isinstance(part, _FusedPart):
+            part.row_range = (row0, row0 + n)
+            part.fill(values, cols_all[rs], vals_all[rs], fcol[rs], fw[rs], fd[rs], Jp[rs], clock)
+            if part.nonfinite.size:
+                raise _NonFinite(
+                    f"residual block {part.blk.name!r} produced non-finite residuals at rows "
+                    f"{part.nonfinite.tolist()}"
+                )
+            k0 = part.width
+            part = []
+        else:
+            Jp[rs] = jp
         for sl in part:
             if sl.factored:
                 sl.fill_factored(fcol[row0 : row0 + n], fw[row0 : row0 + n], fd[row0 : row0 + n])
@@ -402,30 +474,67 @@ def _assemble(layout: _Layout, slot_parts, pidx_parts, jp_parts, M: int, factore
         row0 += n
     if layout.tie_blocks:
         _merge_tied_columns(cols_all, vals_all)
-    pidx = np.concatenate(pidx_parts) if pidx_parts else np.full(M, -1)
-    Jp = np.concatenate(jp_parts) if jp_parts else np.zeros((M, layout.p))
     Jrc = _RowJac(cols_all, vals_all, layout.n_c, *((fcol, fw, fd) if Q else ()))
     return Jrc, pidx, Jp
 
 
 def _evaluate(
-    layout: _Layout, blocks: Sequence[ResidualBlock], masks, jacobian: bool, compiled: bool = True
+    layout: _Layout,
+    blocks: Sequence[ResidualBlock],
+    masks,
+    jacobian: bool,
+    compiled: bool = True,
+    clock: _Clock | None = None,
+    loss: tuple | None = None,
+    fused: bool = True,
 ) -> _System:
     """Whitened residuals (and with ``jacobian`` the row-compressed Jacobian) at the current
     values of ``layout.params``; rows of ``masks[i] == False`` are left out. ``compiled``
-    keeps factored Jacobians factored (the compiled kernels' form).
+    keeps factored Jacobians factored (the compiled kernels' form). ``clock`` takes the
+    seconds of the blocks' own evaluation (``model``) and of the assembly (``jacobian``).
+
+    ``loss = (kind, k, scales)``: the observation rows under a robust loss
+    (:mod:`hsgeo.adjust.loss`), with the scale of each block index in ``scales`` (None: ``k``
+    robust σ of the residuals here); with ``jacobian`` rows are scaled by ``√ρ′`` and the
+    system carries the robust cost, otherwise by ``√(ρ/s)`` (``½ ‖r‖²`` is that cost).
+
+    ``fused`` (compiled, no loss): blocks with ``evaluate_into`` write their rows themselves
+    (:class:`_FusedPart`), evaluated in :func:`_assemble`.
     """
+    from hsgeo.adjust._fused import _FusedPart
+
+    clock = clock or _Clock()
+    t = time.perf_counter()
     values = layout.params.values()
     r_parts, slot_parts, pidx_parts, jp_parts = [], [], [], []
     factored_k = None  # width k of the factored Jacobians (one per row, one k for all)
     offset = 0
     pname = layout.pblock.name if layout.pblock is not None else None
+    loss_c, rho_sum = {}, 0.0
     for ib, (blk, keep) in enumerate(zip(blocks, masks, strict=True)):
+        t = clock.add("jacobian", t)
+        spec = None
+        if jacobian and fused and compiled and loss is None:
+            spec = _FusedPart.spec_of(layout, blk, keep, factored_k)
+        if spec is not None:
+            part = _FusedPart(layout, blk, ib, keep, 1.0 / blk.sigma, spec)
+            factored_k = part.qk[1]
+            r_parts.append(part.r_kept)
+            slot_parts.append(part)
+            pidx_parts.append(part.pidx)
+            jp_parts.append(None)
+            offset += part.rows.size
+            continue
         r, jac = _block_residuals(blk, values, jacobian)
+        t = clock.add("model", t)
         w = 1.0 / blk.sigma
         rows_kept = np.flatnonzero(keep)
         all_kept = rows_kept.size == blk.m
-        r_parts.append(r * w if all_kept else r.take(rows_kept) * w.take(rows_kept))
+        rw = r * w if all_kept else r.take(rows_kept) * w.take(rows_kept)
+        if loss is not None:
+            w, rw, loss_c[ib], part = _robust_rows(loss, ib, blk, w, rw, keep, jacobian)
+            rho_sum += part
+        r_parts.append(rw)
         if jacobian:
             pidx = np.full(rows_kept.size, -1, dtype=np.int64)
             jp = np.zeros((rows_kept.size, layout.p))
@@ -458,11 +567,41 @@ def _evaluate(
         offset += rows_kept.size
     n_obs_rows = offset
     offset += _prior_rows(layout, jacobian, r_parts, slot_parts, pidx_parts, jp_parts)
-    r_all = np.concatenate(r_parts) if r_parts else np.zeros(0)
+    lc = loss_c if loss is not None else None
     if not jacobian:
-        return _System(r_all, None, None, None, n_obs_rows)
-    Jrc, pidx, Jp = _assemble(layout, slot_parts, pidx_parts, jp_parts, offset, factored_k)
-    return _System(r_all, Jrc, pidx, Jp, n_obs_rows)
+        r_all = np.concatenate(r_parts) if r_parts else np.zeros(0)
+        clock.add("model", t)
+        return _System(r_all, None, None, None, n_obs_rows, lc)
+    model0 = clock.seconds.get("model", 0.0)
+    Jrc, pidx, Jp = _assemble(
+        layout, slot_parts, pidx_parts, jp_parts, offset, factored_k, values, clock
+    )
+    # the fused parts' evaluation went to "model": not the assembly's too
+    clock.seconds["jacobian"] = clock.seconds.get("jacobian", 0.0) - (
+        clock.seconds.get("model", 0.0) - model0
+    )
+    r_all = np.concatenate(r_parts) if r_parts else np.zeros(0)  # after the fused parts
+    robust = None
+    if loss is not None:
+        prior = r_all[n_obs_rows:]
+        robust = 0.5 * (rho_sum + float(prior @ prior))
+    gd_parts = [(*sl.row_range, sl.g, sl.d) for sl in slot_parts if isinstance(sl, _FusedPart)]
+    clock.add("jacobian", t)
+    return _System(r_all, Jrc, pidx, Jp, n_obs_rows, lc, robust, gd_parts)
+
+
+def _robust_rows(loss, ib: int, blk: ResidualBlock, w, rw, keep, jacobian: bool):
+    """One block's rows under the robust loss ``loss = (kind, k, scales)``: the row weights
+    ``w`` (all rows) and the kept whitened residuals ``rw`` scaled, the scale, and ``Σ ρ``.
+    """
+    from hsgeo.adjust.loss import scale, weigh
+
+    kind, k, scales = loss
+    c = scales[ib] if scales is not None else scale(rw, k)
+    f, part = weigh(kind, rw, blk.group_size, c, jacobian)
+    w_all = np.broadcast_to(np.asarray(w, dtype=np.float64), (blk.m,)).copy()
+    w_all[keep] *= f  # the Jacobian's rows are whitened with w (see _Slots)
+    return w_all, rw * f, c, part
 
 
 def _merge_tied_columns(cols: np.ndarray, vals: np.ndarray) -> None:

@@ -105,8 +105,9 @@ def _image(R, dR, d, lever, beta, c, dist, x0, y0, k_px, q, p, Jp, JpB, d6):  # 
 def _derivatives(
     j, d6, Jp, JpB, dbeta, q, c, xb, yb, gx, gy, k_px, dP, dN, dB, dL, dD, dC
 ):  # pragma: no cover - compiled
-    """Rows 2j, 2j+1 of the derivatives w.r.t. the point, the spline nodes (× their weights),
-    the boresight, the lever arm, the distortion and the principal distance.
+    """Rows 2j, 2j+1 (j: the destination pair, see ``dst`` of ``_lines_kernel``) of the
+    derivatives w.r.t. the point, the spline nodes (× their weights), the boresight, the lever
+    arm, the distortion and the principal distance.
     """
     for u in range(2):
         row = 2 * j + u
@@ -158,6 +159,63 @@ def _through_time(j, fx, fy, dP, dN, dB, dL, dD, dC):  # pragma: no cover - comp
     dC[ry, 0] *= fy
 
 
+@njit(cache=True, inline="always")
+def _whiten(t, w0, w1, wts, fw, dP, dN, dB, dL, dD, dC):  # pragma: no cover - compiled
+    """Rows 2t, 2t+1 scaled by their whitening weights ``w0``, ``w1`` (1/σ), and the spline
+    weights ``wts`` written as the rows' factored weights ``fw`` (fused path).
+    """
+    for u in range(2):
+        row = 2 * t + u
+        s = w0 if u == 0 else w1
+        for a in range(3):
+            dP[row, a] *= s
+            dB[row, a] *= s
+            dL[row, a] *= s
+        for a in range(6):
+            dN[row, a] *= s
+        for a in range(4):
+            dD[row, a] *= s
+            fw[row, a] = wts[a]
+        dC[row, 0] *= s
+
+
+@njit(cache=True, inline="always")
+def _accumulate(
+    t, rw0, rw1, idx_j, wts, cam_cols, c_col, node_c0, g, dg, dN, dB, dL, dD, dC
+):  # pragma: no cover - compiled
+    """The gradient ``Jᵀ r`` and the diagonal ``diag(JᵀJ)`` of the non-point unknowns from the
+    whitened rows 2t, 2t+1 (residuals ``rw0``, ``rw1``): camera columns ``cam_cols``
+    (boresight, lever arm, distortion; -1 fixed), the band's ``c_col``, and the four nodes
+    ``idx_j`` of the spline group at ``node_c0 + 6 idx + a`` with weights ``wts``.
+    """
+    for u in range(2):
+        row = 2 * t + u
+        ru = rw0 if u == 0 else rw1
+        for a in range(10):
+            col = cam_cols[a]
+            if col >= 0:
+                if a < 3:
+                    v = dB[row, a]
+                elif a < 6:
+                    v = dL[row, a - 3]
+                else:
+                    v = dD[row, a - 6]
+                g[col] += v * ru
+                dg[col] += v * v
+        if c_col >= 0:
+            v = dC[row, 0]
+            g[c_col] += v * ru
+            dg[c_col] += v * v
+        for b in range(4):
+            if idx_j[b] < 0:
+                continue
+            base = node_c0 + 6 * idx_j[b]
+            for a in range(6):
+                v = wts[b] * dN[row, a]
+                g[base + a] += v * ru
+                dg[base + a] += v * v
+
+
 @njit(cache=True, parallel=True)
 def _lines_kernel(
     P,
@@ -193,6 +251,13 @@ def _lines_kernel(
     dL,
     dD,
     dC,
+    dst,
+    w_row,
+    fw,
+    gd,
+    cam_cols,
+    c_cols,
+    node_c0,
 ):  # pragma: no cover
     """002 eq. (2)–(4) and their derivatives, one observation per iteration (rows 2j, 2j+1).
 
@@ -202,9 +267,21 @@ def _lines_kernel(
     ``ẏ_ref (t_e − t*)``, and their derivatives follow from the implicit function theorem,
     ``∂t*/∂θ = −(∂y/∂θ)/ẏ``. The spline weights used are returned in ``w_out``. ``dt_start``
     (in and out): ``t* − t_e`` at which Newton starts, overwritten with this evaluation's.
+
+    Fused path (``dst.size == m``): the derivatives of observation j go to rows
+    ``2 dst[j], 2 dst[j] + 1`` of the destination arrays (none if ``dst[j] < 0``: a rejected
+    observation), scaled by ``w_row[2j], w_row[2j + 1]``, with the spline weights in ``fw``;
+    otherwise to rows 2j, 2j + 1 unscaled (``dst``, ``w_row``, ``fw`` unused). With
+    ``gd`` of shape ``(2, n_chunks, n_c)`` (fused path) each chunk of observations also
+    accumulates the gradient (``gd[0]``) and the diagonal (``gd[1]``) of the non-point unknowns
+    in its row (see ``_accumulate``; the caller sums the chunks in order).
     """
+    fused = dst.size == pidx.size
     m = pidx.size
     n_chunks = 64 if m > 6400 else 1
+    gradient = fused and gd.shape[1] > 0
+    if gradient:
+        n_chunks = gd.shape[1]
     step = (m + n_chunks - 1) // n_chunks
     for ch in prange(n_chunks):
         R = np.empty((3, 3))
@@ -264,6 +341,29 @@ def _lines_kernel(
                 r[2 * j + 1] = y * k_px - xy_obs[j, 1]
             if not jac:
                 continue
-            _derivatives(j, d6, Jp, JpB, dbeta, q, c, xb, yb, gx, gy, k_px, dP, dN, dB, dL, dD, dC)
+            t = dst[j] if fused else j
+            if t < 0:
+                continue
+            _derivatives(t, d6, Jp, JpB, dbeta, q, c, xb, yb, gx, gy, k_px, dP, dN, dB, dL, dD, dC)
             if timed:
-                _through_time(j, xdot / ydot, y_rate_ref / ydot, dP, dN, dB, dL, dD, dC)
+                _through_time(t, xdot / ydot, y_rate_ref / ydot, dP, dN, dB, dL, dD, dC)
+            if fused:
+                _whiten(t, w_row[2 * j], w_row[2 * j + 1], w, fw, dP, dN, dB, dL, dD, dC)
+            if gradient:
+                _accumulate(
+                    t,
+                    r[2 * j] * w_row[2 * j],
+                    r[2 * j + 1] * w_row[2 * j + 1],
+                    idx[j],
+                    w,
+                    cam_cols,
+                    c_cols[band[j]],
+                    node_c0,
+                    gd[0, ch],
+                    gd[1, ch],
+                    dN,
+                    dB,
+                    dL,
+                    dD,
+                    dC,
+                )

@@ -258,6 +258,10 @@ class PushbroomObservations:
         return self.xyz_rate_nav_m_s is not None
 
 
+#: ``cols`` of PushbroomLines._kernel when no gradient is accumulated
+_NO_COLS = (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), 0)
+
+
 class PushbroomLines(ResidualBlock):
     """Image observations of tie points in LP lines (002 eq. 2–4) as a residual block.
 
@@ -493,10 +497,6 @@ class PushbroomLines(ResidualBlock):
     def evaluate(self, values, jacobian):
         nm = self.blocks
         m = self.point.size
-        idx = self._basis[0]
-        bore = values[nm["boresight"]]
-        beta = R_from_opk(bore[0], bore[1], bore[2]) @ self.beta0
-        dbeta = dR_dopk(bore[0], bore[1], bore[2]) @ self.beta0
         r = np.empty(2 * m)
         w_out = np.empty((m, 4))
         shp = (2 * m,) if jacobian else (0,)
@@ -506,6 +506,85 @@ class PushbroomLines(ResidualBlock):
         dL = np.empty(shp + (3,))
         dD = np.empty(shp + (4,))
         dC = np.empty(shp + (1,))
+        none = np.zeros(0, dtype=np.int64)
+        derivs = (dP, dN, dB, dL, dD, dC)
+        self._kernel(values, jacobian, r, w_out, derivs, none, np.zeros(0), np.zeros((0, 4)))
+        if not jacobian:
+            return r, None
+        jac = {
+            nm["points"]: Indexed(self._pidx2, dP),
+            # 002 eq. (4) through the spline: ∂r/∂c_a = B_a(t*) ∂r/∂δ (factored)
+            nm["nodes"]: Indexed(self._idx2, dN, weights=np.repeat(w_out, 2, axis=0)),
+            nm["boresight"]: dB,
+            nm["lever_arm"]: dL,
+            nm["distortion"]: dD,
+            nm["c"]: Indexed(self._band2, dC),
+        }
+        return r, jac
+
+    def fused_spec(self) -> dict:
+        """The layout :meth:`evaluate_into` writes (the engine's fused path, see
+        :class:`hsgeo.adjust.system._FusedPart`): the points block, the factored block
+        ``(name, item index (2m, 4), k)``, and the slot columns in order, ``(name, index)``
+        with ``index`` (2m,) the item of an indexed block of width 1, None for a dense block.
+        """
+        nm = self.blocks
+        return {
+            "points": (nm["points"], self._pidx2),
+            "factored": (nm["nodes"], self._idx2, 6),
+            "slots": [
+                (nm["boresight"], None),
+                (nm["lever_arm"], None),
+                (nm["distortion"], None),
+                (nm["c"], self._band2),
+            ],
+        }
+
+    def evaluate_into(self, values, dst, w_row, r, jp, vals, fw, fd, gd=None, cols=None):
+        """:meth:`evaluate` writing the whitened derivatives straight into the engine's arrays.
+
+        Parameters
+        ----------
+        values : mapping
+            The parameter values.
+        dst : (m,) int64 ndarray
+            The destination pair of each observation (rows ``2 dst[j], 2 dst[j] + 1`` of the
+            destination arrays); -1: not written (a rejected observation).
+        w_row : (2m,) ndarray
+            Whitening weights of the residual rows (1/σ, 1/px).
+        r : (2m,) ndarray
+            Out: the residuals of every row (px, not whitened).
+        jp : (n, 3) ndarray
+            Out: whitened derivatives w.r.t. the observation's point (1/m).
+        vals : (n, 11) ndarray
+            Out: whitened derivatives w.r.t. the boresight (3), the lever arm (3), the
+            distortion (4) and the observation's band's principal distance (1), in the order
+            of :meth:`fused_spec`'s slots.
+        fw : (n, 4) ndarray
+            Out: the spline weights of the observation's four nodes.
+        fd : (n, 6) ndarray
+            Out: whitened derivatives w.r.t. the trajectory correction at the crossing time;
+            the node columns are ``fw × fd``.
+        gd : (2, n_chunks, n_c) ndarray, optional
+            Out (zeroed by the caller): per chunk of observations, the gradient ``Jᵀ r``
+            (``gd[0]``) and the diagonal ``diag(JᵀJ)`` (``gd[1]``) of the engine's non-point
+            unknowns over the rows written, accumulated in the same pass.
+        cols : tuple, optional
+            With ``gd``: ``(cam_cols (10,), c_cols (n_bands,), node_c0)``, the engine's
+            columns of the boresight, lever arm and distortion entries, of each band's
+            principal distance (-1: fixed) and of the first node entry.
+        """
+        m = self.point.size
+        derivs = (jp, fd, vals[:, 0:3], vals[:, 3:6], vals[:, 6:10], vals[:, 10:11])
+        self._kernel(values, True, r, np.empty((m, 4)), derivs, dst, w_row, fw, gd, cols)
+
+    def _kernel(self, values, jacobian, r, w_out, derivs, dst, w_row, fw, gd=None, cols=None):
+        """One call of the compiled kernel (see ``_pushbroom_kernel._lines_kernel``)."""
+        nm = self.blocks
+        idx = self._basis[0]
+        bore = values[nm["boresight"]]
+        beta = R_from_opk(bore[0], bore[1], bore[2]) @ self.beta0
+        dbeta = dR_dopk(bore[0], bore[1], bore[2]) @ self.beta0
         _lines_kernel(
             np.ascontiguousarray(values[nm["points"]], dtype=np.float64),
             self.point,
@@ -534,25 +613,13 @@ class PushbroomLines(ResidualBlock):
             self._dt_s,
             r,
             w_out,
-            dP,
-            dN,
-            dB,
-            dL,
-            dD,
-            dC,
+            *derivs,
+            dst,
+            w_row,
+            fw,
+            np.zeros((2, 0, 0)) if gd is None else gd,
+            *(_NO_COLS if cols is None else cols),
         )
-        if not jacobian:
-            return r, None
-        jac = {
-            nm["points"]: Indexed(self._pidx2, dP),
-            # 002 eq. (4) through the spline: ∂r/∂c_a = B_a(t*) ∂r/∂δ (factored)
-            nm["nodes"]: Indexed(self._idx2, dN, weights=np.repeat(w_out, 2, axis=0)),
-            nm["boresight"]: dB,
-            nm["lever_arm"]: dL,
-            nm["distortion"]: dD,
-            nm["c"]: Indexed(self._band2, dC),
-        }
-        return r, jac
 
 
 # ----------------------------------------------------------------------------------------------

@@ -1,0 +1,122 @@
+"""The fused path of the engine (``SolverOptions.fused``): a residual block that writes its
+whitened derivatives straight into the row-compressed arrays of :mod:`hsgeo.adjust.system`.
+
+On the generic path a block returns its Jacobian, and :class:`~hsgeo.adjust.system._Slots`
+copies it (whitened, rows kept) into the engine's ``(M, K)`` arrays: every derivative is
+written twice and read once in between. A block with ``fused_spec()`` and ``evaluate_into``
+(:class:`hsgeo.sensors.pushbroom.PushbroomLines`) is instead evaluated once the arrays are
+allocated, into its own rows of them; the engine writes the column indices (static for a
+given set of kept rows) and the block's residuals. The numbers are those of the generic path
+bit for bit (the same products, in the same rows); ``tests/test_engine_fused.py``.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from hsgeo.adjust.residuals import ResidualBlock
+
+__all__: list[str] = []
+
+
+class _FusedPart:
+    """A residual block that writes its own whitened rows into the row-compressed arrays.
+
+    The block (e.g. :class:`~hsgeo.sensors.pushbroom.PushbroomLines`) has ``fused_spec()``
+    (which blocks its derivatives go to, in which slots) and ``evaluate_into(values, dst,
+    w_row, r, jp, vals, fw, fd)``; it is evaluated when :func:`_assemble` has allocated the
+    arrays, so its derivatives are written once, where the kernels read them, instead of into
+    a Jacobian of its own that :class:`_Slots` copies (``SolverOptions.fused``). The column
+    indices are the engine's (from the layout), as on the generic path.
+    """
+
+    def __init__(self, layout, blk: ResidualBlock, ib: int, keep, w, spec: dict):
+        self.blk, self.spec, self.layout = blk, spec, layout
+        pair = keep[0::2]
+        self.dst = np.where(pair, np.cumsum(pair) - 1, -1).astype(np.int64)
+        self.rows = np.flatnonzero(keep)
+        self.w = np.ascontiguousarray(np.broadcast_to(np.asarray(w, dtype=np.float64), (blk.m,)))
+        _, fidx, k = spec["factored"]
+        self.qk = (fidx.shape[1], k)
+        self.factored = True
+        self.width = sum(
+            layout.params[name].size if index is None else 1 for name, index in spec["slots"]
+        )
+        pidx = spec["points"][1]
+        layout.row_point[ib] = pidx
+        self.pidx = pidx.take(self.rows)
+        self.r_kept = np.empty(self.rows.size)  # filled by fill (the _System's residuals)
+        #: after fill: the gradient and diagonal of the non-point unknowns over these rows,
+        #: accumulated by the block's pass (see _System.gd_parts), and the rows' range
+        self.g = self.d = None
+        self.row_range = (0, 0)
+
+    @staticmethod
+    def spec_of(layout, blk: ResidualBlock, keep, factored_k) -> dict | None:
+        """The block's ``fused_spec()`` if the fused path applies to it here, else None."""
+        if not hasattr(blk, "evaluate_into") or blk.group_size != 2:
+            return None
+        keep = np.asarray(keep, dtype=bool)
+        if not np.array_equal(keep[0::2], keep[1::2]):
+            return None
+        spec = blk.fused_spec()
+        pname, _ = spec["points"]
+        fname, fidx, k = spec["factored"]
+        names = [pname, fname] + [nm for nm, _ in spec["slots"]]
+        pb = layout.pblock
+        if pb is None or pname != pb.name or layout.p != 3 or not layout.pfree.all():
+            return None
+        if any(nm in layout.tie_blocks for nm in names) or factored_k not in (None, k):
+            return None
+        cm = layout.colmap[fname]
+        size = layout.params[fname].size
+        contiguous = cm.size and cm[0] >= 0 and np.all(np.diff(cm) == 1)
+        if not contiguous or size % k or (fidx.size and int(fidx.max()) >= size // k):
+            return None
+        return spec
+
+    def fill(self, values, cols, vals, fcol, fw, fd, jp, clock) -> None:
+        """Evaluate the block into the part's rows of the arrays (see :func:`_assemble`)."""
+        t = time.perf_counter()
+        blk, layout = self.blk, self.layout
+        r = np.empty(blk.m)
+        w = self.width
+        q, k = self.qk
+        dense = [layout.colmap[nm] for nm, index in self.spec["slots"] if index is None]
+        indexed = [layout.colmap[nm] for nm, index in self.spec["slots"] if index is not None]
+        cols_of = (
+            np.concatenate(dense).astype(np.int64),
+            indexed[0].astype(np.int64),
+            int(layout.colmap[self.spec["factored"][0]][0]),
+        )
+        gd = np.zeros((2, 64 if blk.m > 12800 else 1, layout.n_c))
+        blk.evaluate_into(
+            values, self.dst, self.w, r, jp, vals[:, :w], fw[:, :q], fd[:, :k], gd, cols_of
+        )
+        # the chunks summed in a fixed order: the same bits for any number of threads
+        self.g, self.d = gd.sum(axis=1)
+        clock.add("model", t)  # (the rest is the caller's "jacobian")
+        self.nonfinite = np.flatnonzero(~np.isfinite(r))[:5]  # checked by system._assemble
+        np.multiply(r.take(self.rows), self.w.take(self.rows), out=self.r_kept)
+        fname, fidx, _ = self.spec["factored"]
+        fi = fidx.take(self.rows, axis=0)
+        fcol[:, :q] = np.where(fi >= 0, layout.colmap[fname][0] + fi * k, -1)
+        if (fi < 0).any():
+            fw[:, :q][fi < 0] = 0.0
+        s0 = 0
+        for name, index in self.spec["slots"]:
+            cm = layout.colmap[name]
+            if index is None:
+                cols[:, s0 : s0 + cm.size] = cm
+                fixed = np.flatnonzero(cm < 0)
+                if fixed.size:
+                    vals[:, s0 + fixed] = 0.0
+                s0 += cm.size
+            else:
+                c = cm.take(index.take(self.rows))
+                cols[:, s0] = c
+                if (c < 0).any():
+                    vals[c < 0, s0] = 0.0
+                s0 += 1
