@@ -1,0 +1,187 @@
+"""Profile the chapter's pushbroom adjustment by call, in CPU seconds (issue 29).
+
+``python bench/profile_pushbroom.py 1 3 10`` adjusts the scaling benchmark's problem at each
+scale (one fresh process each, ``NUMBA_NUM_THREADS=1`` so that the compiled kernels' CPU
+seconds are the calling thread's, the Makefile's ``GLIBC_TUNABLES``), under ``cProfile`` with
+``time.process_time`` as its clock: unlike wall seconds, CPU seconds do not grow when other
+processes take the cores of a shared host. Writes ``bench/results/pushbroom_profile.json``:
+per scale the calls and CPU seconds per call of the kernels that take the time, the user and
+system seconds and page faults of the solve, and each call's CPU seconds per observation
+relative to the 1× row (1: linear growth).
+
+``--from-pstats DIR`` builds the JSON from ``cpu_<scale>.pstat`` dumps (with their ``.txt``
+first line) of an earlier run instead of profiling again.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+
+#: the calls reported: (label, file suffix, function name)
+CALLS = [
+    ("reduced_matrix_kernel", "adjust/_fast.py", "_reduced_kernel"),
+    ("model_linearisation", "sensors/pushbroom.py", "evaluate_into"),
+    ("model_trial", "sensors/pushbroom.py", "evaluate"),
+    ("assembly_fused_fill", "adjust/_fused.py", "fill"),
+    ("jacobian_matvec", "adjust/_fast.py", "matvec"),
+    ("jacobian_rmatvec_diag", "adjust/_fast.py", "rmatvec_diag"),
+    ("cholesky", "scipy/linalg/_decomp_cholesky.py", "_cholesky"),
+    ("datum_check", "adjust/datum.py", "_check_datum"),
+    ("hold_points", "adjust/solver.py", "_hold_points"),
+    ("rejection", "adjust/robust.py", "_reject"),
+    ("solve_total", "workflows/pushbroom_ba.py", "solve"),
+]
+
+
+def _child(scale: float, seed: int, dump: Path) -> dict:
+    import cProfile
+    import gc
+    import resource
+
+    sys.path.insert(0, str(HERE))
+    import bench_pushbroom_ba as B
+
+    from hsgeo.reproduce.pushbroom_ba import REJECT_K
+    from hsgeo.workflows.pushbroom_ba import solve
+
+    obs, p, blocks = B._problem(scale, seed)
+    n_obs = obs.lines.n
+    del obs
+    gc.collect()
+    B._load_compiled_kernels(seed)
+    r0 = resource.getrusage(resource.RUSAGE_SELF)
+    pr = cProfile.Profile(time.process_time)
+    t0 = time.perf_counter()
+    pr.enable()
+    res = solve(p, blocks, reject_k=REJECT_K)
+    pr.disable()
+    wall = time.perf_counter() - t0
+    r1 = resource.getrusage(resource.RUSAGE_SELF)
+    pr.dump_stats(str(dump))
+    return {
+        "scale": scale,
+        "n_observations": n_obs,
+        "iterations": res.iterations,
+        "wall_seconds": wall,
+        "user_seconds": r1.ru_utime - r0.ru_utime,
+        "system_seconds": r1.ru_stime - r0.ru_stime,
+        "minor_faults": r1.ru_minflt - r0.ru_minflt,
+        "peak_rss_gb": r1.ru_maxrss / 2**20,
+    }
+
+
+def _calls(pstat: Path) -> dict:
+    """CPU seconds (cumulative) and calls of :data:`CALLS` in a profile dump."""
+    import pstats
+
+    stats = pstats.Stats(str(pstat)).stats
+    out = {}
+    for label, suffix, name in CALLS:
+        hits = [v for (f, _, fn), v in stats.items() if f.endswith(suffix) and fn == name]
+        if hits:
+            _, ncalls, _, cum, _ = hits[0]
+            out[label] = {"calls": ncalls, "cpu_seconds": cum, "cpu_seconds_per_call": cum / ncalls}
+    return out
+
+
+def _designs(row: dict) -> dict | None:
+    """Upper bounds, from the 1× row's calls, of what three designs for the paper-size goal
+    would save (CPU seconds and share of the solve); none of them is built."""
+    c = row["calls"]
+    need = ("solve_total", "assembly_fused_fill", "model_linearisation", "model_trial")
+    if not all(k in c for k in need + ("reduced_matrix_kernel",)):
+        return None
+    total = c["solve_total"]["cpu_seconds"]
+    lin, trial = c["model_linearisation"], c["model_trial"]
+    # A: the arrays kept between linearisations with the same kept rows, the column indices
+    # (and the padding) written once: at most fill's own seconds
+    a = c["assembly_fused_fill"]["cpu_seconds"] - lin["cpu_seconds"]
+    # B: each trial evaluated with derivatives into a second set of arrays, which becomes the
+    # next linearisation when the step is accepted and no row is rejected: saves one
+    # evaluation without derivatives a linearisation after the first
+    b = min(trial["calls"], lin["calls"] - 1) * trial["cpu_seconds_per_call"]
+    # C: one reduced-matrix formation fewer (changes the iterates: not to 1e-9)
+    cc = c["reduced_matrix_kernel"]["cpu_seconds_per_call"]
+    return {
+        name: {"cpu_seconds": v, "share_of_solve": v / total}
+        for name, v in (
+            ("A_arrays_kept_column_indices_once", a),
+            ("B_trial_with_derivatives_double_buffered", b),
+            ("C_one_reduced_matrix_formation_fewer", cc),
+        )
+    }
+
+
+def _summary(rows: list[dict]) -> dict:
+    one = next((r for r in rows if r["scale"] == 1.0), None)
+    for r in rows:
+        if one is None:
+            break
+        n = r["n_observations"] / one["n_observations"]
+        for label, c in r["calls"].items():
+            if label in one["calls"]:
+                c["per_call_per_observation_per_1x"] = (
+                    c["cpu_seconds_per_call"] / one["calls"][label]["cpu_seconds_per_call"] / n
+                )
+    designs = _designs(one) if one is not None else None
+    return {
+        "designs_at_1x": designs,
+        "problem": "the scaling benchmark's rows (bench_pushbroom_ba.py --scaling), adjusted "
+        "as in the chapter, profiled by call with cProfile(time.process_time), one numba "
+        "thread, one BLAS thread, the Makefile's GLIBC_TUNABLES",
+        "rows": rows,
+        "notes": "cpu_seconds are cumulative (the call and what it calls); "
+        "per_call_per_observation_per_1x: CPU seconds per call per observation relative to "
+        "the 1x row (1: linear growth); model_linearisation is the LP kernel with derivatives "
+        "(fused path), model_trial without",
+    }
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("scales", nargs="*", type=float, default=[1.0, 3.0, 10.0])
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
+    ap.add_argument("--dump", default="/tmp/hsgeo_profile")
+    ap.add_argument("--from-pstats", help="build the JSON from an earlier run's dumps")
+    ap.add_argument("--out", default=str(HERE / "results" / "pushbroom_profile.json"))
+    args = ap.parse_args(argv)
+    if args.child:
+        out = _child(args.scales[0], args.seed, Path(args.dump))
+        print("RESULT " + json.dumps(out), flush=True)
+        return 0
+    rows = []
+    for s in args.scales:
+        if args.from_pstats:
+            d = Path(args.from_pstats)
+            row = json.loads((d / f"cpu_{s}.json").read_text())
+            dump = d / f"cpu_{s}.pstat"
+        else:
+            dump = Path(f"{args.dump}_{s}.pstat")
+            env = dict(os.environ, NUMBA_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1")
+            env["OMP_NUM_THREADS"] = "1"
+            env["PYTHONPATH"] = str(HERE.parent / "src") + os.pathsep + env.get("PYTHONPATH", "")
+            cmd = [sys.executable, __file__, str(s), "--child", "--dump", str(dump)]
+            cp = subprocess.run(cmd, env=env, capture_output=True, text=True, check=True)
+            row = next(json.loads(x[7:]) for x in cp.stdout.splitlines() if x[:7] == "RESULT ")
+        row["calls"] = _calls(dump)
+        rows.append(row)
+    out = _summary(rows)
+    out["date"] = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
+    out["loadavg"] = os.getloadavg()
+    out["glibc_tunables"] = os.environ.get("GLIBC_TUNABLES", "")
+    Path(args.out).write_text(json.dumps(out, indent=1) + "\n")
+    print(json.dumps(out, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
