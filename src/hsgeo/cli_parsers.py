@@ -260,7 +260,7 @@ def add_orthomosaic(sub) -> argparse.ArgumentParser:
         help="orthomosaic LP strips onto a DSM: a Cloud-Optimized GeoTIFF in EPSG:25832",
         description="Orthorectify every pixel of every line of the LP strips (ray of the camera "
         "at the line's time on the trajectory, met with the DSM) and mosaic them onto a "
-        "north-up grid in ETRS89 / UTM 32N (EPSG:25832) by nearest neighbour (pyresample); "
+        "north-up grid in ETRS89 / UTM 32N (EPSG:25832) by nearest neighbour (pykdtree); "
         "where strips overlap the pixel nearest to nadir wins. The local east-north-up frame of "
         "the navigation is the one about the 002 site (59.665 N, 10.775 E, ellipsoidal height "
         "0). LINES: LP line files (NetCDF: lines(line, column, band), t_s(line), "
