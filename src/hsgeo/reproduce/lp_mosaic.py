@@ -5,7 +5,7 @@ cells, made on a 20 cm DSM with the adjusted trajectory, and the white reference
 enlarged in it: "they can be accurately found in the orthomosaic". :func:`fig9` makes that
 mosaic of a rendered campaign (:func:`hsgeo.simulate.lp_campaign.simulate`) twice, through the
 user's path (:mod:`hsgeo.workflows.orthomosaic`, :func:`hsgeo.ortho.orthomosaic`: nearest
-neighbour by pyresample, nearest-to-nadir mosaic rule) in ETRS89 / UTM 32N (EPSG:25832, the
+neighbour, nearest-to-nadir mosaic rule) in ETRS89 / UTM 32N (EPSG:25832, the
 site :data:`hsgeo.crs.SITE_AAS`):
 
 * **adjusted**: the navigation with the adjustment's node corrections (002 eq. 4) and the
@@ -19,7 +19,9 @@ a few tenths of a degree, ~10–15 m on the ground at 1875 m AGL, in opposite di
 strips flown in opposite directions), farther than the squares' spacing allows a window
 around the RTK position to search; there the window is centred on where the raw geometry
 puts the square (:func:`where_squares_land`: the truth's line and pixel that saw it, sent down
-the raw ray; the truth only places the window, the position is measured in the mosaic).
+the raw ray, per strip that saw it; the strip whose view is found there within
+:data:`FOUND_WITHIN_M`; the truth only places the window, the position is measured in the
+mosaic).
 
 Both on the simulation's true DSM (:attr:`LpTruth.terrain`: the rendered ground's surface on
 its own grid, where 002 had a 20 cm photogrammetric DSM). Each of the 17 squares is measured in
@@ -52,12 +54,24 @@ from hsgeo.workflows.orthomosaic import (
     lp_mosaic_strips,
 )
 
-__all__ = ["fig9", "mosaic_of", "square_errors", "where_squares_land", "TABLE", "SEARCH_M"]
+__all__ = [
+    "fig9",
+    "mosaic_of",
+    "square_errors",
+    "where_squares_land",
+    "TABLE",
+    "SEARCH_M",
+    "FOUND_WITHIN_M",
+]
 
 TABLE = "002 Fig. 9"
 #: Half width of the window searched around each square's expected position, m: the adjusted
 #: geometry is good to a few dm, the next square ≥ 30 m away.
 SEARCH_M = 3.0
+#: A square in the raw mosaic counts as found where a strip's view of it lands when its centroid
+#: lies within this distance of that landing, m (which strip's view a cell shows depends on the
+#: mosaic rule at that cell, among pixels that saw different ground).
+FOUND_WITHIN_M = 1.0
 
 
 def mosaic_of(obs, truth, camera, trajectory, *, resolution_m: float, bands_nm=TRUE_COLOUR_NM):
@@ -75,21 +89,22 @@ def mosaic_of(obs, truth, camera, trajectory, *, resolution_m: float, bands_nm=T
 
 
 def where_squares_land(obs, truth, camera, trajectory, *, band: int = 3):
-    """Where each square lands in a mosaic made with ``camera`` and ``trajectory``: the line
-    time and pixel that saw its centre (true camera and trajectory), on the strip nearest to
-    nadir there, sent down the given geometry's ray onto the DSM.
+    """Where each square lands in a mosaic made with ``camera`` and ``trajectory``, once per
+    strip that saw it: the line time and pixel that saw its centre (true camera and
+    trajectory), sent down the given geometry's ray onto the DSM.
 
     Returns
     -------
-    (k, 2) ndarray
-        Map x, y in EPSG:25832, m (NaN for a square no strip saw).
+    (k, n_strips, 2) ndarray
+        Map x, y in EPSG:25832, m, per square the strips that saw it first, nearest to nadir
+        first (NaN for the rest).
     """
     from hsgeo.ortho import Strip, geolocate_lines
 
     X = np.asarray(truth.square_xyz_m, float)
-    out = np.full((X.shape[0], 2), np.nan)
+    out = np.full((X.shape[0], len(obs.strips), 2), np.nan)
     for k in range(X.shape[0]):
-        best = None
+        seen = []
         for s in obs.strips:
             t = s.t_s
             y = truth.camera.project(
@@ -106,12 +121,30 @@ def where_squares_land(obs, truth, camera, trajectory, *, band: int = 3):
                 continue
             st = Strip(camera, trajectory, [tt], np.array([[x, 0.0]]), None, {"band": band})
             enu, _, nadir = geolocate_lines(st, truth.terrain, SITE_AAS)
-            if best is None or float(nadir.ravel()[0]) < best[0]:
-                best = (float(nadir.ravel()[0]), enu.reshape(3))
-        if best is not None:
-            xm, ym, _ = SITE_AAS.enu_to_map(*best[1])
-            out[k] = float(xm), float(ym)
+            xm, ym, _ = SITE_AAS.enu_to_map(*enu.reshape(3))
+            seen.append((float(nadir.ravel()[0]), float(xm), float(ym)))
+        for j, (_, xm, ym) in enumerate(sorted(seen)):
+            out[k, j] = xm, ym
     return out
+
+
+def _found_where_landed(mosaic, square_xyz_m, landings, tol_m: float):
+    """Per square, the landing (of :func:`where_squares_land`) where a square is found within
+    ``tol_m`` of it, nearest to nadir first: the error found and the error expected, m.
+    """
+    none = np.full((landings.shape[0], 2), np.nan)
+    rtk, err = square_errors(mosaic, square_xyz_m, search_m=SEARCH_M, search_xy_m=none)
+    exp = landings[:, 0, :].copy()
+    done = np.zeros(landings.shape[0], bool)
+    for j in range(landings.shape[1]):
+        at = np.where(done[:, None], np.nan, landings[:, j, :])
+        if not np.isfinite(at).any():
+            break
+        rtk, e = square_errors(mosaic, square_xyz_m, search_m=SEARCH_M, search_xy_m=at)
+        ok = np.all(np.isfinite(e), axis=1) & (np.hypot(*(rtk + e - at).T) <= tol_m)
+        err[ok], exp[ok] = e[ok], at[ok]
+        done |= ok
+    return err, exp - rtk
 
 
 def square_errors(mosaic, square_xyz_m, *, search_m: float, search_xy_m=None):
@@ -194,12 +227,13 @@ def fig9(obs, truth, adjusted, *, resolution_m: float = P002["fig9_pixel_m"]):
         mosaics[key] = mosaic_of(obs, truth, cam, traj, resolution_m=resolution_m)
         seconds[key] = time.perf_counter() - t0
         land = where_squares_land(obs, truth, cam, traj)
-        # adjusted: the window around the RTK position (not steered by the truth)
-        at = None if key == "adjusted" else land
-        rtk, errors[key] = square_errors(
-            mosaics[key], obs.square_xyz_m, search_m=SEARCH_M, search_xy_m=at
-        )
-        expected[key] = land - rtk
+        if key == "adjusted":  # the window around the RTK position (not steered by the truth)
+            rtk, errors[key] = square_errors(mosaics[key], obs.square_xyz_m, search_m=SEARCH_M)
+            expected[key] = land[:, 0, :] - rtk
+        else:  # around where each strip's view of the square lands: the one found there
+            errors[key], expected[key] = _found_where_landed(
+                mosaics[key], obs.square_xyz_m, land, FOUND_WITHIN_M
+            )
     per_square = {
         "square_ids": tuple(obs.square_ids),
         "rtk_xy_m": rtk,
