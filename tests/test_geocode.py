@@ -336,3 +336,87 @@ def test_geocode_command_takes_the_002_camera_file(tmp_path):
 
     np.testing.assert_allclose(swath_m(d0) / swath_m(ds), 40.0 / 36.0, rtol=0.02)
     assert main(args + ["-o", str(tmp_path / "x.nc"), "--band", "2"]) == 2
+
+
+def test_geocode_outputs_carry_the_local_frame_crs(tmp_path):
+    """``hsgeo geocode`` (on the orthomosaic's path): the NetCDF and the ENVI file carry a real
+    CRS, the local frame's plane about ``--site``; GDAL reads it from both, and a cell's E, N
+    are its position in that CRS (pyproj: the ENU point of a cell centre has the same E, N)."""
+    import rasterio
+
+    from hsgeo.cli import main
+    from hsgeo.crs import LocalFrame, lonlat_to_crs
+
+    nav = straight_nav(heading_deg=0.0, T=10.0)
+    write_trajectory(tmp_path / "nav.csv", nav)
+    zeta = np.arange(200.0, 800.0, 2.0)
+    g = geocode_image(nav, CAL, 40, zeta, t0_s=0.0, line_rate_hz=8.0, terrain=PlaneTerrain(3.0))
+    write_lines(tmp_path / "lines.nc", g[..., 0], zeta, t0_s=0.0, line_rate_hz=8.0)
+    (tmp_path / "sensor.toml").write_text(
+        "[sensor]\nmodel = 'calibrated'\nzeta0_px = 486.8\nc_px = 3539.0\n"
+        "K = [1.459, -0.1636, 0.00526]\n"
+    )
+    argv = [
+        "geocode",
+        str(tmp_path / "lines.nc"),
+        "--trajectory",
+        str(tmp_path / "nav.csv"),
+        "--sensor",
+        str(tmp_path / "sensor.toml"),
+        "--height",
+        "3",
+        "-o",
+        str(tmp_path / "o.nc"),
+        "--envi",
+        str(tmp_path / "o_envi"),
+        "--quiet",
+        "--site",
+        "45.0,13.9,20",
+    ]
+    assert main(argv) == 0
+    frame = LocalFrame(45.0, 13.9, 20.0)
+    from pyproj import CRS
+
+    ds = xr.open_dataset(tmp_path / "o.nc")
+    corner = (float(ds["E"].values[0]) - 0.25, float(ds["N"].values[0]) + 0.25)
+    for path in (f"netcdf:{tmp_path / 'o.nc'}:radiance", str(tmp_path / "o_envi")):
+        with rasterio.open(path) as src:
+            assert CRS.from_wkt(src.crs.to_wkt()) == CRS.from_user_input(frame.local_crs())
+            np.testing.assert_allclose((src.transform.c, src.transform.f), corner)
+            assert (src.transform.a, src.transform.e) == (0.5, -0.5)
+    E, N = float(ds["E"].values[3]), float(ds["N"].values[5])
+    lon, lat, _ = frame.enu_to_lonlat(E, N, 3.0)
+    np.testing.assert_allclose(lonlat_to_crs(frame.local_crs(), lon, lat), (E, N), atol=1e-3)
+
+
+def test_intersect_on_a_wall_where_the_fixed_point_iteration_cycles(monkeypatch):
+    """A ray 30° off nadir meets a 10 m wall (a DSM step over one cell): the height iteration
+    jumps between roof and ground (|slope · tan 30°| = 5.8 > 1); the march and bisection find
+    the first crossing, against a dense sampling of the ray (an independent truth)."""
+    import xarray as xr
+
+    from hsgeo import geocode
+    from hsgeo.geocode import DemTerrain, intersect
+
+    calls = []
+    march = geocode._march_bisect
+    monkeypatch.setattr(
+        geocode, "_march_bisect", lambda O, *a, **k: calls.append(len(O)) or march(O, *a, **k)
+    )
+    E = np.arange(0.0, 101.0)
+    z = np.where(E >= 50.0, 10.0, 0.0)[None, :].repeat(21, axis=0)
+    dem = DemTerrain(xr.DataArray(z, dims=("N", "E"), coords={"N": np.arange(21.0), "E": E}))
+    t30 = np.tan(np.radians(30.0))
+    O = np.array([[49.2 - 98.0 * t30, 10.0, 100.0], [49.2 - 98.0 * t30 + 20.0, 10.0, 100.0]])
+    d = np.array([[0.5, 0.0, -np.sqrt(0.75)]] * 2)
+    X = intersect(O, d, dem, tol_m=1e-6)
+    assert calls == [1]  # the first ray only: the iteration did not converge there
+    # dense sampling: the first point of the ray below the DSM
+    h = np.linspace(12.0, -1.0, 1_300_001)
+    P = O[0] + ((h - O[0, 2]) / d[0, 2])[:, None] * d[0]
+    first = np.argmax(h <= dem.height(P[:, 0], P[:, 1]))
+    np.testing.assert_allclose(X[0], P[first], atol=2e-5)
+    assert 1.9 < X[0, 2] < 2.1 and 49.0 < X[0, 0] < 50.0  # on the wall, near the expected 2 m
+    # the second ray meets the flat roof: the iteration converges there as before
+    np.testing.assert_allclose(X[1, 2], 10.0, atol=1e-6)
+    np.testing.assert_allclose(X[1], O[1] + (10.0 - 100.0) / d[1, 2] * d[1], atol=1e-6)

@@ -156,6 +156,39 @@ def _cmd_versions(args) -> int:
     return 0
 
 
+def _cmd_orthomosaic(args) -> int:
+    from hsgeo.workflows.orthomosaic import orthomosaic_files
+
+    progress = None if args.quiet else terminal.progress_counter("mosaic tiles")
+    try:
+        out = orthomosaic_files(
+            args.lines,
+            args.trajectory,
+            args.camera,
+            dsm=args.dsm,
+            output=args.output,
+            resolution_m=args.resolution,
+            bands=args.bands,
+            adjustment=args.adjustment,
+            scheduler=args.scheduler,
+            overwrite=args.overwrite,
+            progress=progress,
+            max_nav_gap_s=args.max_nav_gap_s,
+            line_pixels=args.line_pixels,
+        )
+    finally:
+        terminal.clear_progress()
+    if args.json:
+        print(json_text(out))
+    else:
+        print(
+            f"mosaicked {len(out['strips'])} strip(s), {len(out['bands'])} band(s) onto "
+            f"{out['height']} x {out['width']} cells of {out['resolution_m']:g} m "
+            f"({out['crs']}) -> {out['output']}"
+        )
+    return 0
+
+
 def _cmd_geocode(args) -> int:
     from hsgeo.workflows.geocoding import geocode_files
 
@@ -173,6 +206,7 @@ def _cmd_geocode(args) -> int:
         max_grid_gib=args.max_grid_gib,
         max_nav_gap_s=args.max_nav_gap_s,
         band=args.band,
+        site=args.site,
     )
     print(
         f"orthorectified {ortho.sizes['band']} band(s) onto {ortho.sizes['N']} x "

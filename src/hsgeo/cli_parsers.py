@@ -214,6 +214,93 @@ def add_geocode(sub) -> argparse.ArgumentParser:
         default=0,
         help="band of a pushbroom camera file whose geometry is used (default 0)",
     )
+    p.add_argument(
+        "--site",
+        type=_site,
+        metavar="LAT,LON[,H]",
+        help="ETRS89 latitude, longitude (degrees) and ellipsoidal height (m) of the origin of "
+        "the navigation's east-north-up frame: the output's CRS (default the 002 site, "
+        "59.665,10.775,0)",
+    )
+    p.add_argument("--quiet", action="store_true", help="no progress display")
+    return p
+
+
+def _site(text: str) -> tuple:
+    """``--site LAT,LON[,H]``."""
+    try:
+        v = tuple(float(x) for x in text.split(","))
+    except ValueError:
+        v = ()
+    if len(v) not in (2, 3) or not (-90 < v[0] < 90 and -180 <= v[1] <= 180):
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: give LAT,LON or LAT,LON,H (degrees north and east, metres), e.g. "
+            "59.665,10.775,0"
+        )
+    return v
+
+
+def _wavelengths(text: str) -> tuple:
+    """``--bands 640,550,460``: wavelengths in nm."""
+    try:
+        out = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: give band wavelengths in nm separated by commas, e.g. 640,550,460"
+        ) from None
+    if not out or not all(0 < v < 1e5 for v in out):
+        raise argparse.ArgumentTypeError(f"{text!r}: wavelengths must be positive numbers of nm")
+    return out
+
+
+def add_orthomosaic(sub) -> argparse.ArgumentParser:
+    """``hsgeo orthomosaic``."""
+    p = sub.add_parser(
+        "orthomosaic",
+        help="orthomosaic LP strips onto a DSM: a Cloud-Optimized GeoTIFF in EPSG:25832",
+        description="Orthorectify every pixel of every line of the LP strips (ray of the camera "
+        "at the line's time on the trajectory, met with the DSM) and mosaic them onto a "
+        "north-up grid in ETRS89 / UTM 32N (EPSG:25832) by nearest neighbour (pykdtree); "
+        "where strips overlap the pixel nearest to nadir wins. The local east-north-up frame of "
+        "the navigation is the one about the 002 site (59.665 N, 10.775 E, ellipsoidal height "
+        "0). LINES: LP line files (NetCDF: lines(line, column, band), t_s(line), "
+        "wavelength_nm(band), attributes col0, strip_id and optionally n_px_full: see "
+        "hsgeo.io.lp_lines). NAV: the navigation file of every "
+        "command. CAMERA: the camera TOML of hsgeo adjust-pushbroom; RESULT: its --json output "
+        "(camera parameters and node corrections: the adjusted trajectory). DSM: a GeoTIFF of "
+        "ellipsoidal heights in EPSG:25832. Output: a COG with overviews, band names and "
+        "wavelengths; tiles computed with Dask (--scheduler: on a dask.distributed cluster).",
+    )
+    p.add_argument("lines", nargs="+", metavar="LINES")
+    p.add_argument("--trajectory", required=True, metavar="NAV", help="navigation file")
+    p.add_argument("--camera", required=True, metavar="CAMERA.toml")
+    p.add_argument("--adjustment", metavar="RESULT.json", help="hsgeo adjust-pushbroom --json")
+    p.add_argument("--dsm", required=True, metavar="DSM.tif")
+    p.add_argument("--resolution", type=_POSITIVE, default=0.3, help="cell size in m (default 0.3)")
+    p.add_argument("-o", "--output", required=True, metavar="MOSAIC.tif")
+    p.add_argument(
+        "--bands",
+        type=_wavelengths,
+        default=(640.0, 550.0, 460.0),
+        metavar="R,G,B",
+        help="wavelengths (nm) of the bands to mosaic, nearest band each (default 640,550,460)",
+    )
+    p.add_argument("--scheduler", metavar="ADDRESS", help="dask.distributed scheduler address")
+    p.add_argument(
+        "--line-pixels",
+        type=option_number(integer=True, lo=1, hi=100000),
+        default=None,
+        help="pixels of a full line; overrides the files' n_px_full attribute (default: that "
+        "attribute, else 1800, 002 §4)",
+    )
+    p.add_argument(
+        "--max-nav-gap-s",
+        type=_POSITIVE,
+        default=1.0,
+        help="longest gap between navigation records interpolated across, s (default 1)",
+    )
+    p.add_argument("--overwrite", action="store_true", help="replace an existing output")
+    p.add_argument("--json", action="store_true", help="the summary as JSON")
     p.add_argument("--quiet", action="store_true", help="no progress display")
     return p
 
@@ -284,7 +371,8 @@ def add_lp_observations(sub) -> argparse.ArgumentParser:
         "camera's), tie points seen in >= 3 lines of >= 3 strips, each observation at the "
         "centre of its original pixel. SCENES: LP line files, one strip each (NetCDF, see "
         "hsgeo.io.lp_lines: lines(line, column, band) DN, t_s(line), wavelength_nm(band), "
-        "attributes col0 and strip_id). NAV: the navigation file of every command, CSV or "
+        "attributes col0, strip_id and optionally n_px_full). NAV: the navigation file of "
+        "every command, CSV or "
         "Parquet with t_s, E_m, N_m, U_m, roll_deg, pitch_deg, heading_deg (see "
         "hsgeo.io.navigation). CAMERA: the camera TOML of hsgeo adjust-pushbroom (one band "
         "per band of the line files; c_band_mm, boresight_deg as known a priori). SQUARES: "
@@ -335,8 +423,9 @@ def add_lp_observations(sub) -> argparse.ArgumentParser:
     p.add_argument(
         "--line-pixels",
         type=option_number(integer=True, lo=1, hi=100000),
-        default=1800,
-        help="pixels of a full line (default 1800, 002 §4)",
+        default=None,
+        help="pixels of a full line; overrides the files' n_px_full attribute (default: that "
+        "attribute, else 1800, 002 §4)",
     )
     p.add_argument(
         "--max-nav-gap-s",
@@ -513,6 +602,7 @@ SUBCOMMANDS = (
     ("_cmd_calibrate_frame", add_calibrate_frame),
     ("_cmd_data", add_data),
     ("_cmd_geocode", add_geocode),
+    ("_cmd_orthomosaic", add_orthomosaic),
     ("_cmd_adjust_pushbroom", add_adjust_pushbroom),
     ("_cmd_lp_observations", add_lp_observations),
     ("_cmd_adjust_bal", add_adjust_bal),

@@ -327,6 +327,9 @@ P002 = {
     },  # 002 Table 3, row H
     "fig8_max_abs_diff_um": 11.8,  # 002 Fig. 8 caption: "differences are ≤ 11.8 µm"
     "fig8_sigma_um": (1.2, 2.4),  # 002 Fig. 8 caption: "precision estimates of 1.2–2.4 µm"
+    "fig9_pixel_m": 0.30,  # 002 Fig. 9 caption: orthoimages "with a pixel size of 30 cm"
+    "fig9_dsm_m": 0.20,  # 002 §5.1: orthoimages "created using a 20 cm digital surface model"
+    "fig9_agl_m": 1875.0,  # 002 Fig. 9 caption: "the acquisition at 1875 m AGL"
     "chromatic_shift_px": 0.27,  # 002 §5: "maximum absolute shift ≤ 0.27 pixels"
     "n_unknowns": 342407,  # 002 §4: "A total of 342407 unknowns"
     "n_observations_2d": 441587,  # 002 §4: "441 587 2D observations"

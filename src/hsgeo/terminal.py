@@ -32,6 +32,7 @@ __all__ = [
     "error_line",
     "progress_printer",
     "stage_printer",
+    "progress_counter",
     "clear_progress",
     "json_text",
 ]
@@ -188,9 +189,10 @@ def progress_printer(stream=None):
 
 
 def stage_printer(stream=None):
-    """A ``progress(done, total, stage)`` callback for work in steps (strips, files): ``stage
-    done/total`` on one self-clearing line of an interactive terminal (:func:`clear_progress`
-    erases it); ``None`` when ``stream`` (default stderr) is not a terminal.
+    """A ``progress(done, total, stage)`` callback for work in steps (strips, files, tiles):
+    ``stage: done/total (percent)`` on one self-clearing line of an interactive terminal
+    (:func:`clear_progress` erases it); ``None`` when ``stream`` (default stderr) is not a
+    terminal.
     """
     stream = sys.stderr if stream is None else stream
     try:
@@ -202,11 +204,21 @@ def stage_printer(stream=None):
 
     def show(done: int, total: int, stage: str) -> None:
         global _progress_shown
-        stream.write(f"\r\033[K{stage}: {done}/{total}")
+        stream.write(f"\r\033[K{stage}: {done}/{total} ({100.0 * done / max(1, total):.0f} %)")
         stream.flush()
         _progress_shown = True
 
     return show
+
+
+def progress_counter(what: str, stream=None):
+    """:func:`stage_printer` for one named stage: a ``progress(done, total)`` callback (tiles,
+    lines), ``None`` when ``stream`` (default stderr) is not a terminal.
+    """
+    show = stage_printer(stream)
+    if show is None:
+        return None
+    return lambda done, total: show(done, total, what)
 
 
 def clear_progress(stream=None) -> None:

@@ -77,6 +77,7 @@ __all__ = [
     "rph_from_platform_rpy",
     "platform_rpy_rate_from_rph_rate",
     "SplineNodes",
+    "corrected_trajectory",
     "bspline_basis",
     "bspline_basis_derivative",
 ]
@@ -390,3 +391,36 @@ def platform_rpy_rate_from_rph_rate(roll_pitch_heading_rate_rad_s) -> np.ndarray
     """
     a = _angles3(roll_pitch_heading_rate_rad_s, "roll_pitch_heading_rate_rad_s")
     return np.stack([a[..., 0], -a[..., 1], -a[..., 2]], axis=-1)
+
+
+def corrected_trajectory(trajectory: Trajectory, nodes: SplineNodes, values) -> Trajectory:
+    """The trajectory with the spline corrections of an adjustment applied (002 eq. 4).
+
+    At every record ``x = x_nav + δ_xyz`` and the platform angles ``rpy_nav + δ_rpy``
+    (:func:`platform_rpy_from_rph`), converted back to roll, pitch, heading. Records outside the
+    spline's span take the correction at its nearest end (held constant).
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        The GNSS/INS solution the adjustment started from.
+    nodes : SplineNodes
+    values : (n_nodes, 6) array_like
+        Node corrections in the order of :data:`CORRECTION_COLUMNS` (m, rad).
+
+    Returns
+    -------
+    Trajectory
+        At the same record times (the corrections vary over the node interval, seconds, far
+        slower than the records).
+    """
+    t = np.clip(trajectory.t_s, nodes.t_start_s, nodes.t_end_s)
+    v = np.asarray(values, dtype=np.float64)
+    if v.shape != (nodes.n_nodes, len(CORRECTION_COLUMNS)):
+        raise InputError(
+            f"node corrections must be ({nodes.n_nodes}, {len(CORRECTION_COLUMNS)}) "
+            f"({', '.join(CORRECTION_COLUMNS)}), got {v.shape}"
+        )
+    d = nodes.evaluate(v, t)
+    rpy = platform_rpy_from_rph(trajectory.roll_pitch_heading_rad) + d[:, 3:]
+    return Trajectory(trajectory.t_s, trajectory.xyz_m + d[:, :3], rph_from_platform_rpy(rpy))

@@ -36,6 +36,7 @@ def _header(
     data_ignore_value=None,
     default_bands=None,
     description="hsgeo",
+    crs_wkt=None,
 ) -> str:
     """The text of an ENVI header for data of shape (bands, lines, samples)."""
     b, lines, samples = shape_bls
@@ -54,6 +55,8 @@ def _header(
     if map_info is not None:
         e, n, de, dn = map_info
         hdr.append(f"map info = {{Arbitrary, 1, 1, {e!r}, {n!r}, {de!r}, {dn!r}, 0, units=Meters}}")
+    if crs_wkt is not None:  # ENVI's key for the CRS (WKT), which GDAL reads
+        hdr.append("coordinate system string = {" + " ".join(str(crs_wkt).split()) + "}")
     if band_names is not None:
         hdr.append("band names = {" + ", ".join(str(x) for x in band_names) + "}")
     if wavelength_nm is not None:
@@ -89,6 +92,7 @@ def write_envi(
     default_bands=None,
     interleave: str = "bsq",
     description: str = "hsgeo",
+    crs_wkt: str | None = None,
     inputs=(),
 ) -> tuple[Path, Path]:
     """Write an ENVI file ``path`` and its header ``path.hdr``.
@@ -113,6 +117,8 @@ def write_envi(
         Order of the values in the file: band-sequential (the paper's, 001 §2.4),
         band-interleaved by line, by pixel.
     description : str
+    crs_wkt : str, optional
+        The CRS of ``map_info`` as WKT (header ``coordinate system string``).
     inputs : iterable of path, optional
         Files the command reads; writing over one raises :class:`~hsgeo.InputError`.
 
@@ -139,6 +145,7 @@ def write_envi(
         data_ignore_value=data_ignore_value,
         default_bands=default_bands,
         description=description,
+        crs_wkt=crs_wkt,
         inputs=inputs,
     ) as w:
         w[:, :, :] = arr.transpose(1, 2, 0)

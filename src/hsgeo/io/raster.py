@@ -13,9 +13,9 @@ from hsgeo.io.lines import open_netcdf
 
 __all__ = ["to_map_files", "read_dem", "MAP_FORMATS"]
 
-#: The extensions of the orthoimage written by ``-o`` (NetCDF 3 through xarray's scipy engine);
-#: a GeoTIFF needs rasterio, which hsgeo does not depend on (``--envi`` writes ENVI with map
-#: info, which GIS programs read).
+#: The extensions of the orthoimage written by ``-o`` (NetCDF 3 through xarray's scipy engine,
+#: the CRS in rioxarray's ``spatial_ref`` variable); ``--envi`` writes ENVI with map info and the
+#: CRS as WKT, which GIS programs read. (The orthomosaic writes GeoTIFF: hsgeo.io.geotiff.)
 MAP_FORMATS = {".nc": "NetCDF", ".nc4": "NetCDF", ".cdf": "NetCDF", ".netcdf": "NetCDF"}
 
 
@@ -70,10 +70,25 @@ def _write_map_envi(da, path_envi, inputs) -> list:
                 map_info=(E0, N0, res, res),
                 band_names=[str(b) for b in da["band"].values],
                 description="hsgeo orthorectified line-scanner image",
+                crs_wkt=_crs_wkt(da),
                 inputs=inputs,
             )
         )
     return out
+
+
+def _crs_wkt(da):
+    """The raster's CRS as WKT (rioxarray's ``spatial_ref``, or the ``crs`` attribute), or None."""
+    crs = da.rio.crs if hasattr(da, "rio") else None
+    if crs is None and "crs" in da.attrs:
+        from pyproj import CRS
+        from pyproj.exceptions import CRSError
+
+        try:
+            crs = CRS.from_user_input(da.attrs["crs"])
+        except CRSError:
+            return None
+    return None if crs is None else crs.to_wkt()
 
 
 def read_dem(path):

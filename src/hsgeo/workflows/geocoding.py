@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from hsgeo.crs import SITE_AAS, LocalFrame
 from hsgeo.errors import HsgeoError, InputError
 from hsgeo.geocode import (
     DemTerrain,
@@ -21,9 +22,9 @@ from hsgeo.geocode import (
     calibrate_boresight,
     geocode_image,
     geocode_observations,
-    orthorectify,
 )
 from hsgeo.io import read_dem, read_lines, read_scanning_sensor, to_map_files
+from hsgeo.ortho import grid_swath
 from hsgeo.sensors.line import LineGeometry
 from hsgeo.sensors.pushbroom import PushbroomCamera
 
@@ -66,8 +67,13 @@ def geocode_files(
     max_grid_gib: float = MAX_GRID_GIB,
     max_nav_gap_s: float = MAX_NAV_GAP_S,
     band: int = 0,
+    site=None,
 ):
     """Orthorectify a recorded flight line from files (see ``hsgeo geocode --help``).
+
+    ``site``: ``(latitude_deg, longitude_deg[, height_m])`` (ETRS89) of the navigation's local
+    frame origin (``--site``; default the 002 site, :data:`hsgeo.crs.SITE_AAS`): the output's
+    CRS.
 
     ``sensor``: the 000 sensor file (``[sensor]``, the LINES pixel coordinate is ζ) or the 002
     camera file (``[camera]``, the LINES pixel coordinate is x in px from the line centre; the
@@ -88,6 +94,7 @@ def geocode_files(
         raise InputError("give exactly one of --dem DEM.nc or --height H (a plane)")
     if not (np.isfinite(resolution_m) and resolution_m > 0):
         raise InputError(f"--resolution must be a positive number of metres, got {resolution_m}")
+    frame = _frame(site)
     inputs = (lines, trajectory, sensor, dem)
     outs = [(output, "-o/--output", MAP_FORMATS)]
     if envi is not None:
@@ -119,11 +126,21 @@ def geocode_files(
     terrain = _terrain(dem, height_m, nav.pose(t_lines)[0][:, 2])
     res = orthorectify_lines(
         GeocodeInputs(da, t0, rate, nav, scanner, terrain, pixels, pixel_kw),
-        GeocodeOptions(resolution_m=resolution_m, max_grid_gib=max_grid_gib),
+        GeocodeOptions(resolution_m=resolution_m, max_grid_gib=max_grid_gib, frame=frame),
         attrs={"source": str(lines), "sensor": str(sensor)},
         progress=progress,
     )
     return res.ortho, to_map_files(res.ortho, output, envi, inputs=inputs)
+
+
+def _frame(site):
+    """The local frame of ``--site LAT,LON[,H]`` (default the 002 site)."""
+    if site is None:
+        return SITE_AAS
+    site = tuple(float(v) for v in site)
+    if len(site) not in (2, 3):
+        raise InputError(f"--site needs LAT,LON or LAT,LON,H (degrees, metres), got {site}")
+    return LocalFrame(*site)
 
 
 def _terrain(dem, height_m, U):
@@ -177,10 +194,14 @@ class GeocodeInputs:
 
 @dataclass(frozen=True)
 class GeocodeOptions:
-    """Cell size of the map grid (m) and the largest memory it may take (GiB)."""
+    """Cell size of the map grid (m), the largest memory it may take (GiB), and where the
+    navigation's local east-north-up frame lies (:class:`hsgeo.crs.LocalFrame`; the grid's CRS
+    is the frame's own plane, :meth:`~hsgeo.crs.LocalFrame.local_crs`).
+    """
 
     resolution_m: float = 0.5
     max_grid_gib: float = MAX_GRID_GIB
+    frame: object = SITE_AAS
 
 
 @dataclass(frozen=True)
@@ -233,14 +254,41 @@ def orthorectify_lines(
             f"about {need / _GIB:.3g} GiB, over --max-grid-gib {max_grid_gib:g}; use a coarser "
             "--resolution, or raise --max-grid-gib"
         )
-    ortho = orthorectify(
-        da.values,
-        ground,
-        resolution_m=resolution_m,
-        band_names=da["band"].values,
-        attrs=attrs or {},
-    )
+    ortho = _to_grid(da, ground, options, attrs)
     return GeocodeResult(ortho, ground)
+
+
+def _to_grid(da, ground, options, attrs):
+    """The swath onto the local frame's grid with a CRS (:func:`hsgeo.ortho.grid_swath`, the
+    resampling of the orthomosaic: nearest neighbour, :func:`hsgeo.ortho.resample_swath`), as
+    ``(band, N, E)``.
+    """
+    import rioxarray  # noqa: F401  (the .rio accessor)
+    import xarray as xr
+
+    frame = options.frame
+    v, grid, radius = grid_swath(
+        da.values.astype(np.float64), ground, frame, resolution_m=options.resolution_m
+    )
+    ortho = xr.DataArray(
+        v.astype(np.float64),
+        dims=("band", "N", "E"),
+        coords={"band": da["band"].values, "N": grid.y_m, "E": grid.x_m},
+        name="radiance",
+        attrs={
+            "crs": grid.crs,
+            "local_frame_origin": f"{frame.lat_deg!r} N, {frame.lon_deg!r} E, {frame.h_m!r} m "
+            "(ETRS89, ellipsoidal height)",
+            "resolution_m": options.resolution_m,
+            "resampling": "nearest neighbour (pykdtree in the grid's CRS)",
+            "max_distance_m": radius,
+            **(attrs or {}),
+        },
+    )
+    ortho["E"].attrs.update(units="m", long_name="easting")
+    ortho["N"].attrs.update(units="m", long_name="northing")
+    ortho = ortho.rio.set_spatial_dims("E", "N").rio.write_crs(grid.crs)
+    return ortho.rio.write_transform(grid.transform)
 
 
 def _line_pixels(scanner, pixel, band, sensor):

@@ -1,0 +1,451 @@
+"""Orthorectification and mosaicking of any scanning sensor's lines onto a map grid with a CRS.
+
+The gridded half of :mod:`hsgeo.geocode` (which meets rays with the terrain): every pixel of
+every line of a :class:`Strip` is geolocated (the sensor's ``rays`` at the line's time on its
+:class:`~hsgeo.trajectory.Trajectory`, :func:`hsgeo.geocode.intersect` with the terrain in the
+local ENU frame, then ETRS89 longitude and latitude by :class:`hsgeo.crs.LocalFrame`), and the
+swath is resampled onto a :class:`MapGrid` in the map CRS (EPSG:25832 for 002) by nearest
+neighbour within a radius of influence (every spectrum stays as it was measured, as is usual for
+imaging spectrometers), found by pykdtree (pyresample's kd-tree) in the grid's own metres
+(:func:`resample_swath` says why not through pyresample's geographic path).
+
+**Mosaic rule (nearest to nadir).** Where strips overlap, a map cell takes the pixel whose ray
+is closest to the nadir (smallest off-nadir angle ``arccos(−d_U)`` of its ray) among the nearest
+pixels of each strip; within one strip the nearest pixel wins. The rule needs nothing of a
+particular sensor (it is the ``|x|``-smallest rule of a pushbroom camera on a level platform).
+
+**Chunks.** :func:`orthomosaic` returns an :class:`xarray.DataArray` ``(band, y, x)`` backed by
+Dask, one chunk per output tile. A tile's task geolocates only the line blocks whose footprint
+(the geolocated perimeter of the block, plus the radius of influence) meets the tile, from the
+lines of those blocks alone: the cube may be a lazily generated Dask array larger than memory,
+and the same graph runs on the threaded scheduler or on a ``dask.distributed`` cluster.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from hsgeo.errors import InputError
+from hsgeo.geocode import intersect
+from hsgeo.mapgrid import MapGrid, MapTerrain
+
+__all__ = [
+    "MapGrid",
+    "MapTerrain",
+    "Strip",
+    "geolocate_lines",
+    "strip_footprints",
+    "resample_swath",
+    "orthomosaic",
+    "mosaic_tile",
+    "grid_swath",
+    "OFF_NADIR_NAME",
+]
+
+OFF_NADIR_NAME = "off_nadir_deg"
+
+
+@dataclass(frozen=True)
+class Strip:
+    """One flight strip of any scanning sensor: its lines, their times, and its geometry.
+
+    Parameters
+    ----------
+    sensor : a scanning sensor of :mod:`hsgeo.sensors` (``rays(pixels, t_s, trajectory, **kw)``)
+    trajectory : hsgeo.trajectory.Trajectory
+        The (adjusted) navigation of the body.
+    t_s : (n_lines,) ndarray, s
+        Time of each line.
+    pixels : (n_px,) or (n_px, 2) ndarray
+        One line's pixel coordinates in the sensor's convention (ζ of the 000 line scanner,
+        ``(x, y = 0)`` px of the 002 LP camera), the same in every line.
+    values : (n_lines, n_px, n_bands) array_like or None
+        Radiance or reflectance; a Dask array is never loaded whole (None: the geometry only).
+    pixel_kw : dict
+        What else ``rays`` takes per pixel (``band=`` of a pushbroom camera).
+    name : str
+        The strip's id, for messages.
+    """
+
+    sensor: object
+    trajectory: object
+    t_s: np.ndarray
+    pixels: np.ndarray
+    values: object
+    pixel_kw: dict = field(default_factory=dict)
+    name: str = "strip"
+
+    def __post_init__(self):
+        t = np.asarray(self.t_s, dtype=float)
+        px = np.asarray(self.pixels, dtype=float)
+        shape = tuple(np.shape(self.values)) if self.values is not None else None
+        if shape is not None and (len(shape) != 3 or shape[:2] != (t.size, px.shape[0])):
+            raise InputError(
+                f"strip {self.name!r}: values must be (n_lines, n_px, n_bands) = ({t.size}, "
+                f"{px.shape[0]}, …), got {shape}"
+            )
+        object.__setattr__(self, "t_s", t)
+        object.__setattr__(self, "pixels", px)
+
+    @property
+    def n_lines(self) -> int:
+        return int(self.t_s.size)
+
+    @property
+    def n_bands(self) -> int:
+        return int(np.shape(self.values)[2])
+
+    def geometry(self) -> Strip:
+        """The strip without its values (``values=None``): what a tile's task needs besides
+        the line blocks it reads, so that a task never depends on the whole cube.
+        """
+        return replace(self, values=None)
+
+
+def geolocate_lines(strip: Strip, terrain, frame, lines=slice(None), columns=slice(None)):
+    """Ground points of pixels of lines of a strip: ENU, longitude/latitude and off-nadir angle.
+
+    Parameters
+    ----------
+    strip : Strip
+    terrain : PlaneTerrain, DemTerrain or MapTerrain (``height(E, N)`` in the local frame)
+    frame : hsgeo.crs.LocalFrame
+    lines, columns : slice or index array
+        Which lines and pixels of a line.
+
+    Returns
+    -------
+    enu_m : (m, k, 3) ndarray
+        Ground points (E, N, U), m.
+    lonlat_deg : (m, k, 2) ndarray
+        ETRS89 longitude and latitude, degrees.
+    off_nadir_deg : (m, k) ndarray
+        Angle between each ray and the downward vertical of the local frame, degrees.
+    """
+    t = strip.t_s[lines]
+    px = strip.pixels[columns]
+    m, k = t.size, px.shape[0]
+    tt = np.repeat(t, k)
+    pp = np.tile(px, (m,) + (1,) * (px.ndim - 1))
+    o, d = strip.sensor.rays(pp, tt, strip.trajectory, **strip.pixel_kw)
+    X = intersect(o, d, terrain)
+    lon, lat, _ = frame.enu_to_lonlat(X[:, 0], X[:, 1], X[:, 2])
+    off = np.degrees(np.arccos(np.clip(-d[:, 2], -1.0, 1.0)))
+    return X.reshape(m, k, 3), np.stack([lon, lat], -1).reshape(m, k, 2), off.reshape(m, k)
+
+
+def strip_footprints(strip: Strip, terrain, frame, lines_per_block: int, crs: str):
+    """Bounding boxes in ``crs`` of a strip's line blocks and its largest ground pixel spacing.
+
+    Geolocates the perimeter of each block of ``lines_per_block`` lines (its first and last
+    line, its first and last pixel of every line).
+
+    Returns
+    -------
+    blocks : list of (line0, line1)
+    bbox_m : (n_blocks, 4) ndarray
+        ``x_min, y_min, x_max, y_max`` in ``crs``, m.
+    spacing_m : float
+        Largest distance between neighbouring pixels along a line or between lines, m.
+    """
+    from hsgeo.crs import lonlat_to_crs
+
+    n = strip.n_lines
+    blocks = [(a, min(n, a + lines_per_block)) for a in range(0, n, lines_per_block)]
+    bbox = np.empty((len(blocks), 4))
+    spacing = 0.0
+    for i, (a, b) in enumerate(blocks):
+        e1, l1, _ = geolocate_lines(strip, terrain, frame, np.unique([a, b - 1]))
+        e2, l2, _ = geolocate_lines(strip, terrain, frame, slice(a, b), [0, -1])
+        ll = np.concatenate([l1.reshape(-1, 2), l2.reshape(-1, 2)])
+        x, y = lonlat_to_crs(crs, ll[:, 0], ll[:, 1])
+        bbox[i] = np.min(x), np.min(y), np.max(x), np.max(y)
+        if e1.shape[1] > 1:
+            step = np.linalg.norm(np.diff(e1[..., :2], axis=1), axis=-1)
+            spacing = max(spacing, float(step.max()))
+        if b - a > 1:
+            step = np.linalg.norm(np.diff(e2[..., :2], axis=0), axis=-1)
+            spacing = max(spacing, float(step.max()))
+    return blocks, bbox, spacing
+
+
+def resample_swath(lonlat_deg, values, rank, grid: MapGrid, radius_m: float):
+    """Nearest swath pixel of every cell of ``grid`` within ``radius_m``, in the grid's CRS.
+
+    The swath's pixels go into the grid's CRS (pyproj), and pykdtree (the kd-tree pyresample
+    itself uses) finds each cell centre's nearest pixel in the grid's own metres. pyresample's
+    ``kd_tree`` (used before) works through geographic coordinates only: the lon/lat of every
+    cell (pyproj), geocentric x, y, z of cells and pixels, its radius on a 6370997 m sphere
+    (0.3 % short at 60° N), then a second check in map metres; on a 0.9 M-pixel swath onto
+    0.97 M cells of 0.3 m that took 1.16 CPU s against 0.22 s for the query here (+0.1 s for
+    the pixels' projection), with the same cells filled.
+
+    Parameters
+    ----------
+    lonlat_deg : (n, 2) ndarray
+        Longitude and latitude of the swath pixels, degrees.
+    values : (n, n_bands) ndarray
+    rank : (n,) ndarray
+        The mosaic's ranking of each pixel (the off-nadir angle, degrees): carried along.
+    grid : MapGrid
+    radius_m : float
+        Radius of influence: cells farther from every pixel stay empty.
+
+    Returns
+    -------
+    values : (n_bands, height, width) ndarray, NaN where empty
+    rank : (height, width) ndarray, +inf where empty
+    """
+    from pykdtree.kdtree import KDTree
+
+    from hsgeo.crs import lonlat_to_crs
+
+    n_cells = grid.width * grid.height
+    out = np.full((values.shape[1], n_cells), np.nan, dtype=np.float32)
+    r = np.full(n_cells, np.inf)
+    if lonlat_deg.shape[0]:
+        px, py = lonlat_to_crs(grid.crs, lonlat_deg[:, 0], lonlat_deg[:, 1])
+        tree = KDTree(np.column_stack([px, py]))
+        X, Y = np.meshgrid(grid.x_m, grid.y_m)
+        dist, pix = tree.query(
+            np.column_stack([X.ravel(), Y.ravel()]), k=1, distance_upper_bound=radius_m
+        )
+        cell = np.flatnonzero(np.isfinite(dist) & (dist <= radius_m))
+        pix = pix[cell].astype(np.intp)
+        out[:, cell] = values[pix].T
+        r[cell] = rank[pix]
+    return out.reshape(-1, grid.height, grid.width), r.reshape(grid.height, grid.width)
+
+
+def grid_swath(image, ground_enu_m, frame, *, resolution_m: float, crs=None, radius_m=None):
+    """One geolocated swath onto a grid, in memory (``hsgeo geocode``): the resampling of
+    :func:`mosaic_tile` (nearest neighbour within ``radius_m``, :func:`resample_swath`) without
+    Dask.
+
+    Parameters
+    ----------
+    image : (n_bands, n_lines, n_px) ndarray
+    ground_enu_m : (n_lines, n_px, 3) ndarray
+        Every pixel's ground point in the local frame (:func:`hsgeo.geocode.geocode_image`).
+    frame : hsgeo.crs.LocalFrame
+    resolution_m : float
+    crs : str, optional
+        The grid's CRS; default the local frame's own (:meth:`~hsgeo.crs.LocalFrame.local_crs`:
+        E, N of the frame within h·d/R).
+    radius_m : float, optional
+        Default: 0.55 × the diagonal of the largest pixel spacings along and across the line
+        plus half a cell.
+
+    Returns
+    -------
+    values : (n_bands, height, width) float32 ndarray
+    grid : MapGrid
+    radius_m : float
+    """
+    from hsgeo.crs import lonlat_to_crs
+
+    g = np.asarray(ground_enu_m, dtype=float)
+    crs = crs or frame.local_crs()
+    lon, lat, _ = frame.enu_to_lonlat(g[..., 0], g[..., 1], g[..., 2])
+    x, y = lonlat_to_crs(crs, lon, lat)
+    grid = MapGrid.covering((x.min(), x.max()), (y.min(), y.max()), resolution_m, crs)
+    if radius_m is None:
+        along = (
+            np.linalg.norm(np.diff(g[..., :2], axis=0), axis=-1).max() if g.shape[0] > 1 else 0.0
+        )
+        across = (
+            np.linalg.norm(np.diff(g[..., :2], axis=1), axis=-1).max() if g.shape[1] > 1 else 0.0
+        )
+        radius_m = 0.55 * float(np.hypot(along, across)) + 0.5 * resolution_m
+    img = np.asarray(image)
+    vals = img.reshape(img.shape[0], -1).T
+    ll = np.column_stack([lon.ravel(), lat.ravel()])
+    out, _ = resample_swath(ll, vals, np.zeros(ll.shape[0]), grid, radius_m)
+    return out, grid, float(radius_m)
+
+
+def mosaic_tile(grid: MapGrid, parts, terrain, frame, radius_m: float, n_bands: int):
+    """One output tile: each strip's lines that meet it, resampled, nearest to nadir wins.
+
+    Parameters
+    ----------
+    grid : MapGrid
+        The tile.
+    parts : list of (Strip, [(line0, line1, values_block), ...])
+        Per strip (its geometry) the line blocks that meet the tile and their values
+        ``(m, n_px, n_bands)``.
+
+    Returns
+    -------
+    (n_bands, height, width) float32 ndarray, NaN where no strip covers the cell.
+    """
+    best = np.full((n_bands, grid.height, grid.width), np.nan, dtype=np.float32)
+    best_rank = np.full((grid.height, grid.width), np.inf)
+    for strip, blocks in parts:
+        ll, vals, ranks = [], [], []
+        for a, b, v in blocks:
+            _, lonlat, off = geolocate_lines(strip, terrain, frame, slice(a, b))
+            ll.append(lonlat.reshape(-1, 2))
+            vals.append(np.asarray(v, dtype=np.float32).reshape(-1, n_bands))
+            ranks.append(off.ravel())
+        v, r = resample_swath(
+            np.concatenate(ll), np.concatenate(vals), np.concatenate(ranks), grid, radius_m
+        )
+        win = r < best_rank  # the mosaic rule: the ray nearest to nadir
+        best[:, win] = v[:, win]
+        best_rank[win] = r[win]
+    return best
+
+
+def _tile_task(grid, layout, terrain, frame, radius_m, n_bands, *arrays):
+    """:func:`mosaic_tile` with flat arguments (``layout``: per strip its number of blocks and
+    their line ranges; ``arrays``: per strip its geometry, then its blocks' values).
+    """
+    parts, k = [], 0
+    for ranges in layout:
+        geom, vals = arrays[k], arrays[k + 1 : k + 1 + len(ranges)]
+        parts.append((geom, [(a, b, v) for (a, b), v in zip(ranges, vals, strict=True)]))
+        k += 1 + len(ranges)
+    return mosaic_tile(grid, parts, terrain, frame, radius_m, n_bands)
+
+
+def orthomosaic(
+    strips,
+    terrain,
+    frame,
+    *,
+    grid: MapGrid | None = None,
+    resolution_m: float | None = None,
+    crs: str | None = None,
+    band_names=None,
+    wavelength_nm=None,
+    tile_px: int = 512,
+    lines_per_block: int = 256,
+    radius_m: float | None = None,
+):
+    """The orthomosaic of strips of any scanning sensor: a Dask-backed DataArray with a CRS.
+
+    Parameters
+    ----------
+    strips : sequence of Strip
+        Their ``values`` all with the same bands (select the bands before, e.g. true colour).
+    terrain : ``height(E, N)`` in the local frame (PlaneTerrain, DemTerrain, MapTerrain)
+    frame : hsgeo.crs.LocalFrame
+    grid : MapGrid, optional
+        The output grid; default: the cells of ``resolution_m`` in ``crs`` (default the
+        frame's map CRS) that cover every strip's footprint.
+    band_names : sequence of str, optional
+    wavelength_nm : sequence of float, optional
+    tile_px : int
+        Output chunk (tile) size, cells.
+    lines_per_block : int
+        Lines geolocated together (and the footprint granularity).
+    radius_m : float, optional
+        Radius of influence; default 0.55 × the diagonal of the largest ground pixel spacing
+        plus half a cell (cells outside every swath stay NaN).
+
+    Returns
+    -------
+    xarray.DataArray
+        ``(band, y, x)`` float32, chunks ``(n_bands, tile_px, tile_px)``, coordinates of the
+        cell centres, ``band`` names and ``wavelength_nm``; CRS and transform written by
+        rioxarray (``da.rio.crs``, ``da.rio.transform()``).
+    """
+    strips = list(strips)
+    if not strips:
+        raise InputError("no strips to mosaic")
+    n_bands = strips[0].n_bands
+    if any(s.n_bands != n_bands for s in strips):
+        raise InputError(f"strips with different band counts: {[s.n_bands for s in strips]}")
+    crs = grid.crs if grid is not None else (crs or f"EPSG:{frame.map_epsg}")
+    foot, spacing = [], 0.0
+    for s in strips:
+        blocks, bbox, sp = strip_footprints(s, terrain, frame, lines_per_block, crs)
+        foot.append((blocks, bbox))
+        spacing = max(spacing, sp)
+    if grid is None:
+        if resolution_m is None:
+            raise InputError("give the output grid or its resolution_m")
+        allb = np.concatenate([f[1] for f in foot])
+        grid = MapGrid.covering(allb[:, [0, 2]].ravel(), allb[:, [1, 3]].ravel(), resolution_m, crs)
+    if radius_m is None:
+        radius_m = 0.55 * np.hypot(spacing, spacing) + 0.5 * grid.resolution_m
+    data = _mosaic_array(strips, foot, grid, terrain, frame, radius_m, tile_px, lines_per_block)
+    return _as_dataarray(data, grid, strips, band_names, wavelength_nm, radius_m)
+
+
+def _mosaic_array(strips, foot, grid, terrain, frame, radius_m, tile_px, lines_per_block):
+    """The Dask array ``(n_bands, height, width)``: one task per tile (:func:`mosaic_tile`)."""
+    import dask
+    import dask.array as dsa
+
+    n_bands = strips[0].n_bands
+    g_terrain, g_frame = dask.delayed(terrain, pure=True), dask.delayed(frame, pure=True)
+    # one key per strip's geometry, shared by the tiles (dask would unpack a Strip dataclass
+    # with its values and make every tile depend on every chunk of the cube)
+    g_strips = [dask.delayed(s.geometry(), pure=True) for s in strips]
+    values = [
+        s.values
+        if isinstance(s.values, dsa.Array)
+        else dsa.from_array(np.asarray(s.values), chunks=(lines_per_block, -1, -1))
+        for s in strips
+    ]
+    rows = []
+    for r0 in range(0, grid.height, tile_px):
+        r1 = min(grid.height, r0 + tile_px)
+        row = []
+        for c0 in range(0, grid.width, tile_px):
+            c1 = min(grid.width, c0 + tile_px)
+            tile = grid.window(r0, r1, c0, c1)
+            x0, y0, x1, y1 = tile.extent_m
+            layout, args = [], []
+            for s, v, (blocks, bbox) in zip(g_strips, values, foot, strict=True):
+                hit = (
+                    (bbox[:, 0] - radius_m < x1)
+                    & (bbox[:, 2] + radius_m > x0)
+                    & (bbox[:, 1] - radius_m < y1)
+                    & (bbox[:, 3] + radius_m > y0)
+                )
+                ranges = [blocks[i] for i in np.flatnonzero(hit)]
+                if ranges:
+                    layout.append(ranges)
+                    args += [s, *(v[a:b] for a, b in ranges)]
+            shape = (n_bands, r1 - r0, c1 - c0)
+            if layout:
+                task = dask.delayed(_tile_task, pure=True)(
+                    tile, layout, g_terrain, g_frame, radius_m, n_bands, *args
+                )
+                row.append(dsa.from_delayed(task, shape, dtype=np.float32))
+            else:
+                row.append(dsa.full(shape, np.nan, dtype=np.float32, chunks=shape))
+        rows.append(row)
+    return dsa.block(rows)
+
+
+def _as_dataarray(data, grid, strips, band_names, wavelength_nm, radius_m):
+    import rioxarray  # noqa: F401  (the .rio accessor)
+    import xarray as xr
+
+    n_bands = data.shape[0]
+    names = [str(b) for b in (band_names if band_names is not None else range(n_bands))]
+    coords = {"band": names, "y": grid.y_m, "x": grid.x_m}
+    if wavelength_nm is not None:
+        coords["wavelength_nm"] = ("band", np.asarray(wavelength_nm, dtype=float))
+    da = xr.DataArray(
+        data,
+        dims=("band", "y", "x"),
+        coords=coords,
+        name="radiance",
+        attrs={
+            "resampling": "nearest neighbour (pykdtree in the grid's CRS)",
+            "mosaic_rule": "nearest to nadir: the smallest off-nadir angle of the ray wins",
+            "radius_of_influence_m": float(radius_m),
+            "resolution_m": grid.resolution_m,
+            "strips": ",".join(s.name for s in strips),
+        },
+    )
+    da["x"].attrs.update(units="m", long_name="easting")
+    da["y"].attrs.update(units="m", long_name="northing")
+    return da.rio.write_crs(grid.crs).rio.write_transform(grid.transform)

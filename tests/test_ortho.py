@@ -1,0 +1,190 @@
+"""hsgeo.ortho: any sensor's strips -> map grid (pyresample) -> mosaic -> COG (rasterio)."""
+
+import numpy as np
+import pytest
+from ortho_inputs import FRAME, GSD_M, WAVELENGTH_NM, flight, squares_xy
+
+from hsgeo.errors import InputError, ObservationError
+from hsgeo.measure.squares import square_centroids
+from hsgeo.ortho import MapGrid, MapTerrain, Strip, orthomosaic
+
+
+def test_map_grid_cells_and_transform():
+    g = MapGrid.covering((600000.05, 600010.0), (6615000.0, 6615003.1), 0.3)
+    assert (g.x_min_m, g.y_max_m) == (pytest.approx(600000.0), pytest.approx(6615003.3))
+    np.testing.assert_allclose(np.diff(g.x_m), 0.3)
+    t = g.transform
+    # the centre of cell (row 2, col 3) through the affine transform
+    np.testing.assert_allclose(t @ (3.5, 2.5), (g.x_m[3], g.y_m[2]))
+    w = g.window(2, 5, 3, 7)
+    np.testing.assert_allclose(w.x_m, g.x_m[3:7])
+    np.testing.assert_allclose(w.y_m, g.y_m[2:5])
+
+
+@pytest.fixture(scope="module", params=["lp", "line"])
+def mosaic(request):
+    fl = flight(request.param)
+    m = orthomosaic(
+        fl.strips,
+        fl.terrain,
+        FRAME,
+        resolution_m=0.3,
+        band_names=list("RGBN"),
+        wavelength_nm=WAVELENGTH_NM,
+        tile_px=256,
+    )
+    return request.param, fl, m.persist()  # still Dask-backed, computed once
+
+
+def test_squares_within_one_gsd_any_sensor(mosaic):
+    """The 002 LP camera and the 000 line scanner through the same code: every reference
+    square's centroid in the mosaic within 1 GSD (RMS) of its true position."""
+    _, _, m = mosaic
+    assert m.chunks[1][0] == 256 and m.rio.crs.to_epsg() == 25832
+    xy, n = square_centroids(m.compute(), squares_xy())
+    err = np.hypot(*(xy - squares_xy()).T)
+    assert np.all(n >= 9)
+    assert np.sqrt(np.mean(err**2)) < GSD_M
+    assert err.max() < 1.5 * GSD_M
+
+
+def test_cells_take_their_nearest_pixel_and_background(mosaic):
+    """Every filled cell's value is the scene's value at a point within the radius of
+    influence (background cells: a smooth field known in closed form)."""
+    from ortho_inputs import scene
+
+    _, _, m = mosaic
+    v = m.isel(band=0).values
+    X, Y = np.meshgrid(m["x"].values, m["y"].values)
+    sc = scene()
+    far = (
+        np.min(
+            np.hypot(X[..., None] - sc.centres_xy_m[:, 0], Y[..., None] - sc.centres_xy_m[:, 1]), -1
+        )
+        > 3
+    )
+    ok = np.isfinite(v) & far
+    assert ok.mean() > 0.8
+    truth = sc.radiance(X[ok], Y[ok])[:, 0]
+    # the field's gradient is ≤ 100·0.2/7 per m: a nearest pixel within r differs by ≤ 2.9·r
+    r = m.attrs["radius_of_influence_m"]
+    assert np.max(np.abs(v[ok] - truth)) <= 2.9 * r + 1e-3
+
+
+def test_nearest_to_nadir_rule():
+    """Where two strips overlap, the cell takes the strip whose flight line is nearer (smaller
+    off-nadir angle on a level flight): strip 1 all 1, strip 2 all 2."""
+    fl = flight("lp")
+    strips = [
+        Strip(
+            s.sensor,
+            s.trajectory,
+            s.t_s,
+            s.pixels,
+            np.full(s.values.shape[:2] + (1,), i + 1.0, np.float32),
+            s.pixel_kw,
+            s.name,
+        )
+        for i, s in enumerate(fl.strips)
+    ]
+    m = orthomosaic(strips, fl.terrain, FRAME, resolution_m=0.5).compute()
+    v = m.values[0]
+    X, Y = np.meshgrid(m["x"].values, m["y"].values)
+    E, N, _ = FRAME.map_to_enu(X, Y, 100.0)
+    e1 = fl.trajectories[0].pose(fl.strips[0].t_s[0])[0][0, 0]
+    e2 = fl.trajectories[0].pose(fl.strips[1].t_s[0])[0][0, 0]  # the lines (true north, local)
+    both = np.isfinite(v) & (np.abs(N) < 100)  # both strips' lines span N = ±120 m
+    # the overlap is ±16 m about the middle; the ±0.05° roll moves a nadir by < 2 m
+    d1, d2 = np.abs(E - e1), np.abs(E - e2)
+    near1 = both & (d1 < d2 - 3) & (d1 > 14)
+    near2 = both & (d2 < d1 - 3) & (d2 > 14)
+    assert near1.sum() > 1000 and near2.sum() > 1000
+    assert np.all(v[near1] == 1.0), np.unique(v[near1], return_counts=True)
+    assert np.all(v[near2] == 2.0), np.unique(v[near2], return_counts=True)
+
+
+def test_square_centroids_exact_on_area_weighted_mosaic():
+    """Cells that average the scene over their area: the centroid is the square's centre."""
+    import xarray as xr
+
+    r = 0.3
+    x = 600000 + (np.arange(200) + 0.5) * r
+    y = 6615000 - (np.arange(150) + 0.5) * r
+    centres = np.array([[600010.123, 6614990.456], [600040.77, 6614980.01]])
+    img = np.full((150, 200), 50.0)
+    for cx, cy in centres:
+        ox = np.clip(np.minimum(x + r / 2, cx + 0.6) - np.maximum(x - r / 2, cx - 0.6), 0, None)
+        oy = np.clip(np.minimum(y + r / 2, cy + 0.6) - np.maximum(y - r / 2, cy - 0.6), 0, None)
+        img += 900.0 * np.outer(oy, ox) / r**2
+    m = xr.DataArray(img[None], dims=("band", "y", "x"), coords={"x": x, "y": y})
+    xy, n = square_centroids(m, centres + [[0.8, -0.5], [-1.0, 0.9]])
+    np.testing.assert_allclose(xy, centres, atol=1e-9)
+    assert np.all(n >= 16)
+    xy, _ = square_centroids(m, [[600030.0, 6614970.0]], search_m=2.0)  # nothing there
+    assert np.all(np.isnan(xy))
+
+
+def test_cog_reads_back_in_rasterio(tmp_path, mosaic):
+    import rasterio
+
+    from hsgeo.io.geotiff import write_cog
+
+    _, _, m = mosaic
+    p = write_cog(m, tmp_path / "m.tif")
+    with rasterio.open(p) as src:
+        assert src.crs.to_epsg() == 25832
+        t = src.transform
+        assert (t.a, t.e, t.b, t.d) == (0.3, -0.3, 0.0, 0.0)
+        np.testing.assert_allclose((t.c, t.f), (m["x"].values[0] - 0.15, m["y"].values[0] + 0.15))
+        assert src.overviews(1), "a COG has overviews"
+        assert src.tags(ns="IMAGE_STRUCTURE").get("LAYOUT") == "COG"
+        assert src.descriptions == ("R", "G", "B", "N")
+        assert [float(src.tags(b)["wavelength_nm"]) for b in (1, 2, 3, 4)] == list(WAVELENGTH_NM)
+        np.testing.assert_array_equal(src.read(), m.values)
+    with pytest.raises(InputError, match="exists"):
+        write_cog(m, p)
+    write_cog(m.isel(band=[0]), p, overwrite=True)
+    with rasterio.open(p) as src:
+        assert src.count == 1
+
+
+def test_dsm_must_cover_and_match_crs():
+    from ortho_inputs import dsm
+
+    fl = flight("lp")
+    z, g = dsm(pad_m=60.0)
+    small = MapTerrain(z, g, FRAME, source="DSM.tif")
+    with pytest.raises(ObservationError, match="outside DSM.tif"):
+        orthomosaic(fl.strips, small, FRAME, resolution_m=0.3)
+    g2 = MapGrid(g.x_min_m, g.y_max_m, g.resolution_m, g.width, g.height, "EPSG:32632")
+    with pytest.raises(InputError, match="EPSG:32632"):
+        MapTerrain(z, g2, FRAME)
+
+
+def test_corrected_trajectory():
+    from hsgeo.trajectory import (
+        SplineNodes,
+        Trajectory,
+        corrected_trajectory,
+        platform_rpy_from_rph,
+    )
+
+    t = np.linspace(0, 30, 301)
+    tr = Trajectory(
+        t,
+        np.column_stack([t, 2 * t, np.full_like(t, 500)]),
+        np.column_stack([0.01 * np.sin(t), 0.02 * np.cos(t), np.full_like(t, 1.0)]),
+    )
+    nodes = SplineNodes(0.0, 30.0, 10.0)
+    v = np.tile(
+        [0.1, -0.2, 0.3, 1e-3, -2e-3, 3e-3], (nodes.n_nodes, 1)
+    )  # constant: B-spline sums to 1
+    c = corrected_trajectory(tr, nodes, v)
+    np.testing.assert_allclose(c.xyz_m - tr.xyz_m, np.tile(v[0, :3], (t.size, 1)), atol=1e-12)
+    d = platform_rpy_from_rph(c.roll_pitch_heading_rad) - platform_rpy_from_rph(
+        tr.roll_pitch_heading_rad
+    )
+    np.testing.assert_allclose(d, np.tile(v[0, 3:], (t.size, 1)), atol=1e-12)
+    np.testing.assert_allclose(corrected_trajectory(tr, nodes, 0 * v).xyz_m, tr.xyz_m)
+    with pytest.raises(InputError, match="node corrections"):
+        corrected_trajectory(tr, nodes, v[:, :3])
