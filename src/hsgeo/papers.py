@@ -345,9 +345,6 @@ P002 = {
     "min_ransac_correspondences": 11,  # 002 §3.1: "at least 11 key-point correspondences"
     "n_tie_points": 113758,  # 002 §4: "113758 used tie points"
     "gsd_m": (0.3, 0.4),  # 002 §4: "ground sampling distances of 0.3 and 0.4 m"
-    # 002 Fig. 9: orthomosaic of the 1875 m AGL acquisition at 30 cm on a 20 cm DSM (§5.1)
-    "fig9_pixel_m": 0.3,  # 002 Fig. 9 caption: "with a pixel size of 30 cm"
-    "fig9_dsm_m": 0.2,  # 002 §5.1: "created using a 20 cm digital surface model"
 }
 
 __all__ += ["P002_STATS", "P002"]

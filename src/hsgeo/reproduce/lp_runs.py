@@ -39,6 +39,7 @@ __all__ = [
     "scene_length_counts",
     "parameter_z",
     "headline",
+    "exact_twin",
     "MATCH_SAMPLE",
 ]
 
@@ -203,6 +204,35 @@ def evaluate(obs, truth, seed: int, *, nogcp: bool = True, progress=None) -> dic
         sel = np.isin(ids0, cp_ids)
         out.update(adjusted_nogcp=r0, cp_errors_nogcp_m=E0[sel], cp_cov_nogcp_m2=cov0[sel])
     return out
+
+
+def exact_twin(ev: dict, obs, truth) -> dict:
+    """The retrieval's exact twin, adjusted with the same settings: the pseudo-truth.
+
+    The same observations (tie points and squares, the same lines and bands) moved to their true
+    image position (:func:`hsgeo.reproduce.lp_judge.observation_errors_px`: the point's true
+    ground point projected with the true camera at the observation's line time), adjusted with
+    the same GCPs and options as ``ev["adjusted"]``. What the adjustment's estimates then miss
+    of the truth is what its model cannot represent even from perfect observations (the
+    GNSS/INS error's Gauss–Markov process seen through the spline's nodes, GUIDE §4
+    "unmodelled effect"): the pseudo-truth the retrieved estimates are judged against.
+
+    Returns
+    -------
+    dict
+        ``adjusted`` (:class:`PushbroomResult`), ``parameters`` (:func:`parameter_z`: the
+        twin's estimates, their σ̂ and the generating truth), ``seconds``.
+    """
+    from dataclasses import replace
+
+    res = ev["retrieval"]
+    err = ev["obs_errors_px"]
+    table = res.table.copy()
+    table["x_px"] = table["x_px"].to_numpy(float) - err[:, 0]
+    table["y_px"] = table["y_px"].to_numpy(float) - err[:, 1]
+    cam = camera_prior(obs, truth.cfg)
+    r, _, sec = _adjust(replace(res, table=table), obs, cam, True, ev["gcp_ids"])
+    return {"adjusted": r, "parameters": parameter_z(r.result, truth.camera), "seconds": sec}
 
 
 def scene_length_counts(obs, lengths, seed: int, progress=None) -> dict:
