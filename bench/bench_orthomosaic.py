@@ -6,7 +6,7 @@ memory (only the mosaic is timed), onto a 0.3 m grid in EPSG:25832. Each path ru
 process; its peak RSS is sampled while it runs (``peak_rss_over_start_mib``: over the process
 with the inputs in memory):
 
-* ``in_memory`` — :func:`hsgeo.ortho.grid_swath` per strip (pyresample on the whole grid at
+* ``in_memory`` — :func:`hsgeo.ortho.grid_swath` per strip (the kd-tree on the whole grid at
   once, no Dask), then the nearest-to-nadir rule;
 * ``chunked_1`` — :func:`hsgeo.ortho.orthomosaic` (Dask tiles of 512 cells, the geolocation per
   line block inside each tile's task), synchronous scheduler (one core);

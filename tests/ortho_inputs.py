@@ -184,7 +184,7 @@ def write_ortho_inputs(d, *, adjusted: bool = False, lazy: bool = False) -> dict
     from pathlib import Path
 
     from hsgeo.io.geotiff import write_geotiff
-    from hsgeo.io.lp_strips import write_lp_strip
+    from hsgeo.io.lp_lines import LpStrip, write_lp_lines
     from hsgeo.io.navigation import write_trajectory
     from hsgeo.trajectory import corrected_trajectory
 
@@ -202,7 +202,8 @@ def write_ortho_inputs(d, *, adjusted: bool = False, lazy: bool = False) -> dict
     files["lines"] = []
     for s in fl.strips:
         p = d / f"{s.name}.nc"
-        write_lp_strip(p, s.values, s.t_s, WAVELENGTH_NM, strip_id=s.name)
+        n = s.pixels.shape[0]  # a full line: x_px = j - (n - 1)/2
+        write_lp_lines(p, LpStrip(s.values, s.t_s, 0, WAVELENGTH_NM, s.name, n_px_full=n))
         files["lines"].append(p)
     files["nav"] = write_trajectory(d / "nav.csv", nav)
     files["camera"] = d / "camera.toml"

@@ -56,6 +56,7 @@ def test_adjustment_puts_the_squares_in_place(adjusted, capsys):
     out = json.loads(capsys.readouterr().out)
     assert out["crs"] == "EPSG:25832" and out["bands"] == ["640 nm", "550 nm", "460 nm"]
     assert out["adjusted"] and out["strips"] == ["s1", "s2"]
+    assert out["line_pixels"] == 300  # the files' n_px_full attribute (io.lp_lines)
     err = _square_errors(d / "adj.tif")
     assert np.sqrt(np.mean(err**2)) < GSD_M
     assert main(_argv(f, d / "raw.tif", adjustment=False)) == 0
@@ -72,6 +73,7 @@ def test_adjustment_puts_the_squares_in_place(adjusted, capsys):
         ("dsm_crs", "EPSG:32632"),
         ("scheduler", "--scheduler"),
         ("nav_short", "navigation"),
+        ("line_pixels", "do not fit a line of 299 px (from --line-pixels)"),
     ],
 )
 def test_bad_input_one_line_exit_2(adjusted, tmp_path, capsys, monkeypatch, edit, expect):
@@ -98,6 +100,8 @@ def test_bad_input_one_line_exit_2(adjusted, tmp_path, capsys, monkeypatch, edit
     elif edit == "scheduler":
         monkeypatch.setattr("hsgeo.workflows.orthomosaic.SCHEDULER_TIMEOUT_S", 1.0)
         extra = ["--scheduler", "tcp://127.0.0.1:9"]
+    elif edit == "line_pixels":  # the option overrides the files' n_px_full (300)
+        extra = ["--line-pixels", "299"]
     elif edit == "nav_short":
         nav = read_trajectory(f["nav"])
         keep = nav.t_s < nav.t_s[-1] / 2

@@ -387,3 +387,36 @@ def test_geocode_outputs_carry_the_local_frame_crs(tmp_path):
     E, N = float(ds["E"].values[3]), float(ds["N"].values[5])
     lon, lat, _ = frame.enu_to_lonlat(E, N, 3.0)
     np.testing.assert_allclose(lonlat_to_crs(frame.local_crs(), lon, lat), (E, N), atol=1e-3)
+
+
+def test_intersect_on_a_wall_where_the_fixed_point_iteration_cycles(monkeypatch):
+    """A ray 30° off nadir meets a 10 m wall (a DSM step over one cell): the height iteration
+    jumps between roof and ground (|slope · tan 30°| = 5.8 > 1); the march and bisection find
+    the first crossing, against a dense sampling of the ray (an independent truth)."""
+    import xarray as xr
+
+    from hsgeo import geocode
+    from hsgeo.geocode import DemTerrain, intersect
+
+    calls = []
+    march = geocode._march_bisect
+    monkeypatch.setattr(
+        geocode, "_march_bisect", lambda O, *a, **k: calls.append(len(O)) or march(O, *a, **k)
+    )
+    E = np.arange(0.0, 101.0)
+    z = np.where(E >= 50.0, 10.0, 0.0)[None, :].repeat(21, axis=0)
+    dem = DemTerrain(xr.DataArray(z, dims=("N", "E"), coords={"N": np.arange(21.0), "E": E}))
+    t30 = np.tan(np.radians(30.0))
+    O = np.array([[49.2 - 98.0 * t30, 10.0, 100.0], [49.2 - 98.0 * t30 + 20.0, 10.0, 100.0]])
+    d = np.array([[0.5, 0.0, -np.sqrt(0.75)]] * 2)
+    X = intersect(O, d, dem, tol_m=1e-6)
+    assert calls == [1]  # the first ray only: the iteration did not converge there
+    # dense sampling: the first point of the ray below the DSM
+    h = np.linspace(12.0, -1.0, 1_300_001)
+    P = O[0] + ((h - O[0, 2]) / d[0, 2])[:, None] * d[0]
+    first = np.argmax(h <= dem.height(P[:, 0], P[:, 1]))
+    np.testing.assert_allclose(X[0], P[first], atol=2e-5)
+    assert 1.9 < X[0, 2] < 2.1 and 49.0 < X[0, 0] < 50.0  # on the wall, near the expected 2 m
+    # the second ray meets the flat roof: the iteration converges there as before
+    np.testing.assert_allclose(X[1, 2], 10.0, atol=1e-6)
+    np.testing.assert_allclose(X[1], O[1] + (10.0 - 100.0) / d[1, 2] * d[1], atol=1e-6)

@@ -491,3 +491,50 @@ def test_write_table_round_trip_and_refuses_an_input(tmp_path):
     with pytest.raises(InputError, match="input"):
         write_table(tmp_path / "in.csv", df, inputs=[tmp_path / "in.csv"])
     assert (tmp_path / "in.csv").read_text() == "keep\n"
+
+
+def test_read_adjustment(tmp_path):
+    """hsgeo.io.sensors.read_adjustment: what adjust-pushbroom --json prints, round trip."""
+    import json
+
+    from ortho_inputs import adjustment_json, flight_trajectory, node_corrections
+
+    from hsgeo.io.sensors import read_adjustment
+
+    nav, _ = flight_trajectory()
+    nodes, v = node_corrections(nav)
+    p = tmp_path / "r.json"
+    p.write_text(adjustment_json(nodes, v))
+    a = read_adjustment(p)
+    np.testing.assert_array_equal(a["nodes"], v)
+    np.testing.assert_array_equal(a["t_nodes_s"], nodes.t_nodes_s)
+    assert a["boresight_rad"].shape == (3,) and a["c_mm"].tolist() == [40.0]
+    d = json.loads(p.read_text())
+    del d["nodes"]["value"]
+    p.write_text(json.dumps(d))
+    with pytest.raises(InputError, match="adjust-pushbroom --json"):
+        read_adjustment(p)
+
+
+def test_read_dsm(tmp_path):
+    from affine import Affine
+
+    from hsgeo.io.geotiff import read_dsm, write_geotiff
+
+    z = np.arange(12, dtype=float).reshape(3, 4)
+    write_geotiff(tmp_path / "d.tif", z, Affine(2.0, 0, 600000.0, 0, -2.0, 6615000.0), 25832)
+    h, g = read_dsm(tmp_path / "d.tif")
+    np.testing.assert_array_equal(h, z)
+    assert (g.x_min_m, g.y_max_m, g.resolution_m, g.width, g.height, g.crs) == (
+        600000.0,
+        6615000.0,
+        2.0,
+        4,
+        3,
+        "EPSG:25832",
+    )
+    (tmp_path / "x.tif").write_text("not a raster")
+    with pytest.raises(InputError, match="not a raster"):
+        read_dsm(tmp_path / "x.tif")
+    with pytest.raises(InputError, match="not found"):
+        read_dsm(tmp_path / "missing.tif")

@@ -1,11 +1,19 @@
-"""The LP line file (hsgeo.io.lp_lines): round trip, overwrite refusal, bad files."""
+"""The LP line file (hsgeo.io.lp_lines): round trip (in memory and lazy), overwrite refusal, bad
+files, the full-line width convention."""
 
 import numpy as np
 import pytest
 import xarray as xr
 
 from hsgeo.errors import InputError
-from hsgeo.io.lp_lines import LpStrip, read_lp_lines, write_lp_lines
+from hsgeo.io.lp_lines import (
+    DEFAULT_N_PX_FULL,
+    LpStrip,
+    full_line_px,
+    open_lp_lines,
+    read_lp_lines,
+    write_lp_lines,
+)
 
 
 def _strip(n_lines=5, n_cols=7, n_bands=3, seed=0):
@@ -73,7 +81,7 @@ def _write(tmp_path, **over):
     }
     attrs = {"col0": 3, "strip_id": "x"}
     for k, v in over.items():
-        if k in attrs:
+        if k in ("col0", "strip_id", "n_px_full"):
             if v is None:
                 attrs.pop(k)
             else:
@@ -96,12 +104,15 @@ def _write(tmp_path, **over):
         ({"strip_id": None}, "strip_id"),
         ({"lines": (("line", "pixel", "band"), np.zeros((5, 7, 3), np.float32))}, "dimensions"),
         ({"t_s": ("line", [0.0, 1.0, 1.0, 2.0, 3.0])}, "increase strictly"),
+        ({"n_px_full": 9}, "n_px_full = 9 must be an integer of at least"),
+        ({"n_px_full": 1800.5}, "n_px_full = 1800.5 must be an integer"),
     ],
 )
-def test_bad_files_say_what_is_wrong(tmp_path, over, match):
+@pytest.mark.parametrize("reader", [read_lp_lines, open_lp_lines])
+def test_bad_files_say_what_is_wrong(tmp_path, over, match, reader):
     p = _write(tmp_path, **over)
     with pytest.raises(InputError, match=match):
-        read_lp_lines(p)
+        reader(p)
 
 
 def test_missing_file_and_not_netcdf(tmp_path):
@@ -125,3 +136,57 @@ def test_strip_checks_its_arrays():
     with pytest.raises(InputError, match="strip_id"):
         LpStrip(s.lines, s.t_s, 0, s.wavelengths_nm, "")
     assert np.allclose(s.x_px(1800)[:2], [123 - 899.5, 124 - 899.5])
+
+
+def test_lazy_round_trip(tmp_path):
+    """open_lp_lines: the same strip as read_lp_lines, its lines a Dask array read in chunks;
+    a Dask strip writes chunk by chunk."""
+    import dask.array as dsa
+
+    s = _strip(n_lines=50, n_cols=20, n_bands=4, seed=3)
+    lazy = LpStrip(
+        dsa.from_array(s.lines, chunks=(16, -1, -1)),
+        s.t_s,
+        100,
+        s.wavelengths_nm,
+        "A7",
+        n_px_full=1800,
+    )
+    p = write_lp_lines(tmp_path / "a.nc", lazy)
+    r = open_lp_lines(p, lines_per_chunk=16)
+    assert isinstance(r.lines, dsa.Array) and r.lines.chunks[0][0] == 16
+    assert r.lines.dtype == np.float32
+    np.testing.assert_array_equal(r.lines.compute(), s.lines)
+    m = read_lp_lines(p)
+    np.testing.assert_array_equal(m.lines, s.lines)
+    assert (
+        (r.col0, r.strip_id, r.n_px_full) == (m.col0, m.strip_id, m.n_px_full) == (100, "A7", 1800)
+    )
+    np.testing.assert_array_equal(r.t_s, s.t_s)
+    # column j is column col0 + j of the full line, x from its centre (1800 px)
+    np.testing.assert_allclose(r.x_px(), 100 + np.arange(20) - 899.5)
+    with pytest.raises(InputError, match="lines_per_chunk"):
+        open_lp_lines(p, lines_per_chunk=0)
+
+
+def test_full_line_width_convention(tmp_path):
+    """--line-pixels overrides the files; else their n_px_full; else 1800 (002 §4)."""
+    s = _strip()  # col0 123, 7 columns
+    p = write_lp_lines(tmp_path / "a.nc", s)
+    r = read_lp_lines(p)
+    assert r.n_px_full is None and "n_px_full" not in xr.open_dataset(p).attrs
+    assert full_line_px([r]) == DEFAULT_N_PX_FULL == 1800
+    np.testing.assert_allclose(r.x_px(), r.x_px(1800))
+    w = LpStrip(s.lines, s.t_s, s.col0, s.wavelengths_nm, "w", n_px_full=400)
+    r400 = read_lp_lines(write_lp_lines(tmp_path / "w.nc", w))
+    assert r400.n_px_full == 400 and full_line_px([r400, r]) == 400
+    np.testing.assert_allclose(r400.x_px(), 123 + np.arange(7) - 199.5)
+    assert full_line_px([r400], 1000) == 1000  # the option overrides the file
+    other = LpStrip(s.lines, s.t_s, 0, s.wavelengths_nm, "o", n_px_full=500)
+    with pytest.raises(InputError, match=r"different full-line widths .*\[400, 500\]"):
+        full_line_px([r400, other])
+    assert full_line_px([r400, other], 600) == 600
+    with pytest.raises(InputError, match="do not fit a line of 100 px .*--line-pixels"):
+        full_line_px([r], 100)
+    with pytest.raises(InputError, match="n_px_full = 129"):
+        LpStrip(s.lines, s.t_s, s.col0, s.wavelengths_nm, "x", n_px_full=129)

@@ -185,11 +185,54 @@ def test_done_means_observations_for_another_seed(rep7):
 @pytest.mark.slow
 @pytest.mark.xfail(
     strict=True,
-    reason="known, cause not found: in this campaign (seed 7, scale 0.3) 2 of the 17 camera "
-    "parameters lie beyond 3σ̂ (boresight φ z = −3.8, P2 z = +3.3; with the motion blur off φ is "
-    "as far off, P2 at +2.95), both acting across the line (y): issue 25's ≥ 95 % within 3σ̂ is "
-    "not met here",
+    reason="known: in this campaign (seed 7, scale 0.3) the distortion term P2 lies 3.5σ̂ from "
+    "its pseudo-true value (the exact twin's estimate), 16 of 17 within 3σ̂; over 8 seeds "
+    "(bench/results/lp_parameters_seeds.json) P2's z against the twin has an RMS of ~1.9: its "
+    "σ̂ is too small, the observations of one feature in several bands share their line's "
+    "rounding (dy correlated 0.74 across bands at seed 7) where the adjustment takes them as "
+    "independent (the same dy permuted among the observations: P2's RMS z 0.91, all 8 seeds "
+    "meet 95 %). Issue 25's ≥ 95 % within 3σ̂ is not met here",
 )
 def test_done_means_parameters_for_another_seed(rep7):
     z = np.array([q.z for q in rep7.rows_of("parameters")])
     assert np.mean(np.abs(z) <= 3) >= 0.95
+
+
+@pytest.mark.slow
+def test_exact_twin_is_exact_and_judges_the_parameters(rep7):
+    """The pseudo-truth: the retrieval's exact twin holds every observation at its true image
+    position (judged again by lp_judge: zero error), and the "parameters" rows' truth is the
+    twin's estimate (provenance derived) with the generating camera kept beside it."""
+    from hsgeo.reproduce.lp_judge import observation_errors_px
+
+    ev, obs, truth = rep7.extras["evaluation"], rep7.extras["observations"], rep7.extras["truth"]
+    t = ev["retrieval"].table.copy()
+    e = ev["obs_errors_px"]
+    t["x_px"] -= e[:, 0]
+    t["y_px"] -= e[:, 1]
+    e_twin = observation_errors_px(t, truth, obs.square_ids, truth.square_xyz_m)
+    ok = np.all(np.isfinite(e), axis=1)
+    assert ok.mean() > 0.99
+    # the squares are judged against their fixed centres: exact; a tie point's truth is the
+    # median of the ground points its observations see at y = 0 of their lines, which the
+    # twin's y moves by millipixels
+    sq = ok & ev["is_square"]
+    np.testing.assert_allclose(e_twin[sq], 0.0, atol=1e-6)
+    assert np.max(np.abs(e_twin[ok & ~ev["is_square"]])) < 0.02
+    assert np.median(np.abs(e[ok])) > 0.1
+    twin = rep7.extras["twin"]
+    assert twin["adjusted"].result.sigma0 < 0.5 * ev["adjusted"].result.sigma0
+    rows = rep7.rows_of("parameters")
+    assert len(rows) == 17 and all(r.provenance == "derived" for r in rows)
+    gen = {
+        r.quantity: r.truth
+        for r in rep7.rows_of("unmodelled effect")
+        if r.quantity.startswith("generating.")
+    }
+    assert len(gen) == 17
+    shift = [
+        r for r in rep7.rows_of("unmodelled effect") if r.quantity.startswith("trajectory_shift_z.")
+    ]
+    for r, s in zip(rows, shift, strict=True):
+        assert s.quantity.endswith(r.quantity)
+        assert s.reproduced == pytest.approx((r.truth - gen[f"generating.{r.quantity}"]) / r.sigma)

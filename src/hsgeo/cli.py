@@ -174,6 +174,7 @@ def _cmd_orthomosaic(args) -> int:
             overwrite=args.overwrite,
             progress=progress,
             max_nav_gap_s=args.max_nav_gap_s,
+            line_pixels=args.line_pixels,
         )
     finally:
         terminal.clear_progress()

@@ -260,11 +260,12 @@ def add_orthomosaic(sub) -> argparse.ArgumentParser:
         help="orthomosaic LP strips onto a DSM: a Cloud-Optimized GeoTIFF in EPSG:25832",
         description="Orthorectify every pixel of every line of the LP strips (ray of the camera "
         "at the line's time on the trajectory, met with the DSM) and mosaic them onto a "
-        "north-up grid in ETRS89 / UTM 32N (EPSG:25832) by nearest neighbour (pyresample); "
+        "north-up grid in ETRS89 / UTM 32N (EPSG:25832) by nearest neighbour (pykdtree); "
         "where strips overlap the pixel nearest to nadir wins. The local east-north-up frame of "
         "the navigation is the one about the 002 site (59.665 N, 10.775 E, ellipsoidal height "
         "0). LINES: LP line files (NetCDF: lines(line, column, band), t_s(line), "
-        "wavelength_nm(band), attributes col0, strip_id). NAV: the navigation file of every "
+        "wavelength_nm(band), attributes col0, strip_id and optionally n_px_full: see "
+        "hsgeo.io.lp_lines). NAV: the navigation file of every "
         "command. CAMERA: the camera TOML of hsgeo adjust-pushbroom; RESULT: its --json output "
         "(camera parameters and node corrections: the adjusted trajectory). DSM: a GeoTIFF of "
         "ellipsoidal heights in EPSG:25832. Output: a COG with overviews, band names and "
@@ -285,6 +286,13 @@ def add_orthomosaic(sub) -> argparse.ArgumentParser:
         help="wavelengths (nm) of the bands to mosaic, nearest band each (default 640,550,460)",
     )
     p.add_argument("--scheduler", metavar="ADDRESS", help="dask.distributed scheduler address")
+    p.add_argument(
+        "--line-pixels",
+        type=option_number(integer=True, lo=1, hi=100000),
+        default=None,
+        help="pixels of a full line; overrides the files' n_px_full attribute (default: that "
+        "attribute, else 1800, 002 §4)",
+    )
     p.add_argument(
         "--max-nav-gap-s",
         type=_POSITIVE,
@@ -363,7 +371,8 @@ def add_lp_observations(sub) -> argparse.ArgumentParser:
         "camera's), tie points seen in >= 3 lines of >= 3 strips, each observation at the "
         "centre of its original pixel. SCENES: LP line files, one strip each (NetCDF, see "
         "hsgeo.io.lp_lines: lines(line, column, band) DN, t_s(line), wavelength_nm(band), "
-        "attributes col0 and strip_id). NAV: the navigation file of every command, CSV or "
+        "attributes col0, strip_id and optionally n_px_full). NAV: the navigation file of "
+        "every command, CSV or "
         "Parquet with t_s, E_m, N_m, U_m, roll_deg, pitch_deg, heading_deg (see "
         "hsgeo.io.navigation). CAMERA: the camera TOML of hsgeo adjust-pushbroom (one band "
         "per band of the line files; c_band_mm, boresight_deg as known a priori). SQUARES: "
@@ -414,8 +423,9 @@ def add_lp_observations(sub) -> argparse.ArgumentParser:
     p.add_argument(
         "--line-pixels",
         type=option_number(integer=True, lo=1, hi=100000),
-        default=1800,
-        help="pixels of a full line (default 1800, 002 §4)",
+        default=None,
+        help="pixels of a full line; overrides the files' n_px_full attribute (default: that "
+        "attribute, else 1800, 002 §4)",
     )
     p.add_argument(
         "--max-nav-gap-s",

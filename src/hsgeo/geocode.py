@@ -140,19 +140,58 @@ def intersect(origin_m, direction, terrain, *, tol_m: float = 1e-4, max_iter: in
             "boresight"
         )
     h = np.full(O.shape[0], terrain.mean_height_m)
+    lo, hi = h.copy(), h.copy()  # the heights the iteration visited, per ray
     for _ in range(max_iter):
         s = (h - O[:, 2]) / d[:, 2]
         X = O + s[:, None] * d
         if isinstance(terrain, PlaneTerrain):
             return X
         h_new = terrain.height(X[:, 0], X[:, 1])
-        if np.all(np.abs(h_new - h) < tol_m):
+        lo, hi = np.minimum(lo, h_new), np.maximum(hi, h_new)
+        bad = np.abs(h_new - h) >= tol_m
+        if not bad.any():
             X[:, 2] = h_new
             return X
         h = h_new
-    raise ConvergenceError(
-        "the ray–DEM intersection did not converge (grazing rays over steep terrain?)"
-    )
+    # At a step of the DSM (a wall steeper than the ray) the fixed-point iteration jumps between
+    # the levels: those rays are marched down between the heights it visited and bisected
+    X[bad] = _march_bisect(O[bad], d[bad], terrain, hi[bad] + 1.0, lo[bad] - 1.0, tol_m)
+    X[~bad, 2] = h_new[~bad]
+    return X
+
+
+def _march_bisect(O, d, terrain, top_m, bottom_m, tol_m, step_m: float = 0.25):
+    """The first crossing of each ray (``(n, 3)`` origins, directions) with the terrain between
+    the heights ``top_m`` and ``bottom_m`` (``(n,)``): a march down in steps of ``step_m`` in
+    height, then bisection to ``tol_m``.
+    """
+
+    def above(hr):  # is the ray's point at height hr above the terrain?
+        P = O + ((hr - O[:, 2]) / d[:, 2])[:, None] * d
+        return hr > terrain.height(P[:, 0], P[:, 1])
+
+    a = top_m.copy()  # above the terrain
+    b = np.full_like(a, np.nan)  # the first height below it
+    n_steps = int(np.ceil(np.max(top_m - bottom_m) / step_m)) + 1
+    for k in range(1, n_steps + 1):
+        hk = np.maximum(top_m - k * step_m, bottom_m)
+        todo = np.isnan(b)
+        if not todo.any():
+            break
+        up = above(hk)
+        hit = todo & ~up
+        b[hit] = hk[hit]
+        a[todo & up] = hk[todo & up]
+    if np.isnan(b).any():
+        raise ConvergenceError(
+            f"the ray–DEM intersection did not converge for {int(np.isnan(b).sum())} rays "
+            "(the ray does not cross the DSM between the heights the iteration visited)"
+        )
+    while np.max(a - b) > tol_m:
+        m = 0.5 * (a + b)
+        up = above(m)
+        a, b = np.where(up, m, a), np.where(up, b, m)
+    return O + ((b - O[:, 2]) / d[:, 2])[:, None] * d
 
 
 # ----------------------------------------------------------------------------------------------

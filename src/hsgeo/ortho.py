@@ -4,9 +4,10 @@ The gridded half of :mod:`hsgeo.geocode` (which meets rays with the terrain): ev
 every line of a :class:`Strip` is geolocated (the sensor's ``rays`` at the line's time on its
 :class:`~hsgeo.trajectory.Trajectory`, :func:`hsgeo.geocode.intersect` with the terrain in the
 local ENU frame, then ETRS89 longitude and latitude by :class:`hsgeo.crs.LocalFrame`), and the
-swath is resampled onto a :class:`MapGrid` in the map CRS (EPSG:25832 for 002) by
-:mod:`pyresample` (``SwathDefinition`` → ``AreaDefinition``, nearest neighbour within a radius of
-influence: every spectrum stays as it was measured, as is usual for imaging spectrometers).
+swath is resampled onto a :class:`MapGrid` in the map CRS (EPSG:25832 for 002) by nearest
+neighbour within a radius of influence (every spectrum stays as it was measured, as is usual for
+imaging spectrometers), found by pykdtree (pyresample's kd-tree) in the grid's own metres
+(:func:`resample_swath` says why not through pyresample's geographic path).
 
 **Mosaic rule (nearest to nadir).** Where strips overlap, a map cell takes the pixel whose ray
 is closest to the nadir (smallest off-nadir angle ``arccos(−d_U)`` of its ray) among the nearest
@@ -171,7 +172,15 @@ def strip_footprints(strip: Strip, terrain, frame, lines_per_block: int, crs: st
 
 
 def resample_swath(lonlat_deg, values, rank, grid: MapGrid, radius_m: float):
-    """Nearest swath pixel of every cell of ``grid`` within ``radius_m`` (pyresample).
+    """Nearest swath pixel of every cell of ``grid`` within ``radius_m``, in the grid's CRS.
+
+    The swath's pixels go into the grid's CRS (pyproj), and pykdtree (the kd-tree pyresample
+    itself uses) finds each cell centre's nearest pixel in the grid's own metres. pyresample's
+    ``kd_tree`` (used before) works through geographic coordinates only: the lon/lat of every
+    cell (pyproj), geocentric x, y, z of cells and pixels, its radius on a 6370997 m sphere
+    (0.3 % short at 60° N), then a second check in map metres; on a 0.9 M-pixel swath onto
+    0.97 M cells of 0.3 m that took 1.16 CPU s against 0.22 s for the query here (+0.1 s for
+    the pixels' projection), with the same cells filled.
 
     Parameters
     ----------
@@ -189,37 +198,31 @@ def resample_swath(lonlat_deg, values, rank, grid: MapGrid, radius_m: float):
     values : (n_bands, height, width) ndarray, NaN where empty
     rank : (height, width) ndarray, +inf where empty
     """
-    from pyresample.geometry import SwathDefinition
-    from pyresample.kd_tree import get_neighbour_info
+    from pykdtree.kdtree import KDTree
 
     from hsgeo.crs import lonlat_to_crs
 
-    swath = SwathDefinition(lons=lonlat_deg[:, 0], lats=lonlat_deg[:, 1])
-    # pyresample measures on a sphere of 6370997 m (0.3 % short of the ellipsoid's radii of
-    # curvature at 60° N): search a little wider, then keep the radius in the grid's metres
-    vin, vout, idx, _ = get_neighbour_info(
-        swath, grid.area_definition(), 1.01 * radius_m, neighbours=1, nprocs=1
-    )
     n_cells = grid.width * grid.height
-    src = np.flatnonzero(vin)
-    out_cells = np.flatnonzero(vout)
-    ok = idx < src.size
-    cell = out_cells[ok]
-    pix = src[idx[ok]]
-    px, py = lonlat_to_crs(grid.crs, lonlat_deg[pix, 0], lonlat_deg[pix, 1])
-    r_, c_ = np.divmod(cell, grid.width)
-    near = np.hypot(px - grid.x_m[c_], py - grid.y_m[r_]) <= radius_m
-    cell, pix = cell[near], pix[near]
     out = np.full((values.shape[1], n_cells), np.nan, dtype=np.float32)
-    out[:, cell] = values[pix].T
     r = np.full(n_cells, np.inf)
-    r[cell] = rank[pix]
+    if lonlat_deg.shape[0]:
+        px, py = lonlat_to_crs(grid.crs, lonlat_deg[:, 0], lonlat_deg[:, 1])
+        tree = KDTree(np.column_stack([px, py]))
+        X, Y = np.meshgrid(grid.x_m, grid.y_m)
+        dist, pix = tree.query(
+            np.column_stack([X.ravel(), Y.ravel()]), k=1, distance_upper_bound=radius_m
+        )
+        cell = np.flatnonzero(np.isfinite(dist) & (dist <= radius_m))
+        pix = pix[cell].astype(np.intp)
+        out[:, cell] = values[pix].T
+        r[cell] = rank[pix]
     return out.reshape(-1, grid.height, grid.width), r.reshape(grid.height, grid.width)
 
 
 def grid_swath(image, ground_enu_m, frame, *, resolution_m: float, crs=None, radius_m=None):
     """One geolocated swath onto a grid, in memory (``hsgeo geocode``): the resampling of
-    :func:`mosaic_tile` (pyresample, nearest neighbour within ``radius_m``) without Dask.
+    :func:`mosaic_tile` (nearest neighbour within ``radius_m``, :func:`resample_swath`) without
+    Dask.
 
     Parameters
     ----------
@@ -436,7 +439,7 @@ def _as_dataarray(data, grid, strips, band_names, wavelength_nm, radius_m):
         coords=coords,
         name="radiance",
         attrs={
-            "resampling": "nearest neighbour (pyresample kd_tree)",
+            "resampling": "nearest neighbour (pykdtree in the grid's CRS)",
             "mosaic_rule": "nearest to nadir: the smallest off-nadir angle of the ray wins",
             "radius_of_influence_m": float(radius_m),
             "resolution_m": grid.resolution_m,

@@ -327,6 +327,9 @@ P002 = {
     },  # 002 Table 3, row H
     "fig8_max_abs_diff_um": 11.8,  # 002 Fig. 8 caption: "differences are ≤ 11.8 µm"
     "fig8_sigma_um": (1.2, 2.4),  # 002 Fig. 8 caption: "precision estimates of 1.2–2.4 µm"
+    "fig9_pixel_m": 0.30,  # 002 Fig. 9 caption: orthoimages "with a pixel size of 30 cm"
+    "fig9_dsm_m": 0.20,  # 002 §5.1: orthoimages "created using a 20 cm digital surface model"
+    "fig9_agl_m": 1875.0,  # 002 Fig. 9 caption: "the acquisition at 1875 m AGL"
     "chromatic_shift_px": 0.27,  # 002 §5: "maximum absolute shift ≤ 0.27 pixels"
     "n_unknowns": 342407,  # 002 §4: "A total of 342407 unknowns"
     "n_observations_2d": 441587,  # 002 §4: "441 587 2D observations"
@@ -342,9 +345,6 @@ P002 = {
     "min_ransac_correspondences": 11,  # 002 §3.1: "at least 11 key-point correspondences"
     "n_tie_points": 113758,  # 002 §4: "113758 used tie points"
     "gsd_m": (0.3, 0.4),  # 002 §4: "ground sampling distances of 0.3 and 0.4 m"
-    # 002 Fig. 9: orthomosaic of the 1875 m AGL acquisition at 30 cm on a 20 cm DSM (§5.1)
-    "fig9_pixel_m": 0.3,  # 002 Fig. 9 caption: "with a pixel size of 30 cm"
-    "fig9_dsm_m": 0.2,  # 002 §5.1: "created using a 20 cm digital surface model"
 }
 
 __all__ += ["P002_STATS", "P002"]

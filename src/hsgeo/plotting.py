@@ -30,6 +30,7 @@ __all__ = [
     "displacement_vs_pixel",
     "solver_scaling",
     "plot_lp_compensation",
+    "plot_lp_mosaic",
 ]
 
 
@@ -780,4 +781,81 @@ def plot_lp_compensation(axes, strip, scene, *, band: int = 0, columns=None, vma
         ax.set_title(title, fontsize=9)
         ax.set_xlabel("scene column v (px)")
     axes[0].set_ylabel("scene row u (line)")
+    return axes
+
+
+# ---- 002 Fig. 9: the orthomosaic with the reference squares
+def _true_colour(mosaic, lo_hi=None):
+    """``(y, x, 3)`` in [0, 1] from a ``(band, y, x)`` mosaic (R, G, B), a 1–99 % stretch."""
+    rgb = np.moveaxis(np.asarray(mosaic.values, float)[:3], 0, -1)
+    lo, hi = lo_hi or (np.nanpercentile(rgb, 1), np.nanpercentile(rgb, 99))
+    out = np.clip((rgb - lo) / max(hi - lo, 1e-12), 0.0, 1.0)
+    return np.where(np.isfinite(out), out, 1.0), (lo, hi)  # no data: white
+
+
+def plot_lp_mosaic(
+    axes, mosaics, rtk_xy_m, *, titles=None, insets=4, inset_half_m: float = 2.4, square_ids=None
+):
+    """002 Fig. 9: true-colour mosaics with the RTK positions of the squares, a few of them
+    enlarged in insets (each with its RTK centre as a cross).
+
+    Parameters
+    ----------
+    axes : sequence of matplotlib Axes
+        One per mosaic (e.g. adjusted, raw).
+    mosaics : sequence of xarray.DataArray
+        ``(band, y, x)`` R, G, B in a map CRS with cell-centre ``x``, ``y`` in m
+        (:func:`hsgeo.reproduce.lp_mosaic.fig9`).
+    rtk_xy_m : (k, 2) ndarray
+        The squares' RTK positions in the same CRS, m.
+    titles : sequence of str, optional
+    insets : int
+        Squares enlarged (the first ``insets`` inside the mosaic, spread over it).
+    inset_half_m : float
+        Half width of an inset, m.
+    square_ids : sequence of str, optional
+        Labels of the squares.
+
+    Returns
+    -------
+    the Axes.
+    """
+    P = np.asarray(rtk_xy_m, float)
+    lo_hi = None
+    for i, (ax, m) in enumerate(zip(axes, mosaics, strict=True)):
+        img, lo_hi = _true_colour(m, lo_hi)  # the same stretch in every panel
+        x, y = m["x"].values, m["y"].values
+        dx, dy = abs(x[1] - x[0]), abs(y[1] - y[0])
+        ext = (x.min() - dx / 2, x.max() + dx / 2, y.min() - dy / 2, y.max() + dy / 2)
+        ax.imshow(img if y[0] > y[-1] else img[::-1], extent=ext, interpolation="nearest")
+        inside = (P[:, 0] > ext[0]) & (P[:, 0] < ext[1]) & (P[:, 1] > ext[2]) & (P[:, 1] < ext[3])
+        ax.plot(P[inside, 0], P[inside, 1], "o", mfc="none", mec="C3", ms=9, mew=1.0)
+        if square_ids is not None:
+            for k in np.flatnonzero(inside):
+                ax.annotate(
+                    str(square_ids[k]),
+                    P[k],
+                    xytext=(5, 5),
+                    textcoords="offset points",
+                    color="C3",
+                    fontsize=7,
+                )
+        pick = np.flatnonzero(inside)
+        pick = pick[np.linspace(0, pick.size - 1, min(insets, pick.size)).astype(int)]
+        for j, k in enumerate(pick):
+            ins = ax.inset_axes([0.02 + 0.245 * j, 0.02, 0.22, 0.22])
+            ins.imshow(img if y[0] > y[-1] else img[::-1], extent=ext, interpolation="nearest")
+            ins.set_xlim(P[k, 0] - inset_half_m, P[k, 0] + inset_half_m)
+            ins.set_ylim(P[k, 1] - inset_half_m, P[k, 1] + inset_half_m)
+            ins.plot(*P[k], "+", color="C3", ms=10, mew=1.2)
+            ins.set_xticks([])
+            ins.set_yticks([])
+            if square_ids is not None:
+                ins.set_title(str(square_ids[k]), fontsize=6, pad=1)
+            ax.indicate_inset_zoom(ins, edgecolor="C3")
+        ax.set_xlabel("E (m, EPSG:25832)")
+        ax.set_ylabel("N (m)")
+        ax.ticklabel_format(useOffset=False, style="plain")
+        if titles is not None:
+            ax.set_title(titles[i], fontsize=9)
     return axes

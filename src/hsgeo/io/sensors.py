@@ -1,12 +1,16 @@
 """Sensor and camera descriptions in TOML: ``hsgeo geocode --sensor`` and ``hsgeo
-adjust-pushbroom --camera``.
+adjust-pushbroom --camera``; and the adjusted camera and node corrections that ``hsgeo
+adjust-pushbroom --json`` prints (:func:`read_adjustment`, ``hsgeo orthomosaic --adjustment``).
 """
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 
 from hsgeo.errors import InputError
+from hsgeo.io._files import read_text
 from hsgeo.io.config import Key, read_config
 
 __all__ = [
@@ -15,6 +19,7 @@ __all__ = [
     "read_sensor_toml",
     "read_camera_toml",
     "read_pushbroom_camera",
+    "read_adjustment",
     "read_scanning_sensor",
     "read_band_split",
     "read_frame_layouts",
@@ -337,3 +342,43 @@ def read_frame_layouts(path=None) -> dict:
         "bits": cfg["instrument"]["bits"],
         "layouts": layouts,
     }
+
+
+def read_adjustment(path) -> dict:
+    """Camera parameters and node corrections from ``hsgeo adjust-pushbroom --json``.
+
+    Returns
+    -------
+    dict
+        ``boresight_rad`` (3,), ``lever_arm_m`` (3,), ``distortion`` (4,), ``c_mm`` (n,),
+        ``t_nodes_s`` (n_nodes,), ``nodes`` (n_nodes, 6) in m and rad, ``node_columns``.
+    """
+    text = read_text(path, "--adjustment file", "JSON")
+    try:
+        d = json.loads(text)
+        par, nodes = d["parameters"], d["nodes"]
+        out = {
+            "boresight_rad": np.radians(np.asarray(par["boresight_deg"]["value"], float)),
+            "lever_arm_m": np.asarray(par["lever_arm_m"]["value"], float),
+            "distortion": np.asarray(par["distortion"]["value"], float),
+            "c_mm": np.atleast_1d(np.asarray(par["c_mm"]["value"], float)),
+            "t_nodes_s": np.asarray(nodes["t_s"], float),
+            "nodes": np.asarray(nodes["value"], float),
+            "node_columns": tuple(nodes["columns"]),
+        }
+    except (ValueError, KeyError, TypeError) as exc:
+        raise InputError(
+            f"--adjustment {str(path)!r}: not the JSON of `hsgeo adjust-pushbroom --json` "
+            f"({type(exc).__name__}: {exc}); give that command's output"
+        ) from None
+    shapes = {"boresight_rad": (3,), "lever_arm_m": (3,), "distortion": (4,)}
+    for k, shp in shapes.items():
+        if out[k].shape != shp:
+            raise InputError(f"--adjustment {str(path)!r}: {k} must have {shp[0]} values")
+    n = out["t_nodes_s"].size
+    if n < 4 or out["nodes"].shape != (n, len(out["node_columns"])):
+        raise InputError(
+            f"--adjustment {str(path)!r}: nodes.value must be ({n}, "
+            f"{len(out['node_columns'])}) for {n} node times"
+        )
+    return out

@@ -3,19 +3,20 @@
 002 Fig. 9 places reference squares of 1.2 m (white targets, their centres surveyed by RTK) in
 the orthomosaic. :func:`square_centroids` finds, near each given map position, the bright blob
 of the mosaic and returns its centroid: the background (the median of the search window) is
-subtracted, the blob is the connected set of cells brighter than halfway between background and
-the window's maximum that lies nearest the given position, grown by one cell (so that the cells
-the square covers in part count with their part), and the centroid is the mean of the cell
-centres weighted by their excess over the background. On cells that average the scene over
-their area this centroid is the square's centre exactly; on a nearest-neighbour mosaic its
-error is a fraction of a cell.
+subtracted, and the centroid is :func:`hsgeo.measure.blobs.weighted_blob_centroid` (the one
+shared with the LP-scene measurer :mod:`hsgeo.measure.targets_lp`) of the blob nearest the
+given position, in map coordinates. On cells that average the scene over their area this
+centroid is the square's centre exactly; on a nearest-neighbour mosaic its error is a fraction
+of a cell. Kept apart from :mod:`hsgeo.measure.targets_lp`: a map window around a known
+position, no detection among the scene's bright things, x/y coordinates of a georeferenced
+grid.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from hsgeo.errors import InputError, ObservationError
+from hsgeo.errors import InputError
 
 __all__ = ["square_centroids"]
 
@@ -72,22 +73,22 @@ def square_centroids(mosaic, positions_xy_m, *, search_m: float = 3.0, band=None
 
 
 def _blob_centroid(win, xs, ys, px, py):
-    from scipy import ndimage
+    from hsgeo.measure.blobs import weighted_blob_centroid
 
     if not np.any(np.isfinite(win)):
         return None
     bg = float(np.nanmedian(win))
-    top = float(np.nanmax(win))
-    if not top > bg:
+    w = np.where(np.isfinite(win), win - bg, 0.0)
+    near = (
+        np.interp(py, ys, np.arange(ys.size))
+        if ys[0] < ys[-1]
+        else np.interp(-py, -ys, np.arange(ys.size)),
+        np.interp(px, xs, np.arange(xs.size)),
+    )
+    rc, blob = weighted_blob_centroid(w, near)
+    if rc is None:
         return None
-    bright = np.nan_to_num(win, nan=bg) > bg + 0.5 * (top - bg)
-    lab, n_lab = ndimage.label(bright)
-    if n_lab == 0:
-        return None
-    X, Y = np.meshgrid(xs, ys)
-    d = [np.min(np.hypot(X[lab == i] - px, Y[lab == i] - py)) for i in range(1, n_lab + 1)]
-    blob = ndimage.binary_dilation(lab == 1 + int(np.argmin(d)), structure=np.ones((3, 3), bool))
-    w = np.where(blob & np.isfinite(win), np.clip(win - bg, 0.0, None), 0.0)
-    if not w.sum() > 0:
-        raise ObservationError("a square's cells are not brighter than the background")
-    return (float((w * X).sum() / w.sum()), float((w * Y).sum() / w.sum())), int(blob.sum())
+    # cell centres are evenly spaced: the centroid's row/column maps linearly to y/x
+    x = xs[0] + rc[1] * (xs[-1] - xs[0]) / max(xs.size - 1, 1)
+    y = ys[0] + rc[0] * (ys[-1] - ys[0]) / max(ys.size - 1, 1)
+    return (float(x), float(y)), int(blob.sum())

@@ -18,7 +18,11 @@ is not said; ours, :func:`square_centroid`, for one square in one band of a scen
    subtracted; the pixels above half the peak that are 8-connected to it, grown by one pixel
    (the partly covered edge pixels), are the blob, and its centroid weighted by the
    background-subtracted DN (negative values as 0)
-   is the centre, in scene coordinates ``(u, v)`` (sub-pixel).
+   is the centre, in scene coordinates ``(u, v)`` (sub-pixel). The centroid is the one of
+   :func:`hsgeo.measure.blobs.weighted_blob_centroid`, shared with the orthomosaic's
+   measurer (:mod:`hsgeo.measure.squares`); kept apart from it: the detection in a raw scene
+   (box contrast among roofs and roads, a predicted position tens of pixels off) and the
+   rejections, which a mosaic searched within a few cells of the RTK position does not need.
 
 Rejected (``ok = False``): a contrast below ``min_snr`` times the noise, a blob touching the
 window's border or larger than ``max_area_factor`` times the square's area or reaching outside
@@ -162,7 +166,7 @@ def blob_centroid(band, uv_peak, *, box_px: int = 4, max_area_factor: float = 4.
         border or larger than ``max_area_factor · box_px²``).
     ok : bool
     """
-    from scipy.ndimage import binary_dilation, label
+    from hsgeo.measure.blobs import weighted_blob_centroid
 
     a = np.asarray(band, dtype=np.float64)
     h = 2 * box_px
@@ -174,23 +178,17 @@ def blob_centroid(band, uv_peak, *, box_px: int = 4, max_area_factor: float = 4.
         return np.full(2, np.nan), False
     border = np.r_[sub[0], sub[-1], sub[1:-1, 0], sub[1:-1, -1]]
     w = sub - np.median(border)
-    peak = np.unravel_index(np.argmax(w), w.shape)
-    lab, _ = label(w > 0.5 * w[peak], structure=np.ones((3, 3)))
-    # the half-maximum blob grown by one pixel: the square's partly covered edge pixels count
-    # on every side, or the centroid leans toward the side whose edge pixels are fuller
-    blob = binary_dilation(lab == lab[peak], structure=np.ones((3, 3)))
+    rc, blob = weighted_blob_centroid(w, np.unravel_index(np.argmax(w), w.shape))
     if (
-        blob[0].any()
+        rc is None
+        or blob[0].any()
         or blob[-1].any()
         or blob[:, 0].any()
         or blob[:, -1].any()
         or blob.sum() > max_area_factor * box_px**2
     ):
         return np.full(2, np.nan), False
-    rr, cc = np.nonzero(blob)
-    ww = np.maximum(w[rr, cc], 0.0)
-    uv = np.array([np.sum(ww * rr) / ww.sum() + pr - h, np.sum(ww * cc) / ww.sum() + pc - h])
-    return uv, True
+    return rc + (pr - h, pc - h), True
 
 
 def square_centroid(

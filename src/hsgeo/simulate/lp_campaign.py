@@ -398,7 +398,14 @@ def simulate(
             cols = np.arange(c.pixels_per_line)[cs]
             lines = _render_strip(cfg, cam_true, traj_true, tt[ls], cols, ground, rng)
             strips.append(
-                LpStrip(lines, tt[ls], int(cols[0]), np.asarray(c.wavelengths_nm[:nb]), f"s{i:02d}")
+                LpStrip(
+                    lines,
+                    tt[ls],
+                    int(cols[0]),
+                    np.asarray(c.wavelengths_nm[:nb]),
+                    f"s{i:02d}",
+                    n_px_full=c.pixels_per_line,
+                )
             )
             index.append(i)
         if progress is not None:

@@ -260,7 +260,8 @@ def orthorectify_lines(
 
 def _to_grid(da, ground, options, attrs):
     """The swath onto the local frame's grid with a CRS (:func:`hsgeo.ortho.grid_swath`, the
-    resampling of the orthomosaic: pyresample, nearest neighbour), as ``(band, N, E)``.
+    resampling of the orthomosaic: nearest neighbour, :func:`hsgeo.ortho.resample_swath`), as
+    ``(band, N, E)``.
     """
     import rioxarray  # noqa: F401  (the .rio accessor)
     import xarray as xr
@@ -279,7 +280,7 @@ def _to_grid(da, ground, options, attrs):
             "local_frame_origin": f"{frame.lat_deg!r} N, {frame.lon_deg!r} E, {frame.h_m!r} m "
             "(ETRS89, ellipsoidal height)",
             "resolution_m": options.resolution_m,
-            "resampling": "nearest neighbour (pyresample kd_tree)",
+            "resampling": "nearest neighbour (pykdtree in the grid's CRS)",
             "max_distance_m": radius,
             **(attrs or {}),
         },

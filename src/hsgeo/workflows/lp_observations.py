@@ -571,7 +571,7 @@ def lp_observation_files(
     options: LpOptions = LpOptions(),
     overwrite: bool = False,
     progress=None,
-    n_px_full: int = 1800,
+    n_px_full: int | None = None,
 ) -> LpResult:
     """``hsgeo lp-observations``: LP line files → the observation table of ``adjust-pushbroom``.
 
@@ -592,6 +592,10 @@ def lp_observation_files(
         ``adjust-pushbroom``).
     height_m : float, optional
         Mean terrain height (default: the squares' mean height).
+    n_px_full : int, optional
+        Pixels of a full line (``--line-pixels``); overrides the files' ``n_px_full``
+        attribute (default: that attribute, else 1800 px, 002 §4:
+        :func:`hsgeo.io.lp_lines.full_line_px`, the convention ``hsgeo orthomosaic`` shares).
 
     Returns
     -------
@@ -601,7 +605,7 @@ def lp_observation_files(
 
     from hsgeo.io import read_pushbroom_camera, read_table, read_trajectory
     from hsgeo.io._files import check_outputs
-    from hsgeo.io.lp_lines import read_lp_lines
+    from hsgeo.io.lp_lines import full_line_px, read_lp_lines
     from hsgeo.io.tables import TABLE_FORMATS, write_table
     from hsgeo.validate import check_navigation_covers
     from hsgeo.workflows.pushbroom_ba import GCP_COLUMNS
@@ -626,10 +630,8 @@ def lp_observation_files(
             used=f"the lines of {str(p)!r} (t_s)",
             max_gap_s=options.max_nav_gap_s,
         )
-    n_px = {int(getattr(s, "n_px_full", n_px_full)) for s in strips}
-    if len(n_px) > 1:
-        raise InputError(f"the line files come from lines of {sorted(n_px)} pixels: one camera")
-    inputs = LpInputs(tuple(strips), traj, cam, ids, xyz, height_m, n_px.pop())
+    n_px = full_line_px(strips, n_px_full)
+    inputs = LpInputs(tuple(strips), traj, cam, ids, xyz, height_m, n_px)
     res = retrieve(inputs, options, progress=progress)
     write_table(output, pd.DataFrame(res.table), inputs=[f for f in files if f is not None])
     return res

@@ -28,6 +28,10 @@ __all__ = [
     "build_mosaic",
     "select_bands",
     "camera_from_files",
+    "adjustment_of",
+    "adjusted_camera",
+    "adjusted_trajectory",
+    "lp_mosaic_strips",
     "orthomosaic_files",
 ]
 
@@ -89,6 +93,41 @@ def select_bands(wavelength_nm, wanted_nm, source: str) -> list[int]:
     return out
 
 
+def adjustment_of(result) -> dict:
+    """What :func:`hsgeo.io.sensors.read_adjustment` reads from ``adjust-pushbroom --json``,
+    from the in-memory result (:class:`~hsgeo.workflows.pushbroom_ba.PushbroomResult`).
+    """
+    r = result.result
+    return {
+        "boresight_rad": np.asarray(r.value("boresight_rad"), float).ravel(),
+        "lever_arm_m": np.asarray(r.value("lever_arm_m"), float).ravel(),
+        "distortion": np.asarray(r.value("distortion"), float).ravel(),
+        "c_mm": np.atleast_1d(np.asarray(r.value("c_mm"), float).ravel()),
+        "t_nodes_s": np.asarray(result.nodes.t_nodes_s, float),
+        "nodes": np.asarray(r.value("nodes"), float),
+        "node_columns": tuple(r.params["nodes"].columns),
+    }
+
+
+def adjusted_camera(prior, adjustment=None):
+    """The LP camera (:class:`~hsgeo.sensors.pushbroom.PushbroomCamera`) ``prior`` with the
+    adjusted c (per band), boresight, lever arm and distortion of ``adjustment`` (the dict of
+    :func:`adjustment_of` / :func:`hsgeo.io.sensors.read_adjustment`; None: ``prior``).
+    """
+    from dataclasses import replace
+
+    if adjustment is None:
+        return prior
+    c = np.broadcast_to(adjustment["c_mm"], (len(prior.c_mm),))
+    return replace(
+        prior,
+        c_mm=tuple(float(v) for v in c),
+        boresight_rad=tuple(adjustment["boresight_rad"]),
+        lever_arm_m=tuple(adjustment["lever_arm_m"]),
+        distortion=tuple(adjustment["distortion"]),
+    )
+
+
 def camera_from_files(camera, adjustment=None):
     """The LP camera (:class:`~hsgeo.sensors.pushbroom.PushbroomCamera`) from the camera TOML,
     with the parameters of an ``adjust-pushbroom --json`` result when given.
@@ -97,33 +136,26 @@ def camera_from_files(camera, adjustment=None):
     from hsgeo.workflows.pushbroom_ba import read_camera
 
     prior = read_camera(camera)
-    kw = dict(
+    cam = PushbroomCamera(
         c_mm=(float(prior.c_mm),) * int(prior.n_bands),
         pixel_mm=prior.pixel_mm,
         x0_mm=prior.x0_mm,
         y0_mm=prior.y0_mm,
         lever_arm_m=tuple(prior.lever_arm_m),
     )
-    if adjustment is not None:
-        c = np.broadcast_to(adjustment["c_mm"], (int(prior.n_bands),))
-        kw.update(
-            c_mm=tuple(c),
-            boresight_rad=tuple(adjustment["boresight_rad"]),
-            lever_arm_m=tuple(adjustment["lever_arm_m"]),
-            distortion=tuple(adjustment["distortion"]),
-        )
-    return PushbroomCamera(**kw)
+    return adjusted_camera(cam, adjustment)
 
 
-def _trajectory(trajectory, adjustment):
-    from hsgeo.io.navigation import read_trajectory
+def adjusted_trajectory(nav, adjustment=None):
+    """The navigation ``nav`` with the node corrections of ``adjustment`` (002 eq. 4,
+    :func:`hsgeo.trajectory.corrected_trajectory`; None: ``nav``).
+    """
     from hsgeo.trajectory import CORRECTION_COLUMNS, SplineNodes, corrected_trajectory
 
-    nav = read_trajectory(trajectory)
     if adjustment is None:
         return nav
     t = adjustment["t_nodes_s"]
-    if adjustment["node_columns"] != CORRECTION_COLUMNS:
+    if tuple(adjustment["node_columns"]) != CORRECTION_COLUMNS:
         raise InputError(
             f"--adjustment: node columns {adjustment['node_columns']} are not {CORRECTION_COLUMNS}"
         )
@@ -134,20 +166,45 @@ def _trajectory(trajectory, adjustment):
     return corrected_trajectory(nav, nodes, adjustment["nodes"])
 
 
-def _strips(lines, nav, cam, band_idx, max_nav_gap_s, trajectory):
-    from hsgeo.io.lp_strips import open_lp_strip
+def lp_mosaic_strips(lps, camera, trajectory, bands_nm, n_px_full: int, names=None):
+    """The mosaic's :class:`~hsgeo.ortho.Strip` of LP strips (:class:`hsgeo.io.lp_lines.LpStrip`,
+    numpy or Dask lines): the bands nearest ``bands_nm``, the middle one's geometry.
+
+    Returns
+    -------
+    strips : list of Strip
+    wavelength_nm : (n_bands,) ndarray
+    """
+    strips, wl = [], None
+    for k, lp in enumerate(lps):
+        who = repr(str(names[k])) if names is not None else f"strip {lp.strip_id!r}"
+        if wl is None:
+            wl, first = lp.wavelengths_nm, who
+            idx = select_bands(wl, bands_nm, who)
+        elif lp.wavelengths_nm.shape != wl.shape or not np.allclose(lp.wavelengths_nm, wl):
+            raise InputError(f"LINES {who}: its bands differ from those of {first}")
+        band = min(idx[len(idx) // 2], len(camera.c_mm) - 1)  # the middle band's geometry
+        x = lp.x_px(n_px_full)
+        px = np.column_stack([x, np.zeros_like(x)])
+        strips.append(
+            Strip(camera, trajectory, lp.t_s, px, lp.lines[:, :, idx], {"band": band}, lp.strip_id)
+        )
+    return strips, wl[idx]
+
+
+def _trajectory(trajectory, adjustment):
+    from hsgeo.io.navigation import read_trajectory
+
+    return adjusted_trajectory(read_trajectory(trajectory), adjustment)
+
+
+def _strips(lines, nav, cam, bands_nm, max_nav_gap_s, trajectory, line_pixels):
+    from hsgeo.io.lp_lines import full_line_px, open_lp_lines
     from hsgeo.validate import check_navigation_covers
 
-    strips, wl = [], None
-    for path in lines:
-        lp = open_lp_strip(path)
-        if wl is None:
-            wl = lp.wavelength_nm
-            idx = select_bands(wl, band_idx, repr(str(path)))
-        elif lp.wavelength_nm.shape != wl.shape or not np.allclose(lp.wavelength_nm, wl):
-            raise InputError(
-                f"LINES {str(path)!r}: its bands differ from those of {str(lines[0])!r}"
-            )
+    lps = [open_lp_lines(p) for p in lines]
+    n_px_full = full_line_px(lps, line_pixels)
+    for path, lp in zip(lines, lps, strict=True):
         check_navigation_covers(
             nav.t_s,
             lp.t_s,
@@ -155,12 +212,8 @@ def _strips(lines, nav, cam, band_idx, max_nav_gap_s, trajectory):
             used=f"the lines of {str(path)!r} (t_s)",
             max_gap_s=max_nav_gap_s,
         )
-        band = min(idx[len(idx) // 2], len(cam.c_mm) - 1)  # the middle band's geometry
-        px = np.column_stack([lp.x_px, np.zeros_like(lp.x_px)])
-        strips.append(
-            Strip(cam, nav, lp.t_s, px, lp.values[:, :, idx], {"band": band}, lp.strip_id)
-        )
-    return strips, wl[idx]
+    strips, wl = lp_mosaic_strips(lps, cam, nav, bands_nm, n_px_full, names=lines)
+    return strips, wl, n_px_full
 
 
 def orthomosaic_files(
@@ -178,16 +231,20 @@ def orthomosaic_files(
     progress=None,
     max_nav_gap_s: float = 1.0,
     options: MosaicOptions | None = None,
+    line_pixels: int | None = None,
 ) -> dict:
     """Orthomosaic LP line files into a COG (see ``hsgeo orthomosaic --help``).
 
     Every check comes before the work: the output (refused if it exists, unless ``overwrite``),
     the inputs, the bands, the navigation covering every line, the DSM's CRS and its cover of
-    every strip's footprint. Returns a summary (grid, bands, strips, file).
+    every strip's footprint. ``line_pixels`` (``--line-pixels``) is the full line's width; it
+    overrides the files' ``n_px_full`` attribute (default: that attribute, else 1800 px:
+    :func:`hsgeo.io.lp_lines.full_line_px`, the convention ``hsgeo lp-observations`` shares).
+    Returns a summary (grid, bands, strips, file).
     """
     from hsgeo.io._files import check_outputs
     from hsgeo.io.geotiff import GEOTIFF_FORMATS, read_dsm, write_cog
-    from hsgeo.io.lp_strips import read_adjustment
+    from hsgeo.io.sensors import read_adjustment
 
     lines = list(lines)
     if not lines:
@@ -202,7 +259,7 @@ def orthomosaic_files(
     nav = _trajectory(trajectory, adj)
     z, grid = read_dsm(dsm)
     terrain = MapTerrain(z, grid, opts.frame, source=f"--dsm {str(dsm)!r}")
-    strips, wl = _strips(lines, nav, cam, bands, max_nav_gap_s, trajectory)
+    strips, wl, n_px_full = _strips(lines, nav, cam, bands, max_nav_gap_s, trajectory, line_pixels)
     names = [f"{w:g} nm" for w in wl]
     try:
         mosaic = build_mosaic(MosaicInputs(tuple(strips), terrain, tuple(names), tuple(wl)), opts)
@@ -225,6 +282,7 @@ def orthomosaic_files(
         "y_m": [float(y.min()), float(y.max())],
         "bands": names,
         "strips": [s.name for s in strips],
+        "line_pixels": n_px_full,
         "adjusted": adjustment is not None,
         "scheduler": scheduler,
     }
