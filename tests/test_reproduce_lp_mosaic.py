@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from hsgeo.reproduce.lp_mosaic import TABLE, fig9
+from hsgeo.reproduce.lp_runs import camera_prior
 
 SCALE = 0.1
 SEEDS = (2, 3, 5)
@@ -15,7 +16,7 @@ SEEDS = (2, 3, 5)
 def _adjusted(obs, truth, seed):
     """Retrieve the observations from the pixels and adjust them with the GCPs found."""
     from hsgeo.workflows.lp_observations import LpInputs, LpOptions, retrieve, to_pushbroom_inputs
-    from hsgeo.workflows.pushbroom_ba import CameraPrior, PushbroomOptions, adjust_pushbroom
+    from hsgeo.workflows.pushbroom_ba import PushbroomOptions, adjust_pushbroom
 
     inp = LpInputs(
         tuple(obs.strips),
@@ -27,20 +28,7 @@ def _adjusted(obs, truth, seed):
         obs.n_px_full,
     )
     res = retrieve(inp, LpOptions(rng=seed))
-    c = truth.cfg.campaign  # the operator's a-priori knowledge (the pushbroom chapter's)
-    prior = CameraPrior(
-        n_bands=len(obs.camera.c_mm),
-        pixel_mm=c.pixel_mm,
-        c_mm=c.c_nominal_mm,
-        x0_mm=c.x0_mm,
-        y0_mm=c.y0_mm,
-        lever_arm_m=tuple(obs.camera.lever_arm_m),
-        sigma_lever_m=c.sigma_lever_m,
-        sigma_pos_m=c.sigma_pos_m,
-        sigma_att_rad=c.sigma_att_rad,
-        sigma_obs_px=c.sigma_obs_px,
-        sigma_gcp_m=c.sigma_gcp_m,
-    )
+    prior = camera_prior(obs, truth.cfg)  # the operator's a-priori knowledge, as the chapter's
     found = set(res.table["point_id"].astype(str))
     gcp = [g for g in obs.gcp_ids if g in found]
     k = [list(obs.square_ids).index(g) for g in gcp]

@@ -25,6 +25,25 @@ class HsgeoParser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {msg} (see {self.prog} --help)\n")
 
 
+def _lp_line_options(p) -> None:
+    """The options of every command that reads LP line files: the full line's width and the
+    navigation gaps interpolated across (``lp-observations``, ``orthomosaic``).
+    """
+    p.add_argument(
+        "--line-pixels",
+        type=option_number(integer=True, lo=1, hi=100000),
+        default=None,
+        help="pixels of a full line; overrides the files' n_px_full attribute (default: that "
+        "attribute, else 1800, 002 §4)",
+    )
+    p.add_argument(
+        "--max-nav-gap-s",
+        type=_POSITIVE,
+        default=1.0,
+        help="longest gap between navigation records interpolated across, s (default 1)",
+    )
+
+
 def root_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]:
     """The ``hsgeo`` parser and its subparsers action (no subcommand yet)."""
     from hsgeo import __version__
@@ -286,19 +305,7 @@ def add_orthomosaic(sub) -> argparse.ArgumentParser:
         help="wavelengths (nm) of the bands to mosaic, nearest band each (default 640,550,460)",
     )
     p.add_argument("--scheduler", metavar="ADDRESS", help="dask.distributed scheduler address")
-    p.add_argument(
-        "--line-pixels",
-        type=option_number(integer=True, lo=1, hi=100000),
-        default=None,
-        help="pixels of a full line; overrides the files' n_px_full attribute (default: that "
-        "attribute, else 1800, 002 §4)",
-    )
-    p.add_argument(
-        "--max-nav-gap-s",
-        type=_POSITIVE,
-        default=1.0,
-        help="longest gap between navigation records interpolated across, s (default 1)",
-    )
+    _lp_line_options(p)
     p.add_argument("--overwrite", action="store_true", help="replace an existing output")
     p.add_argument("--json", action="store_true", help="the summary as JSON")
     p.add_argument("--quiet", action="store_true", help="no progress display")
@@ -420,19 +427,7 @@ def add_lp_observations(sub) -> argparse.ArgumentParser:
         action="store_true",
         help="x at the key point's sub-pixel position (default: the pixel centre, 002 §3.1)",
     )
-    p.add_argument(
-        "--line-pixels",
-        type=option_number(integer=True, lo=1, hi=100000),
-        default=None,
-        help="pixels of a full line; overrides the files' n_px_full attribute (default: that "
-        "attribute, else 1800, 002 §4)",
-    )
-    p.add_argument(
-        "--max-nav-gap-s",
-        type=_POSITIVE,
-        default=1.0,
-        help="longest gap between navigation records interpolated across, s (default 1)",
-    )
+    _lp_line_options(p)
     p.add_argument(
         "--overwrite", action="store_true", help="replace an existing output (default: refuse)"
     )
