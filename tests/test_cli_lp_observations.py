@@ -98,6 +98,15 @@ def test_lp_observations_feeds_adjust_pushbroom(files, capsys):
     line = capsys.readouterr().out
     assert "observations of" in line and "frame-F RANSAC inliers" in line
     assert len(pd.read_csv(out2)) > 0
+    # --all-bands: every band's tie points, a superset of the default's rows
+    out3 = d / "obs_all.parquet"
+    assert main([*_argv(d, strips, out3), "--all-bands", "--json"]) == 0
+    s3 = json.loads(capsys.readouterr().out)
+    every = pd.read_parquet(out3)
+    assert s3["n_observations"] == len(every) == s3["n_observations_all_bands"] > len(tab)
+    assert summary["n_observations_all_bands"] == len(every)
+    cols = ["point_id", "band", "strip", "line"]
+    assert len(tab[cols].merge(every[cols])) == len(tab)
 
 
 @pytest.mark.parametrize(

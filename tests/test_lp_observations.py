@@ -247,7 +247,10 @@ def test_end_to_end_within_one_pixel(campaign, retrieved):
     # diagnostics: every match judged by both models; the kept ones are the LP-F inliers
     m = res.matches
     assert (m["kept"] == m["inlier_lp"]).all()
-    assert res.counts["all"]["matches"] == len(m) and res.counts["all"]["observations"] == len(ties)
+    assert res.counts["all"]["matches"] == len(m)
+    assert res.counts["all"]["observations_adjusted"] == len(ties)
+    allb = res.all_bands
+    assert res.counts["all"]["observations"] == int((allb["feature"] >= 0).sum()) > len(ties)
     few = m["pair"].map(res.pairs.set_index("pair")["n_matches"]) < 11
     assert not (m["inlier_lp"] | m["inlier_frame"])[few].any()
     assert set(res.timings_s) >= {"scenes", "detection", "matching", "ransac", "squares"}
@@ -324,3 +327,42 @@ def test_bad_retrievals(campaign):
         retrieve(replace(base, strips=strips[:2]))
     with pytest.raises(InputError, match="terrain height"):
         retrieve(replace(base, terrain_height_m=None))
+
+
+def test_one_band_per_feature_keeps_one_tie_point_of_coinciding_bands(retrieved):
+    """A feature found in several bands is several tie points whose observations coincide
+    (same strip, line and pixel): the adjustment's table keeps one per feature, the one seen in
+    most strips, and no two of its tie points then coincide; every band's stay in all_bands."""
+    allb, tab = retrieved.all_bands, retrieved.table
+    ties = allb[allb["feature"] >= 0]
+    kept = ties[ties["adjusted"]]
+    assert kept.groupby("feature")["point_id"].nunique().eq(1).all()
+    assert (
+        ties["feature"].nunique()
+        == kept["feature"].nunique()
+        == retrieved.counts["all"]["features"]
+    )
+    n_obs = ties.groupby("point_id").size()
+    best = ties.groupby("feature")["point_id"].agg(lambda p: n_obs[p.unique()].max())
+    assert (kept.groupby("feature")["point_id"].first().map(n_obs) == best).all()
+    # no two kept tie points share an observation's strip, line and pixel
+    t = tab[tab["point_id"].str.startswith("tp")]
+    assert not t.duplicated(["strip", "line", "x_px"]).any()
+    assert len(tab) == int(allb["adjusted"].sum())
+
+
+def test_one_band_per_feature_groups_within_a_pixel():
+    """Synthetic: tie points 0 and 1 coincide (x 10 and 11 in one line), 2 and 3 in one line
+    (x 40 and 41); 3 has the most observations; 4 is 2 px from 1 (another feature)."""
+    from hsgeo.measure.tie_points import one_band_per_feature
+
+    point = np.array([0, 0, 0, 1, 1, 1, 2, 2, 2, 3, 3, 3, 3, 4, 4])
+    strip = np.array([0, 1, 2, 0, 1, 2, 0, 1, 2, 2, 3, 4, 5, 0, 1])
+    line = np.array([5, 6, 7, 5, 6, 8, 5, 6, 7, 7, 1, 1, 1, 5, 9])
+    x = np.array([10, 3, 4, 11, 3, 9, 20, 30, 40, 41, 0, 0, 0, 13, 50.0])
+    keep, feature = one_band_per_feature(point, strip, line, x)
+    assert keep.tolist() == [True, False, False, True, True]
+    assert feature[0] == feature[1] and feature[2] == feature[3]
+    assert len(set(feature.tolist())) == 3
+    with pytest.raises(InputError, match="tol_px"):
+        one_band_per_feature(point, strip, line, x, tol_px=2.5)

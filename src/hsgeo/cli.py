@@ -121,6 +121,7 @@ def _cmd_lp_observations(args) -> int:
         bands=args.bands,
         x_at="subpixel" if args.subpixel_x else "pixel_centre",
         max_nav_gap_s=args.max_nav_gap_s,
+        one_band_per_feature=not args.all_bands,
     )
     res = lp_observation_files(
         args.scenes,
@@ -141,8 +142,9 @@ def _cmd_lp_observations(args) -> int:
         return 0
     c = d["counts"]["all"]
     print(
-        f"{d['n_observations']} observations of {d['n_tie_points']} tie points and "
-        f"{d['n_squares']} squares from {c['scenes']} scenes in {len(args.scenes)} strips: "
+        f"{d['n_observations']} observations of {c['tie_points_adjusted']} tie points and "
+        f"{d['n_squares']} squares ({c['observations']} tie-point observations in all bands, "
+        f"{c['features']} features) from {c['scenes']} scenes in {len(args.scenes)} strips: "
         f"{c['keypoints']} key points, {c['matches']} matches, {c['inliers_lp']} LP-F and "
         f"{c['inliers_frame']} frame-F RANSAC inliers -> {args.output}"
     )

@@ -376,7 +376,9 @@ def add_lp_observations(sub) -> argparse.ArgumentParser:
         "BRISK key points matched within each band between scenes of different strips whose "
         "footprints overlap, RANSAC on the Gupta-Hartley LP fundamental matrix (or the frame "
         "camera's), tie points seen in >= 3 lines of >= 3 strips, each observation at the "
-        "centre of its original pixel. SCENES: LP line files, one strip each (NetCDF, see "
+        "centre of its original pixel; of the bands that found one feature in the same "
+        "lines and pixels, one tie point is written (--all-bands: every band's). SCENES: LP "
+        "line files, one strip each (NetCDF, see "
         "hsgeo.io.lp_lines: lines(line, column, band) DN, t_s(line), wavelength_nm(band), "
         "attributes col0, strip_id and optionally n_px_full). NAV: the navigation file of "
         "every command, CSV or "
@@ -426,6 +428,13 @@ def add_lp_observations(sub) -> argparse.ArgumentParser:
         "--subpixel-x",
         action="store_true",
         help="x at the key point's sub-pixel position (default: the pixel centre, 002 §3.1)",
+    )
+    p.add_argument(
+        "--all-bands",
+        action="store_true",
+        help="write every band's tie points, also where several bands found one feature in "
+        "the same lines and pixels (default: one per feature; those coincide and share their "
+        "rounding, so adjusted as independent they make σ̂ too small)",
     )
     _lp_line_options(p)
     p.add_argument(

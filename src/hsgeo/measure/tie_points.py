@@ -17,6 +17,12 @@ A component is then checked and filtered (:func:`link_tie_points`):
   observed in three or more LP image lines were used …, which required three overlapping
   flight strips").
 
+Matches are found within one band, so one ground feature found in k bands becomes k tie points
+whose observations coincide: the same line of the same strip, and (registered at the pixel
+centre) the same pixel. They are one measurement repeated, not k: their errors are the same
+line rounding and nearly the same pixel rounding. :func:`one_band_per_feature` groups such
+tie points into features and keeps one of each (ours; 002 does not say how it treated them).
+
 References
 ----------
 Jonassen et al. (2024), 002 §4.
@@ -28,7 +34,7 @@ import numpy as np
 
 from hsgeo.errors import InputError
 
-__all__ = ["link_tie_points", "components"]
+__all__ = ["link_tie_points", "components", "one_band_per_feature"]
 
 
 def components(n_nodes: int, a, b) -> np.ndarray:
@@ -137,3 +143,68 @@ def link_tie_points(
         "n_too_few": int(n_comp - bad_comp.size - comps.size),
         "n_points": int(comps.size),
     }
+
+
+def one_band_per_feature(point, strip, line, x_px, *, tol_px: float = 1.0):
+    """One tie point per ground feature: of the tie points (each in one band) whose
+    observations coincide, the one with the most observations (module docstring).
+
+    Two tie points are the same feature when an observation of one and an observation of the
+    other lie in the same line of the same strip within ``tol_px`` along it (the band's own
+    principal distance moves a feature by a pixel or less near the line's ends); the relation
+    is closed transitively (connected components).
+
+    Parameters
+    ----------
+    point : (m,) int array_like
+        Tie point of each observation (0 … n_points − 1).
+    strip, line : (m,) int array_like
+        Strip and line (within the strip) of each observation.
+    x_px : (m,) array_like, px
+        Position along the line.
+    tol_px : float
+        Largest distance along the line of two coinciding observations (< 2).
+
+    Returns
+    -------
+    keep : (n_points,) bool ndarray
+        The tie point kept for its feature (ties: the lowest index).
+    feature : (n_points,) int ndarray
+        Feature of each tie point (0 … n_features − 1).
+    """
+    point = np.asarray(point, dtype=np.int64)
+    strip = np.asarray(strip, dtype=np.int64)
+    line = np.asarray(line, dtype=np.int64)
+    x = np.asarray(x_px, dtype=np.float64)
+    if not (point.shape == strip.shape == line.shape == x.shape) or point.ndim != 1:
+        raise InputError("point, strip, line and x_px need one value per observation")
+    if not 0 < tol_px < 2:
+        raise InputError(f"tol_px must be in (0, 2), got {tol_px!r}")
+    n = int(point.max()) + 1 if point.size else 0
+    if point.size and point.min() < 0:
+        raise InputError("tie point indices must be ≥ 0")
+    # observations within tol_px of each other share a bin of width 2·tol_px, or of the same
+    # bins shifted by tol_px: two bin keys per observation, linked to its tie point
+    cells = []
+    for shift in (0.0, tol_px):
+        b = np.floor((x + shift) / (2 * tol_px)).astype(np.int64)
+        cells.append(np.column_stack([strip, line, b, np.full_like(b, int(shift > 0))]))
+    _, cell = np.unique(np.concatenate(cells), axis=0, return_inverse=True)
+    cell = cell.ravel()
+    near = np.r_[point, point]
+    # the bins over-link up to 2·tol_px apart; keep only the pairs within tol_px: link each
+    # observation to the first of its bin (sorted by x) when within tol_px of it, else alone
+    xs = np.r_[x, x]
+    order = np.lexsort((xs, cell))
+    c, pnt, xo = cell[order], near[order], xs[order]
+    start = np.r_[True, c[1:] != c[:-1]]
+    head = np.maximum.accumulate(np.where(start, np.arange(c.size), 0))
+    ok = ~start & (xo - xo[head] <= tol_px)
+    feature = components(max(n, 1), pnt[head[ok]], pnt[ok])[:n]
+    _, feature = np.unique(feature, return_inverse=True)
+    n_obs = np.bincount(point, minlength=n)
+    order = np.lexsort((np.arange(n), -n_obs, feature))
+    first = np.r_[True, feature[order][1:] != feature[order][:-1]] if n else np.zeros(0, bool)
+    keep = np.zeros(n, bool)
+    keep[order[first]] = True
+    return keep, feature.astype(np.int64)

@@ -24,7 +24,13 @@ The user's pipeline, truth-free (002 §3.1 steps 2–3, and the reference square
    per strip, seen in ≥ 3 lines of ≥ 3 strips (002 §4; :mod:`hsgeo.measure.tie_points`).
    Each observation is registered at the centre of its original pixel (002 §3.1: "the
    observations are registered at the center of their respective pixel"; ``x_at``), in its
-   line (``y_px = 0``, the line's ``t_s``).
+   line (``y_px = 0``, the line's ``t_s``). Matching is within a band, so a feature found in k
+   bands is k tie points whose observations coincide (the same line and pixel): one
+   measurement repeated, with one line rounding. The adjustment gets one of them
+   (:func:`hsgeo.measure.tie_points.one_band_per_feature`: the one seen in most strips;
+   ``one_band_per_feature``); taken as k independent tie points they make σ̂ too small (the
+   chapter measures by how much). Every band's observations stay in ``LpResult.all_bands``,
+   and the counts (002's observations per band and scene length) are of those.
 6. **Reference squares** (optional): each square's centre measured in every scene that should
    see it (:func:`hsgeo.measure.targets_lp.square_centroid`), back to line and x (sub-pixel:
    a centroid measures the centre, not a pixel), with the square's id.
@@ -45,7 +51,7 @@ import numpy as np
 from hsgeo.errors import InputError, ObservationError
 from hsgeo.measure.keypoints import BRISK_OCTAVES, BRISK_THRESHOLD, RATIO
 from hsgeo.measure.targets_lp import SEARCH_PX
-from hsgeo.measure.tie_points import link_tie_points
+from hsgeo.measure.tie_points import link_tie_points, one_band_per_feature
 from hsgeo.workflows import _lp_squares as sq
 from hsgeo.workflows._lp_stages import MIN_MATCHES, Keys, match_all, strip_scenes
 
@@ -133,6 +139,9 @@ class LpOptions:
         The longest navigation gap interpolated across.
     rng : int
         Seed of RANSAC's sampling.
+    one_band_per_feature : bool
+        The adjustment's table keeps one tie point per ground feature, of the bands that found
+        it in the same lines and pixels (module docstring, step 5); False: every band's.
     """
 
     n_lines_per_scene: int = 200
@@ -151,6 +160,7 @@ class LpOptions:
     min_square_observations: int = 2
     max_nav_gap_s: float = 1.0
     rng: int = 0
+    one_band_per_feature: bool = True
 
     def __post_init__(self):
         if self.ransac not in ("lp", "frame"):
@@ -176,7 +186,8 @@ class LpResult:
     table : pandas.DataFrame
         :data:`TABLE_COLUMNS`: ``point_id`` (``tp…`` for tie points, the square's id),
         ``band``, ``t_s``, ``x_px``, ``y_px`` (0), ``strip`` (its id), ``line`` (index in the
-        strip) — the observation table of ``hsgeo adjust-pushbroom``.
+        strip) — the observation table of ``hsgeo adjust-pushbroom`` (one band per
+        feature, :attr:`LpOptions.one_band_per_feature`).
     matches : pandas.DataFrame
         Every match before RANSAC: ``pair``, ``band``, ``strip_a``, ``strip_b``, ``scene_a``,
         ``scene_b``, scene coordinates ``u_a, v_a, u_b, v_b``, ``line_a, x_a_px, t_a_s,
@@ -193,11 +204,16 @@ class LpResult:
         ``v``, ``snr``, ``ok``.
     counts : dict
         Per band and in all: key points, matches before and after RANSAC (both models),
-        tie points and observations.
+        tie points and observations of every band (002's counts; ``tie_points``,
+        ``observations``), and of the table (``tie_points_adjusted``,
+        ``observations_adjusted``); in all also ``features``.
     timings_s : dict
         Seconds per stage: ``scenes``, ``detection``, ``matching``, ``ransac``, ``squares``,
         ``tie_points``; ``ransac_per_strip``.
     options : LpOptions
+    all_bands : pandas.DataFrame
+        Every band's tie-point observations (:data:`TABLE_COLUMNS`, then ``feature`` and
+        ``adjusted``: in :attr:`table`) and the squares' (feature −1).
     """
 
     table: object
@@ -208,6 +224,7 @@ class LpResult:
     counts: dict
     timings_s: dict
     options: LpOptions = field(default_factory=LpOptions)
+    all_bands: object = None
 
     def to_dict(self) -> dict:
         """Counts, timings and the options (JSON-ready); the tables stay in the attributes."""
@@ -216,6 +233,7 @@ class LpResult:
         opts = asdict(self.options)
         return {
             "n_observations": int(len(self.table)),
+            "n_observations_all_bands": int(len(self.all_bands)),
             "n_tie_points": int(self.counts["all"]["tie_points"]),
             "n_squares": int(self.counts["all"]["squares"]),
             "counts": self.counts,
@@ -377,9 +395,13 @@ def retrieve(inputs: LpInputs, options: LpOptions = LpOptions(), progress=None) 
             f"{len(rows['pairs'])} scene pairs; give more overlapping strips, or scenes with "
             "texture in these bands (--bands)"
         )
-    table = _table(inputs, options, keys, point, rows["squares"])
+    all_bands = _table(inputs, options, keys, point, rows["squares"])
+    table = all_bands.loc[all_bands["adjusted"].to_numpy(), list(TABLE_COLUMNS)]
+    table = table.reset_index(drop=True)
     matches = _matches_frame(inputs, keys, m, kept, point)
-    return _result(inputs, options, bands, keys, point, link, table, matches, rows, timings)
+    return _result(
+        inputs, options, bands, keys, point, link, (table, all_bands), matches, rows, timings
+    )
 
 
 def _observation_x(x, options, n_px_full):
@@ -391,21 +413,29 @@ def _observation_x(x, options, n_px_full):
 
 
 def _table(inputs, options, keys, point, square_rows):
-    """The observation table: tie points then squares (:data:`TABLE_COLUMNS`)."""
+    """Every band's observations: tie points then squares (:data:`TABLE_COLUMNS`, ``feature``,
+    ``adjusted``: one band per feature, or all, :attr:`LpOptions.one_band_per_feature`).
+    """
     import pandas as pd
 
     ids = np.array([str(s.strip_id) for s in inputs.strips])
     obs = np.flatnonzero(point >= 0)
     obs = obs[np.lexsort((keys.strip[obs], point[obs]))]
+    x = _observation_x(keys.x[obs], options, inputs.n_px_full)
+    keep, feature = one_band_per_feature(point[obs], keys.strip[obs], keys.line[obs], x)
+    if not options.one_band_per_feature:
+        keep[:] = True
     ties = pd.DataFrame(
         {
             "point_id": [f"tp{p:07d}" for p in point[obs]],
             "band": keys.band[obs].astype(np.int64),
             "t_s": keys.t[obs],
-            "x_px": _observation_x(keys.x[obs], options, inputs.n_px_full),
+            "x_px": x,
             "y_px": np.zeros(obs.size),
             "strip": ids[keys.strip[obs]],
             "line": keys.line[obs],
+            "feature": feature[point[obs]],
+            "adjusted": keep[point[obs]],
         }
     )
     sq = pd.DataFrame(
@@ -413,8 +443,8 @@ def _table(inputs, options, keys, point, square_rows):
     )
     sq = sq.loc[sq["ok"].astype(bool)].drop_duplicates(["point_id", "band", "strip"])
     count = sq.groupby("point_id")["point_id"].transform("size")
-    sq = sq[count >= options.min_square_observations].assign(y_px=0.0)
-    table = pd.concat([ties, sq[list(TABLE_COLUMNS)]], ignore_index=True)
+    sq = sq[count >= options.min_square_observations].assign(y_px=0.0, feature=-1, adjusted=True)
+    table = pd.concat([ties, sq[[*TABLE_COLUMNS, "feature", "adjusted"]]], ignore_index=True)
     table["band"] = table["band"].astype(np.int64)
     table["line"] = table["line"].astype(np.int64)
     return table
@@ -454,18 +484,20 @@ def _matches_frame(inputs, keys, m, kept, point):
     )
 
 
-def _result(inputs, options, bands, keys, point, link, table, matches, rows, timings):
+def _result(inputs, options, bands, keys, point, link, tables, matches, rows, timings):
     """Counts per band and in all, and the result."""
     import pandas as pd
 
+    table, all_bands = tables
     pairs = pd.DataFrame(rows["pairs"])
     counts = {}
     for b in (*bands, "all"):
         sel = slice(None) if b == "all" else (keys.band == b)
         msel = slice(None) if b == "all" else (matches["band"].to_numpy() == b)
-        tsel = slice(None) if b == "all" else (table["band"].to_numpy() == b)
-        tab = table[tsel]
-        tie = tab["point_id"].str.startswith("tp")
+        tsel = slice(None) if b == "all" else (all_bands["band"].to_numpy() == b)
+        tab = all_bands[tsel]
+        tie = tab["feature"].to_numpy() >= 0
+        adj = tie & tab["adjusted"].to_numpy(bool)
         counts["all" if b == "all" else f"band{b}"] = {
             "keypoints": int(np.sum(np.ones(keys.n, bool)[sel])),
             "matches": int(len(matches[msel])),
@@ -481,6 +513,8 @@ def _result(inputs, options, bands, keys, point, link, table, matches, rows, tim
             "inliers_frame": int(matches["inlier_frame"][msel].sum()),
             "tie_points": int(tab.loc[tie, "point_id"].nunique()),
             "observations": int(tie.sum()),
+            "tie_points_adjusted": int(tab.loc[adj, "point_id"].nunique()),
+            "observations_adjusted": int(adj.sum()),
             "squares": int(tab.loc[~tie, "point_id"].nunique()),
             "square_observations": int((~tie).sum()),
         }
@@ -488,6 +522,7 @@ def _result(inputs, options, bands, keys, point, link, table, matches, rows, tim
         scenes=len(rows["scenes"]),
         pairs=int(pairs[["scene_a", "scene_b"]].drop_duplicates().shape[0]),
         pair_bands_with_11=int((pairs["n_matches"] >= MIN_MATCHES).sum()),
+        features=int(all_bands.loc[all_bands["feature"] >= 0, "feature"].nunique()),
         **{f"link_{k}": v for k, v in link.items()},
     )
     return LpResult(
@@ -502,6 +537,7 @@ def _result(inputs, options, bands, keys, point, link, table, matches, rows, tim
         counts=counts,
         timings_s=timings,
         options=options,
+        all_bands=all_bands,
     )
 
 
