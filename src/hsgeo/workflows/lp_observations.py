@@ -1,5 +1,9 @@
 """LP observations from pixels (002 §3.1, §4): scenes → BRISK → matches → RANSAC → tie points.
 
+Kept as one file: one workflow in GUIDE §2's template — its inputs, options and result, the
+in-memory core :func:`retrieve` and its file front end; the per-strip stages are in
+:mod:`hsgeo.workflows._lp_stages`, the geometry in ``_lp_geometry``, the squares in ``_lp_squares``.
+
 The user's pipeline, truth-free (002 §3.1 steps 2–3, and the reference squares of §4):
 
 1. **Scenes**: each strip's lines, ``n_lines_per_scene`` at a time, rotation-compensated in x
