@@ -16,6 +16,9 @@ error), so:
    prediction error; each square and band takes its candidate nearest prediction + offset,
    if one lies within that tolerance. A blob of a neighbouring square is off that common
    offset by the squares' spacing and is not taken.
+
+The chosen centroid is registered at its sub-pixel x in the nearest line and at the time of its
+sub-line row (:func:`_time_at`).
 """
 
 from __future__ import annotations
@@ -95,7 +98,7 @@ def choose(cands: list, strip, predicted, inputs, options) -> list:
                 "band": int(b),
                 "strip": str(strip.strip_id),
                 "line": ln,
-                "t_s": float(t_s[ln]),
+                "t_s": _time_at(t_s, ln + (uv[0] - np.round(uv[0]))),
                 "x_px": xx,
                 "u": float(uv[0]),
                 "v": float(uv[1]),
@@ -104,3 +107,14 @@ def choose(cands: list, strip, predicted, inputs, options) -> list:
             }
         )
     return rows
+
+
+def _time_at(t_s, line) -> float:
+    """The time of a fractional line (the centroid's row between two lines, linear in time).
+
+    A square's centroid measures its centre along the track too: the observation is registered
+    at that time (``y_px = 0`` there), not at the nearest line's, so it carries no line
+    rounding — which, shared by the k bands that see the square in one line, would count k
+    times (:func:`hsgeo.measure.tie_points.one_band_per_feature` says why for tie points).
+    """
+    return float(np.interp(line, np.arange(t_s.size), t_s))

@@ -36,8 +36,11 @@ The user's pipeline, truth-free (002 §3.1 steps 2–3, and the reference square
    chapter measures by how much). Every band's observations stay in ``LpResult.all_bands``,
    and the counts (002's observations per band and scene length) are of those.
 6. **Reference squares** (optional): each square's centre measured in every scene that should
-   see it (:func:`hsgeo.measure.targets_lp.square_centroid`), back to line and x (sub-pixel:
-   a centroid measures the centre, not a pixel), with the square's id.
+   see it (:func:`hsgeo.measure.targets_lp.square_centroid`), back to line and x, with the
+   square's id. Sub-pixel in both: a centroid measures the centre, not a pixel, so x is its
+   sub-pixel x in the nearest line and ``t_s`` the time of its sub-line row (between two lines'
+   times; ``line`` names the nearest) — no line rounding, which the k bands that see a square
+   in one line would share.
 
 The in-memory core :func:`retrieve` (frozen :class:`LpInputs`, :class:`LpOptions` →
 :class:`LpResult`) is what ``hsgeo reproduce lp-observations`` and ``hsgeo lp-observations``
