@@ -443,6 +443,8 @@ def _table(inputs, options, keys, point, square_rows):
             "line": keys.line[obs],
             "feature": feature[point[obs]],
             "adjusted": keep[point[obs]],
+            "x_keypoint_px": keys.x[obs],
+            "line_offset": keys.uv[obs, 0] - np.rint(keys.uv[obs, 0]),
         }
     )
     sq = pd.DataFrame(
