@@ -1,12 +1,12 @@
 """Every bad input gets one clear error, and nothing is ever lost (issue 12).
 
 The valid inputs of ``tests/test_cli*.py`` (a line-scanner calibration, a pushbroom campaign,
-a geocoding flight line, OpenCV's ChArUco photographs) are built once; each case copies the
-command's inputs, spoils one thing (a table of mutations: missing, empty, garbage, binary and
-mistyped files; NaN, inf, 1e300; wrong units and types; degenerate geometry; duplicates; bad
-options; output paths) and runs ``hsgeo.cli.main`` in-process. Each case must end with exit
-status 2, exactly one line on stderr (no traceback) naming the file / column / option / id in
-question (a per-case substring), and nothing on stdout. Benign variants (reordered and extra
+a geocoding flight line, OpenCV's ChArUco photographs, two LP strips to orthomosaic) are built
+once; each case copies the command's inputs, spoils one thing (a table of mutations: missing,
+empty, garbage, binary and mistyped files; NaN, inf, 1e300; wrong units and types; degenerate
+geometry; duplicates; bad options; output paths) and runs ``hsgeo.cli.main`` in-process.
+Each case must end with exit status 2, exactly one line on stderr (no traceback) naming the
+file / column / option / id in question (a per-case substring), and nothing on stdout. Benign variants (reordered and extra
 columns, CRLF, a UTF-8 BOM, 16-bit images, Parquet) must still work. The SHA-256 of every
 input file is the same before and after every command, failing or succeeding.
 
