@@ -6,9 +6,10 @@ once; each case copies the command's inputs, spoils one thing (a table of mutati
 empty, garbage, binary and mistyped files; NaN, inf, 1e300; wrong units and types; degenerate
 geometry; duplicates; bad options; output paths) and runs ``hsgeo.cli.main`` in-process.
 Each case must end with exit status 2, exactly one line on stderr (no traceback) naming the
-file / column / option / id in question (a per-case substring), and nothing on stdout. Benign variants (reordered and extra
-columns, CRLF, a UTF-8 BOM, 16-bit images, Parquet) must still work. The SHA-256 of every
-input file is the same before and after every command, failing or succeeding.
+file / column / option / id in question (a per-case substring), and nothing on stdout. Benign
+variants (reordered and extra columns, CRLF, a UTF-8 BOM, 16-bit images, Parquet) must still
+work. The SHA-256 of every input file is the same before and after every command, failing or
+succeeding.
 
 ``python tests/test_bad_input.py`` prints the count of cases by command and class.
 """
