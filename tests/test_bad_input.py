@@ -1,14 +1,15 @@
 """Every bad input gets one clear error, and nothing is ever lost (issue 12).
 
 The valid inputs of ``tests/test_cli*.py`` (a line-scanner calibration, a pushbroom campaign,
-a geocoding flight line, OpenCV's ChArUco photographs) are built once; each case copies the
-command's inputs, spoils one thing (a table of mutations: missing, empty, garbage, binary and
-mistyped files; NaN, inf, 1e300; wrong units and types; degenerate geometry; duplicates; bad
-options; output paths) and runs ``hsgeo.cli.main`` in-process. Each case must end with exit
-status 2, exactly one line on stderr (no traceback) naming the file / column / option / id in
-question (a per-case substring), and nothing on stdout. Benign variants (reordered and extra
-columns, CRLF, a UTF-8 BOM, 16-bit images, Parquet) must still work. The SHA-256 of every
-input file is the same before and after every command, failing or succeeding.
+a geocoding flight line, OpenCV's ChArUco photographs, two LP strips to orthomosaic) are built
+once; each case copies the command's inputs, spoils one thing (a table of mutations: missing,
+empty, garbage, binary and mistyped files; NaN, inf, 1e300; wrong units and types; degenerate
+geometry; duplicates; bad options; output paths) and runs ``hsgeo.cli.main`` in-process.
+Each case must end with exit status 2, exactly one line on stderr (no traceback) naming the
+file / column / option / id in question (a per-case substring), and nothing on stdout. Benign
+variants (reordered and extra columns, CRLF, a UTF-8 BOM, 16-bit images, Parquet) must still
+work. The SHA-256 of every input file is the same before and after every command, failing or
+succeeding.
 
 ``python tests/test_bad_input.py`` prints the count of cases by command and class.
 """
@@ -202,6 +203,15 @@ def _asf(d: Path) -> None:
     write_asf_inputs(d)
 
 
+def _ortho(d: Path) -> None:
+    """Two LP strips over the Ås hill (tests/ortho_inputs.py), their navigation lacking known
+    node corrections, the adjust-pushbroom result that carries them, the camera and the DSM."""
+    from ortho_inputs import write_ortho_inputs
+
+    d.mkdir()
+    write_ortho_inputs(d, adjusted=True)
+
+
 def build_valid(root: Path) -> Path:
     """Write the valid inputs of every command under ``root`` (one folder per command)."""
     _asf(root / "asf")
@@ -214,6 +224,7 @@ def build_valid(root: Path) -> Path:
     _geocode(root / "geocode")
     _frame(root / "calibrate-frame")
     _lp(root / "lp-observations")
+    _ortho(root / "orthomosaic")
     return root
 
 
@@ -265,6 +276,27 @@ def base_argv(cmd: str, d: Path) -> list[str]:
             s(d / "squares.csv"),
             "-o",
             s(out / "obs.parquet"),
+        ]
+    if cmd == "orthomosaic":
+        out = d.parent / "out"
+        out.mkdir(exist_ok=True)
+        return [
+            cmd,
+            s(d / "s1.nc"),
+            s(d / "s2.nc"),
+            "--trajectory",
+            s(d / "nav.csv"),
+            "--camera",
+            s(d / "camera.toml"),
+            "--adjustment",
+            s(d / "result.json"),
+            "--dsm",
+            s(d / "dsm.tif"),
+            "--resolution",
+            "1",  # a 244 x 166 mosaic: about 1 s
+            "-o",
+            s(out / "mosaic.tif"),
+            "--quiet",
         ]
     if cmd == "adjust-bal":
         return [cmd, s(d / "problem.txt"), "--json"]
@@ -1764,6 +1796,277 @@ def _bal_points_behind(p: Path):
     p.write_text("\n".join(lines[:n] + [repr(float(v)) for v in pts.ravel()]) + "\n")
 
 
+# --- orthomosaic ---------------------------------------------------------------------------
+C = "orthomosaic"
+
+
+def _h5_edit(fn):
+    """Rewrite an LP line file (NetCDF-4) through ``fn(Dataset) -> Dataset``."""
+
+    def edit(p: Path) -> None:
+        import xarray as xr
+
+        with xr.open_dataset(p, engine="h5netcdf") as ds:
+            new = fn(ds.load())
+        p.unlink()
+        new.to_netcdf(p, engine="h5netcdf")
+
+    return edit
+
+
+def _tif_edit(fn):
+    """Rewrite the DSM GeoTIFF through ``fn(z, transform, crs) -> (z, transform, crs)``."""
+
+    def edit(p: Path) -> None:
+        import rasterio
+
+        with rasterio.open(p) as src:
+            z, t, crs = fn(src.read(1), src.transform, src.crs)
+        p.unlink()
+        with rasterio.open(
+            p, "w", driver="GTiff", width=z.shape[1], height=z.shape[0], count=1,
+            dtype=z.dtype, crs=crs, transform=t,
+        ) as dst:  # fmt: skip
+            dst.write(z, 1)
+
+    return edit
+
+
+def _json_edit(fn):
+    """Rewrite the adjust-pushbroom result through ``fn(dict)`` (in place)."""
+
+    def edit(p: Path) -> None:
+        d = json.loads(p.read_text())
+        fn(d)
+        p.write_text(json.dumps(d))
+
+    return edit
+
+
+def _set(path: str, value):
+    """``d[a][b]... = value`` for ``path`` 'a.b...' (a list index as a number)."""
+
+    def f(d):
+        *head, last = path.split(".")
+        for k in head:
+            d = d[int(k)] if isinstance(d, list) else d[k]
+        d[int(last) if isinstance(d, list) else last] = value
+
+    return f
+
+
+def _uneven_nodes(d):
+    d["nodes"]["t_s"][3] += 2.5
+
+
+NAV_S = ["t_s", "E_m", "N_m", "U_m", "roll_deg", "pitch_deg", "heading_deg"]
+table_file_cases(C, "nav.csv", "navigation", NAV_S, "camera.toml")
+case(C, "duplicates", "nav-duplicate-time", "t_s", [("nav.csv", duplicate_row(5))])
+case(C, "degenerate", "nav-times-decreasing", "t_s", [("nav.csv", swap_rows(5, 6))])
+case(C, "degenerate", "nav-not-covering", "navigation", [("nav.csv", keep_rows(100))])
+case(C, "degenerate", "nav-gap", "--max-nav-gap-s", [("nav.csv", delete_rows(100, 200))])
+case(C, "units", "nav-east-in-mm", "jumps", [("nav.csv", scale_column("E_m", 1000.0))])
+case(C, "units", "nav-times-in-ms", "t_s", [("nav.csv", scale_column("t_s", 1000.0))])
+# LINES
+for f in ("s1.nc", "s2.nc"):
+    case(C, "missing", f"{f}-missing", f, [(f, remove)])
+    case(C, "binary", f"{f}-binary", f, [(f, text(BINARY))])
+f = "s1.nc"
+case(C, "missing", f"{f}-directory", f, [(f, make_dir)])
+case(C, "empty", f"{f}-empty", f, [(f, text(""))])
+case(C, "garbage", f"{f}-text", f, [(f, text("hello world\n"))])
+case(C, "binary", f"{f}-hdf5-garbage", f, [(f, text(b"\x89HDF\r\n\x1a\n" + BINARY))])
+case(C, "binary", f"{f}-truncated", f, [(f, lambda p: p.write_bytes(p.read_bytes()[:4000]))])
+case(C, "mistyped", f"{f}-a-csv", f, [(f, copy_from("nav.csv"))])
+case(C, "mistyped", f"{f}-the-dsm", f, [(f, copy_from("dsm.tif"))])
+for var in ("lines", "t_s", "wavelength_nm"):
+    case(C, "mistyped", f"{f}-no-{var}", var, [(f, _h5_edit(lambda ds, v=var: ds.drop_vars(v)))])
+case(
+    C, "mistyped", f"{f}-no-col0", "col0",
+    [(f, _h5_edit(lambda ds: _drop_attr_lp(ds, "col0")))],
+)  # fmt: skip
+case(
+    C, "nonfinite", f"{f}-t_s-nan", "t_s",
+    [(f, _h5_edit(lambda ds: ds.assign(t_s=ds["t_s"].where(ds["line"] != 3))))],
+)  # fmt: skip
+case(
+    C, "degenerate", f"{f}-t_s-decreasing", "line times must increase",
+    [(f, _h5_edit(lambda ds: ds.assign(t_s=("line", ds["t_s"].values[::-1]))))],
+)  # fmt: skip
+case(
+    C, "degenerate", f"{f}-zero-lines", f,
+    [(f, _h5_edit(lambda ds: ds.isel(line=slice(0, 0))))],
+)  # fmt: skip
+case(
+    C, "mismatch", "strips-other-bands", "bands differ",
+    [("s2.nc", _h5_edit(lambda ds: ds.assign(wavelength_nm=ds["wavelength_nm"] + 30.0)))],
+)  # fmt: skip
+case(
+    C, "mismatch", "strips-other-n_px_full", "n_px_full",
+    [("s2.nc", _h5_edit(lambda ds: _set_attr(ds, "n_px_full", 600)))],
+)  # fmt: skip
+case(
+    C, "range", f"{f}-col0-beyond-the-line", "n_px_full",
+    [(f, _h5_edit(lambda ds: _set_attr(ds, "col0", 100)))],
+)  # fmt: skip
+case(C, "duplicates", "strip-twice", "twice", argv=lambda a, d: [a[0], a[1], *a[1:]])
+case(
+    C, "degenerate", "lines-after-navigation", "navigation",
+    [(f, _h5_edit(lambda ds: ds.assign(t_s=ds["t_s"] + 1000.0)))],
+)  # fmt: skip
+# CAMERA
+case(C, "missing", "cam-missing", "camera.toml", [("camera.toml", remove)])
+case(C, "empty", "cam-empty", "[camera]", [("camera.toml", text(""))])
+case(C, "garbage", "cam-garbage", "camera.toml", [("camera.toml", text("[camera\nn_bands = \n"))])
+case(C, "binary", "cam-binary", "camera.toml", [("camera.toml", text(BINARY))])
+case(C, "mistyped", "cam-is-csv", "camera.toml", [("camera.toml", copy_from("nav.csv"))])
+for key, value, kind in [
+    ("n_bands", "0", "range"),
+    ("n_bands", "3", "mismatch"),
+    ("pixel_mm", "-0.0065", "range"),
+    ("pixel_mm", "6.5", "units"),
+    ("c_mm", "nan", "nonfinite"),
+    ("c_mm", None, "missing"),
+]:
+    case(C, kind, f"cam-{key}={value}", key, [("camera.toml", toml_set("camera", key, value))])
+case(
+    C, "mistyped", "cam-pixel-mm-misspelled", "pixel_mm",
+    [("camera.toml", toml_rename("pixel_mm", "pixel_size_mm"))],
+)  # fmt: skip
+# RESULT.json of adjust-pushbroom
+R = "result.json"
+case(C, "missing", "adjustment-missing", R, [(R, remove)])
+case(C, "empty", "adjustment-empty", R, [(R, text(""))])
+case(C, "garbage", "adjustment-garbage", R, [(R, text("{'converged': true,"))])
+case(C, "binary", "adjustment-binary", R, [(R, text(BINARY))])
+case(C, "mistyped", "adjustment-a-list", R, [(R, text("[1, 2, 3]\n"))])
+case(C, "mistyped", "adjustment-is-toml", R, [(R, copy_from("camera.toml"))])
+case(C, "mistyped", "adjustment-no-nodes", "nodes", [(R, _json_edit(lambda d: d.pop("nodes")))])
+for path, value, kind, expect in [
+    ("parameters.boresight_deg.value", [0.0, 0.0], "type", "boresight"),
+    ("parameters.boresight_deg.value", [0.0, "a", 0.0], "type", "boresight"),
+    ("parameters.boresight_deg.value", [1e300, 0.0, 0.0], "range", "boresight"),
+    ("parameters.lever_arm_m.value", [float("nan"), 0.0, 0.0], "nonfinite", "lever_arm_m"),
+    ("parameters.c_mm.value", [40.0, 40.0], "mismatch", "c_mm"),
+    ("parameters.c_mm.value", [-40.0], "range", "c_mm"),
+    ("parameters.distortion.value", [0.0], "type", "distortion"),
+    ("nodes.columns", ["E", "N", "U", "r", "p", "h"], "mistyped", "columns"),
+    ("nodes.value.2.0", float("nan"), "nonfinite", "nodes"),
+    ("nodes.value.2.0", 1e300, "range", "nodes"),
+    ("nodes.t_s.0", float("nan"), "nonfinite", "t_s"),
+]:
+    case(C, kind, f"adjustment-{path}={value}", expect, [(R, _json_edit(_set(path, value)))])
+case(C, "degenerate", "adjustment-nodes-uneven", "evenly", [(R, _json_edit(_uneven_nodes))])
+case(
+    C, "mismatch", "adjustment-nodes-not-covering", "node times of --adjustment",
+    [(R, _json_edit(lambda d: d["nodes"].update(t_s=[t + 500.0 for t in d["nodes"]["t_s"]])))],
+)  # fmt: skip
+case(
+    C, "degenerate", "adjustment-three-nodes", "nodes",
+    [(R, _json_edit(lambda d: d["nodes"].update(t_s=d["nodes"]["t_s"][:3],
+                                                 value=d["nodes"]["value"][:3])))],
+)  # fmt: skip
+# DSM
+case(C, "missing", "dsm-missing", "dsm.tif", [("dsm.tif", remove)])
+case(C, "missing", "dsm-directory", "dsm.tif", [("dsm.tif", make_dir)])
+case(C, "empty", "dsm-empty", "dsm.tif", [("dsm.tif", text(""))])
+case(C, "garbage", "dsm-text", "dsm.tif", [("dsm.tif", text("hello world\n"))])
+case(C, "binary", "dsm-binary", "dsm.tif", [("dsm.tif", text(BINARY))])
+case(C, "mistyped", "dsm-is-lines", "dsm.tif", [("dsm.tif", copy_from("s1.nc"))])
+case(C, "mistyped", "dsm-no-crs", "CRS", [("dsm.tif", _tif_edit(lambda z, t, c: (z, t, None)))])
+case(
+    C, "mismatch", "dsm-wgs84-utm", "EPSG:32632",
+    [("dsm.tif", _tif_edit(lambda z, t, c: (z, t, "EPSG:32632")))],
+)  # fmt: skip
+case(
+    C, "mismatch", "dsm-geographic", "EPSG:4326",
+    [("dsm.tif", _tif_edit(lambda z, t, c: (z, t, "EPSG:4326")))],
+)  # fmt: skip
+case(
+    C, "degenerate", "dsm-not-covering", "outside --dsm",
+    [("dsm.tif", _tif_edit(lambda z, t, c: (z[:40, :40], t, c)))],
+)  # fmt: skip
+case(
+    C, "nonfinite", "dsm-all-nan", "dsm",
+    [("dsm.tif", _tif_edit(lambda z, t, c: (z * np.nan, t, c)))],
+)  # fmt: skip
+case(
+    C, "nonfinite", "dsm-nan-under-the-strips", "dsm",
+    [("dsm.tif", _tif_edit(lambda z, t, c: (_nan_middle(z), t, c)))],
+)  # fmt: skip
+case(
+    C, "units", "dsm-heights-in-mm", "dsm",
+    [("dsm.tif", _tif_edit(lambda z, t, c: (z * 1000.0, t, c)))],
+)  # fmt: skip
+case(
+    C, "degenerate", "dsm-rotated", "north-up",
+    [("dsm.tif", _tif_edit(lambda z, t, c: (z, t * t.rotation(10.0), c)))],
+)  # fmt: skip
+case(
+    C, "degenerate", "dsm-south-up", "north-up",
+    [("dsm.tif", _tif_edit(lambda z, t, c: (z, t * t.scale(1.0, -1.0), c)))],
+)  # fmt: skip
+# options
+for o, vals in {
+    "--resolution": ["0", "-1", "nan", "inf", "abc"],
+    "--line-pixels": ["0", "1.5", "abc"],
+    "--max-nav-gap-s": ["0", "-1", "nan"],
+    "--bands": ["red", "-640", "", "640,,460"],
+}.items():
+    for v in vals:
+        case(C, "options", f"{o}={v}", o, argv=opt(o, v))
+case(C, "options", "bands-1200", "--bands 1200", argv=opt("--bands", "640,1200"))
+case(C, "options", "bands-in-um", "--bands", argv=opt("--bands", "0.64,0.55,0.46"))
+case(C, "options", "line-pixels-299", "--line-pixels", argv=opt("--line-pixels", "299"))
+case(C, "degenerate", "resolution-1mm", "--resolution", argv=opt("--resolution", "0.001"))
+case(C, "degenerate", "resolution-1e-9", "--resolution", argv=opt("--resolution", "1e-9"))
+case(C, "degenerate", "resolution-10km", "--resolution", argv=opt("--resolution", "10000"))
+case(C, "options", "scheduler-not-an-address", "--scheduler", argv=opt("--scheduler", "nowhere"))
+case(C, "options", "scheduler-bad-port", "--scheduler", argv=opt("--scheduler", "tcp://x:port"))
+for o in ("--trajectory", "--camera", "--dsm", "-o"):
+    case(C, "options", f"no-{o}", o, argv=opt(o))
+case(C, "options", "no-lines", "LINES", argv=lambda a, d: [a[0], *a[3:]])
+case(C, "options", "unknown-option", "--dem", argv=flag("--dem", "x.tif"))
+# outputs
+for name in ("s1.nc", "nav.csv", "camera.toml", "dsm.tif", "result.json"):
+    case(
+        C,
+        "output",
+        f"output-is-{name}",
+        name,
+        argv=lambda a, d, n=name: opt("-o", str(d / n))(a, d),
+    )
+case(
+    C, "output", "output-is-dsm-overwrite", "dsm.tif",
+    argv=lambda a, d: flag("--overwrite")(opt("-o", str(d / "dsm.tif"))(a, d), d),
+)  # fmt: skip
+case(C, "output", "output-exists", "--overwrite", argv=lambda a, d: _touch_output(a, d))
+case(C, "output", "output-nc", "mosaic.tif", argv=_out("mosaic.nc"))
+case(C, "output", "output-no-extension", "mosaic.tif", argv=_out("mosaic"))
+case(C, "output", "output-dir-missing", "does-not-exist", argv=_out("does-not-exist/m.tif"))
+case(C, "output", "output-is-directory", "folder", argv=_out("./"))
+case(C, "output", "output-dir-readonly", "writ", argv=lambda a, d: _readonly_tif(a, d))
+
+
+def _drop_attr_lp(ds, a):
+    ds.attrs.pop(a, None)
+    return ds
+
+
+def _readonly_tif(a, d):
+    ro = d.parent / "readonly"
+    ro.mkdir()
+    ro.chmod(0o555)
+    return opt("-o", str(ro / "m.tif"))(a, d)
+
+
+def _nan_middle(z):
+    z = z.copy()
+    n, m = z.shape
+    z[n // 2 - 20 : n // 2 + 20, :] = np.nan
+    return z
+
+
 # ---------------------------------------------------------------------------------------------
 # running
 
@@ -1920,6 +2223,18 @@ BENIGN = [
     ("geocode", "reordered-nav", [("nav.csv", _reorder)], None),
     ("geocode", "extra-column-nav", [("nav.csv", _extra_column)], None),
     ("geocode", "dem", [], _dem),
+    (
+        "orthomosaic",
+        "crlf-bom-nav-json",
+        [("nav.csv", _crlf), ("camera.toml", _bom)],
+        flag("--json"),
+    ),
+    (
+        "orthomosaic",
+        "overwrite-existing",
+        [],
+        lambda a, d: flag("--overwrite")(_touch_output(a, d), d),
+    ),
     (
         "geocode",
         "envi-and-overwrite",

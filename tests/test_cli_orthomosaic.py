@@ -129,3 +129,15 @@ def test_overwrite_replaces(adjusted, tmp_path, capsys):
 
     with rasterio.open(out) as src:
         assert src.count == 1 and src.descriptions == ("640 nm",)
+
+
+def test_a_failed_scheduler_leaves_no_default_client(adjusted, tmp_path, capsys):
+    """A --scheduler that does not answer is refused, and the next mosaic in the same process
+    is computed here (a failed Client made the default made every later compute wait on it)."""
+    from distributed.client import _get_global_client
+
+    _, f = adjusted
+    assert main(_argv(f, tmp_path / "a.tif", "--scheduler", "nowhere", "--bands", "640")) == 2
+    assert "--scheduler nowhere" in capsys.readouterr().err
+    assert _get_global_client() is None
+    assert main(_argv(f, tmp_path / "b.tif", "--bands", "640", "--resolution", "1")) == 0

@@ -324,6 +324,7 @@ def orthomosaic(
     tile_px: int = 512,
     lines_per_block: int = 256,
     radius_m: float | None = None,
+    max_gib: float | None = None,
 ):
     """The orthomosaic of strips of any scanning sensor: a Dask-backed DataArray with a CRS.
 
@@ -345,6 +346,10 @@ def orthomosaic(
     radius_m : float, optional
         Radius of influence; default 0.55 × the diagonal of the largest ground pixel spacing
         plus half a cell (cells outside every swath stay NaN).
+    max_gib : float, optional
+        The largest mosaic (GiB of float32) built on ``resolution_m``; a larger one (cells far
+        finer than the ground pixels), or one a single cell wide, is refused
+        (:class:`~hsgeo.InputError`). Default: no size limit.
 
     Returns
     -------
@@ -370,10 +375,31 @@ def orthomosaic(
             raise InputError("give the output grid or its resolution_m")
         allb = np.concatenate([f[1] for f in foot])
         grid = MapGrid.covering(allb[:, [0, 2]].ravel(), allb[:, [1, 3]].ravel(), resolution_m, crs)
+        _check_size(grid, n_bands, spacing, max_gib)
     if radius_m is None:
         radius_m = 0.55 * np.hypot(spacing, spacing) + 0.5 * grid.resolution_m
     data = _mosaic_array(strips, foot, grid, terrain, frame, radius_m, tile_px, lines_per_block)
     return _as_dataarray(data, grid, strips, band_names, wavelength_nm, radius_m)
+
+
+def _check_size(grid: MapGrid, n_bands: int, spacing_m: float, max_gib: float | None) -> None:
+    """Refuse a mosaic of more than ``max_gib`` GiB of float32 (None: any size), or of a
+    single row or column of cells (a resolution coarser than the strips' extent).
+    """
+    gib = float(grid.width) * grid.height * n_bands * 4 / 2**30
+    if min(grid.width, grid.height) < 2:
+        raise InputError(
+            f"--resolution {grid.resolution_m:g} m: the mosaic would be {grid.width} x "
+            f"{grid.height} cells, coarser than the strips' extent; give a finer --resolution "
+            f"(the strips' ground pixels are {spacing_m:.2g} m apart)"
+        )
+    if max_gib is not None and gib > max_gib:
+        raise InputError(
+            f"--resolution {grid.resolution_m:g} m: the mosaic would be {grid.width} x "
+            f"{grid.height} cells x {n_bands} band(s) ({gib:.3g} GiB of float32), over "
+            f"{max_gib:g} GiB; give a coarser --resolution (the strips' ground pixels are "
+            f"{spacing_m:.2g} m apart)"
+        )
 
 
 def _mosaic_array(strips, foot, grid, terrain, frame, radius_m, tile_px, lines_per_block):

@@ -354,31 +354,76 @@ def read_adjustment(path) -> dict:
         ``t_nodes_s`` (n_nodes,), ``nodes`` (n_nodes, 6) in m and rad, ``node_columns``.
     """
     text = read_text(path, "--adjustment file", "JSON")
+    where = f"--adjustment {str(path)!r}"
     try:
         d = json.loads(text)
         par, nodes = d["parameters"], d["nodes"]
-        out = {
-            "boresight_rad": np.radians(np.asarray(par["boresight_deg"]["value"], float)),
-            "lever_arm_m": np.asarray(par["lever_arm_m"]["value"], float),
-            "distortion": np.asarray(par["distortion"]["value"], float),
-            "c_mm": np.atleast_1d(np.asarray(par["c_mm"]["value"], float)),
-            "t_nodes_s": np.asarray(nodes["t_s"], float),
-            "nodes": np.asarray(nodes["value"], float),
-            "node_columns": tuple(nodes["columns"]),
-        }
+        columns = tuple(nodes["columns"])
     except (ValueError, KeyError, TypeError) as exc:
         raise InputError(
-            f"--adjustment {str(path)!r}: not the JSON of `hsgeo adjust-pushbroom --json` "
+            f"{where}: not the JSON of `hsgeo adjust-pushbroom --json` "
             f"({type(exc).__name__}: {exc}); give that command's output"
         ) from None
-    shapes = {"boresight_rad": (3,), "lever_arm_m": (3,), "distortion": (4,)}
+    keys = {
+        "boresight_rad": ("parameters.boresight_deg.value", lambda: par["boresight_deg"]["value"]),
+        "lever_arm_m": ("parameters.lever_arm_m.value", lambda: par["lever_arm_m"]["value"]),
+        "distortion": ("parameters.distortion.value", lambda: par["distortion"]["value"]),
+        "c_mm": ("parameters.c_mm.value", lambda: par["c_mm"]["value"]),
+        "t_nodes_s": ("nodes.t_s", lambda: nodes["t_s"]),
+        "nodes": ("nodes.value", lambda: nodes["value"]),
+    }
+    out = {k: _adjustment_array(where, key, get) for k, (key, get) in keys.items()}
+    out["boresight_rad"] = np.radians(out["boresight_rad"])
+    out["c_mm"] = np.atleast_1d(out["c_mm"])
+    out["node_columns"] = columns
+    _check_adjustment(where, out)
+    return out
+
+
+def _adjustment_array(where: str, key: str, get) -> np.ndarray:
+    """One array of the adjust-pushbroom result, finite, or an error naming its key."""
+    try:
+        a = np.asarray(get(), dtype=float)
+    except (ValueError, KeyError, TypeError) as exc:
+        raise InputError(
+            f"{where}: {key} is missing or not numbers ({type(exc).__name__}: {exc}); give the "
+            "output of `hsgeo adjust-pushbroom --json`"
+        ) from None
+    if not np.all(np.isfinite(a)):
+        raise InputError(
+            f"{where}: {key} holds NaN or inf; the adjustment did not give finite values, rerun "
+            "hsgeo adjust-pushbroom"
+        )
+    return a
+
+
+#: The largest node correction taken as one (m; rad): beyond, the file is not a correction of
+#: a GNSS/INS solution (adjust-pushbroom's corrections are metres and hundredths of a degree).
+MAX_NODE_CORRECTION = (1000.0, 1.0)
+
+
+def _check_adjustment(where: str, out: dict) -> None:
+    shapes = {"boresight_deg": (3,), "lever_arm_m": (3,), "distortion": (4,)}
     for k, shp in shapes.items():
-        if out[k].shape != shp:
-            raise InputError(f"--adjustment {str(path)!r}: {k} must have {shp[0]} values")
+        if out[k.replace("_deg", "_rad")].shape != shp:
+            raise InputError(f"{where}: parameters.{k}.value must have {shp[0]} values")
+    if np.any(np.abs(out["boresight_rad"]) > np.pi) or np.any(np.abs(out["lever_arm_m"]) > 100):
+        raise InputError(
+            f"{where}: boresight_deg beyond ±180° or lever_arm_m beyond ±100 m; give the output "
+            "of `hsgeo adjust-pushbroom --json` (degrees, metres)"
+        )
+    if np.any(out["c_mm"] <= 0):
+        raise InputError(f"{where}: c_mm must be positive (mm), got {out['c_mm'].tolist()}")
     n = out["t_nodes_s"].size
     if n < 4 or out["nodes"].shape != (n, len(out["node_columns"])):
         raise InputError(
-            f"--adjustment {str(path)!r}: nodes.value must be ({n}, "
-            f"{len(out['node_columns'])}) for {n} node times"
+            f"{where}: nodes.value must be ({n}, "
+            f"{len(out['node_columns'])}) for {n} node times (at least 4)"
         )
-    return out
+    big = np.abs(out["nodes"][:, :3]).max() > MAX_NODE_CORRECTION[0]
+    if big or np.abs(out["nodes"][:, 3:]).max() > MAX_NODE_CORRECTION[1]:
+        raise InputError(
+            f"{where}: nodes.value holds corrections beyond {MAX_NODE_CORRECTION[0]:g} m or "
+            f"{MAX_NODE_CORRECTION[1]:g} rad, not those of a GNSS/INS solution; give the output "
+            "of `hsgeo adjust-pushbroom --json` for this flight"
+        )

@@ -13,6 +13,7 @@ are computed on that ``dask.distributed`` cluster.
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -41,14 +42,21 @@ SCHEDULER_TIMEOUT_S = 10.0
 TRUE_COLOUR_NM = (640.0, 550.0, 460.0)
 
 
+#: The largest mosaic built, GiB of float32 (a --resolution far finer than the ground pixels).
+MAX_MOSAIC_GIB = 64.0
+
+
 @dataclass(frozen=True)
 class MosaicOptions:
-    """Cell size (m), output tile (cells), lines per geolocated block, the local frame."""
+    """Cell size (m), output tile (cells), lines per geolocated block, the local frame, the
+    largest mosaic (GiB of float32).
+    """
 
     resolution_m: float = 0.3
     tile_px: int = 512
     lines_per_block: int = 256
     frame: object = SITE_AAS
+    max_gib: float = MAX_MOSAIC_GIB
 
 
 @dataclass(frozen=True)
@@ -73,6 +81,7 @@ def build_mosaic(inputs: MosaicInputs, options: MosaicOptions = MosaicOptions())
         wavelength_nm=list(inputs.wavelength_nm) or None,
         tile_px=options.tile_px,
         lines_per_block=options.lines_per_block,
+        max_gib=options.max_gib,
     )
 
 
@@ -118,7 +127,13 @@ def adjusted_camera(prior, adjustment=None):
 
     if adjustment is None:
         return prior
-    c = np.broadcast_to(adjustment["c_mm"], (len(prior.c_mm),))
+    n = len(prior.c_mm)
+    if adjustment["c_mm"].size not in (1, n):
+        raise InputError(
+            f"--adjustment: {adjustment['c_mm'].size} values of c_mm for a camera of {n} bands "
+            "(--camera n_bands); give the adjustment of this camera"
+        )
+    c = np.broadcast_to(adjustment["c_mm"], (n,))
     return replace(
         prior,
         c_mm=tuple(float(v) for v in c),
@@ -183,6 +198,11 @@ def lp_mosaic_strips(lps, camera, trajectory, bands_nm, n_px_full: int, names=No
             idx = select_bands(wl, bands_nm, who)
         elif lp.wavelengths_nm.shape != wl.shape or not np.allclose(lp.wavelengths_nm, wl):
             raise InputError(f"LINES {who}: its bands differ from those of {first}")
+        if len(camera.c_mm) != wl.size:
+            raise InputError(
+                f"LINES {who} has {wl.size} bands, the camera (--camera n_bands) "
+                f"{len(camera.c_mm)}: give the camera TOML of the camera that recorded the lines"
+            )
         band = min(idx[len(idx) // 2], len(camera.c_mm) - 1)  # the middle band's geometry
         x = lp.x_px(n_px_full)
         px = np.column_stack([x, np.zeros_like(x)])
@@ -198,7 +218,23 @@ def _trajectory(trajectory, adjustment):
     return adjusted_trajectory(read_trajectory(trajectory), adjustment)
 
 
-def _strips(lines, nav, cam, bands_nm, max_nav_gap_s, trajectory, line_pixels):
+def _check_nodes_cover(adjustment, lines, lps) -> None:
+    """Every strip's lines within one node interval of the adjustment's node span (outside it
+    the correction is held at its end value: a result of another flight would pass silently).
+    """
+    t = adjustment["t_nodes_s"]
+    dt = float(t[2] - t[1])
+    lo, hi = float(t[1]) - dt, float(t[-2]) + dt
+    for path, lp in zip(lines, lps, strict=True):
+        if lp.t_s[0] < lo or lp.t_s[-1] > hi:
+            raise InputError(
+                f"the lines of {str(path)!r} (t_s {lp.t_s[0]:.6g}…{lp.t_s[-1]:.6g} s) lie outside "
+                f"the node times of --adjustment ({t[1]:.6g}…{t[-2]:.6g} s): give the "
+                "adjustment of this flight (adjust-pushbroom on observations of these strips)"
+            )
+
+
+def _strips(lines, nav, cam, bands_nm, max_nav_gap_s, trajectory, line_pixels, adjustment):
     from hsgeo.io.lp_lines import full_line_px, open_lp_lines
     from hsgeo.validate import check_navigation_covers
 
@@ -212,6 +248,8 @@ def _strips(lines, nav, cam, bands_nm, max_nav_gap_s, trajectory, line_pixels):
             used=f"the lines of {str(path)!r} (t_s)",
             max_gap_s=max_nav_gap_s,
         )
+    if adjustment is not None:
+        _check_nodes_cover(adjustment, lines, lps)
     strips, wl = lp_mosaic_strips(lps, cam, nav, bands_nm, n_px_full, names=lines)
     return strips, wl, n_px_full
 
@@ -249,6 +287,7 @@ def orthomosaic_files(
     lines = list(lines)
     if not lines:
         raise InputError("give at least one LINES file")
+    _check_distinct(lines)
     if not (np.isfinite(resolution_m) and resolution_m > 0):
         raise InputError(f"--resolution must be a positive number of metres, got {resolution_m}")
     inputs = [*lines, trajectory, camera, dsm, adjustment]
@@ -259,18 +298,16 @@ def orthomosaic_files(
     nav = _trajectory(trajectory, adj)
     z, grid = read_dsm(dsm)
     terrain = MapTerrain(z, grid, opts.frame, source=f"--dsm {str(dsm)!r}")
-    strips, wl, n_px_full = _strips(lines, nav, cam, bands, max_nav_gap_s, trajectory, line_pixels)
+    strips, wl, n_px_full = _strips(
+        lines, nav, cam, bands, max_nav_gap_s, trajectory, line_pixels, adj
+    )
     names = [f"{w:g} nm" for w in wl]
     try:
         mosaic = build_mosaic(MosaicInputs(tuple(strips), terrain, tuple(names), tuple(wl)), opts)
     except ObservationError as exc:
         raise InputError(str(exc)) from None
-    client = _client(scheduler)
-    try:
+    with _client(scheduler):
         write_cog(mosaic, output, overwrite=overwrite, inputs=inputs, progress=progress)
-    finally:
-        if client is not None:
-            client.close()
     x, y = mosaic["x"].values, mosaic["y"].values
     return {
         "output": str(output),
@@ -288,16 +325,43 @@ def orthomosaic_files(
     }
 
 
+def _check_distinct(lines) -> None:
+    """No LINES file given twice (it would be mosaicked twice, silently)."""
+    from pathlib import Path
+
+    seen = {}
+    for p in lines:
+        key = Path(p).resolve()
+        if key in seen:
+            raise InputError(
+                f"LINES {str(p)!r} is given twice (also as {str(seen[key])!r}); give each strip "
+                "once"
+            )
+        seen[key] = p
+
+
+@contextmanager
 def _client(scheduler):
-    """A ``dask.distributed`` client of the scheduler at ``scheduler`` (None: threads here)."""
+    """The tiles computed on the ``dask.distributed`` scheduler at ``scheduler`` (None: threads
+    here) while the context lasts. The client is not made the process's default: a failed
+    ``Client(..., set_as_default=True)`` stays registered, and every later compute in the
+    process would wait on a scheduler that is not there.
+    """
     if scheduler is None:
-        return None
+        yield None
+        return
+    import dask
     from distributed import Client
 
     try:
-        return Client(scheduler, timeout=f"{SCHEDULER_TIMEOUT_S}s", set_as_default=True)
+        client = Client(scheduler, timeout=f"{SCHEDULER_TIMEOUT_S}s", set_as_default=False)
     except (OSError, TimeoutError, ValueError) as exc:
         raise InputError(
             f"--scheduler {scheduler}: no dask scheduler answers there ({type(exc).__name__}); "
             "start one (dask scheduler; dask worker ADDRESS) or leave the option out"
         ) from None
+    try:
+        with dask.config.set(scheduler=client.get):
+            yield client
+    finally:
+        client.close()
