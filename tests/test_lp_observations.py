@@ -334,8 +334,9 @@ def test_bad_retrievals(campaign):
 
 def test_one_band_per_feature_keeps_one_tie_point_of_coinciding_bands(retrieved):
     """A feature found in several bands is several tie points whose observations coincide
-    (same strip, line and pixel): the adjustment's table keeps one per feature, the one seen in
-    most strips, and no two of its tie points then coincide; every band's stay in all_bands."""
+    (same strip, line and pixel): the adjustment's table keeps one per feature, the one whose
+    matches have the smallest mean Hamming distance (recomputed here from the matches table),
+    and no two of its tie points then coincide; every band's stay in all_bands."""
     allb, tab = retrieved.all_bands, retrieved.table
     ties = allb[allb["feature"] >= 0]
     kept = ties[ties["adjusted"]]
@@ -345,9 +346,12 @@ def test_one_band_per_feature_keeps_one_tie_point_of_coinciding_bands(retrieved)
         == kept["feature"].nunique()
         == retrieved.counts["all"]["features"]
     )
-    n_obs = ties.groupby("point_id").size()
-    best = ties.groupby("feature")["point_id"].agg(lambda p: n_obs[p.unique()].max())
-    assert (kept.groupby("feature")["point_id"].first().map(n_obs) == best).all()
+    m = retrieved.matches
+    m = m[m["kept"] & (m["point"] >= 0)]
+    ham = m.groupby("point")["hamming"].mean()
+    ham.index = [f"tp{p:07d}" for p in ham.index]
+    best = ties.groupby("feature")["point_id"].agg(lambda p: ham[p.unique()].min())
+    assert np.allclose(kept.groupby("feature")["point_id"].first().map(ham), best)
     # no two kept tie points share an observation's strip, line and pixel
     t = tab[tab["point_id"].str.startswith("tp")]
     assert not t.duplicated(["strip", "line", "x_px"]).any()
@@ -369,3 +373,8 @@ def test_one_band_per_feature_groups_within_a_pixel():
     assert len(set(feature.tolist())) == 3
     with pytest.raises(InputError, match="tol_px"):
         one_band_per_feature(point, strip, line, x, tol_px=2.5)
+    # a score decides before the number of observations: 2 scores lower than 3
+    keep, _ = one_band_per_feature(point, strip, line, x, score=[1.0, 0.5, 0.2, 0.3, 9.0])
+    assert keep.tolist() == [False, True, True, False, True]
+    with pytest.raises(InputError, match="score"):
+        one_band_per_feature(point, strip, line, x, score=[1.0, 2.0])

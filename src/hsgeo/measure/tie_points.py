@@ -145,9 +145,10 @@ def link_tie_points(
     }
 
 
-def one_band_per_feature(point, strip, line, x_px, *, tol_px: float = 1.0):
+def one_band_per_feature(point, strip, line, x_px, *, score=None, tol_px: float = 1.0):
     """One tie point per ground feature: of the tie points (each in one band) whose
-    observations coincide, the one with the most observations (module docstring).
+    observations coincide, the one with the lowest ``score`` (then the most observations;
+    module docstring).
 
     Two tie points are the same feature when an observation of one and an observation of the
     other lie in the same line of the same strip within ``tol_px`` along it (the band's own
@@ -162,13 +163,17 @@ def one_band_per_feature(point, strip, line, x_px, *, tol_px: float = 1.0):
         Strip and line (within the strip) of each observation.
     x_px : (m,) array_like, px
         Position along the line.
+    score : (n_points,) array_like, optional
+        Per tie point, lower is better (e.g. the mean Hamming distance of its matches: the
+        band whose descriptors agree best between strips); default: all equal.
     tol_px : float
         Largest distance along the line of two coinciding observations (< 2).
 
     Returns
     -------
     keep : (n_points,) bool ndarray
-        The tie point kept for its feature (ties: the lowest index).
+        The tie point kept for its feature (ties: the most observations, then the lowest
+        index).
     feature : (n_points,) int ndarray
         Feature of each tie point (0 … n_features − 1).
     """
@@ -203,7 +208,10 @@ def one_band_per_feature(point, strip, line, x_px, *, tol_px: float = 1.0):
     feature = components(max(n, 1), pnt[head[ok]], pnt[ok])[:n]
     _, feature = np.unique(feature, return_inverse=True)
     n_obs = np.bincount(point, minlength=n)
-    order = np.lexsort((np.arange(n), -n_obs, feature))
+    score = np.zeros(n) if score is None else np.asarray(score, dtype=np.float64)
+    if score.shape != (n,) or np.isnan(score).any():
+        raise InputError(f"score needs one number per tie point ({n}), not NaN")
+    order = np.lexsort((np.arange(n), -n_obs, score, feature))
     first = np.r_[True, feature[order][1:] != feature[order][:-1]] if n else np.zeros(0, bool)
     keep = np.zeros(n, bool)
     keep[order[first]] = True

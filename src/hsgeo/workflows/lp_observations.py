@@ -31,10 +31,12 @@ The user's pipeline, truth-free (002 §3.1 steps 2–3, and the reference square
    line (``y_px = 0``, the line's ``t_s``). Matching is within a band, so a feature found in k
    bands is k tie points whose observations coincide (the same line and pixel): one
    measurement repeated, with one line rounding. The adjustment gets one of them
-   (:func:`hsgeo.measure.tie_points.one_band_per_feature`: the one seen in most strips;
-   ``one_band_per_feature``); taken as k independent tie points they make σ̂ too small (the
-   chapter measures by how much). Every band's observations stay in ``LpResult.all_bands``,
-   and the counts (002's observations per band and scene length) are of those.
+   (:func:`hsgeo.measure.tie_points.one_band_per_feature`: the one whose matches have the
+   smallest mean Hamming distance, the band whose descriptors agree best between strips;
+   ``one_band_per_feature``). Taken as k independent tie points they make σ̂ too small, and
+   the chapter measures by how much, and how accurate the kept band is. Every band's
+   observations stay in ``LpResult.all_bands``, and the counts (002's observations per band
+   and scene length) are of those.
 6. **Reference squares** (optional): each square's centre measured in every scene that should
    see it (:func:`hsgeo.measure.targets_lp.square_centroid`), back to line and x, with the
    square's id. Sub-pixel in both: a centroid measures the centre, not a pixel, so x is its
@@ -402,7 +404,8 @@ def retrieve(inputs: LpInputs, options: LpOptions = LpOptions(), progress=None) 
             f"{len(rows['pairs'])} scene pairs; give more overlapping strips, or scenes with "
             "texture in these bands (--bands)"
         )
-    all_bands = _table(inputs, options, keys, point, rows["squares"])
+    score = _mean_hamming(point, m, kept)
+    all_bands = _table(inputs, options, keys, point, rows["squares"], score)
     table = all_bands.loc[all_bands["adjusted"].to_numpy(), list(TABLE_COLUMNS)]
     table = table.reset_index(drop=True)
     matches = _matches_frame(inputs, keys, m, kept, point)
@@ -419,7 +422,19 @@ def _observation_x(x, options, n_px_full):
     return np.floor(np.asarray(x, float) + h + 0.5) - h
 
 
-def _table(inputs, options, keys, point, square_rows):
+def _mean_hamming(point, m, kept) -> np.ndarray:
+    """Per tie point, the mean Hamming distance of the surviving matches that made it (the
+    feature's band whose descriptors agree best between strips scores lowest).
+    """
+    n = int(point.max()) + 1 if point.size else 0
+    a, b, h = m["a"][kept], m["b"][kept], np.asarray(m["hamming"], float)[kept]
+    same = (point[a] >= 0) & (point[a] == point[b])
+    p = point[a][same]
+    c = np.bincount(p, minlength=n)
+    return np.where(c > 0, np.bincount(p, h[same], minlength=n) / np.maximum(c, 1), np.inf)
+
+
+def _table(inputs, options, keys, point, square_rows, score):
     """Every band's observations: tie points then squares (:data:`TABLE_COLUMNS`, ``feature``,
     ``adjusted``: one band per feature, or all, :attr:`LpOptions.one_band_per_feature`).
     """
@@ -429,7 +444,9 @@ def _table(inputs, options, keys, point, square_rows):
     obs = np.flatnonzero(point >= 0)
     obs = obs[np.lexsort((keys.strip[obs], point[obs]))]
     x = _observation_x(keys.x[obs], options, inputs.n_px_full)
-    keep, feature = one_band_per_feature(point[obs], keys.strip[obs], keys.line[obs], x)
+    keep, feature = one_band_per_feature(
+        point[obs], keys.strip[obs], keys.line[obs], x, score=score
+    )
     if not options.one_band_per_feature:
         keep[:] = True
     ties = pd.DataFrame(
