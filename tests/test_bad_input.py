@@ -1942,6 +1942,10 @@ case(C, "binary", "adjustment-binary", R, [(R, text(BINARY))])
 case(C, "mistyped", "adjustment-a-list", R, [(R, text("[1, 2, 3]\n"))])
 case(C, "mistyped", "adjustment-is-toml", R, [(R, copy_from("camera.toml"))])
 case(C, "mistyped", "adjustment-no-nodes", "nodes", [(R, _json_edit(lambda d: d.pop("nodes")))])
+case(
+    C, "degenerate", "adjustment-not-converged", "did not converge",
+    [(R, _json_edit(lambda d: d.update(converged=False)))],
+)  # fmt: skip
 for path, value, kind, expect in [
     ("parameters.boresight_deg.value", [0.0, 0.0], "type", "boresight"),
     ("parameters.boresight_deg.value", [0.0, "a", 0.0], "type", "boresight"),

@@ -352,6 +352,12 @@ def read_adjustment(path) -> dict:
     dict
         ``boresight_rad`` (3,), ``lever_arm_m`` (3,), ``distortion`` (4,), ``c_mm`` (n,),
         ``t_nodes_s`` (n_nodes,), ``nodes`` (n_nodes, 6) in m and rad, ``node_columns``.
+
+    Raises
+    ------
+    InputError
+        Not that command's JSON, a key missing or not finite, values beyond a correction, or
+        an adjustment that did not converge (``"converged": false``).
     """
     text = read_text(path, "--adjustment file", "JSON")
     where = f"--adjustment {str(path)!r}"
@@ -364,6 +370,12 @@ def read_adjustment(path) -> dict:
             f"{where}: not the JSON of `hsgeo adjust-pushbroom --json` "
             f"({type(exc).__name__}: {exc}); give that command's output"
         ) from None
+    if d.get("converged", True) is not True:
+        raise InputError(
+            f"{where}: the adjustment did not converge (converged: {d.get('converged')!r}), so "
+            "its camera and node corrections are not a solution; rerun hsgeo adjust-pushbroom "
+            "until it converges (its fit verdict names the likely causes) and give that output"
+        )
     keys = {
         "boresight_rad": ("parameters.boresight_deg.value", lambda: par["boresight_deg"]["value"]),
         "lever_arm_m": ("parameters.lever_arm_m.value", lambda: par["lever_arm_m"]["value"]),
