@@ -82,8 +82,23 @@ def scene(n_lines: int, n_px: int = 900):
     return strips, terrain, F
 
 
-def _in_memory(strips, terrain, frame):
+def _ground(s, terrain):
+    """Every pixel's ground point of one strip (hsgeo.geocode.geocode_image, band 0)."""
     from hsgeo.geocode import geocode_image
+
+    return geocode_image(
+        s.trajectory,
+        s.sensor,
+        s.n_lines,
+        s.pixels,
+        t0_s=s.t_s[0],
+        line_rate_hz=1.0 / (s.t_s[1] - s.t_s[0]),
+        terrain=terrain,
+        band=0,
+    )
+
+
+def _in_memory(strips, terrain, frame):
     from hsgeo.ortho import MapGrid, resample_swath, strip_footprints
 
     allb = np.concatenate(
@@ -93,16 +108,7 @@ def _in_memory(strips, terrain, frame):
     best = np.full((3, grid.height, grid.width), np.nan, np.float32)
     rank = np.full((grid.height, grid.width), np.inf)
     for s in strips:
-        g = geocode_image(
-            s.trajectory,
-            s.sensor,
-            s.n_lines,
-            s.pixels,
-            t0_s=s.t_s[0],
-            line_rate_hz=1.0 / (s.t_s[1] - s.t_s[0]),
-            terrain=terrain,
-            band=0,
-        )
+        g = _ground(s, terrain)
         lon, lat, _ = frame.enu_to_lonlat(g[..., 0], g[..., 1], g[..., 2])
         o, d = s.sensor.rays(
             np.tile(s.pixels, (s.n_lines, 1)),
@@ -149,20 +155,11 @@ def _chunked(strips, terrain, frame, scheduler):
 
 
 def _ckdtree(strips, terrain):
-    from hsgeo.geocode import geocode_image, orthorectify
+    from hsgeo.geocode import orthorectify
 
     cells = 0
     for s in strips:
-        g = geocode_image(
-            s.trajectory,
-            s.sensor,
-            s.n_lines,
-            s.pixels,
-            t0_s=s.t_s[0],
-            line_rate_hz=1.0 / (s.t_s[1] - s.t_s[0]),
-            terrain=terrain,
-            band=0,
-        )
+        g = _ground(s, terrain)
         da = orthorectify(np.moveaxis(np.asarray(s.values), -1, 0), g, resolution_m=0.3)
         cells += da.sizes["N"] * da.sizes["E"]
     return cells

@@ -190,20 +190,23 @@ def test_orthorectify_places_pixels_where_they_belong():
     assert np.max(np.abs(da.values[1][ok] - N[ok])) < 1.5
 
 
-def test_geocode_command_end_to_end(tmp_path):
-    from hsgeo.cli import main
-    from hsgeo.io import read_envi
-
+def _geocode_setup(tmp_path, n_lines: int) -> tuple:
+    """A straight north-bound line of ``n_lines`` lines whose every pixel records its own east
+    coordinate, its navigation and the 000 calibrated sensor written to ``tmp_path``; the
+    ``hsgeo geocode`` command line (height 3 m, NetCDF and ENVI outputs, quiet), the
+    navigation and the pixels' ζ."""
     nav = straight_nav(heading_deg=0.0, T=10.0)
     write_trajectory(tmp_path / "nav.csv", nav)
     zeta = np.arange(200.0, 800.0, 2.0)
-    g = geocode_image(nav, CAL, 80, zeta, t0_s=0.0, line_rate_hz=8.0, terrain=PlaneTerrain(3.0))
+    g = geocode_image(
+        nav, CAL, n_lines, zeta, t0_s=0.0, line_rate_hz=8.0, terrain=PlaneTerrain(3.0)
+    )
     write_lines(tmp_path / "lines.nc", g[..., 0], zeta, t0_s=0.0, line_rate_hz=8.0)
     (tmp_path / "sensor.toml").write_text(
         "[sensor]\nmodel = 'calibrated'\nzeta0_px = 486.8\nc_px = 3539.0\n"
         "K = [1.459, -0.1636, 0.00526]\n"
     )
-    rc = main(
+    return (
         [
             "geocode",
             str(tmp_path / "lines.nc"),
@@ -218,8 +221,18 @@ def test_geocode_command_end_to_end(tmp_path):
             "--envi",
             str(tmp_path / "o_envi"),
             "--quiet",
-        ]
+        ],
+        nav,
+        zeta,
     )
+
+
+def test_geocode_command_end_to_end(tmp_path):
+    from hsgeo.cli import main
+    from hsgeo.io import read_envi
+
+    argv, nav, zeta = _geocode_setup(tmp_path, n_lines=80)
+    rc = main(argv)
     assert rc == 0
     ds = xr.open_dataset(tmp_path / "o.nc")
     E = np.broadcast_to(ds["E"].values, ds["radiance"].shape[1:])
@@ -347,32 +360,7 @@ def test_geocode_outputs_carry_the_local_frame_crs(tmp_path):
     from hsgeo.cli import main
     from hsgeo.crs import LocalFrame, lonlat_to_crs
 
-    nav = straight_nav(heading_deg=0.0, T=10.0)
-    write_trajectory(tmp_path / "nav.csv", nav)
-    zeta = np.arange(200.0, 800.0, 2.0)
-    g = geocode_image(nav, CAL, 40, zeta, t0_s=0.0, line_rate_hz=8.0, terrain=PlaneTerrain(3.0))
-    write_lines(tmp_path / "lines.nc", g[..., 0], zeta, t0_s=0.0, line_rate_hz=8.0)
-    (tmp_path / "sensor.toml").write_text(
-        "[sensor]\nmodel = 'calibrated'\nzeta0_px = 486.8\nc_px = 3539.0\n"
-        "K = [1.459, -0.1636, 0.00526]\n"
-    )
-    argv = [
-        "geocode",
-        str(tmp_path / "lines.nc"),
-        "--trajectory",
-        str(tmp_path / "nav.csv"),
-        "--sensor",
-        str(tmp_path / "sensor.toml"),
-        "--height",
-        "3",
-        "-o",
-        str(tmp_path / "o.nc"),
-        "--envi",
-        str(tmp_path / "o_envi"),
-        "--quiet",
-        "--site",
-        "45.0,13.9,20",
-    ]
+    argv = [*_geocode_setup(tmp_path, n_lines=40)[0], "--site", "45.0,13.9,20"]
     assert main(argv) == 0
     frame = LocalFrame(45.0, 13.9, 20.0)
     from pyproj import CRS

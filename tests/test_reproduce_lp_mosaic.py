@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from hsgeo.reproduce.lp_mosaic import TABLE, fig9
-from hsgeo.reproduce.lp_runs import camera_prior
+from hsgeo.reproduce.lp_runs import camera_prior, retrieval_inputs
 
 SCALE = 0.1
 SEEDS = (2, 3, 5)
@@ -15,19 +15,10 @@ SEEDS = (2, 3, 5)
 
 def _adjusted(obs, truth, seed):
     """Retrieve the observations from the pixels and adjust them with the GCPs found."""
-    from hsgeo.workflows.lp_observations import LpInputs, LpOptions, retrieve, to_pushbroom_inputs
+    from hsgeo.workflows.lp_observations import LpOptions, retrieve, to_pushbroom_inputs
     from hsgeo.workflows.pushbroom_ba import PushbroomOptions, adjust_pushbroom
 
-    inp = LpInputs(
-        tuple(obs.strips),
-        obs.navigation,
-        obs.camera,
-        tuple(obs.square_ids),
-        obs.square_xyz_m,
-        None,
-        obs.n_px_full,
-    )
-    res = retrieve(inp, LpOptions(rng=seed))
+    res = retrieve(retrieval_inputs(obs), LpOptions(rng=seed))
     prior = camera_prior(obs, truth.cfg)  # the operator's a-priori knowledge, as the chapter's
     found = set(res.table["point_id"].astype(str))
     gcp = [g for g in obs.gcp_ids if g in found]
