@@ -153,7 +153,11 @@ def one_band_per_feature(point, strip, line, x_px, *, score=None, tol_px: float 
     Two tie points are the same feature when an observation of one and an observation of the
     other lie in the same line of the same strip within ``tol_px`` along it (the band's own
     principal distance moves a feature by a pixel or less near the line's ends); the relation
-    is closed transitively (connected components).
+    is closed transitively (connected components). The pairs are found through bins of width
+    2·``tol_px`` (and the same bins shifted by ``tol_px``), each observation linked to the
+    first of its bin: on the pixel-centre grid that is every pair within ``tol_px``; with
+    sub-pixel x a pair within ``tol_px`` whose bins' first observations are farther may stay
+    unlinked unless a third observation links them.
 
     Parameters
     ----------
@@ -196,12 +200,12 @@ def one_band_per_feature(point, strip, line, x_px, *, score=None, tol_px: float 
         cells.append(np.column_stack([strip, line, b, np.full_like(b, int(shift > 0))]))
     _, cell = np.unique(np.concatenate(cells), axis=0, return_inverse=True)
     cell = cell.ravel()
-    near = np.r_[point, point]
+    point2 = np.r_[point, point]  # the tie point of each bin entry
     # the bins over-link up to 2·tol_px apart; keep only the pairs within tol_px: link each
     # observation to the first of its bin (sorted by x) when within tol_px of it, else alone
     xs = np.r_[x, x]
     order = np.lexsort((xs, cell))
-    c, pnt, xo = cell[order], near[order], xs[order]
+    c, pnt, xo = cell[order], point2[order], xs[order]
     start = np.r_[True, c[1:] != c[:-1]]
     head = np.maximum.accumulate(np.where(start, np.arange(c.size), 0))
     ok = ~start & (xo - xo[head] <= tol_px)
