@@ -173,6 +173,8 @@ def test_geoid_heights_are_not_ellipsoidal(files):
         dst.write(data, 1)
     wrong = read_terrain(plain, FRAME, BOUNDS, vertical="ellipsoidal")
     assert 40 < float((t.dem - wrong.dem).mean()) < 55
+    stated = read_terrain(plain, FRAME, BOUNDS, vertical="EPSG:5773")  # the datum stated
+    assert float(np.abs(stated.dem - t.dem).max()) < 1e-6
 
 
 def test_a_void_under_a_ray_is_refused_by_place(files):
@@ -218,3 +220,25 @@ def test_only_the_window_under_the_lines_is_read(files, monkeypatch):
     read_terrain(files["3035"], FRAME, (-500.0, -500.0, 500.0, 500.0), vertical="ellipsoidal")
     (w,) = seen
     assert w is not None and w.width < 200 and w.height < 200
+
+
+def test_a_vertical_datum_whose_geoid_grid_is_missing_is_refused(tmp_path):
+    """Norway's DTM CRS, EPSG:25832+5941 (NN2000 heights): without PROJ's HREF2018B grid, PROJ
+    would fall back to a 'ballpark' conversion that ignores the geoid (≈ 39.5 m at Ås); the
+    reader refuses it, naming the grid."""
+    import os
+
+    from pyproj import Transformer
+    from rasterio.transform import from_origin
+
+    from hsgeo.io.terrain import read_terrain
+
+    grid = "no_kv_HREF2018B_NN2000_EUREF89.tif"
+    if os.path.exists(f"/usr/share/proj/{grid}"):
+        pytest.skip("the NN2000 grid is installed")
+    frame = LocalFrame(59.665, 10.775, 0.0, 25832, 4937)
+    x0, y0 = Transformer.from_crs(4326, 25832, always_xy=True).transform(10.775, 59.665)
+    tr = from_origin(round(x0) - 3000.0, round(y0) + 3000.0, 10.0, 10.0)
+    p = _write(tmp_path / "nn2000.tif", "EPSG:25832+5941", tr, (600, 600), lambda lo, la: lo * 0)
+    with pytest.raises(InputError, match=f"needs the grid {grid}, which is not installed"):
+        read_terrain(p, frame, (-1000.0, -1000.0, 1000.0, 1000.0))

@@ -180,9 +180,8 @@ def read_terrain(path, frame, bounds, vertical=None, *, cell_m: float | None = N
 
 def _crs_chain(name, wkt, vertical, frame):
     """(horizontal CRS, transformer file 3D → frame's geographic 3D, vertical in words)."""
-    from pyproj import CRS, Transformer
+    from pyproj import CRS
     from pyproj.crs import CompoundCRS
-    from pyproj.exceptions import ProjError
 
     from hsgeo.crs import parse_crs
 
@@ -218,15 +217,43 @@ def _crs_chain(name, wkt, vertical, frame):
                 )
             src3d = CompoundCRS(f"{crs.name} + {vert.name}", [crs, vert])
             vdesc = f"{vert.name} ({vert.to_string()}, as stated)"
-    try:
-        to_datum = Transformer.from_crs(src3d, frame.datum_crs, always_xy=True, only_best=True)
-    except ProjError as exc:
-        raise InputError(
-            f"{name}: PROJ cannot convert its heights ({vdesc}) to ellipsoidal heights on "
-            f"{frame.datum_crs.name} with its best transformation ({exc}); install the geoid "
-            "grids (Debian: apt-get install proj-data; `make venv` does it as root)"
-        ) from exc
+    to_datum = _best_transformer(name, src3d, frame, vdesc)
     return horiz, to_datum, vdesc
+
+
+def _best_transformer(name, src3d, frame, vdesc):
+    """PROJ's best transformation of the file's heights to ellipsoidal heights on the frame's
+    datum, refused when its grid is missing or when PROJ would ignore the geoid (a "ballpark"
+    vertical transformation: tens of metres off, silently).
+    """
+    from pyproj.transformer import TransformerGroup
+
+    group = TransformerGroup(src3d, frame.datum_crs, always_xy=True)
+    if not group.best_available or not group.transformers:
+        grids = sorted(
+            {
+                g.short_name
+                for op in group.unavailable_operations
+                for g in op.grids
+                if not g.available
+            }
+        )
+        raise InputError(
+            f"{name}: PROJ's transformation of its heights ({vdesc}) to ellipsoidal heights on "
+            f"{frame.datum_crs.name} needs the grid {', '.join(grids) or '(unnamed)'}, which is "
+            "not installed. Install it into /usr/share/proj (Debian's proj-data has EGM96; "
+            "others: projsync --file NAME, or from cdn.proj.org), or give the DSM with "
+            "ellipsoidal heights (--vertical ellipsoidal on a 2D CRS)"
+        )
+    to_datum = group.transformers[0]
+    if "ballpark vertical" in to_datum.description.lower():
+        raise InputError(
+            f"{name}: PROJ knows no transformation of its heights ({vdesc}) to ellipsoidal "
+            f"heights on {frame.datum_crs.name} (it offers only one that ignores the geoid: "
+            f"{to_datum.description}); give the DSM with ellipsoidal heights or in a vertical "
+            "CRS PROJ can convert (e.g. EPSG:5773, EGM96 height)"
+        )
+    return to_datum
 
 
 def _frame_grid(src, frame, horiz, bounds, cell_m):
