@@ -184,3 +184,7 @@ def test_parse_crs_and_its_errors():
         default_output_crs(151.2, -33.9, 4937)
     with pytest.raises(InputError, match="not a geographic"):
         LocalFrame(59.0, 10.0, 0.0, 25832, 25832)
+    with pytest.raises(InputError, match=r"EPSG:4326 is not a geographic 3D CRS: use .*EPSG:4979"):
+        LocalFrame(59.0, 10.0, 0.0, 32632, 4326)
+    words = LocalFrame(59.0, 10.0, 0.0, 32632, 4979).describe()
+    assert "on WGS 84 (EPSG:4979)" in words and "WGS 84 / UTM zone 32N (EPSG:32632)" in words

@@ -125,7 +125,13 @@ class LocalFrame:
         """The PROJ ellipsoid parameters of the datum (``+ellps=GRS80`` for ETRS89, as before)."""
         if int(self.datum_epsg) == ETRS89_GEOGRAPHIC_3D:
             return "+ellps=GRS80"
-        e = self.datum_crs.ellipsoid
+        d3 = self.datum_crs
+        if d3.to_epsg() != int(self.datum_epsg):
+            raise InputError(
+                f"the frame's datum EPSG:{self.datum_epsg} is not a geographic 3D CRS: use its "
+                f"3D form EPSG:{d3.to_epsg()} ({d3.name}, longitude, latitude, ellipsoidal height)"
+            )
+        e = d3.ellipsoid
         return f"+a={e.semi_major_metre!r} +rf={e.inverse_flattening!r}"
 
     def pipeline(self) -> str:

@@ -16,6 +16,24 @@ Degrees at the file edge, radians inside (:class:`hsgeo.trajectory.Trajectory`).
 ``%.17g``, so a round trip is lossless, and writes atomically (a temporary file in the target's
 directory, then :func:`os.replace`).
 
+Navigation as a GNSS/INS delivers it (:func:`read_navigation`)
+--------------------------------------------------------------
+A geodetic CSV or Parquet (``lat_deg, lon_deg, h_m`` ellipsoidal height on a named geographic
+CRS, or ``X_m, Y_m, Z_m`` on a geocentric one; the CRS as ``# crs: EPSG:4979`` before the header
+or passed), with the attitude ``roll_deg, pitch_deg, heading_deg`` against the north-east-down
+*at each record* and the time scale in the time column's name (``gps_sow_s`` with an optional
+``gps_week``, or ``sod_s``), for example::
+
+    # crs: EPSG:4979
+    gps_week,gps_sow_s,lat_deg,lon_deg,h_m,roll_deg,pitch_deg,heading_deg
+    2400,345350,60.0,9.73,2000.0,0.1,-0.3,92.5
+
+or the Applanix SBET (:mod:`hsgeo.io.sbet`; its datum passed). Both are read into a local frame
+chosen from the data (:meth:`hsgeo.crs.LocalFrame.about`, unless one is given): positions through
+PROJ, and each record's attitude carried exactly from its own NED into the frame's
+(:meth:`hsgeo.crs.LocalFrame.R_enu_from_ned_at`: meridian convergence, tilt of the normal), so
+the :class:`Trajectory` returned is in the form above. The local-ENU file stays readable.
+
 The former ``hsgeo adjust-pushbroom`` format (``t_s, E_m, N_m, H_m, roll_rad, pitch_rad,
 yaw_rad`` with ENU platform angles) is recognised and rejected with the conversion
 (:func:`hsgeo.trajectory.rph_from_platform_rpy`): ``U_m = H_m``, ``roll_deg = roll``,
