@@ -133,3 +133,25 @@ def test_times_that_go_back(tmp_path):
         match=r"line 12, column gps_sow_s: 1004 s does not come after 1004.5 s of line 11",
     ):
         read_navigation(p)
+
+
+def test_a_datum_without_a_3d_epsg_code_names_the_realisations(tmp_path):
+    with pytest.raises(InputError, match=r"'NAD83'.*no geographic 3D form.*EPSG:6319"):
+        read_navigation(_csv(tmp_path / "n.csv", np.full(50, 90.0), crs="EPSG:4269"))
+
+
+def test_a_terrain_grid_too_large_names_the_spacing(tmp_path):
+    from hsgeo.crs import LocalFrame
+    from hsgeo.io.terrain import read_terrain
+
+    p = tmp_path / "dsm.tif"
+    import rasterio
+    from rasterio.transform import from_origin
+
+    tr = from_origin(500000, 6600000, 1, 1)
+    kw = dict(driver="GTiff", width=10, height=10, count=1, dtype="float32", crs="EPSG:32632")
+    with rasterio.open(p, "w", transform=tr, **kw) as d:
+        d.write(np.zeros((1, 10, 10), np.float32))
+    frame = LocalFrame(59.5, 9.0, 0.0, 32632, 4979)
+    with pytest.raises(InputError, match=r"coarser grid spacing \(cell_m ≥"):
+        read_terrain(p, frame, (-20000, -5000, 20000, 5000), vertical="ellipsoidal")

@@ -510,7 +510,12 @@ def _to_frame(
     epsg = crs3d.to_epsg()
     if frame is None:
         if epsg is None:
-            raise InputError(f"{name}: the CRS {crs3d.name!r} has no EPSG code; name it by one")
+            raise InputError(
+                f"{name}: the CRS {src.name!r} ({src.to_string()}) has no geographic 3D form with "
+                "an EPSG code (longitude, latitude, ellipsoidal height); name the realisation the "
+                "positions are on, e.g. EPSG:6319 (NAD83(2011)), EPSG:4979 (WGS 84), EPSG:4937 "
+                "(ETRS89)"
+            )
         m = None if map_crs is None else parse_crs(map_crs).to_epsg()
         frame = LocalFrame.about(lon, lat, epsg, map_epsg=m)
     if epsg != int(frame.datum_epsg):

@@ -35,6 +35,9 @@ from hsgeo.errors import InputError, ObservationError
 
 __all__ = ["RasterTerrain", "read_terrain"]
 
+#: The most nodes of the frame grid read at once (≈ 1.6 GB of working arrays).
+MAX_GRID_NODES = 20_000_000
+
 #: Convergence of the node heights' fixed-point iteration (m) and its most steps.
 _TOL_M = 1e-4
 _MAX_ITER = 10
@@ -275,6 +278,13 @@ def _frame_grid(src, frame, horiz, bounds, cell_m):
         raise InputError(f"terrain grid spacing {cell_m!r} m is not positive")
     nE = int(np.ceil((E1 - E0) / cell_m)) + 1
     nN = int(np.ceil((N1 - N0) / cell_m)) + 1
+    if nE * nN > MAX_GRID_NODES:
+        need = cell_m * np.sqrt(nE * nN / MAX_GRID_NODES)
+        raise InputError(
+            f"the terrain under the lines would be {nN} × {nE} nodes at {cell_m:.3g} m (more "
+            f"than {MAX_GRID_NODES:,}): give a coarser grid spacing (cell_m ≥ {need:.2g} m) or "
+            "read the lines in parts"
+        )
     return E0 + cell_m * np.arange(nE), N0 + cell_m * np.arange(nN)
 
 
