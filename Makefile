@@ -16,7 +16,7 @@ export GLIBC_TUNABLES ?= glibc.malloc.mmap_max=0:glibc.malloc.trim_threshold=429
 export PYDEVD_DISABLE_FILE_VALIDATION := 1
 
 .DEFAULT_GOAL := help
-.PHONY: help venv data test test-fast book book-student check-book browser bench lint clean lock dist
+.PHONY: help venv proj-data data test test-fast book book-student check-book browser bench lint clean lock dist
 
 help: ## list the targets
 	@grep -hE '^[a-zA-Z_-]+:.*## ' $(MAKEFILE_LIST) | awk 'BEGIN {FS = ":.*## "}; {printf "  make %-10s %s\n", $$1, $$2}'
@@ -29,7 +29,18 @@ $(STAMP): requirements.lock pyproject.toml
 	$(PY) -m ipykernel install --sys-prefix --name python3 >/dev/null
 	touch $(STAMP)
 
-venv: $(STAMP) ## create .venv from requirements.lock and install hsgeo (about 1 min)
+venv: $(STAMP) proj-data ## create .venv from requirements.lock and install hsgeo (about 1 min)
+
+# PROJ's geoid grids (EGM96 `egm96_15.gtx`) for DSMs with orthometric heights: Debian's proj-data,
+# installed as root when missing (hsgeo.crs.use_system_proj_grids points pyproj at /usr/share/proj).
+PROJ_GRID := /usr/share/proj/egm96_15.gtx
+proj-data: ## install Debian's proj-data (PROJ's geoid grids: EGM96) if missing (apt-get, as root)
+	@if [ -f $(PROJ_GRID) ]; then echo "proj-data: $(PROJ_GRID)"; \
+	elif [ "$$(id -u)" = 0 ]; then \
+	  apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends proj-data; \
+	elif command -v sudo >/dev/null && sudo -n true 2>/dev/null; then \
+	  sudo apt-get update -qq && sudo DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends proj-data; \
+	else echo "warning: $(PROJ_GRID) not found: DSMs with orthometric heights (EGM96) need Debian's proj-data (apt-get install proj-data, as root)"; fi
 
 data: $(STAMP) ## regenerate data_synthetic/generated from the scenario TOMLs and verify the SHA-256 manifest
 	$(PY) -m hsgeo.cli data --verify

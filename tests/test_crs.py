@@ -79,3 +79,112 @@ def test_bad_frames():
         LocalFrame(59.0, 10.0, 0.0, 1)
     assert same_crs("EPSG:25832", SITE_AAS.crs)
     assert not same_crs("EPSG:32632", "EPSG:25832")
+
+
+# ---- the frame chosen from the data, the output CRS of the data ------------------------------
+SITES = {  # name: (lat, lon, datum, expected UTM EPSG) — pyproj's UTM areas of use
+    "Sydney": (-33.9, 151.2, 4979, 32756),
+    "Boulder": (40.0, -105.3, 4979, 32613),
+    "Boulder NAD83(2011)": (40.0, -105.3, 6319, 6342),
+    "Svalbard": (78.2, 15.6, 4979, 32633),
+    "antimeridian": (-16.5, 179.95, 4979, 32760),
+    "12 E, UTM 32/33": (48.0, 12.0, 4979, 32633),
+    "Ås": (59.665, 10.775, 4937, 25832),
+}
+
+
+@pytest.mark.parametrize("site", list(SITES))
+def test_default_output_crs_is_the_utm_zone_of_the_centre(site):
+    from hsgeo.crs import default_output_crs
+
+    lat, lon, datum, epsg = SITES[site]
+    assert default_output_crs(lon, lat, datum).to_epsg() == epsg
+
+
+@pytest.mark.parametrize("site", list(SITES))
+def test_local_frame_to_output_crs_against_pyproj_alone(site):
+    """A 30 km line about the site (across 12° E for the 32/33 case, across 180° for the
+    antimeridian): the frame is its centre; ENU → output CRS equals the test's own ENU →
+    geocentric (the topocentric rotation at the origin, EPSG method 9837) → pyproj's
+    geocentric → UTM, to 1 mm."""
+    from pyproj import CRS, Geod, Transformer
+
+    from hsgeo.crs import LocalFrame, default_output_crs
+
+    lat, lon, datum, epsg = SITES[site]
+    ellps = CRS.from_epsg(datum).ellipsoid
+    g = Geod(a=ellps.semi_major_metre, rf=ellps.inverse_flattening)
+    s = np.linspace(-15000, 15000, 31)
+    lons, lats, _ = g.fwd(np.full(31, lon), np.full(31, lat), np.full(31, 90.0), s)
+    frame = LocalFrame.about(lons, lats, datum)
+    assert frame.map_epsg == epsg
+    assert abs(frame.lat_deg - lat) < 0.02 and abs((frame.lon_deg - lon + 180) % 360 - 180) < 1e-6
+    out = default_output_crs(frame.lon_deg, frame.lat_deg, datum)
+    rng = np.random.default_rng(3)
+    enu = rng.uniform([-15000, -15000, -50], [15000, 15000, 3000], size=(40, 3))
+    x, y, z = frame.enu_to_crs(out, *enu.T)
+    # pyproj alone: the origin's geocentric position and axes, then geocentric -> UTM
+    geocentric = CRS.from_epsg(datum).to_3d()
+    to_xyz = Transformer.from_crs(
+        geocentric,
+        {"proj": "geocent", "a": ellps.semi_major_metre, "rf": ellps.inverse_flattening},
+        always_xy=True,
+    )
+    X0 = np.array(to_xyz.transform(frame.lon_deg, frame.lat_deg, 0.0))
+    lam, phi = np.radians(frame.lon_deg), np.radians(frame.lat_deg)
+    R = np.array([
+        [-np.sin(lam), -np.sin(phi) * np.cos(lam), np.cos(phi) * np.cos(lam)],
+        [np.cos(lam), -np.sin(phi) * np.sin(lam), np.cos(phi) * np.sin(lam)],
+        [0.0, np.cos(phi), np.sin(phi)],
+    ])  # fmt: skip
+    XYZ = X0 + enu @ R.T
+    lo, la, h = to_xyz.transform(*XYZ.T, direction="INVERSE")
+    xr, yr = Transformer.from_crs(geocentric, out, always_xy=True).transform(lo, la)[:2]
+    np.testing.assert_allclose(x, xr, atol=1e-3, rtol=0)
+    np.testing.assert_allclose(y, yr, atol=1e-3, rtol=0)
+    np.testing.assert_allclose(z, h, atol=1e-3, rtol=0)
+    back = np.column_stack(frame.crs_to_enu(out, x, y, z))
+    np.testing.assert_allclose(back, enu, atol=1e-6)
+
+
+def test_R_enu_from_ned_at_is_projs_topocentric_rotation():
+    """The rotation from a point's NED to the frame's ENU equals PROJ's: 1 m steps north, east
+    and down at a point 20 km away, mapped through the frame's pipeline."""
+    from hsgeo.crs import LocalFrame
+
+    frame = LocalFrame(60.0, 10.0, 0.0, 32632, 4979)
+    lon, lat, h = 10.36, 60.05, 1500.0
+    from pyproj import Transformer
+
+    topo = Transformer.from_pipeline(
+        f"+proj=pipeline +step +inv +proj=topocentric +lat_0={lat} +lon_0={lon} +h_0={h} "
+        "+ellps=WGS84 +step +inv +proj=cart +ellps=WGS84 "
+        "+step +proj=unitconvert +xy_in=rad +xy_out=deg"
+    )
+    P0 = np.ravel(frame.lonlat_to_enu(lon, lat, h))
+    cols = []
+    for ned in ([100.0, 0, 0], [0, 100.0, 0], [0, 0, 100.0]):
+        enu_local = (ned[1], ned[0], -ned[2])
+        cols.append((np.ravel(frame.lonlat_to_enu(*topo.transform(*enu_local))) - P0) / 100.0)
+    np.testing.assert_allclose(frame.R_enu_from_ned_at(lon, lat), np.column_stack(cols), atol=1e-8)
+
+
+def test_parse_crs_and_its_errors():
+    from hsgeo.crs import default_output_crs, geographic_3d_crs, parse_crs
+
+    assert parse_crs("EPSG:32633").to_epsg() == 32633
+    assert parse_crs("25832").to_epsg() == 25832
+    with pytest.raises(InputError, match=r"--crs 'EPSG:999999' is not a CRS.*EPSG:32633"):
+        parse_crs("EPSG:999999")
+    with pytest.raises(InputError, match="not a geographic or geocentric CRS"):
+        geographic_3d_crs("EPSG:32633")
+    assert geographic_3d_crs(4326).to_epsg() == 4979
+    assert geographic_3d_crs("EPSG:4978").to_epsg() == 4979
+    with pytest.raises(InputError, match=r"no UTM zone on the datum 'ETRS89'.*--crs"):
+        default_output_crs(151.2, -33.9, 4937)
+    with pytest.raises(InputError, match="not a geographic"):
+        LocalFrame(59.0, 10.0, 0.0, 25832, 25832)
+    with pytest.raises(InputError, match=r"EPSG:4326 is not a geographic 3D CRS: use .*EPSG:4979"):
+        LocalFrame(59.0, 10.0, 0.0, 32632, 4326)
+    words = LocalFrame(59.0, 10.0, 0.0, 32632, 4979).describe()
+    assert "on WGS 84 (EPSG:4979)" in words and "WGS 84 / UTM zone 32N (EPSG:32632)" in words

@@ -9,7 +9,11 @@ One module per format:
 * :mod:`hsgeo.io.boards` — the calibration-board description (:class:`Board`, mm) and the
   board TOML of ``hsgeo calibrate-frame``;
 * :mod:`hsgeo.io.navigation` — the one navigation file of every command (GNSS/INS
-  trajectory, :class:`~hsgeo.trajectory.Trajectory`);
+  trajectory, :class:`~hsgeo.trajectory.Trajectory`), and navigation as delivered
+  (:func:`read_navigation`: geodetic or geocentric CSV on a named datum, the Applanix SBET of
+  :mod:`hsgeo.io.sbet`) into a local frame chosen from the data;
+* :mod:`hsgeo.io.terrain` — a DSM/DEM GDAL reads, in any CRS and vertical datum, into the local
+  frame (:func:`read_terrain`);
 * :mod:`hsgeo.io.lines` — recorded flight lines (NetCDF);
 * :mod:`hsgeo.io.lp_lines` — the LP image lines of one strip (:class:`LpStrip`, NetCDF-4) of
   ``hsgeo lp-observations``;
@@ -34,10 +38,17 @@ from hsgeo.io.config import Key, read_config, read_toml
 from hsgeo.io.envi import read_envi, write_envi
 from hsgeo.io.lines import read_lines, write_lines
 from hsgeo.io.lp_lines import LpStrip, read_lp_lines, write_lp_lines
-from hsgeo.io.navigation import NAV_COLUMNS, read_trajectory, write_trajectory
+from hsgeo.io.navigation import (
+    NAV_COLUMNS,
+    Navigation,
+    read_navigation,
+    read_trajectory,
+    write_trajectory,
+)
 from hsgeo.io.nist_strd import read_nist_strd
 from hsgeo.io.opencv import read_opencv_storage
 from hsgeo.io.raster import read_dem, to_map_files
+from hsgeo.io.sbet import read_sbet
 from hsgeo.io.sensors import (
     read_band_split,
     read_camera_toml,
@@ -47,6 +58,7 @@ from hsgeo.io.sensors import (
     read_sensor_toml,
 )
 from hsgeo.io.tables import read_table, write_csv_array, write_csv_lines
+from hsgeo.io.terrain import RasterTerrain, read_terrain
 
 __all__ = [
     "atomic_path",
@@ -60,6 +72,11 @@ __all__ = [
     "NAV_COLUMNS",
     "read_trajectory",
     "write_trajectory",
+    "Navigation",
+    "read_navigation",
+    "read_sbet",
+    "RasterTerrain",
+    "read_terrain",
     "Key",
     "read_config",
     "read_toml",
