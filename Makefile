@@ -45,11 +45,11 @@ proj-data: ## install Debian's proj-data (PROJ's geoid grids: EGM96) if missing 
 data: $(STAMP) ## regenerate data_synthetic/generated from the scenario TOMLs and verify the SHA-256 manifest
 	$(PY) -m hsgeo.cli data --verify
 
-test: $(STAMP) ## the whole test suite, chapters included (about 6 min on 2 cores)
+test: $(STAMP) proj-data ## the whole test suite, chapters included (about 6 min on 2 cores)
 	$(PY) -m hsgeo.cli data --verify
 	$(PY) -m pytest -q tests
 
-test-fast: $(STAMP) ## the test suite without the chapter executions and slow Monte Carlo tests
+test-fast: $(STAMP) proj-data ## the test suite without the chapter executions and slow Monte Carlo tests
 	$(PY) -m pytest -q -m "not slow" --ignore=tests/test_chapters.py tests
 
 # The execution cache is keyed on each chapter's code only: when the library or the scenarios
