@@ -573,7 +573,7 @@ def add_asf(sub) -> argparse.ArgumentParser:
         "of a BRDF cancels). RAW SCANS (with --sensor and --trajectory): NetCDF flight lines "
         "with radiance(band, line, pixel), the coordinate pixel (the detector pixel of each "
         "column) and the attributes t0_s (time of line 0 on the navigation's time scale) and "
-        "line_rate_hz. SENSOR: TOML, [sensor] model = \"panoramic\", n_px, ifov_deg (degrees), "
+        'line_rate_hz. SENSOR: TOML, [sensor] model = "panoramic", n_px, ifov_deg (degrees), '
         "active_fraction, boresight_deg, lever_arm_m. NAV: t_s, E_m, N_m, U_m, roll_deg, "
         "pitch_deg, heading_deg (hsgeo.io.navigation). SCANS GEOREGISTERED ELSEWHERE (without "
         "--sensor/--trajectory): NetCDF with reflectance(band, line, pixel), E_m(line, pixel) "
@@ -587,9 +587,7 @@ def add_asf(sub) -> argparse.ArgumentParser:
     p.add_argument(
         "--runway", required=True, metavar="RUNWAY.csv", help="runway corners (E_m, N_m)"
     )
-    p.add_argument(
-        "--sensor", metavar="SENSOR.toml", help="the scanner's sensor file (raw scans)"
-    )
+    p.add_argument("--sensor", metavar="SENSOR.toml", help="the scanner's sensor file (raw scans)")
     p.add_argument(
         "--trajectory", metavar="NAV.csv", help="the navigation of the flights (raw scans)"
     )

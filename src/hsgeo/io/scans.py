@@ -247,7 +247,8 @@ def read_panoramic_sensor(path):
 
 def write_panoramic_sensor(path, sensor, *, inputs=()):
     """Write a panoramic scanner's sensor file (the format :func:`read_panoramic_sensor`
-    reads)."""
+    reads).
+    """
     from hsgeo.rotations import rpy_from_R
 
     rpy = np.rad2deg(rpy_from_R(sensor.mount.R_body_from_sensor))

@@ -31,7 +31,7 @@ The flights follow each other in time, so that one navigation record covers them
 
 Chosen (not in 004, stated in the chapter): the true ASF curves (:func:`true_asf`, shaped as
 the paper describes them — largest variation 15 % in channel 1, 4–12 % in the others), the
-reflectances, the texture, the joints (6 mm, half as bright as the pavement) and the dashes,
+reflectances, the texture, the joints (5.5 mm, half as bright as the pavement) and the dashes,
 the landmarks, the BRDF and path-radiance coefficients, the noise (0.5 % per sample),
 the speed and line rate (0.63 m per line), the navigation errors.
 """
@@ -114,7 +114,7 @@ class RunwayScene:
     # registration pass): sealed transverse joints between the pavement's slabs and the
     # centre-line markings (ICAO Annex 14: dashes 30 m long, 20 m gaps, 0.9 m wide)
     joint_spacing_m: float = 5.0
-    joint_width_m: float = 0.006
+    joint_width_m: float = 0.0055
     joint_factor: float = 0.5  # the sealant's reflectance / the pavement's
     centreline_dash_m: float = 30.0
     centreline_gap_m: float = 20.0

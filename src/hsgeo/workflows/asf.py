@@ -403,14 +403,17 @@ MIN_MEAN_NCC = 0.4
 
 def _check_coarse_match(score, i, j, n_windows, options: AsfOptions) -> None:
     """Refuse a coarse registration that found no match: the best shift on the edge of the
-    search grid, or windows that hardly correlate there."""
+    search grid, or windows that hardly correlate there.
+    """
     last = score.shape[0] - 1
     mean_ncc = float(score[i, j]) / max(n_windows, 1)
-    if mean_ncc < MIN_MEAN_NCC or i in (0, last) or j in (0, last):
+    edge = i in (0, last) or j in (0, last)
+    if mean_ncc < MIN_MEAN_NCC or edge:
+        where = ", at the edge of the search" if edge else ""
         raise InputError(
             f"the landmarks of the two scans do not match within ±{options.search_m:g} m "
             f"(best mean correlation of the {n_windows} registration windows "
-            f"{mean_ncc:.2f}{', at the edge of the search' if i in (0, last) or j in (0, last) else ''}): "
+            f"{mean_ncc:.2f}{where}): "
             "the along scan's navigation is off by more than the search (a time or position "
             "offset?) or the scans do not show the same runway; correct the navigation, or "
             "widen the search (AsfOptions.search_m)"
@@ -494,7 +497,8 @@ class AsfResult:
 def _disagreeing_samples(c, a, inside, k: float) -> np.ndarray:
     """Samples whose log ratio c / a lies more than ``k`` robust σ from its column's median in
     any band, ``(lines, pixels)`` bool (the column's σ: 1.4826 × the median absolute deviation,
-    at least 0.1 %)."""
+    at least 0.1 %).
+    """
     with np.errstate(invalid="ignore", divide="ignore"):
         r = np.log(c / a)
     r = np.where(inside[None] & np.isfinite(r), r, np.nan)

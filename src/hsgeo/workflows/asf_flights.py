@@ -16,7 +16,14 @@ import numpy as np
 from hsgeo.errors import InputError
 from hsgeo.geocode import PlaneTerrain
 from hsgeo.radiometry import combine_opposite_crossings
-from hsgeo.workflows.asf import AsfInputs, AsfOptions, AsfResult, GeoScan, asf_from_scans, georegister
+from hsgeo.workflows.asf import (
+    AsfInputs,
+    AsfOptions,
+    AsfResult,
+    GeoScan,
+    asf_from_scans,
+    georegister,
+)
 
 __all__ = [
     "RawScan",
@@ -140,10 +147,11 @@ class FlightsResult:
         return out
 
 
-def asf_from_flights(inputs: FlightsInputs, options: AsfOptions = AsfOptions()) -> FlightsResult:
+def asf_from_flights(inputs: FlightsInputs, options: AsfOptions | None = None) -> FlightsResult:
     """Georegister the flights, then the ASF of each crossing against the along image; two
     crossings of opposite heading combined (:func:`hsgeo.radiometry.combine_opposite_crossings`).
     """
+    options = options or AsfOptions()
     terrain = PlaneTerrain(float(inputs.terrain_height_m))
     geo = {}
     for k in ("cross", "along", "reverse"):
@@ -184,7 +192,7 @@ def asf_files(
     cross_path,
     along_path,
     runway_path,
-    options: AsfOptions = AsfOptions(),
+    options: AsfOptions | None = None,
     *,
     sensor_path=None,
     trajectory_path=None,
@@ -202,6 +210,7 @@ def asf_files(
 
     from hsgeo.io.scans import read_geoscan, read_runway
 
+    options = options or AsfOptions()
     paths = {"CROSS": cross_path, "ALONG": along_path}
     if reverse_path is not None:
         paths["REVERSE"] = reverse_path
