@@ -19,8 +19,7 @@ the sensor file and the navigation (:func:`read_raw_scan`).
 polygon in order around it, columns ``E_m, N_m`` (at least 3 corners; a last row repeating the
 first, as a closed ring is often written, is dropped).
 
-**Panoramic sensor** (TOML, :func:`read_panoramic_sensor`; to be replaced by
-``hsgeo.io.read_sensor``)::
+**Panoramic sensor** (TOML, :func:`hsgeo.io.read_sensor`, model ``panoramic``)::
 
     [sensor]
     model = "panoramic"
@@ -37,7 +36,6 @@ import numpy as np
 
 from hsgeo.errors import InputError
 from hsgeo.io._files import atomic_path
-from hsgeo.io.config import Key, read_config
 from hsgeo.io.lines import open_netcdf
 
 __all__ = [
@@ -47,7 +45,6 @@ __all__ = [
     "read_runway",
     "read_panoramic_sensor",
     "write_panoramic_sensor",
-    "PANORAMIC_SCHEMA",
 ]
 
 
@@ -190,84 +187,44 @@ def read_raw_scan(path, role: str = "SCAN"):
     return v, np.asarray(da["pixel"].values, float), t0_s, rate
 
 
-#: The panoramic scanner's sensor file (004): the keys of :class:`PanoramicScanner`.
-PANORAMIC_SCHEMA = {
-    "sensor": {
-        "model": Key("str", required=True, choices=("panoramic",), doc="'panoramic' (004)"),
-        "n_px": Key("int", required=True, positive=True, doc="pixels per scan line"),
-        "ifov_deg": Key(
-            "float", required=True, positive=True, limit=10.0, doc="angular pixel size, degrees"
-        ),
-        "active_fraction": Key(
-            "float",
-            default=2 * 43.0 / 360.0,
-            positive=True,
-            limit=1.0,
-            doc="share of the line period during which the mirror sweeps the pixels",
-        ),
-        "boresight_deg": Key(
-            "floats",
-            length=3,
-            default=(0.0, 0.0, 0.0),
-            doc="roll, pitch, heading of R_body_from_sensor, degrees",
-        ),
-        "lever_arm_m": Key(
-            "floats", length=3, default=(0.0, 0.0, 0.0), limit=50.0, doc="lever arm (body), m"
-        ),
-    },
-}
-
-
 def read_panoramic_sensor(path):
-    """A :class:`hsgeo.sensors.panoramic.PanoramicScanner` from its sensor file (module
-    docstring). A stand-in until ``hsgeo.io.read_sensor`` reads every model.
+    """The scanner of ``hsgeo asf --sensor``: a sensor file of the panoramic model, read by
+    :func:`hsgeo.io.read_sensor` (any other model is refused with the reason).
     """
-    from hsgeo.sensors.mount import Mount
+    from hsgeo.io.sensor_file import read_sensor
     from hsgeo.sensors.panoramic import PanoramicScanner
 
-    cfg = read_config(path, PANORAMIC_SCHEMA, "SENSOR file", required_tables=("sensor",))
-    s = cfg["sensor"]
+    sensor = read_sensor(path)
     name = f"SENSOR file {str(path)!r}"
-    if s["n_px"] * s["ifov_deg"] < 5.0:
+    if not isinstance(sensor, PanoramicScanner):
         raise InputError(
-            f"{name}: n_px × ifov_deg = {s['n_px'] * s['ifov_deg']:.3g}°: a scan this narrow "
+            f"{name} describes a {type(sensor).__name__}: the ASF from crossing flights is "
+            'measured with a whiskbroom scanner; give a sensor file with model = "panoramic"'
+        )
+    if sensor.n_px * sensor.ifov_deg < 5.0:
+        raise InputError(
+            f"{name}: n_px × ifov_deg = {sensor.n_px * sensor.ifov_deg:.3g}°: a scan this narrow "
             "cannot give an ASF; is ifov_deg in radians instead of degrees?"
         )
-    try:
-        mount = Mount.from_rpy(np.deg2rad(s["boresight_deg"]), s["lever_arm_m"])
-        return PanoramicScanner(
-            n_px=s["n_px"],
-            ifov_deg=s["ifov_deg"],
-            mount=mount,
-            active_fraction=s["active_fraction"],
-        )
-    except InputError as e:
-        raise InputError(f"{name}: {e}") from None
+    return sensor
 
 
 def write_panoramic_sensor(path, sensor, *, inputs=()):
-    """Write a panoramic scanner's sensor file (the format :func:`read_panoramic_sensor`
-    reads).
-    """
+    """Write a panoramic scanner's sensor file (:func:`hsgeo.io.sensor_file.sensor_toml`)."""
+    from hsgeo.io.sensor_file import sensor_toml
     from hsgeo.rotations import rpy_from_R
 
-    rpy = np.rad2deg(rpy_from_R(sensor.mount.R_body_from_sensor))
-    lever = np.asarray(sensor.mount.lever_arm_m, float)
-
-    def arr(x):
-        return "[" + ", ".join(f"{float(v):.17g}" for v in x) + "]"
-
-    text = (
-        "[sensor]\n"
-        'model = "panoramic"\n'
-        f"n_px = {int(sensor.n_px)}\n"
-        f"ifov_deg = {float(sensor.ifov_deg):.17g}\n"
-        f"active_fraction = {float(sensor.active_fraction):.17g}\n"
-        f"boresight_deg = {arr(rpy)}\n"
-        f"lever_arm_m = {arr(lever)}\n"
-    )
+    values = {
+        "n_px": int(sensor.n_px),
+        "ifov_deg": float(sensor.ifov_deg),
+        "active_fraction": float(sensor.active_fraction),
+        "boresight_deg": [
+            float(x) for x in np.rad2deg(rpy_from_R(sensor.mount.R_body_from_sensor))
+        ],
+        "lever_arm_m": [float(x) for x in sensor.mount.lever_arm_m],
+    }
     with atomic_path(path, inputs) as tmp:
-        tmp.write_text(text)
+        tmp.write_text(sensor_toml("panoramic", values))
     return path
 
 
