@@ -216,3 +216,27 @@ def test_georegister_scan_uses_the_scans_own_geometry():
     sm = GroundSampler(g)
     lp = sm.locate(g.E_m[::20, ::50].ravel(), g.N_m[::20, ::50].ravel())
     assert np.all(np.isfinite(lp))
+
+
+def test_subpixel_features_are_integrated_over_the_footprint():
+    """The joints and the centre-line dashes cover exactly their share of a pixel's footprint,
+    wherever the footprint sits (the jittered rays would hit a 6 mm joint by chance)."""
+    from hsgeo.simulate.asf_runway import _field, _periodic_overlap
+
+    # one joint (6 mm every 5 m) in any window of 5 m, two in 10 m, whatever the phase
+    a0 = np.linspace(-7.3, 4.1, 50)
+    np.testing.assert_allclose(_periodic_overlap(a0, a0 + 5.0, 0.4, 5.0, 0.006), 0.006)
+    np.testing.assert_allclose(_periodic_overlap(a0, a0 + 10.0, 0.4, 5.0, 0.006), 0.012)
+    # a window inside one dash (30 m of 50) is all paint, inside a gap none
+    assert _periodic_overlap(np.array([1.0]), np.array([2.0]), 0.0, 50.0, 30.0)[0] == 1.0
+    assert _periodic_overlap(np.array([31.0]), np.array([32.0]), 0.0, 50.0, 30.0)[0] == 0.0
+    scene = RunwayScene()
+    f = _field(scene, np.random.default_rng(0))
+    E = np.linspace(-100, 100, 40001)
+    paint, joint = f.subpixel(E, np.zeros_like(E), np.full(E.size, 0.63), np.full(E.size, 0.63))
+    # along the centre line, the mean shares: the dashes' duty cycle × the pixel inside the line,
+    # and the joints' width per spacing
+    assert paint.mean() == pytest.approx(0.6 * min(0.9 / 0.63, 1.0), rel=0.02)
+    assert joint.mean() == pytest.approx(scene.joint_width_m / scene.joint_spacing_m, rel=0.02)
+    far = f.subpixel(E, np.full(E.size, 40.0), np.full(E.size, 0.63), np.full(E.size, 0.63))
+    assert np.all(far[0] == 0) and np.all(far[1] == 0)  # off the runway: grass
