@@ -9,6 +9,7 @@ from hsgeo.radiometry import asf_ratio, combine_opposite_crossings, even_odd_par
 from hsgeo.simulate.asf_runway import RunwayScene, simulate_runway, true_asf
 from hsgeo.workflows.asf import (
     AsfInputs,
+    AsfOptions,
     GroundSampler,
     asf_from_scans,
     georegister,
@@ -99,15 +100,18 @@ def test_ground_sampler_inverts_the_georegistration():
     assert np.all(np.isnan(sm.locate([5000.0], [0.0])))
 
 
-def _recover(seed, scene=None):
+def _recover(seed, scene=None, geo=False):
     obs, tr = simulate_runway(scene or RunwayScene(), seed, reverse=False)
 
-    def geo(s):
+    def georeg(s):
         return georegister(s.values, s.zeta_px, s.t0_s, s.line_rate_hz, s.sensor, s.trajectory)
 
-    res = asf_from_scans(AsfInputs(geo(obs.cross), geo(obs.along), obs.runway_polygon_m))
+    gc, ga = georeg(obs.cross), georeg(obs.along)
+    res = asf_from_scans(AsfInputs(gc, ga, obs.runway_polygon_m))
     near = np.abs(tr.scan_angle_rad) <= np.deg2rad(1.0)
     truth = tr.asf / tr.asf[:, near].mean(axis=1, keepdims=True)
+    if geo:
+        return res, tr, truth, (gc, ga, obs.runway_polygon_m)
     return res, tr, truth
 
 
@@ -116,11 +120,25 @@ def _recover(seed, scene=None):
 def test_lambertian_runway_asf_within_1_percent_for_any_seed(seed):
     """Issue 27's 'done': over a Lambertian runway the recovered ASF lies within 1 % of the truth
     at every usable scan angle in every channel; every column usable; registration within
-    0.1 m of the true offset between the two flights' navigation errors."""
-    res, tr, truth = _recover(seed)
+    0.1 m of the true offset between the two flights' navigation errors. Issue 37.6: a bar that
+    can fail — with the runway's sub-metre structure (joints, centre-line dashes), the along
+    image left where the navigation puts it misses the bar, one pixel of registration error
+    along or across the runway does not."""
+    from dataclasses import replace
+
+    from hsgeo.reproduce.asf import asf_at_shift
+
+    res, tr, truth, g = _recover(seed, geo=True)
     assert res.usable.all()
     assert np.max(np.abs(res.asf - truth)) < 0.01
     assert np.all(np.abs(res.registration.shift_m - tr.shift_m) < 0.1)
+    gc, ga, P = g
+    none = asf_from_scans(AsfInputs(gc, ga, P), replace(AsfOptions(), register=False))
+    assert np.max(np.abs(none.asf - truth)) > 0.01
+    px = res.registration.gsd_m
+    for d in ((px, 0.0), (0.0, px)):
+        off = asf_at_shift(gc, ga, P, tr.shift_m + np.array(d))
+        assert np.max(np.abs(off.asf - truth)) <= 0.01
 
 
 def test_lambertian_runway_asf_one_seed_and_z():
@@ -198,3 +216,27 @@ def test_georegister_scan_uses_the_scans_own_geometry():
     sm = GroundSampler(g)
     lp = sm.locate(g.E_m[::20, ::50].ravel(), g.N_m[::20, ::50].ravel())
     assert np.all(np.isfinite(lp))
+
+
+def test_subpixel_features_are_integrated_over_the_footprint():
+    """The joints and the centre-line dashes cover exactly their share of a pixel's footprint,
+    wherever the footprint sits (the jittered rays would hit a 6 mm joint by chance)."""
+    from hsgeo.simulate.asf_runway import _field, _periodic_overlap
+
+    # one joint (6 mm every 5 m) in any window of 5 m, two in 10 m, whatever the phase
+    a0 = np.linspace(-7.3, 4.1, 50)
+    np.testing.assert_allclose(_periodic_overlap(a0, a0 + 5.0, 0.4, 5.0, 0.006), 0.006)
+    np.testing.assert_allclose(_periodic_overlap(a0, a0 + 10.0, 0.4, 5.0, 0.006), 0.012)
+    # a window inside one dash (30 m of 50) is all paint, inside a gap none
+    assert _periodic_overlap(np.array([1.0]), np.array([2.0]), 0.0, 50.0, 30.0)[0] == 1.0
+    assert _periodic_overlap(np.array([31.0]), np.array([32.0]), 0.0, 50.0, 30.0)[0] == 0.0
+    scene = RunwayScene()
+    f = _field(scene, np.random.default_rng(0))
+    E = np.linspace(-100, 100, 40001)
+    paint, joint = f.subpixel(E, np.zeros_like(E), np.full(E.size, 0.63), np.full(E.size, 0.63))
+    # along the centre line, the mean shares: the dashes' duty cycle × the pixel inside the line,
+    # and the joints' width per spacing
+    assert paint.mean() == pytest.approx(0.6 * min(0.9 / 0.63, 1.0), rel=0.02)
+    assert joint.mean() == pytest.approx(scene.joint_width_m / scene.joint_spacing_m, rel=0.02)
+    far = f.subpixel(E, np.full(E.size, 40.0), np.full(E.size, 0.63), np.full(E.size, 0.63))
+    assert np.all(far[0] == 0) and np.all(far[1] == 0)  # off the runway: grass

@@ -35,7 +35,10 @@ def test_tables_and_json(rep):
 
 def test_the_done_criterion_and_the_leak(rep):
     """Within 1 % on a Lambertian runway; the BRDF's odd part leaks into one crossing and is
-    removed by two opposite crossings, its even part stays (004's stated limit)."""
+    removed by two opposite crossings, its even part stays (004's stated limit). The per-angle
+    rows' σ is the noise's spread only: the joints leave a systematic error of a few tenths of a
+    per cent in single columns (the two scans' footprints differ), so more than the noise's
+    share of them lie beyond 3σ (seed 5: 82 % within, was > 90 % on a runway without joints)."""
     assert rep.meta["max_abs_error_percent"] < 1.0
     assert rep.meta["n_usable"] == rep.meta["n_px"] == 716
     leak = {r.quantity: r for r in rep.rows_of("004 BRDF leak")}
@@ -46,7 +49,7 @@ def test_the_done_criterion_and_the_leak(rep):
     assert abs(one.reproduced - one.truth) < 0.5 and abs(even2.reproduced - even2.truth) < 0.5
     assert even2.reproduced > 1.0
     z = [r.z for r in rep.rows_of("004 ASF") if r.z is not None]
-    assert len(z) == 44 and np.mean(np.abs(z) <= 3) > 0.9
+    assert len(z) == 44 and np.mean(np.abs(z) <= 3) > 0.75
 
 
 def test_simulation_is_deterministic():
@@ -92,5 +95,25 @@ def test_unmodelled_effects_carry_their_noise_spread(rep):
     assert all(r.sigma is not None and 0 < r.sigma < 0.2 for r in u.values())
     base = u["none (Lambertian runway, registered)"]
     assert base.reproduced == rep.meta["max_abs_error_percent_runs"][0]
-    for k in ("BRDF of the runway (one crossing)", "no registration (navigation only)"):
+    from hsgeo.reproduce.asf import path_label
+
+    path = path_label(RunwayScene())
+    for k in ("BRDF of the runway (one crossing)", "no registration (navigation only)", path):
         assert u[k].reproduced - base.reproduced > 5 * max(u[k].sigma, base.sigma)
+    # the residual path radiance is zero at nadir and 3 % of the runway at 43°: it enters the
+    # ASF almost in full
+    assert 2.0 < u[path].reproduced < 4.0
+    assert u[path].reproduced > 1.0 > base.reproduced
+
+
+def test_the_chapter_runs_the_users_workflow(rep):
+    """Run 0 is hsgeo asf's workflow on the raw scans with the recorded navigation of all flights
+    in one record: the same numbers as the command on the same files would give."""
+    from hsgeo.reproduce.asf import flights_inputs
+    from hsgeo.workflows.asf_flights import asf_from_flights
+
+    obs, _ = simulate_runway(RunwayScene(), 5)
+    inp = flights_inputs(obs)
+    assert inp.trajectory.t_s[0] <= obs.cross.t0_s and inp.trajectory.t_s[-1] > obs.along.t0_s
+    res = asf_from_flights(inp)
+    np.testing.assert_array_equal(res.cross.asf, rep.extras["results"][0].asf)

@@ -285,31 +285,47 @@ def _cmd_mtf_edge(args) -> int:
 def _cmd_asf(args) -> int:
     import numpy as np
 
-    from hsgeo.workflows.asf import AsfOptions, asf_files
+    from hsgeo.workflows.asf import AsfOptions
+    from hsgeo.workflows.asf_flights import asf_files
 
     opts = AsfOptions(margin_m=args.margin, register=not args.no_register)
-    res = asf_files(args.cross, args.along, args.runway, opts)
-    if args.json:
-        print(json_text(res.to_dict()))
-        return 0
-    reg = res.registration
-    if reg is not None:
-        print(
-            f"registration: along image shifted by ({reg.shift_m[0]:+.2f}, {reg.shift_m[1]:+.2f}) "
-            f"m (E, N) from {reg.n_windows} windows; scatter between windows "
-            f"{reg.scatter_px:.2f} px, σ̂ of the shift {reg.sigma_px:.3f} px"
-        )
-    print(f"{int(res.usable.sum())} of {res.usable.size} columns usable")
-    pp = ", ".join(f"{v:.1f}" for v in res.peak_to_peak_percent)
-    print(f"peak-to-peak ASF variation per band, %: {pp}")
-    print(
-        "scan_angle_deg " + " ".join(f"{'band ' + str(b + 1):>8}" for b in range(res.asf.shape[0]))
+    out = asf_files(
+        args.cross,
+        args.along,
+        args.runway,
+        opts,
+        sensor_path=args.sensor,
+        trajectory_path=args.trajectory,
+        reverse_path=args.reverse,
+        terrain_height_m=args.runway_height,
     )
+    if args.json:
+        print(json_text(out.to_dict()))
+        return 0
+    res = getattr(out, "cross", out)
+    for label, r in (("", res), ("reverse crossing: ", getattr(out, "reverse", None))):
+        reg = None if r is None else r.registration
+        if reg is not None:
+            print(
+                f"{label}registration: along image shifted by ({reg.shift_m[0]:+.2f}, "
+                f"{reg.shift_m[1]:+.2f}) m (E, N) from {reg.n_windows} windows; scatter between "
+                f"windows {reg.scatter_px:.2f} px, σ̂ of the shift {reg.sigma_px:.3f} px"
+            )
+    usable = getattr(out, "usable", res.usable)
+    asf = getattr(out, "asf", res.asf)
+    if getattr(out, "reverse", None) is not None:
+        print("ASF of the two opposite crossings combined (sqrt of their product)")
+    print(f"{int(usable.sum())} of {usable.size} columns usable")
+    from hsgeo.workflows.asf import peak_to_peak_percent
+
+    pp = ", ".join(f"{v:.1f}" for v in peak_to_peak_percent(asf, usable, res.smooth_px))
+    print(f"peak-to-peak ASF variation per band, %: {pp}")
+    print("scan_angle_deg " + " ".join(f"{'band ' + str(b + 1):>8}" for b in range(asf.shape[0])))
     for ang in (-40, -30, -20, -10, 0, 10, 20, 30, 40):
         j = int(np.argmin(np.abs(res.scan_angle_deg - ang)))
-        if abs(res.scan_angle_deg[j] - ang) > 1 or not res.usable[j]:
+        if abs(res.scan_angle_deg[j] - ang) > 1 or not usable[j]:
             continue
-        vals = " ".join(f"{v:8.4f}" for v in res.asf[:, j])
+        vals = " ".join(f"{v:8.4f}" for v in asf[:, j])
         print(f"{res.scan_angle_deg[j]:14.2f} {vals}")
     return 0
 

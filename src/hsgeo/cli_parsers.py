@@ -564,19 +564,43 @@ def add_asf(sub) -> argparse.ArgumentParser:
         "asf",
         help="angular sensitivity of a whiskbroom scanner: cross-runway / along-runway (004)",
         description="The angular sensitivity function (ASF) of a whiskbroom scanner from a scan "
-        "crossing a runway divided by an overflight along it (004 steps 1-3): the along image "
-        "is registered onto the cross scan by the landmarks at the runway's sides (a shift per "
-        "window along both long edges, their median), both are averaged over the runway's "
-        "width, divided, and normalised to nadir. CROSS and ALONG: georegistered scans, NetCDF "
-        "with reflectance(band, line, pixel), E_m(line, pixel) and N_m(line, pixel) (the "
-        "ground point of every sample, m, in one map frame) and scan_angle_deg(pixel) "
-        "(positive to the right of the heading). RUNWAY: CSV or Parquet with columns E_m, N_m, "
-        "the runway's corners in order around it.",
+        "crossing a runway divided by an overflight along it (004 steps 1-3): the scans are "
+        "georegistered with the sensor and the navigation (the panoramic model), the along "
+        "image is registered onto the cross scan by the landmarks at the runway's sides (a "
+        "shift per window along both long edges, their median), both are averaged over the "
+        "runway's width, divided, and normalised to nadir; with --reverse, a second crossing "
+        "flown the opposite way is combined with the first (sqrt of the product: the odd part "
+        "of a BRDF cancels). RAW SCANS (with --sensor and --trajectory): NetCDF flight lines "
+        "with radiance(band, line, pixel), the coordinate pixel (the detector pixel of each "
+        "column) and the attributes t0_s (time of line 0 on the navigation's time scale) and "
+        'line_rate_hz. SENSOR: TOML, [sensor] model = "panoramic", n_px, ifov_deg (degrees), '
+        "active_fraction, boresight_deg, lever_arm_m. NAV: t_s, E_m, N_m, U_m, roll_deg, "
+        "pitch_deg, heading_deg (hsgeo.io.navigation). SCANS GEOREGISTERED ELSEWHERE (without "
+        "--sensor/--trajectory): NetCDF with reflectance(band, line, pixel), E_m(line, pixel) "
+        "and N_m(line, pixel) (the ground point of every sample, m, in one map frame) and "
+        "scan_angle_deg(pixel) (degrees, positive to the right of the heading). RUNWAY: CSV or "
+        "Parquet with columns E_m, N_m, the runway's corners in order around it, in the "
+        "navigation's map frame.",
     )
     p.add_argument("cross", metavar="CROSS.nc", help="the scan crossing the runway")
     p.add_argument("along", metavar="ALONG.nc", help="the scan flown along the runway")
     p.add_argument(
         "--runway", required=True, metavar="RUNWAY.csv", help="runway corners (E_m, N_m)"
+    )
+    p.add_argument("--sensor", metavar="SENSOR.toml", help="the scanner's sensor file (raw scans)")
+    p.add_argument(
+        "--trajectory", metavar="NAV.csv", help="the navigation of the flights (raw scans)"
+    )
+    p.add_argument(
+        "--reverse",
+        metavar="REVERSE.nc",
+        help="a second crossing flown with the opposite heading (raw scans)",
+    )
+    p.add_argument(
+        "--runway-height",
+        type=option_number(lo=-1000.0, hi=10000.0),
+        default=0.0,
+        help="the runway's height U in the navigation's frame, m (default 0)",
     )
     p.add_argument(
         "--margin",

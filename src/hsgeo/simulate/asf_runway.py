@@ -2,7 +2,10 @@
 
 The scene (004 § Application): a runway of asphalt about 50 pixels wide whose reflectance varies
 by up to 20 % (a sum of cosines of 15–200 m wavelength, shared by the channels, plus a weaker
-pattern that differs between channels), grass beside it, small bright landmarks at its sides;
+pattern that differs between channels), with structure finer than a pixel — sealed transverse
+joints every 5 m and the centre line's painted dashes (ICAO: 30 m long, 0.9 m wide, 20 m apart),
+integrated exactly over each pixel's footprint (:meth:`_Field.subpixel`) — grass beside it,
+small bright landmarks at its sides;
 the sun 40° from the zenith, at an azimuth such that the cross-runway scan makes 68.5° (to the
 left) and 111.5° (to the right) with it. Reflectance images (the atmosphere already removed,
 as in 004). The runway runs east–west, centred on N = 0.
@@ -17,13 +20,19 @@ times the channel's true ASF at the pixel's scan angle and a mild BRDF factor (s
     f(θv, φ) = 1 + k_even·sin²θv + k_odd·sin θv·cos φ
 
 (θv the view zenith, φ the azimuth between the view and the sun): across the principal plane the
-first term is even in the scan angle and the second odd. Multiplicative sensor noise is added.
+first term is even in the scan angle and the second odd. A residual of the atmospheric
+correction (switchable, off by default) adds path radiance growing as 1/cos θv − 1. Multiplicative
+sensor noise is added.
 The recorded navigation differs from the true one by a constant position error per flight, so
 that the along-runway image must be registered onto the cross scan.
 
+The flights follow each other in time, so that one navigation record covers them all
+(:func:`navigation`), as a GNSS/INS delivers it.
+
 Chosen (not in 004, stated in the chapter): the true ASF curves (:func:`true_asf`, shaped as
 the paper describes them — largest variation 15 % in channel 1, 4–12 % in the others), the
-reflectances, the texture, the landmarks, the BRDF coefficients, the noise (0.5 % per sample),
+reflectances, the texture, the joints (5.5 mm, half as bright as the pavement) and the dashes,
+the landmarks, the BRDF and path-radiance coefficients, the noise (0.5 % per sample),
 the speed and line rate (0.63 m per line), the navigation errors.
 """
 
@@ -46,6 +55,7 @@ __all__ = [
     "true_asf",
     "simulate_runway",
     "add_noise",
+    "navigation",
     "ASF_PEAK_TO_PEAK_PERCENT",
 ]
 
@@ -81,6 +91,7 @@ class RunwayScene:
     runway_length_m: float = 1400.0
     reflectance_variation: float = 0.10  # 004: "deviations of up to 20 %" (±10 %)
     n_cosines: int = 12
+    texture_min_wavelength_m: float = 15.0
     landmark_spacing_m: float = 15.0
     landmark_size_m: float = 1.5
     landmark_offset_m: float = 3.0  # outside the runway edge
@@ -99,6 +110,22 @@ class RunwayScene:
     along_nav_error_m: tuple = (-0.9, 0.7, 0.0)
     reverse_nav_error_m: tuple = (0.3, 0.5, 0.0)
     along_offset_m: float = 1.5  # the along track's distance north of the runway's centre line
+    # sub-metre structure of the runway (chosen; 37.6: a runway with none lets any
+    # registration pass): sealed transverse joints between the pavement's slabs and the
+    # centre-line markings (ICAO Annex 14: dashes 30 m long, 20 m gaps, 0.9 m wide)
+    joint_spacing_m: float = 5.0
+    joint_width_m: float = 0.0055
+    joint_factor: float = 0.5  # the sealant's reflectance / the pavement's
+    centreline_dash_m: float = 30.0
+    centreline_gap_m: float = 20.0
+    centreline_width_m: float = 0.9
+    # residual of the atmospheric correction (unmodelled; off by default): an additive term
+    # growing with the view angle as 1/cos θv − 1, this share of the runway's mean
+    # reflectance at θv = 43°
+    path_radiance: bool = False
+    path_radiance_percent: float = 3.0
+    # the flights follow each other (one navigation file for all): start times, s
+    flight_start_s: tuple = (0.0, 100.0, 200.0)
     sensor: PanoramicScanner = field(default_factory=PanoramicScanner)
 
     @property
@@ -196,6 +223,7 @@ class _Field:
     weights2: np.ndarray
     grass: tuple
     landmarks_en: np.ndarray
+    feature_offsets_m: tuple  # where the joints and the centre-line dashes start (E, m)
 
     def __call__(self, E, N):
         s = self.scene
@@ -217,10 +245,47 @@ class _Field:
             hit |= (np.abs(E - lm[jj, 0]) <= half) & (np.abs(np.abs(N) - lm[jj, 1]) <= half)
         return np.where(hit, np.asarray(_PAINT)[:, None], rho)
 
+    def subpixel(self, E, N, wE, wN):
+        """Shares of each pixel's footprint (a box ``wE × wN`` m centred on (E, N)) covered by
+        the centre-line paint and by the joints' sealant: these features are narrower than a
+        pixel, so they are integrated over the footprint exactly instead of being hit by the
+        jittered rays (a 2 cm joint hit by one ray in four would add its full contrast to a
+        pixel by chance).
+        """
+        s = self.scene
+        w = s.runway_width_m / 2
+        e0, e1 = E - wE / 2, E + wE / 2
+        n0, n1 = N - wN / 2, N + wN / 2
+        jo, do = self.feature_offsets_m
+        joints = _periodic_overlap(e0, e1, jo, s.joint_spacing_m, s.joint_width_m)
+        joints *= _overlap(n0, n1, -w, w)
+        cw = s.centreline_width_m / 2
+        period = s.centreline_dash_m + s.centreline_gap_m
+        paint = _periodic_overlap(e0, e1, do, period, s.centreline_dash_m)
+        paint *= _overlap(n0, n1, -cw, cw)
+        area = wE * wN
+        return paint / area, joints / area
+
+
+def _overlap(a0, a1, b0, b1):
+    """Length of [a0, a1] ∩ [b0, b1]."""
+    return np.clip(np.minimum(a1, b1) - np.maximum(a0, b0), 0.0, None)
+
+
+def _periodic_overlap(a0, a1, x0, period, length):
+    """Length of [a0, a1] ∩ (the union of [x0 + k·period, x0 + k·period + length], all k)."""
+
+    def cum(x):
+        u = x - x0
+        return np.floor(u / period) * length + np.clip(np.mod(u, period), 0.0, length)
+
+    return cum(a1) - cum(a0)
+
 
 def _field(scene: RunwayScene, rng) -> _Field:
-    runway = _cosines(rng, scene.n_cosines, 15.0, 200.0, 0.8 * scene.reflectance_variation)
-    runway2 = _cosines(rng, 6, 15.0, 200.0, 0.2 * scene.reflectance_variation)
+    lam = (scene.texture_min_wavelength_m, 200.0)
+    runway = _cosines(rng, scene.n_cosines, *lam, 0.8 * scene.reflectance_variation)
+    runway2 = _cosines(rng, 6, *lam, 0.2 * scene.reflectance_variation)
     weights2 = rng.uniform(-1, 1, scene.n_channels)
     grass = _cosines(rng, 8, 5.0, 40.0, 0.15)
     half = scene.runway_length_m / 2
@@ -229,7 +294,22 @@ def _field(scene: RunwayScene, rng) -> _Field:
     row = scene.runway_width_m / 2 + scene.landmark_offset_m
     # one landmark on each side at each E (the field looks them up at |N| = row)
     lm = np.column_stack([np.sort(E), np.full(E.size, row)])
-    return _Field(scene, runway, runway2, weights2, grass, lm)
+    offsets = (
+        rng.uniform(0, scene.joint_spacing_m),
+        rng.uniform(0, scene.centreline_dash_m + scene.centreline_gap_m),
+    )
+    return _Field(scene, runway, runway2, weights2, grass, lm, offsets)
+
+
+def _path_radiance(scene: RunwayScene, directions) -> np.ndarray:
+    """The atmospheric correction's residual, ``(bands, n)`` in reflectance units (0 if off)."""
+    nb = scene.n_channels
+    if not scene.path_radiance:
+        return np.zeros((nb, directions.shape[0]))
+    grow = 1.0 / np.abs(directions[:, 2]) - 1.0
+    edge = 1.0 / np.cos(np.deg2rad(43.0)) - 1.0
+    level = scene.path_radiance_percent / 100.0 * np.asarray(_ASPHALT)[:, None]
+    return level * (grow / edge)[None]
 
 
 def _brdf(scene: RunwayScene, origins, directions) -> np.ndarray:
@@ -270,24 +350,38 @@ def _render(scene, field_, traj, lines, zeta, t0_s, asf, rng):
                 o, d = s.rays(Z.ravel() + dz, t, traj)
                 g = intersect(o, d, terrain)
                 acc += field_(g[:, 0], g[:, 1])
-        out[:, a : a + ll.size] = (acc / m**2).reshape(nb, ll.size, nz)
+        base = acc / m**2
         t = s.times(L.ravel(), Z.ravel(), t0_s, scene.line_rate_hz)
         o, d = s.rays(Z.ravel(), t, traj)
-        brdf[a : a + ll.size] = _brdf(scene, o, d).reshape(ll.size, nz)
-    return out * asf[:, None, :] * brdf[None], brdf
+        g0 = intersect(o, d, terrain)
+        # the footprint's extent in E and N from the neighbouring pixel and line
+        ext = np.zeros((2, L.size))
+        for dl, dz in ((0.0, 1.0), (1.0, 0.0)):
+            t1 = s.times(L.ravel() + dl, Z.ravel() + dz, t0_s, scene.line_rate_hz)
+            g1 = intersect(*s.rays(Z.ravel() + dz, t1, traj), terrain)
+            ext += np.abs(g1[:, :2] - g0[:, :2]).T
+        if hasattr(field_, "subpixel"):  # a bare function of (E, N) has no sub-pixel parts
+            paint, joint = field_.subpixel(g0[:, 0], g0[:, 1], ext[0], ext[1])
+            base = base * (1.0 - paint - (1.0 - scene.joint_factor) * joint)
+            base += paint[None] * np.asarray(_PAINT)[:, None]
+        b = _brdf(scene, o, d)
+        val = base * b[None] + _path_radiance(scene, d)
+        out[:, a : a + ll.size] = val.reshape(nb, ll.size, nz)
+        brdf[a : a + ll.size] = b.reshape(ll.size, nz)
+    return out * asf[:, None, :], brdf
 
 
-def _flight(scene, heading_rad, start_en, n_lines, nav_error_m):
+def _flight(scene, heading_rad, start_en, n_lines, nav_error_m, t_start_s=0.0):
     """True and recorded trajectories of a straight level flight, and t0 of line 0."""
     T = n_lines / scene.line_rate_hz + 2.0
     v = scene.speed_m_s * np.array([np.sin(heading_rad), np.cos(heading_rad), 0.0])
     p0 = np.array([start_en[0], start_en[1], scene.height_m]) - v * 1.0
-    t = np.array([0.0, T])
+    t = t_start_s + np.array([0.0, T])
     xyz = np.stack([p0, p0 + v * T])
     att = np.tile(np.deg2rad([0.3, -0.2, 0.0]) + [0, 0, heading_rad], (2, 1))
     true = Trajectory(t, xyz, att)
     rec = Trajectory(t, xyz + np.asarray(nav_error_m, float), att)
-    return true, rec, 1.0
+    return true, rec, t_start_s + 1.0
 
 
 def simulate_runway(scene: RunwayScene | None = None, rng=0, *, reverse: bool = True):
@@ -324,8 +418,9 @@ def simulate_runway(scene: RunwayScene | None = None, rng=0, *, reverse: bool = 
     if reverse:
         flights["reverse"] = (np.pi, (0.0, half_w), n_cross, scene.reverse_nav_error_m, zeta_all)
     scans, clean, brdfs = {}, {}, {}
+    starts = dict(zip(("cross", "along", "reverse"), scene.flight_start_s, strict=True))
     for name, (heading, start, n, err, zeta) in flights.items():
-        true, rec, t0 = _flight(scene, heading, start, n, err)
+        true, rec, t0 = _flight(scene, heading, start, n, err, starts[name])
         a = asf[:, np.rint(zeta).astype(int)]
         img, brdf = _render(scene, field_, true, np.arange(n), zeta, t0, a, rng)
         clean[name] = img
@@ -364,3 +459,16 @@ def add_noise(clean, scene: RunwayScene, rng) -> np.ndarray:
     rng = as_rng(rng)
     x = np.asarray(clean, dtype=float)
     return x * (1.0 + scene.noise_relative * rng.standard_normal(x.shape))
+
+
+def navigation(obs: RunwayObservations) -> Trajectory:
+    """The recorded navigation of all flights as one record (what a GNSS/INS delivers for the
+    whole campaign): the flights' records in time order.
+    """
+    trs = [s.trajectory for s in (obs.cross, obs.along, obs.reverse) if s is not None]
+    trs.sort(key=lambda tr: tr.t_s[0])
+    return Trajectory(
+        np.concatenate([tr.t_s for tr in trs]),
+        np.concatenate([tr.xyz_m for tr in trs]),
+        np.concatenate([tr.roll_pitch_heading_rad for tr in trs]),
+    )

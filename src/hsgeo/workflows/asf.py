@@ -14,7 +14,8 @@ The user's pipeline, truth-free (004 § Application, steps 1–3):
 
 The in-memory core :func:`asf_from_scans` (frozen :class:`AsfInputs`, :class:`AsfOptions` →
 :class:`AsfResult`) is what ``hsgeo reproduce asf`` and the command line both call; the file
-front end :func:`asf_files` reads through :mod:`hsgeo.io.scans`.
+front end :func:`hsgeo.workflows.asf_flights.asf_files` reads through :mod:`hsgeo.io.scans`
+(raw scans georegistered there, :mod:`hsgeo.workflows.asf_flights`).
 """
 
 from __future__ import annotations
@@ -41,7 +42,6 @@ __all__ = [
     "inside_polygon",
     "register",
     "asf_from_scans",
-    "asf_files",
     "peak_to_peak_percent",
 ]
 
@@ -176,6 +176,13 @@ class AsfOptions:
     smooth_px : int
         Local quadratic fit over this many columns (odd) before the peak-to-peak variation is
         taken (:func:`peak_to_peak_percent`).
+    reject_k : float or None
+        Samples whose ratio cross / along departs from its column's median by more than this
+        many robust σ (NMAD over the column, in any band) are left out of the averages: a
+        marking narrower than the runway (the centre line's paint) seen by one scan and not by
+        the other at the same ground point — at a dash's end, where one pixel of registration
+        error or the two scans' different footprints put paint in one and asphalt in the
+        other. ``None`` averages every sample (004's "average over the width").
     """
 
     margin_m: float = 2.0
@@ -188,15 +195,19 @@ class AsfOptions:
     search_m: float = 4.0
     search_step_m: float = 0.8
     smooth_px: int = 31
+    reject_k: float | None = 5.0
 
 
 @dataclass(frozen=True)
 class AsfInputs:
-    """The cross-runway scan, the along-runway image and the runway polygon (E, N corners)."""
+    """The cross-runway scan, the along-runway image and the runway polygon (E, N corners);
+    ``names``: how messages name the two scans (the file front end gives the files).
+    """
 
     cross: GeoScan
     along: GeoScan
     runway_polygon_m: np.ndarray
+    names: tuple = ("the cross scan", "the along image")
 
 
 @dataclass(frozen=True)
@@ -357,7 +368,11 @@ def register(
                 for de in g
             ]
         )  # fmt: skip
+        if not np.any(np.nan_to_num(score) != 0):
+            break  # the along image covers no window: the check of the windows below says so
         i, j = np.unravel_index(np.nanargmax(score), score.shape)
+        if half == options.search_m:
+            _check_coarse_match(score, i, j, len(sel), options)
         d0 = d0 + [g[i], g[j]]
     centres, shifts = [], []
     for k in range(len(sel)):
@@ -378,6 +393,31 @@ def register(
     scatter = float(np.hypot(*spread)) / gsd
     se = np.sqrt(np.pi / 2) / np.sqrt(len(S))  # standard error of a median, normal errors
     return Registration(med, S, np.array(centres), scatter, se * scatter, gsd, se * spread)
+
+
+#: The smallest mean normalised cross-correlation of the registration windows at the best
+#: shift of the coarse search (chosen: landmarks seen by both scans correlate at 0.6–0.9 on the
+#: simulated runway; scans whose navigation is off by more than the search correlate at < 0.3).
+MIN_MEAN_NCC = 0.4
+
+
+def _check_coarse_match(score, i, j, n_windows, options: AsfOptions) -> None:
+    """Refuse a coarse registration that found no match: the best shift on the edge of the
+    search grid, or windows that hardly correlate there.
+    """
+    last = score.shape[0] - 1
+    mean_ncc = float(score[i, j]) / max(n_windows, 1)
+    edge = i in (0, last) or j in (0, last)
+    if mean_ncc < MIN_MEAN_NCC or edge:
+        where = ", at the edge of the search" if edge else ""
+        raise InputError(
+            f"the landmarks of the two scans do not match within ±{options.search_m:g} m "
+            f"(best mean correlation of the {n_windows} registration windows "
+            f"{mean_ncc:.2f}{where}): "
+            "the along scan's navigation is off by more than the search (a time or position "
+            "offset?) or the scans do not show the same runway; correct the navigation, or "
+            "widen the search (AsfOptions.search_m)"
+        )
 
 
 def peak_to_peak_percent(asf, usable, smooth_px: int) -> np.ndarray:
@@ -454,14 +494,38 @@ class AsfResult:
         }
 
 
+def _disagreeing_samples(c, a, inside, k: float) -> np.ndarray:
+    """Samples whose log ratio c / a lies more than ``k`` robust σ from its column's median in
+    any band, ``(lines, pixels)`` bool (the column's σ: 1.4826 × the median absolute deviation,
+    at least 0.1 %).
+    """
+    with np.errstate(invalid="ignore", divide="ignore"):
+        r = np.log(c / a)
+    r = np.where(inside[None] & np.isfinite(r), r, np.nan)
+    out = np.zeros(inside.shape, bool)
+    cols = np.flatnonzero(np.isfinite(r).any(axis=(0, 1)))
+    if cols.size == 0:
+        return out
+    rc = r[:, :, cols]
+    med = np.nanmedian(rc, axis=1, keepdims=True)
+    dev = np.abs(rc - med)
+    sd = np.maximum(1.4826 * np.nanmedian(dev, axis=1, keepdims=True), 1e-3)
+    with np.errstate(invalid="ignore"):
+        out[:, cols] = np.any(dev > k * sd, axis=0)
+    return out
+
+
 def asf_from_scans(inputs: AsfInputs, options: AsfOptions = AsfOptions()) -> AsfResult:
     """The ASF from a cross-runway scan and an along-runway image (004 steps 1–3)."""
     cross, along = inputs.cross, inputs.along
     if cross.values.shape[0] != along.values.shape[0]:
         raise InputError(
-            f"the cross scan has {cross.values.shape[0]} bands, the along image "
+            f"{inputs.names[0]} has {cross.values.shape[0]} bands, {inputs.names[1]} "
             f"{along.values.shape[0]}: give scans of the same channels"
         )
+    from hsgeo.workflows.asf_checks import check_pair
+
+    check_pair(inputs)
     inside = inside_polygon(cross.E_m, cross.N_m, inputs.runway_polygon_m, options.margin_m)
     if inside.sum() == 0:
         raise InputError(
@@ -484,6 +548,8 @@ def asf_from_scans(inputs: AsfInputs, options: AsfOptions = AsfOptions()) -> Asf
         )
     a = np.full(cross.values.shape, np.nan)
     a[:, inside] = sampler.values(lp)
+    if options.reject_k is not None:
+        inside = inside & ~_disagreeing_samples(cross.values, a, inside, options.reject_k)
     r = asf_ratio(
         cross.values,
         a,
@@ -496,15 +562,3 @@ def asf_from_scans(inputs: AsfInputs, options: AsfOptions = AsfOptions()) -> Asf
     return AsfResult(
         cross.scan_angle_rad, r.asf, r.sigma, r.n_samples, usable, reg, options.smooth_px
     )
-
-
-def asf_files(cross_path, along_path, runway_path, options: AsfOptions = AsfOptions()):
-    """The file front end of ``hsgeo asf``: two georegistered scans and the runway polygon
-    (formats in :mod:`hsgeo.io.scans`).
-    """
-    from hsgeo.io.scans import read_geoscan, read_runway
-
-    cross = GeoScan(*read_geoscan(cross_path, "CROSS"))
-    along = GeoScan(*read_geoscan(along_path, "ALONG"))
-    poly = read_runway(runway_path)
-    return asf_from_scans(AsfInputs(cross, along, poly), options)
