@@ -476,7 +476,8 @@ def read_sensor_tables(path, what: str = "sensor file") -> tuple[str, dict, str]
     if not isinstance(s, dict):
         raise InputError(
             f"{what} {path}: [sensor]: missing table; a sensor file starts with [sensor] and "
-            f'model = "..." (one of {_models_text()})'
+            f'model = "..." (one of {_models_text()}), or is the former 002 camera file '
+            "with a [camera] table"
         )
     if "model" not in s:
         raise InputError(
