@@ -212,3 +212,14 @@ def test_netcdf_lines_by_suffix(tmp_path):
     np.testing.assert_array_equal(open_line_strip(tmp_path / "s1.nc").t_s, strip.t_s)
     with pytest.raises(InputError, match="carries its own line times"):
         read_line_cube(tmp_path / "s1.nc", [1, 2, 3, 4, 5])
+
+
+def test_read_line_cube_is_lazy(tmp_path):
+    """Nothing is read when the cube is opened: bytes changed afterwards are what is computed
+    (Dask given a memmap ndarray would copy it whole into its graph)."""
+    v = _cube()
+    p, _ = _write(tmp_path, "lazy.raw", v, extra="start time_s = 0\nline_rate_hz = 100\n")
+    da, _ = read_line_cube(p, lines_per_chunk=2)
+    assert type(da.data).__module__.startswith("dask")
+    (2 * v).astype("<f4").transpose(0, 2, 1).tofile(p)  # the same size, new values (BIL)
+    np.testing.assert_array_equal(da.values, 2 * v)
