@@ -223,3 +223,17 @@ def test_read_line_cube_is_lazy(tmp_path):
     assert type(da.data).__module__.startswith("dask")
     (2 * v).astype("<f4").transpose(0, 2, 1).tofile(p)  # the same size, new values (BIL)
     np.testing.assert_array_equal(da.values, 2 * v)
+
+
+def test_ignore_value_compared_exactly(tmp_path):
+    """int32 16777217 marks no-data; 16777216 (the same float32) stays a value. A uint16 cube
+    with a negative ignore value has no no-data (and no error)."""
+    v = _cube("int32")
+    v[0, 0, 0], v[0, 0, 1] = 16777217, 16777216
+    extra = "data ignore value = 16777217\nstart time_s = 0\nline_rate_hz = 100\n"
+    p, _ = _write(tmp_path, "i.raw", v, extra=extra, dtype_code=3)
+    out = read_line_cube(p)[0].values
+    assert np.isnan(out[0, 0, 0]) and out[0, 0, 1] == 16777216 and np.isnan(out).sum() == 1
+    extra = "data ignore value = -9999\nstart time_s = 0\nline_rate_hz = 100\n"
+    p, _ = _write(tmp_path, "u.raw", _cube("uint16"), extra=extra, dtype_code=12)
+    assert not np.isnan(read_line_cube(p)[0].values).any()

@@ -46,10 +46,10 @@ def _lazy_float32(cube, lines_per_chunk: int):
     arr = da.from_array(
         _Window(cube.lsb), chunks=(int(lines_per_chunk), -1, -1), name=name, asarray=True
     )
-    arr = arr.astype(np.float32)
-    if cube.ignore_value is not None:
-        arr = da.where(arr == np.float32(cube.ignore_value), np.float32(np.nan), arr)
-    return arr
+    out = arr.astype(np.float32)
+    if cube.ignore_value is not None:  # compared in float64: exact for every stored type
+        out = da.where(arr == np.float64(cube.ignore_value), np.float32(np.nan), out)
+    return out
 
 
 def read_line_cube(path, times=None, *, lines_per_chunk: int = 256):
