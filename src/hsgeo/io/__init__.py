@@ -18,6 +18,10 @@ One module per format:
   ``hsgeo lp-observations``;
 * :mod:`hsgeo.io.raster` — orthoimages (NetCDF and ENVI) and DEMs (NetCDF);
 * :mod:`hsgeo.io.envi` — ENVI BSQ/BIL/BIP + ``.hdr``, also written in blocks of lines;
+* :mod:`hsgeo.io.envi_read` — ENVI cubes as line scanners write them (``name.hdr`` or
+  ``name.ext.hdr``, memory-mapped) and their line times;
+* :mod:`hsgeo.io.line_cube` — recorded lines of either format (ENVI or NetCDF, by suffix);
+* :mod:`hsgeo.io.view_angles` — the per-pixel view-angle table of a line scanner;
 * :mod:`hsgeo.io.frames` — folders of raw ImSpector frames (16-bit TIFF or ``.npy``) with their
   exposure times and wavelengths (``hsgeo cube``);
 * :mod:`hsgeo.io.cube` — reflectance cubes, NetCDF-4 or ENVI, written chunk by chunk;
