@@ -715,6 +715,14 @@ case(C, "empty", "cam-empty", "[camera]", [("cam.toml", text(""))])
 case(C, "binary", "cam-binary", "cam.toml", [("cam.toml", text(BINARY))])
 case(C, "garbage", "cam-malformed", "cam.toml", [("cam.toml", text("[camera\nc_mm = \n"))])
 case(C, "mistyped", "cam-is-csv", "cam.toml", [("cam.toml", copy_from("gcp.csv"))])
+# the one sensor file (issue 36): a mount in the wrong units, the 002 camera's keys checked
+RAD = "[0.005235987755982988, -0.003490658503988659, 0.0017453292519943296]"  # 0.3, -0.2, 0.1°
+for name, key, value, expect in [
+    ("cam-lever-arm-in-mm", "lever_arm_m", "[150.0, 0.0, -300.0]", "not mm"),
+    ("cam-boresight-in-radians", "boresight_deg", RAD, "are radians"),
+    ("cam-c_band-count", "c_band_mm", "[40.0, 40.1]", "c_band_mm has 2 values"),
+]:
+    case(C, "units", name, expect, [("cam.toml", toml_set("camera", key, value))])
 for o, vals in {"--node-interval": ["0", "-10", "nan", "inf", "abc"]}.items():
     for v in vals:
         case(C, "options", f"{o}={v}", o, argv=opt(o, v))
@@ -987,6 +995,14 @@ case(
     "boresight_deg",
     [("sensor.toml", toml_rename("boresight_deg", "borsight_deg"))],
 )
+# the one sensor file (issue 36): unknown model, a key the model cannot use, wrong units
+for name, key, value, kind, expect in [
+    ("sensor-unknown-model", "model", "'pushbrom'", "mistyped", "did you mean 'pushbroom'"),
+    ("sensor-key-of-pushbroom", "c_band_mm", "[40.0]", "mistyped", "cannot use this key"),
+    ("sensor-lever-arm-in-mm", "lever_arm_m", "[300.0, 0.0, -150.0]", "units", "not mm"),
+    ("sensor-boresight-in-radians", "boresight_deg", RAD, "units", "are radians"),
+]:
+    case(C, kind, name, expect, [("sensor.toml", toml_set("sensor", key, value))])
 case(
     C,
     "mistyped",

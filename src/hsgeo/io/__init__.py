@@ -22,6 +22,10 @@ One module per format:
   ``hsgeo lp-observations``;
 * :mod:`hsgeo.io.raster` — orthoimages (NetCDF and ENVI) and DEMs (NetCDF);
 * :mod:`hsgeo.io.envi` — ENVI BSQ/BIL/BIP + ``.hdr``, also written in blocks of lines;
+* :mod:`hsgeo.io.envi_read` — ENVI cubes as line scanners write them (``name.hdr`` or
+  ``name.ext.hdr``, memory-mapped) and their line times;
+* :mod:`hsgeo.io.line_cube` — recorded lines of either format (ENVI or NetCDF, by suffix);
+* :mod:`hsgeo.io.view_angles` — the per-pixel view-angle table of a line scanner;
 * :mod:`hsgeo.io.frames` — folders of raw ImSpector frames (16-bit TIFF or ``.npy``) with their
   exposure times and wavelengths (``hsgeo cube``);
 * :mod:`hsgeo.io.cube` — reflectance cubes, NetCDF-4 or ENVI, written chunk by chunk;
@@ -39,6 +43,8 @@ from hsgeo.io._files import atomic_path, refuse_inputs
 from hsgeo.io.boards import Board, read_board
 from hsgeo.io.config import Key, read_config, read_toml
 from hsgeo.io.envi import read_envi, write_envi
+from hsgeo.io.envi_read import line_times, open_envi
+from hsgeo.io.line_cube import open_line_strip, read_line_cube
 from hsgeo.io.lines import read_lines, write_lines
 from hsgeo.io.lp_lines import LpStrip, read_lp_lines, write_lp_lines
 from hsgeo.io.navigation import (
@@ -98,6 +104,10 @@ __all__ = [
     "to_map_files",
     "read_dem",
     "read_envi",
+    "open_envi",
+    "line_times",
+    "read_line_cube",
+    "open_line_strip",
     "write_envi",
     "read_opencv_storage",
     "read_nist_strd",

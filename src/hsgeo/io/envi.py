@@ -228,61 +228,39 @@ class EnviWriter:
 
 
 def read_envi(path) -> tuple[np.ndarray, dict]:
-    """Read a BSQ/BIL/BIP ENVI file written by :func:`write_envi` (or ENVI itself).
+    """Read a BSQ/BIL/BIP ENVI file written by :func:`write_envi` (or ENVI, or a line scanner).
+
+    The reading is :func:`hsgeo.io.envi_read.open_envi`'s: the header ``name.hdr`` or
+    ``name.ext.hdr``, either byte order, a ``header offset``, the size checked.
+
+    Parameters
+    ----------
+    path : str or Path
+        The binary file, its header, or the name without extension.
 
     Returns
     -------
     data : (bands, lines, samples) ndarray
+        A read-only view of a :class:`numpy.memmap` (nothing is read until used; copy it to
+        change it). ``data ignore value`` is not applied (see ``header``).
     header : dict
-        Header entries (strings; ``map info`` parsed to floats under ``map_info``).
+        Header entries (strings); ``map info`` parsed to floats under ``map_info``;
+        ``wavelength_nm``, ``fwhm_nm`` in nm (converted from ``wavelength units``).
     """
-    path = Path(path)
-    hpath = path.with_name(path.name + ".hdr")
-    if not hpath.is_file():
-        raise InputError(f"{hpath}: ENVI header not found next to {path}")
-    text = hpath.read_text()
-    if not text.startswith("ENVI"):
-        raise InputError(f"{hpath}: not an ENVI header (first line must be 'ENVI')")
-    hdr: dict = {}
-    key, buf = None, ""
-    for line in text.splitlines()[1:]:
-        if key is not None:
-            buf += " " + line.strip()
-            if "}" in line:
-                hdr[key], key = buf.strip(), None
-            continue
-        if "=" not in line:
-            continue
-        k, v = (s.strip() for s in line.split("=", 1))
-        if v.startswith("{") and "}" not in v:
-            key, buf = k.lower(), v
-        else:
-            hdr[k.lower()] = v
-    try:
-        b, lines, samples = int(hdr["bands"]), int(hdr["lines"]), int(hdr["samples"])
-        dtype = {v: k for k, v in _ENVI_TYPES.items()}[int(hdr["data type"])]
-    except (KeyError, ValueError) as exc:
-        raise InputError(
-            f"{hpath}: missing or bad entry ({exc}); need samples, lines, bands, data type"
-        ) from None
-    if hdr.get("byte order", "0") == "1":
-        dtype = dtype.newbyteorder(">")
-    raw = np.fromfile(path, dtype=dtype, offset=int(hdr.get("header offset", 0)))
-    if raw.size != b * lines * samples:
-        raise InputError(f"{path}: {raw.size} values, the header says {b}×{lines}×{samples}")
-    inter = hdr.get("interleave", "bsq").lower()
-    shape = {"bsq": (b, lines, samples), "bil": (lines, b, samples), "bip": (lines, samples, b)}
-    if inter not in shape:
-        raise InputError(f"{hpath}: unknown interleave {inter!r}")
-    data = raw.reshape(shape[inter])
-    data = {"bsq": data, "bil": data.transpose(1, 0, 2), "bip": data.transpose(2, 0, 1)}[inter]
-    for key, name in (("wavelength", "wavelength_nm"), ("fwhm", "fwhm_nm")):
-        if key in hdr:
-            try:
-                hdr[name] = np.array([float(x) for x in hdr[key].strip("{}").split(",")])
-            except ValueError:
-                raise InputError(f"{hpath}: the {key} entry is not a list of numbers") from None
+    from hsgeo.io.envi_read import open_envi
+
+    cube = open_envi(path)
+    hdr = dict(cube.header)
+    if cube.wavelength_nm is not None:
+        hdr["wavelength_nm"] = cube.wavelength_nm
+    if cube.fwhm_nm is not None:
+        hdr["fwhm_nm"] = cube.fwhm_nm
     if "map info" in hdr:
         parts = [p.strip() for p in hdr["map info"].strip("{}").split(",")]
-        hdr["map_info"] = tuple(float(x) for x in parts[3:7])
-    return data, hdr
+        try:
+            hdr["map_info"] = tuple(float(x) for x in parts[3:7])
+        except ValueError:
+            raise InputError(
+                f"{cube.header_path}: map info {hdr['map info']!r} unreadable"
+            ) from None
+    return cube.bls, hdr

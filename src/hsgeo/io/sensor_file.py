@@ -19,7 +19,9 @@ model, that model). Example, the 002 LP camera::
 The models (``hsgeo.io.sensor_file.MODELS``): ``line-scanner`` (000 eq. (2), calibrated),
 ``line-scanner-linear-ifov`` (000, the uncalibrated model), ``pushbroom`` (002 LP camera),
 ``panoramic`` (004 whiskbroom), ``frame-opencv`` (a frame camera in OpenCV's form), ``rikola``
-(003 two-sensor frame camera). The files each command read before are recognised:
+(003 two-sensor frame camera), ``view-angle`` (per-pixel view angles, the form manufacturers
+calibrate in: ``angles_csv = "name.csv"`` beside the file, :mod:`hsgeo.io.view_angles`).
+The files each command read before are recognised:
 
 * the 000 sensor file of ``hsgeo geocode`` (``[sensor] model = "calibrated"`` or
   ``"linear-ifov"``) is read (the names are aliases of ``line-scanner`` and
@@ -98,6 +100,8 @@ class SensorModel:
     example: dict
     kind: str = "scanning"
     tables: Mapping[str, Mapping[str, Key]] = field(default_factory=dict)
+    #: keys holding a file name relative to the sensor file (resolved before ``build``)
+    relative_files: tuple = ()
 
 
 def _mount_keys(frame: str) -> dict:
@@ -170,6 +174,32 @@ def _frame(v, where):
 
     intr = (v["fx_px"], v["fy_px"], v["cx_px"], v["cy_px"])
     return FrameCamera(intr, tuple(v["distortion"]), _mount(v))
+
+
+def _view_angle(v, where):
+    from hsgeo.io.view_angles import read_view_angles
+    from hsgeo.sensors.view_angle import ViewAngleScanner
+
+    if ("angles_csv" in v) == ("across_deg" in v):
+        raise InputError(
+            f"{where}: give the view angles either as angles_csv (a CSV beside the sensor file, "
+            "columns pixel, across_deg, along_deg[, band]) or as across_deg (and along_deg) "
+            "lists, not both or neither"
+        )
+    if "angles_csv" in v:
+        across, along = read_view_angles(v["angles_csv"])
+    else:
+        across = np.asarray(v["across_deg"], float)
+        along = np.asarray(v.get("along_deg", np.zeros_like(across)), float)
+        if along.shape != across.shape:
+            raise InputError(
+                f"{where}: along_deg has {along.size} values for {across.size} pixels "
+                "(across_deg); give one per pixel"
+            )
+    try:
+        return ViewAngleScanner(np.deg2rad(across), np.deg2rad(along), _mount(v))
+    except InputError as exc:
+        raise InputError(f"{where}: {exc}") from None
 
 
 def _rikola(v, where):
@@ -258,6 +288,7 @@ def _models():
     from hsgeo.sensors.panoramic import DAEDALUS_IFOV_DEG, DAEDALUS_N_PX, PanoramicScanner
     from hsgeo.sensors.pushbroom import PushbroomCamera
     from hsgeo.sensors.rikola import RikolaCamera
+    from hsgeo.sensors.view_angle import ViewAngleScanner
 
     _register(
         SensorModel(
@@ -412,6 +443,31 @@ def _models():
         )
     )
 
+    across = np.linspace(-17.0, 17.0, 971)  # a 34° line of 971 pixels with a slight smile
+    _register(
+        SensorModel(
+            "view-angle",
+            "a line scanner given by per-pixel view angles, one table or one per band "
+            "(hsgeo.sensors.view_angle.ViewAngleScanner; table: hsgeo.io.view_angles)",
+            {
+                "angles_csv": Key(
+                    "str",
+                    doc="CSV beside the sensor file: pixel, across_deg, along_deg[, band]",
+                ),
+                "across_deg": Key("floats", limit=89.0, doc="across-track angle per pixel, deg"),
+                "along_deg": Key("floats", limit=89.0, doc="along-track angle per pixel, deg"),
+                **_mount_keys(BODY),
+            },
+            _view_angle,
+            ViewAngleScanner,
+            {
+                "across_deg": [round(float(x), 9) for x in across],
+                "along_deg": [round(0.05 * (float(x) / 17.0) ** 2, 9) for x in across],
+            },
+            relative_files=("angles_csv",),
+        )
+    )
+
 
 _models()
 MODELS = MappingProxyType(dict(MODELS))
@@ -476,7 +532,8 @@ def read_sensor_tables(path, what: str = "sensor file") -> tuple[str, dict, str]
     if not isinstance(s, dict):
         raise InputError(
             f"{what} {path}: [sensor]: missing table; a sensor file starts with [sensor] and "
-            f'model = "..." (one of {_models_text()})'
+            f'model = "..." (one of {_models_text()}), or is the former 002 camera file '
+            "with a [camera] table"
         )
     if "model" not in s:
         raise InputError(
@@ -573,8 +630,14 @@ def read_sensor(path):
     >>> read_sensor(p).n_px
     716
     """
+    from pathlib import Path
+
     name, tables, table = read_sensor_tables(path)
-    return MODELS[name].build(tables["sensor"], f"sensor file {path}: [{table}]")
+    values = dict(tables["sensor"])
+    for k in MODELS[name].relative_files:  # a file named in the sensor file: beside it
+        if k in values:
+            values[k] = str(Path(path).parent / values[k])
+    return MODELS[name].build(values, f"sensor file {path}: [{table}]")
 
 
 def model_of(sensor) -> str:

@@ -48,6 +48,7 @@ def sensor_model(sensor) -> str:
     from hsgeo.sensors.panoramic import PanoramicScanner
     from hsgeo.sensors.pushbroom import PushbroomCamera
     from hsgeo.sensors.rikola import RikolaCamera
+    from hsgeo.sensors.view_angle import ViewAngleScanner
 
     if isinstance(sensor, LineScanner):
         return (
@@ -60,6 +61,7 @@ def sensor_model(sensor) -> str:
         (PanoramicScanner, "panoramic"),
         (FrameCamera, "frame-opencv"),
         (RikolaCamera, "rikola"),
+        (ViewAngleScanner, "view-angle"),
     ):
         if isinstance(sensor, cls):
             return name
