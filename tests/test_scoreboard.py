@@ -186,6 +186,7 @@ def test_compact_table_has_one_short_line_per_claim_with_a_link():
         "verdict",
         "provenance",
         "chapter",
+        "owner",
     ]
     assert len(df) == 3 and df["verdict"].tolist() == ["by construction", "differs", "reproduced"]
     assert df["z"].tolist() == ["+0.3", "−10.3", "−0.2"]  # against the paper, σ combined
@@ -224,7 +225,7 @@ def test_claims_with_reasons_lists_one_papers_claims_with_their_verdicts():
         Row("000 Table 3", "dx_m", "m", paper=1.0, reproduced=5.0, sigma=0.1, provenance="chosen"),
     ]
     df = claims_with_reasons(Reproduction("scoreboard", 0, rows), "000")
-    assert list(df.columns) == ["claim", "verdict", "why"]
+    assert list(df.columns) == ["claim", "verdict", "why", "judged in"]
     # in a reader's words, as the compact table above it (no internal key on the page)
     assert list(df.claim) == ["principal distance c (Table 1)", "dx (Table 3)"]
     assert list(df.verdict) == ["reproduced", "differs"]

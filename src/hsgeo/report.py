@@ -13,13 +13,19 @@ format their tables here, in one way:
 
 * ``z`` is ``(reproduced − truth) / σ̂``: how far the estimate lies from the simulation's truth,
   in units of its own standard deviation (σ̂ from the adjustment, or the spread over ``n_runs``
-  repeated simulations for statistics such as an NMAD that have no σ̂ of their own);
+  repeated simulations for statistics such as an NMAD that have no σ̂ of their own — the σ of
+  the mean when the value is a mean of the runs, :meth:`Row.from_runs`); a "not testable" row
+  shows no z;
 * the **verdict** says whether the paper's value was reproduced (:data:`VERDICTS`), with its
   reason; it is computed from the numbers and the truth's **provenance** (:meth:`Row.rule`,
   GUIDE §4): agreement built in (the truth is the paper's value, computed from it, or tuned to
-  it) is ``"by construction"``, never ``"reproduced"``, and a tuning that missed by more than
-  3σ is ``"differs"``. A chapter may state another verdict (an *override*, e.g. ``"planned"``)
-  only with a reason, which the scoreboard prints (:meth:`Row.overridden`);
+  it) is ``"by construction"``, never ``"reproduced"``; a tuning that missed by more than
+  3σ (or by more than 10 % without a σ) and a paper-valued truth recovered more than 3σ̂ off
+  (a failed recovery) are ``"differs"``; a spread from fewer than 8 runs, or a "reproduced"
+  whose σ exceeds half the paper's value, is ``"not testable"``. A number that another
+  chapter owns is shown as ``"context"`` (:attr:`Row.judged_in`). A chapter may state another
+  verdict (an *override*, e.g. ``"planned"``) only with a reason, which the scoreboard prints
+  (:meth:`Row.overridden`);
 * words about agreement in a chapter's prose come from :func:`agreement` and :func:`summarize`,
   never typed.
 """

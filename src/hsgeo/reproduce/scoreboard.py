@@ -22,6 +22,7 @@ chapter is run here.
 from __future__ import annotations
 
 import re
+from dataclasses import replace
 
 from hsgeo.report import (
     _MINUS,
@@ -193,8 +194,12 @@ def claims_with_chapters(reps: dict[str, Reproduction]) -> list[tuple[str | None
     out = []
     for key, pairs in found.items():
         own = owner(key[0])
-        mine = [p for p in pairs if p[0] == own] or pairs
-        out.append(mine[0])
+        mine = [p for p in pairs if p[0] == own]
+        if mine:
+            out.append(mine[0])
+        else:  # the owner did not reproduce this number: the first chapter's row judges it
+            chapter, r = pairs[0]
+            out.append((chapter, replace(r, judged_in=None)))
     return out + [(None, r) for r in planned_claims()]
 
 
@@ -395,6 +400,14 @@ class ClaimTable:
         )
 
 
+def _owner_words(r: Row, chapter: str | None) -> str:
+    """Why ``chapter`` judges the row: the ownership rule of :data:`OWNERS`, or the only one."""
+    hit = OWNERS.get(published_table(r.table))
+    if hit is None:
+        return "the only chapter reproducing it"
+    return f"owner: {hit[1]}"
+
+
 def compact_table(pairs: list[tuple[str | None, Row]], paper: str | None = None) -> ClaimTable:
     """The claims as the scoreboard page shows them (:class:`ClaimTable`): claim (a link to its
     chapter, its unit under it) | paper | reproduced ± σ | z against the paper | verdict, with the
@@ -411,7 +424,7 @@ def compact_table(pairs: list[tuple[str | None, Row]], paper: str | None = None)
         shown = _format_paper(r.paper)
         if r.paper_sigma is not None and _format_paper(r.paper_sigma) != "—":
             shown += f" ± {_format_paper(r.paper_sigma)}"
-        zp = r.z_paper
+        zp = None if r.judge()[0] == "not testable" else r.z_paper  # no z on "not testable"
         recs.append(
             {
                 "claim": _claim_label(r),
@@ -422,11 +435,13 @@ def compact_table(pairs: list[tuple[str | None, Row]], paper: str | None = None)
                 "verdict": r.judge()[0],
                 "provenance": provenance_group(r),
                 "chapter": chapter or "—",
+                "owner": _owner_words(r, chapter),
             }
         )
         chapters.append(chapter)
         provs.append(provenance_group(r))
     cols = ["claim", "unit", "paper", "reproduced ± σ", "z", "verdict", "provenance", "chapter"]
+    cols.append("owner")
     return ClaimTable(pd.DataFrame(recs, columns=cols), chapters, provs)
 
 
@@ -473,10 +488,20 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
 
 
 def claims_with_reasons(board: Reproduction, paper: str):
-    """Every claim of one paper (tables named ``"000 …"`` for ``paper="000"``) with its verdict
-    and the sentence that explains it: a DataFrame with columns claim, verdict, why.
+    """Every claim of one paper (tables named ``"000 …"`` for ``paper="000"``) with its verdict,
+    the sentence that explains it and the chapter that judges it (with the chapters that show it
+    as context): a DataFrame with columns claim, verdict, why, judged in.
     """
     import pandas as pd
 
-    recs = [(_claim_label(r), *r.judge()) for r in board.rows if r.table.startswith(paper)]
-    return pd.DataFrame(recs, columns=["claim", "verdict", "why"])
+    chapters = board.meta.get("chapters") or [None] * len(board.rows)
+    context = board.meta.get("context") or [[]] * len(board.rows)
+    recs = []
+    for r, c, ctx in zip(board.rows, chapters, context, strict=True):
+        if not r.table.startswith(paper):
+            continue
+        where = c or "—"
+        if ctx:
+            where += f" (context in {', '.join(ctx)})"
+        recs.append((_claim_label(r), *r.judge(), where))
+    return pd.DataFrame(recs, columns=["claim", "verdict", "why", "judged in"])
