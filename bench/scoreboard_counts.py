@@ -33,7 +33,7 @@ def load(directory: Path, rejudge: bool) -> dict[str, Reproduction]:
     reps = {}
     for chapter in PAPER_CHAPTERS:
         path = directory / f"{chapter}.json"
-        if not path.is_file():
+        if not path.is_file() or path.stat().st_size == 0:  # absent, or still being written
             continue
         d = json.loads(path.read_text(encoding="utf-8"))
         rep = Reproduction.from_json(path.read_text(encoding="utf-8"))

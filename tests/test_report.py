@@ -95,6 +95,13 @@ def test_a_paper_valued_truth_recovered_beyond_three_sigma_is_a_failed_recovery(
     assert d.judge()[0] == "differs" and d.judge()[1].startswith("recovery failed")
     d.provenance = "tuned"
     assert d.judge()[0] == "by construction"
+    # a tuned truth that meets the paper, estimated beyond 3σ̂ of it: the recovery failed, not
+    # the tuning (the slanted edge's borderline frequency: 0.3022 ± 0.0006 against 0.3)
+    e = Row("t", "f", "cy/px", paper=0.3, reproduced=0.3022, sigma=0.0006, truth=0.3000,
+            n_runs=24, mean_of_runs=True, provenance="tuned")  # fmt: skip
+    assert e.judge()[0] == "differs" and e.judge()[1].startswith("recovery failed")
+    e.truth = 0.3020  # the tuning missed and the estimate recovered it
+    assert e.judge()[1].startswith("tuning missed")
 
 
 def test_no_verdict_from_fewer_than_eight_runs():

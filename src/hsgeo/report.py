@@ -271,7 +271,8 @@ class Row:
            nothing);
         2. when the truth is the paper's value (provenance ``paper``, or truth = paper), was
            computed from the paper's values (``derived``) or tuned to meet them (``tuned``):
-           ``differs`` beyond 3σ of the paper ("tuning missed" for ``tuned``); ``differs``
+           ``differs`` beyond 3σ of the paper ("tuning missed" for ``tuned``, "recovery failed"
+           when its estimate is also beyond 3σ̂ of the tuned truth); ``differs``
            ("recovery failed") when a ``paper`` or ``derived`` truth was recovered more than
            3σ̂ from it — a failed recovery is no agreement built in; ``differs`` ("tuning
            missed") when a ``tuned`` row without any σ misses the paper's value by more than
@@ -331,6 +332,11 @@ class Row:
                 f"recovery failed: {what}, recovered {abs(z):.1f}σ̂ from it"
             )
         if zp is not None and abs(zp) > Z_LIMIT:
+            if tuned and z is not None and abs(z) > Z_LIMIT:  # the estimate, not the tuning
+                return "differs", self.reason or (
+                    f"recovery failed: {what}, recovered {abs(z):.1f}σ̂ from its truth and "
+                    f"{abs(zp):.1f}σ from the paper ({spread})"
+                )
             missed = "tuning missed" if tuned else what
             return "differs", self.reason or f"{missed}: {abs(zp):.1f}σ from the paper ({spread})"
         if tuned and zp is None:

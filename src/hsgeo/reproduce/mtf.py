@@ -420,19 +420,23 @@ def bias_sentence(rep: Reproduction, table: str, what: str = "values") -> str:
     if not rest:
         return out + "."
     rows = {r.quantity: r for r in rep.rows_of(table)}
-    above = sum(rows[q].reproduced > rows[q].truth for q in rest)
-    top = max(rows[q].truth for q in rest)
+    excess = {q: rows[q].reproduced - rows[q].truth - b["rows"][q][2] for q in rest}
+    above = sum(v > 0 for v in excess.values())
+    worst = max(excess, key=lambda q: abs(excess[q]))
     side = (
         "all above their truth"
         if above == len(rest)
         else ("all below" if above == 0 else f"{above} above and {len(rest) - above} below")
     )
     names = ", ".join(rest[:4]) + (f" and {len(rest) - 4} more" if len(rest) > 4 else "")
-    out += f". The {len(rest)} beyond ({names}) lie {side}, where the true MTF is at most {top:.2f}"
+    out += (
+        f". The {len(rest)} beyond ({names}) lie {side}, by up to {abs(excess[worst]):.4f} "
+        f"beyond the noise-free bias, the most where the true MTF is {rows[worst].truth:.3f}"
+    )
     if above == len(rest):
         out += (
-            ": a modulus of a noisy spectrum is biased upwards where the signal is small, a "
-            "noise bias that noise-free recordings cannot show"
+            ": a bias that the noise adds to the estimate (the modulus of a noisy spectrum is "
+            "biased upwards), which noise-free recordings cannot show"
         )
     return out + "."
 
