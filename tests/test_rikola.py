@@ -322,7 +322,6 @@ def test_joint_model_recovers_the_truth_with_the_eop_drift_on(cfg):
     estimates it recovers its truth within 3σ̂ — the drift rate too — and is of full rank at the
     truth. One seed here; eight in bench/bench_rikola_drift.py."""
     from hsgeo.adjust import identifiability
-
     from hsgeo.reproduce.rikola import SMALL_BANDS
 
     on = make_truth(cfg, np.random.default_rng([0, 0]), n_cubes=8)  # bench seed 0
