@@ -126,16 +126,16 @@ PUBLISHED = {
 OWNERS = {
     "002 Table 1": (
         "lp-observations",
-        "002 measured its tie points from pixels (§3.1); the pushbroom-ba chapter simulates "
-        "their image positions",
+        "002 §3.1 measured its tie points from pixels, while the pushbroom-ba chapter "
+        "simulates their image positions",
     ),
     "002 Table 2": (
         "lp-observations",
-        "002's check points are tie points measured from pixels (§4, §5.3)",
+        "002 §4 and §5.3: its check points are tie points measured from pixels",
     ),
     "002 Table 3": (
         "lp-observations",
-        "002's check points are tie points measured from pixels (§4, §5.3)",
+        "002 §4 and §5.3: its check points are tie points measured from pixels",
     ),
 }
 
