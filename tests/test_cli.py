@@ -12,6 +12,7 @@ from hsgeo.reproduce import chapter_names, run
 KEYS = {"table", "quantity", "unit", "paper", "paper_sigma", "reproduced", "sigma", "truth"}
 KEYS |= {"z", "n_runs", "verdict", "reason"}  # GUIDE §5: rows may carry z and a verdict
 KEYS |= {"provenance", "override"}  # GUIDE §4, issue 22: whence the truth; a stated verdict
+KEYS |= {"mean_of_runs", "judged_in"}  # issue 37: a mean's σ; the chapter that owns the claim
 
 
 def test_reproduce_json_contract(capsys):

@@ -15,7 +15,12 @@ from hsgeo.papers import RIKOLA_BANDS, RIKOLA_TABLE4_ROP_DEG, RIKOLA_TABLE4_ROP_
 from hsgeo.reproduce.rikola import observe
 from hsgeo.rotations import R_from_opk, opk_from_R
 from hsgeo.sensors.frame import FramePhotogrammetric, mm_to_pixel
-from hsgeo.sensors.rikola import JointCentroids, TargetCentroids, project_measured_mm
+from hsgeo.sensors.rikola import (
+    JointCentroids,
+    TargetCentroids,
+    focal_from_gap_mm,
+    project_measured_mm,
+)
 from hsgeo.simulate.rikola import Plate, Renderer, make_truth
 from hsgeo.simulate.scenarios import load_scenario
 from hsgeo.workflows.rikola import (
@@ -115,6 +120,46 @@ def test_joint_centroids_jacobian(truth):
     }
     for name, step in steps.items():
         assert check_jacobian(blk, vals, name, step) < 1e-6, name
+    # with the EOP drift across the bands (issue 37): every block, the drift rate too
+    vals["eop_drift_rad_per_band"] = np.array([2e-5, -1.4e-5, 3e-5])
+    steps["eop_drift_rad_per_band"] = 1e-8
+    for name, step in steps.items():
+        assert check_jacobian(blk, vals, name, step) < 1e-6, name
+
+
+def test_joint_model_with_drift_equals_the_simulators_band_pose(cfg):
+    """The joint model's drift is the simulator's: at the truth it predicts every band."""
+    truth = make_truth(cfg, np.random.default_rng([7, 0]), n_cubes=2)  # drift on (default)
+    assert truth.drift_rad is not None and np.any(truth.drift_rad)
+    plate = Plate()
+    corners = plate.corners()[:10]
+    line = focal_from_gap_mm(
+        RIKOLA_BANDS["gap_nm"],
+        truth.gap_model[RIKOLA_BANDS["sensor"] - 1, 0],
+        truth.gap_model[RIKOLA_BANDS["sensor"] - 1, 1],
+    )
+    rate = truth.drift_rad[1] - truth.drift_rad[0]  # linear in the band number
+    ref = RIKOLA_BANDS["band"][np.argmin(np.abs(truth.drift_rad[:, 1]))]
+    jv = {
+        "poses": truth.poses[:1],
+        "gap_model": truth.gap_model,
+        "df_mm": truth.f_mm - line,
+        "pp_mm": truth.pp_mm,
+        "distortion_mm": truth.KP,
+        "sensor2_rotation": truth.rotation_rad,
+        "sensor2_offset_mm": truth.offset_mm,
+        "eop_drift_rad_per_band": rate,
+    }
+    for band in (1, 5, 13, 20, 25):
+        X = corners.reshape(-1, 3)
+        want = truth.project(0, band, X).reshape(10, 4, 2)
+        blk = JointCentroids(
+            np.zeros(10, int), np.full(10, band - 1), corners, np.zeros((10, 2)), 1.0,
+            RIKOLA_BANDS["gap_nm"], RIKOLA_BANDS["sensor"], drift_ref_band=ref,
+        )  # fmt: skip
+        got = blk.predict(jv).reshape(10, 2)
+        # the block's centroid is the centroid of the four projected corners
+        np.testing.assert_allclose(got, want.mean(axis=1), atol=1e-10)
 
 
 def test_joint_equals_per_band_at_truth(truth):
@@ -269,6 +314,35 @@ def test_joint_model_recovers_truth(bench, truth):
     assert 1.0 <= j.clusters["deff"] < 5.0
     with pytest.raises(ObservationError):
         calibrate_joint(obs, exclude_bands=[2, 5, 10])
+
+
+@pytest.mark.slow
+def test_joint_model_recovers_the_truth_with_the_eop_drift_on(cfg):
+    """Issue 37: with the drift across the bands simulated (the default), the joint model that
+    estimates it recovers its truth within 3σ̂ — the drift rate too — and is of full rank at the
+    truth. One seed here; eight in bench/bench_rikola_drift.py."""
+    from hsgeo.adjust import identifiability
+    from hsgeo.reproduce.rikola import SMALL_BANDS
+
+    on = make_truth(cfg, np.random.default_rng([0, 0]), n_cubes=8)  # bench seed 0
+    obs, *_ = observe(cfg, on, 0, range(8), list(SMALL_BANDS))
+    cals = {b: calibrate_band(obs, b) for b in SMALL_BANDS}
+    j = calibrate_joint(obs, init=cals, scatter_mm=tuple(on.scatter_mm), sigma_px=0.02)
+    rate = on.drift_rad[1] - on.drift_rad[0]
+    for name, tr in (
+        ("gap_model", on.gap_model),
+        ("pp_mm", on.pp_mm),
+        ("sensor2_rotation", on.rotation_rad),
+        ("eop_drift_rad_per_band", rate),
+    ):
+        z = (j.value(name) - tr) / j.sigma(name)
+        assert np.all(np.abs(z) < 3.0), (name, z)
+    assert abs(j.value("eop_drift_rad_per_band")[1] - rate[1]) < 0.25 * abs(rate[1])
+    p = j.result.params.copy()
+    p.set("poses", on.poses[j.cubes])
+    p.set("eop_drift_rad_per_band", rate)
+    ident = identifiability(p, j.block)
+    assert ident.rank == ident.n_unknowns
 
 
 def test_design_effect_recovers_cluster_correlation():

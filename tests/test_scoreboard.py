@@ -186,6 +186,7 @@ def test_compact_table_has_one_short_line_per_claim_with_a_link():
         "verdict",
         "provenance",
         "chapter",
+        "owner",
     ]
     assert len(df) == 3 and df["verdict"].tolist() == ["by construction", "differs", "reproduced"]
     assert df["z"].tolist() == ["+0.3", "−10.3", "−0.2"]  # against the paper, σ combined
@@ -224,8 +225,37 @@ def test_claims_with_reasons_lists_one_papers_claims_with_their_verdicts():
         Row("000 Table 3", "dx_m", "m", paper=1.0, reproduced=5.0, sigma=0.1, provenance="chosen"),
     ]
     df = claims_with_reasons(Reproduction("scoreboard", 0, rows), "000")
-    assert list(df.columns) == ["claim", "verdict", "why"]
+    assert list(df.columns) == ["claim", "verdict", "why", "judged in"]
     # in a reader's words, as the compact table above it (no internal key on the page)
     assert list(df.claim) == ["principal distance c (Table 1)", "dx (Table 3)"]
     assert list(df.verdict) == ["reproduced", "differs"]
     assert list(df.why) == [rows[0].judge()[1], rows[2].judge()[1]]
+
+
+def test_each_published_number_is_judged_once_by_its_owner():
+    from hsgeo.reproduce.scoreboard import OWNERS, context_chapters, mark_context
+
+    def row(table, q, rep):
+        return Row(table, q, "px", paper=0.32, reproduced=rep, sigma=0.01, n_runs=8,
+                   provenance="chosen")  # fmt: skip
+
+    pb = Reproduction("pushbroom-ba", 0, [row("002 Table 1", "nmad_x_px", 0.40)])
+    lp = Reproduction("lp-observations", 0, [row("002 Table 1 from pixels", "nmad_x_px", 0.33)])
+    reps = {"pushbroom-ba": mark_context("pushbroom-ba", pb), "lp-observations": lp}
+    mark_context("lp-observations", lp)
+    assert OWNERS["002 Table 1"][0] == "lp-observations"
+    # the pushbroom chapter shows it as context, naming the owner and its own numbers' verdict
+    v, why = pb.rows[0].judge()
+    assert v == "context" and "lp-observations" in why and "differs" in why
+    assert lp.rows[0].judge()[0] == "reproduced" and lp.rows[0].judged_in is None
+    # the scoreboard has one row for the published number: the owner's, with its context
+    pairs = claims_with_chapters(reps)
+    assert [(c, r.reproduced) for c, r in pairs] == [("lp-observations", 0.33)]
+    assert context_chapters(reps, "002 Table 1", "nmad_x_px") == ["pushbroom-ba"]
+    assert counts([r for _, r in pairs])["reproduced"] == 1
+    # the marking survives the JSON record the book build writes
+    back = Reproduction.from_json(pb.to_json()).rows[0]
+    assert back.judged_in == "lp-observations" and back.judge()[0] == "context"
+    # a table only one chapter reproduces keeps its verdict
+    solo = Reproduction("pushbroom-ba", 0, [row("002 Fig. 8", "c", 0.32)])
+    assert mark_context("pushbroom-ba", solo).rows[0].judge()[0] == "reproduced"

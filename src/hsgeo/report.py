@@ -13,13 +13,19 @@ format their tables here, in one way:
 
 * ``z`` is ``(reproduced − truth) / σ̂``: how far the estimate lies from the simulation's truth,
   in units of its own standard deviation (σ̂ from the adjustment, or the spread over ``n_runs``
-  repeated simulations for statistics such as an NMAD that have no σ̂ of their own);
+  repeated simulations for statistics such as an NMAD that have no σ̂ of their own — the σ of
+  the mean when the value is a mean of the runs, :meth:`Row.from_runs`); a "not testable" row
+  shows no z;
 * the **verdict** says whether the paper's value was reproduced (:data:`VERDICTS`), with its
   reason; it is computed from the numbers and the truth's **provenance** (:meth:`Row.rule`,
   GUIDE §4): agreement built in (the truth is the paper's value, computed from it, or tuned to
-  it) is ``"by construction"``, never ``"reproduced"``, and a tuning that missed by more than
-  3σ is ``"differs"``. A chapter may state another verdict (an *override*, e.g. ``"planned"``)
-  only with a reason, which the scoreboard prints (:meth:`Row.overridden`);
+  it) is ``"by construction"``, never ``"reproduced"``; a tuning that missed by more than
+  3σ (or by more than 10 % without a σ) and a paper-valued truth recovered more than 3σ̂ off
+  (a failed recovery) are ``"differs"``; a spread from fewer than 8 runs, or a "reproduced"
+  whose σ exceeds half the paper's value, is ``"not testable"``. A number that another
+  chapter owns is shown as ``"context"`` (:attr:`Row.judged_in`). A chapter may state another
+  verdict (an *override*, e.g. ``"planned"``) only with a reason, which the scoreboard prints
+  (:meth:`Row.overridden`);
 * words about agreement in a chapter's prose come from :func:`agreement` and :func:`summarize`,
   never typed.
 """
@@ -43,6 +49,9 @@ __all__ = [
     "VERDICTS",
     "PROVENANCES",
     "Z_LIMIT",
+    "MIN_RUNS",
+    "TUNED_MISS",
+    "SIGMA_OVER_PAPER",
     "agreement",
     "summarize",
     "format_value",
@@ -65,12 +74,16 @@ VERDICT_MEANING = {
     "truth) lies within 3σ of the paper's value, σ combining our σ̂ or run spread with the "
     "paper's σ",
     "differs": "the outcome lies more than 3σ from the paper's value; for a tuned or "
-    "paper-derived truth this means the tuning missed",
+    "paper-derived truth this means the tuning missed (a tuning without σ misses beyond 10 %), "
+    "and for a truth that is the paper's value (or computed from it) recovered more than 3σ̂ "
+    "from it, the recovery failed",
     "by construction": "the truth is the paper's value, computed from the paper's values or "
     "tuned so that the outcome meets them: agreement was built in and is not counted as "
     "reproduced (the reason gives how well the estimate recovered its truth)",
     "not testable": "there is no reproduced value, or neither side has a σ to judge a "
-    "difference by, or the chapter states why the comparison carries no information",
+    "difference by, or our σ comes from fewer than 8 runs, or it exceeds half the paper's value "
+    "(a comparison that could not fail), or the chapter states why the comparison carries no "
+    "information; no z is shown",
     "planned": "the chapter that reproduces the claim is not written yet",
 }
 
@@ -82,6 +95,16 @@ PROVENANCES = ("paper", "derived", "chosen", "tuned")
 
 #: |z| up to which a value counts as agreeing (3σ, GUIDE §6).
 Z_LIMIT = 3.0
+
+#: Fewest repeated simulations whose spread may decide a verdict (GUIDE §4, "claims need seeds").
+MIN_RUNS = 8
+
+#: Relative miss of the paper's value beyond which a tuning without any σ missed (10 %).
+TUNED_MISS = 0.10
+
+#: A "reproduced" whose σ exceeds this fraction of the paper's value could not have failed: it is
+#: "not testable" (GUIDE §4).
+SIGMA_OVER_PAPER = 0.5
 
 _MINUS = "\u2212"
 _SUPERSCRIPT = str.maketrans(
@@ -108,8 +131,10 @@ class Row:
     paper, paper_sigma : float, optional
         The paper's value and the standard deviation it gives.
     reproduced, sigma : float, optional
-        Our value and its standard deviation: σ̂ of the adjustment, or the spread over
-        ``n_runs`` repeated simulations.
+        Our value and its standard deviation (the σ that ``z`` divides by): σ̂ of the
+        adjustment, or the spread over ``n_runs`` repeated simulations — of one run's value, or
+        of the mean's when ``reproduced`` is the mean of the runs (``mean_of_runs``; build such
+        a row with :meth:`Row.from_runs`).
     truth : float, optional
         The simulation's true value.
     n_runs : int, optional
@@ -119,6 +144,14 @@ class Row:
         :meth:`judge` when absent.
     provenance : str, optional
         Where the truth comes from, one of :data:`PROVENANCES` (GUIDE §4).
+    mean_of_runs : bool
+        ``reproduced`` is the mean over ``n_runs`` runs and ``sigma`` the σ of that mean
+        (one run's spread / √n_runs), not one run's value and spread.
+    judged_in : str, optional
+        The chapter that owns (judges) this published number when it is another chapter: the
+        row is shown here as context, its verdict ``"context"`` (never counted), its reason
+        naming the owner and what this chapter's numbers alone would give
+        (:data:`hsgeo.reproduce.scoreboard.OWNERS`).
     """
 
     table: str
@@ -133,6 +166,8 @@ class Row:
     verdict: str | None = None
     reason: str = ""
     provenance: str | None = None
+    mean_of_runs: bool = False
+    judged_in: str | None = None
 
     def __post_init__(self):
         if self.verdict is not None and self.verdict not in VERDICTS:
@@ -142,10 +177,42 @@ class Row:
                 f"verdict {self.verdict!r} of {self.quantity} is stated without a reason: a "
                 "chapter may override the computed verdict only with a reason (Row.reason)"
             )
+        if self.mean_of_runs and not self.n_runs:
+            raise InputError(
+                f"{self.quantity}: a mean of runs (mean_of_runs) needs n_runs, the number of runs"
+            )
         if self.provenance is not None and self.provenance not in PROVENANCES:
             raise InputError(
                 f"provenance {self.provenance!r} of {self.quantity}: use one of {PROVENANCES}"
             )
+
+    @classmethod
+    def from_runs(cls, table: str, quantity: str, unit: str, values, *, mean: bool, **kw) -> Row:
+        """A row whose spread comes from repeated simulations: ``values`` holds one value per
+        run (non-finite ones dropped). With ``mean=True`` the row reports their mean and the σ
+        of that mean (sample σ / √n), so that ``z`` of a mean uses the mean's σ (GUIDE §4); with
+        ``mean=False`` the first run's value (the chapter's campaign) and one run's σ. Other
+        keywords (``paper``, ``truth``, ``provenance`` …) go to the row.
+
+        >>> r = Row.from_runs("T", "q", "m", [1.0, 2.0, 3.0, 4.0], mean=True)
+        >>> r.reproduced, round(r.sigma, 4), r.n_runs, r.mean_of_runs
+        (2.5, 0.6455, 4, True)
+        """
+        import numpy as np
+
+        v = np.asarray(values, dtype=float).ravel()
+        v = v[np.isfinite(v)]
+        n = int(v.size)
+        sd = float(np.std(v, ddof=1)) if n > 1 else None
+        if mean:
+            rep = float(v.mean()) if n else None
+            sigma = sd / math.sqrt(n) if sd is not None else None
+        else:
+            rep = float(v[0]) if n else None
+            sigma = sd
+        return cls(
+            table, quantity, unit, reproduced=rep, sigma=sigma, n_runs=n, mean_of_runs=mean, **kw
+        )
 
     @property
     def z(self) -> float | None:
@@ -175,6 +242,9 @@ class Row:
         """The verdict on the paper's value and its reason (None for a row without a paper value):
         the verdict the chapter stated (with its reason), else :meth:`rule`'s.
         """
+        if self.judged_in is not None and _clean(self.paper) is not None:
+            v, why = (self.verdict, self.reason) if self.verdict is not None else self.rule()
+            return "context", f"judged in the {self.judged_in} chapter; here: {v}, {why}"
         if self.verdict is not None:
             return self.verdict, self.reason
         return self.rule()
@@ -186,6 +256,7 @@ class Row:
         """
         return (
             self.verdict is not None
+            and self.judged_in is None
             and self.verdict != "planned"
             and self.verdict != self.rule()[0]
         )
@@ -195,55 +266,101 @@ class Row:
 
         In this order:
 
-        1. None for a row without a paper value; ``not testable`` without a reproduced value;
-        2. ``by construction`` when the truth is the paper's value (provenance ``paper``, or
-           truth = paper), was computed from the paper's values (``derived``) or tuned to meet
-           them (``tuned``), and the reproduced value lies within 3σ of the paper's (or there is
-           no σ to judge by); beyond 3σ it ``differs`` ("tuning missed" for ``tuned``);
+        1. None for a row without a paper value; ``not testable`` without a reproduced value, or
+           when its σ is a spread over fewer than :data:`MIN_RUNS` runs (such a σ decides
+           nothing);
+        2. when the truth is the paper's value (provenance ``paper``, or truth = paper), was
+           computed from the paper's values (``derived``) or tuned to meet them (``tuned``):
+           ``differs`` beyond 3σ of the paper ("tuning missed" for ``tuned``, "recovery failed"
+           when its estimate is also beyond 3σ̂ of the tuned truth); ``differs``
+           ("recovery failed") when a ``paper`` or ``derived`` truth was recovered more than
+           3σ̂ from it — a failed recovery is no agreement built in; ``differs`` ("tuning
+           missed") when a ``tuned`` row without any σ misses the paper's value by more than
+           :data:`TUNED_MISS` (10 %); otherwise ``by construction``;
         3. otherwise (``chosen``, or no provenance): ``reproduced`` / ``differs`` by
            |z_paper| ≤ 3, z_paper combining our σ (σ̂ or the spread over runs) with the paper's;
-           ``not testable`` when neither side has a σ.
+           ``not testable`` when neither side has a σ, and a ``reproduced`` whose σ exceeds
+           :data:`SIGMA_OVER_PAPER` (half) of the paper's value is ``not testable`` (it could
+           not have failed).
 
         ``reason`` (set by the chapter without a verdict) replaces the computed reason of a
-        ``differs``.
+        ``differs`` or ``not testable``.
         """
         if _clean(self.paper) is None:
             return None, ""
         if _clean(self.reproduced) is None:
             return "not testable", self.reason or "no reproduced value"
+        if self.n_runs is not None and self.n_runs < MIN_RUNS and _clean(self.sigma) is not None:
+            return "not testable", self.reason or (
+                f"its σ is the spread over only {self.n_runs} runs; a verdict needs at least "
+                f"{MIN_RUNS}"
+            )
         zp = self.z_paper
-        spread = f"spread over {self.n_runs} runs" if self.n_runs else "σ̂"
+        spread = self._spread_words()
         built_in = self.provenance in ("paper", "derived", "tuned") or self.truth_is_paper()
         if built_in:
-            if self.provenance == "tuned":
-                what = "tuned so that it meets the paper's value"
-            elif self.provenance == "derived":
-                what = "its truth was computed from the paper's values"
-            else:
-                what = "simulated with the paper's value as truth"
-            if zp is not None and abs(zp) > Z_LIMIT:
-                missed = "tuning missed" if self.provenance == "tuned" else what
-                return "differs", self.reason or (
-                    f"{missed}: {abs(zp):.1f}σ from the paper ({spread})"
-                )
-            z = self.z
-            if z is not None:
-                how = f"recovered {agreement(z)} of its truth"
-            elif zp is not None:
-                how = f"{agreement(zp)} of the paper ({spread})"
-            else:
-                how = "no σ to judge by"
-            return "by construction", f"{what}; {how}"
+            return self._rule_built_in(zp, spread)
         if zp is None:
             return "not testable", self.reason or "neither the paper nor the reproduction has a σ"
         if abs(zp) <= Z_LIMIT:
+            s, p = _clean(self.sigma), abs(_clean(self.paper))
+            if s is not None and p > 0 and s > SIGMA_OVER_PAPER * p:
+                return "not testable", self.reason or (
+                    f"our σ ({s:.3g}) exceeds half the paper's value ({p:.3g}): agreement "
+                    "could not have failed"
+                )
             return "reproduced", f"{agreement(zp)} of the paper (our {spread} and the paper's σ)"
         return "differs", self.reason or f"{abs(zp):.1f}σ from the paper ({spread})"
+
+    def _spread_words(self) -> str:
+        if self.mean_of_runs:
+            return f"σ of a mean of {self.n_runs} runs"
+        return f"spread over {self.n_runs} runs" if self.n_runs else "σ̂"
+
+    def _rule_built_in(self, zp, spread) -> tuple[str, str]:
+        """:meth:`rule` for a truth that is, or was computed from or tuned to, the paper's value."""
+        tuned = self.provenance == "tuned"
+        if tuned:
+            what = "tuned so that it meets the paper's value"
+        elif self.provenance == "derived":
+            what = "its truth was computed from the paper's values"
+        else:
+            what = "simulated with the paper's value as truth"
+        z = self.z
+        if z is not None and abs(z) > Z_LIMIT and not tuned:
+            return "differs", self.reason or (
+                f"recovery failed: {what}, recovered {abs(z):.1f}σ̂ from it"
+            )
+        if zp is not None and abs(zp) > Z_LIMIT:
+            if tuned and z is not None and abs(z) > Z_LIMIT:  # the estimate, not the tuning
+                return "differs", self.reason or (
+                    f"recovery failed: {what}, recovered {abs(z):.1f}σ̂ from its truth and "
+                    f"{abs(zp):.1f}σ from the paper ({spread})"
+                )
+            missed = "tuning missed" if tuned else what
+            return "differs", self.reason or f"{missed}: {abs(zp):.1f}σ from the paper ({spread})"
+        if tuned and zp is None:
+            r, p = _clean(self.reproduced), _clean(self.paper)
+            off = abs(r - p) / abs(p) if p else (0.0 if r == p else math.inf)
+            if off > TUNED_MISS:
+                return "differs", self.reason or (
+                    f"tuning missed: {100 * off:.0f} % from the paper's value (no σ to judge "
+                    f"by; a tuning without σ misses beyond {100 * TUNED_MISS:.0f} %)"
+                )
+        if z is not None:
+            how = f"recovered {agreement(z)} of its truth"
+        elif zp is not None:
+            how = f"{agreement(zp)} of the paper ({spread})"
+        elif tuned:
+            how = f"no σ to judge by, within {100 * TUNED_MISS:.0f} % of the paper"
+        else:
+            how = "no σ to judge by"
+        return "by construction", f"{what}; {how}"
 
     def as_dict(self) -> dict:
         """Strict-JSON-ready dict: absent or non-finite numbers are None."""
         verdict, reason = self.judge()
-        z = self.z
+        z = None if verdict == "not testable" or self.rule()[0] == "not testable" else self.z
         return {
             "table": self.table,
             "quantity": self.quantity,
@@ -259,6 +376,8 @@ class Row:
             "reason": reason,
             "provenance": self.provenance,
             "override": self.overridden,
+            "mean_of_runs": self.mean_of_runs,
+            "judged_in": self.judged_in,
         }
 
 
@@ -389,8 +508,8 @@ def format_rows(rows: list[Row]):
             paper += f" ± {_format_paper(r.paper_sigma)}"
         sig = format_value(r.sigma, r.sigma, sig=2) if _clean(r.sigma) else "—"
         if r.n_runs and sig != "—":
-            sig += f" ({r.n_runs} runs)"
-        z = r.z
+            sig += f" (mean of {r.n_runs})" if r.mean_of_runs else f" ({r.n_runs} runs)"
+        z = None if "not testable" in (verdict, r.rule()[0]) else r.z
         out.append(
             {
                 "quantity": quantity_label(r.quantity),
@@ -567,9 +686,11 @@ class Reproduction:
                 n_runs=r.get("n_runs"),
                 # as judged when written (the same numbers: an override stays one, a computed
                 # verdict equals Row.rule's); "tuned" was the verdict's name before issue 22
-                verdict={"tuned": "by construction"}.get(r.get("verdict"), r.get("verdict")),
-                reason=r.get("reason") or "",
+                verdict=_stored_verdict(r),
+                reason=_stored_reason(r),
                 provenance=r.get("provenance"),
+                mean_of_runs=bool(r.get("mean_of_runs", False)),
+                judged_in=r.get("judged_in"),
             )
             for r in d["rows"]
         ]
@@ -676,6 +797,19 @@ class Reproduction:
                     ).rstrip()
                 )
         return "\n".join(out)
+
+
+def _stored_verdict(r: dict) -> str | None:
+    """The verdict of a row as written by :meth:`Reproduction.to_json` ("tuned" was the verdict's
+    name before issue 22; "context" is recomputed from ``judged_in``).
+    """
+    v = {"tuned": "by construction"}.get(r.get("verdict"), r.get("verdict"))
+    return None if v == "context" else v
+
+
+def _stored_reason(r: dict) -> str:
+    """The reason stored with the verdict (none for a context row: it is recomputed)."""
+    return "" if r.get("verdict") == "context" else (r.get("reason") or "")
 
 
 def from_estimates(name: str, result) -> Reproduction:

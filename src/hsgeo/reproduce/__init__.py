@@ -50,6 +50,10 @@ def run(chapter: str, seed: int = 0, scale: float = 1.0) -> Reproduction:
         raise InputError(f"scale must be in (0, 1], got {scale!r}")
     mod = importlib.import_module(f"hsgeo.reproduce.{CHAPTERS[chapter]}")
     rep = mod.run(seed=seed, scale=scale)
+    if chapter != "scoreboard":  # one chapter judges each published number (issue 37)
+        from hsgeo.reproduce.scoreboard import mark_context
+
+        mark_context(chapter, rep)
     rep.meta.setdefault("scale", scale)
     directory = os.environ.get(RECORD_ENV)
     if directory and chapter != "scoreboard":

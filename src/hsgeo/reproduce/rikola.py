@@ -28,6 +28,7 @@ from hsgeo.reproduce.rikola_analyses import (
     unmodelled_rows,
 )
 from hsgeo.sensors.frame import mm_to_pixel
+from hsgeo.sensors.rikola import focal_from_gap_mm
 from hsgeo.workflows.rikola import (
     RikolaOptions,
     calibrate_joint,
@@ -185,7 +186,7 @@ def held_out(res, obs, truth, bands) -> dict[int, dict[str, float]]:
         # the error of everything but f
         gm = jh.result.params.values()["gap_model"]
         s_row = RIKOLA_BANDS["sensor"] - 1
-        line = gm[s_row, 0] * RIKOLA_BANDS["gap_nm"] + gm[s_row, 1]
+        line = focal_from_gap_mm(RIKOLA_BANDS["gap_nm"], gm[s_row, 0], gm[s_row, 1])  # 003 eq. (2)
         held[h] = {
             "joint": _rms(predict_band(jh, obs, h)),
             "joint_true_f": _rms(predict_band(jh, obs, h, df_mm=truth.f_mm - line)),
@@ -425,6 +426,14 @@ def joint_rows(joint, truth) -> list[Row]:
                 provenance="paper",
             )  # fmt: skip
         )
+    # the drift of the EOPs across the bands (003 §3.4, Fig. 5, printed without values): the
+    # joint model's rate per band against the simulated one (zero without the drift)
+    rate, srate = R.value("eop_drift_rad_per_band"), R.sigma("eop_drift_rad_per_band")
+    d = truth.drift_rad
+    true_rate = np.zeros(3) if d is None else d[1] - d[0]  # linear in the band number
+    for i, q in enumerate(("domega", "dphi", "dkappa")):
+        rows.append(Row(t, f"drift_{q}_deg_per_band", "deg", None, None, np.rad2deg(rate[i]),
+                        np.rad2deg(srate[i]), np.rad2deg(true_rate[i])))  # fmt: skip
     off, soff = R.value("sensor2_offset_mm"), R.sigma("sensor2_offset_mm")
     for i, q in enumerate(("tx_mm", "ty_mm", "tz_mm")):
         rows.append(Row(t, q, "mm", None, None, off[i], soff[i], truth.offset_mm[i]))

@@ -1,8 +1,12 @@
 """The claims scoreboard: every numeric claim of the five papers, with its verdict (issue 13).
 
-One row per claim in the papers' tables that a chapter reproduces (the rows of the chapters'
-``reproduce`` tables whose name starts with the paper's number, ``000``–``004``), plus the claims
-of the chapters still to be written, marked ``planned``. Verdicts are computed by
+One row per published number (issue 37): the rows of the chapters' ``reproduce`` tables whose
+name starts with the paper's number, ``000``–``004``, one per (published table, quantity). A
+number that more than one chapter reproduces is judged by the chapter that owns it
+(:data:`OWNERS`, with the reason); the other chapters show it as context (verdict ``context``,
+:attr:`hsgeo.report.Row.judged_in`, set by :func:`mark_context` when a chapter runs), and the
+scoreboard lists them beside the owner without counting them. The claims of chapters still to
+be written are marked ``planned``. Verdicts are computed by
 :meth:`hsgeo.report.Row.judge` from the numbers, in the style of ReScience C reproductions:
 *reproduced*, *differs* (with the reason), *by construction* (the truth is the paper's value,
 computed from it or tuned to it: agreement was built in; issue 22), *not testable*, *planned*.
@@ -18,6 +22,7 @@ chapter is run here.
 from __future__ import annotations
 
 import re
+from dataclasses import replace
 
 from hsgeo.report import (
     _MINUS,
@@ -45,6 +50,11 @@ __all__ = [
     "claims_with_chapters",
     "paper_paragraph",
     "compact_table",
+    "OWNERS",
+    "PUBLISHED",
+    "published_table",
+    "owner",
+    "mark_context",
 ]
 
 #: The chapters whose tables hold claims of the papers.
@@ -99,6 +109,62 @@ _PAPER_TABLE = re.compile(r"^00[0-4] ")
 NOT_CLAIMS = ("002 check-point factors",)
 
 
+#: A chapter's table whose name says more than the published table it reproduces -> that table.
+PUBLISHED = {
+    "002 Table 1 from pixels": "002 Table 1",
+    "002 Table 2 from pixels": "002 Table 2",
+    "002 Table 3 from pixels": "002 Table 3",
+}
+
+#: The chapter that owns (judges) a published table that more than one chapter reproduces, and
+#: why. 002 measured its Tables 1–3 from pixels: the tie points are key points matched in the LP
+#: lines and registered at the pixel centre (002 §3.1), the check points tie points with known
+#: coordinates (§4, §5.3). The lp-observations chapter measures them from rendered LP lines, as
+#: the paper did; the pushbroom-ba chapter draws the tie points' image positions from the
+#: projection of known points plus noise tuned to 002 Table 1, a model of the measurement, and
+#: shows the three tables as context.
+OWNERS = {
+    "002 Table 1": (
+        "lp-observations",
+        "002 §3.1 measured its tie points from pixels, while the pushbroom-ba chapter "
+        "simulates their image positions",
+    ),
+    "002 Table 2": (
+        "lp-observations",
+        "002 §4 and §5.3: its check points are tie points measured from pixels",
+    ),
+    "002 Table 3": (
+        "lp-observations",
+        "002 §4 and §5.3: its check points are tie points measured from pixels",
+    ),
+}
+
+
+def published_table(table: str) -> str:
+    """The published table a chapter's table reproduces (:data:`PUBLISHED`, else itself)."""
+    return PUBLISHED.get(table, table)
+
+
+def owner(table: str) -> str | None:
+    """The chapter that owns the claims of ``table`` (a chapter's or the paper's name), or None
+    when any chapter that reproduces it may judge it (a table only one chapter reproduces).
+    """
+    hit = OWNERS.get(published_table(table))
+    return hit[0] if hit else None
+
+
+def mark_context(chapter: str, rep: Reproduction) -> Reproduction:
+    """Mark the rows of ``rep`` whose published number another chapter owns as context
+    (:attr:`hsgeo.report.Row.judged_in`); :func:`hsgeo.reproduce.run` calls it for every chapter.
+    Returns ``rep``.
+    """
+    for r in rep.rows:
+        own = owner(r.table) if _PAPER_TABLE.match(r.table) else None
+        if own is not None and own != chapter and r.paper is not None:
+            r.judged_in = own
+    return rep
+
+
 def planned_claims() -> list[Row]:
     """The papers' claims of chapters not written yet (``verdict="planned"``).
 
@@ -109,18 +175,47 @@ def planned_claims() -> list[Row]:
 
 
 def claims_with_chapters(reps: dict[str, Reproduction]) -> list[tuple[str | None, Row]]:
-    """``(chapter, row)`` for every claim row of the chapters' results (tables named after a
-    paper, with a paper value), then ``(None, row)`` for the planned claims.
+    """``(chapter, row)`` for every published number of the chapters' results (tables named
+    after a paper, with a paper value), once: the owner's row (:data:`OWNERS`) where more than one
+    chapter reproduces it, else the first chapter's; then ``(None, row)`` for the planned claims.
     """
-    out = []
+    found: dict[tuple[str, str], list[tuple[str, Row]]] = {}
     for chapter in PAPER_CHAPTERS:
         if chapter in reps:
-            out += [
-                (chapter, r)
-                for r in reps[chapter].rows
-                if _PAPER_TABLE.match(r.table) and r.table not in NOT_CLAIMS and r.paper is not None
-            ]
+            for r in reps[chapter].rows:
+                if (
+                    _PAPER_TABLE.match(r.table)
+                    and r.table not in NOT_CLAIMS
+                    and r.paper is not None
+                ):
+                    found.setdefault((published_table(r.table), r.quantity), []).append(
+                        (chapter, r)
+                    )
+    out = []
+    for key, pairs in found.items():
+        own = owner(key[0])
+        mine = [p for p in pairs if p[0] == own]
+        if mine:
+            out.append(mine[0])
+        else:  # the owner did not reproduce this number: the first chapter's row judges it
+            chapter, r = pairs[0]
+            out.append((chapter, replace(r, judged_in=None)))
     return out + [(None, r) for r in planned_claims()]
+
+
+def context_chapters(reps: dict[str, Reproduction], table: str, quantity: str) -> list[str]:
+    """The chapters other than the owner that show the published number as context."""
+    key = (published_table(table), quantity)
+    own = [
+        c for c, r in claims_with_chapters(reps) if (published_table(r.table), r.quantity) == key
+    ]
+    return [
+        c
+        for c in PAPER_CHAPTERS
+        if c in reps
+        and c not in own
+        and any((published_table(r.table), r.quantity) == key for r in reps[c].rows)
+    ]
 
 
 def claims(reps: dict[str, Reproduction]) -> list[Row]:
@@ -175,7 +270,7 @@ def overrides(rows: list[Row]) -> list[dict]:
 
 def _claim_label(r: Row) -> str:
     """A claim in a reader's words: its quantity and the part of the paper it comes from."""
-    return f"{quantity_label(r.quantity)} ({r.table[4:]})"
+    return f"{quantity_label(r.quantity)} ({published_table(r.table)[4:]})"
 
 
 def _named(rows: list[Row]) -> str:
@@ -305,6 +400,14 @@ class ClaimTable:
         )
 
 
+def _owner_words(r: Row, chapter: str | None) -> str:
+    """Why ``chapter`` judges the row: the ownership rule of :data:`OWNERS`, or the only one."""
+    hit = OWNERS.get(published_table(r.table))
+    if hit is None:
+        return "the only chapter reproducing it"
+    return f"owner: {hit[1]}"
+
+
 def compact_table(pairs: list[tuple[str | None, Row]], paper: str | None = None) -> ClaimTable:
     """The claims as the scoreboard page shows them (:class:`ClaimTable`): claim (a link to its
     chapter, its unit under it) | paper | reproduced ± σ | z against the paper | verdict, with the
@@ -321,7 +424,7 @@ def compact_table(pairs: list[tuple[str | None, Row]], paper: str | None = None)
         shown = _format_paper(r.paper)
         if r.paper_sigma is not None and _format_paper(r.paper_sigma) != "—":
             shown += f" ± {_format_paper(r.paper_sigma)}"
-        zp = r.z_paper
+        zp = None if r.judge()[0] == "not testable" else r.z_paper  # no z on "not testable"
         recs.append(
             {
                 "claim": _claim_label(r),
@@ -332,11 +435,13 @@ def compact_table(pairs: list[tuple[str | None, Row]], paper: str | None = None)
                 "verdict": r.judge()[0],
                 "provenance": provenance_group(r),
                 "chapter": chapter or "—",
+                "owner": _owner_words(r, chapter),
             }
         )
         chapters.append(chapter)
         provs.append(provenance_group(r))
     cols = ["claim", "unit", "paper", "reproduced ± σ", "z", "verdict", "provenance", "chapter"]
+    cols.append("owner")
     return ClaimTable(pd.DataFrame(recs, columns=cols), chapters, provs)
 
 
@@ -359,6 +464,9 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
         sources[chapter] = {"seed": rep.seed, "scale": rep.meta.get("scale"), "source": how}
     pairs = claims_with_chapters(reps)
     rows = [r for _, r in pairs]
+    contexts = [
+        context_chapters(reps, r.table, r.quantity) if c is not None else [] for c, r in pairs
+    ]
     return Reproduction(
         "scoreboard",
         seed,
@@ -371,16 +479,29 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
             "overrides": overrides(rows),
             "n_claims": len(rows),
             "chapters": [c for c, _ in pairs],
+            "context": contexts,
+            "owners": {t: {"chapter": c, "why": why} for t, (c, why) in OWNERS.items()},
+            "n_context_rows": sum(len(c) for c in contexts),
             "paragraphs": {p: paper_paragraph(rows, p) for p in PAPERS},
         },
     )
 
 
 def claims_with_reasons(board: Reproduction, paper: str):
-    """Every claim of one paper (tables named ``"000 …"`` for ``paper="000"``) with its verdict
-    and the sentence that explains it: a DataFrame with columns claim, verdict, why.
+    """Every claim of one paper (tables named ``"000 …"`` for ``paper="000"``) with its verdict,
+    the sentence that explains it and the chapter that judges it (with the chapters that show it
+    as context): a DataFrame with columns claim, verdict, why, judged in.
     """
     import pandas as pd
 
-    recs = [(_claim_label(r), *r.judge()) for r in board.rows if r.table.startswith(paper)]
-    return pd.DataFrame(recs, columns=["claim", "verdict", "why"])
+    chapters = board.meta.get("chapters") or [None] * len(board.rows)
+    context = board.meta.get("context") or [[]] * len(board.rows)
+    recs = []
+    for r, c, ctx in zip(board.rows, chapters, context, strict=True):
+        if not r.table.startswith(paper):
+            continue
+        where = c or "—"
+        if ctx:
+            where += f" (context in {', '.join(ctx)})"
+        recs.append((_claim_label(r), *r.judge(), where))
+    return pd.DataFrame(recs, columns=["claim", "verdict", "why", "judged in"])

@@ -61,15 +61,32 @@ __all__ = [
     "centroid_model",
     "TargetCentroids",
     "JointCentroids",
+    "focal_from_gap_mm",
     "RikolaCamera",
     "GAP_MODEL_COLUMNS",
     "ROTATION_COLUMNS",
     "OFFSET_COLUMNS",
+    "DRIFT_COLUMNS",
 ]
 
 GAP_MODEL_COLUMNS = ("a_mm_per_nm", "b_mm")
 ROTATION_COLUMNS = ("domega_rad", "dphi_rad", "dkappa_rad")
 OFFSET_COLUMNS = ("tx_mm", "ty_mm", "tz_mm")
+#: Columns of the joint model's drift rate across the bands (:class:`JointCentroids`).
+DRIFT_COLUMNS = ("domega_rad_per_band", "dphi_rad_per_band", "dkappa_rad_per_band")
+
+
+def focal_from_gap_mm(gap_nm, a_mm_per_nm, b_mm):
+    """The focal length of a band from its Fabry-Pérot air gap: ``f = a·gap + b`` (003 eq. (2),
+    the straight line of 003 Table 4, second part). The one implementation: the simulator, the
+    joint model and the chapter's tables all call it.
+
+    >>> float(focal_from_gap_mm(1000.0, 1e-4, 9.0))
+    9.1
+    """
+    return np.asarray(a_mm_per_nm) * np.asarray(gap_nm, dtype=np.float64) + np.asarray(
+        b_mm
+    )  # 003 eq. (2)
 
 
 def project_measured_mm(Xc, f_mm, pp_mm, KP) -> np.ndarray:
@@ -254,6 +271,13 @@ class JointCentroids(ResidualBlock):
         (dω, dφ, dκ) of ``R_I_from_II`` (003 eq. (1), Table 4).
     ``sensor2_offset_mm`` (3,)
         Projection centre of sensor II in sensor I's frame.
+    ``eop_drift_rad_per_band`` (3,), optional
+        The drift of the exterior orientation across the bands of a cube (003 §3.4, Fig. 5: "φ
+        and X0 … decrease as a linear function" of the band): a rotation of each band's camera
+        frame about its projection centre by (dω, dφ, dκ)·(band − ``drift_ref_band``), after
+        the sensor's rigid orientation — ``R_world_from_band = R_rigid · R(rate·(b − b_ref))``,
+        as :meth:`hsgeo.simulate.rikola.RikolaTruth.band_pose` applies it. Absent from the
+        values: no drift (the model of the paper's eq. (1)).
 
     Parameters
     ----------
@@ -264,6 +288,12 @@ class JointCentroids(ResidualBlock):
     gap_nm : (n_bands,) ndarray
     sensor : (n_bands,) int ndarray
         1 or 2 for each band.
+    band_number : (n_bands,) ndarray, optional
+        The band numbers of the table's rows (default 1, 2, …): the drift's abscissa.
+    drift_ref_band : float
+        The band whose camera frame the drift leaves in place (the middle band, 13, by default):
+        a choice of parametrisation only — another reference moves the poses and sensor II's
+        rotation by a constant rotation and leaves the predictions the same.
     """
 
     name = "target centroids (joint model)"
@@ -278,11 +308,24 @@ class JointCentroids(ResidualBlock):
             "distortion": "distortion_mm",
             "rotation": "sensor2_rotation",
             "offset": "sensor2_offset_mm",
+            "drift": "eop_drift_rad_per_band",
         }
     )
 
     def __init__(
-        self, cube, band_index, corners, xy_mm, sigma_mm, gap_nm, sensor, *, blocks=None, name=None
+        self,
+        cube,
+        band_index,
+        corners,
+        xy_mm,
+        sigma_mm,
+        gap_nm,
+        sensor,
+        *,
+        band_number=None,
+        drift_ref_band: float = 13.0,
+        blocks=None,
+        name=None,
     ):
         cube, corners, xy = _check_obs(type(self).__name__, cube, corners, xy_mm)
         band_index = np.asarray(band_index)
@@ -300,6 +343,11 @@ class JointCentroids(ResidualBlock):
         self.cube, self.band, self.corners, self.xy = cube, band_index.astype(np.int64), corners, xy
         self.gap = gap_nm[self.band]
         self.srow = sensor[self.band].astype(np.int64) - 1  # 0: sensor I, 1: sensor II
+        numbers = np.arange(1, gap_nm.size + 1) if band_number is None else band_number
+        numbers = np.asarray(numbers, dtype=np.float64)
+        if numbers.shape != gap_nm.shape:
+            raise InputError("JointCentroids: band_number must be (n_bands,), like gap_nm")
+        self.band_steps = numbers - float(drift_ref_band)  # per row of the band table
 
     def predict(self, values) -> np.ndarray:
         return self._model(values, False)[0]
@@ -308,7 +356,8 @@ class JointCentroids(ResidualBlock):
         nm = self.blocks
         n = self.xy.shape[0]
         ab = values[nm["gap"]]
-        f = ab[self.srow, 0] * self.gap + ab[self.srow, 1] + values[nm["df"]][self.band]
+        f = focal_from_gap_mm(self.gap, ab[self.srow, 0], ab[self.srow, 1])
+        f = f + values[nm["df"]][self.band]
         pp = values[nm["pp"]][self.srow]
         XcI, d_pose, _ = camera_coordinates(
             values[nm["poses"]], np.repeat(self.cube, 4), self.corners.reshape(-1, 3), jacobian
@@ -318,10 +367,17 @@ class JointCentroids(ResidualBlock):
         t = values[nm["offset"]]
         M = R_from_opk(*rot)  # R_I_from_II
         two = self.srow == 1
-        Xc = XcI.copy()
-        Xc[two] = np.einsum("ji,nkj->nki", M, XcI[two] - t)  # X_camII = Mᵀ (X_camI − t)
+        Xs = XcI.copy()  # the sensor's rigid camera frame
+        Xs[two] = np.einsum("ji,nkj->nki", M, XcI[two] - t)  # X_camII = Mᵀ (X_camI − t)
+        rate = values.get(nm["drift"])
+        if rate is None:  # no drift block: the rigid model
+            D = dD = None
+            Xc = Xs
+        else:  # the band's frame: X_band = D_bᵀ X_sensor, D_b = R(rate·(b − b_ref))
+            D, dD = _drift_rotations(np.asarray(rate, float), self.band_steps)
+            Xc = np.einsum("nji,nkj->nki", D[self.band], Xs)
         xy, J = centroid_model(Xc, f, pp, values[nm["distortion"]], jacobian)
-        return xy, J, (d_pose, XcI, M, two, t, rot)
+        return xy, J, (d_pose, XcI, M, two, t, rot, Xs, D, dD)
 
     def evaluate(self, values, jacobian):
         nm = self.blocks
@@ -329,11 +385,19 @@ class JointCentroids(ResidualBlock):
         r = xy - self.xy
         if not jacobian:
             return r.ravel(), None
-        d_pose, XcI, M, two, t, rot = aux
+        d_pose, XcI, M, two, t, rot, Xs, D, dD = aux
         n = r.shape[0]
+        JXs = J["Xc"]  # (n, 4, 2, 3) ∂centroid/∂X in the band's frame → the sensor's frame
+        d_drift = None
+        if D is not None:
+            JXs = np.einsum("nkac,nci->nkai", J["Xc"], D[self.band].transpose(0, 2, 1))
+            # ∂X_band/∂rate_j = (∂D_bᵀ/∂angle_j · step_b) X_sensor
+            dXb = np.einsum("naji,nkj->nkia", dD[self.band], Xs)  # (n, 4, 3 xyz, 3 angles)
+            dXb = dXb * self.band_steps[self.band][:, None, None, None]
+            d_drift = np.einsum("nkac,nkcj->naj", J["Xc"], dXb)
         # chain through sensor II's rotation: dXc = Mᵀ dXcI for sensor II rows
-        dXcI = J["Xc"].copy()  # (n, 4, 2, 3) ∂centroid/∂Xc
-        dXcI[two] = np.einsum("nkac,ci->nkai", J["Xc"][two], M.T)
+        dXcI = JXs.copy()
+        dXcI[two] = np.einsum("nkac,ci->nkai", JXs[two], M.T)
         dp = np.einsum("nkac,nkcj->naj", dXcI, d_pose.reshape(n, 4, 3, 6))
         d_rot = np.zeros((n, 2, 3))
         d_off = np.zeros((n, 2, 3))
@@ -341,8 +405,8 @@ class JointCentroids(ResidualBlock):
             dM = dR_dopk(*rot)  # (3, 3, 3): ∂M/∂angle
             v = XcI[two] - t  # (m, 4, 3)
             dXc_drot = np.einsum("aji,nkj->nkia", dM, v)  # (m, 4, 3 xyz, 3 angles)
-            d_rot[two] = np.einsum("nkac,nkcj->naj", J["Xc"][two], dXc_drot)
-            d_off[two] = -np.einsum("nkac,ci->nai", J["Xc"][two], M.T)
+            d_rot[two] = np.einsum("nkac,nkcj->naj", JXs[two], dXc_drot)
+            d_off[two] = -np.einsum("nkac,ci->nai", JXs[two], M.T)
         d_ab = np.stack([J["f"] * self.gap[:, None], J["f"]], axis=-1)  # (n, 2, 2)
         jac = {
             nm["poses"]: Indexed(np.repeat(self.cube, 2), dp.reshape(2 * n, 6)),
@@ -353,7 +417,22 @@ class JointCentroids(ResidualBlock):
             nm["rotation"]: d_rot.reshape(2 * n, 3),
             nm["offset"]: d_off.reshape(2 * n, 3),
         }
+        if d_drift is not None:
+            jac[nm["drift"]] = d_drift.reshape(2 * n, 3)
         return r.ravel(), jac
+
+
+def _drift_rotations(rate_rad, band_steps):
+    """Per band of the table: D_b = R(rate·step_b) (n_bands, 3, 3) and ∂D_b/∂angle (n_bands, 3,
+    3, 3), the angles (dω, dφ, dκ) = rate·step_b (:func:`hsgeo.rotations.R_from_opk`).
+    """
+    D = np.empty((band_steps.size, 3, 3))
+    dD = np.empty((band_steps.size, 3, 3, 3))
+    for i, s in enumerate(band_steps):
+        a = rate_rad * s
+        D[i] = R_from_opk(*a)
+        dD[i] = dR_dopk(*a)
+    return D, dD
 
 
 # ----------------------------------------------------------------------------------------------

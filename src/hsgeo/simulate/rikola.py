@@ -30,7 +30,7 @@ from hsgeo.io.tables import write_csv_array
 from hsgeo.papers import RIKOLA_BANDS
 from hsgeo.rotations import R_from_opk, opk_from_R
 from hsgeo.sensors.frame import pixel_to_mm
-from hsgeo.sensors.rikola import project_measured_mm
+from hsgeo.sensors.rikola import focal_from_gap_mm, project_measured_mm
 
 __all__ = [
     "Plate",
@@ -278,7 +278,9 @@ def make_truth(
     )
     scatter = np.array([gm["scatter_sensor1_mm"], gm["scatter_sensor2_mm"]])
     s = bands["sensor"] - 1
-    f = ab[s, 0] * bands["gap_nm"] + ab[s, 1] + scatter[s] * rng.standard_normal(len(bands))
+    # 003 eq. (2) plus a scatter about the line
+    f = focal_from_gap_mm(bands["gap_nm"], ab[s, 0], ab[s, 1])
+    f = f + scatter[s] * rng.standard_normal(len(bands))
     pp = np.array([cam["pp_sensor1_mm"], cam["pp_sensor2_mm"]], dtype=float)
     KP = np.array(
         [

@@ -26,7 +26,7 @@ from hsgeo.sensors.frame import (
     PHOTOGRAMMETRIC_INTERIOR,
     POSE_COLUMNS,
 )
-from hsgeo.sensors.rikola import TargetCentroids
+from hsgeo.sensors.rikola import TargetCentroids, focal_from_gap_mm
 from hsgeo.workflows._initial import pose_from_pnp
 
 __all__ = [
@@ -262,7 +262,7 @@ def gap_regression(gap_nm, f_mm) -> dict[str, float]:
         raise InputError("gap_regression needs at least 3 (gap, f) pairs of equal length")
     A = np.column_stack([g, np.ones_like(g)])
     coef, *_ = np.linalg.lstsq(A, f, rcond=None)
-    res = f - A @ coef
+    res = f - focal_from_gap_mm(g, coef[0], coef[1])  # 003 eq. (2)
     dof = g.size - 2
     s2 = float(res @ res / dof)
     cov = s2 * np.linalg.inv(A.T @ A)

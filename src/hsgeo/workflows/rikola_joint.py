@@ -2,7 +2,9 @@
 
 One exterior orientation per cube (sensor I's camera frame), ``f = a·gap + b`` per sensor (003
 eq. (2)) plus a per-band deviation ``df`` with a prior, one principal point per sensor, one
-distortion set, and sensor II's rotation ``R_I_from_II`` (003 eq. (1)); the residual block is
+distortion set, sensor II's rotation ``R_I_from_II`` (003 eq. (1)) and the drift of the exterior
+orientation across the bands of a cube (003 §3.4, Fig. 5: a rotation rate per band, zero at the
+middle band :data:`DRIFT_REF_BAND`; issue 37); the residual block is
 :class:`hsgeo.sensors.rikola.JointCentroids`. :func:`calibrate_joint` sets the problem up (the
 one place it is set up) and adjusts it; :func:`predict_band` predicts a band the model did not
 see; :func:`design_effect` measures how much the observations of one target in the bands of a
@@ -20,6 +22,7 @@ from hsgeo.errors import ObservationError
 from hsgeo.measure.targets import Observations
 from hsgeo.sensors.frame import PHOTOGRAMMETRIC_DISTORTION, POSE_COLUMNS
 from hsgeo.sensors.rikola import (
+    DRIFT_COLUMNS,
     GAP_MODEL_COLUMNS,
     OFFSET_COLUMNS,
     ROTATION_COLUMNS,
@@ -29,6 +32,7 @@ from hsgeo.workflows.rikola_bands import BANDS, initial_poses
 
 __all__ = [
     "OFF_LINE_BANDS",
+    "DRIFT_REF_BAND",
     "design_effect",
     "JointCalibration",
     "joint_block",
@@ -38,6 +42,10 @@ __all__ = [
 
 #: Bands whose gaps are off the linear trend (003 §3.5): a free ``df`` and out of the gap line.
 OFF_LINE_BANDS = (1, 11)
+
+#: The band whose camera frame the EOP drift leaves in place (the middle of 1–25): the poses and
+#: sensor II's rotation are those of band 13's frame (a parametrisation, not an assumption).
+DRIFT_REF_BAND = 13
 
 
 def design_effect(residuals_px, cluster) -> dict[str, float]:
@@ -127,10 +135,14 @@ def joint_block(o: Observations, cubes, sigma_mm) -> JointCentroids:
         sigma_mm,
         BANDS["gap_nm"],
         BANDS["sensor"],
+        band_number=BANDS["band"],
+        drift_ref_band=DRIFT_REF_BAND,
     )
 
 
-def _joint_parameters(o: Observations, bands, cubes, f0_mm, scatter_mm, estimate_offset):
+def _joint_parameters(
+    o: Observations, bands, cubes, f0_mm, scatter_mm, estimate_offset, model_drift=True
+):
     """The parameter blocks of the joint model with their initial values and priors."""
     table = BANDS
     poses0 = initial_poses(o.select(o.band >= 11), f0_mm)
@@ -163,6 +175,9 @@ def _joint_parameters(o: Observations, bands, cubes, f0_mm, scatter_mm, estimate
     p.add("sensor2_offset_mm", np.zeros(3), columns=OFFSET_COLUMNS)
     if not estimate_offset:
         p.fix("sensor2_offset_mm")
+    p.add("eop_drift_rad_per_band", np.zeros(3), columns=DRIFT_COLUMNS)
+    if not model_drift:
+        p.fix("eop_drift_rad_per_band")
     return p
 
 
@@ -176,6 +191,7 @@ def calibrate_joint(
     estimate_offset: bool = False,
     reject_k: float | None = 5.0,
     init=None,
+    model_drift: bool = True,
 ) -> JointCalibration:
     """One adjustment of all bands (003 §3.5, the paper's future work).
 
@@ -194,6 +210,10 @@ def calibrate_joint(
         thousandths of a pixel (its σ̂ is millimetres).
     init : BandCalibration dict, optional
         Per-band calibrations to start from (poses of a sensor-I band, mean distortion).
+    model_drift : bool
+        Estimate the drift of the exterior orientation across the bands (a rotation rate
+        (dω, dφ, dκ) per band, zero at :data:`DRIFT_REF_BAND`; 003 §3.4, Fig. 5); False holds
+        it at zero (the rigid model of 003 eq. (1)).
     """
     keep = ~np.isin(obs.band, np.asarray(exclude_bands, int))
     o = obs.select(keep)
@@ -206,7 +226,7 @@ def calibrate_joint(
                 f"the joint model needs at least 2 on-line bands of sensor "
                 f"{'I' if s == 1 else 'II'}, got {on}"
             )
-    p = _joint_parameters(o, bands, cubes, f0_mm, scatter_mm, estimate_offset)
+    p = _joint_parameters(o, bands, cubes, f0_mm, scatter_mm, estimate_offset, model_drift)
     if init is not None:
         _init_from_bands(p, init, cubes)
     blk = joint_block(o, cubes, sigma_px * obs.pixel_mm)
