@@ -50,6 +50,17 @@ sq = pd.DataFrame(
 sq.to_csv(d / "SQUARES.csv", index=False, float_format="%.17g")
 sq[sq["point_id"].isin(obs.gcp_ids)].to_csv(d / "GCP.csv", index=False, float_format="%.17g")
 
+# a flat DSM at the squares' height around the strips (EPSG:25832, the campaign's site)
+from hsgeo.crs import SITE_AAS
+from hsgeo.mapgrid import MapGrid
+
+nav = obs.navigation
+e, n_, h = SITE_AAS.enu_to_map(xyz[:, 0], xyz[:, 1], xyz[:, 2])
+xs, ys, _ = SITE_AAS.enu_to_map(nav.xyz_m[:, 0], nav.xyz_m[:, 1], nav.xyz_m[:, 2])
+grid = MapGrid.covering((xs.min() - 1500, xs.max() + 1500), (ys.min() - 1500, ys.max() + 1500), 20.0)
+z = np.full((grid.y_m.size, grid.x_m.size), float(np.median(h)))
+write_geotiff(d / "DSM.tif", z, grid.transform, 25832)
+
 # a slanted edge (5 deg), Gaussian blur sigma 0.6 px, 8x supersampled pixel aperture
 from math import erf, radians, sqrt, tan
 

@@ -316,6 +316,9 @@ def solve(
         ftol=ftol,
         progress=progress,
         reject_every_iteration=True,  # 002 §3.4
+        # a tie point its rays do not determine is left out and named, not a reason to stop
+        # (issue 42: lp-observations --seed 6062 stopped on one such point)
+        drop_undetermined_points=True,
         keep_jacobian=keep_jacobian,
         raise_on_failure=raise_on_failure,
         **{"chord_end": CHORD_END, **overrides},
@@ -684,6 +687,15 @@ def summary(res, nodes, point_ids, n_observations_2d: int, node_interval_s: floa
         "columns": list(res.params["nodes"].columns),
     }
     out["points"] = {"point_id": ids.tolist(), "xyz_m": res.value("points_m").tolist()}
+    dropped = list(getattr(res, "dropped_points", []))
+    g = res._blocks[0].group_size
+    rows = res._dropped_rows[0] if dropped and res._dropped_rows is not None else None
+    out["dropped_points"] = {
+        "point_id": ids[dropped].tolist(),
+        "n_observations_2d": 0 if rows is None else int(rows.reshape(-1, g)[:, 0].sum()),
+        "reason": "not determined by their observations (too few or degenerate rays): held at "
+        "their initial values, their observations left out",
+    }
     out["fit"] = fit_verdict(res, n_obs)
     return out
 
