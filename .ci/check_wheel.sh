@@ -25,7 +25,7 @@ step --help
 step versions
 step data --verify                    # ./data_synthetic/generated from the wheel's scenarios
 step reproduce frame-reference
-json reproduce geocoding --seed 3 --json
+json reproduce geocoding --seed 3 --scale 0.1 --json   # the README's command, smaller
 json reproduce rikola --scale 0.1 --json
 G=data_synthetic/generated
 step calibrate-line $G/line_lab_observations.csv --control $G/line_lab_control.csv
