@@ -7,8 +7,8 @@ package, where :func:`hsgeo.simulate.scenarios.data_dir` finds them (``hsgeo rep
 ``hsgeo data`` from any folder; issue 42).
 """
 
-from pathlib import Path
 import shutil
+from pathlib import Path
 
 from setuptools import setup
 from setuptools.command.build_py import build_py

@@ -7,15 +7,19 @@ eight LP strips of the rendered campaign with their navigation, camera and squar
 """
 
 import sys
+from math import erf, radians, sqrt, tan
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from PIL import Image
 
+from hsgeo.crs import SITE_AAS
 from hsgeo.io.frames import write_frame_folder
 from hsgeo.io.geotiff import write_geotiff
 from hsgeo.io.lp_lines import write_lp_lines
 from hsgeo.io.navigation import write_trajectory
+from hsgeo.mapgrid import MapGrid
 from hsgeo.simulate import cube_survey as CS
 from hsgeo.simulate.lp_campaign import simulate
 
@@ -51,18 +55,17 @@ sq.to_csv(d / "SQUARES.csv", index=False, float_format="%.17g")
 sq[sq["point_id"].isin(obs.gcp_ids)].to_csv(d / "GCP.csv", index=False, float_format="%.17g")
 
 # a flat DSM at the squares' height around the strips (EPSG:25832, the campaign's site)
-from hsgeo.crs import SITE_AAS
-from hsgeo.mapgrid import MapGrid
 
 nav = obs.navigation
 e, n_, h = SITE_AAS.enu_to_map(xyz[:, 0], xyz[:, 1], xyz[:, 2])
 xs, ys, _ = SITE_AAS.enu_to_map(nav.xyz_m[:, 0], nav.xyz_m[:, 1], nav.xyz_m[:, 2])
-grid = MapGrid.covering((xs.min() - 1500, xs.max() + 1500), (ys.min() - 1500, ys.max() + 1500), 20.0)
+grid = MapGrid.covering(
+    (xs.min() - 1500, xs.max() + 1500), (ys.min() - 1500, ys.max() + 1500), 20.0
+)
 z = np.full((grid.y_m.size, grid.x_m.size), float(np.median(h)))
 write_geotiff(d / "DSM.tif", z, grid.transform, 25832)
 
 # a slanted edge (5 deg), Gaussian blur sigma 0.6 px, 8x supersampled pixel aperture
-from math import erf, radians, sqrt, tan
 
 n, ss = 96, 8
 u = (np.arange(n * ss) + 0.5) / ss
@@ -71,7 +74,6 @@ dist = (x - n / 2) - (y - n / 2) * tan(radians(5.0))
 verf = np.vectorize(erf)
 fine = 0.5 * (1 + verf(dist / (0.6 * sqrt(2))))
 img = fine.reshape(n, ss, n, ss).mean(axis=(1, 3))
-from PIL import Image
 
 Image.fromarray(np.round(20 + 200 * img).astype(np.uint8)).save(d / "EDGE.png")
 print(f"inputs written to {d}")

@@ -56,7 +56,7 @@ from typing import Any
 import numpy as np
 import scipy.linalg as sla
 
-from hsgeo.adjust.datum import _check_datum, _surely_full_rank, _undetermined_points
+from hsgeo.adjust.datum import _check_datum, _undetermined_points
 from hsgeo.adjust.options import SolverOptions
 from hsgeo.adjust.parameters import Parameters
 from hsgeo.adjust.residuals import ResidualBlock
@@ -310,9 +310,9 @@ class _Solve:
         the system at the current values without them.
         """
         layout, opts = self.layout, self.options
-        if layout.pblock is None or _surely_full_rank(layout, ne, opts.rank_rtol):
+        if layout.pblock is None:
             return sy, ne
-        pts = _undetermined_points(layout, ne, opts.rank_rtol)
+        pts = _undetermined_points(layout, ne, opts.rank_rtol)  # 3 × 3 blocks: cheap
         if not pts or sy.pidx is None:
             return sy, ne
         # observation rows of the system, block by block, are the unmasked rows of each block

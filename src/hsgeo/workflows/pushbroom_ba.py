@@ -269,6 +269,12 @@ def build_problem(
     ).rays_at(obs.xy_px, obs.band, obs.xyz_nav_m, R_from_rpy(rpy[:, 0], rpy[:, 1], rpy[:, 2]))
     P0 = intersect_two_rays(obs.point, o, d, n_points)
     p = _parameters(P0, nodes, cam, gcp_index, gcp_xyz_m, node_prior_mean)
+    # a band without observations (a small block, a band the matcher found nothing in) cannot
+    # determine its principal distance: it keeps its a-priori value, and the summary names it
+    # (issue 42: pushbroom-ba at a small --scale stopped on "no observation depends on c_mm[4]")
+    unseen = np.setdiff1d(np.arange(cam.n_bands), np.unique(obs.band))
+    if unseen.size:
+        p.fix(BLOCK_NAMES["c"], index=unseen)
     timed = _time_residual(obs, cam, P0) if y_as_time else {}
     blk = PushbroomLines(
         obs.point,
@@ -687,6 +693,11 @@ def summary(res, nodes, point_ids, n_observations_2d: int, node_interval_s: floa
         "columns": list(res.params["nodes"].columns),
     }
     out["points"] = {"point_id": ids.tolist(), "xyz_m": res.value("points_m").tolist()}
+    c_free = np.asarray(res.params[BLOCK_NAMES["c"]].free).ravel()
+    out["not_estimated"] = {
+        "parameters": [f"{BLOCK_NAMES['c']}[{k}]" for k in np.flatnonzero(~c_free)],
+        "reason": "no observation in the band: the a-priori principal distance is kept",
+    }
     dropped = list(getattr(res, "dropped_points", []))
     g = res._blocks[0].group_size
     rows = res._dropped_rows[0] if dropped and res._dropped_rows is not None else None
