@@ -43,8 +43,11 @@ step cube in/raw --dark in/dark --binning 2 -o cube.nc
 step cube in/raw --dark in/dark --binning 2 -o cube.hdr
 step lp-observations in/STRIP_*.nc --trajectory in/NAV.csv --camera in/CAM.toml \
   --squares in/SQUARES.csv -o OBS.parquet
+# the GCPs that the matcher found among the squares (a GCP without observations is refused)
+"$PY" -c "import pandas as pd; o = set(pd.read_parquet('OBS.parquet')['point_id'].astype(str)); \
+g = pd.read_csv('in/GCP.csv', dtype={'point_id': str}); g[g['point_id'].isin(o)].to_csv('GCP.csv', index=False)"
 json adjust-pushbroom OBS.parquet --trajectory in/NAV.csv --camera in/CAM.toml \
-  --gcp in/GCP.csv --node-interval 10 --json
+  --gcp GCP.csv --node-interval 10 --json
 step orthomosaic in/STRIP_*.nc --trajectory in/NAV.csv --camera in/CAM.toml --dsm in/DSM.tif \
   --resolution 2 -o mosaic.tif
 echo "check-wheel: the installed wheel ran every command above from an empty folder"
