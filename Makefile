@@ -16,7 +16,7 @@ export GLIBC_TUNABLES ?= glibc.malloc.mmap_max=0:glibc.malloc.trim_threshold=429
 export PYDEVD_DISABLE_FILE_VALIDATION := 1
 
 .DEFAULT_GOAL := help
-.PHONY: help venv proj-data data test test-fast book book-student check-book browser bench lint clean lock dist
+.PHONY: help venv proj-data data test test-fast book book-student check-book check-wheel browser bench lint clean lock dist
 
 help: ## list the targets
 	@grep -hE '^[a-zA-Z_-]+:.*## ' $(MAKEFILE_LIST) | awk 'BEGIN {FS = ":.*## "}; {printf "  make %-10s %s\n", $$1, $$2}'
@@ -115,6 +115,12 @@ dist: $(STAMP) ## build the hsgeo wheel into dist/ (pip wheel, offline)
 	rm -rf dist build
 	$(PY) -m pip wheel --quiet --disable-pip-version-check --no-deps --no-build-isolation -w dist .
 	@ls dist/*.whl
+
+# The wheel installed alone (issue 42): a fresh venv outside the repository, the wheel with its
+# dependencies from the package index (at requirements.lock's versions), and the README's
+# commands run from an empty folder (.ci/check_wheel.sh; a few minutes).
+check-wheel: dist ## install the wheel into a fresh venv and run the README's commands from an empty folder
+	PYTHON=$(PYTHON) .ci/check_wheel.sh
 
 lint: $(STAMP) ## ruff check and format check, and the import contracts of the layout (GUIDE §2)
 	$(VENV)/bin/ruff check src tests bench

@@ -59,3 +59,25 @@ def test_mtf_on_the_generated_data(capsys):
     for p in out["profiles"]:
         t = np.interp(p["frequency_cy_px"], truth["f_cy_px"], truth[f"mtf_row{p['row']}"])
         assert np.abs(np.array(p["mtf"]) - t).max() < 0.05
+
+
+def test_mtf_edge_on_a_masked_chip(tmp_path, capsys):
+    """A 16-bit chip with 0 outside a rotated knife-edge target (tests/edge_reference.py, not
+    rendered by hsgeo): found and measured without --roi; a region reaching the fill is refused
+    with the reason, on standard error and, with --json, as JSON."""
+    import cv2
+    import edge_reference as ER
+
+    img, _ = ER.masked_target_chip(seed=3)
+    cv2.imwrite(str(tmp_path / "chip.png"), img.astype(np.uint16))
+    assert main(["mtf-edge", str(tmp_path / "chip.png"), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    f, m = np.array(out["frequency_cy_px"]), np.array(out["mtf"])
+    k = (f >= 0.1) & (f <= 0.4)
+    assert np.abs(m[k] - ER.known_mtf(f[k], 0.8, 5.0, 8)).max() < 0.02
+    assert out["lsf_fwhm_px"] > 1.0
+    rc = main(["mtf-edge", str(tmp_path / "chip.png"), "--roi", "70,20,130,180", "--json"])
+    assert rc == 2
+    cap = capsys.readouterr()
+    err = json.loads(cap.out)["error"]
+    assert "fill" in err and "chip.png" in err and "fill" in cap.err

@@ -131,6 +131,25 @@ def test_undetermined_point():
         adjust(p, Bearings(st[keep], pt[keep], th[keep], 1e-3))
 
 
+def test_undetermined_point_dropped_and_named():
+    """With drop_undetermined_points the point seen once is left out and named; the rest is
+    estimated as without it (issue 42), and its observation is not counted as an outlier."""
+    S, P, st, pt, th = bearing_scene(4)
+    keep = ~((pt == 7) & (st != st[pt == 7][0]))  # point 7 seen from one station only
+    p, _ = _bearing_params(S, P, st, pt, th)
+    res = adjust(p, Bearings(st[keep], pt[keep], th[keep], 1e-3), drop_undetermined_points=True)
+    assert res.converged and res.dropped_points == [7]
+    assert not res.outliers(0).any()
+    assert res.n_observations == int(keep.sum()) - 1
+    # the same adjustment with point 7's observation removed and the point fixed
+    q, _ = _bearing_params(S, P, st, pt, th)
+    q.fix("points", index=[7])
+    k2 = keep & (pt != 7)
+    ref = adjust(q, Bearings(st[k2], pt[k2], th[k2], 1e-3))
+    np.testing.assert_allclose(res.value("stations"), ref.value("stations"), rtol=1e-9, atol=1e-12)
+    assert res.sigma0 == pytest.approx(ref.sigma0, rel=1e-9)
+
+
 def test_fixed_entries_and_priors():
     S, P, st, pt, th = bearing_scene(6)
     p, blk = _bearing_params(S, P, st, pt, th, n_control=0)

@@ -370,20 +370,58 @@ def build_parser() -> argparse.ArgumentParser:
     return ap
 
 
+def _json_error(command: str | None, message: str, status: int) -> None:
+    """With ``--json``, every exit path prints one JSON object on standard output (issue 42):
+    a failure is ``{"command", "ok": false, "exit_status", "error"}``, the same line as on
+    standard error (which keeps it too).
+    """
+    try:
+        print(json_text({"command": command, "ok": False, "exit_status": status, "error": message}))
+        sys.stdout.flush()
+    except (BrokenPipeError, OSError, ValueError):
+        pass
+
+
+def _json_usage_errors(ap: argparse.ArgumentParser, argv) -> None:
+    """Make the parser's usage errors JSON too when ``--json`` is among the arguments."""
+    if "--json" not in argv:
+        return
+    parsers = [ap]
+    for action in ap._actions:  # the subcommands' parsers
+        if isinstance(action, argparse._SubParsersAction):
+            parsers += list(action.choices.values())
+    for p in parsers:
+
+        def error(message, _p=p, _error=p.error):
+            command = _p.prog.split()[-1] if _p is not ap else None
+            line = " ".join(f"{_p.prog}: error: {message} (see {_p.prog} --help)".split())
+            _json_error(command, line, 2)
+            _error(message)  # the parser's own one line on standard error, exit status 2
+
+        p.error = error
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``hsgeo`` console script."""
     terminal.setup_streams()  # any locale: Σ, σ, … in ASCII where the terminal cannot show them
     args = None
+    argv_list = list(sys.argv[1:] if argv is None else argv)
 
     def fail(msg: str, status: int = 2) -> int:
         terminal.clear_progress()
         msg = " ".join(msg.split())  # one line, whatever the message
         prog = "hsgeo" if args is None else f"hsgeo {args.command}"
+        if (getattr(args, "json", False) if args is not None else "--json" in argv_list) and (
+            status != EXIT_BROKEN_PIPE
+        ):
+            _json_error(None if args is None else args.command, f"{prog}: {msg}", status)
         print(f"{prog}: {msg}", file=sys.stderr)
         return status
 
     try:  # from the first import on: Ctrl-C while numpy, pandas, numba load is Ctrl-C too
-        args = build_parser().parse_args(argv)
+        ap = build_parser()
+        _json_usage_errors(ap, argv_list)
+        args = ap.parse_args(argv_list)
         from hsgeo.adjust.threads import blas_threads
 
         # BLAS on one thread, whatever the shell says: on small dense solves a second OpenBLAS
@@ -418,6 +456,8 @@ def main(argv: list[str] | None = None) -> int:
             return fail("interrupted", EXIT_INTERRUPTED)
         line = terminal.error_line(exc)  # the OS refused, or memory ran out
         if line is None:
+            if getattr(args, "json", False):  # a bug: still JSON on stdout, then the traceback
+                _json_error(args.command, f"internal error: {type(exc).__name__}: {exc}", 1)
             raise
         return fail(f"error: {line}")
 

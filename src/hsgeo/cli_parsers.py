@@ -492,8 +492,12 @@ def add_mtf_edge(sub) -> argparse.ArgumentParser:
         "mtf-edge",
         help="slanted-edge MTF (ISO 12233) of an image",
         description="The ISO 12233 slanted-edge MTF of an 8- or 16-bit PNG or TIFF: edge angle, "
-        "4x oversampled edge spread, derivative, Hamming window, FFT. Without --roi the region "
-        "around the strongest edge is used.",
+        "4x oversampled edge spread, derivative, Hamming window, FFT. A region is measured only "
+        "if it holds one straight edge between two plateaus, no fill, nodata or clipped level, "
+        "at least 4 px of each plateau, and a line spread function at least 1 px wide; "
+        "otherwise the reason is given. Without --roi the region around the strongest edge is "
+        "used if it qualifies, else a region that does is searched for (e.g. inside a target "
+        "whose surroundings are set to 0).",
     )
     p.add_argument("image", help="8- or 16-bit PNG or TIFF holding one slanted edge")
     p.add_argument("--roi", help="region x0,y0,x1,y1 in pixels around the edge")

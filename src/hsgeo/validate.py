@@ -239,7 +239,9 @@ def option_number(
     else:
         need = "a positive number" if positive else "a finite number"
     if lo is not None or hi is not None:
-        need += f" in [{'-inf' if lo is None else f'{lo:g}'}, {'inf' if hi is None else f'{hi:g}'}]"
+        # a positive number has the open bound 0 below it unless a lower one is given
+        left = f"[{lo:g}" if lo is not None else ("(0" if positive else "[-inf")
+        need += f" in {left}, {'inf' if hi is None else f'{hi:g}'}]"
 
     def parse(text: str):
         try:

@@ -102,6 +102,11 @@ class SolverOptions:
         at each linearisation).
     check_datum : bool, default True
         Check the rank before the first step; raise :class:`~hsgeo.DatumError` if deficient.
+    drop_undetermined_points : bool, default False
+        With ``check_datum``: a free point whose own normal block is singular (too few or
+        degenerate rays) is held at its initial value and its observations are left out
+        instead of stopping the adjustment; the result names them
+        (``AdjustmentResult.dropped_points``). Any other deficiency still raises.
     rank_rtol : float, default 1e-11
         Relative eigenvalue threshold of the datum check (see
         :func:`~hsgeo.adjust.identifiability`).
@@ -158,6 +163,7 @@ class SolverOptions:
     robust_start: str | None = None
     robust_start_k: float = 3.0
     check_datum: bool = True
+    drop_undetermined_points: bool = False
     rank_rtol: float = 1e-11
     raise_on_failure: bool = True
     compiled: bool = True
@@ -225,6 +231,7 @@ class SolverOptions:
         for name in (
             "reject_every_iteration",
             "check_datum",
+            "drop_undetermined_points",
             "raise_on_failure",
             "compiled",
             "fused",

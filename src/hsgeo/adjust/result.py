@@ -48,6 +48,9 @@ class AdjustmentResult:
     columns : dict of str to ndarray
         For each non-point block, the index in ``labels``/``covariance`` of each entry
         (flattened; -1 where fixed).
+    dropped_points : list of int
+        Points left out because their observations do not determine them (held at their
+        initial values, their observations unused; ``SolverOptions.drop_undetermined_points``).
     seconds_split : dict of str to float
         Where ``seconds`` went: ``model`` (the residual blocks' own evaluation, residuals and
         derivatives; on the fused path, ``SolverOptions.fused``, also their whitening into the
@@ -80,6 +83,9 @@ class AdjustmentResult:
     _point_cofactors: Callable | None = field(default=None, repr=False)
     _point_cov: np.ndarray | None = field(default=None, repr=False)
     seconds_split: dict = field(default_factory=dict, repr=False)
+    dropped_points: list = field(default_factory=list)
+    #: per block, the rows left out with the dropped points (not outliers)
+    _dropped_rows: list | None = field(default=None, repr=False)
 
     # -- estimates and their σ ----------------------------------------------------------------
     def value(self, name: str) -> np.ndarray:
@@ -165,10 +171,15 @@ class AdjustmentResult:
         return self.residuals(block) / b.sigma / self.sigma0
 
     def outliers(self, block: str | int = 0) -> np.ndarray:
-        """Bool mask of the rejected observations (one entry per group)."""
+        """Bool mask of the rejected observations (one entry per group; the observations of
+        :attr:`dropped_points` are not outliers).
+        """
         i = self._block_index(block)
         g = self._blocks[i].group_size
-        return ~self._masks[i].reshape(-1, g)[:, 0]
+        kept = (
+            self._masks[i] if self._dropped_rows is None else self._masks[i] | self._dropped_rows[i]
+        )
+        return ~kept.reshape(-1, g)[:, 0]
 
     def _block_index(self, block) -> int:
         if isinstance(block, int):

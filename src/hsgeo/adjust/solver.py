@@ -56,7 +56,7 @@ from typing import Any
 import numpy as np
 import scipy.linalg as sla
 
-from hsgeo.adjust.datum import _check_datum
+from hsgeo.adjust.datum import _check_datum, _undetermined_points
 from hsgeo.adjust.options import SolverOptions
 from hsgeo.adjust.parameters import Parameters
 from hsgeo.adjust.residuals import ResidualBlock
@@ -244,6 +244,8 @@ class _Solve:
         self.each = options.reject_k is not None and options.reject_every_iteration
         self.D_max: np.ndarray | None = None  # damping_diagonal="max": the running maximum
         self.hold_count: dict[int, int] = {}  # times each point was held (at most HOLD_MAX)
+        self.dropped_points: list[int] = []  # SolverOptions.drop_undetermined_points
+        self.dropped_rows = [np.zeros(b.m, dtype=bool) for b in blocks]  # ... their rows
         self.settled_seen = False  # an iterate was settled (accepted steps no longer held)
         self.clock = _Clock()  # AdjustmentResult.seconds_split
         #: SolverOptions.robust_start: the loss until the first settled iterate, and the
@@ -302,6 +304,34 @@ class _Solve:
         self.clock.add("rejection", t0)
         return out
 
+    def _drop_undetermined(self, sy, ne):
+        """Hold the free points that their observations do not determine (a singular 3 × 3
+        block) and leave their observations out (``SolverOptions.drop_undetermined_points``);
+        the system at the current values without them.
+        """
+        layout, opts = self.layout, self.options
+        if layout.pblock is None:
+            return sy, ne
+        pts = _undetermined_points(layout, ne, opts.rank_rtol)  # 3 × 3 blocks: cheap
+        if not pts or sy.pidx is None:
+            return sy, ne
+        # observation rows of the system, block by block, are the unmasked rows of each block
+        drop = np.isin(sy.pidx[: sy.n_obs_rows], pts)
+        row = 0
+        for m, dropped in zip(self.masks, self.dropped_rows, strict=True):
+            kept = np.flatnonzero(m)
+            rows = kept[drop[row : row + kept.size]]
+            m[rows] = False
+            dropped[rows] = True
+            row += kept.size
+        layout.params.fix(layout.pblock.name, np.asarray(pts))
+        layout.pfree[pts] = False
+        self.dropped_points += [int(i) for i in pts]
+        sy = ne = None
+        sy, ne = self.linearise(check_redundancy=True)
+        self._damping_diagonal(ne)
+        return sy, ne
+
     # -- one pass of the Levenberg–Marquardt loop -------------------------------------------
     def minimise(self, tol: float, check_datum: bool = False):
         """Iterate from the current values to the minimum (to ``tol``) with the current masks.
@@ -315,6 +345,8 @@ class _Solve:
         self._damping_diagonal(ne)
         if check_datum:
             t0 = time.perf_counter()
+            if opts.drop_undetermined_points:
+                sy, ne = self._drop_undetermined(sy, ne)
             _check_datum(self.layout, ne, opts.rank_rtol)
             self.clock.add("datum", t0)
         lam, nu = opts.lambda0, 2.0
@@ -718,6 +750,8 @@ class _Solve:
             _residuals=residuals,
             _point_cofactors=cofactors,
             seconds_split=split,
+            dropped_points=sorted(self.dropped_points),
+            _dropped_rows=[d.copy() for d in self.dropped_rows],
         )
 
 

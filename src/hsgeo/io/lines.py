@@ -66,8 +66,8 @@ def open_netcdf(path, variable: str, what: str, remedy: str):
         ds = xr.open_dataset(src, engine=engine)
     except ImportError:
         raise InputError(
-            f"{role} {str(path)!r} is NetCDF-4 (HDF5): reading it needs the h5py package (pip "
-            "install h5py), or save the file as NetCDF 3 classic"
+            f"{role} {str(path)!r} is NetCDF-4 (HDF5): reading it needs the h5netcdf and h5py "
+            "packages (pip install h5netcdf h5py), or save the file as NetCDF 3 classic"
         ) from None
     except TypeError:  # scipy's reader on a dimension of length 0 (read as 'unlimited')
         raise InputError(

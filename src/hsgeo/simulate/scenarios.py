@@ -15,15 +15,25 @@ __all__ = ["data_dir", "load_scenario"]
 
 
 def data_dir() -> Path:
-    """The repository's ``data_synthetic/`` (found from the working directory or the package):
-    the first such folder that holds scenario TOMLs (a ``./data_synthetic/generated`` written by
-    ``hsgeo data`` outside the repository is not one).
+    """The scenarios' folder: the repository's ``data_synthetic/`` (found from the working
+    directory or, for an editable install, from the package's source tree), else the copy an
+    installed wheel carries in ``hsgeo/data/scenarios`` (``setup.py``), so ``hsgeo reproduce``
+    and ``hsgeo data`` work from any folder. A folder counts only if it holds scenario TOMLs (a
+    ``./data_synthetic/generated`` written by ``hsgeo data`` outside the repository is not one).
     """
-    for base in [Path.cwd(), *Path.cwd().parents, Path(__file__).resolve().parents[3]]:
+    here = Path(__file__).resolve()
+    packaged = here.parents[1] / "data" / "scenarios"
+    for base in [Path.cwd(), *Path.cwd().parents, here.parents[3]]:
         d = base / "data_synthetic"
         if d.is_dir() and any(d.glob("*.toml")):
             return d
-    raise InputError("data_synthetic/ not found: run from the hsgeo repository")
+    if packaged.is_dir() and any(packaged.glob("*.toml")):
+        return packaged
+    raise InputError(
+        "data_synthetic/ not found and this hsgeo was installed without its scenarios "
+        f"({packaged}): reinstall it from a wheel built by `make dist`, or run from the hsgeo "
+        "repository"
+    )
 
 
 def load_scenario(name: str) -> dict:

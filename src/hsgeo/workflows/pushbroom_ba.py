@@ -306,6 +306,12 @@ def build_problem(
     )
     P0 = intersect_two_rays(obs.point, o, d, n_points)
     p = _parameters(P0, nodes, cam, gcp_index, gcp_xyz_m, node_prior_mean)
+    # a band without observations (a small block, a band the matcher found nothing in) cannot
+    # determine its principal distance: it keeps its a-priori value, and the summary names it
+    # (issue 42: pushbroom-ba at a small --scale stopped on "no observation depends on c_mm[4]")
+    unseen = np.setdiff1d(np.arange(cam.n_bands), np.unique(obs.band))
+    if unseen.size:
+        p.fix(BLOCK_NAMES["c"], index=unseen)
     timed = _time_residual(obs, cam, P0) if y_as_time else {}
     blk = PushbroomLines(
         obs.point,
@@ -353,6 +359,9 @@ def solve(
         ftol=ftol,
         progress=progress,
         reject_every_iteration=True,  # 002 §3.4
+        # a tie point its rays do not determine is left out and named, not a reason to stop
+        # (issue 42: lp-observations --seed 6062 stopped on one such point)
+        drop_undetermined_points=True,
         keep_jacobian=keep_jacobian,
         raise_on_failure=raise_on_failure,
         **{"chord_end": CHORD_END, **overrides},
@@ -743,6 +752,20 @@ def summary(res, nodes, point_ids, n_observations_2d: int, node_interval_s: floa
         "columns": list(res.params["nodes"].columns),
     }
     out["points"] = {"point_id": ids.tolist(), "xyz_m": res.value("points_m").tolist()}
+    c_free = np.asarray(res.params[BLOCK_NAMES["c"]].free).ravel()
+    out["not_estimated"] = {
+        "parameters": [f"{BLOCK_NAMES['c']}[{k}]" for k in np.flatnonzero(~c_free)],
+        "reason": "no observation in the band: the a-priori principal distance is kept",
+    }
+    dropped = list(getattr(res, "dropped_points", []))
+    g = res._blocks[0].group_size
+    rows = res._dropped_rows[0] if dropped and res._dropped_rows is not None else None
+    out["dropped_points"] = {
+        "point_id": ids[dropped].tolist(),
+        "n_observations_2d": 0 if rows is None else int(rows.reshape(-1, g)[:, 0].sum()),
+        "reason": "not determined by their observations (too few or degenerate rays): held at "
+        "their initial values, their observations left out",
+    }
     out["fit"] = fit_verdict(res, n_obs)
     return out
 

@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# `make check-wheel`: the wheel is the product too (issue 42). Install dist/hsgeo-*.whl alone into
+# a fresh venv (its dependencies from the package index, held to requirements.lock's versions by
+# `-c`), then, from an empty folder, run the README's commands on files written there: the data,
+# the chapters that read the scenarios, and every command on inputs the installed hsgeo writes
+# (.ci/wheel_inputs.py). Any failure stops the check with the command that failed.
+set -euo pipefail
+ROOT="$(cd "$(dirname "$0")/.." && pwd)"
+PYTHON="${PYTHON:-python3.11}"
+WHEEL="$(ls "$ROOT"/dist/hsgeo-*.whl | head -n 1)"
+WORK="$(mktemp -d)"
+trap 'rm -rf "$WORK"' EXIT
+"$PYTHON" -m venv "$WORK/venv"
+"$WORK/venv/bin/python" -m pip install --quiet --disable-pip-version-check \
+  -c "$ROOT/requirements.lock" "$WHEEL"
+HS="$WORK/venv/bin/hsgeo"
+PY="$WORK/venv/bin/python"
+mkdir "$WORK/empty" && cd "$WORK/empty"
+export OPENBLAS_NUM_THREADS=1 PYTHONDONTWRITEBYTECODE=1
+
+step() { echo "+ hsgeo $*"; "$HS" "$@" > "$WORK/out.txt"; }
+json() { echo "+ hsgeo $* (JSON)"; "$HS" "$@" | "$PY" -c "import json, sys; json.load(sys.stdin)"; }
+
+step --help
+step versions
+step data --verify                    # ./data_synthetic/generated from the wheel's scenarios
+step reproduce frame-reference
+json reproduce geocoding --seed 3 --scale 0.1 --json   # the README's command, smaller
+json reproduce rikola --scale 0.1 --json
+G=data_synthetic/generated
+step calibrate-line $G/line_lab_observations.csv --control $G/line_lab_control.csv
+step mtf $G/mtf_bench_profiles.csv --bars $G/mtf_bench_bars.toml
+BAL="$("$PY" -c 'import hsgeo, pathlib; print(pathlib.Path(hsgeo.__file__).parent / "data/reference/bal-ladybug/problem-49-7776-pre.txt.bz2")')"
+step adjust-bal "$BAL"
+# a usage error says what the option takes (was "a positive number in [-inf, 1]")
+if "$HS" reproduce mtf --scale small 2> "$WORK/err.txt"; then echo "--scale small accepted"; exit 1; fi
+grep -q "(0, 1\]" "$WORK/err.txt" || { cat "$WORK/err.txt"; exit 1; }
+
+"$PY" "$ROOT/.ci/wheel_inputs.py" in > /dev/null
+step mtf-edge in/EDGE.png --roi 8,8,88,88
+step mtf-edge in/EDGE.png
+step cube in/raw --dark in/dark --binning 2 -o cube.nc
+step cube in/raw --dark in/dark --binning 2 -o cube.hdr
+step lp-observations in/STRIP_*.nc --trajectory in/NAV.csv --camera in/CAM.toml \
+  --squares in/SQUARES.csv -o OBS.parquet
+# the GCPs that the matcher found among the squares (a GCP without observations is refused)
+"$PY" -c "import pandas as pd; o = set(pd.read_parquet('OBS.parquet')['point_id'].astype(str)); \
+g = pd.read_csv('in/GCP.csv', dtype={'point_id': str}); g[g['point_id'].isin(o)].to_csv('GCP.csv', index=False)"
+json adjust-pushbroom OBS.parquet --trajectory in/NAV.csv --camera in/CAM.toml \
+  --gcp GCP.csv --node-interval 10 --json
+step orthomosaic in/STRIP_*.nc --trajectory in/NAV.csv --camera in/CAM.toml --dsm in/DSM.tif \
+  --resolution 2 -o mosaic.tif
+echo "check-wheel: the installed wheel ran every command above from an empty folder"

@@ -1,0 +1,105 @@
+"""``--json`` is JSON on every exit path (issue 42): a usage error, a refused input, a command's
+own failure each print one JSON object on standard output (``"ok": false``, the exit status and
+the same one-line message as on standard error), and the exit status is unchanged."""
+
+import json
+
+import pytest
+
+from hsgeo.cli import main
+
+# every command with --json, given an input file that does not exist (an HsgeoError)
+MISSING = {
+    "calibrate-line": ["calibrate-line", "{d}/nope.csv", "--control", "{d}/nope2.csv"],
+    "calibrate-frame": ["calibrate-frame", "{d}/nope.png", "--board", "{d}/board.toml"],
+    "orthomosaic": [
+        "orthomosaic",
+        "{d}/nope.nc",
+        "--trajectory",
+        "{d}/nav.csv",
+        "--camera",
+        "{d}/cam.toml",
+        "--dsm",
+        "{d}/dsm.tif",
+        "--resolution",
+        "1",
+        "-o",
+        "{d}/out.tif",
+    ],
+    "adjust-pushbroom": [
+        "adjust-pushbroom",
+        "{d}/nope.parquet",
+        "--trajectory",
+        "{d}/nav.csv",
+        "--camera",
+        "{d}/cam.toml",
+    ],
+    "lp-observations": [
+        "lp-observations",
+        "{d}/nope.nc",
+        "--trajectory",
+        "{d}/nav.csv",
+        "--camera",
+        "{d}/cam.toml",
+        "-o",
+        "{d}/obs.parquet",
+    ],
+    "adjust-bal": ["adjust-bal", "{d}/nope.txt"],
+    "mtf": ["mtf", "{d}/nope.csv", "--bars", "{d}/bars.toml"],
+    "mtf-edge": ["mtf-edge", "{d}/nope.png"],
+    "cube": ["cube", "{d}/raw", "--dark", "{d}/dark", "-o", "{d}/c.nc"],
+    "asf": ["asf", "{d}/cross.nc", "{d}/along.nc", "--runway", "{d}/runway.csv"],
+}
+
+
+def _one_json(text: str) -> dict:
+    out = json.loads(text)  # exactly one JSON document, nothing else on stdout
+    assert isinstance(out, dict)
+    return out
+
+
+@pytest.mark.parametrize("command", sorted(MISSING))
+def test_refused_input_is_json(command, tmp_path, capsys):
+    argv = [a.format(d=tmp_path) for a in MISSING[command]] + ["--json"]
+    assert main(argv) == 2
+    cap = capsys.readouterr()
+    out = _one_json(cap.out)
+    assert out["ok"] is False and out["exit_status"] == 2 and out["command"] == command
+    assert out["error"] in cap.err  # the same line as on standard error
+    assert "\n" not in out["error"]
+
+
+@pytest.mark.parametrize("command", sorted(MISSING))
+def test_usage_error_is_json(command, tmp_path, capsys):
+    argv = [a.format(d=tmp_path) for a in MISSING[command]] + ["--json", "--no-such-option"]
+    with pytest.raises(SystemExit) as e:
+        main(argv)
+    assert e.value.code == 2
+    cap = capsys.readouterr()
+    out = _one_json(cap.out)
+    assert out["ok"] is False and out["exit_status"] == 2
+    assert "--no-such-option" in out["error"] and "--no-such-option" in cap.err
+
+
+def test_reproduce_bad_scale_is_json(capsys):
+    with pytest.raises(SystemExit):
+        main(["reproduce", "mtf", "--scale", "small", "--json"])
+    out = _one_json(capsys.readouterr().out)
+    assert out["command"] == "reproduce" and "(0, 1]" in out["error"]
+
+
+def test_without_json_stdout_stays_empty(tmp_path, capsys):
+    assert main(["mtf-edge", str(tmp_path / "nope.png")]) == 2
+    cap = capsys.readouterr()
+    assert cap.out == "" and "nope.png" in cap.err
+
+
+def test_observation_error_of_mtf_edge_is_json(tmp_path, capsys):
+    """A refused region (the command's own judgement, not a file error) is JSON too."""
+    import numpy as np
+    from PIL import Image
+
+    Image.fromarray(np.full((64, 64), 100, np.uint8)).save(tmp_path / "flat.png")
+    assert main(["mtf-edge", str(tmp_path / "flat.png"), "--roi", "0,0,64,64", "--json"]) == 2
+    out = _one_json(capsys.readouterr().out)
+    assert out["ok"] is False and "edge" in out["error"]
