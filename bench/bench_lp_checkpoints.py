@@ -217,18 +217,24 @@ def main(argv=None) -> dict:
     for seed in a.seeds:
         runs.append(one_seed(seed, a.scale))
         print(f"seed {seed}: {runs[-1]['seconds']:.0f} s", flush=True)
+        doc = write(runs, a.scale, a.out, time.perf_counter() - t0)  # after every seed
+    return doc
+
+
+def write(runs, scale, out, wall_s) -> dict:
+    """The JSON of the seeds run so far (``runs``), with their summary."""
     doc = {
         "bench": "lp_checkpoints_seeds",
-        "scale": a.scale,
-        "sim_scale": sim_scale(a.scale),
-        "seeds": a.seeds,
+        "scale": scale,
+        "sim_scale": sim_scale(scale),
+        "seeds": [r["seed"] for r in runs],
         "stats": list(P002_STATS),
         "summary": _summary(runs),
         "runs": runs,
-        "wall_s": time.perf_counter() - t0,
+        "wall_s": wall_s,
         "machine": platform.platform(),
     }
-    Path(a.out).write_text(json.dumps(doc, indent=1))
+    Path(out).write_text(json.dumps(doc, indent=1))
     return doc
 
 
