@@ -50,7 +50,9 @@ MATCH_SAMPLE = 60_000
 
 def camera_prior(obs, cfg) -> CameraPrior:
     """What the operator knows of the camera and the GNSS/INS (the pushbroom chapter's priors):
-    the nominal c, pixel pitch and principal point, the tape-measured lever arm, the a-priori σ
+    the nominal c and pixel pitch, the calibrated principal point (the truth plus a
+    calibration error, :attr:`hsgeo.simulate.lp_campaign.LpConfig.sigma_pp_calibration_px`),
+    the tape-measured lever arm, the a-priori σ
     of the campaign (:class:`hsgeo.simulate.pushbroom_campaign_types.CampaignConfig`; 002 §4's
     ½ px for the observations).
     """
@@ -59,8 +61,8 @@ def camera_prior(obs, cfg) -> CameraPrior:
         n_bands=len(obs.camera.c_mm),
         pixel_mm=c.pixel_mm,
         c_mm=c.c_nominal_mm,
-        x0_mm=c.x0_mm,
-        y0_mm=c.y0_mm,
+        x0_mm=float(obs.camera.x0_mm),  # the calibrated principal point (not the truth)
+        y0_mm=float(obs.camera.y0_mm),
         lever_arm_m=tuple(obs.camera.lever_arm_m),
         sigma_lever_m=c.sigma_lever_m,
         sigma_pos_m=c.sigma_pos_m,

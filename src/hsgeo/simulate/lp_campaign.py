@@ -130,6 +130,10 @@ class LpConfig:
     # time, does not model; it moves key points by half the blur, opposite for opposite
     # headings)
     exposure_stamp: str = "middle"
+    # the principal point the operator has (x0, y0 of the a-priori camera, fixed in the
+    # adjustment as 002's calibrated camera) is off the truth by a calibration error of this σ
+    # per axis (ours: a tenth of a pixel); 0: the truth itself
+    sigma_pp_calibration_px: float = 0.1
     # -- radiometry (ours): DN per unit reflectance per band, one integration time; vegetation
     # (ρ ≈ 0.48) reaches ~90 % of dn_max above the red edge (002 §5.3: "close to saturation")
     dn_max: float = 4095.0
@@ -332,10 +336,17 @@ def _checked(scale, cfg):
             raise InputError(f"LpConfig.{name} must be a positive number, got {v!r}")
     if not all(
         getattr(cfg, k) >= 0
-        for k in ("psf_sigma_m", "motion_blur_m", "read_noise_dn", "mount_motion_rad")
+        for k in (
+            "psf_sigma_m",
+            "motion_blur_m",
+            "read_noise_dn",
+            "mount_motion_rad",
+            "sigma_pp_calibration_px",
+        )
     ):
         raise InputError(
-            "LpConfig: psf_sigma_m, motion_blur_m, read_noise_dn and mount_motion_rad must be ≥ 0"
+            "LpConfig: psf_sigma_m, motion_blur_m, read_noise_dn, mount_motion_rad and "
+            "sigma_pp_calibration_px must be ≥ 0"
         )
     if cfg.exposure_stamp not in ("middle", "start"):
         raise InputError(
@@ -392,11 +403,14 @@ def simulate(
     )
     lever_measured = lever + c.sigma_lever_m * rng.standard_normal(3)
     nb = len(cam_true.c_mm)
+    # the operator's calibrated principal point: the truth plus a calibration error (drawn
+    # from a spawned stream, so the campaign's other draws do not move)
+    pp_err = cfg.sigma_pp_calibration_px * c.pixel_mm * rng.spawn(1)[0].standard_normal(2)
     cam_prior = PushbroomCamera(
         c_mm=(c.c_nominal_mm,) * nb,
         pixel_mm=c.pixel_mm,
-        x0_mm=c.x0_mm,
-        y0_mm=c.y0_mm,
+        x0_mm=c.x0_mm + float(pp_err[0]),
+        y0_mm=c.y0_mm + float(pp_err[1]),
         lever_arm_m=tuple(lever_measured),
     )
     times = _line_times(c, plan)
