@@ -576,7 +576,7 @@ def run(seed: int = 0, scale: float = 1.0, progress=None, unmodelled: bool = Tru
     rows += _parameter_rows(ev, twin)
     rows += _shift_rows(ev, twin)
     t0 = time.perf_counter()
-    fig9_rows, mosaic_adj, mosaic_raw, per_square = fig9(obs, truth, ev["adjusted"])
+    fig9_rows, mosaic_adj, mosaic_raw, per_square = fig9(obs, truth, ev["adjusted"], rng=[seed, 9])
     T["fig9"] = time.perf_counter() - t0
     rows += fig9_rows
     off = None
