@@ -148,7 +148,8 @@ class LpOptions:
     square_search_px : int
         Half-width of the square's search window around its predicted position.
     min_square_observations : int
-        A square is kept when measured in at least this many lines.
+        A square is kept when measured in at least this many lines (of as many strips: the
+        bands of one strip see it along one ray).
     max_nav_gap_s : float
         The longest navigation gap interpolated across.
     rng : int
@@ -493,7 +494,8 @@ def _table(inputs, options, keys, point, square_rows, score):
     )
     sq_rows = pd.DataFrame(square_rows, columns=sq.COLUMNS)
     sq_rows = sq_rows.loc[sq_rows["ok"].astype(bool)].drop_duplicates(["point_id", "band", "strip"])
-    count = sq_rows.groupby("point_id")["point_id"].transform("size")
+    # lines of different strips (one strip sees a square in one line; its bands share that ray)
+    count = sq_rows.groupby("point_id")["strip"].transform("nunique")
     cen = sq_rows[count >= options.min_square_observations].assign(
         y_px=0.0, feature=-1, adjusted=True
     )
