@@ -20,7 +20,15 @@ block as a share of 002's 600 m, so the campaign's area fraction is its square (
   true image position before RANSAC, after it (LP-F and frame-F) and after the adjustment's
   rejection; the share of false matches RANSAC keeps;
 * ``"observations per band"``: key points, matches and observations per band;
-* ``"002 Table 1 from pixels"``, ``"002 Table 2 from pixels"``, ``"002 Table 3 from pixels"``;
+* ``"002 Table 1 from pixels"``, ``"002 Table 2 from pixels"``, ``"002 Table 3 from pixels"``:
+  the check points measured as 002 measured them (the matcher's tie points on the squares, at
+  the pixel centre), the GCPs by their centroids; the statistics' σ̂ from the check points'
+  joint covariance (:func:`stat_sigma`);
+* ``"square centroids: 002 Table 2 from pixels"`` (and 3): the same with the check points'
+  blob centroids in every strip and band (context, not a claim);
+* ``"check points"``: rays per check point each way, per tie point, the counts;
+* ``"no-GCP height"``: the mean height without GCPs (joint σ̂), the principal distances' mean
+  error and the height offset it predicts, the c error 002's −1.13 m would mean;
 * ``"parameters"``: the camera parameters against their truth (σ̂, z);
 * ``"unmodelled effect"``: the headline numbers with the motion blur (on in every run) and
   without it (the same campaign rendered again).
