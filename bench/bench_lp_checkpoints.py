@@ -211,7 +211,17 @@ def main(argv=None) -> dict:
     ap.add_argument(
         "--out", default=str(Path(__file__).parent / "results" / "lp_checkpoints_seeds.json")
     )
+    ap.add_argument(
+        "--merge",
+        nargs="+",
+        metavar="JSON",
+        help="merge the runs of these result files (seeds run in parallel) into --out",
+    )
     a = ap.parse_args(argv)
+    if a.merge:
+        docs = [json.loads(Path(f).read_text()) for f in a.merge]
+        runs = sorted((r for d in docs for r in d["runs"]), key=lambda r: r["seed"])
+        return write(runs, docs[0]["scale"], a.out, sum(d["wall_s"] for d in docs))
     t0 = time.perf_counter()
     runs = []
     for seed in a.seeds:

@@ -177,7 +177,7 @@ def check_point_errors(result, point_ids, cp_ids, cp_xyz_true_m):
     return result.value("points_m")[idx] - xyz, idx, np.asarray(cp_ids)[keep]
 
 
-def joint_point_covariance(result, index) -> np.ndarray:
+def joint_point_covariance(result, index, *, engine_diagonal: bool = True) -> np.ndarray:
     """The joint a-posteriori covariance of some points of an adjustment, ``(3k, 3k)`` (m²,
     ordered point by point, E, N, H within a point).
 
@@ -212,6 +212,10 @@ def joint_point_covariance(result, index) -> np.ndarray:
     A = np.einsum("kij,kjc->kic", Vinv, Wi).reshape(k * p, -1)
     s2 = result.sigma0**2 if np.isfinite(result.sigma0) else 1.0
     cross = s2 * (A @ S_inv @ A.T)
-    for i in range(k):  # the diagonal blocks as the engine computes them
-        cross[i * p : (i + 1) * p, i * p : (i + 1) * p] = blocks[i]
+    for i in range(k):
+        sl = slice(i * p, (i + 1) * p)
+        if engine_diagonal:  # the diagonal blocks as the engine computes them
+            cross[sl, sl] = blocks[i]
+        else:  # this function's own: V_i⁻¹ + A_i S⁻¹ A_iᵀ (a test of the cross terms' A)
+            cross[sl, sl] += s2 * Vinv[i]
     return 0.5 * (cross + cross.T)
