@@ -355,8 +355,12 @@ def _ray_rows(ev: dict) -> list[Row]:
     tab = ev["retrieval"].table
     tie = ~ev["is_square"]
     per_tp = tab.loc[tie].groupby("point_id").size().to_numpy(float)
+    pid = tab["point_id"].astype(str)
+    strips = tab[pid.isin([str(c) for c in ev["cp_ids"]])].groupby("point_id")["strip"].nunique()
     rows = [
         Row(T, "rays_per_tie_point_mean", "1", reproduced=float(per_tp.mean())),
+        # a square found in k bands of one strip is k rays along one line (one line rounding)
+        Row(T, "strips_per_check_point_mean_tie_point", "1", reproduced=float(strips.mean())),
         Row(T, "n_check_points", "1", reproduced=float(len(ev["cp_ids"]))),
         Row(T, "n_gcps", "1", reproduced=float(len(ev["gcp_ids"]))),
     ]
