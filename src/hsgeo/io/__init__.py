@@ -4,7 +4,7 @@ One module per format:
 
 * :mod:`hsgeo.io.tables` — CSV / Parquet tables with required columns (units in the names);
 * :mod:`hsgeo.io.config` — TOML with a schema (unknown keys are errors with a suggestion);
-* :mod:`hsgeo.io.sensors` — the sensor TOML of ``hsgeo geocode``, the camera TOML of
+* :mod:`hsgeo.io.sensors` — the sensor TOML of ``hsgeo orthorectify``, the camera TOML of
   ``hsgeo adjust-pushbroom``;
 * :mod:`hsgeo.io.boards` — the calibration-board description (:class:`Board`, mm) and the
   board TOML of ``hsgeo calibrate-frame``;
@@ -13,7 +13,8 @@ One module per format:
 * :mod:`hsgeo.io.lines` — recorded flight lines (NetCDF);
 * :mod:`hsgeo.io.lp_lines` — the LP image lines of one strip (:class:`LpStrip`, NetCDF-4) of
   ``hsgeo lp-observations``;
-* :mod:`hsgeo.io.raster` — orthoimages (NetCDF and ENVI) and DEMs (NetCDF);
+* :mod:`hsgeo.io.raster` — the one writer of orthoimages and mosaics (:func:`write_raster`:
+  COG, CF-1.8 NetCDF or ENVI by the suffix) and DEMs (NetCDF);
 * :mod:`hsgeo.io.envi` — ENVI BSQ/BIL/BIP + ``.hdr``, also written in blocks of lines;
 * :mod:`hsgeo.io.frames` — folders of raw ImSpector frames (16-bit TIFF or ``.npy``) with their
   exposure times and wavelengths (``hsgeo cube``);
@@ -37,7 +38,7 @@ from hsgeo.io.lp_lines import LpStrip, read_lp_lines, write_lp_lines
 from hsgeo.io.navigation import NAV_COLUMNS, read_trajectory, write_trajectory
 from hsgeo.io.nist_strd import read_nist_strd
 from hsgeo.io.opencv import read_opencv_storage
-from hsgeo.io.raster import read_dem, to_map_files
+from hsgeo.io.raster import read_dem, write_raster
 from hsgeo.io.sensors import (
     read_band_split,
     read_camera_toml,
@@ -73,7 +74,7 @@ __all__ = [
     "read_board",
     "read_lines",
     "write_lines",
-    "to_map_files",
+    "write_raster",
     "read_dem",
     "read_envi",
     "write_envi",
