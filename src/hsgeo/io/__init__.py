@@ -4,8 +4,11 @@ One module per format:
 
 * :mod:`hsgeo.io.tables` — CSV / Parquet tables with required columns (units in the names);
 * :mod:`hsgeo.io.config` — TOML with a schema (unknown keys are errors with a suggestion);
-* :mod:`hsgeo.io.sensors` — the sensor TOML of ``hsgeo orthorectify``, the camera TOML of
-  ``hsgeo adjust-pushbroom``;
+* :mod:`hsgeo.io.sensor_file` — the one sensor file (``[sensor] model = ...``) of every
+  command, through a registry of models (:func:`read_sensor`);
+* :mod:`hsgeo.io.sensors` — the former per-command formats (the 000 sensor TOML of ``hsgeo
+  geocode``, the 002 camera TOML of ``hsgeo adjust-pushbroom``), the adjustment JSON and the
+  instrument files;
 * :mod:`hsgeo.io.boards` — the calibration-board description (:class:`Board`, mm) and the
   board TOML of ``hsgeo calibrate-frame``;
 * :mod:`hsgeo.io.navigation` — the one navigation file of every command (GNSS/INS
@@ -39,6 +42,7 @@ from hsgeo.io.navigation import NAV_COLUMNS, read_trajectory, write_trajectory
 from hsgeo.io.nist_strd import read_nist_strd
 from hsgeo.io.opencv import read_opencv_storage
 from hsgeo.io.raster import read_dem, write_raster
+from hsgeo.io.sensor_file import read_sensor
 from hsgeo.io.sensors import (
     read_band_split,
     read_camera_toml,
@@ -64,6 +68,7 @@ __all__ = [
     "Key",
     "read_config",
     "read_toml",
+    "read_sensor",
     "read_sensor_toml",
     "read_camera_toml",
     "read_band_split",

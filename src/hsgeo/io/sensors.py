@@ -163,7 +163,8 @@ def read_camera_toml(path) -> dict:
 
 
 def read_pushbroom_camera(path):
-    """The 002 camera file (:data:`CAMERA_SCHEMA`) as a sensor for geocoding.
+    """The 002 camera as a sensor: :func:`hsgeo.io.read_sensor` of a file whose model is
+    ``pushbroom`` (or the ``[camera]`` file of :data:`CAMERA_SCHEMA`).
 
     Uses ``c_band_mm`` (one principal distance per band; default ``c_mm`` for all
     ``n_bands``), ``pixel_mm``, ``x0_mm``, ``y0_mm``, ``distortion``, ``boresight_deg`` and
@@ -173,49 +174,37 @@ def read_pushbroom_camera(path):
     -------
     hsgeo.sensors.pushbroom.PushbroomCamera
     """
-    from hsgeo.sensors.pushbroom import PushbroomCamera
-
-    cam = read_camera_toml(path)["camera"]
-    c = cam.get("c_band_mm", (cam["c_mm"],) * cam["n_bands"])
-    if len(c) != cam["n_bands"]:
-        raise InputError(
-            f"camera file {path}: [camera] c_band_mm has {len(c)} values for n_bands = "
-            f"{cam['n_bands']}; give one principal distance per band"
-        )
-    return PushbroomCamera(
-        tuple(c),
-        cam["pixel_mm"],
-        tuple(cam.get("distortion", (0.0, 0.0, 0.0, 0.0))),
-        cam.get("x0_mm", 0.0),
-        cam.get("y0_mm", 0.0),
-        tuple(np.deg2rad(cam.get("boresight_deg", (0.0, 0.0, 0.0)))),
-        tuple(cam.get("lever_arm_m", (0.0, 0.0, 0.0))),
-    )
+    return _read_kind(path, ("pushbroom",), "the 002 pushbroom camera")
 
 
 def read_scanning_sensor(path):
-    """A scanning sensor for ``hsgeo geocode --sensor``: the 000 sensor file (``[sensor]``,
-    :func:`read_sensor_toml`) or the 002 camera file (``[camera]``,
-    :func:`read_pushbroom_camera`), told apart by their table.
+    """A scanning sensor for ``hsgeo geocode --sensor``: :func:`hsgeo.io.read_sensor` of a file
+    whose model is a line scanner, the pushbroom camera or the panoramic scanner (the former
+    000 ``[sensor]`` file and the 002 ``[camera]`` file included).
 
     Returns
     -------
-    hsgeo.sensors.line.LineScanner or hsgeo.sensors.pushbroom.PushbroomCamera
+    hsgeo.sensors.line.LineScanner, hsgeo.sensors.pushbroom.PushbroomCamera or
+    hsgeo.sensors.panoramic.PanoramicScanner
     """
-    import tomllib
+    from hsgeo.io.sensor_file import MODELS
 
-    from hsgeo.io._files import read_text
-    from hsgeo.sensors.line import LineScanner
-    from hsgeo.sensors.mount import Mount
+    scanning = tuple(n for n, m in MODELS.items() if m.kind == "scanning")
+    return _read_kind(path, scanning, "a scanning sensor")
 
-    try:
-        tables = set(tomllib.loads(read_text(path, "sensor file", "TOML")))
-    except (InputError, tomllib.TOMLDecodeError):
-        tables = {"sensor"}  # read_sensor_toml gives the one clear error
-    if "camera" in tables and "sensor" not in tables:
-        return read_pushbroom_camera(path)
-    geom, boresight_rad = read_sensor_toml(path)
-    return LineScanner(geom, Mount.from_rpy(boresight_rad))
+
+def _read_kind(path, models: tuple, what: str):
+    """:func:`hsgeo.io.read_sensor`, refusing a sensor of a model not in ``models``."""
+    from hsgeo.io.sensor_file import model_of, read_sensor
+
+    sensor = read_sensor(path)
+    name = model_of(sensor)
+    if name not in models:
+        raise InputError(
+            f"sensor file {path}: model {name!r} is not {what}; this command takes "
+            f"model {' or '.join(repr(m) for m in models)}"
+        )
+    return sensor
 
 
 #: An instrument's band split (``data/instruments/*.toml``): which sensor records each band.
@@ -351,7 +340,9 @@ def read_adjustment(path) -> dict:
     -------
     dict
         ``boresight_rad`` (3,), ``lever_arm_m`` (3,), ``distortion`` (4,), ``c_mm`` (n,),
-        ``t_nodes_s`` (n_nodes,), ``nodes`` (n_nodes, 6) in m and rad, ``node_columns``.
+        ``t_nodes_s`` (n_nodes,), ``nodes`` (n_nodes, 6) in m and rad, ``node_columns``, and
+        ``sensor_model`` = ``"pushbroom"`` (the model of the camera parameters); apply it with
+        :func:`hsgeo.sensors.adjusted`.
 
     Raises
     ------
@@ -388,6 +379,7 @@ def read_adjustment(path) -> dict:
     out["boresight_rad"] = np.radians(out["boresight_rad"])
     out["c_mm"] = np.atleast_1d(out["c_mm"])
     out["node_columns"] = columns
+    out["sensor_model"] = "pushbroom"  # whose parameters these are (hsgeo.sensors.adjusted)
     _check_adjustment(where, out)
     return out
 

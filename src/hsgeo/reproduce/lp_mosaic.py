@@ -43,11 +43,10 @@ import numpy as np
 from hsgeo.crs import SITE_AAS
 from hsgeo.papers import P002
 from hsgeo.report import Row
+from hsgeo.sensors import adjusted as adjusted_geometry
 from hsgeo.workflows.orthorectify import (
     OrthoInputs,
     OrthoOptions,
-    adjusted_camera,
-    adjusted_trajectory,
     adjustment_of,
     lp_strips,
     orthorectify,
@@ -220,7 +219,7 @@ def fig9(obs, truth, adjusted, *, resolution_m: float = P002["fig9_pixel_m"]):
     """
     adj = adjustment_of(adjusted)
     runs = {
-        "adjusted": (adjusted_camera(obs.camera, adj), adjusted_trajectory(obs.navigation, adj)),
+        "adjusted": adjusted_geometry(obs.camera, obs.navigation, adj),
         "raw": (obs.camera, obs.navigation),
     }
     mosaics, errors, seconds, expected = {}, {}, {}, {}

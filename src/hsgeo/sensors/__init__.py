@@ -9,12 +9,19 @@
   cameras (``FrameCamera`` offers ``rays`` / ``project`` at given exposure poses);
 * :mod:`~hsgeo.sensors.panoramic`: the 004 panoramic (whiskbroom) scanner
   (``PanoramicScanner``): a scanning sensor like ``LineScanner`` whose samples along one scan
-  have their own times.
+  have their own times;
+* :mod:`~hsgeo.sensors.adjustment`: :func:`adjusted`, the one way to apply an adjustment
+  (trajectory corrections and the sensor's parameters) to any of them.
+
+A sensor file (``[sensor] model = ...``) becomes one of these through
+:func:`hsgeo.io.read_sensor` (the registry :data:`hsgeo.io.sensor_file.MODELS`).
 """
 
 from __future__ import annotations
 
-__all__ = ["as_sensor"]
+from hsgeo.sensors.adjustment import adjusted, sensor_model
+
+__all__ = ["as_sensor", "adjusted", "sensor_model"]
 
 
 def as_sensor(sensor, boresight_rad=None):

@@ -15,7 +15,7 @@ residual blocks); this module holds what a flying line scanner needs of it.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 
 import numpy as np
@@ -178,10 +178,15 @@ class LineScanner:
 class BoresightGCP(ResidualBlock):
     """Residuals geocoded − reference (E, N) at GCPs as a function of the boresight angles.
 
-    Over a plane of height h: ``X = O + s·d``, ``s = (h − O_U)/d_U`` and
-    ``∂X/∂b = s·(∂d/∂b − d·(∂d_U/∂b)/d_U)`` with ``∂d/∂b = R_map_from_body (∂R_bs/∂b) d_sensor``.
-    Parameter block of role ``boresight`` (default name ``boresight``, see ``blocks``):
-    (roll, pitch, heading) of ``R_body_from_sensor`` in rad.
+    The rays are the sensor's face (:meth:`LineScanner.rays`, lever arm included) with the
+    boresight ``R_body_from_sensor = R_from_rpy(b)`` of the parameter block. Over a plane of
+    height h: ``X = O + s·d``, ``s = (h − O_U)/d_U`` and ``∂X/∂b = s·(∂d/∂b − d·(∂d_U/∂b)/d_U)``
+    with ``∂d/∂b = R_map_from_body (∂R_bs/∂b) d_sensor`` (the origin ``O`` does not depend on
+    the boresight). Parameter block of role ``boresight`` (default name ``boresight``, see
+    ``blocks``): (roll, pitch, heading) of ``R_body_from_sensor`` in rad.
+
+    ``sensor`` is a :class:`LineScanner` (its geometry and its mount's lever arm; its
+    boresight is the parameter's) or a bare :class:`LineGeometry` (no lever arm).
     """
 
     name = "GCP deviations"
@@ -191,7 +196,7 @@ class BoresightGCP(ResidualBlock):
     def __init__(
         self,
         nav,
-        sensor: LineGeometry,
+        sensor: LineGeometry | LineScanner,
         line,
         zeta_px,
         gcp_enu_m,
@@ -204,24 +209,29 @@ class BoresightGCP(ResidualBlock):
     ):
         gcp = np.asarray(gcp_enu_m, dtype=float)
         super().__init__(np.full(2 * gcp.shape[0], sigma_m), blocks=blocks)
-        t_s = t0_s + np.asarray(line, float) / line_rate_hz
-        self.pos, _ = nav.pose(t_s)
-        self.R_mb = nav.R_map_from_body(t_s)
-        t = sensor.tan_angle(zeta_px)
+        scanner = sensor if isinstance(sensor, LineScanner) else LineScanner(sensor)
+        self.scanner, self.nav = scanner, nav
+        self.t_s = t0_s + np.asarray(line, float) / line_rate_hz
+        self.zeta_px = np.asarray(zeta_px, dtype=float)
+        self.R_mb = nav.R_map_from_body(self.t_s)
+        t = scanner.geometry.tan_angle(zeta_px)
         self.d_s = np.stack([np.zeros_like(t), t, np.ones_like(t)], axis=1)
         self.gcp_en = gcp[:, :2]
         self.h = height_m
 
     def evaluate(self, values, jacobian):
         b = values[self.blocks["boresight"]]
-        d = np.einsum("nij,jk,nk->ni", self.R_mb, R_from_rpy(*b), self.d_s)
-        if np.any(d[:, 2] >= 0):
+        m = self.scanner.mount
+        face = replace(self.scanner, mount=Mount(m.lever_arm_m, R_from_rpy(*b)))
+        o, u = face.rays(self.zeta_px, self.t_s, self.nav)  # the sensor's face
+        if np.any(u[:, 2] >= 0):
             raise ObservationError("a GCP ray does not point downwards: check the attitude")
-        s = (self.h - self.pos[:, 2]) / d[:, 2]
-        X = self.pos + s[:, None] * d
+        X = o + ((self.h - o[:, 2]) / u[:, 2])[:, None] * u
         r = (X[:, :2] - self.gcp_en).ravel()
         if not jacobian:
             return r, None
+        d = np.einsum("nij,jk,nk->ni", self.R_mb, R_from_rpy(*b), self.d_s)  # unnormalised u
+        s = (self.h - o[:, 2]) / d[:, 2]
         dR = dR_drpy(*b)  # (3 angles, 3, 3)
         dd = np.einsum("nij,kjl,nl->nki", self.R_mb, dR, self.d_s)  # (n, 3 angles, 3)
         dX = s[:, None, None] * (dd - d[:, None, :] * (dd[:, :, 2:3] / d[:, None, 2:3]))

@@ -26,15 +26,17 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from hsgeo.errors import InputError
-from hsgeo.papers import ASF_004
 from hsgeo.sensors.mount import Mount, line_time
 
 __all__ = ["PanoramicScanner", "DAEDALUS_N_PX", "DAEDALUS_IFOV_DEG"]
 
 #: 004 § Description of the detector: "716 pixels for each of the 11 spectral channels".
 DAEDALUS_N_PX = 716
-#: 004: "Each pixel covers an angular range of 2·43°/716 = 0.12°".
-DAEDALUS_IFOV_DEG = float(ASF_004["angular pixel size"][0])
+#: 004: "Each pixel covers an angular range of 2·43°/716 = 0.12°" (the paper's value is
+#: ``hsgeo.papers.ASF_004["angular pixel size"]``; a test checks both agree). Typed here, not
+#: imported, so that the sensors a workflow reads carry no paper table (the import contract
+#: "workflows are truth-free" holds through hsgeo.io.read_sensor).
+DAEDALUS_IFOV_DEG = 0.12
 
 
 @dataclass(frozen=True)

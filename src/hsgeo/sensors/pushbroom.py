@@ -94,7 +94,7 @@ from hsgeo.distortion import (
 from hsgeo.errors import InputError, ObservationError
 from hsgeo.rotations import R_from_opk, R_from_rpy, dR_dopk, dR_drpy
 from hsgeo.sensors._pushbroom_kernel import _lines_kernel
-from hsgeo.sensors.mount import Mount
+from hsgeo.sensors.mount import Mount, line_time
 from hsgeo.trajectory import R_BODY_FROM_PLATFORM, SplineNodes, bspline_basis
 
 __all__ = [
@@ -754,3 +754,24 @@ class PushbroomCamera:
         pos, _ = trajectory.pose(t_s)
         R = trajectory.R_map_from_body(t_s) @ R_BODY_FROM_PLATFORM
         return self.project_at(xyz_map_m, band, pos, R)
+
+    def line_time(
+        self,
+        xyz_map_m,
+        trajectory,
+        t_start_s,
+        *,
+        band=0,
+        tol_s: float = 1e-10,
+        max_iter: int = 30,
+    ) -> np.ndarray:
+        """Time at which each map point is on the line of ``band`` (image ``y = 0``), s.
+
+        Secant iteration from ``t_start_s`` (one per point), within the trajectory's span
+        (:func:`hsgeo.sensors.mount.line_time`, as for the other scanning sensors).
+        """
+
+        def across_px(X, t):
+            return self.project(X, t, trajectory, band=band)[:, 1]
+
+        return line_time(across_px, xyz_map_m, trajectory, t_start_s, tol_s, max_iter)

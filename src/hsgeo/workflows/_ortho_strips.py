@@ -8,13 +8,11 @@ Two line formats are read (both NetCDF, told apart by their variable):
 * the LP line files (``lines(line, column, band)``, :mod:`hsgeo.io.lp_lines`), opened lazily:
   the times ``t_s(line)``, x of each column from ``col0`` and the full line's width.
 
-Also the application of an ``hsgeo adjust-pushbroom --json`` result to the camera and the
-navigation (until every sensor has one ``adjusted``).
+Also :func:`adjustment_of`: the adjustment dict of an in-memory ``adjust-pushbroom`` result
+(what :func:`hsgeo.sensors.adjusted` applies to any sensor and its trajectory).
 """
 
 from __future__ import annotations
-
-from dataclasses import replace
 
 import numpy as np
 
@@ -24,8 +22,6 @@ from hsgeo.sensors.pushbroom import PushbroomCamera
 
 __all__ = [
     "adjustment_of",
-    "adjusted_camera",
-    "adjusted_trajectory",
     "lp_strips",
     "line_strip",
     "select_bands",
@@ -70,54 +66,6 @@ def adjustment_of(result) -> dict:
         "nodes": np.asarray(r.value("nodes"), float),
         "node_columns": tuple(r.params["nodes"].columns),
     }
-
-
-def adjusted_camera(prior, adjustment=None, option: str = "--adjustment"):
-    """The pushbroom camera ``prior`` with the adjusted c (per band), boresight, lever arm and
-    distortion of ``adjustment`` (the dict of :func:`adjustment_of` /
-    :func:`hsgeo.io.sensors.read_adjustment`; None: ``prior``).
-    """
-    if adjustment is None:
-        return prior
-    if not isinstance(prior, PushbroomCamera):
-        raise InputError(
-            f"{option}: an adjust-pushbroom result adjusts a pushbroom camera ([camera] file), "
-            f"not a {type(prior).__name__}; leave {option} out or give the camera file"
-        )
-    n = len(prior.c_mm)
-    if adjustment["c_mm"].size not in (1, n):
-        raise InputError(
-            f"{option}: {adjustment['c_mm'].size} values of c_mm for a camera of {n} bands "
-            "(--sensor n_bands); give the adjustment of this camera"
-        )
-    c = np.broadcast_to(adjustment["c_mm"], (n,))
-    return replace(
-        prior,
-        c_mm=tuple(float(v) for v in c),
-        boresight_rad=tuple(adjustment["boresight_rad"]),
-        lever_arm_m=tuple(adjustment["lever_arm_m"]),
-        distortion=tuple(adjustment["distortion"]),
-    )
-
-
-def adjusted_trajectory(nav, adjustment=None, option: str = "--adjustment"):
-    """The navigation ``nav`` with the node corrections of ``adjustment`` (002 eq. 4,
-    :func:`hsgeo.trajectory.corrected_trajectory`; None: ``nav``).
-    """
-    from hsgeo.trajectory import CORRECTION_COLUMNS, SplineNodes, corrected_trajectory
-
-    if adjustment is None:
-        return nav
-    t = adjustment["t_nodes_s"]
-    if tuple(adjustment["node_columns"]) != CORRECTION_COLUMNS:
-        raise InputError(
-            f"{option}: node columns {adjustment['node_columns']} are not {CORRECTION_COLUMNS}"
-        )
-    dt = float(t[2] - t[1])
-    nodes = SplineNodes(float(t[1]), float(t[1] + (t.size - 3) * dt), dt)
-    if not np.allclose(nodes.t_nodes_s, t, atol=1e-6 * dt):
-        raise InputError(f"{option}: the node times are not evenly spaced")
-    return corrected_trajectory(nav, nodes, adjustment["nodes"])
 
 
 def pixel_keywords(sensor, band, n_bands: int, source: str, option: str = "--band") -> dict:

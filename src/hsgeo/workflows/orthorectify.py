@@ -4,9 +4,10 @@ The in-memory core :func:`orthorectify` (:class:`OrthoInputs`, :class:`OrthoOpti
 ``(band, y, x)`` :class:`xarray.DataArray` with a CRS, :func:`hsgeo.ortho.orthomosaic`) is what
 the chapters call; the file front end :func:`orthorectify_files` reads the lines (hsgeo's
 recorded flight line or LP line files: :mod:`hsgeo.workflows._ortho_strips`), the navigation,
-the sensor file (the 000 line scanner ``[sensor]`` or the 002 pushbroom camera ``[camera]``, read
-in full: principal distance per band, distortion, boresight and lever arm), optionally an
-``hsgeo adjust-pushbroom --json`` result, and the terrain (a DSM GeoTIFF in the map CRS, a DEM
+the sensor file (:func:`hsgeo.io.read_sensor`: the 000 line scanner, the 002 pushbroom camera read
+in full — principal distance per band, distortion, boresight and lever arm — or the 004
+panoramic scanner), optionally an ``hsgeo adjust-pushbroom --json`` result (applied by
+:func:`hsgeo.sensors.adjusted`), and the terrain (a DSM GeoTIFF in the map CRS, a DEM
 NetCDF in the local frame, or a plane); checks them all before the work; and writes the raster
 in the format of the output's suffix through the one writer :func:`hsgeo.io.raster.write_raster`
 (Cloud-Optimized GeoTIFF, CF-1.8 NetCDF or ENVI). Every pixel's spectrum stays as it was
@@ -25,21 +26,13 @@ import numpy as np
 from hsgeo.crs import SITE_AAS, LocalFrame
 from hsgeo.errors import InputError, ObservationError
 from hsgeo.ortho import MOSAIC_RULES, orthomosaic
-from hsgeo.workflows._ortho_strips import (
-    adjusted_camera,
-    adjusted_trajectory,
-    adjustment_of,
-    line_strip,
-    lp_strips,
-)
+from hsgeo.workflows._ortho_strips import adjustment_of, line_strip, lp_strips
 
 __all__ = [
     "OrthoInputs",
     "OrthoOptions",
     "orthorectify",
     "orthorectify_files",
-    "adjusted_camera",
-    "adjusted_trajectory",
     "adjustment_of",
     "line_strip",
     "lp_strips",
@@ -265,10 +258,12 @@ def orthorectify_files(
     covering every line, the view angles, the terrain below the aircraft and covering every
     strip's footprint, the raster's size. Returns a summary (grid, bands, strips, file).
     """
+    from hsgeo.io import read_sensor
     from hsgeo.io._files import check_outputs
     from hsgeo.io.navigation import read_trajectory
     from hsgeo.io.raster import RASTER_FORMATS, raster_outputs, write_raster
-    from hsgeo.io.sensors import read_adjustment, read_scanning_sensor
+    from hsgeo.io.sensors import read_adjustment
+    from hsgeo.sensors import adjusted
     from hsgeo.workflows._ortho_strips import check_view_angles
 
     lines = list(lines)
@@ -283,8 +278,11 @@ def orthorectify_files(
     inputs = [*lines, trajectory, sensor, dsm, adjustment]
     check_outputs(raster_outputs(output, RASTER_FORMATS), inputs, overwrite=overwrite)
     adj = read_adjustment(adjustment) if adjustment is not None else None
-    cam = adjusted_camera(read_scanning_sensor(sensor), adj)
-    nav = adjusted_trajectory(read_trajectory(trajectory), adj)
+    try:  # the one sensor reader and the one way to apply an adjustment (any sensor)
+        cam, nav = adjusted(read_sensor(sensor), read_trajectory(trajectory), adj)
+    except InputError as exc:
+        msg = str(exc)
+        raise InputError("--" + msg if msg.startswith("adjustment:") else msg) from None
     args = {"line_pixels": line_pixels, "bands": bands, "band": band, "sensor": sensor}
     strips, wl, fw, n_px_full = _read_strips(lines, nav, cam, args)
     _check_nav(strips, nav, trajectory, max_nav_gap_s, adj)

@@ -24,7 +24,7 @@ import numpy as np
 
 from hsgeo.adjust import Parameters
 from hsgeo.errors import InputError
-from hsgeo.io import read_camera_toml, read_table
+from hsgeo.io import read_table
 from hsgeo.rotations import R_from_rpy
 from hsgeo.sensors.pushbroom import (
     BLOCK_NAMES,
@@ -84,7 +84,13 @@ REPORTED_PARAMETERS = (
 
 @dataclass(frozen=True)
 class CameraPrior:
-    """A-priori camera and GNSS/INS values (the adjustment's starting point and priors)."""
+    """A-priori camera and GNSS/INS values (the adjustment's starting point and priors).
+
+    The camera's starting values are those of its sensor file (:func:`read_camera`): one
+    principal distance per band (``c_band_mm``, default ``c_mm`` for every band), the
+    distortion of 002 eq. (3) and the boresight (ω, φ, κ on the nominal mount, rad); the
+    adjustment starts from them, not from zero. :meth:`camera` is that camera as a sensor.
+    """
 
     n_bands: int
     pixel_mm: float = 0.0065
@@ -97,6 +103,37 @@ class CameraPrior:
     sigma_att_rad: tuple = tuple(np.deg2rad([0.005, 0.005, 0.008]))
     sigma_obs_px: float = 0.5
     sigma_gcp_m: float = 0.01
+    c_band_mm: tuple | None = None
+    distortion: tuple = (0.0, 0.0, 0.0, 0.0)
+    boresight_rad: tuple = (0.0, 0.0, 0.0)
+
+    def __post_init__(self):
+        if self.c_band_mm is not None and len(self.c_band_mm) != self.n_bands:
+            raise InputError(
+                f"CameraPrior: c_band_mm has {len(self.c_band_mm)} values for n_bands = "
+                f"{self.n_bands}; give one principal distance per band"
+            )
+
+    @property
+    def c_per_band_mm(self) -> np.ndarray:
+        """The starting principal distance of each band, mm (``(n_bands,)``)."""
+        if self.c_band_mm is None:
+            return np.full(self.n_bands, float(self.c_mm))
+        return np.asarray(self.c_band_mm, dtype=float)
+
+    def camera(self) -> PushbroomCamera:
+        """The camera the priors start from, as a sensor (what :func:`hsgeo.io.read_sensor`
+        gives for the same file).
+        """
+        return PushbroomCamera(
+            tuple(float(c) for c in self.c_per_band_mm),
+            self.pixel_mm,
+            tuple(self.distortion),
+            self.x0_mm,
+            self.y0_mm,
+            tuple(self.boresight_rad),
+            tuple(self.lever_arm_m),
+        )
 
 
 def intersect_two_rays(point, origin, direction, n_points, min_angle_deg: float = 20.0):
@@ -166,15 +203,19 @@ def _parameters(P0, nodes, cam: CameraPrior, gcp_index, gcp_xyz_m, node_prior_me
         prior_mean=0.0 if node_prior_mean is None else node_prior_mean,
         prior_sigma=np.r_[cam.sigma_pos_m, cam.sigma_att_rad][None, :],
     )
-    p.add(names["boresight"], np.zeros(3), columns=("omega_rad", "phi_rad", "kappa_rad"))
+    p.add(
+        names["boresight"],
+        np.asarray(cam.boresight_rad, float),  # the sensor file's, not zero
+        columns=("omega_rad", "phi_rad", "kappa_rad"),
+    )
     p.add(
         names["lever_arm"],
         np.asarray(cam.lever_arm_m, float),
         columns=("x_m", "y_m", "z_m"),
         prior_sigma=cam.sigma_lever_m,
     )
-    p.add(names["distortion"], np.zeros(4), columns=("K1", "K2", "P1", "P2"))
-    p.add(names["c"], np.full(cam.n_bands, cam.c_mm))
+    p.add(names["distortion"], np.asarray(cam.distortion, float), columns=("K1", "K2", "P1", "P2"))
+    p.add(names["c"], cam.c_per_band_mm)
     if gcp_index is not None:
         gi = np.asarray(gcp_index)
         p.set(names["points"], np.asarray(gcp_xyz_m, float), index=gi)
@@ -260,13 +301,9 @@ def build_problem(
     if np.any(obs.band >= cam.n_bands):
         raise InputError(f"band index ≥ the camera's {cam.n_bands} bands")
     rpy = obs.rpy_nav_rad
-    o, d = PushbroomCamera(
-        (cam.c_mm,) * cam.n_bands,
-        cam.pixel_mm,
-        x0_mm=cam.x0_mm,
-        y0_mm=cam.y0_mm,
-        lever_arm_m=cam.lever_arm_m,
-    ).rays_at(obs.xy_px, obs.band, obs.xyz_nav_m, R_from_rpy(rpy[:, 0], rpy[:, 1], rpy[:, 2]))
+    o, d = cam.camera().rays_at(
+        obs.xy_px, obs.band, obs.xyz_nav_m, R_from_rpy(rpy[:, 0], rpy[:, 1], rpy[:, 2])
+    )
     P0 = intersect_two_rays(obs.point, o, d, n_points)
     p = _parameters(P0, nodes, cam, gcp_index, gcp_xyz_m, node_prior_mean)
     timed = _time_residual(obs, cam, P0) if y_as_time else {}
@@ -453,16 +490,36 @@ GCP_COLUMNS = ("point_id", "E_m", "N_m", "H_m")
 
 
 def read_camera(path) -> CameraPrior:
-    """Camera and GNSS/INS priors from a TOML file (:func:`hsgeo.io.read_camera_toml`); keys
-    the file does not give keep the defaults of :class:`CameraPrior`.
+    """Camera and GNSS/INS priors from a sensor file of model ``pushbroom`` (or the former
+    ``[camera]`` file): the camera as :func:`hsgeo.io.read_sensor` reads it (per-band c,
+    distortion, boresight and lever arm: the adjustment starts from them), the σ keys and
+    tables (``sigma_lever_m``, ``[gnss_ins]``, ``[observations]``, ``[gcp]``) as given; keys the
+    file does not give keep the defaults of :class:`CameraPrior`.
     """
-    cfg = read_camera_toml(path)
-    cam, nav = cfg["camera"], cfg["gnss_ins"]
+    from hsgeo.io.sensor_file import read_sensor, read_sensor_tables
+
+    name, cfg, table = read_sensor_tables(path)
+    if name != "pushbroom":
+        raise InputError(
+            f"camera file {path}: model {name!r}; hsgeo adjust-pushbroom adjusts the 002 "
+            'pushbroom camera: give a sensor file with model = "pushbroom"'
+        )
+    camera = read_sensor(path)
+    cam, nav = cfg["sensor"], cfg["gnss_ins"]
+    c = tuple(float(v) for v in camera.c_mm)
     kw = {
-        k: cam[k]
-        for k in ("n_bands", "pixel_mm", "c_mm", "x0_mm", "y0_mm", "lever_arm_m", "sigma_lever_m")
-        if k in cam
+        "n_bands": len(c),
+        "pixel_mm": camera.pixel_mm,
+        "c_mm": cam["c_mm"],
+        "x0_mm": camera.x0_mm,
+        "y0_mm": camera.y0_mm,
+        "lever_arm_m": tuple(camera.lever_arm_m),
+        "c_band_mm": None if all(v == cam["c_mm"] for v in c) else c,
+        "distortion": tuple(camera.distortion),
+        "boresight_rad": tuple(camera.boresight_rad),
     }
+    if "sigma_lever_m" in cam:
+        kw["sigma_lever_m"] = cam["sigma_lever_m"]
     if "sigma_pos_m" in nav:
         kw["sigma_pos_m"] = nav["sigma_pos_m"]
     if "sigma_att_deg" in nav:
@@ -503,8 +560,10 @@ def adjust_files(
         (:func:`hsgeo.trajectory.platform_rpy_from_rph`); its velocity and angular rates (for
         the time residual, ``y_as_time``) are central differences of that interpolation.
     camera : path
-        TOML: ``[camera] n_bands, pixel_mm, c_mm, x0_mm, y0_mm, lever_arm_m, sigma_lever_m``,
-        ``[gnss_ins] sigma_pos_m = [E, N, H], sigma_att_deg = [roll, pitch, yaw]``,
+        The sensor file (:func:`hsgeo.io.read_sensor`, model ``pushbroom``, or the former
+        ``[camera]`` table): ``n_bands, pixel_mm, c_mm, c_band_mm, x0_mm, y0_mm, distortion,
+        boresight_deg, lever_arm_m, sigma_lever_m`` (the adjustment starts from the file's
+        camera), ``[gnss_ins] sigma_pos_m = [E, N, H], sigma_att_deg = [roll, pitch, yaw]``,
         ``[observations] sigma_px``, ``[gcp] sigma_m``.
     gcp : path, optional
         CSV or Parquet with ``point_id, E_m, N_m, H_m`` (points of the observation table).

@@ -1,0 +1,598 @@
+"""The one sensor file: ``[sensor] model = "..."`` read through a registry of models.
+
+:func:`read_sensor` is the one way a sensor file becomes a sensor of :mod:`hsgeo.sensors`
+(the face of :mod:`hsgeo.sensors.mount`: ``rays`` / ``project``). The file names its model;
+each model of :data:`MODELS` has its keys (with units in their names), and a key the model
+cannot use is an error that names the key and the model (and, when the key belongs to another
+model, that model). Example, the 002 LP camera::
+
+    [sensor]
+    model = "pushbroom"
+    n_bands = 3
+    pixel_mm = 0.0065
+    c_mm = 40.0
+    c_band_mm = [40.0, 40.1, 40.2]
+    distortion = [1e-4, 0, 0, 0]
+    boresight_deg = [0.3, -0.2, 0.1]
+    lever_arm_m = [0.1, 0.0, -0.2]
+
+The models (``hsgeo.io.sensor_file.MODELS``): ``line-scanner`` (000 eq. (2), calibrated),
+``line-scanner-linear-ifov`` (000, the uncalibrated model), ``pushbroom`` (002 LP camera),
+``panoramic`` (004 whiskbroom), ``frame-opencv`` (a frame camera in OpenCV's form), ``rikola``
+(003 two-sensor frame camera). The files each command read before are recognised:
+
+* the 000 sensor file of ``hsgeo geocode`` (``[sensor] model = "calibrated"`` or
+  ``"linear-ifov"``) is read (the names are aliases of ``line-scanner`` and
+  ``line-scanner-linear-ifov``); without ``model`` it is refused with the line to add;
+* the 002 camera file (``[camera]``, with ``[gnss_ins]``, ``[observations]``, ``[gcp]``) is
+  read as the ``pushbroom`` model (the same keys);
+* the instrument files of ``hsgeo/data/instruments`` (``[instrument]``: a band split or a
+  frame layout) are refused: they say what an instrument records, not its geometry, and the
+  message spells out the sensor file to write.
+
+**A mount in the wrong units is refused.** A lever arm beyond :data:`MAX_LEVER_ARM_M` (10 m)
+is taken for millimetres or centimetres. A boresight under ``boresight_deg`` whose every
+non-zero angle, read as radians, is a round number of degrees (a multiple of 0.001° to 1e-9)
+while the value itself is not a round number (not a multiple of 0.001) is taken for radians
+pasted at full precision (``0.005235987755982988`` is 0.3° in radians); radians rounded by
+hand are not detected (0.0052 "degrees" is a valid 19″ boresight).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from types import MappingProxyType
+
+import numpy as np
+
+from hsgeo.errors import InputError
+from hsgeo.io.config import Key, did_you_mean, read_config, read_toml
+
+__all__ = [
+    "SensorModel",
+    "MODELS",
+    "ALIASES",
+    "MAX_LEVER_ARM_M",
+    "read_sensor",
+    "read_sensor_tables",
+    "model_of",
+    "sensor_toml",
+]
+
+#: The largest lever arm taken as metres: no airborne or bench sensor sits 10 m from its
+#: navigation reference point; beyond, the numbers are millimetres or centimetres.
+MAX_LEVER_ARM_M = 10.0
+
+
+@dataclass(frozen=True)
+class SensorModel:
+    """One model of the registry: its keys, how a sensor is built from them, an example.
+
+    Attributes
+    ----------
+    name : str
+        The ``[sensor] model`` of the file.
+    doc : str
+        What the model is, with the paper and equation.
+    keys : mapping of str to Key
+        The keys of ``[sensor]`` (besides ``model``).
+    build : callable
+        ``build(values: dict, where: str) -> sensor``, ``values`` the checked keys.
+    cls : type
+        The sensor class built.
+    example : dict
+        Values of a valid ``[sensor]`` table (the registry's test and the docs use it).
+    kind : {"scanning", "frame"}
+        How the sensor moves: ``rays(pixels, t_s, trajectory)`` or ``rays(pixels, poses,
+        view)``.
+    tables : mapping
+        Further tables the file may hold (read by a command, not part of the sensor).
+    """
+
+    name: str
+    doc: str
+    keys: Mapping[str, Key]
+    build: Callable
+    cls: type
+    example: dict
+    kind: str = "scanning"
+    tables: Mapping[str, Mapping[str, Key]] = field(default_factory=dict)
+
+
+def _mount_keys(frame: str) -> dict:
+    return {
+        "lever_arm_m": Key(
+            "floats",
+            length=3,
+            default=(0.0, 0.0, 0.0),
+            limit=MAX_LEVER_ARM_M,
+            doc=f"lever arm, projection centre in the {frame} frame, m (not mm)",
+        ),
+        "boresight_deg": Key(
+            "floats",
+            length=3,
+            default=(0.0, 0.0, 0.0),
+            doc="roll, pitch, heading of R_body_from_sensor, degrees",
+        ),
+    }
+
+
+BODY = "body (x forward, y right, z down)"
+
+
+def _mount(v):
+    from hsgeo.sensors.mount import Mount
+
+    return Mount.from_rpy(np.deg2rad(v["boresight_deg"]), v["lever_arm_m"])
+
+
+def _line(v, where):
+    from hsgeo.sensors.line import CalibratedLine, LineScanner
+
+    return LineScanner(CalibratedLine(v["zeta0_px"], v["c_px"], tuple(v["K"])), _mount(v))
+
+
+def _line_ifov(v, where):
+    from hsgeo.sensors.line import LinearIFOV, LineScanner
+
+    return LineScanner(LinearIFOV(v["zeta0_px"], v["c_px"]), _mount(v))
+
+
+def _pushbroom(v, where):
+    from hsgeo.sensors.pushbroom import PushbroomCamera
+
+    c = v.get("c_band_mm", (v["c_mm"],) * v["n_bands"])
+    if len(c) != v["n_bands"]:
+        raise InputError(
+            f"{where}: c_band_mm has {len(c)} values for n_bands = {v['n_bands']}; give one "
+            "principal distance per band"
+        )
+    return PushbroomCamera(
+        tuple(c),
+        v["pixel_mm"],
+        tuple(v.get("distortion", (0.0, 0.0, 0.0, 0.0))),
+        v.get("x0_mm", 0.0),
+        v.get("y0_mm", 0.0),
+        tuple(float(x) for x in np.deg2rad(v.get("boresight_deg", (0.0, 0.0, 0.0)))),
+        tuple(v.get("lever_arm_m", (0.0, 0.0, 0.0))),
+    )
+
+
+def _panoramic(v, where):
+    from hsgeo.sensors.panoramic import PanoramicScanner
+
+    return PanoramicScanner(v["n_px"], v["ifov_deg"], _mount(v), v["active_fraction"])
+
+
+def _frame(v, where):
+    from hsgeo.sensors.frame import FrameCamera
+
+    intr = (v["fx_px"], v["fy_px"], v["cx_px"], v["cy_px"])
+    return FrameCamera(intr, tuple(v["distortion"]), _mount(v))
+
+
+def _rikola(v, where):
+    from hsgeo.sensors.rikola import RikolaCamera
+
+    f, s = v["f_band_mm"], v["band_sensor"]
+    bands = v.get("bands")
+    problems = []
+    if len(s) != len(f):
+        problems.append(f"band_sensor has {len(s)} values for {len(f)} bands (f_band_mm)")
+    if not all(x in (1.0, 2.0) for x in s):
+        problems.append("band_sensor values must be 1 (sensor I) or 2 (sensor II)")
+    if bands is not None and (
+        len(bands) != len(f)
+        or not all(float(b).is_integer() for b in bands)
+        or list(bands) != sorted(set(bands))
+    ):
+        problems.append("bands must be one increasing whole band number per f_band_mm value")
+    if problems:
+        raise InputError(f"{where}: " + "; ".join(problems))
+    return RikolaCamera(
+        tuple(f),
+        tuple(int(x) for x in s),
+        (tuple(v["pp_I_mm"]), tuple(v["pp_II_mm"])),
+        tuple(v["distortion"]),
+        tuple(float(x) for x in np.deg2rad(v["rotation_deg"])),
+        tuple(v["offset_mm"]),
+        tuple(int(x) for x in v["image_size_px"]),
+        v["pixel_mm"],
+        None if bands is None else tuple(int(b) for b in bands),
+        _mount(v),
+    )
+
+
+_LINE_KEYS = {
+    "zeta0_px": Key("float", required=True, limit=1e5, doc="principal point ζ0 on the line, px"),
+    "c_px": Key("float", required=True, positive=True, doc="principal distance, px"),
+}
+#: The priors of ``hsgeo adjust-pushbroom`` a 002 camera file may carry (tables of the file).
+PUSHBROOM_PRIOR_TABLES = {
+    "gnss_ins": {
+        "sigma_pos_m": Key("floats", length=3, positive=True, doc="σ of E, N, H, m"),
+        "sigma_att_deg": Key(
+            "floats", length=3, positive=True, doc="σ of roll, pitch, yaw, degrees"
+        ),
+    },
+    "observations": {"sigma_px": Key("float", positive=True, doc="σ of an image coordinate, px")},
+    "gcp": {"sigma_m": Key("float", positive=True, doc="σ of a GCP coordinate, m")},
+}
+_PUSHBROOM_KEYS = {
+    "n_bands": Key("int", required=True, positive=True, doc="number of bands"),
+    "pixel_mm": Key(
+        "float", required=True, positive=True, limit=1.0, doc="pixel pitch, mm (at most 1)"
+    ),
+    "c_mm": Key("float", required=True, positive=True, limit=2000.0, doc="principal distance, mm"),
+    "x0_mm": Key("float", limit=100.0, doc="principal point x on the detector, mm"),
+    "y0_mm": Key("float", limit=100.0, doc="principal point y on the detector, mm"),
+    "lever_arm_m": Key(
+        "floats",
+        length=3,
+        limit=MAX_LEVER_ARM_M,
+        doc="lever arm in the platform frame (x forward, y left, z up), m, not mm",
+    ),
+    "sigma_lever_m": Key(
+        "float", positive=True, limit=10.0, doc="σ of the measured lever arm, m (adjust prior)"
+    ),
+    "c_band_mm": Key("floats", positive=True, doc="principal distance of each band, mm"),
+    "distortion": Key(
+        "floats", length=4, doc="K1 (mm^-2), K2 (mm^-4), P1, P2 (mm^-1) of 002 eq. (3)"
+    ),
+    "boresight_deg": Key(
+        "floats", length=3, doc="omega, phi, kappa of the boresight on the nominal mount, deg"
+    ),
+}
+
+MODELS: Mapping[str, SensorModel] = {}
+
+
+def _register(m: SensorModel) -> None:
+    MODELS[m.name] = m  # type: ignore[index]
+
+
+def _models():
+    from hsgeo.sensors.frame import FrameCamera
+    from hsgeo.sensors.line import LineScanner
+    from hsgeo.sensors.panoramic import DAEDALUS_IFOV_DEG, DAEDALUS_N_PX, PanoramicScanner
+    from hsgeo.sensors.pushbroom import PushbroomCamera
+    from hsgeo.sensors.rikola import RikolaCamera
+
+    _register(
+        SensorModel(
+            "line-scanner",
+            "the 000 line scanner, calibrated: 000 eq. (2) (hsgeo.sensors.line.CalibratedLine)",
+            {
+                **_LINE_KEYS,
+                "K": Key(
+                    "floats",
+                    length=3,
+                    default=(0.0, 0.0, 0.0),
+                    doc="K1..K3 of 000 eq. (2), px per (100 px)^(3, 5, 7)",
+                ),
+                **_mount_keys(BODY),
+            },
+            _line,
+            LineScanner,
+            {"zeta0_px": 486.8, "c_px": 3539.0, "K": [1.459, -0.1636, 0.00526]},  # 000 Table 1
+        )
+    )
+    _register(
+        SensorModel(
+            "line-scanner-linear-ifov",
+            "the 000 line scanner, uncalibrated: view angle linear in the pixel (LinearIFOV)",
+            {**_LINE_KEYS, **_mount_keys(BODY)},
+            _line_ifov,
+            LineScanner,
+            {"zeta0_px": 485.0, "c_px": 3600.0},
+        )
+    )
+    _register(
+        SensorModel(
+            "pushbroom",
+            "the 002 LP camera: 002 eq. (2)-(4) (hsgeo.sensors.pushbroom.PushbroomCamera)",
+            _PUSHBROOM_KEYS,
+            _pushbroom,
+            PushbroomCamera,
+            {
+                "n_bands": 3,
+                "pixel_mm": 0.0065,
+                "c_mm": 40.0,
+                "c_band_mm": [40.0, 40.1, 40.2],
+                "distortion": [1e-4, 0.0, 0.0, 0.0],
+                "boresight_deg": [0.3, -0.2, 0.1],
+                "lever_arm_m": [0.1, 0.0, -0.2],
+            },
+            tables=PUSHBROOM_PRIOR_TABLES,
+        )
+    )
+    _register(
+        SensorModel(
+            "panoramic",
+            "the 004 panoramic (whiskbroom) scanner (hsgeo.sensors.panoramic.PanoramicScanner)",
+            {
+                "n_px": Key("int", default=DAEDALUS_N_PX, positive=True, doc="pixels per scan"),
+                "ifov_deg": Key(
+                    "float", default=DAEDALUS_IFOV_DEG, positive=True, doc="angular pixel, deg"
+                ),
+                "active_fraction": Key(
+                    "float",
+                    default=2 * 43.0 / 360.0,
+                    positive=True,
+                    limit=1.0,
+                    doc="share of the line period the mirror sweeps the pixels",
+                ),
+                **_mount_keys(BODY),
+            },
+            _panoramic,
+            PanoramicScanner,
+            {"n_px": 716, "ifov_deg": 0.12, "boresight_deg": [0.2, -0.1, 0.3]},
+        )
+    )
+    _register(
+        SensorModel(
+            "frame-opencv",
+            "a frame camera in OpenCV's form (hsgeo.sensors.frame.FrameCamera)",
+            {
+                "fx_px": Key("float", required=True, positive=True, doc="focal length x, px"),
+                "fy_px": Key("float", required=True, positive=True, doc="focal length y, px"),
+                "cx_px": Key("float", required=True, doc="principal point x, px"),
+                "cy_px": Key("float", required=True, doc="principal point y, px"),
+                "distortion": Key(
+                    "floats",
+                    length=5,
+                    default=(0.0, 0.0, 0.0, 0.0, 0.0),
+                    doc="k1, k2, p1, p2, k3 (OpenCV order)",
+                ),
+                **_mount_keys("body"),
+            },
+            _frame,
+            FrameCamera,
+            {
+                "fx_px": 1200.0,
+                "fy_px": 1190.0,
+                "cx_px": 640.0,
+                "cy_px": 480.0,
+                "distortion": [-0.2, 0.05, 1e-3, -5e-4, 0.0],
+            },
+            kind="frame",
+        )
+    )
+    _register(
+        SensorModel(
+            "rikola",
+            "the 003 Rikola two-sensor frame camera (hsgeo.sensors.rikola.RikolaCamera)",
+            {
+                "f_band_mm": Key("floats", required=True, positive=True, doc="f of each band, mm"),
+                "band_sensor": Key(
+                    "floats", required=True, positive=True, doc="sensor of each band: 1 or 2"
+                ),
+                "bands": Key("floats", positive=True, doc="band numbers (default 1, 2, ...)"),
+                "pp_I_mm": Key("floats", length=2, required=True, doc="x0, y0 of sensor I, mm"),
+                "pp_II_mm": Key("floats", length=2, required=True, doc="x0, y0 of sensor II, mm"),
+                "distortion": Key(
+                    "floats",
+                    length=5,
+                    default=(0.0, 0.0, 0.0, 0.0, 0.0),
+                    doc="K1 (mm^-2), K2 (mm^-4), K3 (mm^-6), P1, P2 (mm^-1)",
+                ),
+                "rotation_deg": Key(
+                    "floats",
+                    length=3,
+                    default=(0.0, 0.0, 0.0),
+                    doc="omega, phi, kappa of R_I_from_II, deg",
+                ),
+                "offset_mm": Key(
+                    "floats",
+                    length=3,
+                    default=(0.0, 0.0, 0.0),
+                    doc="sensor II's centre in sensor I's frame, mm",
+                ),
+                "image_size_px": Key(
+                    "floats", length=2, default=(1017.0, 648.0), positive=True, doc="w, h, px"
+                ),
+                "pixel_mm": Key(
+                    "float", default=0.0055, positive=True, limit=1.0, doc="pixel pitch, mm"
+                ),
+                **_mount_keys("body"),
+            },
+            _rikola,
+            RikolaCamera,
+            {
+                "f_band_mm": [8.7, 8.8, 8.75],
+                "band_sensor": [2, 1, 1],
+                "bands": [1, 2, 3],
+                "pp_I_mm": [0.05, -0.03],
+                "pp_II_mm": [-0.02, 0.04],
+                "distortion": [-2e-3, 1e-5, 0.0, 1e-5, -2e-5],
+                "rotation_deg": [0.1, -0.05, 0.2],
+            },
+            kind="frame",
+        )
+    )
+
+
+_models()
+MODELS = MappingProxyType(dict(MODELS))
+
+#: The model names of the former ``hsgeo geocode --sensor`` file, read as their models.
+ALIASES = MappingProxyType(
+    {"calibrated": "line-scanner", "linear-ifov": "line-scanner-linear-ifov"}
+)
+
+
+def _models_text() -> str:
+    return ", ".join(repr(k) for k in MODELS)
+
+
+def _owners(key: str) -> list[str]:
+    return [n for n, m in MODELS.items() if key in m.keys]
+
+
+def _instrument_refusal(path, cfg) -> InputError:
+    kind = (
+        "a band split (hsgeo.io.read_band_split)"
+        if "bands" in cfg
+        else "a frame layout (hsgeo.io.read_frame_layouts)"
+        if "frame" in cfg
+        else "an instrument description"
+    )
+    if "bands" in cfg:
+        how = (
+            'write [sensor] model = "rikola" with band_sensor = its [bands] sensor list, '
+            "f_band_mm (one focal length per band, mm), pp_I_mm and pp_II_mm (from a "
+            "calibration, e.g. hsgeo reproduce rikola)"
+        )
+    else:
+        how = (
+            'write [sensor] model = "line-scanner" with zeta0_px, c_px and K of a calibration '
+            "(hsgeo calibrate-line)"
+        )
+    return InputError(
+        f"sensor file {path}: this is an instrument file ([instrument]), {kind}: what the "
+        f"instrument records, not its geometry; {how}"
+    )
+
+
+def read_sensor_tables(path, what: str = "sensor file") -> tuple[str, dict, str]:
+    """The model name and the checked tables of a sensor file (the 002 ``[camera]`` file as
+    model ``pushbroom``): ``(model, {"sensor": values, other tables ...}, table)``, ``table``
+    the name of the sensor's table in the file (``"sensor"``, or ``"camera"``).
+
+    The tables besides ``[sensor]`` are those the model allows (the priors of ``hsgeo
+    adjust-pushbroom`` for ``pushbroom``), empty dicts when absent.
+    """
+    cfg = read_toml(path, what)
+    if "camera" in cfg and "sensor" not in cfg:  # the 002 camera file of adjust-pushbroom
+        schema = {"camera": _PUSHBROOM_KEYS, **PUSHBROOM_PRIOR_TABLES}
+        out = read_config(path, schema, what, required_tables=("camera",))
+        out["sensor"] = out.pop("camera")
+        _check_mount(path, "camera", out["sensor"])
+        return "pushbroom", out, "camera"
+    if "instrument" in cfg and "sensor" not in cfg:
+        raise _instrument_refusal(path, cfg)
+    s = cfg.get("sensor")
+    if not isinstance(s, dict):
+        raise InputError(
+            f"{what} {path}: [sensor]: missing table; a sensor file starts with [sensor] and "
+            f'model = "..." (one of {_models_text()})'
+        )
+    if "model" not in s:
+        raise InputError(
+            f'{what} {path}: [sensor] model: missing; add model = "line-scanner" if this is the '
+            "000 line-scanner file (the former default, model = 'calibrated'), or one of "
+            f"{_models_text()}"
+        )
+    name = s["model"]
+    name = ALIASES.get(name, name) if isinstance(name, str) else name
+    if name not in MODELS:
+        raise InputError(
+            f"{what} {path}: [sensor] model: unknown model {s['model']!r}"
+            f"{did_you_mean(str(s['model']), list(MODELS) + list(ALIASES))} "
+            f"(known: {_models_text()})"
+        )
+    model = MODELS[name]
+    problems = []
+    for k in s:
+        if k == "model" or k in model.keys:
+            continue
+        owners = _owners(k)
+        if owners:
+            problems.append(
+                f"[sensor] {k}: model {name!r} cannot use this key (a key of model "
+                f"{', '.join(repr(o) for o in owners)}){did_you_mean(k, model.keys)}; remove it "
+                "or change the model"
+            )
+        else:
+            problems.append(
+                f"[sensor] {k}: unknown key for model {name!r}{did_you_mean(k, model.keys)} "
+                f"(known: {', '.join(model.keys)})"
+            )
+    for t in cfg:
+        if t != "sensor" and t not in model.tables:
+            allowed = ", ".join(f"[{x}]" for x in ("sensor", *model.tables))
+            problems.append(
+                f"[{t}]: a table model {name!r} cannot use{did_you_mean(t, model.tables)} "
+                f"(allowed: {allowed})"
+            )
+    if problems:
+        raise InputError(f"{what} {path}: " + "; ".join(problems))
+    schema = {"sensor": {"model": Key("str", required=True), **model.keys}, **model.tables}
+    out = read_config(path, schema, what, required_tables=("sensor",))
+    out["sensor"].pop("model")
+    _check_mount(path, "sensor", out["sensor"])
+    return name, out, "sensor"
+
+
+def _check_mount(path, table: str, v: dict) -> None:
+    """A boresight in radians under ``boresight_deg`` (see the module docstring)."""
+    b = np.asarray(v.get("boresight_deg", ()), dtype=float)
+    nz = b[b != 0]
+    if nz.size == 0:
+        return
+    deg = np.rad2deg(nz) * 1000.0
+    round_deg = np.abs(deg - np.round(deg)) < 1e-6
+    round_self = np.abs(nz * 1000.0 - np.round(nz * 1000.0)) < 1e-9
+    if np.all(round_deg & ~round_self):
+        shown = ", ".join(f"{x:.6g}" for x in np.rad2deg(b))
+        raise InputError(
+            f"sensor file {path}: [{table}] boresight_deg = {list(b)} are radians (each is a "
+            f"round number of degrees in radians: [{shown}]°); give degrees: boresight_deg = "
+            f"[{shown}]"
+        )
+
+
+def read_sensor(path):
+    """The sensor a sensor file describes (see the module docstring for the format).
+
+    Parameters
+    ----------
+    path : str or Path
+        TOML with ``[sensor] model = "..."`` and the model's keys (:data:`MODELS`), or the
+        002 camera file (``[camera]``).
+
+    Returns
+    -------
+    sensor
+        ``LineScanner``, ``PushbroomCamera``, ``PanoramicScanner``, ``FrameCamera`` or
+        ``RikolaCamera`` (:mod:`hsgeo.sensors`).
+
+    Raises
+    ------
+    InputError
+        Missing or malformed file; no or an unknown model; a key the model cannot use (naming
+        the key, the model and the models that use it); missing keys; values of the wrong type
+        or beyond their unit's range; a mount in the wrong units; an instrument file.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "s.toml"
+    >>> _ = p.write_text(sensor_toml("panoramic", {"n_px": 716}))
+    >>> read_sensor(p).n_px
+    716
+    """
+    name, tables, table = read_sensor_tables(path)
+    return MODELS[name].build(tables["sensor"], f"sensor file {path}: [{table}]")
+
+
+def model_of(sensor) -> str:
+    """The registry name of a sensor's model (:data:`MODELS`)."""
+    from hsgeo.sensors.adjustment import sensor_model
+
+    return sensor_model(sensor)
+
+
+def sensor_toml(model: str, values: Mapping) -> str:
+    """The text of a sensor file of ``model`` with ``values`` (e.g. a model's ``example``)."""
+
+    def fmt(v):
+        if isinstance(v, str):
+            return f'"{v}"'
+        if isinstance(v, (list, tuple)):
+            return "[" + ", ".join(repr(float(x)) for x in v) + "]"
+        return repr(v)
+
+    lines = ["[sensor]", f'model = "{model}"'] + [f"{k} = {fmt(v)}" for k, v in values.items()]
+    return "\n".join(lines) + "\n"
