@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from ortho_inputs import FRAME, GSD_M, flight
 
-from hsgeo.ortho import MapGrid, orthomosaic
+from hsgeo.ortho import MapGrid, Strip, orthomosaic
 
 
 @pytest.fixture(scope="module")
@@ -124,6 +124,55 @@ def test_a_line_scanner_line_through_the_command(tmp_path, capsys):
         xy, _ = square_centroids(m, squares_xy()[inside], search_m=3.0)
         err = np.hypot(*(xy - squares_xy()[inside]).T)
         assert np.sqrt(np.nanmean(err**2)) < GSD_M, (suffix, err)
+
+
+def test_a_panoramic_scanner_line_through_the_command(tmp_path, capsys):
+    """The 004 panoramic (whiskbroom) scanner from its sensor file (io.read_sensor's registry)
+    on a rendered line: the squares within 1 GSD (RMS) of their positions in the COG. (The
+    renderer shares the geolocation: this checks the command's path for the model, not the
+    model's rays.)"""
+    import rioxarray
+    from ortho_inputs import HEIGHT_M, dsm, flight_trajectory, scene, squares_xy
+
+    from hsgeo.cli import main
+    from hsgeo.io import read_sensor, write_lines
+    from hsgeo.io.geotiff import write_geotiff
+    from hsgeo.io.navigation import write_trajectory
+    from hsgeo.measure.squares import square_centroids
+    from hsgeo.ortho import MapTerrain
+    from hsgeo.simulate.ortho_scene import render_lines
+
+    ifov_deg = float(np.degrees(GSD_M / (HEIGHT_M + 100.0)))
+    (tmp_path / "scanner.toml").write_text(
+        f'[sensor]\nmodel = "panoramic"\nn_px = 300\nifov_deg = {ifov_deg!r}\n'
+        "boresight_deg = [0.2, -0.1, 0.3]\n"
+    )
+    scanner = read_sensor(tmp_path / "scanner.toml")
+    nav, (t, _) = flight_trajectory(120.0)
+    z, g = dsm()
+    zeta = np.arange(300, dtype=float)
+    shell = Strip(scanner, nav, t, zeta, np.zeros((t.size, 300, 4), np.float32))
+    vals = render_lines(shell, scene(), MapTerrain(z, g, FRAME), FRAME)
+    write_lines(
+        tmp_path / "line.nc",
+        np.moveaxis(vals, -1, 0),
+        zeta,
+        t0_s=float(t[0]),
+        line_rate_hz=float(1.0 / (t[1] - t[0])),
+        wavelength_nm=[640.0, 550.0, 460.0, 800.0],
+    )
+    write_trajectory(tmp_path / "nav.csv", nav)
+    write_geotiff(tmp_path / "dsm.tif", z, g.transform, 25832)
+    argv = ["orthorectify", str(tmp_path / "line.nc"), "--sensor", str(tmp_path / "scanner.toml")]
+    argv += ["--trajectory", str(tmp_path / "nav.csv"), "--dsm", str(tmp_path / "dsm.tif")]
+    assert main([*argv, "-o", str(tmp_path / "o.tif"), "--quiet"]) == 0, capsys.readouterr().err
+    m = rioxarray.open_rasterio(tmp_path / "o.tif")
+    m = m.assign_coords(band=["640 nm", "550 nm", "460 nm", "800 nm"])
+    inside = [k for k, xy in enumerate(squares_xy()) if _imaged(m, xy, 3.0)]
+    assert len(inside) >= 2
+    xy, _ = square_centroids(m, squares_xy()[inside], search_m=3.0)
+    err = np.hypot(*(xy - squares_xy()[inside]).T)
+    assert np.sqrt(np.mean(err**2)) < GSD_M, err
 
 
 def _imaged(m, xy, margin_m):
