@@ -1005,7 +1005,7 @@ case(
     C,
     "mistyped",
     "sensor-ifov-with-K",
-    "model = 'calibrated'",
+    "cannot use this key",
     [("sensor.toml", toml_set("sensor", "model", "'linear-ifov'"))],
 )
 case(C, "missing", "sensor-missing", "sensor.toml", [("sensor.toml", remove)])
@@ -1911,7 +1911,7 @@ case(
 )  # fmt: skip
 # CAMERA
 case(C, "missing", "cam-missing", "camera.toml", [("camera.toml", remove)])
-case(C, "empty", "cam-empty", "[camera]", [("camera.toml", text(""))])
+case(C, "empty", "cam-empty", "model", [("camera.toml", text(""))])
 case(C, "garbage", "cam-garbage", "camera.toml", [("camera.toml", text("[camera\nn_bands = \n"))])
 case(C, "binary", "cam-binary", "camera.toml", [("camera.toml", text(BINARY))])
 case(C, "mistyped", "cam-is-csv", "camera.toml", [("camera.toml", copy_from("nav.csv"))])

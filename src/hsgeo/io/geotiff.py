@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import os
 import tempfile
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -180,6 +181,18 @@ def write_geotiff(
     return path
 
 
+@contextmanager
+def _no_georeference_warning():
+    """Rasterio's NotGeoreferencedWarning silenced (a file without a CRS is refused in words)."""
+    import warnings
+
+    from rasterio.errors import NotGeoreferencedWarning
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", NotGeoreferencedWarning)
+        yield
+
+
 def read_dsm(path, option: str = "--dsm"):
     """A DSM GeoTIFF: heights (m, above the ellipsoid) and its grid.
 
@@ -196,7 +209,12 @@ def read_dsm(path, option: str = "--dsm"):
 
     p = check_input_file(path, f"{option} DSM")
     try:
-        with rasterio.open(p) as src:
+        with _no_georeference_warning(), rasterio.open(p) as src:  # refused below, in words
+            if src.driver not in ("GTiff", "COG", "VRT"):
+                raise InputError(
+                    f"{option} {p}: not a GeoTIFF (GDAL reads it as {src.driver}); give the "
+                    "DSM as a GeoTIFF (gdal_translate -of GTiff), or a NetCDF DEM as .nc"
+                )
             if src.crs is None or src.crs.to_epsg() is None:
                 raise InputError(
                     f"{option} {p}: the DSM has no CRS with an EPSG code (got {src.crs}); "
