@@ -2367,7 +2367,16 @@ def test_a_failing_envi_leaves_no_file(cmd, inputs: Inputs, monkeypatch, capsys)
 
 
 @pytest.mark.parametrize(
-    "argv", [["--help"], *([c, "--help"] for c in sorted({c.cmd for c in CASES} - {"hsgeo"}))]
+    "argv",
+    [
+        ["--help"],
+        *(
+            [c, "--help"]
+            for c in sorted(
+                {"orthorectify" if "orthorectify" in c.cmd else c.cmd for c in CASES} - {"hsgeo"}
+            )
+        ),
+    ],
 )
 def test_help_still_works(argv, capsys):
     from hsgeo.cli import main
