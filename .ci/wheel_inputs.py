@@ -2,7 +2,7 @@
 
 Usage: python wheel_inputs.py DIR. Writes under DIR: raw/ and dark/ frame folders (cube),
 eight LP strips of the rendered campaign with their navigation, camera and squares
-(lp-observations, adjust-pushbroom), a DSM around them (orthomosaic) and a slanted-edge PNG
+(lp-observations, adjust-pushbroom), a DSM around them (orthorectify) and a slanted-edge PNG
 (mtf-edge). The same recipes as tests/test_bad_input.py and tests/test_cli_lp_observations.py.
 """
 

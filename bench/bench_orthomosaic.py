@@ -6,17 +6,19 @@ memory (only the mosaic is timed), onto a 0.3 m grid in EPSG:25832. Each path ru
 process; its peak RSS is sampled while it runs (``peak_rss_over_start_mib``: over the process
 with the inputs in memory):
 
-* ``in_memory`` — :func:`hsgeo.ortho.grid_swath` per strip (the kd-tree on the whole grid at
-  once, no Dask), then the nearest-to-nadir rule;
-* ``chunked_1`` — :func:`hsgeo.ortho.orthomosaic` (Dask tiles of 512 cells, the geolocation per
-  line block inside each tile's task), synchronous scheduler (one core);
+* ``in_memory`` — :func:`hsgeo.ortho.resample_swath` per strip (the kd-tree on the whole grid
+  at once, no Dask), then the nearest-to-nadir rule;
+* ``chunked_1`` — :func:`hsgeo.workflows.orthorectify.orthorectify` (what ``hsgeo
+  orthorectify`` runs: Dask tiles of 512 cells, the geolocation per line block inside each
+  tile's task), synchronous scheduler (one core);
 * ``chunked_threads_2`` — the same graph on Dask's threaded scheduler with 2 threads;
 * ``distributed_2`` — the same graph on a ``dask.distributed`` LocalCluster of 2 worker
   processes (1 thread each; their memory is not in the client's RSS, and the wall time excludes
   starting the cluster);
-* ``ckdtree_handwritten`` — the path ``hsgeo geocode`` used before (issue 26):
-  :func:`hsgeo.geocode.geocode_image` then :func:`hsgeo.geocode.orthorectify` (scipy cKDTree on
-  the local-frame plane, in memory), per strip, no mosaic rule and no CRS.
+* ``ckdtree_handwritten`` — the path ``hsgeo geocode`` used before issue 26 (its
+  ``geocode.orthorectify`` is gone; the same steps are written out here):
+  :func:`hsgeo.ortho.ground_points`, then scipy's cKDTree on the local-frame plane, in memory,
+  per strip, no mosaic rule and no CRS.
 
 ``python bench/bench_orthomosaic.py [--lines N]`` → ``bench/results/orthomosaic.json``.
 """
@@ -83,19 +85,10 @@ def scene(n_lines: int, n_px: int = 900):
 
 
 def _ground(s, terrain):
-    """Every pixel's ground point of one strip (hsgeo.geocode.geocode_image, band 0)."""
-    from hsgeo.geocode import geocode_image
+    """Every pixel's ground point of one strip (hsgeo.ortho.ground_points, band 0)."""
+    from hsgeo.ortho import ground_points
 
-    return geocode_image(
-        s.trajectory,
-        s.sensor,
-        s.n_lines,
-        s.pixels,
-        t0_s=s.t_s[0],
-        line_rate_hz=1.0 / (s.t_s[1] - s.t_s[0]),
-        terrain=terrain,
-        band=0,
-    )
+    return ground_points(s.sensor, s.trajectory, s.t_s, s.pixels, terrain, band=0)
 
 
 def _in_memory(strips, terrain, frame):
@@ -130,9 +123,12 @@ def _in_memory(strips, terrain, frame):
 
 
 def _chunked(strips, terrain, frame, scheduler):
-    from hsgeo.ortho import orthomosaic
+    from hsgeo.workflows.orthorectify import OrthoInputs, OrthoOptions, orthorectify
 
-    m = orthomosaic(strips, terrain, frame, resolution_m=0.3, tile_px=512)
+    m = orthorectify(
+        OrthoInputs(tuple(strips), terrain),
+        OrthoOptions(resolution_m=0.3, tile_px=512, frame=frame),
+    )
     if scheduler == "distributed":
         from distributed import Client, LocalCluster
 
@@ -155,13 +151,24 @@ def _chunked(strips, terrain, frame, scheduler):
 
 
 def _ckdtree(strips, terrain):
-    from hsgeo.geocode import orthorectify
+    """Nearest neighbour by scipy's cKDTree on the local-frame plane, per strip (no CRS)."""
+    from scipy.spatial import cKDTree
 
     cells = 0
     for s in strips:
         g = _ground(s, terrain)
-        da = orthorectify(np.moveaxis(np.asarray(s.values), -1, 0), g, resolution_m=0.3)
-        cells += da.sizes["N"] * da.sizes["E"]
+        EN = g[..., :2].reshape(-1, 2)
+        E = np.arange(np.floor(EN[:, 0].min() / 0.3) * 0.3 + 0.15, EN[:, 0].max(), 0.3)
+        N = np.arange(np.ceil(EN[:, 1].max() / 0.3) * 0.3 - 0.15, EN[:, 1].min(), -0.3)
+        gE, gN = np.meshgrid(E, N)
+        dist, idx = cKDTree(EN).query(
+            np.column_stack([gE.ravel(), gN.ravel()]), distance_upper_bound=0.59
+        )
+        ok = np.isfinite(dist)
+        flat = np.asarray(s.values).reshape(-1, 3)
+        out = np.full((gE.size, 3), np.nan)
+        out[ok] = flat[idx[ok]]
+        cells += gE.size
     return cells
 
 

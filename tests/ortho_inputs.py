@@ -106,9 +106,10 @@ def line_scanner(n_px: int = 300):
     return LineScanner(LinearIFOV(zeta0_px=(n_px - 1) / 2, c_px=40.0 / 0.0065))
 
 
-def flight(sensor="lp", lazy=False, length_m=240.0, render_nav=None, nav=None):
+def flight(sensor="lp", lazy=False, length_m=240.0, render_nav=None, nav=None, camera=None):
     """Two rendered strips of the LP camera ("lp") or the 000 line scanner ("line"), rendered
-    along ``render_nav`` (default the navigation) and mosaicked along ``nav``."""
+    along ``render_nav`` (default the navigation) and mosaicked along ``nav``; ``camera``:
+    ``(PushbroomCamera, pixel_kw)`` that renders the LP strips (default :func:`lp_camera`)."""
     z, g = dsm()
     terrain = MapTerrain(z, g, FRAME)
     nav0, times = flight_trajectory(length_m)
@@ -116,7 +117,15 @@ def flight(sensor="lp", lazy=False, length_m=240.0, render_nav=None, nav=None):
     rnav = render_nav or nav0
     sc = scene()
     if sensor == "lp":
-        sen, px, kw = lp_camera(), lp_pixels(), {"band": 0}
+        sen, px, kw = (
+            (lp_camera(), lp_pixels(), {"band": 0})
+            if camera is None
+            else (
+                camera[0],
+                lp_pixels(),
+                camera[1],
+            )
+        )
     else:
         n = 300
         sen, px, kw = line_scanner(n), np.arange(n, dtype=float), {}
@@ -175,11 +184,34 @@ def adjustment_json(nodes, v) -> str:
     )
 
 
-def write_ortho_inputs(d, *, adjusted: bool = False, lazy: bool = False) -> dict:
+#: The camera file of issue 36: a principal distance per band, distortion and a boresight of
+#: 0.3° (≈ 9.8 m on the ground at 1875 m), which a reader that drops them misplaces.
+FULL_CAMERA_TOML = (
+    "[camera]\nn_bands = 4\npixel_mm = 0.0065\nc_mm = 40.0\n"
+    "c_band_mm = [40.0, 40.1, 40.2, 40.3]\ndistortion = [1e-4, 0.0, 0.0, 0.0]\n"
+    "boresight_deg = [0.3, -0.2, 0.1]\n"
+)
+
+
+def full_camera():
+    """The camera of :data:`FULL_CAMERA_TOML`, built here (not by the reader under test)."""
+    return PushbroomCamera(
+        c_mm=(40.0, 40.1, 40.2, 40.3),
+        pixel_mm=0.0065,
+        distortion=(1e-4, 0.0, 0.0, 0.0),
+        boresight_rad=tuple(np.radians([0.3, -0.2, 0.1])),
+    )
+
+
+def write_ortho_inputs(
+    d, *, adjusted: bool = False, lazy: bool = False, full_camera_file: bool = False
+) -> dict:
     """LP line files, NAV, camera TOML, DSM GeoTIFF (and RESULT.json) under ``d``.
 
     With ``adjusted``, the lines are rendered along the true trajectory and the navigation file
-    lacks the corrections of :func:`node_corrections`, which RESULT.json carries.
+    lacks the corrections of :func:`node_corrections`, which RESULT.json carries. With
+    ``full_camera_file``, the lines are rendered with :func:`full_camera` (band 1's geometry,
+    the middle one of 640, 550, 460 nm) and the camera file is :data:`FULL_CAMERA_TOML`.
     """
     from pathlib import Path
 
@@ -198,7 +230,8 @@ def write_ortho_inputs(d, *, adjusted: bool = False, lazy: bool = False) -> dict
         files["adjustment"].write_text(adjustment_json(nodes, v))
     else:
         nav = true_nav
-    fl = flight("lp", lazy=lazy, render_nav=true_nav, nav=nav)
+    cam = (full_camera(), {"band": 1}) if full_camera_file else None
+    fl = flight("lp", lazy=lazy, render_nav=true_nav, nav=nav, camera=cam)
     files["lines"] = []
     for s in fl.strips:
         p = d / f"{s.name}.nc"
@@ -207,7 +240,11 @@ def write_ortho_inputs(d, *, adjusted: bool = False, lazy: bool = False) -> dict
         files["lines"].append(p)
     files["nav"] = write_trajectory(d / "nav.csv", nav)
     files["camera"] = d / "camera.toml"
-    files["camera"].write_text("[camera]\nn_bands = 4\npixel_mm = 0.0065\nc_mm = 40.0\n")
+    files["camera"].write_text(
+        FULL_CAMERA_TOML
+        if full_camera_file
+        else "[camera]\nn_bands = 4\npixel_mm = 0.0065\nc_mm = 40.0\n"
+    )
     z, g = dsm()
     files["dsm"] = write_geotiff(d / "dsm.tif", z, g.transform, 25832)
     return files

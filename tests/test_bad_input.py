@@ -1,7 +1,7 @@
 """Every bad input gets one clear error, and nothing is ever lost (issue 12).
 
 The valid inputs of ``tests/test_cli*.py`` (a line-scanner calibration, a pushbroom campaign,
-a geocoding flight line, OpenCV's ChArUco photographs, two LP strips to orthomosaic) are built
+a flight line to orthorectify, OpenCV's ChArUco photographs, two LP strips to mosaic) are built
 once; each case copies the command's inputs, spoils one thing (a table of mutations: missing,
 empty, garbage, binary and mistyped files; NaN, inf, 1e300; wrong units and types; degenerate
 geometry; duplicates; bad options; output paths) and runs ``hsgeo.cli.main`` in-process.
@@ -84,9 +84,11 @@ def _pushbroom(d: Path) -> None:
 def _geocode(d: Path) -> None:
     import xarray as xr
 
-    from hsgeo.geocode import PlaneTerrain, geocode_image
+    from hsgeo.geocode import PlaneTerrain
     from hsgeo.io import write_lines
     from hsgeo.io.navigation import write_trajectory
+    from hsgeo.ortho import ground_points
+    from hsgeo.sensors import as_sensor
     from hsgeo.sensors.line import CalibratedLine
     from hsgeo.trajectory import Trajectory
 
@@ -98,7 +100,7 @@ def _geocode(d: Path) -> None:
     write_trajectory(d / "nav.csv", nav)
     cal = CalibratedLine(486.8, 3539.0, (1.459, -0.1636, 0.00526))  # 000 Table 1
     zeta = np.arange(200.0, 800.0, 4.0)
-    g = geocode_image(nav, cal, 40, zeta, t0_s=0.5, line_rate_hz=8.0, terrain=PlaneTerrain(3.0))
+    g = ground_points(as_sensor(cal), nav, 0.5 + np.arange(40) / 8.0, zeta, PlaneTerrain(3.0))
     write_lines(d / "lines.nc", g[..., 0], zeta, t0_s=0.5, line_rate_hz=8.0)
     (d / "sensor.toml").write_text(
         "[sensor]\nmodel = 'calibrated'\nzeta0_px = 486.8\nc_px = 3539.0\n"
@@ -221,10 +223,10 @@ def build_valid(root: Path) -> Path:
     _cube(root / "cube")
     _line(root / "calibrate-line")
     _pushbroom(root / "adjust-pushbroom")
-    _geocode(root / "geocode")
+    _geocode(root / "orthorectify-line")
     _frame(root / "calibrate-frame")
     _lp(root / "lp-observations")
-    _ortho(root / "orthomosaic")
+    _ortho(root / "orthorectify-strips")
     return root
 
 
@@ -244,11 +246,11 @@ def base_argv(cmd: str, d: Path) -> list[str]:
             "--gcp",
             s(d / "gcp.csv"),
         ]
-    if cmd == "geocode":
+    if cmd == "orthorectify-line":  # one recorded line of the 000 line scanner
         out = d.parent / "out"
         out.mkdir(exist_ok=True)
         return [
-            cmd,
+            "orthorectify",
             s(d / "lines.nc"),
             "--trajectory",
             s(d / "nav.csv"),
@@ -256,6 +258,8 @@ def base_argv(cmd: str, d: Path) -> list[str]:
             s(d / "sensor.toml"),
             "--height",
             "3",
+            "--resolution",
+            "0.5",
             "-o",
             s(out / "ortho.nc"),
             "--quiet",
@@ -277,16 +281,16 @@ def base_argv(cmd: str, d: Path) -> list[str]:
             "-o",
             s(out / "obs.parquet"),
         ]
-    if cmd == "orthomosaic":
+    if cmd == "orthorectify-strips":  # two LP strips of the 002 camera, adjusted
         out = d.parent / "out"
         out.mkdir(exist_ok=True)
         return [
-            cmd,
+            "orthorectify",
             s(d / "s1.nc"),
             s(d / "s2.nc"),
             "--trajectory",
             s(d / "nav.csv"),
-            "--camera",
+            "--sensor",
             s(d / "camera.toml"),
             "--adjustment",
             s(d / "result.json"),
@@ -818,8 +822,8 @@ case(
 )
 
 
-# --- geocode -------------------------------------------------------------------------------
-C = "geocode"
+# --- orthorectify: one line of the 000 line scanner ----------------------------------------
+C = "orthorectify-line"
 table_file_cases(C, "nav.csv", "navigation", NAV, "sensor.toml")
 case(C, "duplicates", "nav-duplicate-time", "t_s", [("nav.csv", duplicate_row(5))])
 case(C, "degenerate", "nav-times-decreasing", "t_s", [("nav.csv", swap_rows(5, 6))])
@@ -840,11 +844,14 @@ for v in ("nan", "inf", "abc", "1e300"):
     case(C, "options", f"--height={v}", "--height", argv=opt("--height", v))
 for v in ("0", "-1", "nan", "inf", "abc"):
     case(C, "options", f"--resolution={v}", "--resolution", argv=opt("--resolution", v))
-case(C, "degenerate", "resolution-5mm", "--max-grid-gib", argv=opt("--resolution", "0.005"))
-case(C, "degenerate", "resolution-1e-9", "--max-grid-gib", argv=opt("--resolution", "1e-9"))
-case(C, "options", "max-grid-gib-0", "--max-grid-gib", argv=opt("--max-grid-gib", "0"))
+case(
+    C, "degenerate", "resolution-5mm", "--resolution 0.005 m",
+    argv=lambda a, d: flag("--max-gib", "1")(opt("--resolution", "0.005")(a, d), d),
+)  # fmt: skip
+case(C, "degenerate", "resolution-1e-9", "--resolution 1e-09 m", argv=opt("--resolution", "1e-9"))
+case(C, "options", "max-gib-0", "--max-gib", argv=opt("--max-gib", "0"))
 case(C, "options", "max-nav-gap-nan", "--max-nav-gap-s", argv=opt("--max-nav-gap-s", "nan"))
-case(C, "options", "dem-and-height", "--height", argv=flag("--dem", "x.nc"))
+case(C, "options", "dem-and-height", "--height", argv=flag("--dsm", "x.nc"))
 case(C, "options", "no-output", "--output", argv=opt("-o"))
 # LINES
 case(C, "missing", "lines-missing", "lines.nc", [("lines.nc", remove)])
@@ -1014,7 +1021,7 @@ case(
     C,
     "mistyped",
     "sensor-ifov-with-K",
-    "model = 'calibrated'",
+    "cannot use this key",
     [("sensor.toml", toml_set("sensor", "model", "'linear-ifov'"))],
 )
 case(C, "missing", "sensor-missing", "sensor.toml", [("sensor.toml", remove)])
@@ -1042,7 +1049,7 @@ case(
 def _dem(a, d):
     a = [x for x in a]
     i = a.index("--height")
-    a[i : i + 2] = ["--dem", str(d / "dem.nc")]
+    a[i : i + 2] = ["--dsm", str(d / "dem.nc")]
     return a
 
 
@@ -1099,23 +1106,16 @@ case(
     argv=lambda a, d: opt("-o", str(d / "sensor.toml"))(a, d),
 )
 case(
-    C, "output", "envi-is-nav", "nav.csv", argv=lambda a, d: opt("--envi", str(d / "nav.csv"))(a, d)
-)
+    C, "output", "envi-data-is-lines", "lines.nc",
+    argv=lambda a, d: opt("-o", str(d / "lines.nc.hdr"))(a, d),
+)  # fmt: skip
 case(
     C,
     "output",
     "envi-hdr-is-input",
     "s.hdr",
     files=[("sensor.toml", lambda p: shutil.copy(p, p.parent / "s.hdr"))],
-    argv=lambda a, d: chain(opt("--sensor", str(d / "s.hdr")), opt("--envi", str(d / "s")))(a, d),
-)
-case(C, "output", "envi-hdr-is-output", "--envi", argv=lambda a, d: _envi_hdr_is_output(a, d))
-case(
-    C,
-    "output",
-    "envi-equals-output",
-    "--envi",
-    argv=lambda a, d: opt("--envi", a[a.index("-o") + 1])(a, d),
+    argv=lambda a, d: chain(opt("--sensor", str(d / "s.hdr")), opt("-o", str(d / "s.hdr")))(a, d),
 )
 case(
     C,
@@ -1129,11 +1129,11 @@ case(
     "output",
     "envi-dir-missing",
     "does-not-exist",
-    argv=lambda a, d: opt("--envi", str(d / "does-not-exist" / "o"))(a, d),
+    argv=lambda a, d: opt("-o", str(d / "does-not-exist" / "o.hdr"))(a, d),
 )
 case(C, "output", "output-is-directory", "directory", argv=lambda a, d: opt("-o", str(d))(a, d))
 case(C, "output", "output-exists", "--overwrite", argv=lambda a, d: _touch_output(a, d))
-case(C, "output", "envi-exists", "--overwrite", argv=lambda a, d: _touch_envi(a, d))
+case(C, "output", "envi-data-exists", "--overwrite", argv=lambda a, d: _touch_envi(a, d))
 case(C, "output", "output-dir-readonly", "writ", argv=lambda a, d: _readonly_output(a, d))
 
 
@@ -1153,11 +1153,6 @@ def _set_attr(ds, a, v):
     return ds
 
 
-def _envi_hdr_is_output(a, d):
-    out = Path(a[a.index("-o") + 1]).with_name("x")  # -o x.hdr --envi x: the header is -o
-    return chain(opt("-o", str(out) + ".hdr"), opt("--envi", str(out)))(a, d)
-
-
 def _touch_output(a, d):
     out = Path(a[a.index("-o") + 1])
     out.write_text("precious")
@@ -1166,8 +1161,8 @@ def _touch_output(a, d):
 
 def _touch_envi(a, d):
     envi = d.parent / "out" / "ortho_envi"
-    envi.with_name("ortho_envi.hdr").write_text("precious")
-    return opt("--envi", str(envi))(a, d)
+    envi.write_text("precious")  # the ENVI data file of -o ortho_envi.hdr
+    return opt("-o", str(envi) + ".hdr")(a, d)
 
 
 def _readonly_output(a, d):
@@ -1701,20 +1696,20 @@ case(
     "calibrate-line", "os", "input-name-too-long", "too long",
     argv=replace_arg("obs.csv", lambda d: d / (LONG + ".csv")),
 )  # fmt: skip
-case("geocode", "os", "output-name-too-long", "too long", argv=_out(LONG + ".nc"))
+case("orthorectify-line", "os", "output-name-too-long", "too long", argv=_out(LONG + ".nc"))
 case("cube", "os", "output-name-too-long", "too long", argv=_out(LONG + ".nc"))
-case("geocode", "os", "output-in-proc", "no file can be created", argv=_out("/proc/o.nc"))
-case("geocode", "os", "output-in-sys", "no file can be created", argv=_out("/sys/o.nc"))
+case("orthorectify-line", "os", "output-in-proc", "no file can be created", argv=_out("/proc/o.nc"))
+case("orthorectify-line", "os", "output-in-sys", "no file can be created", argv=_out("/sys/o.nc"))
 case("cube", "os", "output-in-proc", "no file can be created", argv=_out("/proc/c.nc"))
-case("geocode", "os", "output-names-a-folder", "names a folder", argv=_out("newdir/"))
-case("geocode", "os", "output-existing-folder/", "names a folder", argv=_out("./"))
+case("orthorectify-line", "os", "output-names-a-folder", "names a folder", argv=_out("newdir/"))
+case("orthorectify-line", "os", "output-existing-folder/", "names a folder", argv=_out("./"))
 case(
-    "geocode", "degenerate", "dem-E-repeats", "strictly increasing",
+    "orthorectify-line", "degenerate", "dem-E-repeats", "strictly increasing",
     [("dem.nc", nc_edit(_dem_e_repeats))], argv=_dem,
 )  # fmt: skip
 # output formats by extension: refuse what is not written
-case("geocode", "output", "output-tif", "name the file o.nc", argv=_out("o.tif"))
-case("geocode", "output", "output-no-extension", "name the file o.nc", argv=_out("o"))
+case("orthorectify-line", "output", "output-png", "name the file o.tif", argv=_out("o.png"))
+case("orthorectify-line", "output", "output-no-extension", "name the file o.tif", argv=_out("o"))
 # sizes a file declares, checked against the file; requests that cannot fit in memory
 case(
     "adjust-bal", "size", "header-1e9-cameras", "header on line 1 declares",
@@ -1735,7 +1730,7 @@ for cmd, file, column in [
     ("adjust-pushbroom", "obs.csv", "x_px"),
     ("adjust-pushbroom", "nav.csv", "roll_deg"),
     ("adjust-pushbroom", "gcp.csv", "H_m"),
-    ("geocode", "nav.csv", "E_m"),
+    ("orthorectify-line", "nav.csv", "E_m"),
     ("mtf", "profiles.csv", "intensity_dn"),
 ]:
     case(cmd, "duplicates", f"{file}-column-{column}-twice", f"{column} 2 times",
@@ -1744,7 +1739,7 @@ for key, value in [
     ("zeta0_px", "900.0"),  # off the LINES file's pixels (200 ... 796), views still < 80 deg
     ("zeta0_px", "-50.0"),
 ]:
-    case("geocode", "units", f"sensor-{key}={value}-off-the-line", "principal point",
+    case("orthorectify-line", "units", f"sensor-{key}={value}-off-the-line", "principal point",
          [("sensor.toml", toml_set("sensor", key, value))])  # fmt: skip
 for key, value in [
     ("lever_arm_m", "[100.0, 0.0, -200.0]"),  # in mm
@@ -1773,7 +1768,7 @@ case(
     [("nav.csv", scale_column("t_s", 1e3))],
 )  # fmt: skip
 case(
-    "geocode", "units", "nav-upside-down", "navigation's attitude",
+    "orthorectify-line", "units", "nav-upside-down", "navigation's attitude",
     [("nav.csv", lambda p: _add_to_column(p, "roll_deg", 180.0))],
 )  # fmt: skip
 case(
@@ -1783,7 +1778,7 @@ case(
         "markers_y = 7\nmarker_mm = 20.0\nseparation_mm = 5.0\n"))],
 )  # fmt: skip
 case(
-    "geocode", "empty", "lines-zero-lines", "length 0",
+    "orthorectify-line", "empty", "lines-zero-lines", "length 0",
     [("lines.nc", nc_edit(lambda ds: ds.isel(line=slice(0, 0))))],
 )  # fmt: skip
 
@@ -1812,8 +1807,8 @@ def _bal_points_behind(p: Path):
     p.write_text("\n".join(lines[:n] + [repr(float(v)) for v in pts.ravel()]) + "\n")
 
 
-# --- orthomosaic ---------------------------------------------------------------------------
-C = "orthomosaic"
+# --- orthorectify: LP strips -----------------------------------------------------------------
+C = "orthorectify-strips"
 
 
 def _h5_edit(fn):
@@ -1932,7 +1927,7 @@ case(
 )  # fmt: skip
 # CAMERA
 case(C, "missing", "cam-missing", "camera.toml", [("camera.toml", remove)])
-case(C, "empty", "cam-empty", "[camera]", [("camera.toml", text(""))])
+case(C, "empty", "cam-empty", "model", [("camera.toml", text(""))])
 case(C, "garbage", "cam-garbage", "camera.toml", [("camera.toml", text("[camera\nn_bands = \n"))])
 case(C, "binary", "cam-binary", "camera.toml", [("camera.toml", text(BINARY))])
 case(C, "mistyped", "cam-is-csv", "camera.toml", [("camera.toml", copy_from("nav.csv"))])
@@ -2043,10 +2038,19 @@ case(C, "degenerate", "resolution-1e-9", "--resolution", argv=opt("--resolution"
 case(C, "degenerate", "resolution-10km", "--resolution", argv=opt("--resolution", "10000"))
 case(C, "options", "scheduler-not-an-address", "--scheduler", argv=opt("--scheduler", "nowhere"))
 case(C, "options", "scheduler-bad-port", "--scheduler", argv=opt("--scheduler", "tcp://x:port"))
-for o in ("--trajectory", "--camera", "--dsm", "-o"):
+for o in ("--trajectory", "--sensor", "-o"):
     case(C, "options", f"no-{o}", o, argv=opt(o))
+case(C, "options", "no--dsm", "--dsm --height", argv=opt("--dsm"))
 case(C, "options", "no-lines", "LINES", argv=lambda a, d: [a[0], *a[3:]])
 case(C, "options", "unknown-option", "--dem", argv=flag("--dem", "x.tif"))
+case(C, "options", "unknown-mosaic-rule", "--mosaic", argv=flag("--mosaic", "median"))
+case(
+    C,
+    "options",
+    "camera-is-now-sensor",
+    "--sensor",
+    argv=replace_arg("--sensor", lambda d: "--camera"),
+)
 # outputs
 for name in ("s1.nc", "nav.csv", "camera.toml", "dsm.tif", "result.json"):
     case(
@@ -2061,7 +2065,7 @@ case(
     argv=lambda a, d: flag("--overwrite")(opt("-o", str(d / "dsm.tif"))(a, d), d),
 )  # fmt: skip
 case(C, "output", "output-exists", "--overwrite", argv=lambda a, d: _touch_output(a, d))
-case(C, "output", "output-nc", "mosaic.tif", argv=_out("mosaic.nc"))
+case(C, "output", "output-png", "mosaic.tif", argv=_out("mosaic.png"))
 case(C, "output", "output-no-extension", "mosaic.tif", argv=_out("mosaic"))
 case(C, "output", "output-dir-missing", "does-not-exist", argv=_out("does-not-exist/m.tif"))
 case(C, "output", "output-is-directory", "folder", argv=_out("./"))
@@ -2241,30 +2245,36 @@ BENIGN = [
     ("calibrate-line", "reordered", [("obs.csv", _reorder), ("control.csv", _reorder)], None),
     ("calibrate-line", "extra-column", [("obs.csv", _extra_column)], None),
     ("calibrate-line", "options", [], flag("--sigma-px", "0.2", "--reject-k", "5", "--json")),
-    ("geocode", "crlf-nav", [("nav.csv", _crlf), ("sensor.toml", _crlf)], None),
-    ("geocode", "bom-nav", [("nav.csv", _bom), ("sensor.toml", _bom)], None),
-    ("geocode", "reordered-nav", [("nav.csv", _reorder)], None),
-    ("geocode", "extra-column-nav", [("nav.csv", _extra_column)], None),
-    ("geocode", "dem", [], _dem),
+    ("orthorectify-line", "crlf-nav", [("nav.csv", _crlf), ("sensor.toml", _crlf)], None),
+    ("orthorectify-line", "bom-nav", [("nav.csv", _bom), ("sensor.toml", _bom)], None),
+    ("orthorectify-line", "reordered-nav", [("nav.csv", _reorder)], None),
+    ("orthorectify-line", "extra-column-nav", [("nav.csv", _extra_column)], None),
+    ("orthorectify-line", "dem", [], _dem),
     (
-        "orthomosaic",
+        "orthorectify-strips",
         "crlf-bom-nav-json",
         [("nav.csv", _crlf), ("camera.toml", _bom)],
         flag("--json"),
     ),
     (
-        "orthomosaic",
+        "orthorectify-strips",
         "overwrite-existing",
         [],
         lambda a, d: flag("--overwrite")(_touch_output(a, d), d),
     ),
     (
-        "geocode",
+        "orthorectify-line",
         "envi-and-overwrite",
         [],
-        lambda a, d: flag("--envi", str(d.parent / "out" / "o_envi"), "--overwrite")(a, d),
+        lambda a, d: flag("--overwrite")(_touch_envi(a, d), d),
     ),
-    ("geocode", "overwrite-existing", [], lambda a, d: flag("--overwrite")(_touch_output(a, d), d)),
+    ("orthorectify-line", "cog", [], _out("o.tif")),
+    (
+        "orthorectify-line",
+        "overwrite-existing",
+        [],
+        lambda a, d: flag("--overwrite")(_touch_output(a, d), d),
+    ),
     (
         "adjust-pushbroom",
         "crlf-bom-reordered",
@@ -2355,20 +2365,20 @@ if __name__ == "__main__":
     print(counts())
 
 
-@pytest.mark.parametrize("cmd", ["geocode"])
-def test_a_failing_envi_leaves_no_netcdf(cmd, inputs: Inputs, monkeypatch, capsys):
-    """-o x.nc --envi y: if writing the ENVI pair fails, the NetCDF is not left behind either
-    (all outputs or none), and no temporary file remains (the fixture checks *.part)."""
+@pytest.mark.parametrize("cmd", ["orthorectify-line"])
+def test_a_failing_envi_leaves_no_file(cmd, inputs: Inputs, monkeypatch, capsys):
+    """-o y.hdr: if writing the ENVI pair fails, neither its header nor its data file is left
+    behind (both or none), and no temporary file remains (the fixture checks *.part)."""
     from hsgeo.errors import InputError
     from hsgeo.io import raster
 
     def fail(*args, **kwargs):
         raise InputError("the ENVI writer failed")
 
-    monkeypatch.setattr(raster, "write_envi", fail)
+    monkeypatch.setattr(raster, "_rows", fail)
     d = inputs.dir
     out = d.parent / "out"
-    a = base_argv("geocode", d) + ["--envi", str(out / "o_envi")]
+    a = opt("-o", str(out / "o_envi.hdr"))(base_argv("orthorectify-line", d), d)
     inputs.before = _sha(d)
     rc, _, err = run_cli(a, capsys)
     assert rc == 2 and "ENVI writer failed" in err
@@ -2376,7 +2386,16 @@ def test_a_failing_envi_leaves_no_netcdf(cmd, inputs: Inputs, monkeypatch, capsy
 
 
 @pytest.mark.parametrize(
-    "argv", [["--help"], *([c, "--help"] for c in sorted({c.cmd for c in CASES} - {"hsgeo"}))]
+    "argv",
+    [
+        ["--help"],
+        *(
+            [c, "--help"]
+            for c in sorted(
+                {"orthorectify" if "orthorectify" in c.cmd else c.cmd for c in CASES} - {"hsgeo"}
+            )
+        ),
+    ],
 )
 def test_help_still_works(argv, capsys):
     from hsgeo.cli import main
@@ -2392,9 +2411,9 @@ def test_help_still_works(argv, capsys):
     [
         ("calibrate-line", lambda a, d: opt("--zeta0-px", "nan")(a, d), "--zeta0-px"),
         ("calibrate-line", lambda a, d: opt("--c-px", "0")(a, d), "--c-px"),
-        ("geocode", lambda a, d: opt("--resolution", "0.005")(a, d), "--max-grid-gib"),
+        ("orthorectify-line", lambda a, d: opt("--resolution", "1e-9")(a, d), "--resolution"),
     ],
-    ids=["zeta0-nan", "c-px-0", "resolution-5mm"],
+    ids=["zeta0-nan", "c-px-0", "resolution-1nm"],
 )
 def test_end_to_end_in_a_subprocess(cmd, edit, expect, inputs: Inputs):
     """The console command as a user runs it: file descriptors 1 and 2 as they are (a LAPACK
@@ -2438,7 +2457,7 @@ def _run_sub(argv, env_extra=None, **kwargs):
         ("calibrate-line", {"PYTHONIOENCODING": "latin-1"}),
         ("mtf", {"PYTHONIOENCODING": "ascii"}),
         ("adjust-pushbroom", {"PYTHONIOENCODING": "ascii"}),
-        ("geocode", {"PYTHONIOENCODING": "ascii", "LANG": "C", "LC_ALL": "C"}),
+        ("orthorectify-line", {"PYTHONIOENCODING": "ascii", "LANG": "C", "LC_ALL": "C"}),
         ("reproduce", {"PYTHONIOENCODING": "ascii"}),
     ],
     ids=[
@@ -2464,11 +2483,12 @@ def test_reports_print_in_any_locale(cmd, env, inputs: Inputs):
     p.stdout.decode("ascii" if env["PYTHONIOENCODING"] == "ascii" else "latin-1")  # encodable
     # the whole report, every line of it, as on a UTF-8 terminal (spelled, not cut short)
     ref = _run_sub(
-        [*argv, "--overwrite"] if cmd == "geocode" else argv, {"PYTHONIOENCODING": "utf-8"}
+        [*argv, "--overwrite"] if cmd == "orthorectify-line" else argv,
+        {"PYTHONIOENCODING": "utf-8"},
     )
     assert ref.returncode == 0, ref.stderr[-500:]
     assert p.stdout.count(b"\n") == ref.stdout.count(b"\n"), (p.stdout[-300:], ref.stdout[-300:])
-    if cmd == "geocode":  # an error line with non-ASCII characters ('…' of a pixel range)
+    if cmd == "orthorectify-line":  # an error line with non-ASCII characters ('…' of a pixel range)
         bad = d / "bad.toml"
         bad.write_text((d / "sensor.toml").read_text().replace("486.8", "900.0"))
         e = _run_sub(
@@ -2731,7 +2751,7 @@ def chain_edits(*fs):
     "cmd,file,edit,must,must_not",
     [
         ("adjust-pushbroom", "nav.csv", drop_column("N_m"), "N_m", "rename"),
-        ("geocode", "nav.csv", drop_column("U_m"), "U_m", "rename"),
+        ("orthorectify-line", "nav.csv", drop_column("U_m"), "U_m", "rename"),
         # image coordinates in mm: the fit is poor, and the message says which units to check
         (
             "adjust-pushbroom",
@@ -2763,7 +2783,7 @@ def test_data_twice_outside_the_repository(cmd, inputs: Inputs, capsys):
     assert "--out " + str(Path.cwd()) not in err
 
 
-@pytest.mark.parametrize("cmd", ["geocode"])
+@pytest.mark.parametrize("cmd", ["orthorectify-line"])
 def test_toml_and_netcdf_from_a_pipe(cmd, inputs: Inputs):
     """A TOML read twice (its kind, then its content) from a pipe: `--sensor /dev/stdin`; a
     NetCDF LINES file from a pipe."""

@@ -1,4 +1,5 @@
-"""Geocoding: ray–terrain intersection, sensor geometries, boresight calibration, ortho, files."""
+"""Geocoding: ray–terrain intersection, sensor geometries, boresight calibration (the
+orthorectification of whole lines: tests/test_orthorectify*.py)."""
 
 import dataclasses
 
@@ -13,18 +14,14 @@ from hsgeo.geocode import (
     DemTerrain,
     PlaneTerrain,
     calibrate_boresight,
-    geocode_image,
     geocode_observations,
     intersect,
-    orthorectify,
 )
-from hsgeo.io import write_lines
-from hsgeo.io.navigation import write_trajectory
 from hsgeo.sensors.line import CalibratedLine, LinearIFOV
 from hsgeo.simulate.pula_flight import observe_gcps, simulate_flight
 from hsgeo.simulate.scenarios import load_scenario
 from hsgeo.trajectory import Trajectory
-from hsgeo.workflows.geocoding import gcp_deviations, geocode_files
+from hsgeo.workflows.geocoding import gcp_deviations
 
 CAL = CalibratedLine(486.8, 3539.0, (1.459, -0.1636, 0.00526))  # 000 Table 1
 
@@ -176,205 +173,9 @@ def test_gcp_deviations_vanish_with_exact_navigation_and_sensor():
     assert np.max(np.abs(dev_nom)) > 0.05
 
 
-def test_orthorectify_places_pixels_where_they_belong():
-    nav = straight_nav(heading_deg=0.0, T=10.0)
-    zeta = np.arange(100.0, 900.0)
-    g = geocode_image(nav, CAL, 100, zeta, t0_s=0.0, line_rate_hz=10.0, terrain=PlaneTerrain(0.0))
-    img = np.stack([g[..., 0], g[..., 1]])  # every pixel's value is its own E and N
-    da = orthorectify(img, g, resolution_m=0.5)
-    E, N = np.meshgrid(da["E"], da["N"])
-    ok = np.isfinite(da.values[0])
-    assert ok.mean() > 0.5
-    # nearest neighbour: within half the largest pixel spacing (along track 2 m here)
-    assert np.max(np.abs(da.values[0][ok] - E[ok])) < 1.5
-    assert np.max(np.abs(da.values[1][ok] - N[ok])) < 1.5
-
-
-def _geocode_setup(tmp_path, n_lines: int) -> tuple:
-    """A straight north-bound line of ``n_lines`` lines whose every pixel records its own east
-    coordinate, its navigation and the 000 calibrated sensor written to ``tmp_path``; the
-    ``hsgeo geocode`` command line (height 3 m, NetCDF and ENVI outputs, quiet), the
-    navigation and the pixels' ζ."""
-    nav = straight_nav(heading_deg=0.0, T=10.0)
-    write_trajectory(tmp_path / "nav.csv", nav)
-    zeta = np.arange(200.0, 800.0, 2.0)
-    g = geocode_image(
-        nav, CAL, n_lines, zeta, t0_s=0.0, line_rate_hz=8.0, terrain=PlaneTerrain(3.0)
-    )
-    write_lines(tmp_path / "lines.nc", g[..., 0], zeta, t0_s=0.0, line_rate_hz=8.0)
-    (tmp_path / "sensor.toml").write_text(
-        "[sensor]\nmodel = 'calibrated'\nzeta0_px = 486.8\nc_px = 3539.0\n"
-        "K = [1.459, -0.1636, 0.00526]\n"
-    )
-    return (
-        [
-            "geocode",
-            str(tmp_path / "lines.nc"),
-            "--trajectory",
-            str(tmp_path / "nav.csv"),
-            "--sensor",
-            str(tmp_path / "sensor.toml"),
-            "--height",
-            "3",
-            "-o",
-            str(tmp_path / "o.nc"),
-            "--envi",
-            str(tmp_path / "o_envi"),
-            "--quiet",
-        ],
-        nav,
-        zeta,
-    )
-
-
-def test_geocode_command_end_to_end(tmp_path):
-    from hsgeo.cli import main
-    from hsgeo.io import read_envi
-
-    argv, nav, zeta = _geocode_setup(tmp_path, n_lines=80)
-    rc = main(argv)
-    assert rc == 0
-    ds = xr.open_dataset(tmp_path / "o.nc")
-    E = np.broadcast_to(ds["E"].values, ds["radiance"].shape[1:])
-    v = ds["radiance"].values[0]
-    ok = np.isfinite(v)
-    # nearest neighbour: a cell holds a pixel no farther than the maximum distance (about half
-    # the diagonal of the 2.5 m × 0.28 m pixel spacing), and mostly much closer
-    err = np.abs(v[ok] - E[ok])
-    assert err.max() <= ds["radiance"].attrs["max_distance_m"] < 2.0
-    assert np.median(err) < 0.1
-    data, hdr = read_envi(tmp_path / "o_envi")
-    assert data.shape == ds["radiance"].shape and hdr["map_info"][2] == 0.5
-    # the in-memory core the command runs: the same grid and values, no files
-    from hsgeo.io import read_lines, read_scanning_sensor
-    from hsgeo.workflows.geocoding import GeocodeInputs, orthorectify_lines
-
-    da, t0, rate = read_lines(tmp_path / "lines.nc")
-    core = orthorectify_lines(
-        GeocodeInputs(
-            da,
-            t0,
-            rate,
-            nav,
-            read_scanning_sensor(tmp_path / "sensor.toml"),
-            PlaneTerrain(3.0),
-            np.asarray(da["pixel"].values, dtype=float),
-        ),
-        progress=False,
-    )
-    np.testing.assert_array_equal(core.ortho.values, ds["radiance"].values)
-    d = core.to_dict()
-    assert (d["bands"], d["n_north"], d["n_east"]) == ds["radiance"].shape
-    assert core.ground_m.shape == (80, zeta.size, 3)
-    assert (
-        main(
-            [
-                "geocode",
-                str(tmp_path / "lines.nc"),
-                "--trajectory",
-                str(tmp_path / "nav.csv"),
-                "--sensor",
-                str(tmp_path / "missing.toml"),
-                "--height",
-                "3",
-                "-o",
-                str(tmp_path / "x.nc"),
-            ]
-        )
-        == 2
-    )
-    with pytest.raises(InputError, match="exactly one"):
-        geocode_files(
-            tmp_path / "lines.nc",
-            tmp_path / "nav.csv",
-            tmp_path / "sensor.toml",
-            output=tmp_path / "y.nc",
-        )
-
-
 def test_zeta_outside_the_model_raises():
     with pytest.raises(ConvergenceError):
         CAL.zeta(np.array([0.2]))  # 700 px from the centre: beyond the calibrated 450 px
-
-
-def test_geocode_command_takes_the_002_camera_file(tmp_path):
-    """``hsgeo geocode --sensor camera.toml`` (the 002 camera file): the LINES pixel is x px from
-    the line centre; the orthoimage of an image whose value is the pixel's own E (geocoded by
-    the camera the file describes) holds each cell's E to within the nearest-neighbour
-    distance, and the file's c_band_mm / distortion / boresight are the camera's."""
-    from hsgeo.cli import main
-    from hsgeo.io import read_pushbroom_camera
-    from hsgeo.sensors.pushbroom import PushbroomCamera
-
-    nav = straight_nav(heading_deg=0.0, T=10.0)
-    write_trajectory(tmp_path / "nav.csv", nav)
-    (tmp_path / "camera.toml").write_text(
-        "[camera]\nn_bands = 2\npixel_mm = 0.0065\nc_mm = 40.0\nc_band_mm = [36.0, 40.0]\n"
-        "x0_mm = 0.01\ndistortion = [-4.0e-5, 3.0e-7, 2.5e-5, -3.0e-5]\n"
-        "boresight_deg = [0.2, -0.1, 0.3]\nlever_arm_m = [0.1, 0.0, -0.2]\n"
-    )
-    cam = PushbroomCamera(
-        (36.0, 40.0),
-        0.0065,
-        (-4.0e-5, 3.0e-7, 2.5e-5, -3.0e-5),
-        0.01,
-        0.0,
-        tuple(np.deg2rad([0.2, -0.1, 0.3])),
-        (0.1, 0.0, -0.2),
-    )
-    got = read_pushbroom_camera(tmp_path / "camera.toml")
-    assert got.c_mm == cam.c_mm and got.distortion == cam.distortion
-    np.testing.assert_allclose(got.beta, cam.beta, atol=1e-15)
-    x = np.arange(-600.0, 600.0, 4.0)
-    xy = np.column_stack([x, np.zeros_like(x)])
-    g = geocode_image(
-        nav, cam, 80, xy, t0_s=0.0, line_rate_hz=8.0, terrain=PlaneTerrain(3.0), band=1
-    )
-    write_lines(tmp_path / "lines.nc", g[..., 0], x, t0_s=0.0, line_rate_hz=8.0)
-    args = ["geocode", str(tmp_path / "lines.nc"), "--trajectory", str(tmp_path / "nav.csv")]
-    args += ["--sensor", str(tmp_path / "camera.toml"), "--height", "3", "--quiet"]
-    assert main(args + ["-o", str(tmp_path / "o.nc"), "--band", "1"]) == 0
-    ds = xr.open_dataset(tmp_path / "o.nc")
-    E = np.broadcast_to(ds["E"].values, ds["radiance"].shape[1:])
-    v = ds["radiance"].values[0]
-    ok = np.isfinite(v)
-    assert ok.mean() > 0.5
-    assert np.abs(v[ok] - E[ok]).max() <= ds["radiance"].attrs["max_distance_m"]
-    # band 0 (c 10 % shorter): the same pixels cover an 11 % wider swath
-    assert main(args + ["-o", str(tmp_path / "b0.nc"), "--band", "0"]) == 0
-    d0 = xr.open_dataset(tmp_path / "b0.nc")
-
-    def swath_m(d):
-        return np.ptp(d["E"].values[np.isfinite(d["radiance"].values[0]).any(axis=0)])
-
-    np.testing.assert_allclose(swath_m(d0) / swath_m(ds), 40.0 / 36.0, rtol=0.02)
-    assert main(args + ["-o", str(tmp_path / "x.nc"), "--band", "2"]) == 2
-
-
-def test_geocode_outputs_carry_the_local_frame_crs(tmp_path):
-    """``hsgeo geocode`` (on the orthomosaic's path): the NetCDF and the ENVI file carry a real
-    CRS, the local frame's plane about ``--site``; GDAL reads it from both, and a cell's E, N
-    are its position in that CRS (pyproj: the ENU point of a cell centre has the same E, N)."""
-    import rasterio
-
-    from hsgeo.cli import main
-    from hsgeo.crs import LocalFrame, lonlat_to_crs
-
-    argv = [*_geocode_setup(tmp_path, n_lines=40)[0], "--site", "45.0,13.9,20"]
-    assert main(argv) == 0
-    frame = LocalFrame(45.0, 13.9, 20.0)
-    from pyproj import CRS
-
-    ds = xr.open_dataset(tmp_path / "o.nc")
-    corner = (float(ds["E"].values[0]) - 0.25, float(ds["N"].values[0]) + 0.25)
-    for path in (f"netcdf:{tmp_path / 'o.nc'}:radiance", str(tmp_path / "o_envi")):
-        with rasterio.open(path) as src:
-            assert CRS.from_wkt(src.crs.to_wkt()) == CRS.from_user_input(frame.local_crs())
-            np.testing.assert_allclose((src.transform.c, src.transform.f), corner)
-            assert (src.transform.a, src.transform.e) == (0.5, -0.5)
-    E, N = float(ds["E"].values[3]), float(ds["N"].values[5])
-    lon, lat, _ = frame.enu_to_lonlat(E, N, 3.0)
-    np.testing.assert_allclose(lonlat_to_crs(frame.local_crs(), lon, lat), (E, N), atol=1e-3)
 
 
 def test_intersect_on_a_wall_where_the_fixed_point_iteration_cycles(monkeypatch):

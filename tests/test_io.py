@@ -19,8 +19,8 @@ from hsgeo.io import (
     read_opencv_storage,
     read_sensor_toml,
     read_table,
-    to_map_files,
     write_lines,
+    write_raster,
 )
 from hsgeo.io.boards import OPENCV_TUTORIAL_CHARUCO, Board
 from hsgeo.sensors.line import CalibratedLine, LinearIFOV
@@ -333,30 +333,34 @@ def test_lines_round_trip_and_errors(tmp_path):
         read_lines(tmp_path / "t.nc")
 
 
-def test_map_files_refuse_inputs_and_are_atomic(tmp_path):
+def test_map_rasters_refuse_inputs_and_are_atomic(tmp_path):
+    import rioxarray  # noqa: F401
     import xarray as xr
 
     from hsgeo.io import read_envi
 
     da = xr.DataArray(
-        np.arange(6.0).reshape(1, 2, 3),
-        dims=("band", "N", "E"),
-        coords={"band": [0], "N": [10.0, 9.0], "E": [0.0, 1.0, 2.0]},
+        np.arange(6.0, dtype=np.float32).reshape(1, 2, 3),
+        dims=("band", "y", "x"),
+        coords={"band": ["b0"], "y": [10.0, 9.0], "x": [0.0, 1.0, 2.0]},
         name="radiance",
         attrs={"resolution_m": 1.0},
-    )
+    ).rio.write_crs("EPSG:25832")
     src = tmp_path / "input.nc"
     src.write_text("the input")
     with pytest.raises(InputError, match="input of the command"):
-        to_map_files(da, src, inputs=[src])
+        write_raster(da, src, inputs=[src])
     with pytest.raises(InputError, match="input of the command"):
-        to_map_files(da, tmp_path / "o.nc", tmp_path / "input", inputs=[tmp_path / "input.hdr"])
-    assert src.read_text() == "the input" and not (tmp_path / "o.nc").exists()
-    out = to_map_files(da, tmp_path / "o.nc", tmp_path / "o_envi", inputs=[src])
-    assert len(out) == 3
+        write_raster(da, tmp_path / "input.hdr", inputs=[tmp_path / "input"])
+    assert src.read_text() == "the input" and not (tmp_path / "input.hdr").exists()
+    out = write_raster(da, tmp_path / "o.nc", inputs=[src])
     np.testing.assert_array_equal(xr.open_dataset(out[0])["radiance"].values, da.values)
+    assert write_raster(da, tmp_path / "o_envi.hdr") == [
+        tmp_path / "o_envi",
+        tmp_path / "o_envi.hdr",
+    ]
     data, hdr = read_envi(tmp_path / "o_envi")
-    np.testing.assert_array_equal(data, da.values.astype(np.float32))
+    np.testing.assert_array_equal(data, da.values)
     assert hdr["map_info"] == (-0.5, 10.5, 1.0, 1.0)
     assert sorted(os.listdir(tmp_path)) == ["input.nc", "o.nc", "o_envi", "o_envi.hdr"]
 

@@ -88,7 +88,7 @@ def test_mosaic_of_a_cube_4x_larger_than_the_memory_limit(tmp_path):
 
 def test_distributed_cluster_same_mosaic_and_cli(tmp_path, capsys):
     """The same graph on a 2-worker dask.distributed LocalCluster gives the same mosaic as the
-    threaded scheduler; ``hsgeo orthomosaic --scheduler ADDRESS`` writes the same COG."""
+    threaded scheduler; ``hsgeo orthorectify --scheduler ADDRESS`` writes the same COG."""
     import rasterio
     from distributed import Client, LocalCluster
     from ortho_inputs import FRAME, flight, write_ortho_inputs
@@ -101,11 +101,11 @@ def test_distributed_cluster_same_mosaic_and_cli(tmp_path, capsys):
     expected = local.compute(scheduler="threads").values
     f = write_ortho_inputs(tmp_path)
     argv = [
-        "orthomosaic",
+        "orthorectify",
         *map(str, f["lines"]),
         "--trajectory",
         str(f["nav"]),
-        "--camera",
+        "--sensor",
         str(f["camera"]),
         "--dsm",
         str(f["dsm"]),

@@ -70,17 +70,17 @@ def test_the_issue_36_camera_is_one_camera_in_every_command(tmp_path, form, path
     assert same(got, read_sensor(p))
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="workflows/orthomosaic.camera_from_files rebuilds the camera without c_band_mm, "
-    "distortion and boresight (helper 'ortho' replaces it with read_sensor + adjusted)",
-)
-def test_orthomosaic_reads_the_same_camera(tmp_path):
-    from hsgeo.workflows.orthomosaic import camera_from_files
+def test_orthorectify_reads_the_same_camera(tmp_path):
+    """``hsgeo orthorectify`` (which replaced ``orthomosaic``, whose camera_from_files dropped
+    c_band_mm, distortion and boresight) reads its --sensor with read_sensor and applies
+    --adjustment with adjusted: the module has no camera reader of its own."""
+    import inspect
 
-    p = tmp_path / "cam.toml"
-    p.write_text("[camera]\n" + ISSUE_36)
-    assert same(camera_from_files(p), EXPECTED)
+    from hsgeo.workflows import _ortho_strips, orthorectify
+
+    src = inspect.getsource(orthorectify) + inspect.getsource(_ortho_strips)
+    assert "read_sensor(sensor)" in src and "adjusted(" in src
+    assert "read_camera" not in src and "read_scanning_sensor" not in src
 
 
 def test_adjust_pushbroom_starts_from_the_files_camera(tmp_path):
@@ -243,11 +243,6 @@ def test_adjusted_pushbroom_camera_and_trajectory():
     assert cam.boresight_rad == (1e-3, -2e-3, 3e-3) and cam.lever_arm_m == (0.1, 0.2, 0.3)
     np.testing.assert_allclose(traj.xyz_m[:, 0], nav.xyz_m[:, 0] + 1.5, atol=1e-12)
     assert not np.allclose(traj.roll_pitch_heading_rad, nav.roll_pitch_heading_rad)
-    # as orthomosaic's adjusted_camera / adjusted_trajectory (the one place it moves to)
-    from hsgeo.workflows.orthomosaic import adjusted_camera, adjusted_trajectory
-
-    assert same(cam, adjusted_camera(EXPECTED, _adjustment()))
-    np.testing.assert_array_equal(traj.xyz_m, adjusted_trajectory(nav, _adjustment()).xyz_m)
     assert adjusted(EXPECTED, nav, None) == (EXPECTED, nav)
 
 

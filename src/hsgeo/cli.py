@@ -158,25 +158,31 @@ def _cmd_versions(args) -> int:
     return 0
 
 
-def _cmd_orthomosaic(args) -> int:
-    from hsgeo.workflows.orthomosaic import orthomosaic_files
+def _cmd_orthorectify(args) -> int:
+    from hsgeo.workflows.orthorectify import orthorectify_files
 
-    progress = None if args.quiet else terminal.progress_counter("mosaic tiles")
+    progress = None if args.quiet else terminal.progress_counter("raster tiles")
     try:
-        out = orthomosaic_files(
+        out = orthorectify_files(
             args.lines,
             args.trajectory,
-            args.camera,
-            dsm=args.dsm,
+            args.sensor,
             output=args.output,
+            dsm=args.dsm,
+            height_m=args.height,
+            adjustment=args.adjustment,
             resolution_m=args.resolution,
             bands=args.bands,
-            adjustment=args.adjustment,
+            band=args.band,
+            mosaic=args.mosaic,
+            crs=args.crs,
+            site=args.site,
             scheduler=args.scheduler,
             overwrite=args.overwrite,
             progress=progress,
             max_nav_gap_s=args.max_nav_gap_s,
             line_pixels=args.line_pixels,
+            max_gib=args.max_gib,
         )
     finally:
         terminal.clear_progress()
@@ -184,36 +190,10 @@ def _cmd_orthomosaic(args) -> int:
         print(json_text(out))
     else:
         print(
-            f"mosaicked {len(out['strips'])} strip(s), {len(out['bands'])} band(s) onto "
+            f"orthorectified {len(out['strips'])} strip(s), {len(out['bands'])} band(s) onto "
             f"{out['height']} x {out['width']} cells of {out['resolution_m']:g} m "
-            f"({out['crs']}) -> {out['output']}"
+            f"({out['crs']}, mosaic {out['mosaic']}) -> " + ", ".join(out["files"])
         )
-    return 0
-
-
-def _cmd_geocode(args) -> int:
-    from hsgeo.workflows.geocoding import geocode_files
-
-    ortho, paths = geocode_files(
-        args.lines,
-        args.trajectory,
-        args.sensor,
-        output=args.output,
-        dem=args.dem,
-        height_m=args.height,
-        resolution_m=args.resolution,
-        envi=args.envi,
-        progress=not args.quiet and sys.stderr.isatty(),  # progress on a terminal only
-        overwrite=args.overwrite,
-        max_grid_gib=args.max_grid_gib,
-        max_nav_gap_s=args.max_nav_gap_s,
-        band=args.band,
-        site=args.site,
-    )
-    print(
-        f"orthorectified {ortho.sizes['band']} band(s) onto {ortho.sizes['N']} x "
-        f"{ortho.sizes['E']} cells of {args.resolution} m: " + ", ".join(map(str, paths))
-    )
     return 0
 
 

@@ -16,7 +16,7 @@ _POSITIVE = option_number(positive=True)
 
 
 class HsgeoParser(argparse.ArgumentParser):
-    """argparse with one-line errors: ``hsgeo geocode: error: ... (see hsgeo geocode --help)``
+    """argparse with one-line errors: ``hsgeo mtf: error: ... (see hsgeo mtf --help)``
     and exit status 2 (the usage, which wraps over many lines, is left to ``--help``).
     """
 
@@ -27,7 +27,7 @@ class HsgeoParser(argparse.ArgumentParser):
 
 def _lp_line_options(p) -> None:
     """The options of every command that reads LP line files: the full line's width and the
-    navigation gaps interpolated across (``lp-observations``, ``orthomosaic``).
+    navigation gaps interpolated across (``lp-observations``, ``orthorectify``).
     """
     p.add_argument(
         "--line-pixels",
@@ -51,7 +51,7 @@ def root_parser() -> tuple[argparse.ArgumentParser, argparse._SubParsersAction]:
     ap = HsgeoParser(
         prog="hsgeo",
         description="Geometry of hyperspectral sensors: reproduce the book's tables, calibrate, "
-        "geocode.",
+        "orthorectify.",
     )
     ap.add_argument("--version", action="version", version=f"hsgeo {__version__}")
     sub = ap.add_subparsers(dest="command", required=True)
@@ -176,75 +176,6 @@ def add_data(sub) -> argparse.ArgumentParser:
     return p
 
 
-def add_geocode(sub) -> argparse.ArgumentParser:
-    """``hsgeo geocode``."""
-    p = sub.add_parser(
-        "geocode",
-        help="orthorectify a line-scanner flight line onto a map grid",
-        description="Geocode every pixel of a flight line (ray from the recorded navigation and "
-        "the sensor model, intersected with a DEM or a plane) and resample it onto a north-up "
-        "grid by nearest neighbour. LINES: NetCDF with radiance(line, pixel) or (band, line, "
-        "pixel), coordinate pixel (ζ, px), attributes t0_s and line_rate_hz. "
-        "NAV: the navigation file of every command, CSV or Parquet with t_s, E_m, N_m, U_m, "
-        "roll_deg, pitch_deg, heading_deg (positions east-north-up in m; attitude of the body, "
-        "x forward, y right, z down, in north-east-down, in degrees; see hsgeo.io.navigation). "
-        "SENSOR: TOML, the 000 line-scanner file ([sensor], see hsgeo.io.read_sensor_toml) or "
-        "the 002 pushbroom camera file ([camera], see hsgeo.io.read_pushbroom_camera; then the "
-        "LINES pixel coordinate is x in px from the line centre). DEM: NetCDF with "
-        "height(N, E) in metres.",
-    )
-    p.add_argument("lines", metavar="LINES")
-    p.add_argument(
-        "--trajectory",
-        required=True,
-        metavar="NAV",
-        help="navigation file (GNSS/INS solution, CSV or Parquet; see above)",
-    )
-    p.add_argument("--sensor", required=True, metavar="SENSOR.toml")
-    g = p.add_mutually_exclusive_group(required=True)
-    g.add_argument("--dem", metavar="DEM.nc")
-    g.add_argument(
-        "--height",
-        type=option_number(lo=-1e5, hi=1e5),
-        metavar="H",
-        help="terrain height of a plane (m)",
-    )
-    p.add_argument("-o", "--output", required=True, metavar="ORTHO.nc")
-    p.add_argument("--envi", metavar="PATH", help="also write ENVI BSQ + .hdr with map info")
-    p.add_argument(
-        "--overwrite", action="store_true", help="replace existing output files (default: refuse)"
-    )
-    p.add_argument("--resolution", type=_POSITIVE, default=0.5, help="cell size in m (default 0.5)")
-    p.add_argument(
-        "--max-grid-gib",
-        type=_POSITIVE,
-        default=2.0,
-        help="largest memory of the map grid, GiB (default 2); checked before the work",
-    )
-    p.add_argument(
-        "--max-nav-gap-s",
-        type=_POSITIVE,
-        default=1.0,
-        help="longest gap between navigation records interpolated across, s (default 1)",
-    )
-    p.add_argument(
-        "--band",
-        type=int,
-        default=0,
-        help="band of a pushbroom camera file whose geometry is used (default 0)",
-    )
-    p.add_argument(
-        "--site",
-        type=_site,
-        metavar="LAT,LON[,H]",
-        help="ETRS89 latitude, longitude (degrees) and ellipsoidal height (m) of the origin of "
-        "the navigation's east-north-up frame: the output's CRS (default the 002 site, "
-        "59.665,10.775,0)",
-    )
-    p.add_argument("--quiet", action="store_true", help="no progress display")
-    return p
-
-
 def _site(text: str) -> tuple:
     """``--site LAT,LON[,H]``."""
     try:
@@ -272,39 +203,94 @@ def _wavelengths(text: str) -> tuple:
     return out
 
 
-def add_orthomosaic(sub) -> argparse.ArgumentParser:
-    """``hsgeo orthomosaic``."""
+def add_orthorectify(sub) -> argparse.ArgumentParser:
+    """``hsgeo orthorectify``."""
     p = sub.add_parser(
-        "orthomosaic",
-        help="orthomosaic LP strips onto a DSM: a Cloud-Optimized GeoTIFF in EPSG:25832",
-        description="Orthorectify every pixel of every line of the LP strips (ray of the camera "
-        "at the line's time on the trajectory, met with the DSM) and mosaic them onto a "
-        "north-up grid in ETRS89 / UTM 32N (EPSG:25832) by nearest neighbour (pykdtree); "
-        "where strips overlap the pixel nearest to nadir wins. The local east-north-up frame of "
-        "the navigation is the one about the 002 site (59.665 N, 10.775 E, ellipsoidal height "
-        "0). LINES: LP line files (NetCDF: lines(line, column, band), t_s(line), "
-        "wavelength_nm(band), attributes col0, strip_id and optionally n_px_full: see "
-        "hsgeo.io.lp_lines). NAV: the navigation file of every "
-        "command. CAMERA: the camera TOML of hsgeo adjust-pushbroom; RESULT: its --json output "
-        "(camera parameters and node corrections: the adjusted trajectory). DSM: a GeoTIFF of "
-        "ellipsoidal heights in EPSG:25832. Output: a COG with overviews, band names and "
-        "wavelengths; tiles computed with Dask (--scheduler: on a dask.distributed cluster).",
+        "orthorectify",
+        help="orthorectify one line or mosaic many strips of any scanning sensor onto a map "
+        "grid (COG, NetCDF or ENVI by the output's suffix)",
+        description="Orthorectify every pixel of every line (the sensor's ray at the line's "
+        "time on the trajectory, met with the terrain at its first crossing) and resample it "
+        "onto a north-up grid by nearest neighbour (pykdtree): every spectrum stays as "
+        "measured. Where strips overlap, --mosaic decides: nearest-nadir (default: the pixel "
+        "whose ray is nearest to the nadir), first (the first LINES file that covers the "
+        "cell), mean (band by band, of the strips' nearest pixels). LINES: hsgeo's recorded "
+        "flight line (NetCDF radiance(band, line, pixel), coordinate pixel: zeta px of the "
+        "000 line scanner or x px from the line centre of the 002 camera, attributes t0_s and "
+        "line_rate_hz; see hsgeo.io.lines) or LP line files (NetCDF lines(line, column, "
+        "band), t_s(line), wavelength_nm(band), attributes col0, strip_id, n_px_full; see "
+        "hsgeo.io.lp_lines); an optional fwhm_nm(band) is carried into the output. NAV: the "
+        "navigation file of every command (t_s, E_m, N_m, U_m, roll_deg, pitch_deg, "
+        "heading_deg in the local east-north-up frame about --site). SENSOR: TOML, the 000 "
+        "line scanner ([sensor]) or the 002 pushbroom camera ([camera], read in full: c per "
+        "band, distortion, boresight, lever arm). RESULT: hsgeo adjust-pushbroom --json "
+        "(camera parameters and node corrections). DSM: a GeoTIFF of ellipsoidal heights with "
+        "an EPSG CRS, or a NetCDF height(N, E) in the local frame's metres; or --height, a "
+        "plane. OUT: .tif (Cloud-Optimized GeoTIFF), .nc (CF-1.8 NetCDF) or .hdr (ENVI; the "
+        "data file beside it without extension), with the bands' wavelengths and FWHM; "
+        "tiles computed with Dask (--scheduler: on a dask.distributed cluster).",
     )
     p.add_argument("lines", nargs="+", metavar="LINES")
+    p.add_argument("--sensor", required=True, metavar="SENSOR.toml", help="sensor file (TOML)")
     p.add_argument("--trajectory", required=True, metavar="NAV", help="navigation file")
-    p.add_argument("--camera", required=True, metavar="CAMERA.toml")
+    g = p.add_mutually_exclusive_group(required=True)
+    g.add_argument("--dsm", metavar="DSM", help="terrain: GeoTIFF (EPSG CRS) or NetCDF DEM")
+    g.add_argument(
+        "--height",
+        type=option_number(lo=-1e5, hi=1e5),
+        metavar="H_M",
+        help="terrain: a plane at this height, m (the navigation's height system)",
+    )
     p.add_argument("--adjustment", metavar="RESULT.json", help="hsgeo adjust-pushbroom --json")
-    p.add_argument("--dsm", required=True, metavar="DSM.tif")
-    p.add_argument("--resolution", type=_POSITIVE, default=0.3, help="cell size in m (default 0.3)")
-    p.add_argument("-o", "--output", required=True, metavar="MOSAIC.tif")
+    p.add_argument(
+        "-o", "--output", required=True, metavar="OUT", help="OUT.tif, OUT.nc or OUT.hdr"
+    )
+    p.add_argument(
+        "--resolution",
+        type=_POSITIVE,
+        default=None,
+        help="cell size in m (default: the lines' largest ground pixel spacing, 2 digits)",
+    )
+    p.add_argument(
+        "--mosaic",
+        choices=("nearest-nadir", "first", "mean"),
+        default="nearest-nadir",
+        help="where strips overlap (default nearest-nadir)",
+    )
     p.add_argument(
         "--bands",
         type=_wavelengths,
-        default=(640.0, 550.0, 460.0),
-        metavar="R,G,B",
-        help="wavelengths (nm) of the bands to mosaic, nearest band each (default 640,550,460)",
+        default=None,
+        metavar="NM,NM,...",
+        help="wavelengths (nm) of the bands to keep, nearest band each (default: all bands)",
+    )
+    p.add_argument(
+        "--band",
+        type=option_number(integer=True, lo=0, hi=100000),
+        default=None,
+        help="band of a pushbroom camera whose geometry every band uses (default: the middle "
+        "kept band's when the camera has the lines' bands, else band 0)",
+    )
+    p.add_argument(
+        "--crs",
+        metavar="CRS",
+        default=None,
+        help="output CRS, e.g. EPSG:25832 (default: the map CRS of --site's frame, EPSG:25832)",
+    )
+    p.add_argument(
+        "--site",
+        type=_site,
+        metavar="LAT,LON[,H]",
+        help="ETRS89 latitude, longitude (degrees) and ellipsoidal height (m) of the origin of "
+        "the navigation's east-north-up frame (default the 002 site, 59.665,10.775,0)",
     )
     p.add_argument("--scheduler", metavar="ADDRESS", help="dask.distributed scheduler address")
+    p.add_argument(
+        "--max-gib",
+        type=_POSITIVE,
+        default=64.0,
+        help="largest raster, GiB of float32 (default 64); checked before the work",
+    )
     _lp_line_options(p)
     p.add_argument("--overwrite", action="store_true", help="replace an existing output")
     p.add_argument("--json", action="store_true", help="the summary as JSON")
@@ -633,8 +619,7 @@ SUBCOMMANDS = (
     ("_cmd_calibrate_line", add_calibrate_line),
     ("_cmd_calibrate_frame", add_calibrate_frame),
     ("_cmd_data", add_data),
-    ("_cmd_geocode", add_geocode),
-    ("_cmd_orthomosaic", add_orthomosaic),
+    ("_cmd_orthorectify", add_orthorectify),
     ("_cmd_adjust_pushbroom", add_adjust_pushbroom),
     ("_cmd_lp_observations", add_lp_observations),
     ("_cmd_adjust_bal", add_adjust_bal),

@@ -1,4 +1,4 @@
-"""Direct georeferencing: any sensor's rays, intersected with the terrain; orthorectification.
+"""Direct georeferencing: any sensor's rays, intersected with the terrain.
 
 This module knows no particular sensor: a sensor of :mod:`hsgeo.sensors` gives the rays of its
 pixels (``rays(pixels, t_s, trajectory)``, origins and unit directions in the map frame, see
@@ -44,8 +44,6 @@ __all__ = [
     "geocode_observations",
     "BoresightGCP",
     "calibrate_boresight",
-    "geocode_image",
-    "orthorectify",
 ]
 
 
@@ -256,138 +254,3 @@ def geocode_observations(
     line = np.asarray(line, dtype=float)
     t = t0_s + line / line_rate_hz
     return geocode_rays(as_sensor(sensor, boresight_rad), zeta_px, t, nav, terrain, **pixel_kwargs)
-
-
-# ----------------------------------------------------------------------------------------------
-# Orthorectification of whole flight lines
-# ----------------------------------------------------------------------------------------------
-def geocode_image(
-    nav,
-    sensor,
-    n_lines: int,
-    zeta_px,
-    *,
-    t0_s: float,
-    line_rate_hz: float,
-    terrain,
-    boresight_rad=None,
-    chunk_lines: int = 2000,
-    progress=None,
-    **pixel_kwargs,
-) -> np.ndarray:
-    """Ground coordinates of every pixel of a flight line: ``(n_lines, n_px, 3)`` (E, N, U).
-
-    ``sensor``: any scanning sensor of :mod:`hsgeo.sensors` (or a bare LineGeometry with
-    ``boresight_rad``, see :func:`geocode_observations`); ``zeta_px`` the pixel coordinates of
-    one line in the sensor's convention ((n_px,) ζ, or (n_px, 2) ``(x, y)``), the same in every
-    line. ``progress``: True prints the share done to stderr; a callable gets ``(done, total)``.
-    """
-    import sys
-
-    sensor = as_sensor(sensor, boresight_rad)
-    px = np.asarray(zeta_px, dtype=float)
-    n_px = px.shape[0]
-    out = np.empty((n_lines, n_px, 3))
-    for a in range(0, n_lines, chunk_lines):
-        b = min(n_lines, a + chunk_lines)
-        m = b - a
-        t = np.repeat(t0_s + np.arange(a, b) / line_rate_hz, n_px)
-        pixels = np.tile(px, (m,) + (1,) * (px.ndim - 1))
-        out[a:b] = geocode_rays(sensor, pixels, t, nav, terrain, **pixel_kwargs).reshape(m, -1, 3)
-        if progress is True:
-            print(
-                f"\r  geocoded {b}/{n_lines} lines",
-                end="" if b < n_lines else "\n",
-                file=sys.stderr,
-                flush=True,
-            )
-        elif callable(progress):
-            progress(b, n_lines)
-    return out
-
-
-def orthorectify(
-    image,
-    ground_enu_m,
-    *,
-    resolution_m: float,
-    bounds=None,
-    band_names=None,
-    max_distance_m: float | None = None,
-    attrs=None,
-):
-    """Resample a line-scanner image onto a north-up map grid by nearest neighbour.
-
-    Nearest neighbour keeps every spectrum as it was measured (no mixing of pixels), as is usual
-    for imaging spectrometers (PARGE does the same).
-
-    Parameters
-    ----------
-    image : (n_lines, n_px) or (n_bands, n_lines, n_px) ndarray
-    ground_enu_m : (n_lines, n_px, 3) ndarray
-        Ground coordinates of every pixel (:func:`geocode_image`).
-    resolution_m : float
-        Cell size.
-    bounds : (E_min, E_max, N_min, N_max), optional
-        Default: the footprint of the line.
-    max_distance_m : float, optional
-        Cells farther than this from every pixel are NaN (default: a little over half the
-        diagonal of the largest pixel spacing plus half a cell, i.e. outside the footprint).
-
-    Returns
-    -------
-    xarray.DataArray
-        Dimensions ``(band, N, E)`` with cell-centre coordinates in metres, N descending (row 0 is
-        north, as in map rasters). ``attrs`` holds the frame and the cell size.
-    """
-    import xarray as xr
-    from scipy.spatial import cKDTree
-
-    img = np.asarray(image)
-    if img.ndim == 2:
-        img = img[None]
-    if img.ndim != 3 or ground_enu_m.shape[:2] != img.shape[1:]:
-        raise InputError(
-            f"image {np.shape(image)} and ground coordinates {ground_enu_m.shape} do not match"
-        )
-    if not resolution_m > 0:
-        raise InputError(f"resolution_m must be positive, got {resolution_m}")
-    g = np.asarray(ground_enu_m)[..., :2]
-    EN = g.reshape(-1, 2)
-    if bounds is None:
-        bounds = (EN[:, 0].min(), EN[:, 0].max(), EN[:, 1].min(), EN[:, 1].max())
-    if max_distance_m is None:
-        along = np.linalg.norm(np.diff(g, axis=0), axis=-1).max() if g.shape[0] > 1 else 0.0
-        across = np.linalg.norm(np.diff(g, axis=1), axis=-1).max() if g.shape[1] > 1 else 0.0
-        max_distance_m = 0.55 * np.hypot(along, across) + 0.5 * resolution_m
-    e0, e1, n0, n1 = bounds
-    E = np.arange(np.floor(e0 / resolution_m) * resolution_m + resolution_m / 2, e1, resolution_m)
-    N = np.arange(np.ceil(n1 / resolution_m) * resolution_m - resolution_m / 2, n0, -resolution_m)
-    gE, gN = np.meshgrid(E, N)
-    dist, idx = cKDTree(EN).query(
-        np.column_stack([gE.ravel(), gN.ravel()]), distance_upper_bound=max_distance_m
-    )
-    ok = np.isfinite(dist)
-    flat = img.reshape(img.shape[0], -1).astype(np.float64)
-    out = np.full((img.shape[0], gE.size), np.nan)
-    out[:, ok] = flat[:, idx[ok]]
-    da = xr.DataArray(
-        out.reshape(img.shape[0], N.size, E.size),
-        dims=("band", "N", "E"),
-        coords={
-            "band": band_names if band_names is not None else np.arange(img.shape[0]),
-            "N": N,
-            "E": E,
-        },
-        name="radiance",
-        attrs={
-            "crs": "local east-north-up frame (metres)",
-            "resolution_m": resolution_m,
-            "resampling": "nearest neighbour",
-            "max_distance_m": float(max_distance_m),
-            **(attrs or {}),
-        },
-    )
-    da["E"].attrs.update(units="m", long_name="easting")
-    da["N"].attrs.update(units="m", long_name="northing")
-    return da

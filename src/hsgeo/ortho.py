@@ -9,10 +9,16 @@ neighbour within a radius of influence (every spectrum stays as it was measured,
 imaging spectrometers), found by pykdtree (pyresample's kd-tree) in the grid's own metres
 (:func:`resample_swath` says why not through pyresample's geographic path).
 
-**Mosaic rule (nearest to nadir).** Where strips overlap, a map cell takes the pixel whose ray
-is closest to the nadir (smallest off-nadir angle ``arccos(−d_U)`` of its ray) among the nearest
-pixels of each strip; within one strip the nearest pixel wins. The rule needs nothing of a
-particular sensor (it is the ``|x|``-smallest rule of a pushbroom camera on a level platform).
+**Mosaic rules** (:data:`MOSAIC_RULES`, ``hsgeo orthorectify --mosaic``). Within one strip a
+map cell takes the strip's nearest pixel (within the radius of influence). Where strips overlap:
+
+* ``nearest-nadir`` (the default): the pixel whose ray is closest to the nadir (smallest
+  off-nadir angle ``arccos(−d_U)`` of its ray) among the nearest pixels of each strip. The rule
+  needs nothing of a particular sensor (it is the ``|x|``-smallest rule of a pushbroom camera on
+  a level platform);
+* ``first``: the first strip given that covers the cell;
+* ``mean``: the mean, band by band, of the strips' nearest pixels that cover the cell (spectra
+  of different strips mixed: for display, not for spectral analysis).
 
 **Chunks.** :func:`orthomosaic` returns an :class:`xarray.DataArray` ``(band, y, x)`` backed by
 Dask, one chunk per output tile. A tile's task geolocates only the line blocks whose footprint
@@ -40,11 +46,18 @@ __all__ = [
     "resample_swath",
     "orthomosaic",
     "mosaic_tile",
-    "grid_swath",
+    "ground_points",
     "OFF_NADIR_NAME",
+    "MOSAIC_RULES",
 ]
 
 OFF_NADIR_NAME = "off_nadir_deg"
+#: The mosaic rules where strips overlap (module docstring), the default first.
+MOSAIC_RULES = {
+    "nearest-nadir": "nearest to nadir: the smallest off-nadir angle of the ray wins",
+    "first": "first: the first strip given that covers the cell wins",
+    "mean": "mean: band by band, of the strips' nearest pixels that cover the cell",
+}
 
 
 @dataclass(frozen=True)
@@ -137,7 +150,7 @@ def geolocate_lines(strip: Strip, terrain, frame, lines=slice(None), columns=sli
 
 
 def strip_footprints(strip: Strip, terrain, frame, lines_per_block: int, crs: str):
-    """Bounding boxes in ``crs`` of a strip's line blocks and its largest ground pixel spacing.
+    """Bounding boxes in ``crs`` of a strip's line blocks and its largest ground pixel spacings.
 
     Geolocates the perimeter of each block of ``lines_per_block`` lines (its first and last
     line, its first and last pixel of every line).
@@ -147,15 +160,16 @@ def strip_footprints(strip: Strip, terrain, frame, lines_per_block: int, crs: st
     blocks : list of (line0, line1)
     bbox_m : (n_blocks, 4) ndarray
         ``x_min, y_min, x_max, y_max`` in ``crs``, m.
-    spacing_m : float
-        Largest distance between neighbouring pixels along a line or between lines, m.
+    spacing_m : (2,) tuple of float
+        Largest distance between neighbouring pixels of a line (across track) and between
+        neighbouring lines (along track), m.
     """
     from hsgeo.crs import lonlat_to_crs
 
     n = strip.n_lines
     blocks = [(a, min(n, a + lines_per_block)) for a in range(0, n, lines_per_block)]
     bbox = np.empty((len(blocks), 4))
-    spacing = 0.0
+    across = along = 0.0
     for i, (a, b) in enumerate(blocks):
         e1, l1, _ = geolocate_lines(strip, terrain, frame, np.unique([a, b - 1]))
         e2, l2, _ = geolocate_lines(strip, terrain, frame, slice(a, b), [0, -1])
@@ -164,11 +178,11 @@ def strip_footprints(strip: Strip, terrain, frame, lines_per_block: int, crs: st
         bbox[i] = np.min(x), np.min(y), np.max(x), np.max(y)
         if e1.shape[1] > 1:
             step = np.linalg.norm(np.diff(e1[..., :2], axis=1), axis=-1)
-            spacing = max(spacing, float(step.max()))
+            across = max(across, float(step.max()))
         if b - a > 1:
             step = np.linalg.norm(np.diff(e2[..., :2], axis=0), axis=-1)
-            spacing = max(spacing, float(step.max()))
-    return blocks, bbox, spacing
+            along = max(along, float(step.max()))
+    return blocks, bbox, (across, along)
 
 
 def resample_swath(lonlat_deg, values, rank, grid: MapGrid, radius_m: float):
@@ -219,55 +233,49 @@ def resample_swath(lonlat_deg, values, rank, grid: MapGrid, radius_m: float):
     return out.reshape(-1, grid.height, grid.width), r.reshape(grid.height, grid.width)
 
 
-def grid_swath(image, ground_enu_m, frame, *, resolution_m: float, crs=None, radius_m=None):
-    """One geolocated swath onto a grid, in memory (``hsgeo geocode``): the resampling of
-    :func:`mosaic_tile` (nearest neighbour within ``radius_m``, :func:`resample_swath`) without
-    Dask.
+def ground_points(
+    sensor, trajectory, t_s, pixels, terrain, *, chunk_lines: int = 2000, progress=None, **pixel_kw
+) -> np.ndarray:
+    """Ground point (E, N, U) of every pixel of every line: ``(n_lines, n_px, 3)``, m.
 
     Parameters
     ----------
-    image : (n_bands, n_lines, n_px) ndarray
-    ground_enu_m : (n_lines, n_px, 3) ndarray
-        Every pixel's ground point in the local frame (:func:`hsgeo.geocode.geocode_image`).
-    frame : hsgeo.crs.LocalFrame
-    resolution_m : float
-    crs : str, optional
-        The grid's CRS; default the local frame's own (:meth:`~hsgeo.crs.LocalFrame.local_crs`:
-        E, N of the frame within h·d/R).
-    radius_m : float, optional
-        Default: 0.55 × the diagonal of the largest pixel spacings along and across the line
-        plus half a cell.
-
-    Returns
-    -------
-    values : (n_bands, height, width) float32 ndarray
-    grid : MapGrid
-    radius_m : float
+    sensor : a scanning sensor of :mod:`hsgeo.sensors` (``rays(pixels, t_s, trajectory, **kw)``;
+        a bare 000 :class:`~hsgeo.sensors.line.LineGeometry` is mounted with
+        :func:`hsgeo.sensors.as_sensor` first)
+    trajectory : hsgeo.trajectory.Trajectory
+    t_s : (n_lines,) ndarray, s
+        Time of each line.
+    pixels : (n_px,) or (n_px, 2) ndarray
+        One line's pixel coordinates in the sensor's convention, the same in every line.
+    terrain : ``height(E, N)`` in the local frame (PlaneTerrain, DemTerrain, MapTerrain)
+    chunk_lines : int
+        Lines geolocated at once (memory).
+    progress : callable, optional
+        ``progress(done_lines, n_lines)`` after each chunk.
+    **pixel_kw
+        What else ``rays`` takes per pixel (``band=`` of a pushbroom camera).
     """
-    from hsgeo.crs import lonlat_to_crs
-
-    g = np.asarray(ground_enu_m, dtype=float)
-    crs = crs or frame.local_crs()
-    lon, lat, _ = frame.enu_to_lonlat(g[..., 0], g[..., 1], g[..., 2])
-    x, y = lonlat_to_crs(crs, lon, lat)
-    grid = MapGrid.covering((x.min(), x.max()), (y.min(), y.max()), resolution_m, crs)
-    if radius_m is None:
-        along = (
-            np.linalg.norm(np.diff(g[..., :2], axis=0), axis=-1).max() if g.shape[0] > 1 else 0.0
-        )
-        across = (
-            np.linalg.norm(np.diff(g[..., :2], axis=1), axis=-1).max() if g.shape[1] > 1 else 0.0
-        )
-        radius_m = 0.55 * float(np.hypot(along, across)) + 0.5 * resolution_m
-    img = np.asarray(image)
-    vals = img.reshape(img.shape[0], -1).T
-    ll = np.column_stack([lon.ravel(), lat.ravel()])
-    out, _ = resample_swath(ll, vals, np.zeros(ll.shape[0]), grid, radius_m)
-    return out, grid, float(radius_m)
+    t_s = np.asarray(t_s, dtype=float)
+    px = np.asarray(pixels, dtype=float)
+    n_lines, n_px = t_s.size, px.shape[0]
+    out = np.empty((n_lines, n_px, 3))
+    for a in range(0, n_lines, chunk_lines):
+        b = min(n_lines, a + chunk_lines)
+        m = b - a
+        tt = np.repeat(t_s[a:b], n_px)
+        pp = np.tile(px, (m,) + (1,) * (px.ndim - 1))
+        o, d = sensor.rays(pp, tt, trajectory, **pixel_kw)
+        out[a:b] = intersect(o, d, terrain).reshape(m, n_px, 3)
+        if progress is not None:
+            progress(b, n_lines)
+    return out
 
 
-def mosaic_tile(grid: MapGrid, parts, terrain, frame, radius_m: float, n_bands: int):
-    """One output tile: each strip's lines that meet it, resampled, nearest to nadir wins.
+def mosaic_tile(
+    grid: MapGrid, parts, terrain, frame, radius_m: float, n_bands: int, rule="nearest-nadir"
+):
+    """One output tile: each strip's lines that meet it, resampled, mosaicked by ``rule``.
 
     Parameters
     ----------
@@ -276,6 +284,9 @@ def mosaic_tile(grid: MapGrid, parts, terrain, frame, radius_m: float, n_bands: 
     parts : list of (Strip, [(line0, line1, values_block), ...])
         Per strip (its geometry) the line blocks that meet the tile and their values
         ``(m, n_px, n_bands)``.
+    rule : str
+        Where strips overlap (:data:`MOSAIC_RULES`): ``"nearest-nadir"``, ``"first"``,
+        ``"mean"``.
 
     Returns
     -------
@@ -283,6 +294,8 @@ def mosaic_tile(grid: MapGrid, parts, terrain, frame, radius_m: float, n_bands: 
     """
     best = np.full((n_bands, grid.height, grid.width), np.nan, dtype=np.float32)
     best_rank = np.full((grid.height, grid.width), np.inf)
+    total = np.zeros((n_bands, grid.height, grid.width)) if rule == "mean" else None
+    count = np.zeros((grid.height, grid.width)) if rule == "mean" else None
     for strip, blocks in parts:
         ll, vals, ranks = [], [], []
         for a, b, v in blocks:
@@ -293,13 +306,24 @@ def mosaic_tile(grid: MapGrid, parts, terrain, frame, radius_m: float, n_bands: 
         v, r = resample_swath(
             np.concatenate(ll), np.concatenate(vals), np.concatenate(ranks), grid, radius_m
         )
-        win = r < best_rank  # the mosaic rule: the ray nearest to nadir
+        covered = np.isfinite(r)
+        if rule == "mean":
+            total[:, covered] += v[:, covered]
+            count[covered] += 1
+            continue
+        if rule == "first":
+            win = covered & ~np.isfinite(best_rank)
+        else:  # nearest-nadir: the ray nearest to nadir
+            win = r < best_rank
         best[:, win] = v[:, win]
         best_rank[win] = r[win]
+    if rule == "mean":
+        seen = count > 0
+        best[:, seen] = (total[:, seen] / count[seen]).astype(np.float32)
     return best
 
 
-def _tile_task(grid, layout, terrain, frame, radius_m, n_bands, *arrays):
+def _tile_task(grid, layout, terrain, frame, radius_m, n_bands, rule, *arrays):
     """:func:`mosaic_tile` with flat arguments (``layout``: per strip its number of blocks and
     their line ranges; ``arrays``: per strip its geometry, then its blocks' values).
     """
@@ -308,7 +332,7 @@ def _tile_task(grid, layout, terrain, frame, radius_m, n_bands, *arrays):
         geom, vals = arrays[k], arrays[k + 1 : k + 1 + len(ranges)]
         parts.append((geom, [(a, b, v) for (a, b), v in zip(ranges, vals, strict=True)]))
         k += 1 + len(ranges)
-    return mosaic_tile(grid, parts, terrain, frame, radius_m, n_bands)
+    return mosaic_tile(grid, parts, terrain, frame, radius_m, n_bands, rule)
 
 
 def orthomosaic(
@@ -321,6 +345,8 @@ def orthomosaic(
     crs: str | None = None,
     band_names=None,
     wavelength_nm=None,
+    fwhm_nm=None,
+    rule: str = "nearest-nadir",
     tile_px: int = 512,
     lines_per_block: int = 256,
     radius_m: float | None = None,
@@ -335,17 +361,22 @@ def orthomosaic(
     terrain : ``height(E, N)`` in the local frame (PlaneTerrain, DemTerrain, MapTerrain)
     frame : hsgeo.crs.LocalFrame
     grid : MapGrid, optional
-        The output grid; default: the cells of ``resolution_m`` in ``crs`` (default the
-        frame's map CRS) that cover every strip's footprint.
+        The output grid; default: the cells of ``resolution_m`` (default the strips' largest
+        ground pixel spacing, 2 significant digits) in ``crs`` (default the frame's map CRS)
+        that cover every strip's footprint.
     band_names : sequence of str, optional
-    wavelength_nm : sequence of float, optional
+    wavelength_nm, fwhm_nm : sequence of float, optional
+        Each band's centre wavelength and full width at half maximum, nm (carried into the
+        outputs).
+    rule : str
+        The mosaic rule where strips overlap (:data:`MOSAIC_RULES`; default nearest to nadir).
     tile_px : int
         Output chunk (tile) size, cells.
     lines_per_block : int
         Lines geolocated together (and the footprint granularity).
     radius_m : float, optional
-        Radius of influence; default 0.55 × the diagonal of the largest ground pixel spacing
-        plus half a cell (cells outside every swath stay NaN).
+        Radius of influence; default 0.55 × the diagonal of the largest ground pixel spacings
+        across and along track plus half a cell (cells outside every swath stay NaN).
     max_gib : float, optional
         The largest mosaic (GiB of float32) built on ``resolution_m``; a larger one (cells far
         finer than the ground pixels), or one a single cell wide, is refused
@@ -355,9 +386,13 @@ def orthomosaic(
     -------
     xarray.DataArray
         ``(band, y, x)`` float32, chunks ``(n_bands, tile_px, tile_px)``, coordinates of the
-        cell centres, ``band`` names and ``wavelength_nm``; CRS and transform written by
-        rioxarray (``da.rio.crs``, ``da.rio.transform()``).
+        cell centres, ``band`` names, ``wavelength_nm`` and ``fwhm_nm`` (when given); CRS and
+        transform written by rioxarray (``da.rio.crs``, ``da.rio.transform()``).
     """
+    if rule not in MOSAIC_RULES:
+        raise InputError(
+            f"--mosaic {rule!r}: not a mosaic rule; give one of {', '.join(MOSAIC_RULES)}"
+        )
     strips = list(strips)
     if not strips:
         raise InputError("no strips to mosaic")
@@ -365,21 +400,25 @@ def orthomosaic(
     if any(s.n_bands != n_bands for s in strips):
         raise InputError(f"strips with different band counts: {[s.n_bands for s in strips]}")
     crs = grid.crs if grid is not None else (crs or f"EPSG:{frame.map_epsg}")
-    foot, spacing = [], 0.0
+    foot, across, along = [], 0.0, 0.0
     for s in strips:
-        blocks, bbox, sp = strip_footprints(s, terrain, frame, lines_per_block, crs)
+        blocks, bbox, (ac, al) = strip_footprints(s, terrain, frame, lines_per_block, crs)
         foot.append((blocks, bbox))
-        spacing = max(spacing, sp)
+        across, along = max(across, ac), max(along, al)
+    spacing = max(across, along)
     if grid is None:
-        if resolution_m is None:
-            raise InputError("give the output grid or its resolution_m")
+        if resolution_m is None:  # the strips' largest ground pixel spacing, 2 digits
+            resolution_m = float(f"{spacing:.2g}")
         allb = np.concatenate([f[1] for f in foot])
         grid = MapGrid.covering(allb[:, [0, 2]].ravel(), allb[:, [1, 3]].ravel(), resolution_m, crs)
         _check_size(grid, n_bands, spacing, max_gib)
     if radius_m is None:
-        radius_m = 0.55 * np.hypot(spacing, spacing) + 0.5 * grid.resolution_m
-    data = _mosaic_array(strips, foot, grid, terrain, frame, radius_m, tile_px, lines_per_block)
-    return _as_dataarray(data, grid, strips, band_names, wavelength_nm, radius_m)
+        radius_m = 0.55 * np.hypot(across, along) + 0.5 * grid.resolution_m
+    data = _mosaic_array(
+        strips, foot, grid, terrain, frame, radius_m, tile_px, lines_per_block, rule
+    )
+    bands = {"names": band_names, "wavelength_nm": wavelength_nm, "fwhm_nm": fwhm_nm}
+    return _as_dataarray(data, grid, strips, bands, radius_m, rule)
 
 
 def _check_size(grid: MapGrid, n_bands: int, spacing_m: float, max_gib: float | None) -> None:
@@ -402,7 +441,7 @@ def _check_size(grid: MapGrid, n_bands: int, spacing_m: float, max_gib: float | 
         )
 
 
-def _mosaic_array(strips, foot, grid, terrain, frame, radius_m, tile_px, lines_per_block):
+def _mosaic_array(strips, foot, grid, terrain, frame, radius_m, tile_px, lines_per_block, rule):
     """The Dask array ``(n_bands, height, width)``: one task per tile (:func:`mosaic_tile`)."""
     import dask
     import dask.array as dsa
@@ -441,7 +480,7 @@ def _mosaic_array(strips, foot, grid, terrain, frame, radius_m, tile_px, lines_p
             shape = (n_bands, r1 - r0, c1 - c0)
             if layout:
                 task = dask.delayed(_tile_task, pure=True)(
-                    tile, layout, g_terrain, g_frame, radius_m, n_bands, *args
+                    tile, layout, g_terrain, g_frame, radius_m, n_bands, rule, *args
                 )
                 row.append(dsa.from_delayed(task, shape, dtype=np.float32))
             else:
@@ -450,15 +489,17 @@ def _mosaic_array(strips, foot, grid, terrain, frame, radius_m, tile_px, lines_p
     return dsa.block(rows)
 
 
-def _as_dataarray(data, grid, strips, band_names, wavelength_nm, radius_m):
+def _as_dataarray(data, grid, strips, bands, radius_m, rule):
     import rioxarray  # noqa: F401  (the .rio accessor)
     import xarray as xr
 
     n_bands = data.shape[0]
-    names = [str(b) for b in (band_names if band_names is not None else range(n_bands))]
+    names = bands["names"]
+    names = [str(b) for b in (names if names is not None else range(n_bands))]
     coords = {"band": names, "y": grid.y_m, "x": grid.x_m}
-    if wavelength_nm is not None:
-        coords["wavelength_nm"] = ("band", np.asarray(wavelength_nm, dtype=float))
+    for key in ("wavelength_nm", "fwhm_nm"):
+        if bands.get(key) is not None:
+            coords[key] = ("band", np.asarray(bands[key], dtype=float))
     da = xr.DataArray(
         data,
         dims=("band", "y", "x"),
@@ -466,7 +507,7 @@ def _as_dataarray(data, grid, strips, band_names, wavelength_nm, radius_m):
         name="radiance",
         attrs={
             "resampling": "nearest neighbour (pykdtree in the grid's CRS)",
-            "mosaic_rule": "nearest to nadir: the smallest off-nadir angle of the ray wins",
+            "mosaic_rule": MOSAIC_RULES[rule],
             "radius_of_influence_m": float(radius_m),
             "resolution_m": grid.resolution_m,
             "strips": ",".join(s.name for s in strips),

@@ -20,7 +20,8 @@ One module per format:
 * :mod:`hsgeo.io.lines` — recorded flight lines (NetCDF);
 * :mod:`hsgeo.io.lp_lines` — the LP image lines of one strip (:class:`LpStrip`, NetCDF-4) of
   ``hsgeo lp-observations``;
-* :mod:`hsgeo.io.raster` — orthoimages (NetCDF and ENVI) and DEMs (NetCDF);
+* :mod:`hsgeo.io.raster` — the one writer of orthoimages and mosaics (:func:`write_raster`:
+  COG, CF-1.8 NetCDF or ENVI by the suffix) and DEMs (NetCDF);
 * :mod:`hsgeo.io.envi` — ENVI BSQ/BIL/BIP + ``.hdr``, also written in blocks of lines;
 * :mod:`hsgeo.io.envi_read` — ENVI cubes as line scanners write them (``name.hdr`` or
   ``name.ext.hdr``, memory-mapped) and their line times;
@@ -56,7 +57,7 @@ from hsgeo.io.navigation import (
 )
 from hsgeo.io.nist_strd import read_nist_strd
 from hsgeo.io.opencv import read_opencv_storage
-from hsgeo.io.raster import read_dem, to_map_files
+from hsgeo.io.raster import read_dem, write_raster
 from hsgeo.io.sbet import read_sbet
 from hsgeo.io.sensor_file import read_sensor
 from hsgeo.io.sensors import (
@@ -101,7 +102,7 @@ __all__ = [
     "read_board",
     "read_lines",
     "write_lines",
-    "to_map_files",
+    "write_raster",
     "read_dem",
     "read_envi",
     "open_envi",

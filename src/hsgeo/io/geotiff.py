@@ -5,8 +5,9 @@ tile by tile: batches of output tiles are computed (on whatever scheduler is act
 or a ``dask.distributed`` client) and written by this process into a tiled GeoTIFF through
 rasterio windows, so that at most a batch of tiles is in memory and no worker needs the file;
 GDAL's COG driver (inside the rasterio wheel) then copies it into a Cloud-Optimized GeoTIFF
-with overviews (streaming, block by block). CRS, transform, band descriptions (names) and the
-band tag ``wavelength_nm`` go into the file, which QGIS and GDAL open as it is.
+with overviews (streaming, block by block). CRS, transform, band descriptions (names) and each
+band's wavelength and FWHM in GDAL's standard keys (:func:`_band_wavelength_tags`) go into the
+file, which QGIS and GDAL open as it is.
 
 Why not ``rioxarray``'s ``to_raster``: with Dask it writes from the workers through a lock on
 one file, which a cluster of several machines cannot share; here the client writes.
@@ -16,6 +17,7 @@ from __future__ import annotations
 
 import os
 import tempfile
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -86,6 +88,7 @@ def write_cog(
     keys = [(i, j) for i in range(len(data.chunks[1])) for j in range(len(data.chunks[2]))]
     names = [str(b) for b in da["band"].values]
     wl = da["wavelength_nm"].values if "wavelength_nm" in da.coords else None
+    fw = da["fwhm_nm"].values if "fwhm_nm" in da.coords else None
     fd, stage = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".stage.tif", dir=path.parent)
     os.close(fd)
     env = rasterio.Env(GDAL_CACHEMAX=GDAL_CACHE_MB * 2**20)  # GDAL's block cache: bounded
@@ -116,11 +119,8 @@ def write_cog(
                     progress(min(len(keys), k + batch_tiles), len(keys))
             for b in range(n_b):
                 dst.set_band_description(b + 1, names[b])
-                if wl is not None:
-                    dst.update_tags(b + 1, wavelength_nm=f"{float(wl[b]):.6g}")
+                _band_wavelength_tags(dst, b + 1, wl, fw)
             dst.update_tags(**{str(k): str(v) for k, v in da.attrs.items()})
-            if wl is not None:
-                dst.update_tags(wavelength_nm=",".join(f"{float(w):.6g}" for w in wl))
         with atomic_path(path, inputs) as tmp:
             rasterio.shutil.copy(
                 stage,
@@ -137,6 +137,22 @@ def write_cog(
         env.__exit__(None, None, None)
         Path(stage).unlink(missing_ok=True)
     return path
+
+
+def _band_wavelength_tags(dst, band: int, wl, fw) -> None:
+    """A band's wavelength and FWHM in GDAL's standard keys: the ``IMAGERY`` domain's
+    ``CENTRAL_WAVELENGTH_UM`` / ``FWHM_UM`` (GDAL RFC 100), and the ENVI-style band items
+    ``wavelength`` / ``wavelength_units`` / ``fwhm`` (what GDAL's ENVI driver reports).
+    """
+    if wl is not None:
+        w_nm = float(wl[band - 1])
+        dst.update_tags(band, ns="IMAGERY", CENTRAL_WAVELENGTH_UM=f"{w_nm / 1e3:.9g}")
+        dst.update_tags(band, wavelength=f"{w_nm:.9g}", wavelength_units="nm")
+        dst.update_tags(band, wavelength_nm=f"{w_nm:.6g}")  # hsgeo's own key, as before
+    if fw is not None:
+        f_nm = float(fw[band - 1])
+        dst.update_tags(band, ns="IMAGERY", FWHM_UM=f"{f_nm / 1e3:.9g}")
+        dst.update_tags(band, fwhm=f"{f_nm:.9g}")
 
 
 def write_geotiff(
@@ -165,6 +181,18 @@ def write_geotiff(
     return path
 
 
+@contextmanager
+def _no_georeference_warning():
+    """Rasterio's NotGeoreferencedWarning silenced (a file without a CRS is refused in words)."""
+    import warnings
+
+    from rasterio.errors import NotGeoreferencedWarning
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", NotGeoreferencedWarning)
+        yield
+
+
 def read_dsm(path, option: str = "--dsm"):
     """A DSM GeoTIFF: heights (m, above the ellipsoid) and its grid.
 
@@ -181,7 +209,12 @@ def read_dsm(path, option: str = "--dsm"):
 
     p = check_input_file(path, f"{option} DSM")
     try:
-        with rasterio.open(p) as src:
+        with _no_georeference_warning(), rasterio.open(p) as src:  # refused below, in words
+            if src.driver not in ("GTiff", "COG", "VRT"):
+                raise InputError(
+                    f"{option} {p}: not a GeoTIFF (GDAL reads it as {src.driver}); give the "
+                    "DSM as a GeoTIFF (gdal_translate -of GTiff), or a NetCDF DEM as .nc"
+                )
             if src.crs is None or src.crs.to_epsg() is None:
                 raise InputError(
                     f"{option} {p}: the DSM has no CRS with an EPSG code (got {src.crs}); "

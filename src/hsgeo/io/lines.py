@@ -13,7 +13,7 @@ import numpy as np
 from hsgeo.errors import InputError
 from hsgeo.io._files import atomic_path
 
-__all__ = ["read_lines", "write_lines"]
+__all__ = ["read_lines", "write_lines", "line_file_kind", "read_band_widths"]
 
 
 def open_netcdf(path, variable: str, what: str, remedy: str):
@@ -22,8 +22,8 @@ def open_netcdf(path, variable: str, what: str, remedy: str):
     Parameters
     ----------
     path : str or Path
-    variable : str
-        The variable the format requires.
+    variable : str or None
+        The variable the format requires (None: any).
     what : str
         How the file is named in messages (``"DEM "``, or ``""``).
     remedy : str
@@ -80,11 +80,55 @@ def open_netcdf(path, variable: str, what: str, remedy: str):
         raise InputError(
             f"{role} {str(path)!r}: not a readable NetCDF file ({msg}); give an intact file"
         ) from None
-    if variable not in ds:
+    if variable is not None and variable not in ds:
         raise InputError(
             f"{what}{path}: no variable {variable!r} (found {list(ds.data_vars)}); {remedy}"
         )
     return ds
+
+
+def line_file_kind(path) -> str:
+    """Which line format a NetCDF file holds: ``"radiance"`` (a recorded flight line, this
+    module) or ``"lp"`` (LP line files, :mod:`hsgeo.io.lp_lines`), from its variables.
+    """
+    ds = open_netcdf(
+        path,
+        None,
+        "",
+        "a recorded flight line (variable radiance) or LP lines (variable lines) are needed",
+    )
+    try:
+        names = set(ds.variables)
+    finally:
+        ds.close()
+    if "radiance" in names:
+        return "radiance"
+    if "lines" in names:
+        return "lp"
+    raise InputError(
+        f"LINES file {str(path)!r}: neither a recorded flight line (variable radiance(band, "
+        "line, pixel)) nor LP lines (variable lines(line, column, band)); its variables: "
+        f"{', '.join(sorted(names)) or 'none'}"
+    )
+
+
+def read_band_widths(path):
+    """The full width at half maximum of each band, nm (``fwhm_nm(band)`` of a LINES file), or
+    None when the file has none.
+    """
+    ds = open_netcdf(path, None, "", "")
+    try:
+        if "fwhm_nm" not in ds.variables:
+            return None
+        fw = np.asarray(ds["fwhm_nm"].values, dtype=float)
+    finally:
+        ds.close()
+    if fw.ndim != 1 or not np.all(np.isfinite(fw) & (fw > 0)):
+        raise InputError(
+            f"LINES file {str(path)!r}: fwhm_nm must be one positive width per band (nm), got "
+            f"{fw!r}"
+        )
+    return fw
 
 
 def read_lines(path):

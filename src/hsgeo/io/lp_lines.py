@@ -22,7 +22,7 @@ name               dimensions / kind          meaning
 Column ``j`` of the file is column ``col0 + j`` of the full line, at ``x_px = col0 + j −
 (n_px_full − 1) / 2`` px from the line centre (:mod:`hsgeo.conventions`: pixel-centre origin,
 x along the line). **The full line's width** ``n_px_full``, one convention for every command
-that reads these files (``hsgeo lp-observations``, ``hsgeo orthomosaic``, see
+that reads these files (``hsgeo lp-observations``, ``hsgeo orthorectify``, see
 :func:`full_line_px`): the command's ``--line-pixels`` option when given (it overrides the
 files); else the file's ``n_px_full`` attribute; else :data:`DEFAULT_N_PX_FULL` = 1800 px, the
 002 camera's (§4). :func:`write_lp_lines` writes the attribute when the strip carries it.

@@ -1,94 +1,212 @@
-"""Map rasters: an orthoimage as NetCDF and/or ENVI with map info."""
+"""Map rasters: the one writer of orthoimages and mosaics (format by suffix), and DEMs (NetCDF).
+
+:func:`write_raster` writes a ``(band, y, x)`` DataArray with a CRS (:func:`hsgeo.workflows.
+orthorectify.orthorectify`, numpy- or Dask-backed) in the format its suffix names
+(:data:`RASTER_FORMATS`):
+
+* ``.tif`` / ``.tiff`` — Cloud-Optimized GeoTIFF (:func:`hsgeo.io.geotiff.write_cog`, tile by
+  tile), each band's wavelength and FWHM in GDAL's standard keys: the ``IMAGERY`` metadata
+  domain's ``CENTRAL_WAVELENGTH_UM`` / ``FWHM_UM`` and the ENVI-style band items
+  ``wavelength`` / ``wavelength_units`` / ``fwhm`` that spectral tools read;
+* ``.nc`` — CF-1.8 NetCDF-4 (h5netcdf): ``x``/``y`` with ``axis``, ``standard_name`` and units,
+  the CRS in a ``grid_mapping`` variable (``spatial_ref``: CF grid-mapping attributes and the
+  full WKT, written by rioxarray), float32 values, the cube in ``(band, y, x)``; the ``band``
+  coordinate is each band's centre wavelength in nm (``standard_name = radiation_wavelength``;
+  GDAL's netCDF driver reports it as the band's ``NETCDF_DIM_band``), ``fwhm(band)`` in nm and
+  ``band_name(band)`` beside it; rioxarray and GDAL read it without help;
+* ``.hdr`` — ENVI BSQ (the data file beside the header, without extension; written in blocks
+  of rows) with ``map info``, the CRS as WKT, ``band names``, ``wavelength``, ``fwhm`` and
+  ``wavelength units``.
+"""
 
 from __future__ import annotations
 
-import contextlib
 from pathlib import Path
 
 import numpy as np
 
-from hsgeo.io._files import atomic_path, refuse_inputs
-from hsgeo.io.envi import write_envi
+from hsgeo.errors import InputError
+from hsgeo.io._files import atomic_path, check_outputs
 from hsgeo.io.lines import open_netcdf
 
-__all__ = ["to_map_files", "read_dem", "MAP_FORMATS"]
+__all__ = ["write_raster", "read_dem", "raster_outputs", "RASTER_FORMATS", "envi_data_path"]
 
-#: The extensions of the orthoimage written by ``-o`` (NetCDF 3 through xarray's scipy engine,
-#: the CRS in rioxarray's ``spatial_ref`` variable); ``--envi`` writes ENVI with map info and the
-#: CRS as WKT, which GIS programs read. (The orthomosaic writes GeoTIFF: hsgeo.io.geotiff.)
-MAP_FORMATS = {".nc": "NetCDF", ".nc4": "NetCDF", ".cdf": "NetCDF", ".netcdf": "NetCDF"}
+#: The formats :func:`write_raster` writes, by the output's suffix.
+RASTER_FORMATS = {
+    ".tif": "Cloud-Optimized GeoTIFF",
+    ".tiff": "Cloud-Optimized GeoTIFF",
+    ".nc": "NetCDF (CF-1.8)",
+    ".hdr": "ENVI (header; the data file beside it has no extension)",
+}
+_NETCDF = (".nc",)
+_ENVI = (".hdr",)
 
 
-def to_map_files(da, path_nc=None, path_envi=None, *, inputs=()) -> list:
-    """Write an orthorectified raster as NetCDF 3 and/or ENVI BSQ with map info.
+def envi_data_path(path_hdr) -> Path:
+    """The ENVI data file of the header ``path_hdr``: the same name without ``.hdr``."""
+    p = Path(path_hdr)
+    return p.with_name(p.name[: -len(p.suffix)])
 
-    NetCDF is written with xarray's scipy engine (no further dependency).
+
+def raster_outputs(path, formats=None, option: str = "-o/--output") -> list:
+    """The files :func:`write_raster` makes for ``path``, as :func:`hsgeo.io._files.
+    check_outputs` takes them (the ENVI data file beside its header included).
+    """
+    out = [(path, option, formats or RASTER_FORMATS)]
+    if Path(path).suffix.lower() in _ENVI:
+        out.append((envi_data_path(path), f"{option} (the ENVI data file of {str(path)!r})"))
+    return out
+
+
+def write_raster(
+    da, path, *, overwrite: bool = False, inputs=(), option: str = "-o/--output", progress=None
+) -> list:
+    """Write a map raster in the format of its suffix (module docstring), atomically.
 
     Parameters
     ----------
     da : xarray.DataArray
-        ``(band, N, E)`` from :func:`hsgeo.geocode.orthorectify` (attribute ``resolution_m``,
-        cell-centre coordinates ``E``, ``N`` in m).
-    path_nc, path_envi : str or Path, optional
-        The NetCDF file and the ENVI data file (its header is ``path_envi + ".hdr"``).
-    inputs : iterable of path, optional
-        The files the command read: none of them is overwritten (:class:`~hsgeo.InputError`
-        before anything is written).
+        ``(band, y, x)`` with a CRS and transform (``da.rio``), numpy- or Dask-backed; band
+        coordinates ``wavelength_nm`` and ``fwhm_nm`` (nm) optional, carried into the file.
+    path : str or Path
+        ``.tif`` / ``.tiff``, ``.nc`` or ``.hdr``; an existing file is replaced only with
+        ``overwrite``.
+    inputs : iterable of path
+        The files the command read: never overwritten.
+    progress : callable, optional
+        ``progress(done, total)`` after each batch of tiles (COG) or row of tiles.
 
     Returns
     -------
-    list of path
-        The paths written, each atomically (temporary file, then :func:`os.replace`).
+    list of Path
+        The files written.
     """
+    from hsgeo.io.geotiff import write_cog
+
     inputs = [p for p in inputs if p is not None]
-    for p in (path_nc, path_envi):
-        if p is not None:
-            refuse_inputs(p, inputs)
-    if path_envi is not None:
-        refuse_inputs(Path(str(path_envi) + ".hdr"), inputs)
-    out = []
-    with contextlib.ExitStack() as stack:  # all files or none: a failing ENVI removes the .nc
-        if path_nc is not None:
-            tmp = stack.enter_context(atomic_path(path_nc, inputs))
-            da.to_dataset(name=da.name or "radiance").to_netcdf(tmp, engine="scipy")
-            out.append(path_nc)
-        if path_envi is not None:
-            out += _write_map_envi(da, path_envi, inputs)
-    return out
+    check_outputs(raster_outputs(path, RASTER_FORMATS, option), inputs, overwrite=overwrite)
+    if da.dims != ("band", "y", "x"):
+        raise InputError(f"a map raster must have dimensions (band, y, x), got {da.dims}")
+    if da.rio.crs is None:
+        raise InputError("the raster has no CRS: write one with da.rio.write_crs")
+    suffix = Path(path).suffix.lower()
+    if suffix in _NETCDF:
+        return [_write_netcdf(da, Path(path), inputs, progress)]
+    if suffix in _ENVI:
+        return _write_envi(da, Path(path), inputs, progress)
+    return [write_cog(da, path, overwrite=True, inputs=inputs, option=option, progress=progress)]
 
 
-def _write_map_envi(da, path_envi, inputs) -> list:
-    out = []
-    if path_envi is not None:
-        res = float(da.attrs["resolution_m"])
-        E0 = float(da["E"].values[0]) - res / 2
-        N0 = float(da["N"].values[0]) + res / 2
-        out += list(
-            write_envi(
-                path_envi,
-                da.values.astype(np.float32),
-                map_info=(E0, N0, res, res),
-                band_names=[str(b) for b in da["band"].values],
-                description="hsgeo orthorectified line-scanner image",
-                crs_wkt=_crs_wkt(da),
-                inputs=inputs,
-            )
+def _rows(da, progress):
+    """The raster's rows of tiles, computed one after the other: ``(r0, r1, block)``."""
+    import dask.array as dsa
+
+    data = da.data if isinstance(da.data, dsa.Array) else dsa.from_array(np.asarray(da.values))
+    edges = np.concatenate([[0], np.cumsum(data.chunks[1])])
+    for i in range(len(data.chunks[1])):
+        r0, r1 = int(edges[i]), int(edges[i + 1])
+        yield r0, r1, np.asarray(data[:, r0:r1, :].compute(), dtype=np.float32)
+        if progress is not None:
+            progress(i + 1, len(data.chunks[1]))
+
+
+def _band_values(da, key):
+    return None if key not in da.coords else np.asarray(da[key].values, dtype=float)
+
+
+def cf_dataset(da, values=None):
+    """The CF-1.8 dataset of a map raster (module docstring), ``values`` its float32 data
+    (default ``da``'s, computed).
+    """
+    import rioxarray  # noqa: F401  (the .rio accessor)
+    import xarray as xr
+
+    v = np.asarray(da.values if values is None else values, dtype=np.float32)
+    n = v.shape[0]
+    wl, fw = _band_values(da, "wavelength_nm"), _band_values(da, "fwhm_nm")
+    if wl is not None:  # the band coordinate is the centre wavelength: GDAL's NETCDF_DIM_band
+        band = (
+            "band",
+            wl,
+            {"units": "nm", "standard_name": "radiation_wavelength", "long_name": "band centre"},
         )
-    return out
+    else:
+        band = ("band", np.arange(1, n + 1, dtype=np.int32), {"long_name": "band number"})
+    coords = {
+        "band": band,
+        "y": ("y", np.asarray(da["y"].values, float)),
+        "x": ("x", np.asarray(da["x"].values, float)),
+        "band_name": ("band", np.array([str(b) for b in da["band"].values], dtype=object)),
+    }
+    if fw is not None:
+        coords["fwhm"] = (
+            "band",
+            fw,
+            {"units": "nm", "long_name": "full width at half maximum of the band"},
+        )
+    attrs = {k: val for k, val in da.attrs.items() if k not in ("grid_mapping",)}
+    out = xr.DataArray(
+        v,
+        dims=("band", "y", "x"),
+        coords=coords,
+        name=da.name or "radiance",
+        attrs={"long_name": str(da.name or "radiance"), **attrs},
+    )
+    out = out.rio.write_crs(da.rio.crs).rio.write_transform(da.rio.transform())
+    ds = out.to_dataset()
+    ds = ds.rio.write_coordinate_system()
+    name = out.name
+    gm = ds[name].encoding.pop("grid_mapping", None) or "spatial_ref"
+    ds[name].attrs["grid_mapping"] = gm  # an attribute, so that no encoding given drops it
+    for c, name in (("x", "easting"), ("y", "northing")):
+        ds[c].attrs.update(units="m", long_name=name)
+    ds.attrs.update(
+        Conventions="CF-1.8",
+        title="hsgeo orthorectified image",
+        source="hsgeo orthorectify",
+    )
+    return ds
 
 
-def _crs_wkt(da):
-    """The raster's CRS as WKT (rioxarray's ``spatial_ref``, or the ``crs`` attribute), or None."""
-    crs = da.rio.crs if hasattr(da, "rio") else None
-    if crs is None and "crs" in da.attrs:
-        from pyproj import CRS
-        from pyproj.exceptions import CRSError
+def _write_netcdf(da, path, inputs, progress):
+    """CF-1.8 NetCDF-4 (h5netcdf), atomically."""
+    v = np.empty(da.shape, dtype=np.float32)
+    for r0, r1, block in _rows(da, progress):
+        v[:, r0:r1, :] = block
+    ds = cf_dataset(da, v)
+    enc = {ds_name: {"_FillValue": None} for ds_name in ("x", "y", "band")}
+    enc[da.name or "radiance"] = {"_FillValue": np.float32(np.nan), "dtype": "float32"}
+    if "fwhm" in ds:
+        enc["fwhm"] = {"_FillValue": None}
+    with atomic_path(path, inputs) as tmp:
+        ds.to_netcdf(tmp, engine="h5netcdf", encoding=enc)
+    return path
 
-        try:
-            crs = CRS.from_user_input(da.attrs["crs"])
-        except CRSError:
-            return None
-    return None if crs is None else crs.to_wkt()
+
+def _write_envi(da, path_hdr, inputs, progress) -> list:
+    """ENVI BSQ float32 in blocks of rows, with map info and the CRS (WKT)."""
+    from hsgeo.io.envi import EnviWriter
+
+    t = da.rio.transform()
+    if t.b != 0 or t.d != 0:
+        raise InputError("ENVI map info needs a north-up raster (no rotation)")
+    names = [str(b) for b in da["band"].values]
+    with EnviWriter(
+        envi_data_path(path_hdr),
+        da.shape,
+        np.float32,
+        map_info=(float(t.c), float(t.f), float(t.a), float(-t.e)),
+        band_names=names,
+        wavelength_nm=_band_values(da, "wavelength_nm"),
+        fwhm_nm=_band_values(da, "fwhm_nm"),
+        data_ignore_value=float("nan"),
+        description="hsgeo orthorectified image",
+        crs_wkt=da.rio.crs.to_wkt(),
+        inputs=inputs,
+    ) as w:
+        for r0, r1, block in _rows(da, progress):
+            w[r0:r1, :, :] = block.transpose(1, 2, 0)
+    return [w.path, w.header_path]
 
 
 def read_dem(path):

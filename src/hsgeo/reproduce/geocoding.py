@@ -77,7 +77,7 @@ def displacement_across_track(obs: FlightObservations, sensors: dict, boresights
     """Ground displacement between geocoding with the ``"calibrated"`` and the
     ``"uncalibrated"`` sensor model, for every across-track pixel of one flight.
 
-    Every line of the flight is geocoded (:func:`hsgeo.geocode.geocode_image`, flat terrain at
+    Every line of the flight is geocoded (:func:`hsgeo.ortho.ground_points`, flat terrain at
     the GCP height) with each model and its own GCP-calibrated boresight; the displacement is
     calibrated − uncalibrated on the ground.
 
@@ -97,22 +97,22 @@ def displacement_across_track(obs: FlightObservations, sensors: dict, boresights
         ``along_m`` (n_lines, n_px): the displacement's components across track (positive
         towards increasing ζ) and along track [m]; ``norm_m`` (n_lines, n_px): its length [m].
     """
-    from hsgeo.geocode import PlaneTerrain, geocode_image
+    from hsgeo.geocode import PlaneTerrain
+    from hsgeo.ortho import ground_points
+    from hsgeo.sensors import as_sensor
 
     half = cfg["scanner"]["usable_half_width_px"]
     z0 = round(cfg["sensor_truth"]["zeta0_px"])
     zeta = np.arange(z0 - half, z0 + half + 1, dtype=float)
     n_lines = int((obs.recorded_nav.t_s[-1] - obs.t0_s) * obs.line_rate_hz)
+    t_s = obs.t0_s + np.arange(n_lines) / obs.line_rate_hz
     ground = {
-        name: geocode_image(
+        name: ground_points(
+            as_sensor(sensors[name], boresights[name]),
             obs.recorded_nav,
-            sensors[name],
-            n_lines,
+            t_s,
             zeta,
-            t0_s=obs.t0_s,
-            line_rate_hz=obs.line_rate_hz,
-            terrain=PlaneTerrain(obs.terrain_height_m),
-            boresight_rad=boresights[name],
+            PlaneTerrain(obs.terrain_height_m),
         )[..., :2]
         for name in ("calibrated", "uncalibrated")
     }

@@ -4,7 +4,7 @@
 cells, made on a 20 cm DSM with the adjusted trajectory, and the white reference squares
 enlarged in it: "they can be accurately found in the orthomosaic". :func:`fig9` makes that
 mosaic of a rendered campaign (:func:`hsgeo.simulate.lp_campaign.simulate`) twice, through the
-user's path (:mod:`hsgeo.workflows.orthomosaic`, :func:`hsgeo.ortho.orthomosaic`: nearest
+user's path (``hsgeo orthorectify``: :mod:`hsgeo.workflows.orthorectify`, nearest
 neighbour, nearest-to-nadir mosaic rule) in ETRS89 / UTM 32N (EPSG:25832, the
 site :data:`hsgeo.crs.SITE_AAS`):
 
@@ -45,16 +45,17 @@ import numpy as np
 from hsgeo.crs import SITE_AAS
 from hsgeo.papers import P002
 from hsgeo.report import Row
-from hsgeo.workflows.orthomosaic import (
-    TRUE_COLOUR_NM,
-    MosaicInputs,
-    MosaicOptions,
-    adjusted_camera,
-    adjusted_trajectory,
+from hsgeo.sensors import adjusted as adjusted_geometry
+from hsgeo.workflows.orthorectify import (
+    OrthoInputs,
+    OrthoOptions,
     adjustment_of,
-    build_mosaic,
-    lp_mosaic_strips,
+    lp_strips,
+    orthorectify,
 )
+
+#: The true-colour bands' wavelengths (R, G, B), nm.
+TRUE_COLOUR_NM = (640.0, 550.0, 460.0)
 
 __all__ = [
     "fig9",
@@ -91,11 +92,11 @@ def mosaic_of(
     xarray.DataArray
         ``(band, y, x)`` float32 in EPSG:25832, NaN outside every swath.
     """
-    strips, wl = lp_mosaic_strips(obs.strips, camera, trajectory, bands_nm, obs.n_px_full)
+    strips, wl, _ = lp_strips(obs.strips, camera, trajectory, bands_nm, obs.n_px_full)
     names = tuple(f"{w:g} nm" for w in wl)
     dsm = truth.terrain if terrain is None else terrain
-    inputs = MosaicInputs(tuple(strips), dsm, names, tuple(float(w) for w in wl))
-    return build_mosaic(inputs, MosaicOptions(resolution_m=resolution_m, frame=SITE_AAS)).compute()
+    inputs = OrthoInputs(tuple(strips), dsm, names, tuple(float(w) for w in wl))
+    return orthorectify(inputs, OrthoOptions(resolution_m=resolution_m, frame=SITE_AAS)).compute()
 
 
 def where_squares_land(obs, truth, camera, trajectory, *, band: int = 3, terrain=None):
@@ -251,7 +252,7 @@ def fig9(obs, truth, adjusted, *, resolution_m: float = P002["fig9_pixel_m"], rn
     """
     adj = adjustment_of(adjusted)
     runs = {
-        "adjusted": (adjusted_camera(obs.camera, adj), adjusted_trajectory(obs.navigation, adj)),
+        "adjusted": adjusted_geometry(obs.camera, obs.navigation, adj),
         "raw": (obs.camera, obs.navigation),
     }
     mosaics, errors, seconds, expected = {}, {}, {}, {}

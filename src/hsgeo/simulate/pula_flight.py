@@ -348,22 +348,20 @@ def render_line_image(truth: FlightTruth, cfg: dict, rng=None, *, noise: float =
     and sensor, with Gaussian noise.
     """
     fl = truth
-    from hsgeo.geocode import geocode_image
+    from hsgeo.ortho import ground_points
+    from hsgeo.sensors import as_sensor
 
     rng = as_rng(0 if rng is None else rng)
     half = cfg["scanner"]["usable_half_width_px"]
     z0 = round(cfg["sensor_truth"]["zeta0_px"])
     zeta = np.arange(z0 - half, z0 + half + 1, dtype=float)
     n_lines = int((fl.true_nav.t_s[-1] - fl.t0_s) * fl.line_rate_hz)
-    ground = geocode_image(
+    ground = ground_points(
+        as_sensor(fl.sensor, fl.boresight_rad),
         fl.true_nav,
-        fl.sensor,
-        n_lines,
+        fl.t0_s + np.arange(n_lines) / fl.line_rate_hz,
         zeta,
-        t0_s=fl.t0_s,
-        line_rate_hz=fl.line_rate_hz,
-        terrain=PlaneTerrain(fl.terrain_height_m),
-        boresight_rad=fl.boresight_rad,
+        PlaneTerrain(fl.terrain_height_m),
     )
     img = airfield_scene(ground[..., 0], ground[..., 1], fl.gcp_enu_m)
     return img + noise * rng.standard_normal(img.shape), zeta

@@ -13,7 +13,9 @@ module                     what it does
 ``rikola``                 per-band and joint calibration of the Rikola FPI camera (003,
                            ``hsgeo calibrate-frame``)
 ``pushbroom_ba``           bundle adjustment of pushbroom lines (002, ``hsgeo adjust-pushbroom``)
-``geocoding``              orthorectification of a recorded flight line (000, ``hsgeo geocode``)
+``geocoding``              GCP deviations after a GCP boresight calibration (000 Tables 2–3)
+``orthorectify``           one line or many strips of any scanning sensor onto a map grid, COG,
+                           NetCDF or ENVI (``hsgeo orthorectify``)
 ``cube``                   raw ImSpector frames → reflectance cube: dark current and hot pixels,
                            reflectance from the diffuse collector, chunked (001 §2.1, §2.4,
                            ``hsgeo cube``)

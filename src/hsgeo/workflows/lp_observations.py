@@ -696,7 +696,7 @@ def lp_observation_files(
     n_px_full : int, optional
         Pixels of a full line (``--line-pixels``); overrides the files' ``n_px_full``
         attribute (default: that attribute, else 1800 px, 002 §4:
-        :func:`hsgeo.io.lp_lines.full_line_px`, the convention ``hsgeo orthomosaic`` shares).
+        :func:`hsgeo.io.lp_lines.full_line_px`, the convention ``hsgeo orthorectify`` shares).
 
     Returns
     -------

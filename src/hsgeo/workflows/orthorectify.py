@@ -1,0 +1,374 @@
+"""Orthorectify any scanning sensor's lines, one line or many strips: ``hsgeo orthorectify``.
+
+The in-memory core :func:`orthorectify` (:class:`OrthoInputs`, :class:`OrthoOptions` → a lazy
+``(band, y, x)`` :class:`xarray.DataArray` with a CRS, :func:`hsgeo.ortho.orthomosaic`) is what
+the chapters call; the file front end :func:`orthorectify_files` reads the lines (hsgeo's
+recorded flight line or LP line files: :mod:`hsgeo.workflows._ortho_strips`), the navigation,
+the sensor file (:func:`hsgeo.io.read_sensor`: the 000 line scanner, the 002 pushbroom camera read
+in full — principal distance per band, distortion, boresight and lever arm — or the 004
+panoramic scanner), optionally an ``hsgeo adjust-pushbroom --json`` result (applied by
+:func:`hsgeo.sensors.adjusted`), and the terrain (a DSM GeoTIFF in the map CRS, a DEM
+NetCDF in the local frame, or a plane); checks them all before the work; and writes the raster
+in the format of the output's suffix through the one writer :func:`hsgeo.io.raster.write_raster`
+(Cloud-Optimized GeoTIFF, CF-1.8 NetCDF or ENVI). Every pixel's spectrum stays as it was
+measured (nearest neighbour); where strips overlap the mosaic rule decides
+(:data:`hsgeo.ortho.MOSAIC_RULES`, default nearest to nadir). Tiles are computed with Dask
+(``scheduler``: on that ``dask.distributed`` cluster).
+"""
+
+from __future__ import annotations
+
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from hsgeo.crs import SITE_AAS, LocalFrame
+from hsgeo.errors import InputError, ObservationError
+from hsgeo.ortho import MOSAIC_RULES, orthomosaic
+from hsgeo.workflows._ortho_strips import adjustment_of, line_strip, lp_strips
+
+__all__ = [
+    "OrthoInputs",
+    "OrthoOptions",
+    "orthorectify",
+    "orthorectify_files",
+    "adjustment_of",
+    "line_strip",
+    "lp_strips",
+    "MAX_MOSAIC_GIB",
+]
+
+#: How long ``--scheduler`` waits for the scheduler to answer, s.
+SCHEDULER_TIMEOUT_S = 10.0
+#: The largest raster built, GiB of float32 (a --resolution far finer than the ground pixels).
+MAX_MOSAIC_GIB = 64.0
+
+
+@dataclass(frozen=True)
+class OrthoOptions:
+    """How the lines become a raster.
+
+    Attributes
+    ----------
+    resolution_m : float or None
+        Cell size, m; None: the strips' largest ground pixel spacing (2 significant digits).
+    mosaic : str
+        The rule where strips overlap (:data:`hsgeo.ortho.MOSAIC_RULES`): ``nearest-nadir``
+        (default), ``first``, ``mean``.
+    crs : str or None
+        The output CRS (anything pyproj reads); None: the frame's map CRS
+        (``EPSG:{frame.map_epsg}``).
+    frame : hsgeo.crs.LocalFrame
+        Where the navigation's local east-north-up frame lies.
+    tile_px, lines_per_block : int
+        Output tile (cells) and lines geolocated together.
+    max_gib : float
+        The largest raster, GiB of float32.
+    """
+
+    resolution_m: float | None = None
+    mosaic: str = "nearest-nadir"
+    crs: str | None = None
+    frame: object = SITE_AAS
+    tile_px: int = 512
+    lines_per_block: int = 256
+    max_gib: float = MAX_MOSAIC_GIB
+
+
+@dataclass(frozen=True)
+class OrthoInputs:
+    """Strips (:class:`hsgeo.ortho.Strip`), the terrain, band names, wavelengths and FWHM (nm)."""
+
+    strips: tuple
+    terrain: object
+    band_names: tuple = ()
+    wavelength_nm: tuple = ()
+    fwhm_nm: tuple = ()
+    meta: dict = field(default_factory=dict)
+
+
+def orthorectify(inputs: OrthoInputs, options: OrthoOptions = OrthoOptions()):
+    """The lazy orthoimage / mosaic ``(band, y, x)`` (:func:`hsgeo.ortho.orthomosaic`).
+
+    Returns
+    -------
+    xarray.DataArray
+        float32, Dask-backed (``.compute()`` for memory, or :func:`hsgeo.io.raster.
+        write_raster`), CRS and transform through rioxarray, coordinates ``wavelength_nm`` and
+        ``fwhm_nm`` of the bands when given.
+    """
+    try:
+        return orthomosaic(
+            inputs.strips,
+            inputs.terrain,
+            options.frame,
+            resolution_m=options.resolution_m,
+            crs=options.crs,
+            band_names=list(inputs.band_names) or None,
+            wavelength_nm=list(inputs.wavelength_nm) or None,
+            fwhm_nm=list(inputs.fwhm_nm) or None,
+            rule=options.mosaic,
+            tile_px=options.tile_px,
+            lines_per_block=options.lines_per_block,
+            max_gib=options.max_gib,
+        )
+    except ObservationError as exc:
+        raise InputError(str(exc)) from None
+
+
+def _frame(site) -> LocalFrame:
+    """The local frame of ``--site LAT,LON[,H]`` (default the 002 site)."""
+    if site is None:
+        return SITE_AAS
+    site = tuple(float(v) for v in site)
+    if len(site) not in (2, 3):
+        raise InputError(f"--site needs LAT,LON or LAT,LON,H (degrees, metres), got {site}")
+    return LocalFrame(*site)
+
+
+def _terrain(dsm, height_m, frame, U_m):
+    """The terrain: ``--dsm`` a GeoTIFF (map CRS) or a NetCDF DEM (local frame), or a plane;
+    checked to lie below the aircraft (``U_m``: its heights in the navigation).
+    """
+    from pathlib import Path
+
+    from hsgeo.geocode import DemTerrain, PlaneTerrain
+    from hsgeo.io.geotiff import read_dsm
+    from hsgeo.io.raster import read_dem
+    from hsgeo.mapgrid import MapTerrain
+
+    if (dsm is None) == (height_m is None):
+        raise InputError("give exactly one of --dsm DSM (GeoTIFF or NetCDF) or --height H_M")
+    low = float(np.min(U_m))
+    if dsm is None:
+        if not height_m < low:
+            raise InputError(
+                f"--height {height_m:g} m is not below the aircraft (U_m down to {low:.6g} m "
+                "in the navigation); give the terrain height in the navigation's height system"
+            )
+        return PlaneTerrain(float(height_m))
+    if Path(dsm).suffix.lower() in (".nc", ".nc4", ".cdf", ".netcdf"):
+        dem = read_dem(dsm)
+        top = float(np.max(dem.values))
+        if top >= low:
+            raise InputError(
+                f"DEM {str(dsm)!r} reaches {top:.6g} m, not below the aircraft (U_m down to "
+                f"{low:.6g} m in the navigation): are the DEM and the navigation in the same "
+                "height system and unit?"
+            )
+        return DemTerrain(dem)
+    z, grid = read_dsm(dsm)
+    return MapTerrain(z, grid, frame, source=f"--dsm {str(dsm)!r}")
+
+
+def _read_strips(lines, nav, sensor, args):
+    """The strips of the LINES files (all of one kind), their wavelengths and FWHM."""
+    from hsgeo.io.lines import line_file_kind, read_band_widths, read_lines
+    from hsgeo.io.lp_lines import full_line_px, open_lp_lines
+    from hsgeo.workflows._ortho_strips import check_principal_point
+
+    kinds = {str(p): line_file_kind(p) for p in lines}
+    if len(set(kinds.values())) > 1:
+        raise InputError(
+            "LINES mixes recorded flight lines (radiance) and LP line files (lines): "
+            + ", ".join(f"{p!r}: {k}" for p, k in kinds.items())
+            + "; give lines of one sensor"
+        )
+    fwhm = read_band_widths(lines[0])
+    if next(iter(kinds.values())) == "lp":
+        lps = [open_lp_lines(p) for p in lines]
+        n_px_full = full_line_px(lps, args["line_pixels"])
+        strips, wl, fw = lp_strips(
+            lps, sensor, nav, args["bands"], n_px_full, names=lines, band=args["band"], fwhm_nm=fwhm
+        )
+        return strips, wl, fw, n_px_full
+    strips, wl, fw = [], None, None
+    for p in lines:
+        da, t0, rate = read_lines(p)
+        strip, idx = line_strip(
+            da, t0, rate, sensor, nav, bands_nm=args["bands"], band=args["band"], name=str(p)
+        )
+        check_principal_point(sensor, da["pixel"].values, args["sensor"], p)
+        if wl is None and "wavelength_nm" in da.coords:
+            wl = np.asarray(da["wavelength_nm"].values, float)[idx]
+            fw = None if fwhm is None else np.asarray(fwhm, float)[idx]
+        strips.append(strip)
+    if len({s.n_bands for s in strips}) > 1:
+        raise InputError(
+            "LINES have different band counts: "
+            + ", ".join(f"{s.name!r}: {s.n_bands}" for s in strips)
+        )
+    return strips, wl, fw, None
+
+
+def _check_nav(strips, nav, trajectory, max_nav_gap_s, adjustment) -> None:
+    """The navigation covers every strip's lines; the adjustment's node span too."""
+    from hsgeo.validate import check_navigation_covers
+
+    for s in strips:
+        check_navigation_covers(
+            nav.t_s,
+            s.t_s,
+            nav=repr(str(trajectory)),
+            used=f"the lines of {s.name!r} (t_s)",
+            max_gap_s=max_nav_gap_s,
+        )
+    if adjustment is None:
+        return
+    t = adjustment["t_nodes_s"]
+    dt = float(t[2] - t[1])
+    lo, hi = float(t[1]) - dt, float(t[-2]) + dt
+    for s in strips:
+        if s.t_s[0] < lo or s.t_s[-1] > hi:
+            raise InputError(
+                f"the lines of {s.name!r} (t_s {s.t_s[0]:.6g}…{s.t_s[-1]:.6g} s) lie outside "
+                f"the node times of --adjustment ({t[1]:.6g}…{t[-2]:.6g} s): give the "
+                "adjustment of this flight (adjust-pushbroom on observations of these strips)"
+            )
+
+
+def orthorectify_files(
+    lines,
+    trajectory,
+    sensor,
+    *,
+    output,
+    dsm=None,
+    height_m=None,
+    adjustment=None,
+    resolution_m: float | None = None,
+    bands=None,
+    band: int | None = None,
+    mosaic: str = "nearest-nadir",
+    crs: str | None = None,
+    site=None,
+    scheduler=None,
+    overwrite: bool = False,
+    progress=None,
+    max_nav_gap_s: float = 1.0,
+    line_pixels: int | None = None,
+    max_gib: float = MAX_MOSAIC_GIB,
+    tile_px: int = 512,
+) -> dict:
+    """Orthorectify line files into one raster (see ``hsgeo orthorectify --help``).
+
+    Every check comes before the work: the output (its suffix names the format; refused if it
+    exists, unless ``overwrite``, or if it is an input), the inputs, the bands, the navigation
+    covering every line, the view angles, the terrain below the aircraft and covering every
+    strip's footprint, the raster's size. Returns a summary (grid, bands, strips, file).
+    """
+    from hsgeo.io import read_sensor
+    from hsgeo.io._files import check_outputs
+    from hsgeo.io.navigation import read_trajectory
+    from hsgeo.io.raster import RASTER_FORMATS, raster_outputs, write_raster
+    from hsgeo.io.sensors import read_adjustment
+    from hsgeo.sensors import adjusted
+    from hsgeo.workflows._ortho_strips import check_view_angles
+
+    lines = list(lines)
+    if not lines:
+        raise InputError("give at least one LINES file")
+    _check_distinct(lines)
+    if resolution_m is not None and not (np.isfinite(resolution_m) and resolution_m > 0):
+        raise InputError(f"--resolution must be a positive number of metres, got {resolution_m}")
+    if mosaic not in MOSAIC_RULES:
+        raise InputError(f"--mosaic {mosaic!r}: give one of {', '.join(MOSAIC_RULES)}")
+    frame = _frame(site)
+    inputs = [*lines, trajectory, sensor, dsm, adjustment]
+    check_outputs(raster_outputs(output, RASTER_FORMATS), inputs, overwrite=overwrite)
+    adj = read_adjustment(adjustment) if adjustment is not None else None
+    try:  # the one sensor reader and the one way to apply an adjustment (any sensor)
+        cam, nav = adjusted(read_sensor(sensor), read_trajectory(trajectory), adj)
+    except InputError as exc:
+        msg = str(exc)
+        raise InputError("--" + msg if msg.startswith("adjustment:") else msg) from None
+    args = {"line_pixels": line_pixels, "bands": bands, "band": band, "sensor": sensor}
+    strips, wl, fw, n_px_full = _read_strips(lines, nav, cam, args)
+    _check_nav(strips, nav, trajectory, max_nav_gap_s, adj)
+    for s in strips:
+        check_view_angles(s, sensor)
+    U = np.concatenate([nav.pose(s.t_s)[0][:, 2] for s in strips])
+    terrain = _terrain(dsm, height_m, frame, U)
+    names = (
+        [f"{w:g} nm" for w in wl] if wl is not None else [str(i) for i in range(strips[0].n_bands)]
+    )
+    opts = OrthoOptions(
+        resolution_m=resolution_m,
+        mosaic=mosaic,
+        crs=crs,
+        frame=frame,
+        max_gib=max_gib,
+        tile_px=tile_px,
+    )
+    ortho = orthorectify(
+        OrthoInputs(
+            tuple(strips),
+            terrain,
+            tuple(names),
+            tuple(wl) if wl is not None else (),
+            tuple(fw) if fw is not None else (),
+        ),
+        opts,
+    )
+    with _client(scheduler):
+        written = write_raster(ortho, output, overwrite=overwrite, inputs=inputs, progress=progress)
+    x, y = ortho["x"].values, ortho["y"].values
+    return {
+        "output": str(output),
+        "files": [str(p) for p in written],
+        "crs": str(ortho.rio.crs),
+        "resolution_m": float(ortho.attrs["resolution_m"]),
+        "mosaic": mosaic,
+        "width": int(x.size),
+        "height": int(y.size),
+        "x_m": [float(x.min()), float(x.max())],
+        "y_m": [float(y.min()), float(y.max())],
+        "bands": names,
+        "strips": [s.name for s in strips],
+        "line_pixels": n_px_full,
+        "adjusted": adjustment is not None,
+        "scheduler": scheduler,
+    }
+
+
+def _check_distinct(lines) -> None:
+    """No LINES file given twice (it would be mosaicked twice, silently)."""
+    from pathlib import Path
+
+    seen = {}
+    for p in lines:
+        key = Path(p).resolve()
+        if key in seen:
+            raise InputError(
+                f"LINES {str(p)!r} is given twice (also as {str(seen[key])!r}); give each strip "
+                "once"
+            )
+        seen[key] = p
+
+
+@contextmanager
+def _client(scheduler):
+    """The tiles computed on the ``dask.distributed`` scheduler at ``scheduler`` (None: threads
+    here) while the context lasts. The client is not made the process's default: a failed
+    ``Client(..., set_as_default=True)`` stays registered, and every later compute in the
+    process would wait on a scheduler that is not there.
+    """
+    if scheduler is None:
+        yield None
+        return
+    import dask
+    from distributed import Client
+
+    try:
+        client = Client(scheduler, timeout=f"{SCHEDULER_TIMEOUT_S}s", set_as_default=False)
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise InputError(
+            f"--scheduler {scheduler}: no dask scheduler answers there ({type(exc).__name__}); "
+            "start one (dask scheduler; dask worker ADDRESS) or leave the option out"
+        ) from None
+    try:
+        with dask.config.set(scheduler=client.get):
+            yield client
+    finally:
+        client.close()
