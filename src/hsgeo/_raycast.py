@@ -137,7 +137,8 @@ def bilinear(z, x, y):  # pragma: no cover - compiled
 @njit(cache=True, inline="always")
 def _cell_root(z, i, j, px, py, oz, qx, qy, dz, sa, sb):  # pragma: no cover - compiled
     """Smallest ``s`` in ``[sa, sb]`` where the ray meets the bilinear patch of cell (i, j)
-    (-1 if none): the root of ``f(t) = A + B t + C t²``, ``t = s − sa``."""
+    (-1 if none): the root of ``f(t) = A + B t + C t²``, ``t = s − sa``.
+    """
     c00 = z[i, j]
     c01 = z[i, j + 1]
     c10 = z[i + 1, j]

@@ -190,7 +190,6 @@ def intersect(
     if isinstance(terrain, PlaneTerrain):
         s = (terrain.height_m - O[:, 2]) / d[:, 2]
         X = O + s[:, None] * d
-        X[:, 2] = terrain.height_m
         if np.any(s < 0):
             return _missed(X, s < 0, np.zeros(s.size, bool), terrain, on_miss)
         return X
@@ -248,7 +247,8 @@ def _missed(X, below, outside, terrain, on_miss):
 
 def _intersect_marching(O, d, terrain, tol_m):
     """The numpy reference for a terrain with only ``height(E, N, outside="nan")``,
-    ``height_range_m`` and ``cell_m`` (a quarter cell's step)."""
+    ``height_range_m`` and ``cell_m`` (a quarter cell's step).
+    """
     for a in ("height_range_m", "cell_m"):
         if not hasattr(terrain, a):
             raise InputError(
@@ -296,7 +296,8 @@ def _intersect_map(O, d, terrain):
 
 def _cast_chord(O, d, u_top, u_bottom, frame, surf):
     """Cast the chords of rays between local heights ``u_top`` and ``u_bottom`` in the map CRS;
-    the crossings in the local frame, projected onto the rays, and the status."""
+    the crossings in the local frame, projected onto the rays, and the status.
+    """
     u_top = np.broadcast_to(u_top, O.shape[:1])
     u_bottom = np.broadcast_to(u_bottom, O.shape[:1])
     P = [O + ((u - O[:, 2]) / d[:, 2])[:, None] * d for u in (u_top, u_bottom)]
