@@ -251,3 +251,37 @@ def test_corrected_trajectory():
     np.testing.assert_allclose(corrected_trajectory(tr, nodes, 0 * v).xyz_m, tr.xyz_m)
     with pytest.raises(InputError, match="node corrections"):
         corrected_trajectory(tr, nodes, v[:, :3])
+
+
+@pytest.mark.parametrize("angle_deg", [0.0, 15.0, 30.0, 45.0])
+def test_intersect_on_a_map_dsm_is_the_first_crossing(angle_deg):
+    """A DSM in the map CRS (the hill with a 12 m block on it, walls over one 2 m cell): rays
+    0°–45° off nadir, some aimed behind the block, meet it where a 1 mm march down the ray in
+    the local frame (the DSM read through :meth:`MapTerrain.height`, 1 cm steps, bisected to
+    1 µm) first goes under it."""
+    from ortho_inputs import dsm, origin_xy
+
+    from hsgeo._raycast import first_crossing_reference
+    from hsgeo.geocode import intersect
+
+    z, g = dsm()
+    x0, y0 = origin_xy()
+    X, Y = np.meshgrid(g.x_m - x0, g.y_m - y0)
+    z = np.where((np.abs(X - 10) < 15) & (np.abs(Y + 5) < 10), z + 12.0, z)
+    terrain = MapTerrain(z, g, FRAME)
+    rng = np.random.default_rng(int(angle_deg))
+    n = 40
+    az = rng.uniform(0, 2 * np.pi, n)
+    t = np.tan(np.radians(angle_deg))
+    d = np.column_stack([t * np.sin(az), t * np.cos(az), -np.ones(n)])
+    target = np.column_stack([rng.uniform(-20, 40, n), rng.uniform(-30, 20, n), np.full(n, 102.0)])
+    O = target - 300.0 * d
+    got = intersect(O, d, terrain)
+    ref = first_crossing_reference(
+        O, d, lambda e, n: terrain.height(e, n, outside="nan"), terrain.u_range_m, 1e-2, 1e-6
+    )
+    np.testing.assert_allclose(got, O + ref[:, None] * d, atol=1e-3, rtol=0)
+    on_block = np.abs(got[:, 2] - terrain.height(got[:, 0], got[:, 1])) < 1e-3
+    assert on_block.all()
+    if angle_deg >= 30:  # some rays stop on the block's roof or walls
+        assert np.sum(got[:, 2] > 105.0 - FRAME.h_m) >= 3
