@@ -165,7 +165,7 @@ def render_rays(origins_m, directions, ground: Ground, band: int | None = None):
 
 
 #: DSM cells per block of the intersection's block maxima (:class:`hsgeo._raycast.GridSurface`).
-BLOCK_CELLS = 8
+BLOCK_CELLS = 16
 
 
 def _surface(ground: Ground) -> GridSurface:
