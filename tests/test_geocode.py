@@ -1,5 +1,5 @@
-"""Geocoding: ray–terrain intersection, sensor geometries, boresight calibration (the
-orthorectification of whole lines: tests/test_orthorectify*.py)."""
+"""Geocoding: ray–terrain intersection (the first crossing), sensor geometries, boresight
+calibration (the orthorectification of whole lines: tests/test_orthorectify*.py)."""
 
 import dataclasses
 
@@ -178,34 +178,146 @@ def test_zeta_outside_the_model_raises():
         CAL.zeta(np.array([0.2]))  # 700 px from the centre: beyond the calibrated 450 px
 
 
-def test_intersect_on_a_wall_where_the_fixed_point_iteration_cycles(monkeypatch):
-    """A ray 30° off nadir meets a 10 m wall (a DSM step over one cell): the height iteration
-    jumps between roof and ground (|slope · tan 30°| = 5.8 > 1); the march and bisection find
-    the first crossing, against a dense sampling of the ray (an independent truth)."""
-    import xarray as xr
+# ---------------------------------------------------------------- the first crossing (issue 36)
+def _town(cell_m=0.5, seed=0):
+    """A DSM of buildings (flat roofs 3–12 m, steps over one cell) on a gentle slope, E, N in
+    0…120 m: the heights and the DemTerrain."""
+    rng = np.random.default_rng(seed)
+    E = np.arange(0.0, 120.0 + cell_m / 2, cell_m)
+    N = np.arange(0.0, 120.0 + cell_m / 2, cell_m)
+    z = 0.02 * E[None, :] + 0.01 * N[:, None] + np.zeros((N.size, E.size))
+    for _ in range(40):
+        e, n = rng.uniform(10, 110, 2)
+        w, h = rng.uniform(3, 15, 2)
+        inside = (np.abs(E[None, :] - e) <= w / 2) & (np.abs(N[:, None] - n) <= h / 2)
+        z = np.where(inside, np.maximum(z, rng.uniform(3, 12) + 0.02 * e), z)
+    dem = xr.DataArray(z, dims=("N", "E"), coords={"N": N, "E": E})
+    return dem, DemTerrain(dem)
 
-    from hsgeo import geocode
-    from hsgeo.geocode import DemTerrain, intersect
 
-    calls = []
-    march = geocode._march_bisect
-    monkeypatch.setattr(
-        geocode, "_march_bisect", lambda O, *a, **k: calls.append(len(O)) or march(O, *a, **k)
+def _dense_first_crossing(O, d, terrain, step_m=1e-4, top_m=20.0, bottom_m=-2.0):
+    """The first point of each ray below the DSM, sampled every ``step_m`` along the ray from
+    height ``top_m`` down to ``bottom_m`` (an independent truth: no bracket, no root finding)."""
+    out = np.empty((len(O), 3))
+    for k in range(len(O)):
+        u = d[k] / np.linalg.norm(d[k])
+        s_top = (top_m - O[k, 2]) / u[2]
+        s_bot = (bottom_m - O[k, 2]) / u[2]
+        s = np.arange(s_top, s_bot, step_m)
+        P = O[k] + s[:, None] * u
+        below = P[:, 2] <= terrain.height(P[:, 0], P[:, 1], outside="nan")
+        assert below.any(), k
+        out[k] = P[np.argmax(below)]
+    return out
+
+
+def _rays_at(angle_deg, n, seed, H=100.0):
+    """``n`` rays ``angle_deg`` off nadir in random azimuths, aimed at random points of the
+    town's middle (so that they stay over the DSM)."""
+    rng = np.random.default_rng(seed)
+    az = rng.uniform(0, 2 * np.pi, n)
+    t = np.tan(np.radians(angle_deg))
+    d = np.column_stack([t * np.sin(az), t * np.cos(az), -np.ones(n)])
+    target = np.column_stack([rng.uniform(25, 95, (n, 2)), np.zeros(n)])
+    return target - H * d, d
+
+
+@pytest.mark.parametrize("angle_deg", [0.0, 15.0, 30.0, 45.0])
+def test_intersect_is_the_first_crossing_on_a_town(angle_deg):
+    """Rays 0°, 15°, 30°, 45° off nadir over a DSM of buildings (occluded rays among them):
+    the intersection is within 1 mm of the first point of a 0.1 mm dense sampling of the ray,
+    and the compiled kernel and the numpy march agree (same tolerance)."""
+    from hsgeo._raycast import first_crossing_reference
+
+    dem, terrain = _town()
+    O, d = _rays_at(angle_deg, 60, seed=int(angle_deg))
+    X = intersect(O, d, terrain)
+    truth = _dense_first_crossing(O, d, terrain)
+    np.testing.assert_allclose(X, truth, atol=1e-3, rtol=0)
+    # the point is on the surface and on the ray
+    np.testing.assert_allclose(X[:, 2], terrain.height(X[:, 0], X[:, 1]), atol=1e-9)
+    s = first_crossing_reference(
+        O, d, lambda E, N: terrain.height(E, N, outside="nan"), terrain.height_range_m, 0.02
     )
+    np.testing.assert_allclose(O + s[:, None] * d, X, atol=1e-3, rtol=0)
+    if angle_deg >= 30:  # some rays meet a roof or wall above the ground they point at
+        ground = intersect(O, d, PlaneTerrain(0.0))
+        assert np.sum(np.hypot(*(X - ground)[:, :2].T) > 1.0) >= 5
+
+
+def test_intersect_the_roof_not_the_ground_behind_it():
+    """Issue 36's example: a 10 m building at E 95–105 m, a ray 30° off nadir from 100 m: the
+    first crossing is on the roof at E = 102.54 m (the former height iteration went on to the
+    ground behind it, E 108.32 m)."""
+    E = np.arange(0.0, 200.5, 0.5)
+    N = np.arange(0.0, 20.5, 0.5)
+    z = np.where((E >= 95) & (E <= 105), 10.0, 0.0)[None, :].repeat(N.size, 0)
+    terrain = DemTerrain(xr.DataArray(z, dims=("N", "E"), coords={"N": N, "E": E}))
+    t30 = np.tan(np.radians(30.0))
+    O = np.array([[102.54 + 90.0 * t30, 10.0, 100.0]])
+    d = np.array([[-t30, 0.0, -1.0]])
+    X = intersect(O, d, terrain)
+    np.testing.assert_allclose(X[0], [102.54, 10.0, 10.0], atol=1e-9)
+
+
+def test_intersect_steep_wall_and_grazing_corner():
+    """A ray 30° off nadir meets a 10 m step (over one 1 m cell) on the wall; a ray that only
+    clips a roof's edge (under it for 2 cm) is occluded there, where a march of a quarter cell
+    steps over it."""
     E = np.arange(0.0, 101.0)
     z = np.where(E >= 50.0, 10.0, 0.0)[None, :].repeat(21, axis=0)
     dem = DemTerrain(xr.DataArray(z, dims=("N", "E"), coords={"N": np.arange(21.0), "E": E}))
     t30 = np.tan(np.radians(30.0))
-    O = np.array([[49.2 - 98.0 * t30, 10.0, 100.0], [49.2 - 98.0 * t30 + 20.0, 10.0, 100.0]])
-    d = np.array([[0.5, 0.0, -np.sqrt(0.75)]] * 2)
-    X = intersect(O, d, dem, tol_m=1e-6)
-    assert calls == [1]  # the first ray only: the iteration did not converge there
-    # dense sampling: the first point of the ray below the DSM
-    h = np.linspace(12.0, -1.0, 1_300_001)
-    P = O[0] + ((h - O[0, 2]) / d[0, 2])[:, None] * d[0]
-    first = np.argmax(h <= dem.height(P[:, 0], P[:, 1]))
-    np.testing.assert_allclose(X[0], P[first], atol=2e-5)
-    assert 1.9 < X[0, 2] < 2.1 and 49.0 < X[0, 0] < 50.0  # on the wall, near the expected 2 m
-    # the second ray meets the flat roof: the iteration converges there as before
-    np.testing.assert_allclose(X[1, 2], 10.0, atol=1e-6)
-    np.testing.assert_allclose(X[1], O[1] + (10.0 - 100.0) / d[1, 2] * d[1], atol=1e-6)
+    O = np.array([[49.2 - 98.0 * t30, 10.0, 100.0]])
+    d = np.array([[0.5, 0.0, -np.sqrt(0.75)]])
+    X = intersect(O, d, dem)
+    np.testing.assert_allclose(X, _dense_first_crossing(O, d, dem, 1e-5, 12.0), atol=1e-4)
+    assert 1.9 < X[0, 2] < 2.1 and 49.0 < X[0, 0] < 50.0  # on the wall, near 2 m
+    # a tent over E 49…51 m peaking at 10 m; a nearly horizontal ray (5° below the horizontal)
+    # passes 1 cm under its top: it is under the tent for 2 mm along E
+    z2 = np.where(E == 50.0, 10.0, 0.0)[None, :].repeat(21, axis=0)
+    ridge = DemTerrain(xr.DataArray(z2, dims=("N", "E"), coords={"N": np.arange(21.0), "E": E}))
+    d2 = np.array([[np.cos(np.radians(5.0)), 0.0, -np.sin(np.radians(5.0))]])
+    O2 = np.array([[50.0 - 30.0 * d2[0, 0], 10.0, 9.99 + 30.0 * np.sin(np.radians(5.0))]])
+    X2 = intersect(O2, d2, ridge)
+    assert 49.998 < X2[0, 0] < 50.0 and X2[0, 2] > 9.98
+    truth = _dense_first_crossing(O2, d2, ridge, 1e-5, top_m=10.5, bottom_m=9.0)
+    np.testing.assert_allclose(X2, truth, atol=1e-4)
+    from hsgeo._raycast import first_crossing_reference
+
+    s = first_crossing_reference(
+        O2, d2, lambda e, n: ridge.height(e, n, outside="nan"), ridge.height_range_m, 0.25
+    )
+    assert not abs((O2 + s[:, None] * d2)[0, 0] - 50.0) < 0.01  # the march stepped over it
+
+
+def test_intersect_misses_are_errors_or_nan():
+    """A ray that leaves the DEM first, or starts under it: an ObservationError that says which
+    (or NaN with ``on_miss="nan"``); a plane above the sensor is an error too."""
+    _, terrain = _town()
+    O = np.array([[60.0, 60.0, 100.0], [60.0, 60.0, 100.0], [60.0, 60.0, -5.0]])
+    d = np.array([[0.0, 0.0, -1.0], [3.0, 0.0, -1.0], [0.0, 0.0, -1.0]])
+    X = intersect(O, d, terrain, on_miss="nan")
+    assert np.all(np.isfinite(X[0])) and np.all(np.isnan(X[1:]))
+    with pytest.raises(ObservationError, match="1 rays reach the ground outside the DEM"):
+        intersect(O[:2], d[:2], terrain)
+    with pytest.raises(ObservationError, match="start under the terrain"):
+        intersect(O[[0, 2]], d[[0, 2]], terrain)
+    with pytest.raises(ObservationError, match="start under the terrain"):
+        intersect([[0.0, 0.0, 10.0]], [[0.0, 0.0, -1.0]], PlaneTerrain(20.0))
+    with pytest.raises(InputError, match="on_miss"):
+        intersect(O, d, terrain, on_miss="skip")
+
+
+def test_uneven_dem_marches_to_the_same_crossing():
+    """A DEM whose coordinates are not evenly spaced is marched (the numpy reference): the same
+    first crossings as the compiled traversal on the evenly spaced DEM it samples."""
+    dem, terrain = _town(cell_m=1.0, seed=3)
+    keep = np.r_[0:60, 60:121:2]  # E spacing 1 m, then 2 m
+    uneven = DemTerrain(dem.isel(E=keep))
+    even = DemTerrain(dem.isel(E=slice(0, 60)))
+    assert uneven.surface is None and even.surface is not None
+    O, d = _rays_at(15.0, 30, seed=5)
+    O[:, 0] = np.clip(O[:, 0], 5, 45)  # over E < 59 m, where the two DEMs are the same
+    d[:, 0] = np.clip(d[:, 0], -0.05, 0.05)
+    np.testing.assert_allclose(intersect(O, d, uneven), intersect(O, d, even), atol=1e-4, rtol=0)

@@ -21,9 +21,72 @@ def test_map_grid_cells_and_transform():
     np.testing.assert_allclose(w.y_m, g.y_m[2:5])
 
 
+def _cast_independently(o, d, z, grid):
+    """Map x, y where rays (local frame) first meet the DSM ``z`` on ``grid``, by a caster that
+    shares nothing with :func:`hsgeo.geocode.intersect` but the frame's pyproj transforms.
+
+    Each ray's chord between local heights 2 m above and below the DSM's range is taken to the
+    map CRS (its two ends; the image of a straight ray departs from that chord by L²/(8 R) ≈
+    5 µm over its 20 m), sampled every 0.25 m of height against scipy's bilinear DSM, and the
+    first sample under it is bisected with its predecessor to 10 µm. On this hill (slopes
+    < 0.1) a ray < 1.5° off nadir cannot dip under the surface and out again within 0.25 m.
+    """
+    from scipy.interpolate import RegularGridInterpolator
+
+    dsm_h = RegularGridInterpolator(
+        (grid.y_m[::-1], grid.x_m), z[::-1], bounds_error=False, fill_value=np.nan
+    )
+    u_top, u_bot = z.max() - FRAME.h_m + 2.0, z.min() - FRAME.h_m - 2.0
+    ends = [o + ((u - o[:, 2]) / d[:, 2])[:, None] * d for u in (u_top, u_bot)]
+    A, B = (np.column_stack(FRAME.enu_to_map(*e.T)) for e in ends)
+
+    def above(tau):  # is the chord's point at tau (0 top, 1 bottom) above the DSM?
+        P = A + tau[:, None] * (B - A)
+        return P[:, 2] > dsm_h(P[:, [1, 0]])
+
+    n = int(np.ceil((u_top - u_bot) / 0.25))
+    lo, hi = np.zeros(len(o)), np.full(len(o), np.nan)
+    for k in range(1, n + 1):
+        tau = np.full(len(o), k / n)
+        todo = np.isnan(hi)
+        hit = todo & ~above(tau)
+        hi[hit] = tau[hit]
+        lo[todo & ~hit] = tau[todo & ~hit]
+    assert np.all(np.isfinite(hi)), "a ray did not meet the DSM"
+    while np.max((hi - lo) * np.linalg.norm(B - A, axis=1)) > 1e-5:
+        mid = 0.5 * (lo + hi)
+        up = above(mid)
+        lo, hi = np.where(up, mid, lo), np.where(up, hi, mid)
+    P = A + hi[:, None] * (B - A)
+    return P[:, 0], P[:, 1]
+
+
+def _flight_rendered_independently(sensor):
+    """:func:`ortho_inputs.flight`'s two strips, their lines rendered by
+    :func:`_cast_independently` (not by the geolocation the mosaic then uses)."""
+    from ortho_inputs import Flight, dsm, flight_trajectory, line_scanner, lp_camera, lp_pixels
+    from ortho_inputs import scene as make_scene
+
+    z, grid = dsm()
+    nav, times = flight_trajectory()
+    if sensor == "lp":
+        sen, px, kw = lp_camera(), lp_pixels(), {"band": 0}
+    else:
+        sen, px, kw = line_scanner(300), np.arange(300, dtype=float), {}
+    strips = []
+    for i, t in enumerate(times):
+        m, k = t.size, px.shape[0]
+        pp = np.tile(px, (m,) + (1,) * (px.ndim - 1))
+        o, d = sen.rays(pp, np.repeat(t, k), nav, **kw)
+        x, y = _cast_independently(o, d, z, grid)
+        vals = make_scene().radiance(x, y).astype(np.float32).reshape(m, k, -1)
+        strips.append(Strip(sen, nav, t, px, vals, kw, f"s{i + 1}"))
+    return Flight(tuple(strips), MapTerrain(z, grid, FRAME), (nav, nav))
+
+
 @pytest.fixture(scope="module", params=["lp", "line"])
 def mosaic(request):
-    fl = flight(request.param)
+    fl = _flight_rendered_independently(request.param)
     m = orthomosaic(
         fl.strips,
         fl.terrain,
@@ -188,3 +251,37 @@ def test_corrected_trajectory():
     np.testing.assert_allclose(corrected_trajectory(tr, nodes, 0 * v).xyz_m, tr.xyz_m)
     with pytest.raises(InputError, match="node corrections"):
         corrected_trajectory(tr, nodes, v[:, :3])
+
+
+@pytest.mark.parametrize("angle_deg", [0.0, 15.0, 30.0, 45.0])
+def test_intersect_on_a_map_dsm_is_the_first_crossing(angle_deg):
+    """A DSM in the map CRS (the hill with a 12 m block on it, walls over one 2 m cell): rays
+    0°–45° off nadir, some aimed behind the block, meet it where a 1 mm march down the ray in
+    the local frame (the DSM read through :meth:`MapTerrain.height`, 1 cm steps, bisected to
+    1 µm) first goes under it."""
+    from ortho_inputs import dsm, origin_xy
+
+    from hsgeo._raycast import first_crossing_reference
+    from hsgeo.geocode import intersect
+
+    z, g = dsm()
+    x0, y0 = origin_xy()
+    X, Y = np.meshgrid(g.x_m - x0, g.y_m - y0)
+    z = np.where((np.abs(X - 10) < 15) & (np.abs(Y + 5) < 10), z + 12.0, z)
+    terrain = MapTerrain(z, g, FRAME)
+    rng = np.random.default_rng(int(angle_deg))
+    n = 40
+    az = rng.uniform(0, 2 * np.pi, n)
+    t = np.tan(np.radians(angle_deg))
+    d = np.column_stack([t * np.sin(az), t * np.cos(az), -np.ones(n)])
+    target = np.column_stack([rng.uniform(-20, 40, n), rng.uniform(-30, 20, n), np.full(n, 102.0)])
+    O = target - 300.0 * d
+    got = intersect(O, d, terrain)
+    ref = first_crossing_reference(
+        O, d, lambda e, n: terrain.height(e, n, outside="nan"), terrain.u_range_m, 1e-2, 1e-6
+    )
+    np.testing.assert_allclose(got, O + ref[:, None] * d, atol=1e-3, rtol=0)
+    on_block = np.abs(got[:, 2] - terrain.height(got[:, 0], got[:, 1])) < 1e-3
+    assert on_block.all()
+    if angle_deg >= 30:  # some rays stop on the block's roof or walls
+        assert np.sum(got[:, 2] > 105.0 - FRAME.h_m) >= 3

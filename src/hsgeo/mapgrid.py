@@ -166,24 +166,44 @@ class MapTerrain:
         )
         c = frame.map_to_enu(grid.x_m[[0, -1]].mean(), grid.y_m[[0, -1]].mean(), float(z.mean()))
         self.mean_height_m = float(c[2])
+        from hsgeo._raycast import GridSurface
+
+        #: the DSM on its own grid (rows northward) for :func:`hsgeo.geocode.intersect`
+        self.map_surface = GridSurface.from_heights(
+            z[::-1], grid.x_m[0], grid.y_m[-1], grid.resolution_m, grid.resolution_m
+        )
+        #: local U the DSM spans (its lowest node at the corners, its highest over the centre
+        #: or the frame's origin, whichever is higher, 1 m apart)
+        xc = grid.x_m[[0, -1, 0, -1]]
+        yc = grid.y_m[[0, 0, -1, -1]]
+        u_lo = frame.map_to_enu(xc, yc, np.full(4, z.min()))[2].min()
+        u_hi = max(float(c[2]) + z.max() - z.mean(), z.max() - frame.h_m)
+        self.u_range_m = (float(u_lo) - 1.0, float(u_hi) + 1.0)
+        self.cell_m = grid.resolution_m
 
     def __reduce__(self):  # the interpolator is rebuilt on a worker from the heights
         return (_rebuild_map_terrain, (self._f.values[::-1], self.grid, self.frame, self.source))
 
-    def height(self, E, N):
+    @property
+    def height_range_m(self):
+        """Local U the DSM spans, m (:attr:`u_range_m`)."""
+        return self.u_range_m
+
+    def height(self, E, N, *, outside: str = "raise"):
+        """Local U of the DSM below (E, N); outside it an error (``outside="raise"``) or NaN."""
         E, N = np.broadcast_arrays(np.asarray(E, float), np.asarray(N, float))
         U0 = np.full(E.shape, self.mean_height_m)
-        U = self._surface_u(E, N, U0)
+        U = self._surface_u(E, N, U0, outside)
         # the map position of (E, N) moves with U by about ΔU·d/R: a second pass where > 1 mm
         redo = np.abs(U - U0) * np.hypot(E, N) / 6.37e6 > 1e-3
         if np.any(redo):
-            U[redo] = self._surface_u(E[redo], N[redo], U[redo])
+            U[redo] = self._surface_u(E[redo], N[redo], U[redo], outside)
         return U
 
-    def _surface_u(self, E, N, U):
+    def _surface_u(self, E, N, U, outside="raise"):
         x, y, _ = self.frame.enu_to_map(E, N, U)
         h = self._f(np.stack([np.ravel(y), np.ravel(x)], axis=1)).reshape(E.shape)
-        if np.any(~np.isfinite(h)):
+        if outside == "raise" and np.any(~np.isfinite(h)):
             x0, y0, x1, y1 = self.grid.extent_m
             raise ObservationError(
                 f"{int(np.sum(~np.isfinite(h)))} rays reach the ground outside {self.source} "
@@ -191,6 +211,13 @@ class MapTerrain:
                 "give a DSM that covers the lines"
             )
         return self.frame.map_to_enu(x, y, h)[2]
+
+    def _outside_message(self, n: int) -> str:
+        x0, y0, x1, y1 = self.grid.extent_m
+        return (
+            f"{n} rays reach the ground outside {self.source} (x {x0:.0f}…{x1:.0f}, "
+            f"y {y0:.0f}…{y1:.0f} m in {self.grid.crs}): give a DSM that covers the lines"
+        )
 
 
 def _rebuild_map_terrain(z, grid, frame, source):

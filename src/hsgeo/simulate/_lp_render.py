@@ -1,16 +1,10 @@
 """Rendering of the LP campaign's ground (:mod:`hsgeo.simulate._lp_ground`): where rays meet the
 DSM, and the blurred reflectance there (compiled kernels and their numpy faces).
 
-The intersection (:func:`render_rays`) is our own compiled kernel rather than
-:func:`hsgeo.geocode.intersect`: the latter's fixed-point iteration on the height diverges where
-a building's wall is steeper than the ray's cotangent (slope × tan(view angle) > 1 near the
-swath's edge), and evaluates scipy's interpolator on every ray each iteration. Ours brackets
-the crossing between the DSM's local highest and lowest points (over blocks of
-:data:`BLOCK_CELLS` cells, dilated by a block), marches down the ray from the top in steps of
-at most half a DSM cell horizontally and 0.5 m vertically, and refines the first sign change by
-the Illinois variant of regula falsi to 1e-7 m: robust on walls (the first crossing, so
-buildings occlude), with the same bilinear DSM as :class:`hsgeo.geocode.DemTerrain` (checked
-against :func:`hsgeo.geocode.intersect` in the tests where that converges).
+The intersection is hsgeo's one ray–terrain intersection, :func:`hsgeo._raycast.first_crossing`
+(the compiled core of :func:`hsgeo.geocode.intersect`): the first crossing of each ray with the
+bilinear DSM, exact to rounding, so buildings occlude (the same bilinear DSM as
+:class:`hsgeo.geocode.DemTerrain`). A ray that leaves the DSM before it meets it gets NaN.
 """
 
 from __future__ import annotations
@@ -19,6 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 from numba import njit, prange
+
+from hsgeo._raycast import HIT, GridSurface, first_crossing
 
 __all__ = ["Ground", "render_rays", "render_lines", "dsm_height", "BLOCK_CELLS"]
 
@@ -88,127 +84,34 @@ def _bilinear(a, u, v):  # pragma: no cover - compiled
     )
 
 
-@njit(cache=True)
-def _hit(ox, oy, oz, dx, dy, dz, dsm, e0, n0, dcell, hmax, hmin, bcell, hmid):  # pragma: no cover
-    """Ray parameter ``s`` of the first crossing of ``O + s D`` with the bilinear DSM.
-
-    The local height bounds ``hmax``/``hmin`` (per block of ``bcell`` m, dilated by one block)
-    bracket the crossing; the ray is marched down from the upper bound in steps of at most
-    half a DSM cell horizontally and 0.5 m vertically, and the first sign change is refined by
-    the Illinois variant of regula falsi to 1e-7 m.
-    """
-    # the block under the ray where it passes the DSM's mean level (its horizontal travel over
-    # the whole height range is far below a block: tan(view angle) · range ≲ 2 m)
-    nb_r, nb_c = hmax.shape
-    s_mid = (hmid - oz) / dz
-    bj = int((ox + s_mid * dx - e0) / bcell)
-    bi = int((oy + s_mid * dy - n0) / bcell)
-    bj = min(max(bj, 0), nb_c - 1)
-    bi = min(max(bi, 0), nb_r - 1)
-    s_top = (hmax[bi, bj] + 0.01 - oz) / dz
-    s_bot = (hmin[bi, bj] - 0.01 - oz) / dz
-    horiz = np.sqrt(dx * dx + dy * dy) * (s_bot - s_top)
-    vert = (s_bot - s_top) * (-dz)
-    n_steps = int(max(horiz / (0.5 * dcell), vert / 0.5)) + 1
-    ds = (s_bot - s_top) / n_steps
-    a = s_top
-    fa = oz + a * dz - _bilinear(dsm, (ox + a * dx - e0) / dcell, (oy + a * dy - n0) / dcell)
-    b = s_bot
-    fb = -1.0
-    for _ in range(n_steps):
-        s = a + ds
-        f = oz + s * dz - _bilinear(dsm, (ox + s * dx - e0) / dcell, (oy + s * dy - n0) / dcell)
-        if f <= 0.0:
-            b = s
-            fb = f
-            break
-        a = s
-        fa = f
-    return _refine(a, fa, b, fb, ox, oy, oz, dx, dy, dz, dsm, e0, n0, dcell)
-
-
-@njit(cache=True)
-def _refine(a, fa, b, fb, ox, oy, oz, dx, dy, dz, dsm, e0, n0, dcell):  # pragma: no cover
-    """Illinois regula falsi on a bracket ``f(a) > 0 ≥ f(b)`` of ``f(s) = z(s) − DSM(s)``."""
-    side = 0
-    for _ in range(60):
-        if fa - fb == 0.0 or (b - a) * (-dz) < 1e-7:
-            break
-        s = (a * fb - b * fa) / (fb - fa)
-        f = oz + s * dz - _bilinear(dsm, (ox + s * dx - e0) / dcell, (oy + s * dy - n0) / dcell)
-        if abs(f) < 1e-7:
-            return s
-        if f > 0.0:
-            a = s
-            fa = f
-            if side == 1:
-                fb *= 0.5
-            side = 1
-        else:
-            b = s
-            fb = f
-            if side == -1:
-                fa *= 0.5
-            side = -1
-    return 0.5 * (a + b)
-
-
-@njit(cache=True)
-def _hit_near(
-    s0, ox, oy, oz, dx, dy, dz, dsm, e0, n0, dcell, hmax, hmin, bcell, hmid
-):  # pragma: no cover
-    """:func:`_hit` for a ray next to one that met the DSM at ``s0`` (another band's ray of the
-    same pixel: ≤ 0.3 px apart): a bracket of ±0.25 m in height around ``s0`` first, the full
-    search if it does not bracket a crossing. A crossing before the bracket would need the
-    DSM to rise 0.25 m within the rays' ≤ 0.1 m horizontal offset and the ray to leave a
-    building again above the ground, which 6 m wide buildings seen at ≤ 8.3° do not allow.
-    """
-    h = 0.25 / (-dz)
-    a = s0 - h
-    b = s0 + h
-    fa = oz + a * dz - _bilinear(dsm, (ox + a * dx - e0) / dcell, (oy + a * dy - n0) / dcell)
-    fb = oz + b * dz - _bilinear(dsm, (ox + b * dx - e0) / dcell, (oy + b * dy - n0) / dcell)
-    if fa > 0.0 and fb <= 0.0:
-        return _refine(a, fa, b, fb, ox, oy, oz, dx, dy, dz, dsm, e0, n0, dcell)
-    return _hit(ox, oy, oz, dx, dy, dz, dsm, e0, n0, dcell, hmax, hmin, bcell, hmid)
-
-
 @njit(cache=True, parallel=True)
 def _render_kernel(
-    O, D, dsm, e0, n0, dcell, hmax, hmin, bcell, hmid, refl, gcell, out_en, out_v
+    O, D, z, e0, n0, de, dn, bmax, blk, zmin, zmax, refl, ge0, gn0, gcell, out_en, out_v
 ):  # pragma: no cover
     for k in prange(O.shape[0]):
-        s = _hit(
-            O[k, 0],
-            O[k, 1],
-            O[k, 2],
-            D[k, 0],
-            D[k, 1],
-            D[k, 2],
-            dsm,
-            e0,
-            n0,
-            dcell,
-            hmax,
-            hmin,
-            bcell,
-            hmid,
-        )
+        s, status = first_crossing(
+            O[k, 0], O[k, 1], O[k, 2], D[k, 0], D[k, 1], D[k, 2], z, e0, n0, de, dn, bmax, blk,
+            zmin, zmax,
+        )  # fmt: skip
+        if status != HIT:
+            out_en[k, 0] = np.nan
+            out_en[k, 1] = np.nan
+            out_v[k] = np.nan
+            continue
         E = O[k, 0] + s * D[k, 0]
         N = O[k, 1] + s * D[k, 1]
         out_en[k, 0] = E
         out_en[k, 1] = N
         if refl.shape[0] > 0:
-            out_v[k] = _bilinear(refl, (E - e0) / gcell, (N - n0) / gcell)
+            out_v[k] = _bilinear(refl, (E - ge0) / gcell, (N - gn0) / gcell)
 
 
 @njit(cache=True, parallel=True)
 def _render_lines_kernel(
-    R, O, d_plat, dsm, e0, n0, dcell, hmax, hmin, bcell, hmid, refl, gcell, out
+    R, O, d_plat, z, e0, n0, de, dn, bmax, blk, zmin, zmax, refl, ge0, gn0, gcell, out
 ):  # pragma: no cover
     """``out[l, c, b]``: reflectance of band ``b`` where the ray ``O[l] + s R[l] d_plat[b, c]``
-    of column ``c`` of line ``l`` meets the DSM (band 0 searched in full, the others next to
-    it, :func:`_hit_near`).
+    of column ``c`` of line ``l`` first meets the DSM (NaN where it leaves the DSM first).
     """
     nl = R.shape[0]
     nb = d_plat.shape[0]
@@ -216,22 +119,20 @@ def _render_lines_kernel(
     for li in prange(nl):
         ox, oy, oz = O[li, 0], O[li, 1], O[li, 2]
         for c in range(nc):
-            s = 0.0
             for b in range(nb):
                 px, py, pz = d_plat[b, c, 0], d_plat[b, c, 1], d_plat[b, c, 2]
                 dx = R[li, 0, 0] * px + R[li, 0, 1] * py + R[li, 0, 2] * pz
                 dy = R[li, 1, 0] * px + R[li, 1, 1] * py + R[li, 1, 2] * pz
                 dz = R[li, 2, 0] * px + R[li, 2, 1] * py + R[li, 2, 2] * pz
-                if b == 0:
-                    s = _hit(ox, oy, oz, dx, dy, dz, dsm, e0, n0, dcell, hmax, hmin, bcell, hmid)
-                    s_b = s
-                else:
-                    s_b = _hit_near(
-                        s, ox, oy, oz, dx, dy, dz, dsm, e0, n0, dcell, hmax, hmin, bcell, hmid
-                    )
-                E = ox + s_b * dx
-                N = oy + s_b * dy
-                out[li, c, b] = _bilinear(refl[b], (E - e0) / gcell, (N - n0) / gcell)
+                s, status = first_crossing(
+                    ox, oy, oz, dx, dy, dz, z, e0, n0, de, dn, bmax, blk, zmin, zmax
+                )
+                if status != HIT:
+                    out[li, c, b] = np.nan
+                    continue
+                E = ox + s * dx
+                N = oy + s * dy
+                out[li, c, b] = _bilinear(refl[b], (E - ge0) / gcell, (N - gn0) / gcell)
 
 
 def render_rays(origins_m, directions, ground: Ground, band: int | None = None):
@@ -258,48 +159,23 @@ def render_rays(origins_m, directions, ground: Ground, band: int | None = None):
     en = np.empty((O.shape[0], 2))
     val = np.empty(O.shape[0])
     _render_kernel(
-        O,
-        D,
-        ground.dsm,
-        ground.e0_m,
-        ground.n0_m,
-        ground.dsm_cell_m,
-        *_bounds(ground),
-        refl,
-        ground.cell_m,
-        en,
-        val,
+        O, D, *_surface(ground).args(), refl, ground.e0_m, ground.n0_m, ground.cell_m, en, val
     )
     return en, (val if band is not None else None)
 
 
-#: DSM cells per block of the local height bounds of :func:`_bounds`.
+#: DSM cells per block of the intersection's block maxima (:class:`hsgeo._raycast.GridSurface`).
 BLOCK_CELLS = 16
 
 
-def _bounds(ground: Ground):
-    """Local height bounds for the intersection: ``(hmax, hmin, block_m)``, the max and min of
-    the DSM over blocks of :data:`BLOCK_CELLS` cells, each dilated by one block (cached).
-    """
-    cached = getattr(ground, "_bounds_cache", None)
+def _surface(ground: Ground) -> GridSurface:
+    """The DSM prepared for the intersection (cached on the ground)."""
+    cached = getattr(ground, "_surface_cache", None)
     if cached is not None:
         return cached
-    from scipy.ndimage import maximum_filter, minimum_filter
-
-    B = BLOCK_CELLS
-    z = ground.dsm
-    nr, nc = -(-z.shape[0] // B) * B, -(-z.shape[1] // B) * B
-    zp = np.pad(z, ((0, nr - z.shape[0]), (0, nc - z.shape[1])), mode="edge")
-    blocks = zp.reshape(nr // B, B, nc // B, B)
-    hmax = maximum_filter(blocks.max(axis=(1, 3)), size=3, mode="nearest")
-    hmin = minimum_filter(blocks.min(axis=(1, 3)), size=3, mode="nearest")
-    out = (
-        np.ascontiguousarray(hmax),
-        np.ascontiguousarray(hmin),
-        B * ground.dsm_cell_m,
-        float(0.5 * (z.max() + z.min())),
-    )
-    object.__setattr__(ground, "_bounds_cache", out)
+    c = ground.dsm_cell_m
+    out = GridSurface.from_heights(ground.dsm, ground.e0_m, ground.n0_m, c, c, BLOCK_CELLS)
+    object.__setattr__(ground, "_surface_cache", out)
     return out
 
 
@@ -331,12 +207,10 @@ def render_lines(R_map_from_platform, origins_m, d_platform, ground: Ground) -> 
         R,
         O,
         d,
-        ground.dsm,
+        *_surface(ground).args(),
+        ground.reflectance,
         ground.e0_m,
         ground.n0_m,
-        ground.dsm_cell_m,
-        *_bounds(ground),
-        ground.reflectance,
         ground.cell_m,
         out,
     )
