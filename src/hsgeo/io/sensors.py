@@ -1,6 +1,12 @@
-"""Sensor and camera descriptions in TOML: ``hsgeo geocode --sensor`` and ``hsgeo
-adjust-pushbroom --camera``; and the adjusted camera and node corrections that ``hsgeo
-adjust-pushbroom --json`` prints (:func:`read_adjustment`, ``hsgeo orthomosaic --adjustment``).
+"""The former per-command sensor files, the adjustment JSON and the instrument files.
+
+A sensor file is read by :func:`hsgeo.io.read_sensor` (:mod:`hsgeo.io.sensor_file`, one
+registry of models); :func:`read_pushbroom_camera` and :func:`read_scanning_sensor` are that
+reader restricted to what a command can use. :func:`read_sensor_toml` and
+:func:`read_camera_toml` are the low-level readers of the former ``hsgeo geocode --sensor``
+(000) and ``hsgeo adjust-pushbroom --camera`` (002) files, which ``read_sensor`` reads too.
+:func:`read_adjustment` reads the adjusted camera and node corrections that ``hsgeo
+adjust-pushbroom --json`` prints (apply them with :func:`hsgeo.sensors.adjusted`).
 """
 
 from __future__ import annotations
