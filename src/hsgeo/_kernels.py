@@ -42,6 +42,8 @@ __all__ = [
     "pushbroom_camera_point",
     "pushbroom_line_distortion",
     "pushbroom_line_distortion_rows",
+    "pushbroom_line_distortion_dcoeff",
+    "pushbroom_line_distortion_dcoeff_rows",
     "pushbroom_image_mm",
     "pushbroom_image_rows",
 ]
@@ -187,6 +189,27 @@ def pushbroom_line_distortion(xb, yb, K1, K2, P1, P2):  # pragma: no cover - com
     gx = 1.0 + 3 * K1 * xb**2 + 5 * K2 * xb**4 + 6 * P1 * xb
     gy = 2 * P2 * xb
     return x, y, gx, gy
+
+
+@njit(cache=True, inline="always")
+def pushbroom_line_distortion_dcoeff(xb):  # pragma: no cover - compiled
+    """∂(x, y)/∂(K1, K2, P1, P2) of 002 eq. (3) at the ideal ``x̄`` (the one place it is coded).
+
+    ``∂x = (x̄³, x̄⁵, 3 x̄², 0)``, ``∂y = (0, 0, 0, x̄²)``: returns the four non-zero entries
+    ``(x̄³, x̄⁵, 3 x̄², x̄²)`` in mm³, mm⁵, mm², mm². The compiled kernel of
+    :class:`hsgeo.sensors.pushbroom.PushbroomLines` and
+    :func:`hsgeo.distortion.distort_pushbroom_line_jacobian` both call it.
+    """
+    return xb**3, xb**5, 3 * xb**2, xb**2
+
+
+@njit(cache=True)
+def pushbroom_line_distortion_dcoeff_rows(xb):  # pragma: no cover - compiled
+    """:func:`pushbroom_line_distortion_dcoeff` for a 1-D array ``xb`` (m,): ``(m, 4)``."""
+    out = np.empty((xb.size, 4))
+    for j in range(xb.size):
+        out[j, 0], out[j, 1], out[j, 2], out[j, 3] = pushbroom_line_distortion_dcoeff(xb[j])
+    return out
 
 
 @njit(cache=True)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from hsgeo._kernels import pushbroom_line_distortion_rows
+from hsgeo._kernels import pushbroom_line_distortion_dcoeff_rows, pushbroom_line_distortion_rows
 from hsgeo.distortion._common import _as_float, _as_last, _broadcast, _newton_invert, _stack22
 from hsgeo.errors import InputError
 
@@ -99,14 +99,12 @@ def _line_002_jacobian(xy: NDArray, dist: NDArray) -> tuple[NDArray, NDArray]:
     _, _, gx, gy, xb = _line_002_terms(xy, dist)
     zero, one = np.zeros_like(xb), np.ones_like(xb)
     J_xy = _stack22(gx, zero, gy, one)
-    x2 = xb**2
-    J_dist = np.stack(
-        [
-            np.stack([xb**3, xb**5, 3.0 * x2, zero], axis=-1),
-            np.stack([zero, zero, zero, x2], axis=-1),
-        ],
-        axis=-2,
-    )
+    # ∂(x, y)/∂(K1, K2, P1, P2): the compiled core the adjustment's kernel calls too
+    d = pushbroom_line_distortion_dcoeff_rows(np.ascontiguousarray(xb.ravel()))
+    d = d.reshape(xb.shape + (4,))
+    J_dist = np.zeros(xb.shape + (2, 4))
+    J_dist[..., 0, :3] = d[..., :3]
+    J_dist[..., 1, 3] = d[..., 3]
     return J_xy, J_dist
 
 

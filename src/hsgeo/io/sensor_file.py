@@ -1,5 +1,8 @@
 """The one sensor file: ``[sensor] model = "..."`` read through a registry of models.
 
+Kept as one file: the registry (each model's keys and builder) and its one reader are one
+concern; a new model adds its entry here.
+
 :func:`read_sensor` is the one way a sensor file becomes a sensor of :mod:`hsgeo.sensors`
 (the face of :mod:`hsgeo.sensors.mount`: ``rays`` / ``project``). The file names its model;
 each model of :data:`MODELS` has its keys (with units in their names), and a key the model
@@ -249,7 +252,8 @@ PUSHBROOM_PRIOR_TABLES = {
     "observations": {"sigma_px": Key("float", positive=True, doc="σ of an image coordinate, px")},
     "gcp": {"sigma_m": Key("float", positive=True, doc="σ of a GCP coordinate, m")},
 }
-_PUSHBROOM_KEYS = {
+#: The keys of the 002 camera (model ``pushbroom``, and the former ``[camera]`` table).
+PUSHBROOM_KEYS = {
     "n_bands": Key("int", required=True, positive=True, doc="number of bands"),
     "pixel_mm": Key(
         "float", required=True, positive=True, limit=1.0, doc="pixel pitch, mm (at most 1)"
@@ -323,7 +327,7 @@ def _models():
         SensorModel(
             "pushbroom",
             "the 002 LP camera: 002 eq. (2)-(4) (hsgeo.sensors.pushbroom.PushbroomCamera)",
-            _PUSHBROOM_KEYS,
+            PUSHBROOM_KEYS,
             _pushbroom,
             PushbroomCamera,
             {
@@ -521,7 +525,7 @@ def read_sensor_tables(path, what: str = "sensor file") -> tuple[str, dict, str]
     """
     cfg = read_toml(path, what)
     if "camera" in cfg and "sensor" not in cfg:  # the 002 camera file of adjust-pushbroom
-        schema = {"camera": _PUSHBROOM_KEYS, **PUSHBROOM_PRIOR_TABLES}
+        schema = {"camera": PUSHBROOM_KEYS, **PUSHBROOM_PRIOR_TABLES}
         out = read_config(path, schema, what, required_tables=("camera",))
         out["sensor"] = out.pop("camera")
         _check_mount(path, "camera", out["sensor"])

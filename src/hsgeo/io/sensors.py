@@ -1,6 +1,12 @@
-"""Sensor and camera descriptions in TOML: ``hsgeo geocode --sensor`` and ``hsgeo
-adjust-pushbroom --camera``; and the adjusted camera and node corrections that ``hsgeo
-adjust-pushbroom --json`` prints (:func:`read_adjustment`, ``hsgeo orthomosaic --adjustment``).
+"""The former per-command sensor files, the adjustment JSON and the instrument files.
+
+A sensor file is read by :func:`hsgeo.io.read_sensor` (:mod:`hsgeo.io.sensor_file`, one
+registry of models); :func:`read_pushbroom_camera` and :func:`read_scanning_sensor` are that
+reader restricted to what a command can use. :func:`read_sensor_toml` and
+:func:`read_camera_toml` are the low-level readers of the former ``hsgeo geocode --sensor``
+(000) and ``hsgeo adjust-pushbroom --camera`` (002) files, which ``read_sensor`` reads too.
+:func:`read_adjustment` reads the adjusted camera and node corrections that ``hsgeo
+adjust-pushbroom --json`` prints (apply them with :func:`hsgeo.sensors.adjusted`).
 """
 
 from __future__ import annotations
@@ -12,6 +18,7 @@ import numpy as np
 from hsgeo.errors import InputError
 from hsgeo.io._files import read_text
 from hsgeo.io.config import Key, read_config
+from hsgeo.io.sensor_file import PUSHBROOM_KEYS, PUSHBROOM_PRIOR_TABLES
 
 __all__ = [
     "SENSOR_SCHEMA",
@@ -53,45 +60,10 @@ SENSOR_SCHEMA = {
     },
 }
 
-#: ``hsgeo adjust-pushbroom --camera``: camera and GNSS/INS priors (002 §4). Absent optional
-#: keys are left out of :func:`read_camera_toml`'s result (the workflow's defaults apply).
-CAMERA_SCHEMA = {
-    "camera": {
-        "n_bands": Key("int", required=True, positive=True, doc="number of bands"),
-        "pixel_mm": Key(
-            "float", required=True, positive=True, limit=1.0, doc="pixel pitch, mm (at most 1)"
-        ),
-        # the limits: what no airborne line camera exceeds (physically impossible beyond)
-        "c_mm": Key(
-            "float", required=True, positive=True, limit=2000.0, doc="principal distance, mm"
-        ),
-        "x0_mm": Key("float", limit=100.0, doc="principal point x on the detector, mm"),
-        "y0_mm": Key("float", limit=100.0, doc="principal point y on the detector, mm"),
-        "lever_arm_m": Key(
-            "floats", length=3, limit=50.0, doc="lever arm (platform frame), m, not mm"
-        ),
-        "sigma_lever_m": Key(
-            "float", positive=True, limit=10.0, doc="σ of the measured lever arm, m"
-        ),
-        "c_band_mm": Key(
-            "floats", positive=True, doc="principal distance of each band, mm (geocoding)"
-        ),
-        "distortion": Key(
-            "floats", length=4, doc="K1 (mm^-2), K2 (mm^-4), P1, P2 (mm^-1) of 002 eq. (3)"
-        ),
-        "boresight_deg": Key(
-            "floats", length=3, doc="omega, phi, kappa of the boresight on the nominal mount, deg"
-        ),
-    },
-    "gnss_ins": {
-        "sigma_pos_m": Key("floats", length=3, positive=True, doc="σ of E, N, H, m"),
-        "sigma_att_deg": Key(
-            "floats", length=3, positive=True, doc="σ of roll, pitch, yaw, degrees"
-        ),
-    },
-    "observations": {"sigma_px": Key("float", positive=True, doc="σ of an image coordinate, px")},
-    "gcp": {"sigma_m": Key("float", positive=True, doc="σ of a GCP coordinate, m")},
-}
+#: ``hsgeo adjust-pushbroom --camera``: camera and GNSS/INS priors (002 §4), the former file
+#: of the ``pushbroom`` model (its keys are the model's, :mod:`hsgeo.io.sensor_file`). Absent
+#: optional keys are left out of :func:`read_camera_toml`'s result (the workflow's defaults apply).
+CAMERA_SCHEMA = {"camera": dict(PUSHBROOM_KEYS), **PUSHBROOM_PRIOR_TABLES}
 
 
 def read_sensor_toml(path):

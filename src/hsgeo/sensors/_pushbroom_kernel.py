@@ -22,6 +22,7 @@ from hsgeo._kernels import (
     bspline_weights,
     pushbroom_camera_point,
     pushbroom_image_mm,
+    pushbroom_line_distortion_dcoeff,
     rpy_rotation,
 )
 
@@ -126,14 +127,15 @@ def _derivatives(
             dB[row, kk] = v
     dC[2 * j, 0] = gx * xb / c * k_px
     dC[2 * j + 1, 0] = (yb / c + gy * xb / c) * k_px
-    dD[2 * j, 0] = xb**3 * k_px
-    dD[2 * j, 1] = xb**5 * k_px
-    dD[2 * j, 2] = 3 * xb**2 * k_px
+    x3, x5, x2_3, x2 = pushbroom_line_distortion_dcoeff(xb)  # 002 eq. (3), hsgeo._kernels
+    dD[2 * j, 0] = x3 * k_px
+    dD[2 * j, 1] = x5 * k_px
+    dD[2 * j, 2] = x2_3 * k_px
     dD[2 * j, 3] = 0.0
     dD[2 * j + 1, 0] = 0.0
     dD[2 * j + 1, 1] = 0.0
     dD[2 * j + 1, 2] = 0.0
-    dD[2 * j + 1, 3] = xb**2 * k_px
+    dD[2 * j + 1, 3] = x2 * k_px
 
 
 @njit(cache=True, inline="always")

@@ -47,6 +47,8 @@ __all__ = [
     "POSE_COLUMNS",
     "camera_coordinates",
     "project_opencv",
+    "pixels_opencv",
+    "normalised_opencv",
     "FrameOpenCV",
     "FramePhotogrammetric",
     "pixel_to_mm",
@@ -155,6 +157,32 @@ def _dproj(Xc):
     )
 
 
+def pixels_opencv(xy_n, intrinsics, dist):
+    """OpenCV's pixel map, the one place it is coded: normalised ideal coordinates
+    ``(X_c/Z_c, Y_c/Z_c)`` ``(n, 2)`` → pixels ``u = fx·x_d + cx``, ``v = fy·y_d + cy`` with
+    ``(x_d, y_d) = distort_opencv(xy_n, dist)``.
+
+    Returns
+    -------
+    uv_px : (n, 2) ndarray
+    xy_d : (n, 2) ndarray
+        The distorted normalised coordinates (for the derivatives w.r.t. fx, fy).
+    """
+    xd = distort_opencv(xy_n, dist)
+    fx, fy, cx, cy = intrinsics
+    return np.column_stack([fx * xd[:, 0] + cx, fy * xd[:, 1] + cy]), xd
+
+
+def normalised_opencv(uv_px, intrinsics, dist) -> np.ndarray:
+    """The inverse of :func:`pixels_opencv`: pixels ``(n, 2)`` → normalised ideal coordinates
+    (undistorted by :func:`hsgeo.distortion.undistort_opencv`).
+    """
+    fx, fy, cx, cy = intrinsics
+    uv = np.atleast_2d(np.asarray(uv_px, dtype=float))
+    xd = np.column_stack([(uv[:, 0] - cx) / fx, (uv[:, 1] - cy) / fy])
+    return undistort_opencv(xd, dist) if any(dist) else xd
+
+
 def project_opencv(poses, view, X, intrinsics, dist):
     """Pixel coordinates of world points in the OpenCV form (see the module docstring).
 
@@ -165,9 +193,7 @@ def project_opencv(poses, view, X, intrinsics, dist):
     Xc, _, _ = camera_coordinates(
         np.asarray(poses, float), np.asarray(view), np.asarray(X, float), False
     )
-    xd = distort_opencv(Xc[:, :2] / Xc[:, 2:3], dist)
-    fx, fy, cx, cy = intrinsics
-    return np.column_stack([fx * xd[:, 0] + cx, fy * xd[:, 1] + cy])
+    return pixels_opencv(Xc[:, :2] / Xc[:, 2:3], intrinsics, dist)[0]
 
 
 class FrameOpenCV(_FrameBase):
@@ -210,8 +236,7 @@ class FrameOpenCV(_FrameBase):
             )
         xn = Xc[:, :2] / Xc[:, 2:3]
         J_xy, J_dist = distort_opencv_jacobian(xn, dist)
-        xd = distort_opencv(xn, dist)
-        uv = np.column_stack([fx * xd[:, 0] + cx, fy * xd[:, 1] + cy])
+        uv, xd = pixels_opencv(xn, (fx, fy, cx, cy), dist)
         r2 = uv - self.xy
         if not jacobian:
             return r2.ravel(), None
@@ -356,10 +381,7 @@ class FrameCamera:
 
     def rays(self, uv_px, poses, view) -> tuple[np.ndarray, np.ndarray]:
         """Origins and unit directions (world frame) of the rays of pixels ``(n, 2)``."""
-        fx, fy, cx, cy = self.intrinsics
-        uv = np.atleast_2d(np.asarray(uv_px, dtype=float))
-        xd = np.column_stack([(uv[:, 0] - cx) / fx, (uv[:, 1] - cy) / fy])
-        xn = undistort_opencv(xd, self.dist) if any(self.dist) else xd
+        xn = normalised_opencv(uv_px, self.intrinsics, self.dist)
         X0, R = self._frames(poses, view)
         d_cam = np.column_stack([xn, np.ones(len(xn))])
         return self.mount.origins(X0, R), unit(self.mount.directions(R, d_cam))
@@ -370,6 +392,4 @@ class FrameCamera:
         Xc = self.mount.to_sensor(xyz_world, X0, R)
         if np.any(Xc[:, 2] <= 0):
             raise ObservationError("points behind the frame camera (Z_c ≤ 0)")
-        xd = distort_opencv(Xc[:, :2] / Xc[:, 2:3], self.dist)
-        fx, fy, cx, cy = self.intrinsics
-        return np.column_stack([fx * xd[:, 0] + cx, fy * xd[:, 1] + cy])
+        return pixels_opencv(Xc[:, :2] / Xc[:, 2:3], self.intrinsics, self.dist)[0]
