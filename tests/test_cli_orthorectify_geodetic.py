@@ -109,16 +109,33 @@ def flight(tmp_path_factory):
     return d, argv, ref
 
 
-def test_sydney_sbet_lands_in_utm_56s_where_pyproj_puts_it(flight, capsys):
+def _geodetic_csv(d):
+    """The flight's navigation as a geodetic CSV (GPS seconds of week, '# crs: EPSG:4979')."""
+    t, lat, lon, h, rph = _flight()
+    rows = ["# crs: EPSG:4979", "gps_sow_s,lat_deg,lon_deg,h_m,roll_deg,pitch_deg,heading_deg"]
+    for k in range(t.size):
+        v = (t[k], lat[k], lon[k], h[k], rph[k, 0], rph[k, 1], rph[k, 2] % 360.0)
+        rows.append(",".join(repr(float(x)) for x in v))
+    (d / "nav.csv").write_text("\n".join(rows) + "\n")
+    return d / "nav.csv"
+
+
+@pytest.mark.parametrize("nav", ["sbet", "csv"])
+def test_sydney_flight_lands_in_utm_56s_where_pyproj_puts_it(flight, capsys, nav):
     import rioxarray
 
     d, argv, ref = flight
-    rc = main([*argv, "--nav-crs", "EPSG:4979", "--vertical", "ellipsoidal", "--gps-week",
-               "2345", "--json", "-o", str(d / "o.tif")])  # fmt: skip
+    argv = list(argv)
+    if nav == "sbet":
+        argv += ["--nav-crs", "EPSG:4979", "--gps-week", "2345"]
+    else:  # the CRS from the file's '# crs:' line
+        argv[argv.index("--trajectory") + 1] = str(_geodetic_csv(d))
+    o = d / f"o_{nav}.tif"
+    rc = main([*argv, "--vertical", "ellipsoidal", "--json", "-o", str(o)])
     assert rc == 0, capsys.readouterr().err
     out = json.loads(capsys.readouterr().out)
     assert out["crs"] == "EPSG:32756" and "WGS 84" in out["navigation"]
-    m = rioxarray.open_rasterio(d / "o.tif").astype(float)
+    m = rioxarray.open_rasterio(o).astype(float)
     assert m.rio.crs.to_epsg() == 32756
     X, Y = np.meshgrid(m["x"].values, m["y"].values)
     ok = np.isfinite(m.values[0])
@@ -138,6 +155,7 @@ def test_sydney_sbet_lands_in_utm_56s_where_pyproj_puts_it(flight, capsys):
     [
         (["--vertical", "ellipsoidal"], "--nav-crs"),  # an SBET names no datum
         (["--nav-crs", "EPSG:4979"], "--vertical"),  # the DSM's 2D CRS: heights unknown
+        (["--nav-crs", "4979", "--vertical", "ellipsoidal", "--site", "-33.9,151.2"], "--site"),
     ],
 )
 def test_bad_input_one_line_exit_2(flight, capsys, extra, expect):
