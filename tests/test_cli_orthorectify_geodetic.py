@@ -155,7 +155,7 @@ def test_sydney_flight_lands_in_utm_56s_where_pyproj_puts_it(flight, capsys, nav
     [
         (["--vertical", "ellipsoidal"], "--nav-crs"),  # an SBET names no datum
         (["--nav-crs", "EPSG:4979"], "--vertical"),  # the DSM's 2D CRS: heights unknown
-        (["--nav-crs", "4979", "--vertical", "ellipsoidal", "--site", "-33.9,151.2"], "--site"),
+        (["--nav-crs", "4979", "--vertical", "ellipsoidal", "--site=-33.9,151.2"], "--site"),
     ],
 )
 def test_bad_input_one_line_exit_2(flight, capsys, extra, expect):
