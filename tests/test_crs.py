@@ -188,3 +188,22 @@ def test_parse_crs_and_its_errors():
         LocalFrame(59.0, 10.0, 0.0, 32632, 4326)
     words = LocalFrame(59.0, 10.0, 0.0, 32632, 4979).describe()
     assert "on WGS 84 (EPSG:4979)" in words and "WGS 84 / UTM zone 32N (EPSG:32632)" in words
+
+
+def test_lonlat_to_crs_starts_from_the_points_own_datum():
+    """Points on a WGS 84 or NAD83 frame go to the output CRS from their own datum (the mosaic
+    once took every frame's longitudes and latitudes as ETRS89); ETRS89 stays bit for bit."""
+    from pyproj import Transformer
+
+    from hsgeo.crs import lonlat_to_crs
+
+    lon, lat = np.array([151.2, 151.21]), np.array([-33.9, -33.91])
+    want = Transformer.from_crs(4326, 32756, always_xy=True).transform(lon, lat)
+    np.testing.assert_array_equal(lonlat_to_crs("EPSG:32756", lon, lat, 4979), want)
+    lon, lat = np.array([-105.3, -105.29]), np.array([40.0, 40.01])
+    want = Transformer.from_crs(6318, 6342, always_xy=True).transform(lon, lat)
+    np.testing.assert_array_equal(lonlat_to_crs("EPSG:6342", lon, lat, 6319), want)
+    lon, lat = np.array([10.775]), np.array([59.665])
+    np.testing.assert_array_equal(
+        lonlat_to_crs("EPSG:25832", lon, lat, 4937), lonlat_to_crs("EPSG:25832", lon, lat)
+    )

@@ -183,6 +183,9 @@ def _cmd_orthorectify(args) -> int:
             max_nav_gap_s=args.max_nav_gap_s,
             line_pixels=args.line_pixels,
             max_gib=args.max_gib,
+            nav_crs=args.nav_crs,
+            gps_week=args.gps_week,
+            vertical=args.vertical,
         )
     finally:
         terminal.clear_progress()

@@ -221,7 +221,13 @@ def add_orthorectify(sub) -> argparse.ArgumentParser:
         "band), t_s(line), wavelength_nm(band), attributes col0, strip_id, n_px_full; see "
         "hsgeo.io.lp_lines); an optional fwhm_nm(band) is carried into the output. NAV: the "
         "navigation file of every command (t_s, E_m, N_m, U_m, roll_deg, pitch_deg, "
-        "heading_deg in the local east-north-up frame about --site). SENSOR: TOML, the 000 "
+        "heading_deg in the local east-north-up frame about --site), or a geodetic one: a CSV "
+        "or Parquet (gps_sow_s or sod_s, lat_deg, lon_deg, h_m, roll_deg, pitch_deg, "
+        "heading_deg; CRS by '# crs: EPSG:n' or --nav-crs) or an Applanix SBET (.out, "
+        "--nav-crs required), whose local frame comes from the data and whose output CRS "
+        "defaults to the UTM zone of its centre on its datum (see hsgeo.io.read_navigation); "
+        "its DSM GeoTIFF may be in any CRS (--vertical for a 2D one) and is read under the "
+        "lines' edge rays followed down to U = -500 m, plus 100 m. SENSOR: TOML, the 000 "
         "line scanner ([sensor]) or the 002 pushbroom camera ([camera], read in full: c per "
         "band, distortion, boresight, lever arm). RESULT: hsgeo adjust-pushbroom --json "
         "(camera parameters and node corrections). DSM: a GeoTIFF of ellipsoidal heights with "
@@ -275,14 +281,36 @@ def add_orthorectify(sub) -> argparse.ArgumentParser:
         "--crs",
         metavar="CRS",
         default=None,
-        help="output CRS, e.g. EPSG:25832 (default: the map CRS of --site's frame, EPSG:25832)",
+        help="output CRS, e.g. EPSG:25832 (default: the map CRS of --site's frame, EPSG:25832; "
+        "for a geodetic navigation the UTM zone of its centre on its datum)",
     )
     p.add_argument(
         "--site",
         type=_site,
         metavar="LAT,LON[,H]",
         help="ETRS89 latitude, longitude (degrees) and ellipsoidal height (m) of the origin of "
-        "the navigation's east-north-up frame (default the 002 site, 59.665,10.775,0)",
+        "the navigation's east-north-up frame (default the 002 site, 59.665,10.775,0); "
+        "only for a local-ENU navigation",
+    )
+    p.add_argument(
+        "--nav-crs",
+        metavar="CRS",
+        default=None,
+        help="the datum of a geodetic navigation (an SBET names none), e.g. EPSG:4979 (WGS 84) "
+        "or EPSG:4937 (ETRS89); overrides a CSV's '# crs:' line",
+    )
+    p.add_argument(
+        "--gps-week",
+        type=option_number(integer=True, lo=0, hi=100000),
+        default=None,
+        help="GPS week of an SBET's or a gps_sow_s navigation's times (recorded, not applied)",
+    )
+    p.add_argument(
+        "--vertical",
+        metavar="ellipsoidal|EPSG:n",
+        default=None,
+        help="heights of a --dsm whose CRS is 2D (with a geodetic navigation): ellipsoidal, or "
+        "a vertical CRS such as EPSG:5711 (AHD) or EPSG:5773 (EGM96)",
     )
     p.add_argument("--scheduler", metavar="ADDRESS", help="dask.distributed scheduler address")
     p.add_argument(

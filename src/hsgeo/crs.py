@@ -372,16 +372,24 @@ def _R_ecef_from_enu(lon_deg, lat_deg) -> np.ndarray:
 SITE_AAS = LocalFrame(59.665, 10.775, 0.0, ETRS89_UTM32N)
 
 
-def lonlat_to_crs(crs: str, lon_deg, lat_deg):
-    """Coordinates in ``crs`` (any CRS pyproj reads) of ETRS89 longitudes and latitudes."""
+def lonlat_to_crs(crs: str, lon_deg, lat_deg, datum_epsg: int = 4258):
+    """Coordinates in ``crs`` (any CRS pyproj reads) of longitudes and latitudes on a datum.
+
+    ``datum_epsg`` is the geographic CRS of ``lon_deg``, ``lat_deg`` (2D or 3D EPSG code; a
+    frame's ``datum_epsg``): ETRS89 (4258, 4937) by default, as the 002 site's frame. A WGS 84
+    or NAD83 navigation's points are transformed from their own datum, never taken as ETRS89.
+    """
+    datum_epsg = int(datum_epsg)
+    key = (crs, datum_epsg)
     cache = getattr(_local, "to_crs", None)
     if cache is None:
         cache = _local.to_crs = {}
-    if crs not in cache:
-        from pyproj import Transformer
+    if key not in cache:
+        from pyproj import CRS, Transformer
 
-        cache[crs] = Transformer.from_crs(4258, crs, always_xy=True)
-    x, y = cache[crs].transform(np.asarray(lon_deg, float), np.asarray(lat_deg, float))
+        src = 4258 if datum_epsg in (4258, ETRS89_GEOGRAPHIC_3D) else CRS(datum_epsg).to_2d()
+        cache[key] = Transformer.from_crs(src, crs, always_xy=True)
+    x, y = cache[key].transform(np.asarray(lon_deg, float), np.asarray(lat_deg, float))
     return np.asarray(x), np.asarray(y)
 
 

@@ -174,7 +174,7 @@ def strip_footprints(strip: Strip, terrain, frame, lines_per_block: int, crs: st
         e1, l1, _ = geolocate_lines(strip, terrain, frame, np.unique([a, b - 1]))
         e2, l2, _ = geolocate_lines(strip, terrain, frame, slice(a, b), [0, -1])
         ll = np.concatenate([l1.reshape(-1, 2), l2.reshape(-1, 2)])
-        x, y = lonlat_to_crs(crs, ll[:, 0], ll[:, 1])
+        x, y = lonlat_to_crs(crs, ll[:, 0], ll[:, 1], frame.datum_epsg)
         bbox[i] = np.min(x), np.min(y), np.max(x), np.max(y)
         if e1.shape[1] > 1:
             step = np.linalg.norm(np.diff(e1[..., :2], axis=1), axis=-1)
@@ -185,7 +185,9 @@ def strip_footprints(strip: Strip, terrain, frame, lines_per_block: int, crs: st
     return blocks, bbox, (across, along)
 
 
-def resample_swath(lonlat_deg, values, rank, grid: MapGrid, radius_m: float):
+def resample_swath(
+    lonlat_deg, values, rank, grid: MapGrid, radius_m: float, datum_epsg: int = 4258
+):
     """Nearest swath pixel of every cell of ``grid`` within ``radius_m``, in the grid's CRS.
 
     The swath's pixels go into the grid's CRS (pyproj), and pykdtree (the kd-tree pyresample
@@ -206,6 +208,8 @@ def resample_swath(lonlat_deg, values, rank, grid: MapGrid, radius_m: float):
     grid : MapGrid
     radius_m : float
         Radius of influence: cells farther from every pixel stay empty.
+    datum_epsg : int
+        The geographic CRS of ``lonlat_deg`` (the frame's datum; ETRS89 by default).
 
     Returns
     -------
@@ -220,7 +224,7 @@ def resample_swath(lonlat_deg, values, rank, grid: MapGrid, radius_m: float):
     out = np.full((values.shape[1], n_cells), np.nan, dtype=np.float32)
     r = np.full(n_cells, np.inf)
     if lonlat_deg.shape[0]:
-        px, py = lonlat_to_crs(grid.crs, lonlat_deg[:, 0], lonlat_deg[:, 1])
+        px, py = lonlat_to_crs(grid.crs, lonlat_deg[:, 0], lonlat_deg[:, 1], datum_epsg)
         tree = KDTree(np.column_stack([px, py]))
         X, Y = np.meshgrid(grid.x_m, grid.y_m)
         dist, pix = tree.query(
@@ -304,7 +308,12 @@ def mosaic_tile(
             vals.append(np.asarray(v, dtype=np.float32).reshape(-1, n_bands))
             ranks.append(off.ravel())
         v, r = resample_swath(
-            np.concatenate(ll), np.concatenate(vals), np.concatenate(ranks), grid, radius_m
+            np.concatenate(ll),
+            np.concatenate(vals),
+            np.concatenate(ranks),
+            grid,
+            radius_m,
+            frame.datum_epsg,
         )
         covered = np.isfinite(r)
         if rule == "mean":

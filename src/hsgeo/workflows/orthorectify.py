@@ -162,6 +162,36 @@ def _terrain(dsm, height_m, frame, U_m):
     return MapTerrain(z, grid, frame, source=f"--dsm {str(dsm)!r}")
 
 
+def _geodetic_terrain(dsm, height_m, frame, U_m, strips, vertical):
+    """The terrain of a geodetic navigation: ``--dsm`` a raster in any CRS read into the frame
+    under the lines' footprint (:func:`hsgeo.io.read_terrain`; the ground points checked
+    against its voids), or a plane ``--height`` (the frame's U).
+    """
+    from pathlib import Path
+
+    from hsgeo.geocode import DemTerrain
+    from hsgeo.io import read_terrain
+    from hsgeo.workflows import _ortho_geodetic as geo
+
+    if dsm is None or height_m is not None:
+        return _terrain(dsm, height_m, frame, U_m)
+    if Path(dsm).suffix.lower() in (".nc", ".nc4", ".cdf", ".netcdf"):
+        raise InputError(
+            f"--dsm {str(dsm)!r}: a NetCDF DEM is in a local frame, but the navigation is "
+            "geodetic (its frame comes from the data); give the DSM as a GeoTIFF with its CRS"
+        )
+    raster = read_terrain(dsm, frame, geo.terrain_bounds(strips, frame), vertical)
+    top, low = float(np.max(raster.dem.values)), float(np.min(U_m))
+    if top >= low:
+        raise InputError(
+            f"{raster.source} reaches U {top:.6g} m in the local frame, not below the aircraft "
+            f"(U down to {low:.6g} m): check its vertical datum (--vertical) and unit"
+        )
+    terrain = DemTerrain(raster.dem)
+    geo.check_voids(strips, raster, terrain, frame)
+    return terrain
+
+
 def _read_strips(lines, nav, sensor, args):
     """The strips of the LINES files (all of one kind), their wavelengths and FWHM."""
     from hsgeo.io.lines import line_file_kind, read_band_widths, read_lines
@@ -250,6 +280,9 @@ def orthorectify_files(
     line_pixels: int | None = None,
     max_gib: float = MAX_MOSAIC_GIB,
     tile_px: int = 512,
+    nav_crs: str | None = None,
+    gps_week: int | None = None,
+    vertical: str | None = None,
 ) -> dict:
     """Orthorectify line files into one raster (see ``hsgeo orthorectify --help``).
 
@@ -257,13 +290,18 @@ def orthorectify_files(
     exists, unless ``overwrite``, or if it is an input), the inputs, the bands, the navigation
     covering every line, the view angles, the terrain below the aircraft and covering every
     strip's footprint, the raster's size. Returns a summary (grid, bands, strips, file).
+
+    A geodetic navigation (a geodetic CSV/Parquet or an SBET; ``nav_crs``, ``gps_week``: see
+    :func:`hsgeo.io.read_navigation`) brings its own local frame (``site`` refused) and the
+    output CRS defaults to the UTM zone of its centre on its datum; its DSM GeoTIFF may be in
+    any CRS (``vertical``: ``"ellipsoidal"`` or ``"EPSG:n"`` for a file with a 2D CRS).
     """
     from hsgeo.io import read_sensor
     from hsgeo.io._files import check_outputs
-    from hsgeo.io.navigation import read_trajectory
     from hsgeo.io.raster import RASTER_FORMATS, raster_outputs, write_raster
     from hsgeo.io.sensors import read_adjustment
     from hsgeo.sensors import adjusted
+    from hsgeo.workflows import _ortho_geodetic as geo
     from hsgeo.workflows._ortho_strips import check_view_angles
 
     lines = list(lines)
@@ -274,12 +312,16 @@ def orthorectify_files(
         raise InputError(f"--resolution must be a positive number of metres, got {resolution_m}")
     if mosaic not in MOSAIC_RULES:
         raise InputError(f"--mosaic {mosaic!r}: give one of {', '.join(MOSAIC_RULES)}")
-    frame = _frame(site)
     inputs = [*lines, trajectory, sensor, dsm, adjustment]
     check_outputs(raster_outputs(output, RASTER_FORMATS), inputs, overwrite=overwrite)
+    navigation = geo.read_nav(trajectory, nav_crs, gps_week, site, vertical)
+    geodetic = navigation.source_crs != "local ENU"
+    frame = navigation.frame if geodetic else _frame(site)
+    if geodetic and crs is None:
+        crs = geo.output_crs(frame)
     adj = read_adjustment(adjustment) if adjustment is not None else None
     try:  # the one sensor reader and the one way to apply an adjustment (any sensor)
-        cam, nav = adjusted(read_sensor(sensor), read_trajectory(trajectory), adj)
+        cam, nav = adjusted(read_sensor(sensor), navigation.trajectory, adj)
     except InputError as exc:
         msg = str(exc)
         raise InputError("--" + msg if msg.startswith("adjustment:") else msg) from None
@@ -289,7 +331,10 @@ def orthorectify_files(
     for s in strips:
         check_view_angles(s, sensor)
     U = np.concatenate([nav.pose(s.t_s)[0][:, 2] for s in strips])
-    terrain = _terrain(dsm, height_m, frame, U)
+    if geodetic:
+        terrain = _geodetic_terrain(dsm, height_m, frame, U, strips, vertical)
+    else:
+        terrain = _terrain(dsm, height_m, frame, U)
     names = (
         [f"{w:g} nm" for w in wl] if wl is not None else [str(i) for i in range(strips[0].n_bands)]
     )
@@ -328,6 +373,7 @@ def orthorectify_files(
         "strips": [s.name for s in strips],
         "line_pixels": n_px_full,
         "adjusted": adjustment is not None,
+        "navigation": navigation.source_crs,
         "scheduler": scheduler,
     }
 

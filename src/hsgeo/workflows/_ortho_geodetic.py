@@ -1,0 +1,97 @@
+"""``hsgeo orthorectify`` on a geodetic navigation (a geodetic CSV/Parquet or an SBET).
+
+The local frame comes from the data (:meth:`hsgeo.crs.LocalFrame.about` the trajectory's centre,
+:func:`hsgeo.io.read_navigation`); the output CRS defaults to :func:`hsgeo.crs.default_output_crs`
+of that centre on the navigation's datum; a DSM GeoTIFF in any CRS is read into the frame by
+:func:`hsgeo.io.read_terrain` under the lines' footprint, and the lines' ground points are checked
+against its voids (:meth:`hsgeo.io.terrain.RasterTerrain.check_voids`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hsgeo.errors import InputError, ObservationError
+
+__all__ = ["FLOOR_U_M", "MARGIN_M", "read_nav", "output_crs", "terrain_bounds", "check_voids"]
+
+#: The plane (frame U, m) the lines' edge rays are followed down to for the DSM's bounds: below
+#: the ellipsoidal height of any land near the frame's origin (the Dead Sea shore: about −400 m).
+FLOOR_U_M = -500.0
+#: Added on every side of the bounds, m (the ellipsoid falls 18 m below the frame's plane 15 km
+#: from the origin).
+MARGIN_M = 100.0
+
+
+def read_nav(trajectory, nav_crs, gps_week, site, vertical):
+    """The navigation (:class:`hsgeo.io.Navigation`), the options checked against its kind."""
+    from hsgeo.io import read_navigation
+
+    nav = read_navigation(trajectory, crs=nav_crs, gps_week=gps_week)
+    local = nav.source_crs == "local ENU"
+    if local:
+        for opt, v in (("--nav-crs", nav_crs), ("--gps-week", gps_week), ("--vertical", vertical)):
+            if v is not None:
+                raise InputError(
+                    f"{opt} {v}: navigation file {str(trajectory)!r} is in a local east-north-up "
+                    f"frame (t_s, E_m, N_m, U_m), where {opt} has no meaning; leave it out (the "
+                    "frame is --site's) or give a geodetic navigation (lat_deg, lon_deg, h_m or "
+                    "an SBET)"
+                )
+    elif site is not None:
+        raise InputError(
+            f"--site: navigation file {str(trajectory)!r} is geodetic ({nav.source_crs}); its "
+            "local frame comes from the data, leave --site out"
+        )
+    return nav
+
+
+def output_crs(frame) -> str:
+    """``EPSG:n`` of the UTM zone of the frame's origin on its datum."""
+    from hsgeo.crs import default_output_crs
+
+    c = default_output_crs(frame.lon_deg, frame.lat_deg, int(frame.datum_epsg))
+    return f"EPSG:{c.to_epsg()}"
+
+
+def _edge_points(strips, terrain, frame, lattice: bool):
+    """Ground points of every line's first and last pixel and of every pixel of the first and
+    last line (with ``lattice``: of about 64 lines spread over each strip).
+    """
+    from hsgeo.ortho import geolocate_lines
+
+    pts = []
+    for s in strips:
+        n = s.n_lines
+        rows = np.linspace(0, n - 1, min(n, 64)).astype(int) if lattice else [0, n - 1]
+        rows = np.unique(rows)
+        pts.append(geolocate_lines(s, terrain, frame, rows)[0].reshape(-1, 3))
+        pts.append(geolocate_lines(s, terrain, frame, slice(None), [0, -1])[0].reshape(-1, 3))
+    return np.concatenate(pts)
+
+
+def terrain_bounds(strips, frame) -> tuple:
+    """``(E_min, N_min, E_max, N_max)`` of the frame the rays can reach: the lines' edge rays
+    followed down to the plane U = :data:`FLOOR_U_M`, plus :data:`MARGIN_M`.
+    """
+    from hsgeo.geocode import PlaneTerrain
+
+    g = _edge_points(strips, PlaneTerrain(FLOOR_U_M), frame, lattice=False)
+    E, N = g[:, 0], g[:, 1]
+    return (
+        float(E.min()) - MARGIN_M,
+        float(N.min()) - MARGIN_M,
+        float(E.max()) + MARGIN_M,
+        float(N.max()) + MARGIN_M,
+    )
+
+
+def check_voids(strips, raster, terrain, frame) -> None:
+    """The strips' perimeter and about 64 whole lines each met with the terrain must not land
+    in a void of the DSM (filled by the nearest height there: a silently wrong ground).
+    """
+    g = _edge_points(strips, terrain, frame, lattice=True)
+    try:
+        raster.check_voids(g[:, 0], g[:, 1])
+    except ObservationError as exc:
+        raise InputError(f"--dsm: {exc}") from None
