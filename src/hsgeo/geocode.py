@@ -236,10 +236,12 @@ def _missed(X, below, outside, terrain, on_miss):
             else f"{int(outside.sum())} rays reach the ground outside the terrain's grid: "
             "give a DEM or DSM that covers the lines"
         )
+    source = getattr(terrain, "source", None)
+    where = f"{source} (the DSM)" if source else "the terrain"
     raise ObservationError(
-        f"{int(below.sum())} rays start under the terrain (a projection centre below the DEM, "
+        f"{int(below.sum())} rays start under {where} (a projection centre below the DSM or DEM, "
         "or a plane above the sensor): check that the navigation's heights and the terrain's "
-        "are in the same vertical datum (ellipsoidal or orthometric) and units"
+        "are in the same vertical datum (ellipsoidal or orthometric) and units (metres)"
     )
 
 

@@ -325,7 +325,9 @@ def read_navigation(
     if path.suffix.lower() in (".out", ".sbet") or _is_binary(path):
         return _read_sbet_navigation(path, crs, frame, gps_week, map_crs)
     cols = _columns_of(path)
-    if "E_m" in cols and "lat_deg" not in cols and "X_m" not in cols:
+    geodetic = {"lat_deg", "lon_deg", "X_m", "Y_m", "Z_m", "gps_sow_s", "sod_s"}
+    if not geodetic & set(cols) and ({"t_s", "E_m", "N_m", "U_m"} & set(cols)):
+        # a local-ENU file (even one that lacks a column: read_trajectory names it)
         return Navigation(read_trajectory(path), frame, "as in the file (t_s)", None, "local ENU")
     return _read_geodetic_table(path, cols, crs, frame, gps_week, map_crs)
 
