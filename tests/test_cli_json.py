@@ -12,12 +12,12 @@ from hsgeo.cli import main
 MISSING = {
     "calibrate-line": ["calibrate-line", "{d}/nope.csv", "--control", "{d}/nope2.csv"],
     "calibrate-frame": ["calibrate-frame", "{d}/nope.png", "--board", "{d}/board.toml"],
-    "orthomosaic": [
-        "orthomosaic",
+    "orthorectify": [
+        "orthorectify",
         "{d}/nope.nc",
         "--trajectory",
         "{d}/nav.csv",
-        "--camera",
+        "--sensor",
         "{d}/cam.toml",
         "--dsm",
         "{d}/dsm.tif",

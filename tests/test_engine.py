@@ -559,6 +559,7 @@ def test_sensor_blocks_declare_their_roles():
         "distortion",
         "rotation",
         "offset",
+        "drift",
     }
     assert TargetCentroids.BLOCKS["interior"] == "interior"
     assert LineObservations.BLOCKS["xy"] == "xy_m"
