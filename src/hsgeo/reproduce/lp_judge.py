@@ -33,7 +33,6 @@ __all__ = [
     "observation_errors_px",
     "within_fractions",
     "check_point_errors",
-    "joint_point_covariance",
 ]
 
 #: A match (or observation) this far (px) from its true image position counts as false (ours:
@@ -76,9 +75,7 @@ def match_errors_px(matches, truth) -> np.ndarray:
     return np.maximum(ea, eb)
 
 
-def observation_errors_px(
-    table, truth, square_ids=(), square_xyz_m=None, *, leave_one_out: bool = False
-) -> np.ndarray:
+def observation_errors_px(table, truth, square_ids=(), square_xyz_m=None) -> np.ndarray:
     """Error ``(dx, dy)`` of every observation of the table against its true image position.
 
     Parameters
@@ -90,11 +87,6 @@ def observation_errors_px(
         Ids of the reference squares (their rows are judged against ``square_xyz_m``).
     square_xyz_m : (k, 3) array_like, optional
         The squares' true centres (E, N, U, m).
-    leave_one_out : bool
-        A tie point's observation judged against the median of the ground points of its
-        *other* observations (not its own among them): a reference that does not share the
-        observation it judges (the median of ≥ 3 leans toward each member; the squares are
-        judged against their surveyed centres either way).
 
     Returns
     -------
@@ -122,19 +114,13 @@ def observation_errors_px(
         _, inv = np.unique(pid[tie], return_inverse=True)
         order = np.argsort(inv, kind="stable")
         starts = np.r_[0, np.flatnonzero(np.diff(inv[order])) + 1]
-        ends = np.r_[starts[1:], tie.size]
-        if leave_one_out:
-            ref = np.empty((tie.size, 3))
-            for a, b in zip(starts, ends, strict=True):
-                rows = order[a:b]
-                for j in range(rows.size):
-                    ref[rows[j]] = np.median(g[np.delete(rows, j)], axis=0)
-            P[tie] = ref
-        else:
-            med = np.array(
-                [np.median(g[order[a:b]], axis=0) for a, b in zip(starts, ends, strict=True)]
-            )
-            P[tie] = med[inv]
+        med = np.array(
+            [
+                np.median(g[order[a:b]], axis=0)
+                for a, b in zip(starts, np.r_[starts[1:], tie.size], strict=True)
+            ]
+        )
+        P[tie] = med[inv]
     p = truth.camera.project(P, t, truth.trajectory, band)
     out[:, 0] = x - p[:, 0]
     out[:, 1] = y - p[:, 1]
@@ -175,47 +161,3 @@ def check_point_errors(result, point_ids, cp_ids, cp_xyz_true_m):
     idx = np.array([pos[str(cp_ids[j])] for j in keep], dtype=np.int64)
     xyz = np.asarray(cp_xyz_true_m, float)[keep]
     return result.value("points_m")[idx] - xyz, idx, np.asarray(cp_ids)[keep]
-
-
-def joint_point_covariance(result, index, *, engine_diagonal: bool = True) -> np.ndarray:
-    """The joint a-posteriori covariance of some points of an adjustment, ``(3k, 3k)`` (m²,
-    ordered point by point, E, N, H within a point).
-
-    ``σ0²·(blockdiag V_i⁻¹ + A S⁻¹ Aᵀ)`` with ``A_i = V_i⁻¹ W_iᵀ`` (the Schur complement's
-    back-substitution: every point moves with the non-point unknowns through its own ``A_i``).
-    Without GCPs the check points share one datum error — the whole block shifts together —
-    so their heights are strongly correlated: the per-point 3×3 blocks
-    (:meth:`hsgeo.adjust.AdjustmentResult.point_covariance`) alone make a statistic that does
-    not see that shift (a standard deviation, an NMAD) look as uncertain as one that does (a
-    mean). The diagonal blocks are those of ``point_covariance``.
-
-    The engine exposes only the diagonal blocks; the cross terms are read from the normal
-    equations it keeps for ``point_covariance`` (``keep_jacobian=True``). Falls back to the
-    block-diagonal when those are not there.
-    """
-    idx = np.atleast_1d(np.asarray(index, dtype=np.int64))
-    blocks = np.asarray(result.point_covariance(index=idx), float)
-    k, p = blocks.shape[0], blocks.shape[-1]
-    out = np.zeros((k * p, k * p))
-    for i in range(k):
-        out[i * p : (i + 1) * p, i * p : (i + 1) * p] = blocks[i]
-    f = getattr(result, "_point_cofactors", None)
-    args = getattr(f, "args", ())
-    if k < 2 or len(args) != 2 or getattr(args[0], "V", None) is None:
-        return out
-    ne, S_inv = args
-    if S_inv.shape[0] == 0 or ne.W is None:
-        return out
-    cols = (idx[:, None] * p + np.arange(p)).ravel()
-    Wi = ne.W[:, cols].toarray().T.reshape(k, p, -1)  # (k, p, n_c)
-    Vinv = np.linalg.inv(ne.V[idx])
-    A = np.einsum("kij,kjc->kic", Vinv, Wi).reshape(k * p, -1)
-    s2 = result.sigma0**2 if np.isfinite(result.sigma0) else 1.0
-    cross = s2 * (A @ S_inv @ A.T)
-    for i in range(k):
-        sl = slice(i * p, (i + 1) * p)
-        if engine_diagonal:  # the diagonal blocks as the engine computes them
-            cross[sl, sl] = blocks[i]
-        else:  # this function's own: V_i⁻¹ + A_i S⁻¹ A_iᵀ (a test of the cross terms' A)
-            cross[sl, sl] += s2 * Vinv[i]
-    return 0.5 * (cross + cross.T)
