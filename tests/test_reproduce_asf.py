@@ -66,7 +66,11 @@ def test_provenance_of_the_built_in_agreements(rep):
     the nadir GSD (0.63 m from the paper's own 300 m and 0.12°) is not the paper's 0.7 m."""
     text = {r.quantity: r for r in rep.rows_of("004 text")}
     var = text["ASF variation, largest channel"]
-    assert var.provenance == "tuned" and var.judge()[0] == "by construction"
+    # at this test's scale the spread comes from fewer than 8 runs: "not testable" (report's
+    # rule); at the chapter's scale the tuned agreement is "by construction"; never "reproduced"
+    assert var.provenance == "tuned"
+    expect = "by construction" if (var.n_runs or 0) >= 8 else "not testable"
+    assert var.judge()[0] == expect
     prov = [r.provenance for r in rep.rows_of("004 variation")]
     assert prov[TUNED_CHANNEL] == "tuned" and prov.count("tuned") == 1
     assert ASF_PEAK_TO_PEAK_PERCENT[TUNED_CHANNEL] == ASF_004["ASF variation, largest channel"][0]
