@@ -616,13 +616,25 @@ def as_text(value, sigma=None, *, unit: str = "", sig: int = 4) -> str:
     return text
 
 
+def _myst_glue():
+    """myst-nb's ``glue``: the chapters' glue needs the book's optional extra (``hsgeo[book]``);
+    the library and the command line do not, so it is imported here only, when a chapter glues.
+    """
+    try:
+        from myst_nb import glue
+    except ImportError as exc:  # a wheel installed without the book extra
+        raise ImportError(
+            "hsgeo.report.glue_* need myst-nb, part of the book's extra: pip install 'hsgeo[book]'"
+        ) from exc
+    return glue
+
+
 def glue_text(name: str, value, sigma=None, *, unit: str = "", sig: int = 4) -> str:
     """Glue ``value`` for a chapter's prose as formatted text (:func:`as_text`), never as a
     Python repr: ``{glue:text}`name``` and ``{glue}`name``` both show e.g. ``1.235 µm``. Returns
     the text. Needs myst-nb (the book's environment).
     """
-    from myst_nb import glue
-
+    glue = _myst_glue()
     text = _Prose(as_text(value, sigma, unit=unit, sig=sig))
     glue(name, text, display=False)
     return str(text)
@@ -634,8 +646,8 @@ def glue_value(name: str, value) -> None:
     ending with it shows nothing. Needs myst-nb.
     """
     import numpy as np
-    from myst_nb import glue
 
+    glue = _myst_glue()
     if isinstance(value, np.generic):
         value = value.item()
     glue(name, value, display=False)
@@ -646,8 +658,8 @@ def glue_figure(name: str, fig) -> None:
     cell does not show it a second time). Needs myst-nb.
     """
     import matplotlib.pyplot as plt
-    from myst_nb import glue
 
+    glue = _myst_glue()
     glue(name, fig, display=False)
     plt.close(fig)
 
