@@ -101,7 +101,10 @@ browser: ## install Debian's chromium (apt-get, as root) if it is missing; `make
 book/_build/html/index.html: $(BOOK_SOURCES)
 	$(MAKE) book
 
-check-book: $(STAMP) browser book/_build/html/index.html ## open every page of the built book in headless chromium, offline, and check it (builds the book first if needed)
+book/_build/html-student/index.html: book/_build/html/index.html
+	$(MAKE) book-student
+
+check-book: $(STAMP) browser book/_build/html/index.html book/_build/html-student/index.html ## open every page of the built book (and the student edition's files) in headless chromium, offline, and check them (builds both first if needed)
 	HSGEO_CHECK_BOOK=1 HSGEO_CHROMIUM="$$(command -v chromium || command -v chromium-browser || echo $(CHROMIUM))" \
 	  $(PY) -m pytest -q -p no:cacheprovider -m book tests/book
 

@@ -22,7 +22,8 @@
   Chapters glue numbers with ``hsgeo.report.glue_text``, which formats them; a ``np.float64(…)``
   that still reaches a page is reported by ``make check-book``, not hidden here.
 - **Student edition**: with ``HSGEO_STUDENT=1`` (``make book-student``) the solutions of the
-  exercises are left out (``RemoveSolutions``).
+  exercises are left out of the pages (``RemoveSolutions``) and of every download, the ``.md``
+  sources and the ``.ipynb`` notebooks (``strip_solutions``).
 - **Version**: every page's footer names the hsgeo version the book was built with
   (``hsgeo.__version__``) and how to cite it (``CITATION.cff``).
 """
@@ -115,6 +116,68 @@ def _student_edition(app: Sphinx, config) -> None:
         config.nb_execution_cache_path = cache
 
 
+#: A MyST directive fence opening a solution: ```` ```{solution} ````, ``:::{solution-start}`` …
+_SOLUTION_OPEN = re.compile(r"^(?P<fence>`{3,}|:{3,})\{(?P<kind>solution(?:-start|-end)?)\}")
+
+
+def strip_solutions(text: str) -> str:
+    """MyST Markdown ``text`` without its exercises' solutions (the student edition's downloads).
+
+    Removes every ``{solution}`` directive block, and every gated solution from its
+    ``{solution-start}`` fence to the end of its ``{solution-end}`` fence (the code cells and text
+    between them included). A fence closes on a line of the same character at least as long as
+    its opener, as in MyST; exercises and everything else are kept byte for byte. An unclosed
+    solution is an error, not a silent truncation of the page.
+    """
+    lines = text.splitlines(keepends=True)
+    out: list[str] = []
+    i = 0
+
+    def close_of(start: int, fence: str) -> int:
+        """Index of the line closing the fence opened at ``start``."""
+        for j in range(start + 1, len(lines)):
+            body = lines[j].strip()
+            if body and set(body) == {fence[0]} and len(body) >= len(fence):
+                return j
+        raise ValueError(f"line {start + 1}: solution fence {fence!r} is never closed")
+
+    while i < len(lines):
+        m = _SOLUTION_OPEN.match(lines[i])
+        if m is None:
+            out.append(lines[i])
+            i += 1
+            continue
+        end = close_of(i, m["fence"])
+        if m["kind"] == "solution-start":
+            # through the next {solution-end} block
+            for j in range(end + 1, len(lines)):
+                m_end = _SOLUTION_OPEN.match(lines[j])
+                if m_end is not None and m_end["kind"] == "solution-end":
+                    end = close_of(j, m_end["fence"])
+                    break
+            else:
+                raise ValueError(f"line {i + 1}: {{solution-start}} without a {{solution-end}}")
+        i = end + 1
+        while out and i < len(lines) and not lines[i].strip() and not out[-1].strip():
+            i += 1  # no doubled blank line where the solution was
+    return "".join(out)
+
+
+def _student() -> bool:
+    return os.environ.get("HSGEO_STUDENT") == "1"
+
+
+def _strip_sources(app: Sphinx, exception: Exception | None) -> None:
+    """Student edition: the ``.md`` downloads (Sphinx's ``_sources`` copies) without solutions."""
+    if exception is not None or not _student() or app.builder.format != "html":
+        return
+    sources = Path(app.outdir) / "_sources"
+    for docname in app.env.found_docs:
+        for path in sources.glob(f"{docname}.md*"):
+            if path.suffix in (".md", ".txt") and path.is_file():
+                path.write_text(strip_solutions(path.read_text(encoding="utf-8")), "utf-8")
+
+
 class RemoveSolutions(SphinxTransform):
     """The student edition (``HSGEO_STUDENT=1``): every exercise's solution is removed, after
     sphinx-exercise has merged the gated ones (its ``MergeGatedSolutions``, priority 10).
@@ -161,6 +224,8 @@ def _notebook_of(app: Sphinx, docname: str):
     if source.suffix != ".md":
         return None
     text = source.read_text(encoding="utf-8")
+    if _student():
+        text = strip_solutions(text)
     if not text.startswith("---") or "kernelspec:" not in text.split("\n---", 1)[0]:
         return None
     nb = jupytext.reads(text, fmt="md:myst")
@@ -477,6 +542,7 @@ def setup(app: Sphinx) -> dict:
     app.connect("config-inited", _version_footer)
     app.connect("config-inited", _student_edition)
     app.connect("build-finished", _copy_mathjax)
+    app.connect("build-finished", _strip_sources)
     app.connect("html-page-context", _add_ipynb_download, priority=500)
     app.connect("doctree-resolved", _resolve)
     app.connect("env-updated", _pages_with_run_times)
