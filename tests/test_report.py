@@ -260,12 +260,21 @@ def test_provenance_is_checked_and_survives_json():
 def test_shown_tables_pad_cells_and_right_align_numbers():
     rep = Reproduction("x", 0, [Row("T", "c_px", "px", 3539, 14, 3538.2, 0.9, 3539.0)])
     html = rep.show("T").to_html()
-    assert "padding: 0.3em 0.75em" in html  # cells never touch their neighbours
+    assert "padding: 0.3em 0.5em" in html  # cells never touch their neighbours
+    # every body cell names its column (the phone's cards), the verdict included
+    assert html.count("<td data-label=") == 8 and 'data-label="verdict"' in html
     assert 'class="data row0 col3 hsgeo-num"' in html  # reproduced
     assert 'class="data row0 col0 hsgeo-text"' in html  # quantity
     assert "th.col3 {\n  text-align: right" in html and "th.col0 {\n  text-align: left" in html
     assert "principal distance c" in html and "c_px" not in html
     assert 'class="hsgeo-table"' in rep.verdicts().to_html()
+
+
+def test_sigma_over_runs_shows_its_count_below_the_number():
+    rows = [Row("T", "c_px", "px", 3539, 14, 3538.2, 0.9, 3539.0, n_runs=24)]
+    html = Reproduction("x", 0, rows).show("T").to_html()
+    assert '<br><span class="hsgeo-runs">(24 runs)</span>' in html
+    assert "(24 runs)" in Reproduction("x", 0, rows).to_text()  # the text tables unchanged
 
 
 def test_glued_numbers_are_text_not_reprs():

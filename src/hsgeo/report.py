@@ -32,8 +32,10 @@ format their tables here, in one way:
 
 from __future__ import annotations
 
+import functools
 import json
 import math
+import re
 from dataclasses import dataclass, field
 
 from hsgeo.errors import InputError
@@ -527,7 +529,7 @@ def format_rows(rows: list[Row]):
 
 
 #: Cell padding of the book's tables (also in book/_static/hsgeo.css, for tables made elsewhere).
-_PAD = "0.3em 0.75em"
+_PAD = "0.3em 0.5em"
 
 
 def highlight_below(df, limits: dict, *, fmt: str = "{:.1f}", colour: str = "#f4b6b6"):
@@ -541,6 +543,53 @@ def highlight_below(df, limits: dict, *, fmt: str = "{:.1f}", colour: str = "#f4
 
     cols = list(limits)
     return df.style.apply(shade, subset=cols).format(fmt, subset=cols).hide(axis="index")
+
+
+_RUNS = re.compile(r"^(.*\S) (\((?:mean of )?\d+(?: runs)?\))$")
+
+
+def _runs_on_own_line(value) -> str:
+    """A number cell's HTML: its "(n runs)" / "(mean of n)" note below the number."""
+    text = str(value)
+    m = _RUNS.match(text)
+    return f'{m[1]}<br><span class="hsgeo-runs">{m[2]}</span>' if m else text
+
+
+_HEAD = re.compile(r'<th [^>]*class="col_heading level0 col(\d+)"[^>]*>(.*?)</th>', re.S)
+_CELL = re.compile(r'<td (?!data-label)([^>]*class="data row\d+ col(\d+)[ "])')
+
+
+def with_data_labels(html: str) -> str:
+    """A Styler's HTML table whose every body cell names its column (``data-label``), so that
+    the book's CSS can show each row as a card on a phone, every value beside its column's name
+    (the verdict never beyond a sideways scroll).
+    """
+    import html as html_mod
+
+    names = {
+        int(col): html_mod.escape(re.sub(r"<[^>]+>", "", text).strip(), quote=True)
+        for col, text in _HEAD.findall(html)
+    }
+    return _CELL.sub(lambda m: f'<td data-label="{names.get(int(m[2]), "")}" {m[1]}', html)
+
+
+@functools.cache
+def _card_styler():
+    """The pandas Styler whose HTML carries :func:`with_data_labels` (created on first use: pandas
+    is imported lazily).
+    """
+    from pandas.io.formats.style import Styler
+
+    class CardStyler(Styler):
+        def to_html(self, *args, **kwargs):
+            html = super().to_html(*args, **kwargs)
+            return with_data_labels(html) if isinstance(html, str) else html
+
+        def _repr_html_(self):  # pandas' own calls to_html; labels are added once either way
+            html = super()._repr_html_()
+            return with_data_labels(html) if isinstance(html, str) else html
+
+    return CardStyler
 
 
 def styled(df, numeric: tuple[str, ...] = NUMERIC_COLUMNS):
@@ -562,7 +611,8 @@ def styled(df, numeric: tuple[str, ...] = NUMERIC_COLUMNS):
         for c in df.columns
     }
     style = (
-        df.style.hide(axis="index")
+        _card_styler()(df)
+        .hide(axis="index")
         .set_table_attributes('class="hsgeo-table"')
         .set_td_classes(classes)
         .set_table_styles([{"selector": "th, td", "props": f"padding: {_PAD}"}])
@@ -570,6 +620,9 @@ def styled(df, numeric: tuple[str, ...] = NUMERIC_COLUMNS):
     )
     if num:
         style = style.set_properties(subset=num, **{"text-align": "right", "white-space": "nowrap"})
+        # "0.0052 (24 runs)": the count on a line of its own, so a table of σ over runs fits
+        # its column on a wide screen (the number itself never breaks)
+        style = style.format(_runs_on_own_line, subset=num)
     if text:
         style = style.set_properties(subset=text, **{"text-align": "left"})
     return style

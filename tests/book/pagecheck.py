@@ -144,6 +144,24 @@ async () => {
         + cell.textContent.trim().slice(0, 30) + "» padding " + left + "/" + right + " px");
     }
   }
+  // result tables (hsgeo.report, class hsgeo-table) that hide a column beyond a sideways scroll
+  const hidden_columns = [];
+  let result_tables = 0;
+  for (const table of main.querySelectorAll("table.hsgeo-table")) {
+    if (table.offsetParent === null) continue;
+    result_tables += 1;
+    const box = table.getBoundingClientRect();
+    const beyond = [...table.querySelectorAll("td")].filter((td) => {
+      const r = td.getBoundingClientRect();
+      return r.width > 0 && (r.right > box.right + 1 || r.right > width + 1);
+    });
+    if (table.scrollWidth > table.clientWidth + 1 || beyond.length) {
+      hidden_columns.push(describe(table) + ": " + table.scrollWidth + " px wide in "
+        + table.clientWidth + " px; cells beyond: " + beyond.length
+        + (beyond.length ? " (first «" + beyond[0].textContent.trim().slice(0, 30) + "», column «"
+          + (beyond[0].getAttribute("data-label") || "?") + "»)" : ""));
+    }
+  }
   const hrefs = [...document.querySelectorAll("a[href]")].map((a) => a.getAttribute("href"));
   const downloads = hrefs.filter((h) => /\.ipynb$/.test(h));
   const sources = hrefs.filter((h) => /_sources\/.*\.md$/.test(h));
@@ -168,6 +186,8 @@ async () => {
     slips: slips.slice(0, 8),
     unpadded: unpadded.slice(0, 8),
     table_cells: cells,
+    result_tables: result_tables,
+    hidden_columns: hidden_columns.slice(0, 8),
     footer: [...document.querySelectorAll("footer, .bd-footer, .extra_footer")]
       .map((el) => el.textContent || "").join(" "),
     exercises: main.querySelectorAll(".exercise").length,
@@ -302,6 +322,14 @@ def problems_glue_slips(facts: dict) -> list[str]:
 def problems_cell_padding(facts: dict) -> list[str]:
     """Every table cell has horizontal padding, so no cell's text touches its neighbour's."""
     return [f"unpadded: {d}" for d in facts["unpadded"]]
+
+
+def problems_result_tables(facts: dict) -> list[str]:
+    """Every result table (``hsgeo-table``) shows all its columns without a sideways scroll: on
+    a phone each row is a card (book/_static/hsgeo.css), so σ̂, truth, z and the verdict stay in
+    view.
+    """
+    return [f"result table hides columns: {d}" for d in facts["hidden_columns"]]
 
 
 def problems_version_footer(facts: dict) -> list[str]:

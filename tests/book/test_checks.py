@@ -36,6 +36,7 @@ from pagecheck import (
     problems_nan,
     problems_offline,
     problems_page_width,
+    problems_result_tables,
     problems_version_footer,
 )
 
@@ -137,6 +138,17 @@ CASES = {
         '<table><tr><td style="padding:0 6px">657</td>'
         '<td style="padding:0 6px">20</td></tr></table>',
     ),
+    "result-table-scrolls": (
+        problems_result_tables,
+        '<table class="hsgeo-table" style="display:block; overflow-x:auto; max-width:100%">'
+        "<tr>"
+        + '<td style="white-space:nowrap">'
+        + "0.0052 (24 runs) " * 3
+        + "</td>" * 1
+        + '<td data-label="verdict">within 1σ̂</td></tr></table>',
+        '<table class="hsgeo-table"><tr><td>c</td><td data-label="verdict">within 1σ̂</td></tr>'
+        "</table>",
+    ),
     "version-footer": (
         problems_version_footer,
         "<footer>Built by hand</footer>",
@@ -153,7 +165,7 @@ CASES = {
 @pytest.mark.parametrize("case", list(CASES))
 def test_check_reports_the_defect_and_passes_the_repair(browser, tmp_path, case):
     check, defective, repaired = CASES[case]
-    width = NARROW_PX if check is problems_page_width else WIDE_PX
+    width = NARROW_PX if check in (problems_page_width, problems_result_tables) else WIDE_PX
     bad = page_facts(browser, _page(tmp_path, "bad", defective), width)
     good = page_facts(browser, _page(tmp_path, "good", repaired), width)
     assert check(bad), f"{case}: the defect was not reported"
@@ -208,6 +220,18 @@ pd.DataFrame(np.arange(40.0).reshape(2, 20), columns=[f"column_{i}" for i in ran
 
 ```{code-cell} ipython3
 print("a long output line " * 20)
+```
+
+```{code-cell} ipython3
+from hsgeo.report import styled
+
+styled(pd.DataFrame({
+    "quantity": ["principal distance c", "principal point x0"], "unit": ["px", "px"],
+    "paper": ["3539.0", "12.1"], "reproduced": ["3538.21 (24 runs)", "12.05 (24 runs)"],
+    "σ̂": ["0.0052 (24 runs)", "0.0041 (24 runs)"], "truth": ["3539.00", "12.10"],
+    "z": ["−0.85", "−1.20"], "verdict": ["within 1σ̂", "within 2σ̂"],
+    "provenance": ["the paper's value, simulated", "the paper's value, simulated"],
+}))
 ```
 
 ```{code-cell} ipython3
@@ -280,6 +304,7 @@ def test_synthetic_chapter_passes_every_check(browser, demo_book, width):
         + problems_glue_slips(facts)
         + problems_cell_padding(facts)
         + problems_version_footer(facts)
+        + problems_result_tables(facts)
     )
     assert problems == []
     # the checks saw what they check, so passing is not vacuous
@@ -287,6 +312,7 @@ def test_synthetic_chapter_passes_every_check(browser, demo_book, width):
     assert facts["exercises"] >= 1 and facts["solutions"] >= 1
     assert facts["ipynb_links"]
     assert facts["table_cells"] >= 10  # the padding check measured the tables
+    assert facts["result_tables"] >= 1  # and a report table, as cards at 400 px
 
 
 def test_synthetic_chapter_infrastructure(demo_book):
@@ -299,5 +325,5 @@ def test_synthetic_chapter_infrastructure(demo_book):
     import nbformat
 
     nb = nbformat.read(demo_book / "_sources" / "chapters" / "demo.ipynb", as_version=4)
-    assert [c.cell_type for c in nb.cells].count("code") == 3
+    assert [c.cell_type for c in nb.cells].count("code") == 4
     assert "Run it yourself" in html and "Run time measured when this book was built" in html

@@ -31,6 +31,7 @@ from pagecheck import (
     problems_nan,
     problems_offline,
     problems_page_width,
+    problems_result_tables,
     problems_version_footer,
 )
 
@@ -112,6 +113,12 @@ def test_nothing_clipped_at_1400px(facts):
 @_params(DOCS, NARROW_PX)
 def test_no_sideways_scroll_at_400px(facts):
     _check(problems_page_width(facts), facts)
+
+
+@_params(DOCS, NARROW_PX)
+def test_result_tables_show_every_column_at_400px(facts):
+    """σ̂, truth, z and the verdict of every result table in view on a phone (cards)."""
+    _check(problems_result_tables(facts), facts)
 
 
 @_params(DOCS, NARROW_PX)
