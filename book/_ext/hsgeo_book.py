@@ -517,8 +517,24 @@ def _glued_text_without_quotes(doctree: nodes.document) -> None:
         node["classes"] = ["pasted-text"]
 
 
+def _alt_from_captions(doctree: nodes.document) -> None:
+    """Every image of a captioned figure without a real alt text (myst-nb writes the output's
+    hashed file path) gets its caption as alt text, for screen readers and text browsers.
+    """
+    for figure in doctree.findall(nodes.figure):
+        captions = list(figure.findall(nodes.caption))
+        if not captions:
+            continue
+        text = re.sub(r"\s+", " ", captions[0].astext()).strip()
+        for image in figure.findall(nodes.image):
+            alt = image.get("alt", "")
+            if not alt or alt == image.get("uri") or re.search(r"[/\\]|\.(png|svg|jpe?g)$", alt):
+                image["alt"] = text
+
+
 def _resolve(app: Sphinx, doctree: nodes.document, docname: str) -> None:
     _glued_text_without_quotes(doctree)
+    _alt_from_captions(doctree)
     for node in list(doctree.findall(RunTimesNode)):
         node.replace_self(_run_times_table(app, docname))
     if docname.startswith(CHAPTER_PREFIX) and app.builder.format == "html":

@@ -55,6 +55,15 @@ async () => {
       uncaptioned.push(describe(img.closest(".cell") || img) + " " + (img.src || ""));
     }
   }
+  // images a screen reader cannot describe: no alt text, or a file path as alt text
+  const no_alt = [];
+  for (const img of main.querySelectorAll("img")) {
+    if (img.closest("mjx-container, button, a.headerlink")) continue;
+    const alt = (img.getAttribute("alt") || "").trim();
+    if (!alt || /[\/\\]|\.(png|svg|jpe?g)$/i.test(alt)) {
+      no_alt.push(describe(img.closest("figure") || img) + " alt «" + alt.slice(0, 40) + "»");
+    }
+  }
   const figures = main.querySelectorAll("figure").length;
   const nan_cells = [];
   for (const cell of main.querySelectorAll("table td, table th")) {
@@ -175,6 +184,7 @@ async () => {
     images: images.length,
     figures: figures,
     uncaptioned: uncaptioned,
+    no_alt: no_alt.slice(0, 8),
     nan_cells: nan_cells,
     scroll_width: document.scrollingElement.scrollWidth,
     inner_width: width,
@@ -254,6 +264,11 @@ def problems_offline(facts: dict) -> list[str]:
 def problems_captions(facts: dict) -> list[str]:
     """Every image is part of a figure with a caption."""
     return [f"figure without caption: {d}" for d in facts["uncaptioned"]]
+
+
+def problems_alt_text(facts: dict) -> list[str]:
+    """Every image has an alt text that describes it (a figure's caption), not a file path."""
+    return [f"image without a description: {d}" for d in facts["no_alt"]]
 
 
 def problems_nan(facts: dict) -> list[str]:

@@ -24,6 +24,7 @@ from pagecheck import (
     NARROW_PX,
     WIDE_PX,
     page_facts,
+    problems_alt_text,
     problems_captions,
     problems_cell_padding,
     problems_clipped,
@@ -81,6 +82,13 @@ CASES = {
         problems_captions,
         f'<figure><img src="{PNG_1PX}"><figcaption> </figcaption></figure>',
         f'<figure><img src="{PNG_1PX}"><figcaption>Fig. 1</figcaption></figure>',
+    ),
+    "image-alt-is-a-path": (
+        problems_alt_text,
+        f'<figure><img src="{PNG_1PX}" alt="../_images/3f2a9c.png"><figcaption>Fig. 1</figcaption>'
+        "</figure>",
+        f'<figure><img src="{PNG_1PX}" alt="Fig. 1: a pixel"><figcaption>Fig. 1</figcaption>'
+        "</figure>",
     ),
     "nan-in-table": (
         problems_nan,
@@ -294,6 +302,7 @@ def test_synthetic_chapter_passes_every_check(browser, demo_book, width):
         problems_equations(facts)
         + problems_offline(facts)
         + problems_captions(facts)
+        + problems_alt_text(facts)
         + problems_nan(facts)
         + problems_page_width(facts)
         + problems_clipped(facts)

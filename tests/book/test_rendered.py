@@ -19,6 +19,7 @@ from pagecheck import (
     NARROW_PX,
     WIDE_PX,
     page_facts,
+    problems_alt_text,
     problems_captions,
     problems_cell_padding,
     problems_clipped,
@@ -98,6 +99,11 @@ def test_offline(facts):
 @_params(DOCS, WIDE_PX)
 def test_figures_captioned(facts):
     _check(problems_captions(facts), facts)
+
+
+@_params(DOCS, WIDE_PX)
+def test_images_have_alt_text(facts):
+    _check(problems_alt_text(facts), facts)
 
 
 @_params(DOCS, WIDE_PX)
