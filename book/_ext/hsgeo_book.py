@@ -517,6 +517,32 @@ def _glued_text_without_quotes(doctree: nodes.document) -> None:
         node["classes"] = ["pasted-text"]
 
 
+#: A hyphen-minus written as a minus sign: at the start of a word, before a digit ("-0.8 σ̂",
+#: "(-3.1, 2.0)"), not inside one ("2-3 s", "2026-11-28", "EPSG:25832+5941").
+_HYPHEN_MINUS = re.compile(r"(?:(?<=^)|(?<=[\s(\[=:,;/]))-(?=\d)")
+#: Nodes whose text is code or math, kept as written.
+_VERBATIM = (nodes.literal, nodes.literal_block, nodes.math, nodes.math_block, nodes.raw)
+
+
+def _true_minus_signs(doctree: nodes.document) -> None:
+    """Running text's numbers get a true minus sign (U+2212), as the tables have (glued values
+    and sentences formatted with ``:+.2f`` wrote a hyphen); code, math and raw HTML keep theirs.
+    """
+    for text in list(doctree.findall(nodes.Text)):
+        if not _HYPHEN_MINUS.search(text.astext()):
+            continue
+        parent = text.parent
+        if parent is None or any(isinstance(a, _VERBATIM) for a in _ancestors(parent)):
+            continue
+        parent.replace(text, nodes.Text(_HYPHEN_MINUS.sub("\u2212", text.astext())))
+
+
+def _ancestors(node: nodes.Node):
+    while node is not None:
+        yield node
+        node = node.parent
+
+
 def _alt_from_captions(doctree: nodes.document) -> None:
     """Every image of a captioned figure without a real alt text (myst-nb writes the output's
     hashed file path) gets its caption as alt text, for screen readers and text browsers.
@@ -535,6 +561,7 @@ def _alt_from_captions(doctree: nodes.document) -> None:
 def _resolve(app: Sphinx, doctree: nodes.document, docname: str) -> None:
     _glued_text_without_quotes(doctree)
     _alt_from_captions(doctree)
+    _true_minus_signs(doctree)
     for node in list(doctree.findall(RunTimesNode)):
         node.replace_self(_run_times_table(app, docname))
     if docname.startswith(CHAPTER_PREFIX) and app.builder.format == "html":

@@ -138,6 +138,14 @@ async () => {
     if (rep) slips.push("repeated word «" + rep[0] + "» in " + describe(el));
     const range = t.match(/(?<![\d.,])(\d+(?:\.\d+)?)\s*(?:–|to)\s*\1(?![\d.]*\d)/);
     if (range) slips.push("range with equal ends «" + range[0] + "» in " + describe(el));
+    // the machinery's words in what a reader reads: the developers' guide, internal keys
+    // (lever_arm_m[z_m]), a hyphen-minus for a minus sign (−0.8, not -0.8)
+    const guide = t.match(/\bGUIDE\b.{0,20}/);
+    if (guide) slips.push("the developers' GUIDE «" + guide[0] + "» in " + describe(el));
+    const key = t.match(/\b[a-z][a-z0-9]*_[a-z0-9_]*\[[^\]\s]+\]/);
+    if (key) slips.push("an internal key «" + key[0] + "» in " + describe(el));
+    const minus = t.match(/(?:^|[\s(\[=:,;])-\d[\d.]*/);
+    if (minus) slips.push("a hyphen for a minus «" + minus[0].trim() + "» in " + describe(el));
   }
   // table cells whose text would touch their neighbour's: no horizontal padding
   const unpadded = [];

@@ -140,6 +140,21 @@ CASES = {
         "<p>precision estimates of 1.3–1.3 µm</p>",
         "<p>precision estimates of 1.3–1.35 µm and 13–130 px</p>",
     ),
+    "developers-guide": (
+        problems_glue_slips,
+        "<p>not testable (GUIDE §4)</p>",
+        "<p>not testable (fewer than 8 runs)</p>",
+    ),
+    "internal-key": (
+        problems_glue_slips,
+        "<p>lever_arm_m[z_m] is 0.1 m</p>",
+        "<p>the lever arm's z is 0.1 m; <code>lever_arm_m[z_m]</code> in code</p>",
+    ),
+    "hyphen-minus": (
+        problems_glue_slips,
+        "<p>f moves by -0.8 σ̂</p>",
+        "<p>f moves by −0.8 σ̂ over 2-3 s in EPSG:25832+5941 on 2026-11-28</p>",
+    ),
     "unpadded-cells": (
         problems_cell_padding,
         '<table><tr><td style="padding:0">657</td><td style="padding:0">20</td></tr></table>',
@@ -214,6 +229,7 @@ $$
 $$
 
 and a long path in text: `data_synthetic/generated/a_very_long_file_name_without_breaks.parquet`.
+A sentence formatted with a hyphen for a minus: z moves by -0.8 σ̂ in 2-3 s, `x = -1` in code.
 
 | quantity | unit | paper | reproduced | σ̂ | truth | z | verdict | note | more |
 |---|---|---|---|---|---|---|---|---|---|
@@ -336,3 +352,5 @@ def test_synthetic_chapter_infrastructure(demo_book):
     nb = nbformat.read(demo_book / "_sources" / "chapters" / "demo.ipynb", as_version=4)
     assert [c.cell_type for c in nb.cells].count("code") == 4
     assert "Run it yourself" in html and "Run time measured when this book was built" in html
+    assert "moves by \u22120.8 σ̂ in 2-3 s" in html  # a true minus in the prose only
+    assert '<span class="pre">-1</span>' in html  # code keeps its hyphen

@@ -70,7 +70,7 @@ PAPER_BLOCK_KM2 = 0.36
 _N_DRAWS = 2000
 _ONE_CAMPAIGN = (
     "one simulated campaign: the count has no spread over campaigns to judge a difference by "
-    "(GUIDE §4: a claim about a distribution rests on ≥ 8 seeds)"
+    "(a claim about a distribution rests on ≥ 8 campaigns)"
 )
 
 
