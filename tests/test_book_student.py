@@ -21,6 +21,7 @@ pytest.importorskip("sphinx")
 hsgeo_book = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(hsgeo_book)
 strip_solutions = hsgeo_book.strip_solutions
+import hsgeo_notebooks  # noqa: E402  (book/_ext, put on sys.path by hsgeo_book)
 
 PAGES = sorted(p for p in BOOK.rglob("*.md") if "_build" not in p.parts)
 WITH_SOLUTIONS = [p for p in PAGES if "{solution" in p.read_text(encoding="utf-8")]
@@ -71,3 +72,44 @@ def test_unclosed_solution_is_an_error():
         strip_solutions("````{solution} ex-a\nThe answer.\n```\n")
     with pytest.raises(ValueError, match="without a"):
         strip_solutions("````{solution-start} ex-a\n````\n\nsecret\n")
+
+
+# --- the downloads' text, readable in plain Jupyter ----------------------------------------
+
+
+def test_readable_markdown_writes_glued_values_and_role_texts():
+    md = (
+        "(sec-x)=\n## Results\n\n"
+        "The RMS is {glue:text}`rms` px ({glue:text}`z:.1f` σ̂), see {term}`GSD`, "
+        "{term}`ground distance <GSD>`, {cite:t}`Muller2002` and {numref}`fig-a`; "
+        "{math}`\\sigma_0`.\n\n"
+        "````{exercise} ★ The borderline\n:label: ex-a\n\nCompute it.\n```python\nx = 1\n```\n"
+        "````\n\n"
+        ":::{admonition} What was tuned\n:class: note\nNothing.\n:::"
+    )
+    out = hsgeo_notebooks.readable_markdown(md, {"rms": "0.34", "z": -0.8123})
+    assert "The RMS is 0.34 px (-0.8 σ̂), see GSD, ground distance, [Muller2002] and fig-a" in out
+    assert "$\\sigma_0$" in out
+    assert "**Exercise: ★ The borderline**" in out and ":label:" not in out
+    assert "```python\nx = 1\n```" in out  # a code block inside the exercise kept
+    assert "**Admonition: What was tuned**" in out and ":class:" not in out
+    assert "{" not in out.replace("{glue", "") and "(sec-x)=" not in out
+    assert "````" not in out and ":::" not in out
+
+
+def test_outputs_attach_by_source_so_a_removed_cell_takes_none():
+    import nbformat
+    from nbformat.v4 import new_code_cell, new_notebook, new_output
+
+    executed = new_notebook(
+        cells=[
+            new_code_cell("a = 1", outputs=[new_output("stream", text="one")], execution_count=1),
+            new_code_cell("secret()", outputs=[new_output("stream", text="42")], execution_count=2),
+            new_code_cell("a + 1", outputs=[new_output("stream", text="two")], execution_count=3),
+        ]
+    )
+    student = new_notebook(cells=[new_code_cell("a = 1"), new_code_cell("a + 1")])
+    assert hsgeo_notebooks.attach_outputs(student, executed) == 2
+    assert [c.outputs[0]["text"] for c in student.cells] == ["one", "two"]
+    assert [c.execution_count for c in student.cells] == [1, 3]
+    assert nbformat.validate(student) is None

@@ -9,8 +9,9 @@
   the menu, the accessibility and speech components; not the SVG output, the other combined
   components or the TypeScript sources.
 - **Notebook downloads**: every page written as a MyST Markdown notebook is converted with
-  jupytext into ``_sources/<page>.ipynb`` (code and text, no outputs), and sphinx-book-theme's
-  download menu offers it next to the ``.md`` source.
+  jupytext into ``_sources/<page>.ipynb`` with the build's outputs and its glued numbers written
+  into the text (``hsgeo_notebooks.readable_notebook``: it opens in plain Jupyter), and
+  sphinx-book-theme's download menu offers it next to the ``.md`` source.
 - **"Run it yourself"**: every chapter page (``chapters/*``) gets a collapsible box saying how
   to run it, with the run time that myst-nb measured when it executed the chapter (or when it
   was put into the execution cache).
@@ -36,6 +37,7 @@ import inspect
 import os
 import re
 import shutil
+import sys
 from datetime import UTC, datetime
 from pathlib import Path
 
@@ -47,6 +49,9 @@ from sphinx.transforms import SphinxTransform
 from sphinx.transforms.post_transforms import SphinxPostTransform
 from sphinx.util import logging
 from sphinx.util.docutils import SphinxDirective
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # the book's other local module
+from hsgeo_notebooks import readable_notebook  # noqa: E402
 
 LOGGER = logging.getLogger(__name__)
 
@@ -243,6 +248,9 @@ def _add_ipynb_download(app: Sphinx, pagename: str, templatename, context, doctr
     import jupytext
 
     nb.metadata.pop("jupytext", None)  # a plain notebook, not paired with a text file
+    # with the build's outputs and glued numbers, readable in plain Jupyter (hsgeo_notebooks)
+    folder = Path(app.env.mystnb_config.output_folder)
+    readable_notebook(nb, folder / f"{pagename}.ipynb", folder / f"{pagename}.glue.json")
     target = Path(app.outdir) / "_sources" / f"{pagename}.ipynb"
     target.parent.mkdir(parents=True, exist_ok=True)
     jupytext.write(nb, target, fmt="ipynb")

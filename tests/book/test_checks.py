@@ -247,6 +247,15 @@ print("a long output line " * 20)
 ```
 
 ```{code-cell} ipython3
+:tags: [remove-cell]
+from hsgeo.report import glue_text
+
+glue_text("demo_c", 3538.214, 0.93, unit="px")
+```
+
+The principal distance is {glue:text}`demo_c`.
+
+```{code-cell} ipython3
 from hsgeo.report import styled
 
 styled(pd.DataFrame({
@@ -350,7 +359,12 @@ def test_synthetic_chapter_infrastructure(demo_book):
     import nbformat
 
     nb = nbformat.read(demo_book / "_sources" / "chapters" / "demo.ipynb", as_version=4)
-    assert [c.cell_type for c in nb.cells].count("code") == 4
+    assert [c.cell_type for c in nb.cells].count("code") == 5
+    # the download opens in plain Jupyter with its numbers: outputs and glued values
+    assert sum(bool(c.get("outputs")) for c in nb.cells if c.cell_type == "code") >= 4
+    text = "\n".join(c.source for c in nb.cells if c.cell_type == "markdown")
+    assert "The principal distance is 3538.21 px." in text
+    assert "{glue" not in text and "{exercise}" not in text and "**Exercise" in text
     assert "Run it yourself" in html and "Run time measured when this book was built" in html
     assert "moves by \u22120.8 σ̂ in 2-3 s" in html  # a true minus in the prose only
     assert '<span class="pre">-1</span>' in html  # code keeps its hyphen
