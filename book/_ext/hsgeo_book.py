@@ -382,8 +382,8 @@ def _run_box(app: Sphinx, docname: str) -> nodes.admonition:
     box += _literal("make book   # creates .venv from requirements.lock, then book/_build/html")
     para = nodes.paragraph()
     para += nodes.Text(
-        "To run only this chapter, create the environment once and execute the "
-        "downloaded notebook, or open it in Jupyter with the "
+        "To run only this chapter, create the environment once, then open the downloaded "
+        "notebook (it holds this page's outputs and numbers) in JupyterLab with the "
     )
     para += nodes.literal(text="python3")
     para += nodes.Text(" kernel of ")
@@ -392,7 +392,10 @@ def _run_box(app: Sphinx, docname: str) -> nodes.admonition:
     para += nodes.literal(text="HSGEO_SCALE=small")
     para += nodes.Text(" for the reduced size the tests use):")
     box += para
-    box += _literal(f"make venv\n.venv/bin/jupyter execute --inplace {name}.ipynb")
+    box += _literal(
+        f"make venv\n.venv/bin/jupyter lab {name}.ipynb               # read and run it\n"
+        f".venv/bin/jupyter execute --inplace {name}.ipynb   # or run it all"
+    )
     if "install" in app.env.all_docs:
         para = nodes.paragraph()
         para += nodes.Text("To install the library elsewhere (with pip, or as a wheel from ")
