@@ -45,8 +45,9 @@ proj-data: ## install Debian's proj-data (PROJ's geoid grids: EGM96) if missing 
 data: $(STAMP) ## regenerate data_synthetic/generated from the scenario TOMLs and verify the SHA-256 manifest
 	$(PY) -m hsgeo.cli data --verify
 
-test: $(STAMP) proj-data ## the whole test suite, chapters included (about 6 min on 2 cores)
+test: $(STAMP) proj-data ## the docstrings' examples (doctest) and the whole test suite, chapters included
 	$(PY) -m hsgeo.cli data --verify
+	$(PY) -m pytest -q -p no:cacheprovider --doctest-modules src/hsgeo
 	$(PY) -m pytest -q tests
 
 test-fast: $(STAMP) proj-data ## the test suite without the chapter executions and slow Monte Carlo tests
