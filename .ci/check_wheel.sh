@@ -48,6 +48,6 @@ step lp-observations in/STRIP_*.nc --trajectory in/NAV.csv --camera in/CAM.toml 
 g = pd.read_csv('in/GCP.csv', dtype={'point_id': str}); g[g['point_id'].isin(o)].to_csv('GCP.csv', index=False)"
 json adjust-pushbroom OBS.parquet --trajectory in/NAV.csv --camera in/CAM.toml \
   --gcp GCP.csv --node-interval 10 --json
-step orthorectify in/STRIP_*.nc --trajectory in/NAV.csv --sensor in/CAM.toml --dsm in/DSM.tif \
-  --resolution 2 -o mosaic.tif
+step orthorectify in/STRIP_*.nc --trajectory in/NAV.csv --site 59.665,10.775,0 \
+  --nav-crs EPSG:4937 --sensor in/CAM.toml --dsm in/DSM.tif --resolution 2 -o mosaic.tif
 echo "check-wheel: the installed wheel ran every command above from an empty folder"

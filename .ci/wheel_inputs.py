@@ -60,10 +60,13 @@ nav = obs.navigation
 e, n_, h = SITE_AAS.enu_to_map(xyz[:, 0], xyz[:, 1], xyz[:, 2])
 xs, ys, _ = SITE_AAS.enu_to_map(nav.xyz_m[:, 0], nav.xyz_m[:, 1], nav.xyz_m[:, 2])
 grid = MapGrid.covering(
-    (xs.min() - 1500, xs.max() + 1500), (ys.min() - 1500, ys.max() + 1500), 20.0
+    (xs.min() - 1500, xs.max() + 1500),
+    (ys.min() - 1500, ys.max() + 1500),
+    20.0,
+    f"EPSG:{SITE_AAS.map_epsg}",
 )
 z = np.full((grid.y_m.size, grid.x_m.size), float(np.median(h)))
-write_geotiff(d / "DSM.tif", z, grid.transform, 25832)
+write_geotiff(d / "DSM.tif", z, grid.transform, SITE_AAS.map_epsg)
 
 # a slanted edge (5 deg), Gaussian blur sigma 0.6 px, 8x supersampled pixel aperture
 

@@ -57,7 +57,12 @@ def scene(n_lines: int, n_px: int = 900):
     x0, y0 = (float(v) for v in F.enu_to_map(0.0, 0.0, 0.0)[:2])
     gsd, v = 1875.0 * 0.0065 / 40.0, 67.0
     length = n_lines * gsd
-    g = MapGrid.covering((x0 - 400, x0 + 400), (y0 - length / 2 - 200, y0 + length / 2 + 200), 2.0)
+    g = MapGrid.covering(
+        (x0 - 400, x0 + 400),
+        (y0 - length / 2 - 200, y0 + length / 2 + 200),
+        2.0,
+        f"EPSG:{F.map_epsg}",
+    )
     X, Y = np.meshgrid(g.x_m - x0, g.y_m - y0)
     terrain = MapTerrain(100.0 + 4.0 * np.exp(-(X**2 + Y**2) / 2 / 80.0**2), g, F)
     cam = PushbroomCamera(c_mm=(40.0,), pixel_mm=0.0065)
@@ -97,7 +102,7 @@ def _in_memory(strips, terrain, frame):
     allb = np.concatenate(
         [strip_footprints(s, terrain, frame, 256, "EPSG:25832")[1] for s in strips]
     )
-    grid = MapGrid.covering(allb[:, [0, 2]].ravel(), allb[:, [1, 3]].ravel(), 0.3)
+    grid = MapGrid.covering(allb[:, [0, 2]].ravel(), allb[:, [1, 3]].ravel(), 0.3, "EPSG:25832")
     best = np.full((3, grid.height, grid.width), np.nan, np.float32)
     rank = np.full((grid.height, grid.width), np.inf)
     for s in strips:
@@ -116,6 +121,7 @@ def _in_memory(strips, terrain, frame):
             off,
             grid,
             0.55 * np.hypot(0.31, 0.31) + 0.15,
+            frame.datum_epsg,
         )
         win = r < rank
         best[:, win], rank[win] = v[:, win], r[win]

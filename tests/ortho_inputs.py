@@ -19,6 +19,14 @@ from hsgeo.sensors.pushbroom import PushbroomCamera
 from hsgeo.simulate.ortho_scene import SquaresScene, lazy_cube, render_lines, straight_flight
 
 FRAME = SITE_AAS
+#: ``hsgeo orthorectify``'s options for FRAME (a local-ENU navigation names its origin, --site, on
+#: its datum, --nav-crs): the paper's site is the test's input, never the command's default.
+SITE_ARGS = [
+    "--site",
+    f"{FRAME.lat_deg!r},{FRAME.lon_deg!r},{FRAME.h_m!r}",
+    "--nav-crs",
+    f"EPSG:{FRAME.datum_epsg}",
+]
 HEIGHT_M = 1875.0
 SPEED_M_S = 67.0
 GSD_M = HEIGHT_M * 0.0065 / 40.0
@@ -36,6 +44,7 @@ def dsm(pad_m: float = 250.0, cell_m: float = 2.0, shift_xy=(0.0, 0.0)):
         (x0 - pad_m + shift_xy[0], x0 + pad_m + shift_xy[0]),
         (y0 - pad_m + shift_xy[1], y0 + pad_m + shift_xy[1]),
         cell_m,
+        f"EPSG:{FRAME.map_epsg}",
     )
     X, Y = np.meshgrid(grid.x_m - x0, grid.y_m - y0)
     z = 100.0 + 4.0 * np.exp(-(X**2 + Y**2) / (2 * 60.0**2)) + 0.01 * X

@@ -6,7 +6,7 @@ import json
 
 import numpy as np
 import pytest
-from ortho_inputs import GSD_M, squares_xy, write_ortho_inputs
+from ortho_inputs import GSD_M, SITE_ARGS, squares_xy, write_ortho_inputs
 
 from hsgeo.cli import main
 
@@ -17,6 +17,7 @@ def _argv(f, out, *extra, adjustment=True):
         *map(str, f["lines"]),
         "--trajectory",
         str(f["nav"]),
+        *SITE_ARGS,
         "--sensor",
         str(f["camera"]),
         "--dsm",

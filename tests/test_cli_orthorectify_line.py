@@ -5,6 +5,7 @@ core the command runs."""
 import numpy as np
 import pytest
 import xarray as xr
+from ortho_inputs import SITE_ARGS
 
 from hsgeo import InputError
 from hsgeo.crs import SITE_AAS, LocalFrame
@@ -38,7 +39,9 @@ def test_orthorectify_places_pixels_where_they_belong():
     g = ground_points(sensor, nav, t, zeta, PlaneTerrain(0.0))
     vals = np.stack([g[..., 0], g[..., 1]], axis=-1)
     line = OrthoInputs((Strip(sensor, nav, t, zeta, vals),), PlaneTerrain(0.0))
-    da = orthorectify(line, OrthoOptions(resolution_m=0.5, crs=SITE_AAS.local_crs())).compute()
+    da = orthorectify(
+        line, OrthoOptions(resolution_m=0.5, crs=SITE_AAS.local_crs(), frame=SITE_AAS)
+    ).compute()
     X, Y = np.meshgrid(da["x"], da["y"])
     ok = np.isfinite(da.values[0])
     assert ok.mean() > 0.5
@@ -62,7 +65,7 @@ def _line_setup(tmp_path, n_lines: int, out="o.nc") -> tuple:
     )
     argv = ["orthorectify", str(tmp_path / "lines.nc"), "--trajectory", str(tmp_path / "nav.csv")]
     argv += ["--sensor", str(tmp_path / "sensor.toml"), "--height", "3", "--resolution", "0.5"]
-    argv += ["--crs", SITE_AAS.local_crs(), "--quiet"]
+    argv += ["--crs", SITE_AAS.local_crs(), *SITE_ARGS, "--quiet"]
     return argv, nav, zeta
 
 
@@ -93,7 +96,7 @@ def test_a_line_end_to_end_and_the_core_it_runs(tmp_path):
     )
     core = orthorectify(
         OrthoInputs((strip,), PlaneTerrain(3.0)),
-        OrthoOptions(resolution_m=0.5, crs=SITE_AAS.local_crs()),
+        OrthoOptions(resolution_m=0.5, crs=SITE_AAS.local_crs(), frame=SITE_AAS),
     ).compute()
     np.testing.assert_array_equal(core.values, ds["radiance"].values)
     bad = [*argv, "-o", str(tmp_path / "x.nc")]
@@ -136,7 +139,7 @@ def test_the_002_camera_file_on_a_line(tmp_path):
     write_lines(tmp_path / "lines.nc", g[..., 0], x, t0_s=0.0, line_rate_hz=8.0)
     args = ["orthorectify", str(tmp_path / "lines.nc"), "--trajectory", str(tmp_path / "nav.csv")]
     args += ["--sensor", str(tmp_path / "camera.toml"), "--height", "3", "--quiet"]
-    args += ["--resolution", "0.5", "--crs", SITE_AAS.local_crs()]
+    args += ["--resolution", "0.5", "--crs", SITE_AAS.local_crs(), *SITE_ARGS]
     assert main(args + ["-o", str(tmp_path / "o.nc"), "--band", "1"]) == 0
     ds = xr.open_dataset(tmp_path / "o.nc")
     X = np.broadcast_to(ds["x"].values, ds["radiance"].shape[1:])
@@ -165,10 +168,10 @@ def test_the_outputs_carry_the_crs_asked_for(tmp_path):
     from hsgeo.cli import main
     from hsgeo.crs import lonlat_to_crs
 
-    frame = LocalFrame(45.0, 13.9, 20.0)
+    frame = LocalFrame(45.0, 13.9, 20.0, datum_epsg=4937)  # ETRS89, as --nav-crs of SITE_ARGS
     argv = _line_setup(tmp_path, n_lines=40)[0]
     argv[argv.index("--crs") + 1] = frame.local_crs()
-    argv += ["--site", "45.0,13.9,20"]
+    argv[argv.index("--site") + 1] = "45.0,13.9,20"
     assert main([*argv, "-o", str(tmp_path / "o.nc")]) == 0
     assert main([*argv, "-o", str(tmp_path / "o.hdr")]) == 0
     ds = xr.open_dataset(tmp_path / "o.nc")
@@ -180,7 +183,9 @@ def test_the_outputs_carry_the_crs_asked_for(tmp_path):
             assert (src.transform.a, src.transform.e) == (0.5, -0.5)
     E, N = float(ds["x"].values[3]), float(ds["y"].values[5])
     lon, lat, _ = frame.enu_to_lonlat(E, N, 3.0)
-    np.testing.assert_allclose(lonlat_to_crs(frame.local_crs(), lon, lat), (E, N), atol=1e-3)
+    np.testing.assert_allclose(
+        lonlat_to_crs(frame.local_crs(), lon, lat, frame.datum_epsg), (E, N), atol=1e-3
+    )
 
 
 def test_terrain_is_one_of_dsm_or_height(tmp_path):
@@ -193,4 +198,73 @@ def test_terrain_is_one_of_dsm_or_height(tmp_path):
             tmp_path / "nav.csv",
             tmp_path / "sensor.toml",
             output=tmp_path / "y.nc",
+            site=(59.665, 10.775, 0.0),
         )
+
+
+def test_a_local_enu_navigation_needs_its_site(tmp_path, capsys):
+    """No site is a default (issue 38): a local-ENU navigation without ``--site`` is refused
+    before any work, exit 2, naming the option; with ``--json`` the same line as JSON."""
+    import json
+
+    from hsgeo.cli import main
+
+    argv = _line_setup(tmp_path, n_lines=20)[0]
+    i = argv.index("--site")
+    argv = argv[:i] + argv[i + 2 :]  # --site and its value out; --nav-crs stays (--site's datum)
+    assert main([*argv, "-o", str(tmp_path / "o.nc")]) == 2
+    err = capsys.readouterr().err
+    assert "--site LAT,LON[,H] is needed" in err and "nav.csv" in err and "Traceback" not in err
+    assert not (tmp_path / "o.nc").exists()
+    assert main([*argv, "-o", str(tmp_path / "o.nc"), "--json"]) == 2
+    out = json.loads(capsys.readouterr().out)
+    assert out["ok"] is False and out["exit_status"] == 2 and "--site" in out["error"]
+
+
+def test_a_local_enu_flight_in_sydney_lands_where_pyproj_puts_it(tmp_path):
+    """``--site=-33.9,151.2`` (no --nav-crs: WGS 84): the output CRS is WGS 84 / UTM 56S
+    (EPSG:32756, :func:`hsgeo.crs.default_output_crs` of the site, as a geodetic navigation's
+    centre gets) and every cell holds the pixel whose ground point pyproj alone (topocentric
+    about the site on WGS 84 → geographic → EPSG:32756) puts nearest to it."""
+    from pyproj import CRS, Transformer
+    from pyproj.enums import TransformDirection
+
+    from hsgeo.cli import main
+
+    argv, nav, zeta = _line_setup(tmp_path, n_lines=40)
+    i = argv.index("--crs")
+    argv = argv[:i] + argv[i + 2 :]  # the default output CRS
+    i = argv.index("--site")
+    argv[i : i + 2] = ["--site=-33.9,151.2"]  # a negative value: in the option's word
+    i = argv.index("--nav-crs")
+    argv = argv[:i] + argv[i + 2 :]  # the site's datum: WGS 84 by default
+    assert main([*argv, "-o", str(tmp_path / "o.nc"), "--json"]) == 0
+    ds = xr.open_dataset(tmp_path / "o.nc")
+    assert CRS.from_wkt(ds["spatial_ref"].attrs["crs_wkt"]) == CRS.from_epsg(32756)
+    # pyproj alone: the cell centres in EPSG:32756 -> WGS 84 -> the site's ENU
+    to_ll = Transformer.from_crs(32756, 4979, always_xy=True)
+    enu = Transformer.from_pipeline(
+        "+proj=pipeline +step +proj=unitconvert +xy_in=deg +xy_out=rad +step +proj=cart "
+        "+ellps=WGS84 +step +proj=topocentric +lat_0=-33.9 +lon_0=151.2 +h_0=0 +ellps=WGS84"
+    )
+    X, Y = np.meshgrid(ds["x"].values, ds["y"].values)
+    v = ds["radiance"].values[0]
+    ok = np.isfinite(v)
+    assert ok.sum() > 1000
+    lon, lat, _ = to_ll.transform(X[ok], Y[ok], np.full(ok.sum(), 3.0))
+    E, N, U = enu.transform(lon, lat, np.full(lon.size, 3.0))
+    # each cell's value is the east coordinate of the pixel nearest to its centre (within the
+    # radius of influence: half the diagonal of the 2.5 m × 0.28 m pixel spacing)
+    err = np.abs(v[ok] - E)
+    assert err.max() <= ds["radiance"].attrs["radius_of_influence_m"] < 2.5
+    assert np.median(err) < 0.1
+    # and the grid is where the ground points are: the line's first and last pixel of the
+    # first line, by pyproj alone, inside the grid
+    g = ground_points(as_sensor(CAL), nav, np.array([0.0]), zeta[[0, -1]], PlaneTerrain(3.0))
+    lon, lat, _ = enu.transform(
+        g[0, :, 0], g[0, :, 1], g[0, :, 2], direction=TransformDirection.INVERSE
+    )
+    x, y = Transformer.from_crs(4979, 32756, always_xy=True).transform(lon, lat)
+    r = float(ds["radiance"].attrs["resolution_m"])
+    assert ds["x"].values.min() - r < x.min() and x.max() < ds["x"].values.max() + r
+    assert ds["y"].values.min() - r < y.min() and y.max() < ds["y"].values.max() + r

@@ -59,7 +59,7 @@ def test_site_origin_axes_and_grid_convergence():
     dl = np.radians(1.775) * np.cos(np.radians(59.665))
     assert abs(k - 0.9996 * (1 + dl**2 / 2)) < 2e-6
     # the geographic <-> map transformation of the site agrees with pyproj's EPSG:4258
-    xs, ys = lonlat_to_crs("EPSG:25832", 10.775, 59.665)
+    xs, ys = lonlat_to_crs("EPSG:25832", 10.775, 59.665, 4258)
     np.testing.assert_allclose([x0, y0], [xs, ys], atol=1e-6)
 
 
@@ -67,7 +67,7 @@ def test_local_crs_is_the_frame_plane_near_the_ground():
     """The local frame's CRS (ellipsoidal orthographic) gives E, N of ground points to < 1 mm."""
     E, N = np.meshgrid(np.linspace(-1500, 1500, 7), np.linspace(-1500, 1500, 7))
     lon, lat, _ = SITE_AAS.enu_to_lonlat(E, N, np.zeros_like(E))
-    e, n = lonlat_to_crs(SITE_AAS.local_crs(), lon, lat)
+    e, n = lonlat_to_crs(SITE_AAS.local_crs(), lon, lat, SITE_AAS.datum_epsg)
     np.testing.assert_allclose(e, E, atol=1e-3)
     np.testing.assert_allclose(n, N, atol=1e-3)
 
@@ -205,5 +205,5 @@ def test_lonlat_to_crs_starts_from_the_points_own_datum():
     np.testing.assert_array_equal(lonlat_to_crs("EPSG:6342", lon, lat, 6319), want)
     lon, lat = np.array([10.775]), np.array([59.665])
     np.testing.assert_array_equal(
-        lonlat_to_crs("EPSG:25832", lon, lat, 4937), lonlat_to_crs("EPSG:25832", lon, lat)
+        lonlat_to_crs("EPSG:25832", lon, lat, 4937), lonlat_to_crs("EPSG:25832", lon, lat, 4258)
     )

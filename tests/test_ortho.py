@@ -10,7 +10,7 @@ from hsgeo.ortho import MapGrid, MapTerrain, Strip, orthomosaic
 
 
 def test_map_grid_cells_and_transform():
-    g = MapGrid.covering((600000.05, 600010.0), (6615000.0, 6615003.1), 0.3)
+    g = MapGrid.covering((600000.05, 600010.0), (6615000.0, 6615003.1), 0.3, "EPSG:25832")
     assert (g.x_min_m, g.y_max_m) == (pytest.approx(600000.0), pytest.approx(6615003.3))
     np.testing.assert_allclose(np.diff(g.x_m), 0.3)
     t = g.transform

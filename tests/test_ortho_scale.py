@@ -91,7 +91,7 @@ def test_distributed_cluster_same_mosaic_and_cli(tmp_path, capsys):
     threaded scheduler; ``hsgeo orthorectify --scheduler ADDRESS`` writes the same COG."""
     import rasterio
     from distributed import Client, LocalCluster
-    from ortho_inputs import FRAME, flight, write_ortho_inputs
+    from ortho_inputs import FRAME, SITE_ARGS, flight, write_ortho_inputs
 
     from hsgeo.cli import main
     from hsgeo.ortho import orthomosaic
@@ -105,6 +105,7 @@ def test_distributed_cluster_same_mosaic_and_cli(tmp_path, capsys):
         *map(str, f["lines"]),
         "--trajectory",
         str(f["nav"]),
+        *SITE_ARGS,
         "--sensor",
         str(f["camera"]),
         "--dsm",

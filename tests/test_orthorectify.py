@@ -3,7 +3,7 @@ rules, the line scanner's recorded line through ``hsgeo orthorectify``, the one 
 
 import numpy as np
 import pytest
-from ortho_inputs import FRAME, GSD_M, flight
+from ortho_inputs import FRAME, GSD_M, SITE_ARGS, flight
 
 from hsgeo.ortho import MapGrid, Strip, orthomosaic
 
@@ -102,6 +102,7 @@ def test_a_line_scanner_line_through_the_command(tmp_path, capsys):
                 str(tmp_path / "scanner.toml"),
                 "--trajectory",
                 str(tmp_path / "nav.csv"),
+                *SITE_ARGS,
                 "--dsm",
                 str(tmp_path / "dsm.tif"),
                 "-o",
@@ -165,6 +166,7 @@ def test_a_panoramic_scanner_line_through_the_command(tmp_path, capsys):
     write_geotiff(tmp_path / "dsm.tif", z, g.transform, 25832)
     argv = ["orthorectify", str(tmp_path / "line.nc"), "--sensor", str(tmp_path / "scanner.toml")]
     argv += ["--trajectory", str(tmp_path / "nav.csv"), "--dsm", str(tmp_path / "dsm.tif")]
+    argv += SITE_ARGS
     assert main([*argv, "-o", str(tmp_path / "o.tif"), "--quiet"]) == 0, capsys.readouterr().err
     m = rioxarray.open_rasterio(tmp_path / "o.tif")
     m = m.assign_coords(band=["640 nm", "550 nm", "460 nm", "800 nm"])

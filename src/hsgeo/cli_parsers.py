@@ -185,7 +185,7 @@ def _site(text: str) -> tuple:
     if len(v) not in (2, 3) or not (-90 < v[0] < 90 and -180 <= v[1] <= 180):
         raise argparse.ArgumentTypeError(
             f"{text!r}: give LAT,LON or LAT,LON,H (degrees north and east, metres), e.g. "
-            "59.665,10.775,0"
+            "-33.9,151.2,40"
         )
     return v
 
@@ -221,8 +221,8 @@ def add_orthorectify(sub) -> argparse.ArgumentParser:
         "band), t_s(line), wavelength_nm(band), attributes col0, strip_id, n_px_full; see "
         "hsgeo.io.lp_lines); an optional fwhm_nm(band) is carried into the output. NAV: the "
         "navigation file of every command (t_s, E_m, N_m, U_m, roll_deg, pitch_deg, "
-        "heading_deg in the local east-north-up frame about --site), or a geodetic one: a CSV "
-        "or Parquet (gps_sow_s or sod_s, lat_deg, lon_deg, h_m, roll_deg, pitch_deg, "
+        "heading_deg in the local east-north-up frame about --site, required), or a geodetic "
+        "one: a CSV or Parquet (gps_sow_s or sod_s, lat_deg, lon_deg, h_m, roll_deg, pitch_deg, "
         "heading_deg; CRS by '# crs: EPSG:n' or --nav-crs) or an Applanix SBET (.out, "
         "--nav-crs required), whose local frame comes from the data and whose output CRS "
         "defaults to the UTM zone of its centre on its datum (see hsgeo.io.read_navigation); "
@@ -281,23 +281,25 @@ def add_orthorectify(sub) -> argparse.ArgumentParser:
         "--crs",
         metavar="CRS",
         default=None,
-        help="output CRS, e.g. EPSG:25832 (default: the map CRS of --site's frame, EPSG:25832; "
-        "for a geodetic navigation the UTM zone of its centre on its datum)",
+        help="output CRS, e.g. EPSG:32756 (default: the UTM zone of --site on its datum, or of a "
+        "geodetic navigation's centre on its datum)",
     )
     p.add_argument(
         "--site",
         type=_site,
         metavar="LAT,LON[,H]",
-        help="ETRS89 latitude, longitude (degrees) and ellipsoidal height (m) of the origin of "
-        "the navigation's east-north-up frame (default the 002 site, 59.665,10.775,0); "
-        "only for a local-ENU navigation",
+        help="latitude, longitude (degrees) and ellipsoidal height (m, default 0) of the origin "
+        "of a local-ENU navigation's east-north-up frame, on the datum --nav-crs (default "
+        "EPSG:4979, WGS 84); required for a local-ENU navigation (e.g. --site=-33.9,151.2,40), "
+        "refused for a geodetic one",
     )
     p.add_argument(
         "--nav-crs",
         metavar="CRS",
         default=None,
         help="the datum of a geodetic navigation (an SBET names none), e.g. EPSG:4979 (WGS 84) "
-        "or EPSG:4937 (ETRS89); overrides a CSV's '# crs:' line",
+        "or EPSG:4937 (ETRS89), overriding a CSV's '# crs:' line; for a local-ENU navigation "
+        "the datum of --site (default EPSG:4979)",
     )
     p.add_argument(
         "--gps-week",

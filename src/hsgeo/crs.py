@@ -2,18 +2,20 @@
 
 The simulations and the sensor models work in a local east-north-up (ENU) frame in metres about
 a site (the map frame of :mod:`hsgeo.sensors.mount`). :class:`LocalFrame` ties that frame to the
-Earth: its origin is a point of ETRS89 (latitude, longitude, ellipsoidal height), its axes are
-east, north and the ellipsoid normal there (the topocentric frame of PROJ's
-``+proj=topocentric``), and a map CRS (default ETRS89 / UTM 32N, EPSG:25832) is where the
-orthomosaic is written. Every transformation is a PROJ pipeline built by :mod:`pyproj`; there is
-no hand-written projection maths here:
+Earth: its origin is a point of a geodetic datum (latitude, longitude, ellipsoidal height; WGS 84
+unless the frame names another, ``datum_epsg``), its axes are east, north and the ellipsoid
+normal there (the topocentric frame of PROJ's ``+proj=topocentric``), and a map CRS (default the
+UTM zone of the origin on its datum, :func:`default_output_crs`) is where the orthomosaic is
+written. No site is a default: the origin is the caller's (a user's ``--site``, the centre of a
+navigation) and the paper's site is passed as :data:`SITE_AAS`. Every transformation is a PROJ
+pipeline built by :mod:`pyproj`; there is no hand-written projection maths here:
 
-* ENU → ETRS89 geographic: ``+inv +proj=topocentric`` (ENU → geocentric), ``+inv +proj=cart``
-  (geocentric → longitude, latitude, ellipsoidal height) on the GRS80 ellipsoid;
-* ETRS89 geographic (EPSG:4937) → the map CRS: :meth:`pyproj.Transformer.from_crs`.
+* ENU → geographic: ``+inv +proj=topocentric`` (ENU → geocentric), ``+inv +proj=cart``
+  (geocentric → longitude, latitude, ellipsoidal height) on the datum's ellipsoid;
+* geographic (``datum_epsg``) → the map CRS: :meth:`pyproj.Transformer.from_crs`.
 
-The paper's site (002 §2: Ås, Norway) is :data:`SITE_AAS`. Transformers are built once per
-thread (PROJ objects are not shared between threads) and never pickled, so a :class:`LocalFrame`
+The paper's site (002 §2: Ås, Norway, on ETRS89) is :data:`SITE_AAS`. Transformers are built once
+per thread (PROJ objects are not shared between threads) and never pickled, so a :class:`LocalFrame`
 travels to dask workers as five numbers.
 
 The frame of a real flight is chosen from its data (:meth:`LocalFrame.about`: the centre of the
@@ -39,6 +41,7 @@ __all__ = [
     "SITE_AAS",
     "ETRS89_GEOGRAPHIC_3D",
     "ETRS89_UTM32N",
+    "WGS84_GEOGRAPHIC_3D",
     "lonlat_to_crs",
     "same_crs",
     "default_output_crs",
@@ -51,39 +54,43 @@ __all__ = [
 ETRS89_GEOGRAPHIC_3D = 4937
 #: ETRS89 / UTM zone 32N: the map CRS of the 002 orthomosaic.
 ETRS89_UTM32N = 25832
+#: WGS 84 geographic 3D: the datum of a frame that names none (a GNSS's own).
+WGS84_GEOGRAPHIC_3D = 4979
 
 _local = threading.local()
 
 
 @dataclass(frozen=True)
 class LocalFrame:
-    """A local east-north-up frame (metres) about an ETRS89 point, and a map CRS.
+    """A local east-north-up frame (metres) about a geodetic point, and a map CRS.
 
     Parameters
     ----------
     lat_deg, lon_deg : float, degrees
-        ETRS89 latitude and longitude of the origin.
+        Latitude and longitude of the origin on the datum ``datum_epsg`` (no default: the
+        origin is the data's or the user's; the 002 site is :data:`SITE_AAS`).
     h_m : float, m
-        Ellipsoidal (GRS80) height of the origin: U = 0 there.
-    map_epsg : int
-        EPSG code of the projected map CRS (default 25832, ETRS89 / UTM 32N).
+        Ellipsoidal height of the origin: U = 0 there.
+    map_epsg : int, optional
+        EPSG code of the projected map CRS; default (None) the UTM zone of the origin on the
+        datum (:func:`default_output_crs`).
     datum_epsg : int
         EPSG code of the geographic 3D CRS of the origin and of every geodetic coordinate in and
-        out of the frame (default 4937, ETRS89); its ellipsoid is the frame's (GRS80 for ETRS89
-        and NAD83, WGS 84's for EPSG:4979).
+        out of the frame (default 4979, WGS 84; 4937 ETRS89 for the 002 site); its ellipsoid is
+        the frame's (GRS80 for ETRS89 and NAD83, WGS 84's for EPSG:4979).
 
     Examples
     --------
-    >>> f = LocalFrame(59.665, 10.775)
-    >>> x, y, z = f.enu_to_map(0.0, 0.0, 0.0)
-    >>> round(float(x), 3), round(float(y), 3)  # doctest: +SKIP
+    >>> f = LocalFrame(-33.9, 151.2)  # Sydney, on WGS 84
+    >>> f.map_epsg  # WGS 84 / UTM zone 56S
+    32756
     """
 
-    lat_deg: float = 59.665
-    lon_deg: float = 10.775
+    lat_deg: float
+    lon_deg: float
     h_m: float = 0.0
-    map_epsg: int = ETRS89_UTM32N
-    datum_epsg: int = ETRS89_GEOGRAPHIC_3D
+    map_epsg: int | None = None
+    datum_epsg: int = WGS84_GEOGRAPHIC_3D
 
     def __post_init__(self):
         if not (np.isfinite(self.lat_deg) and -90 < self.lat_deg < 90):
@@ -92,8 +99,11 @@ class LocalFrame:
             raise InputError(f"longitude {self.lon_deg!r}° of the local frame is not in ±180")
         if not np.isfinite(self.h_m):
             raise InputError(f"height {self.h_m!r} m of the local frame is not finite")
+        self._ellps()  # an unknown or non-geographic datum fails here
+        if self.map_epsg is None:  # the UTM zone of the origin on its datum
+            zone = default_output_crs(self.lon_deg, self.lat_deg, int(self.datum_epsg))
+            object.__setattr__(self, "map_epsg", int(zone.to_epsg()))
         self.crs  # noqa: B018  (an unknown EPSG code fails here, once)
-        self._ellps()  # and an unknown or non-geographic datum here
 
     @property
     def crs(self):
@@ -108,11 +118,11 @@ class LocalFrame:
 
     def local_crs(self) -> str:
         """The local frame's horizontal plane as a CRS: PROJ's ellipsoidal orthographic projection
-        about the origin (E, N of the foot of each point on the GRS80 ellipsoid; for points at
+        about the origin (E, N of the foot of each point on the datum's ellipsoid; for points at
         ellipsoidal height h, distance d from the origin, within h·d/R of the topocentric E, N).
         """
         return (
-            f"+proj=ortho +lat_0={self.lat_deg!r} +lon_0={self.lon_deg!r} +ellps=GRS80 "
+            f"+proj=ortho +lat_0={self.lat_deg!r} +lon_0={self.lon_deg!r} {self._ellps()} "
             "+units=m +no_defs +type=crs"
         )
 
@@ -255,7 +265,7 @@ class LocalFrame:
         epsg = datum.to_epsg()
         if epsg is None:
             raise InputError(f"{datum.name!r} has no EPSG code; name the datum by an EPSG code")
-        probe = cls(0.0, 0.0, 0.0, ETRS89_UTM32N, epsg)._ellps()
+        probe = cls(0.0, 0.0, 0.0, ETRS89_UTM32N, epsg)._ellps()  # any map CRS: the ellipsoid
         cart = Transformer.from_pipeline(
             f"+proj=pipeline +step +proj=unitconvert +xy_in=deg +xy_out=rad "
             f"+step +proj=cart {probe}"
@@ -369,15 +379,15 @@ def _R_ecef_from_enu(lon_deg, lat_deg) -> np.ndarray:
 
 
 #: The 002 site, Ås (Norway): 59.665° N, 10.775° E (002 §2), map CRS ETRS89 / UTM 32N.
-SITE_AAS = LocalFrame(59.665, 10.775, 0.0, ETRS89_UTM32N)
+SITE_AAS = LocalFrame(59.665, 10.775, 0.0, ETRS89_UTM32N, ETRS89_GEOGRAPHIC_3D)
 
 
-def lonlat_to_crs(crs: str, lon_deg, lat_deg, datum_epsg: int = 4258):
+def lonlat_to_crs(crs: str, lon_deg, lat_deg, datum_epsg: int):
     """Coordinates in ``crs`` (any CRS pyproj reads) of longitudes and latitudes on a datum.
 
     ``datum_epsg`` is the geographic CRS of ``lon_deg``, ``lat_deg`` (2D or 3D EPSG code; a
-    frame's ``datum_epsg``): ETRS89 (4258, 4937) by default, as the 002 site's frame. A WGS 84
-    or NAD83 navigation's points are transformed from their own datum, never taken as ETRS89.
+    frame's ``datum_epsg``), never assumed: a WGS 84 or NAD83 navigation's points are
+    transformed from their own datum, an ETRS89 one's (4258, 4937) from ETRS89.
     """
     datum_epsg = int(datum_epsg)
     key = (crs, datum_epsg)

@@ -30,8 +30,8 @@ class MapGrid:
     width, height : int
         Columns (east) and rows (south).
     crs : str
-        The CRS, anything :class:`pyproj.CRS` reads (default ``"EPSG:25832"``, ETRS89 /
-        UTM 32N; :meth:`hsgeo.crs.LocalFrame.local_crs` for the local frame).
+        The CRS, anything :class:`pyproj.CRS` reads (e.g. ``"EPSG:32756"``, or
+        :meth:`hsgeo.crs.LocalFrame.local_crs` for the local frame); no default: the data's.
     """
 
     x_min_m: float
@@ -39,7 +39,7 @@ class MapGrid:
     resolution_m: float
     width: int
     height: int
-    crs: str = "EPSG:25832"
+    crs: str
 
     def __post_init__(self):
         if not (np.isfinite(self.resolution_m) and self.resolution_m > 0):
@@ -50,9 +50,7 @@ class MapGrid:
             raise InputError(f"the grid needs at least one cell, got {self.width} x {self.height}")
 
     @classmethod
-    def covering(
-        cls, x_range_m, y_range_m, resolution_m: float, crs: str = "EPSG:25832"
-    ) -> MapGrid:
+    def covering(cls, x_range_m, y_range_m, resolution_m: float, crs: str) -> MapGrid:
         """The grid of cells on multiples of ``resolution_m`` that covers the ranges."""
         r = float(resolution_m)
         if not (np.isfinite(r) and r > 0):
@@ -154,7 +152,7 @@ class MapTerrain:
         if not same_crs(grid.crs, f"EPSG:{frame.map_epsg}"):
             raise InputError(
                 f"{source} is in {grid.crs}, the mosaic in EPSG:{frame.map_epsg}: reproject "
-                "the DSM (gdalwarp -t_srs EPSG:25832) or give a DSM in the mosaic's CRS"
+                f"the DSM (gdalwarp -t_srs EPSG:{frame.map_epsg}) or give a DSM in the mosaic's CRS"
             )
         self.grid, self.frame, self.source = grid, frame, source
         self._f = RegularGridInterpolator(

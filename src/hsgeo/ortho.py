@@ -3,8 +3,9 @@
 The gridded half of :mod:`hsgeo.geocode` (which meets rays with the terrain): every pixel of
 every line of a :class:`Strip` is geolocated (the sensor's ``rays`` at the line's time on its
 :class:`~hsgeo.trajectory.Trajectory`, :func:`hsgeo.geocode.intersect` with the terrain in the
-local ENU frame, then ETRS89 longitude and latitude by :class:`hsgeo.crs.LocalFrame`), and the
-swath is resampled onto a :class:`MapGrid` in the map CRS (EPSG:25832 for 002) by nearest
+local ENU frame, then longitude and latitude on the frame's datum by
+:class:`hsgeo.crs.LocalFrame`), and the swath is resampled onto a :class:`MapGrid` in the map CRS
+(EPSG:25832 for 002) by nearest
 neighbour within a radius of influence (every spectrum stays as it was measured, as is usual for
 imaging spectrometers), found by pykdtree (pyresample's kd-tree) in the grid's own metres
 (:func:`resample_swath` says why not through pyresample's geographic path).
@@ -185,9 +186,7 @@ def strip_footprints(strip: Strip, terrain, frame, lines_per_block: int, crs: st
     return blocks, bbox, (across, along)
 
 
-def resample_swath(
-    lonlat_deg, values, rank, grid: MapGrid, radius_m: float, datum_epsg: int = 4258
-):
+def resample_swath(lonlat_deg, values, rank, grid: MapGrid, radius_m: float, datum_epsg: int):
     """Nearest swath pixel of every cell of ``grid`` within ``radius_m``, in the grid's CRS.
 
     The swath's pixels go into the grid's CRS (pyproj), and pykdtree (the kd-tree pyresample
@@ -209,7 +208,7 @@ def resample_swath(
     radius_m : float
         Radius of influence: cells farther from every pixel stay empty.
     datum_epsg : int
-        The geographic CRS of ``lonlat_deg`` (the frame's datum; ETRS89 by default).
+        The geographic CRS of ``lonlat_deg`` (the frame's datum, ``frame.datum_epsg``).
 
     Returns
     -------

@@ -1,4 +1,5 @@
-"""``hsgeo orthorectify`` on a geodetic navigation (a geodetic CSV/Parquet or an SBET).
+"""``hsgeo orthorectify``'s local frame: a geodetic navigation's (a CSV/Parquet or an SBET), or
+the ``--site`` of a local-ENU one (required: no site is a default, :func:`site_frame`).
 
 The local frame comes from the data (:meth:`hsgeo.crs.LocalFrame.about` the trajectory's centre,
 :func:`hsgeo.io.read_navigation`); the output CRS defaults to :func:`hsgeo.crs.default_output_crs`
@@ -13,7 +14,15 @@ import numpy as np
 
 from hsgeo.errors import InputError, ObservationError
 
-__all__ = ["FLOOR_U_M", "MARGIN_M", "read_nav", "output_crs", "terrain_bounds", "check_voids"]
+__all__ = [
+    "FLOOR_U_M",
+    "MARGIN_M",
+    "read_nav",
+    "site_frame",
+    "output_crs",
+    "terrain_bounds",
+    "check_voids",
+]
 
 #: The plane (frame U, m) the lines' edge rays are followed down to for the DSM's bounds: below
 #: the ellipsoidal height of any land near the frame's origin (the Dead Sea shore: about −400 m).
@@ -30,7 +39,7 @@ def read_nav(trajectory, nav_crs, gps_week, site, vertical):
     nav = read_navigation(trajectory, crs=nav_crs, gps_week=gps_week)
     local = nav.source_crs == "local ENU"
     if local:
-        for opt, v in (("--nav-crs", nav_crs), ("--gps-week", gps_week), ("--vertical", vertical)):
+        for opt, v in (("--gps-week", gps_week), ("--vertical", vertical)):
             if v is not None:
                 raise InputError(
                     f"{opt} {v}: navigation file {str(trajectory)!r} is in a local east-north-up "
@@ -38,12 +47,51 @@ def read_nav(trajectory, nav_crs, gps_week, site, vertical):
                     "frame is --site's) or give a geodetic navigation (lat_deg, lon_deg, h_m or "
                     "an SBET)"
                 )
+        if site is None:
+            raise InputError(
+                f"--site LAT,LON[,H] is needed: navigation file {str(trajectory)!r} is in a local "
+                "east-north-up frame (t_s, E_m, N_m, U_m) whose origin is not in the file; give "
+                "the origin's latitude, longitude (degrees) and ellipsoidal height (m), e.g. "
+                "--site=-33.9,151.2,40 (on WGS 84; --nav-crs EPSG:n for another datum), or a "
+                "geodetic navigation (lat_deg, lon_deg, h_m or an SBET)"
+            )
     elif site is not None:
         raise InputError(
             f"--site: navigation file {str(trajectory)!r} is geodetic ({nav.source_crs}); its "
             "local frame comes from the data, leave --site out"
         )
     return nav
+
+
+def site_frame(site, nav_crs, crs):
+    """The local frame of a local-ENU navigation: its origin ``--site LAT,LON[,H]`` on the datum
+    ``--nav-crs`` (default WGS 84, EPSG:4979); its map CRS the projected ``--crs`` when it has an
+    EPSG code, else the UTM zone of the site on that datum (:func:`hsgeo.crs.default_output_crs`,
+    as a geodetic navigation's centre).
+    """
+    from hsgeo.crs import WGS84_GEOGRAPHIC_3D, LocalFrame, geographic_3d_crs, parse_crs
+
+    site = tuple(float(v) for v in site)
+    if len(site) not in (2, 3):
+        raise InputError(f"--site needs LAT,LON or LAT,LON,H (degrees, metres), got {site}")
+    datum = WGS84_GEOGRAPHIC_3D
+    if nav_crs is not None:
+        d3 = geographic_3d_crs(nav_crs)
+        if d3.to_epsg() is None:
+            raise InputError(
+                f"--nav-crs {nav_crs}: {d3.name!r} has no EPSG code; name the datum of --site by "
+                "one, e.g. EPSG:4979 (WGS 84), EPSG:4937 (ETRS89)"
+            )
+        datum = int(d3.to_epsg())
+    map_epsg = None
+    if crs is not None:
+        c = parse_crs(crs)
+        if c.is_projected and c.to_epsg() is not None:
+            map_epsg = int(c.to_epsg())
+    try:
+        return LocalFrame(*site, map_epsg=map_epsg, datum_epsg=datum)
+    except InputError as exc:
+        raise InputError(f"--site {','.join(f'{v:g}' for v in site)}: {exc}") from None
 
 
 def output_crs(frame) -> str:

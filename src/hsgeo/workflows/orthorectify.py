@@ -23,7 +23,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from hsgeo.crs import SITE_AAS, LocalFrame
 from hsgeo.errors import InputError, ObservationError
 from hsgeo.ortho import MOSAIC_RULES, orthomosaic
 from hsgeo.workflows._ortho_strips import adjustment_of, line_strip, lp_strips
@@ -59,8 +58,9 @@ class OrthoOptions:
     crs : str or None
         The output CRS (anything pyproj reads); None: the frame's map CRS
         (``EPSG:{frame.map_epsg}``).
-    frame : hsgeo.crs.LocalFrame
-        Where the navigation's local east-north-up frame lies.
+    frame : hsgeo.crs.LocalFrame or None
+        Where the navigation's local east-north-up frame lies: required (None is refused; the
+        002 site is :data:`hsgeo.crs.SITE_AAS`).
     tile_px, lines_per_block : int
         Output tile (cells) and lines geolocated together.
     max_gib : float
@@ -70,7 +70,7 @@ class OrthoOptions:
     resolution_m: float | None = None
     mosaic: str = "nearest-nadir"
     crs: str | None = None
-    frame: object = SITE_AAS
+    frame: object = None
     tile_px: int = 512
     lines_per_block: int = 256
     max_gib: float = MAX_MOSAIC_GIB
@@ -98,6 +98,8 @@ def orthorectify(inputs: OrthoInputs, options: OrthoOptions = OrthoOptions()):
         write_raster`), CRS and transform through rioxarray, coordinates ``wavelength_nm`` and
         ``fwhm_nm`` of the bands when given.
     """
+    if options.frame is None:
+        raise InputError("OrthoOptions.frame: give the navigation's local frame (hsgeo.crs)")
     try:
         return orthomosaic(
             inputs.strips,
@@ -115,16 +117,6 @@ def orthorectify(inputs: OrthoInputs, options: OrthoOptions = OrthoOptions()):
         )
     except ObservationError as exc:
         raise InputError(str(exc)) from None
-
-
-def _frame(site) -> LocalFrame:
-    """The local frame of ``--site LAT,LON[,H]`` (default the 002 site)."""
-    if site is None:
-        return SITE_AAS
-    site = tuple(float(v) for v in site)
-    if len(site) not in (2, 3):
-        raise InputError(f"--site needs LAT,LON or LAT,LON,H (degrees, metres), got {site}")
-    return LocalFrame(*site)
 
 
 def _terrain(dsm, height_m, frame, U_m):
@@ -291,8 +283,10 @@ def orthorectify_files(
     covering every line, the view angles, the terrain below the aircraft and covering every
     strip's footprint, the raster's size. Returns a summary (grid, bands, strips, file).
 
-    A geodetic navigation (a geodetic CSV/Parquet or an SBET; ``nav_crs``, ``gps_week``: see
-    :func:`hsgeo.io.read_navigation`) brings its own local frame (``site`` refused) and the
+    A local-ENU navigation needs ``site`` (LAT, LON[, H], the frame's origin on the datum
+    ``nav_crs``, default WGS 84); the output CRS defaults to the UTM zone of the site on that
+    datum. A geodetic navigation (a geodetic CSV/Parquet or an SBET; ``nav_crs``, ``gps_week``:
+    see :func:`hsgeo.io.read_navigation`) brings its own local frame (``site`` refused) and the
     output CRS defaults to the UTM zone of its centre on its datum; its DSM GeoTIFF may be in
     any CRS (``vertical``: ``"ellipsoidal"`` or ``"EPSG:n"`` for a file with a 2D CRS).
     """
@@ -316,7 +310,7 @@ def orthorectify_files(
     check_outputs(raster_outputs(output, RASTER_FORMATS), inputs, overwrite=overwrite)
     navigation = geo.read_nav(trajectory, nav_crs, gps_week, site, vertical)
     geodetic = navigation.source_crs != "local ENU"
-    frame = navigation.frame if geodetic else _frame(site)
+    frame = navigation.frame if geodetic else geo.site_frame(site, nav_crs, crs)
     if geodetic and crs is None:
         crs = geo.output_crs(frame)
     adj = read_adjustment(adjustment) if adjustment is not None else None
