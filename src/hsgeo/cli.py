@@ -186,6 +186,7 @@ def _cmd_orthorectify(args) -> int:
             nav_crs=args.nav_crs,
             gps_week=args.gps_week,
             vertical=args.vertical,
+            line_times=args.line_times,
         )
     finally:
         terminal.clear_progress()

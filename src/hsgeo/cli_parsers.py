@@ -203,6 +203,21 @@ def _wavelengths(text: str) -> tuple:
     return out
 
 
+def _line_times_option(p) -> None:
+    """``--line-times``: the times files of ENVI LINES cubes (issue 38)."""
+    p.add_argument(
+        "--line-times",
+        action="append",
+        metavar="TIMES",
+        default=None,
+        help="line times of an ENVI LINES cube: a file of one time (s, the navigation's time "
+        "scale) per line, or a CSV with a t_s column; once per cube, in the order of LINES "
+        "(default: the header's start time and line period). LINES may be ENVI cubes (BIL/BIP/"
+        "BSQ, name.hdr or name.ext.hdr beside name.raw/.dat/.bil …): sample s is zeta = s of "
+        "a line scanner or view-angle sensor, x = s - (samples - 1)/2 px of the 002 camera",
+    )
+
+
 def add_orthorectify(sub) -> argparse.ArgumentParser:
     """``hsgeo orthorectify``."""
     p = sub.add_parser(
@@ -312,6 +327,7 @@ def add_orthorectify(sub) -> argparse.ArgumentParser:
         help="heights of a --dsm whose CRS is 2D (with a geodetic navigation): ellipsoidal, or "
         "a vertical CRS such as EPSG:5711 (AHD) or EPSG:5773 (EGM96)",
     )
+    _line_times_option(p)
     p.add_argument("--scheduler", metavar="ADDRESS", help="dask.distributed scheduler address")
     p.add_argument(
         "--max-gib",
