@@ -1705,6 +1705,29 @@ case(
     C, "output", "out-readonly", "writ", argv=lambda a, d, C=C: [C, "--out", str(_readonly_dir(d))]
 )
 case(C, "options", "verify-and-update", "--verify", argv=flag("--verify", "--update-manifest"))
+
+
+def _flight_argv(*extra, out="f"):
+    return lambda a, d: ["data", "flight", "--out", str(d / out), "--length-km", "0.5", *extra]
+
+
+def _flight_file_exists(a, d):
+    (d / "f").mkdir()
+    (d / "f" / "lines.raw").write_bytes(b"")
+    return _flight_argv("--site=59.7,10.8")(a, d)
+
+
+case(C, "options", "flight-no-site", "--site", argv=_flight_argv())
+case(C, "options", "flight-site-lat-95", "--site", argv=_flight_argv("--site=95,10"))
+case(C, "options", "flight-site-garbage", "--site", argv=_flight_argv("--site=abc"))
+case(C, "options", "site-without-flight", "data flight",
+     argv=lambda a, d: ["data", "--site=59.7,10.8", "--out", str(d / "f")])  # fmt: skip
+case(C, "options", "flight-length-0", "--length-km", argv=_flight_argv("--length-km", "0"))
+case(C, "output", "flight-out-missing-dir", "does not exist",
+     argv=_flight_argv("--site=59.7,10.8", out="no/such"))  # fmt: skip
+case(C, "output", "flight-out-is-file", "is a file",
+     argv=lambda a, d: _flight_argv("--site=59.7,10.8", out=_a_file(d).name)(a, d))  # fmt: skip
+case(C, "output", "flight-file-exists", "--overwrite", argv=_flight_file_exists)
 case(C, "options", "unknown-option", "--outt", argv=flag("--outt", "x"))
 C = "versions"
 case(C, "options", "extra-argument", "unrecognized", argv=flag("now"))

@@ -173,7 +173,31 @@ def add_data(sub) -> argparse.ArgumentParser:
         "installed package",
     )
     p.add_argument("--overwrite", action="store_true", help="replace existing files in --out DIR")
+    _data_flight_options(p)
     return p
+
+
+def _data_flight_options(p) -> None:
+    """``hsgeo data flight --site LAT,LON --out DIR``: a simulated flight (issue 38)."""
+    p.add_argument(
+        "what",
+        nargs="?",
+        choices=("flight",),
+        help="flight: write a simulated flight about --site into --out DIR in the formats a "
+        "real one is delivered in (ENVI lines + times file, geodetic navigation CSV, a "
+        "view-angle sensor file, a DSM GeoTIFF, the targets' true positions; command.txt: "
+        "the hsgeo orthorectify command that maps it)",
+    )
+    p.add_argument("--site", type=_site, metavar="LAT,LON", help="the flight's centre (WGS 84)")
+    p.add_argument(
+        "--length-km",
+        type=option_number(lo=0.1, hi=200.0),
+        default=30.0,
+        help="length of the flight line, km (default 30)",
+    )
+    p.add_argument(
+        "--seed", type=option_number(integer=True, lo=0, hi=2**31), default=0, help="rng seed"
+    )
 
 
 def _site(text: str) -> tuple:
