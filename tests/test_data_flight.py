@@ -70,7 +70,14 @@ def test_targets_land_where_pyproj_puts_them(tmp_path, site, capsys):
     np.testing.assert_allclose(tg["y_m"], ty, atol=1e-6)
     m = rioxarray.open_rasterio(d / "ortho.tif")
     assert m.rio.crs.to_epsg() == epsg
-    assert m.shape[0] == 3  # the cube's three bands
+    assert m.shape[0] == 3  # the cube's three bands, their ENVI header's wavelengths and FWHM
+    import rasterio  # … in GDAL's standard keys of the COG
+
+    with rasterio.open(d / "ortho.tif") as src:
+        um = [float(src.tags(b, ns="IMAGERY")["CENTRAL_WAVELENGTH_UM"]) for b in (1, 2, 3)]
+        fw = [float(src.tags(b, ns="IMAGERY")["FWHM_UM"]) for b in (1, 2, 3)]
+    np.testing.assert_allclose(um, [0.46, 0.55, 0.64])
+    np.testing.assert_allclose(fw, [0.009, 0.010, 0.011])
     from hsgeo.simulate.geo_flight import FlightConfig, view_angles
 
     cfg = FlightConfig(*SITES[site])
