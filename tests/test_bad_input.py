@@ -139,6 +139,44 @@ def _lp(d: Path) -> None:
     ).to_csv(d / "squares.csv", index=False, float_format="%.17g")
 
 
+def _envi_lines(d: Path) -> None:
+    """One line of a view-angle line scanner as it writes it (issue 38): an ENVI BIL cube
+    (cube.raw + cube.hdr, 2 bands, wavelengths in the header), its times file (one time per
+    line), the view-angle sensor file (va.toml + angles.csv) and the navigation."""
+    from hsgeo.geocode import PlaneTerrain
+    from hsgeo.io.navigation import write_trajectory
+    from hsgeo.ortho import ground_points
+    from hsgeo.sensors.view_angle import ViewAngleScanner
+    from hsgeo.trajectory import Trajectory
+
+    d.mkdir()
+    t = np.linspace(0, 10.0, 201)
+    EN = np.outer(20.0 * t, [0.0, 1.0])
+    rpy = np.column_stack([0.01 * np.sin(t), 0.005 * np.cos(t), np.zeros(t.size)])
+    nav = Trajectory(t, np.column_stack([EN, np.full(t.size, 500.0)]), rpy)
+    write_trajectory(d / "nav.csv", nav)
+    across = np.linspace(-0.2, 0.2, 150)
+    along = 0.01 * across**2
+    rows = ["pixel,across_deg,along_deg"]
+    rows += [
+        f"{i},{float(np.rad2deg(a))!r},{float(np.rad2deg(b))!r}"
+        for i, (a, b) in enumerate(zip(across, along, strict=True))
+    ]
+    (d / "angles.csv").write_text("\n".join(rows) + "\n")
+    (d / "va.toml").write_text("[sensor]\nmodel = 'view-angle'\nangles_csv = 'angles.csv'\n")
+    t_l = 0.5 + np.arange(40) / 8.0
+    g = ground_points(
+        ViewAngleScanner(across, along), nav, t_l, np.arange(150.0), PlaneTerrain(3.0)
+    )
+    np.ascontiguousarray(g[..., :2].astype("<f4").transpose(0, 2, 1)).tofile(d / "cube.raw")
+    (d / "cube.hdr").write_text(
+        "ENVI\nsamples = 150\nlines = 40\nbands = 2\nheader offset = 0\ndata type = 4\n"
+        "interleave = bil\nbyte order = 0\nwavelength units = Nanometers\n"
+        "wavelength = {500.0, 600.0}\nfwhm = {5.0, 5.0}\n"
+    )
+    (d / "times.txt").write_text("".join(f"{float(v)!r}\n" for v in t_l))
+
+
 def _frame(d: Path) -> None:
     d.mkdir()
     for p in sorted((CHARUCO / "images").glob("*.jpg"))[:3]:
@@ -227,6 +265,7 @@ def build_valid(root: Path) -> Path:
     _frame(root / "calibrate-frame")
     _lp(root / "lp-observations")
     _ortho(root / "orthorectify-strips")
+    _envi_lines(root / "orthorectify-envi")
     return root
 
 
@@ -262,6 +301,28 @@ def base_argv(cmd: str, d: Path) -> list[str]:
             s(d / "sensor.toml"),
             "--height",
             "3",
+            "--resolution",
+            "0.5",
+            "-o",
+            s(out / "ortho.nc"),
+            "--quiet",
+        ]
+    if cmd == "orthorectify-envi":  # an ENVI cube of a view-angle line scanner (issue 38)
+        out = d.parent / "out"
+        out.mkdir(exist_ok=True)
+        return [
+            "orthorectify",
+            s(d / "cube.raw"),
+            "--line-times",
+            s(d / "times.txt"),
+            "--trajectory",
+            s(d / "nav.csv"),
+            "--sensor",
+            s(d / "va.toml"),
+            "--height",
+            "3",
+            "--site",
+            "59.665,10.775",
             "--resolution",
             "0.5",
             "-o",
@@ -433,6 +494,14 @@ def text(content: str | bytes):
             p.write_bytes(content)
         else:
             p.write_text(content)
+
+    return edit
+
+
+def chain_edits(*edits):
+    def edit(p: Path):
+        for e in edits:
+            e(p)
 
     return edit
 
@@ -1644,6 +1713,29 @@ case(
     C, "output", "out-readonly", "writ", argv=lambda a, d, C=C: [C, "--out", str(_readonly_dir(d))]
 )
 case(C, "options", "verify-and-update", "--verify", argv=flag("--verify", "--update-manifest"))
+
+
+def _flight_argv(*extra, out="f"):
+    return lambda a, d: ["data", "flight", "--out", str(d / out), "--length-km", "0.5", *extra]
+
+
+def _flight_file_exists(a, d):
+    (d / "f").mkdir()
+    (d / "f" / "lines.raw").write_bytes(b"")
+    return _flight_argv("--site=59.7,10.8")(a, d)
+
+
+case(C, "options", "flight-no-site", "--site", argv=_flight_argv())
+case(C, "options", "flight-site-lat-95", "--site", argv=_flight_argv("--site=95,10"))
+case(C, "options", "flight-site-garbage", "--site", argv=_flight_argv("--site=abc"))
+case(C, "options", "site-without-flight", "data flight",
+     argv=lambda a, d: ["data", "--site=59.7,10.8", "--out", str(d / "f")])  # fmt: skip
+case(C, "options", "flight-length-0", "--length-km", argv=_flight_argv("--length-km", "0"))
+case(C, "output", "flight-out-missing-dir", "does not exist",
+     argv=_flight_argv("--site=59.7,10.8", out="no/such"))  # fmt: skip
+case(C, "output", "flight-out-is-file", "is a file",
+     argv=lambda a, d: _flight_argv("--site=59.7,10.8", out=_a_file(d).name)(a, d))  # fmt: skip
+case(C, "output", "flight-file-exists", "--overwrite", argv=_flight_file_exists)
 case(C, "options", "unknown-option", "--outt", argv=flag("--outt", "x"))
 C = "versions"
 case(C, "options", "extra-argument", "unrecognized", argv=flag("now"))
@@ -1789,6 +1881,73 @@ case(
     "orthorectify-line", "empty", "lines-zero-lines", "length 0",
     [("lines.nc", nc_edit(lambda ds: ds.isel(line=slice(0, 0))))],
 )  # fmt: skip
+
+
+# --- orthorectify: an ENVI cube of a view-angle line scanner (issue 38) ----------------------
+C = "orthorectify-envi"
+
+
+def _cut(n_bytes: int):
+    def edit(p: Path):
+        p.write_bytes(p.read_bytes()[:-n_bytes])
+
+    return edit
+
+
+def _hdr_set(key: str, value: str):
+    def edit(p: Path):
+        lines = [ln for ln in p.read_text().splitlines() if not ln.startswith(key + " =")]
+        p.write_text("\n".join([*lines, f"{key} = {value}"]) + "\n")
+
+    return edit
+
+
+case(C, "size", "envi-truncated", "cut short", [("cube.raw", _cut(1000))])
+case(C, "size", "envi-one-byte-more", "larger than its header",
+     [("cube.raw", lambda p: p.write_bytes(p.read_bytes() + b"\0"))])  # fmt: skip
+case(C, "size", "hdr-samples-disagree", "header says", [("cube.hdr", _hdr_set("samples", "149"))])
+case(C, "size", "hdr-lines-disagree", "header says", [("cube.hdr", _hdr_set("lines", "41"))])
+case(C, "size", "hdr-bands-disagree", "header says", [("cube.hdr", _hdr_set("bands", "3"))])
+case(
+    C, "size", "hdr-data-type-disagrees", "header says", [("cube.hdr", _hdr_set("data type", "5"))]
+)
+case(C, "units", "hdr-byte-order-2", "byte order", [("cube.hdr", _hdr_set("byte order", "2"))])
+case(C, "units", "hdr-interleave-xyz", "interleave", [("cube.hdr", _hdr_set("interleave", "xyz"))])
+case(C, "missing", "hdr-missing", "no header beside it", [("cube.hdr", remove)])
+case(C, "empty", "envi-empty", "cut short", [("cube.raw", text(""))])
+case(C, "mismatch", "times-shorter-than-lines", "times.txt", [("times.txt", drop_last_lines(1))])
+case(C, "mismatch", "times-longer-than-lines", "41 times", [("times.txt", text_append("99.0"))])
+case(C, "degenerate", "times-not-increasing", "does not increase",
+     [("times.txt", lambda p: p.write_text(p.read_text().replace("0.625", "0.5")))])  # fmt: skip
+
+
+def _garbage_line_3(p: Path):
+    rows = p.read_text().splitlines()
+    rows[2] = "abc"
+    p.write_text("\n".join(rows) + "\n")
+
+
+case(C, "garbage", "times-garbage", "line 3", [("times.txt", _garbage_line_3)])
+case(C, "missing", "times-missing", "times file", [("times.txt", remove)])
+case(C, "missing", "no-times-anywhere", "no line times", argv=opt("--line-times"))
+case(C, "options", "line-times-twice", "one times file per cube",
+     argv=flag("--line-times", "x.txt"))  # fmt: skip
+case(C, "mismatch", "angles-one-pixel-short", "150 samples", [("angles.csv", keep_rows(149))])
+case(C, "units", "angles-in-radians", "radians",
+     [("angles.csv", chain_edits(scale_column("across_deg", np.pi / 180),
+                                 scale_column("along_deg", np.pi / 180)))])  # fmt: skip
+case(C, "duplicates", "angles-row-twice", "repeats line", [("angles.csv", duplicate_row(5))])
+case(
+    C,
+    "duplicates",
+    "angles-pixel-twice",
+    "appears twice",
+    [("angles.csv", set_cell("pixel", "6", 5))],
+)
+case(C, "degenerate", "angles-not-monotone", "monotonically",
+     [("angles.csv", set_cell("across_deg", "30.0", 5))])  # fmt: skip
+case(C, "mismatch", "lines-mix-envi-and-netcdf", "mixes ENVI",
+     argv=lambda a, d: [a[0], a[1], str(d / "nav.csv.nc"), *a[2:]])  # fmt: skip
 
 
 def _add_to_column(p: Path, column: str, value: float):

@@ -14,7 +14,7 @@ import os
 import sys
 
 from hsgeo import terminal
-from hsgeo.errors import ConvergenceError, HsgeoError
+from hsgeo.errors import ConvergenceError, HsgeoError, InputError
 from hsgeo.terminal import json_text
 
 __all__ = ["main", "EXIT_INTERRUPTED", "EXIT_BROKEN_PIPE"]
@@ -80,9 +80,42 @@ def _cmd_calibrate_frame(args) -> int:
 def _cmd_data(args) -> int:
     from hsgeo.reproduce.data import generate_all
 
+    if args.what == "flight" or args.site is not None:
+        return _data_flight(args)
+
     return generate_all(
         verify=args.verify, update=args.update_manifest, out=args.out, overwrite=args.overwrite
     )
+
+
+def _data_flight(args) -> int:
+    """``hsgeo data flight --site LAT,LON --out DIR`` (issue 38)."""
+    import shlex
+
+    from hsgeo.io.flight_files import check_flight_outputs, orthorectify_command, write_flight
+    from hsgeo.simulate.geo_flight import FlightConfig, simulate_flight
+
+    if args.what != "flight":
+        raise InputError("--site is for 'hsgeo data flight'; give: hsgeo data flight --site ...")
+    if args.site is None or args.out is None:
+        raise InputError(
+            "hsgeo data flight needs --site LAT,LON (the flight's centre) and --out DIR "
+            "(a folder for its files)"
+        )
+    if args.verify or args.update_manifest:
+        raise InputError("--verify and --update-manifest are for the scenario data, not a flight")
+    check_flight_outputs(args.out, overwrite=args.overwrite)
+    cfg = FlightConfig(args.site[0], args.site[1], length_m=1000.0 * args.length_km)
+    flight = simulate_flight(cfg, rng=args.seed)
+    files = write_flight(args.out, flight, overwrite=args.overwrite)
+    cmd = shlex.join(orthorectify_command(args.out, flight.output_epsg))
+    print(
+        f"a {args.length_km:g} km flight over {cfg.lat_deg:g}, {cfg.lon_deg:g}: "
+        f"{flight.lines_lsb.shape[0]} lines of {flight.lines_lsb.shape[1]} pixels, ground "
+        f"pixel {flight.gsd_m:.3g} m, output CRS EPSG:{flight.output_epsg}; {len(files)} files "
+        f"in {args.out}\northorectify it with:\n  {cmd}"
+    )
+    return 0
 
 
 def _cmd_adjust_pushbroom(args) -> int:
@@ -186,6 +219,7 @@ def _cmd_orthorectify(args) -> int:
             nav_crs=args.nav_crs,
             gps_week=args.gps_week,
             vertical=args.vertical,
+            line_times=args.line_times,
         )
     finally:
         terminal.clear_progress()

@@ -173,7 +173,31 @@ def add_data(sub) -> argparse.ArgumentParser:
         "installed package",
     )
     p.add_argument("--overwrite", action="store_true", help="replace existing files in --out DIR")
+    _data_flight_options(p)
     return p
+
+
+def _data_flight_options(p) -> None:
+    """``hsgeo data flight --site LAT,LON --out DIR``: a simulated flight (issue 38)."""
+    p.add_argument(
+        "what",
+        nargs="?",
+        choices=("flight",),
+        help="flight: write a simulated flight about --site into --out DIR in the formats a "
+        "real one is delivered in (ENVI lines + times file, geodetic navigation CSV, a "
+        "view-angle sensor file, a DSM GeoTIFF, the targets' true positions; command.txt: "
+        "the hsgeo orthorectify command that maps it)",
+    )
+    p.add_argument("--site", type=_site, metavar="LAT,LON", help="the flight's centre (WGS 84)")
+    p.add_argument(
+        "--length-km",
+        type=option_number(lo=0.1, hi=200.0),
+        default=30.0,
+        help="length of the flight line, km (default 30)",
+    )
+    p.add_argument(
+        "--seed", type=option_number(integer=True, lo=0, hi=2**31), default=0, help="rng seed"
+    )
 
 
 def _site(text: str) -> tuple:
@@ -201,6 +225,21 @@ def _wavelengths(text: str) -> tuple:
     if not out or not all(0 < v < 1e5 for v in out):
         raise argparse.ArgumentTypeError(f"{text!r}: wavelengths must be positive numbers of nm")
     return out
+
+
+def _line_times_option(p) -> None:
+    """``--line-times``: the times files of ENVI LINES cubes (issue 38)."""
+    p.add_argument(
+        "--line-times",
+        action="append",
+        metavar="TIMES",
+        default=None,
+        help="line times of an ENVI LINES cube: a file of one time (s, the navigation's time "
+        "scale) per line, or a CSV with a t_s column; once per cube, in the order of LINES "
+        "(default: the header's start time and line period). LINES may be ENVI cubes (BIL/BIP/"
+        "BSQ, name.hdr or name.ext.hdr beside name.raw/.dat/.bil …): sample s is zeta = s of "
+        "a line scanner or view-angle sensor, x = s - (samples - 1)/2 px of the 002 camera",
+    )
 
 
 def add_orthorectify(sub) -> argparse.ArgumentParser:
@@ -314,6 +353,7 @@ def add_orthorectify(sub) -> argparse.ArgumentParser:
         help="heights of a --dsm whose CRS is 2D (with a geodetic navigation): ellipsoidal, or "
         "a vertical CRS such as EPSG:5711 (AHD) or EPSG:5773 (EGM96)",
     )
+    _line_times_option(p)
     p.add_argument("--scheduler", metavar="ADDRESS", help="dask.distributed scheduler address")
     p.add_argument(
         "--max-gib",

@@ -186,6 +186,11 @@ def _geodetic_terrain(dsm, height_m, frame, U_m, strips, vertical):
 
 def _read_strips(lines, nav, sensor, args):
     """The strips of the LINES files (all of one kind), their wavelengths and FWHM."""
+    from hsgeo.workflows._ortho_envi import envi_lines
+
+    envi = envi_lines(lines, sensor, nav, args)
+    if envi is not None:  # ENVI cubes and their line times
+        return envi
     from hsgeo.io.lines import line_file_kind, read_band_widths, read_lines
     from hsgeo.io.lp_lines import full_line_px, open_lp_lines
     from hsgeo.workflows._ortho_strips import check_principal_point
@@ -275,6 +280,7 @@ def orthorectify_files(
     nav_crs: str | None = None,
     gps_week: int | None = None,
     vertical: str | None = None,
+    line_times=None,
 ) -> dict:
     """Orthorectify line files into one raster (see ``hsgeo orthorectify --help``).
 
@@ -289,6 +295,9 @@ def orthorectify_files(
     see :func:`hsgeo.io.read_navigation`) brings its own local frame (``site`` refused) and the
     output CRS defaults to the UTM zone of its centre on its datum; its DSM GeoTIFF may be in
     any CRS (``vertical``: ``"ellipsoidal"`` or ``"EPSG:n"`` for a file with a 2D CRS).
+
+    LINES may be ENVI cubes (:mod:`hsgeo.workflows._ortho_envi`), their line times from
+    ``line_times`` (one times file per cube) or their headers.
     """
     from hsgeo.io import read_sensor
     from hsgeo.io._files import check_outputs
@@ -306,7 +315,9 @@ def orthorectify_files(
         raise InputError(f"--resolution must be a positive number of metres, got {resolution_m}")
     if mosaic not in MOSAIC_RULES:
         raise InputError(f"--mosaic {mosaic!r}: give one of {', '.join(MOSAIC_RULES)}")
-    inputs = [*lines, trajectory, sensor, dsm, adjustment]
+    from hsgeo.workflows._ortho_envi import envi_files
+
+    inputs = [*lines, trajectory, sensor, dsm, adjustment, *(line_times or ()), *envi_files(lines)]
     check_outputs(raster_outputs(output, RASTER_FORMATS), inputs, overwrite=overwrite)
     navigation = geo.read_nav(trajectory, nav_crs, gps_week, site, vertical)
     geodetic = navigation.source_crs != "local ENU"
@@ -320,6 +331,7 @@ def orthorectify_files(
         msg = str(exc)
         raise InputError("--" + msg if msg.startswith("adjustment:") else msg) from None
     args = {"line_pixels": line_pixels, "bands": bands, "band": band, "sensor": sensor}
+    args["line_times"] = line_times
     strips, wl, fw, n_px_full = _read_strips(lines, nav, cam, args)
     _check_nav(strips, nav, trajectory, max_nav_gap_s, adj)
     for s in strips:
