@@ -46,6 +46,10 @@ HEAVY = [
     "tests/test_asf.py",
     "tests/test_nist_strd.py",
 ]
+WHAT = (
+    "CPU seconds (user + system, os.wait4) of one `python -m pytest -q FILE` process per test "
+    "file or selection; base = a clone of the previous main, ours = this tree, run in turn"
+)
 _SUMMARY = re.compile(r"(\d+) (passed|failed|skipped|errors?|xfailed|xpassed|deselected)")
 
 
@@ -97,30 +101,24 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
 
     trees = {"ours": ROOT} if args.base is None else {"base": args.base, "ours": ROOT}
-    started = dt.datetime.now(dt.UTC).isoformat(timespec="seconds")
-    result = {
-        "what": "CPU seconds of one `python -m pytest -q FILE` process per test file",
-        "started_utc": started,
-        "cpus": os.cpu_count(),
-        "loadavg_at_start": [round(x, 2) for x in os.getloadavg()],
-        "trees": {k: str(v) for k, v in trees.items()},
-        "marker": args.marker,
-        "select": args.select,
-        "cold": args.cold,
-        "files": {},
-    }
     for test in args.files:
         if not args.cold:
             for tree in trees.values():
                 # untimed: the compiled-kernel cache warm
                 run_file(tree, test, args.marker, args.select)
+        row = {
+            "started_utc": dt.datetime.now(dt.UTC).isoformat(timespec="seconds"),
+            "loadavg_at_start": [round(x, 2) for x in os.getloadavg()],
+            "trees": {k: str(v) for k, v in trees.items()},
+            "marker": args.marker,
+            "select": args.select,
+            "cold": args.cold,
+        }
         runs: dict[str, list[dict]] = {k: [] for k in trees}
         for _ in range(args.repeat):
             for name, tree in trees.items():
-                if not (tree / test).is_file():
-                    continue
-                runs[name].append(run_file(tree, test, args.marker, args.select))
-        row = {}
+                if (tree / test).is_file():
+                    runs[name].append(run_file(tree, test, args.marker, args.select))
         for name, rs in runs.items():
             if rs:
                 row[name] = {
@@ -128,22 +126,33 @@ def main(argv: list[str] | None = None) -> int:
                     "wall_s_median": _median(rs, "wall_s"),
                     "runs": rs,
                 }
-        if "base" in row and "ours" in row:
+        if runs.get("base") and runs.get("ours"):
             row["cpu_ratio_ours_over_base"] = round(
                 statistics.median(
                     o["cpu_s"] / b["cpu_s"]
-                    for o, b in zip(row["ours"]["runs"], row["base"]["runs"], strict=False)
+                    for o, b in zip(runs["ours"], runs["base"], strict=False)
                 ),
                 3,
             )
-        result["files"][test] = row
-        print(test, json.dumps({k: v.get("cpu_s_median", v) for k, v in row.items()}), flush=True)
-    result["loadavg_at_end"] = [round(x, 2) for x in os.getloadavg()]
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = args.out.with_suffix(".json.part")
-    tmp.write_text(json.dumps(result, indent=1) + "\n", encoding="utf-8")
-    shutil.move(tmp, args.out)
+        row["loadavg_at_end"] = [round(x, 2) for x in os.getloadavg()]
+        key = test + (f" -m {args.marker!r}" if args.marker else "")
+        key += f" -k {args.select!r}" if args.select else ""
+        _record(args.out, key, row)
+        summary = {k: row[k]["cpu_s_median"] for k in trees if k in row}
+        print(key, json.dumps(summary), row.get("cpu_ratio_ours_over_base"), flush=True)
     return 0
+
+
+def _record(out: Path, key: str, row: dict) -> None:
+    """Add (or replace) one measured entry of ``out``, keeping the others."""
+    doc = {"what": WHAT, "cpus": os.cpu_count(), "entries": {}}
+    if out.is_file():
+        doc = json.loads(out.read_text(encoding="utf-8"))
+    doc["entries"][key] = row
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = out.with_suffix(".json.part")
+    tmp.write_text(json.dumps(doc, indent=1) + "\n", encoding="utf-8")
+    shutil.move(tmp, out)
 
 
 if __name__ == "__main__":
