@@ -6,8 +6,9 @@ and every child it waited for, wall seconds, peak resident memory) is recorded w
 average at start and end. With ``--base DIR`` (a clone of the previous main) every file runs
 in both trees in turn, base then ours, ``--repeat`` times (paired, alternating runs), each tree
 from its own ``src`` (``PYTHONPATH``), so a figure and its comparison share the machine's
-state. The compiled-kernel cache (numba ``cache=True``, ``__pycache__`` beside the sources) is
-warmed by one untimed run of each tree first, unless ``--cold`` asks for the fresh-clone cost.
+state. ``--warmup`` runs each tree once untimed first, so the compiled-kernel cache (numba
+``cache=True``, ``__pycache__`` beside the sources) is warm; without it a fresh clone's first
+run includes the kernels' compilation (``make bench`` runs each heavy file once, no warm-up).
 
 ``python bench/bench_test_suite.py [--base DIR] [--repeat N] [FILE ...]`` writes
 ``bench/results/test_suite_cost.json`` (``--out`` elsewhere); ``make bench`` runs it with the
@@ -94,7 +95,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("files", nargs="*", default=HEAVY, help="test files (default: the heavy ones)")
     ap.add_argument("--base", type=Path, help="a clone of the previous main, run in turn with ours")
     ap.add_argument("--repeat", type=int, default=1, help="paired runs per file (default 1)")
-    ap.add_argument("--cold", action="store_true", help="no warm-up run (a fresh clone's compile)")
+    ap.add_argument(
+        "--warmup", action="store_true", help="one untimed run per tree first (kernel cache warm)"
+    )
     ap.add_argument("-m", dest="marker", help="a pytest -m expression, e.g. 'not slow'")
     ap.add_argument("-k", dest="select", help="a pytest -k expression (the tests a change touched)")
     ap.add_argument("--out", type=Path, default=HERE / "results" / "test_suite_cost.json")
@@ -102,7 +105,7 @@ def main(argv: list[str] | None = None) -> int:
 
     trees = {"ours": ROOT} if args.base is None else {"base": args.base, "ours": ROOT}
     for test in args.files:
-        if not args.cold:
+        if args.warmup:
             for tree in trees.values():
                 # untimed: the compiled-kernel cache warm
                 run_file(tree, test, args.marker, args.select)
@@ -112,7 +115,7 @@ def main(argv: list[str] | None = None) -> int:
             "trees": {k: str(v) for k, v in trees.items()},
             "marker": args.marker,
             "select": args.select,
-            "cold": args.cold,
+            "warmup": args.warmup,
         }
         runs: dict[str, list[dict]] = {k: [] for k in trees}
         for _ in range(args.repeat):
