@@ -1,6 +1,8 @@
 """The 004 ASF: the ratio of radiometry, the workflow's parts, and the recovery of the true ASF
 from the simulated runway flights over seeds."""
 
+import functools
+
 import numpy as np
 import pytest
 
@@ -86,9 +88,7 @@ def test_inside_polygon_with_margin():
 
 
 def test_ground_sampler_inverts_the_georegistration():
-    obs, _ = simulate_runway(RunwayScene(), 3, reverse=False)
-    s = obs.along
-    g = georegister(s.values, s.zeta_px, s.t0_s, s.line_rate_hz, s.sensor, s.trajectory)
+    _, _, _, g = _flights(3)  # g: the along scan, georegistered
     sm = GroundSampler(g)
     rng = np.random.default_rng(0)
     lp = np.stack([rng.uniform(5, 900, 500), rng.uniform(2, 95, 500)])
@@ -100,13 +100,27 @@ def test_ground_sampler_inverts_the_georegistration():
     assert np.all(np.isnan(sm.locate([5000.0], [0.0])))
 
 
-def _recover(seed, scene=None, geo=False):
-    obs, tr = simulate_runway(scene or RunwayScene(), seed, reverse=False)
+@functools.cache
+def _flights(seed: int):
+    """The default runway's two flights for ``seed`` and their georegistered scans, simulated
+    once in this module (≈ 2 CPU-s each; the 1 % test over 8 seeds and the registration test
+    over 10 share seeds 0-7, issue 41). Read only: no test changes them."""
+    obs, tr = simulate_runway(RunwayScene(), seed, reverse=False)
+    return obs, tr, _georeg(obs.cross), _georeg(obs.along)
 
-    def georeg(s):
-        return georegister(s.values, s.zeta_px, s.t0_s, s.line_rate_hz, s.sensor, s.trajectory)
 
-    gc, ga = georeg(obs.cross), georeg(obs.along)
+@pytest.fixture(scope="module", autouse=True)
+def _free_flights():
+    yield
+    _flights.cache_clear()
+
+
+def _georeg(s):
+    return georegister(s.values, s.zeta_px, s.t0_s, s.line_rate_hz, s.sensor, s.trajectory)
+
+
+def _recover(seed, geo=False):
+    obs, tr, gc, ga = _flights(seed)
     res = asf_from_scans(AsfInputs(gc, ga, obs.runway_polygon_m))
     near = np.abs(tr.scan_angle_rad) <= np.deg2rad(1.0)
     truth = tr.asf / tr.asf[:, near].mean(axis=1, keepdims=True)
@@ -185,13 +199,10 @@ def test_registration_shift_agrees_with_the_truth_over_seeds():
     seed)."""
     from hsgeo.workflows.asf import register
 
-    def geo(s):
-        return georegister(s.values, s.zeta_px, s.t0_s, s.line_rate_hz, s.sensor, s.trajectory)
-
     z = []
     for seed in range(10):
-        obs, tr = simulate_runway(RunwayScene(), seed, reverse=False)
-        r = register(geo(obs.cross), geo(obs.along), obs.runway_polygon_m)
+        obs, tr, gc, ga = _flights(seed)
+        r = register(gc, ga, obs.runway_polygon_m)
         z.append((r.shift_m - tr.shift_m) / r.sigma_m)
     z = np.array(z)
     assert np.all(np.abs(z.mean(axis=0)) < 1.0), z
@@ -202,7 +213,7 @@ def test_georegister_scan_uses_the_scans_own_geometry():
     """The scan's sensor and trajectory, as the explicit call; other values keep the geometry."""
     from hsgeo.reproduce.asf import georegister_scan
 
-    obs, _ = simulate_runway(RunwayScene(), 3, reverse=False)
+    obs, _, _, _ = _flights(3)
     s = obs.along
     g = georegister_scan(s)
     ref = georegister(s.values, s.zeta_px, s.t0_s, s.line_rate_hz, s.sensor, s.trajectory)

@@ -3,6 +3,7 @@ the simulated truth within 3σ̂ over seeds, bounded memory while streaming, bad
 
 from __future__ import annotations
 
+import functools
 import json
 import subprocess
 import sys
@@ -80,12 +81,19 @@ def _share_within_3(rep, table):
     return np.mean(np.abs(z) <= 3), len(z)
 
 
+@functools.cache
+def _run(seed: int):
+    """``hsgeo reproduce cube`` at scale 0.2, once per seed in this module (≈ 17 CPU-s a run;
+    the paper-row test reads seed 0's report, which the 3σ̂ test computed, issue 41)."""
+    return RC.run(seed=seed, scale=0.2)
+
+
 @pytest.mark.parametrize(
     "seed", [0, 1, 5, *(pytest.param(k, marks=pytest.mark.slow) for k in (2, 3, 4, 6, 7))]
 )
 def test_truth_recovered_within_3_sigma(seed):
     """Hot-pixel coefficients, reflectance and indices within 3σ̂ of the truth (≥ 95 % of rows)."""
-    rep = RC.run(seed=seed, scale=0.2)
+    rep = _run(seed)
     for table in ("hot pixels", "reflectance", "vegetation indices"):
         share, n = _share_within_3(rep, table)
         assert n > 0 and share >= 0.95, (table, share)
@@ -103,7 +111,7 @@ def test_truth_recovered_within_3_sigma(seed):
 
 
 def test_paper_rows_and_verdicts():
-    rep = RC.run(seed=0, scale=0.2)
+    rep = _run(0)
     rows = {r.quantity: r for r in rep.rows_of("001 §3.2")}
     # the paper's arithmetic (derived): it agrees by construction, never "reproduced"
     assert rows["GSDv, binning 2 at 2.5 m"].judge()[0] == "by construction"
