@@ -1542,6 +1542,27 @@ case(
     C, "range", "black-above-white", "black",
     [("bars.toml", toml_set("target", "black_reflectance", "0.95"))],
 )  # fmt: skip
+
+
+def _mirror_profile(p: Path) -> None:
+    h, rows = read_csv(p)
+    j = h.index("intensity_dn")
+    vals = [r[j] for r in rows][::-1]
+    for r, v in zip(rows, vals, strict=True):
+        r[j] = v
+    write_csv(p, h, rows)
+
+
+# issue 42: answers on wrong profiles (exit 0) before
+case(C, "degenerate", "profile-mirrored", "mirrored", [("profiles.csv", _mirror_profile)])
+case(
+    C, "degenerate", "profile-shifted-half-pair", "shifted by half a pair",
+    [("bars.toml", toml_set("profile", "start_px", "104.5"))],
+)  # fmt: skip
+case(
+    C, "range", "dark-above-bright", "dark_dn = 5000",
+    [("bars.toml", toml_set("profile", "dark_dn", "5000.0"))],
+)  # fmt: skip
 case(C, "options", "no-bars", "--bars", argv=opt("--bars"))
 case(C, "options", "unknown-option", "--roi", argv=flag("--roi", "1,2,3,4"))
 C = "mtf-edge"
