@@ -134,13 +134,24 @@ def _cmd_adjust_pushbroom(args) -> int:
     res = out.pop("_result")
     print(json_text(out) if args.json else res.report(max_block_size=20))
     fit = out["fit"]
+    warnings = fit.get("warnings", [])
     if fit["verdict"] == "poor" and not args.accept_poor_fit:
         print(
             f"hsgeo {args.command}: error: implausible fit: {'; '.join(fit['reasons'])} "
-            "(the result is printed above; --accept-poor-fit keeps it with exit status 0)",
+            "(the result is printed above; --accept-poor-fit keeps it with exit status 0)"
+            + "".join(f"; also: {w}" for w in warnings),
             file=sys.stderr,
         )
         return 2
+    if warnings and args.strict:
+        print(
+            f"hsgeo {args.command}: error: --strict: {'; '.join(warnings)} (the result is "
+            "printed above)",
+            file=sys.stderr,
+        )
+        return 2
+    for w in warnings:
+        print(f"hsgeo {args.command}: warning: {w}", file=sys.stderr)
     return 0
 
 

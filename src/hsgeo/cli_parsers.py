@@ -419,6 +419,12 @@ def add_adjust_pushbroom(sub) -> argparse.ArgumentParser:
         help="exit 0 even when the fit is implausible (σ0 off by more than a factor of 3, more "
         "than 5 %% of the observations rejected, or no convergence; the JSON's 'fit' says why)",
     )
+    p.add_argument(
+        "--strict",
+        action="store_true",
+        help="exit 2 when the data do not determine some parameters at the solution (default: "
+        "a warning; the rest is estimated, those are named with no σ)",
+    )
     p.add_argument("--json", action="store_true", help="JSON instead of the text report")
     return p
 

@@ -107,6 +107,13 @@ class SolverOptions:
         degenerate rays) is held at its initial value and its observations are left out
         instead of stopping the adjustment; the result names them
         (``AdjustmentResult.dropped_points``). Any other deficiency still raises.
+    strict_covariance : bool, default False
+        If the normal matrix at the solution is singular (a datum defect that appeared during
+        the iterations: e.g. every observation of a band rejected), raise
+        :class:`~hsgeo.DatumError`. Default: the covariance of the estimable part is returned
+        (a generalised inverse, unique for estimable functions) and the parameters the data
+        no longer determine are named (``AdjustmentResult.undetermined_parameters``, NaN
+        rows and columns of ``covariance``).
     rank_rtol : float, default 1e-11
         Relative eigenvalue threshold of the datum check (see
         :func:`~hsgeo.adjust.identifiability`).
@@ -164,6 +171,7 @@ class SolverOptions:
     robust_start_k: float = 3.0
     check_datum: bool = True
     drop_undetermined_points: bool = False
+    strict_covariance: bool = False
     rank_rtol: float = 1e-11
     raise_on_failure: bool = True
     compiled: bool = True
@@ -232,6 +240,7 @@ class SolverOptions:
             "reject_every_iteration",
             "check_datum",
             "drop_undetermined_points",
+            "strict_covariance",
             "raise_on_failure",
             "compiled",
             "fused",

@@ -33,7 +33,8 @@ class AdjustmentResult:
     sigma0 : float
         A-posteriori standard deviation of unit weight, sqrt(vᵀPv / dof).
     dof : int
-        Redundancy: residual components (priors included, rejected excluded) − unknowns.
+        Redundancy: residual components (priors included, rejected excluded) − unknowns (+ the
+        rank defect at the solution, if any: see ``undetermined_parameters``).
     n_observations : int
         Observation components used (rejected excluded, priors excluded).
     n_unknowns : int
@@ -51,6 +52,11 @@ class AdjustmentResult:
     dropped_points : list of int
         Points left out because their observations do not determine them (held at their
         initial values, their observations unused; ``SolverOptions.drop_undetermined_points``).
+    undetermined_parameters : list of str
+        Labels of the free non-point parameters that the normal matrix at the solution does not
+        determine (a datum defect that appeared during the iterations); their rows and columns
+        of ``covariance`` are NaN, the rest is the covariance of the estimable part
+        (``SolverOptions.strict_covariance`` raises instead).
     seconds_split : dict of str to float
         Where ``seconds`` went: ``model`` (the residual blocks' own evaluation, residuals and
         derivatives; on the fused path, ``SolverOptions.fused``, also their whitening into the
@@ -84,6 +90,7 @@ class AdjustmentResult:
     _point_cov: np.ndarray | None = field(default=None, repr=False)
     seconds_split: dict = field(default_factory=dict, repr=False)
     dropped_points: list = field(default_factory=list)
+    undetermined_parameters: list = field(default_factory=list)
     #: per block, the rows left out with the dropped points (not outliers)
     _dropped_rows: list | None = field(default=None, repr=False)
 
@@ -225,6 +232,15 @@ class AdjustmentResult:
     def _summary_lines(self) -> list[str]:
         n_rej = sum(int((~m).sum()) for m in self._masks)
         lo, hi = self.chi2_interval() if self.dof > 0 else (np.nan, np.nan)
+        und = self.undetermined_parameters
+        extra = (
+            [
+                f"not determined at the solution (σ NaN, covariance of the rest only): "
+                f"{', '.join(und[:12])}{f', … ({len(und)} in all)' if len(und) > 12 else ''}"
+            ]
+            if und
+            else []
+        )
         return [
             f"converged: {self.converged} ({self.message}) after {self.iterations} iterations, "
             f"{self.seconds:.2f} s",
@@ -232,7 +248,7 @@ class AdjustmentResult:
             f"{self.reject_rounds} rounds); unknowns: {self.n_unknowns}; redundancy: {self.dof}",
             f"sigma0 (a posteriori, unit weight): {self.sigma0:.4f}   "
             f"[99% chi2 interval under the model: {lo:.3f} … {hi:.3f}]",
-        ]
+        ] + extra
 
     def report(self, max_block_size: int = 60) -> str:
         """A plain-text report: summary, then value ± σ of every non-point parameter."""

@@ -449,6 +449,58 @@ def _reduced_inverse(layout: _Layout, ne: _Normal) -> np.ndarray:
     return _spd_inverse(S, ne.options.rank_rtol)
 
 
+#: A parameter is undetermined when its entries of the null space (unit-diagonal scaled, unit
+#: null vectors) carry at least this share of a unit vector: the null vectors of a matrix
+#: singular to rounding have entries of order √eps elsewhere.
+NULL_SHARE = 1e-6
+
+
+def _estimable_inverse(S: np.ndarray, rtol: float) -> tuple[np.ndarray, np.ndarray, int]:
+    """A generalised inverse of a singular ``S`` and the parameters it cannot determine.
+
+    Columns with a zero diagonal (no observation left) are undetermined outright; the rest is
+    scaled to unit diagonal and decomposed (``eigh``); eigenvalues below ``rtol`` × the
+    largest (the datum check's rule) span the null space, and every parameter with a share of
+    at least :data:`NULL_SHARE` in it is undetermined. The pseudo-inverse of the scaled matrix,
+    scaled back, is a generalised inverse ``G`` of ``S`` (``S G S = S``), so ``G`` gives the
+    unique covariance of every estimable function — a parameter outside the null space
+    among them (the caller sets the undetermined parameters' rows and columns to NaN).
+
+    Returns
+    -------
+    G : (n, n) ndarray
+    undetermined : (k,) int ndarray
+        Indices of the undetermined parameters (sorted).
+    defect : int
+        ``n − rank(S)``: the dimension of the null space.
+    """
+    n = S.shape[0]
+    d = np.diag(S).copy()
+    live = np.flatnonzero(d > 0)
+    G = np.zeros_like(S)
+    if live.size:
+        w = 1.0 / np.sqrt(d[live])
+        Ss = S[np.ix_(live, live)] * w[:, None] * w[None, :]
+        ev, evec = np.linalg.eigh(Ss)
+        null = ev < rtol * max(float(ev[-1]), 1e-300)
+        share = np.sum(evec[:, null] ** 2, axis=1)
+        keep = ~null
+        Gs = (evec[:, keep] / ev[keep]) @ evec[:, keep].T
+        G[np.ix_(live, live)] = Gs * w[:, None] * w[None, :]
+        bad = np.union1d(np.setdiff1d(np.arange(n), live), live[share >= NULL_SHARE])
+        defect = n - live.size + int(null.sum())
+    else:
+        bad, defect = np.arange(n), n
+    return G, bad.astype(int), defect
+
+
+def _reduced_estimable_inverse(layout: _Layout, ne: _Normal) -> tuple[np.ndarray, np.ndarray, int]:
+    """:func:`_estimable_inverse` of the undamped reduced matrix at the point of ``ne``."""
+    ne.exact()
+    S, _, _, _ = _reduced(layout, ne, 0.0)
+    return _estimable_inverse(S, ne.options.rank_rtol)
+
+
 def _point_cofactors(
     ne: _Normal, S_inv: np.ndarray, pts: np.ndarray, chunk: int = 20000
 ) -> np.ndarray:

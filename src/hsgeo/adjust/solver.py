@@ -69,6 +69,7 @@ from hsgeo.adjust.schur import (
     _point_cofactor_function,
     _predicted_decrease,
     _reduced,
+    _reduced_estimable_inverse,
     _reduced_inverse,
     _step,
 )
@@ -705,20 +706,32 @@ class _Solve:
         """σ0, covariance and residuals at the final iterate, as an :class:`AdjustmentResult`."""
         layout, blocks = self.layout, self.blocks
         n_unk = layout.n_unknowns
-        dof = int(sy.r.size - n_unk)
-        vtpv = float(sy.r @ sy.r)
-        sigma0 = float(np.sqrt(vtpv / dof)) if dof > 0 else float("nan")
         t_cov = time.perf_counter()
+        bad, defect = np.zeros(0, dtype=int), 0
         try:
             S_inv = _reduced_inverse(layout, ne)
         except (np.linalg.LinAlgError, sla.LinAlgError) as exc:
-            raise DatumError(
-                "the normal matrix at the solution is singular: the covariance cannot be "
-                "computed (a datum defect that appeared during the iteration?)",
-                layout.labels_c,
-            ) from exc
+            # a datum defect that appeared during the iterations (e.g. every observation of a
+            # parameter rejected): the estimable part keeps its covariance, the rest is named
+            # (issue 42); SolverOptions.strict_covariance raises instead
+            S_inv, bad, defect = _reduced_estimable_inverse(layout, ne)
+            undetermined = [layout.labels_c[i] for i in bad]
+            if self.options.strict_covariance or not bad.size:
+                raise DatumError(
+                    "the normal matrix at the solution is singular: the covariance cannot be "
+                    "computed (a datum defect that appeared during the iteration); not "
+                    f"determined: {_name_list(undetermined)}",
+                    undetermined or layout.labels_c,
+                ) from exc
         self.clock.add("covariance", t_cov)
+        dof = int(sy.r.size - n_unk + defect)  # n − rank: the undetermined use no redundancy
+        vtpv = float(sy.r @ sy.r)
+        sigma0 = float(np.sqrt(vtpv / dof)) if dof > 0 else float("nan")
         s2 = sigma0**2 if np.isfinite(sigma0) else 1.0
+        covariance = s2 * S_inv
+        if bad.size:
+            covariance[bad, :] = np.nan
+            covariance[:, bad] = np.nan
         full = _evaluate(layout, blocks, [np.ones(b.m, dtype=bool) for b in blocks], False)
         residuals, off = {}, 0
         for b in blocks:
@@ -740,7 +753,7 @@ class _Solve:
             dof=dof,
             n_observations=int(sy.n_obs_rows),
             n_unknowns=n_unk,
-            covariance=s2 * S_inv,
+            covariance=covariance,
             labels=list(layout.labels_c),
             seconds=seconds,
             reject_rounds=rounds,
@@ -751,8 +764,17 @@ class _Solve:
             _point_cofactors=cofactors,
             seconds_split=split,
             dropped_points=sorted(self.dropped_points),
+            undetermined_parameters=[layout.labels_c[i] for i in bad],
             _dropped_rows=[d.copy() for d in self.dropped_rows],
         )
+
+
+def _name_list(names: list[str], most: int = 12) -> str:
+    """``a, b, c`` (and ``… (N in all)`` beyond ``most``)."""
+    if not names:
+        return "(none identified)"
+    head = ", ".join(names[:most])
+    return head if len(names) <= most else f"{head}, … ({len(names)} in all)"
 
 
 def _settled(actual: float, pred: float, new_cost: float, share: float) -> bool:

@@ -88,6 +88,15 @@ def write_cube(ds, path, *, inputs=(), progress=None) -> list[Path]:
     n_lines = data.shape[0]
     if fmt == "netcdf":
         out = ds.copy()
+        # every other variable in memory before the write (they are small: lines × bands):
+        # with more than one Dask-backed variable, the order in which the delayed store
+        # computes them, and so where each lands in the file, varied from run to run (the
+        # same content in different bytes in 1 of 6 runs, issue 42)
+        for name in list(out.data_vars) + list(out.coords):
+            if name != "reflectance" and isinstance(out[name].data, da.Array):
+                # synchronous: a thread pool would receive the SIGINT that atomic_path holds
+                # back in the main thread while it makes its temporary file
+                out[name] = out[name].compute(scheduler="synchronous")
         out["reflectance"] = refl.copy(data=data.astype(np.float32))
         enc = {
             "reflectance": {

@@ -37,6 +37,13 @@ def _frame_shape(path: Path):
             raise InputError(
                 f"frame file {str(path)!r} is not a readable .npy array: {exc}"
             ) from None
+        if arr.dtype.kind not in "ui" or arr.dtype.itemsize < 2:
+            raise InputError(
+                f"frame file {str(path)!r} holds {arr.dtype} values; a frame is the camera's "
+                "raw DN as unsigned 16-bit integers (uint16): 8-bit or scaled frames have lost "
+                "the 12-bit levels the dark and reflectance corrections need; export the raw "
+                "frames"
+            )
         if arr.ndim == 2:
             return (1, *arr.shape)
         if arr.ndim == 3:
@@ -58,6 +65,52 @@ def _frame_shape(path: Path):
             return (1, im.height, im.width)
     except (UnidentifiedImageError, OSError) as exc:
         raise InputError(f"frame file {str(path)!r} is not a readable TIFF: {exc}") from None
+
+
+#: Files of other frame formats that a frame folder must not hold (they would be left out)
+_OTHER_FRAME_SUFFIXES = (".hdr", ".raw", ".img", ".bsq", ".bil", ".bip", ".png", ".jpg", ".bmp")
+
+
+def _check_frame_names(folder: Path, files: list, what: str) -> None:
+    """The frame files are one numbered series: one name pattern, no number missing, and no
+    frames in another format beside them (issue 42: a lost frame, a stray file or ENVI frames
+    were taken silently).
+    """
+    import re
+
+    others = sorted(p.name for p in folder.iterdir() if p.suffix.lower() in _OTHER_FRAME_SUFFIXES)
+    if others:
+        raise InputError(
+            f"{what} {str(folder)!r} holds {others[0]}"
+            + (f" and {len(others) - 1} more" if len(others) > 1 else "")
+            + ": frames are read only as 16-bit TIFF or .npy (ENVI or 8-bit images are not "
+            "frames); convert them, or move other files out of the folder"
+        )
+    pat = re.compile(r"^(.*?)(\d+)(\.[^.]+)$")
+    parts = [pat.match(p.name) for p in files]
+    if len(files) < 2 or not all(parts):
+        return  # names without a number: the name order is the only order there is
+    stems = {(m.group(1), m.group(3).lower()) for m in parts}
+    if len(stems) > 1:
+        common = max(stems, key=lambda k: sum((m.group(1), m.group(3).lower()) == k for m in parts))
+        odd = next(
+            p.name
+            for p, m in zip(files, parts, strict=True)
+            if (m.group(1), m.group(3).lower()) != common
+        )
+        raise InputError(
+            f"{what} {str(folder)!r}: {odd} is not one of the series {common[0]}NNNN{common[1]}; "
+            "move files that are not frames of this run out of the folder"
+        )
+    nums = np.array([int(m.group(2)) for m in parts])
+    gaps = np.flatnonzero(np.diff(nums) != 1)
+    if gaps.size:
+        i = int(gaps[0])
+        raise InputError(
+            f"{what} {str(folder)!r}: the frame numbers jump from {files[i].name} to "
+            f"{files[i + 1].name} ({int(nums[i + 1] - nums[i] - 1)} frame(s) missing): the "
+            "lines would be stacked without them; restore the missing frames"
+        )
 
 
 def _read_file(path: Path) -> np.ndarray:
@@ -106,6 +159,7 @@ class FrameFolder:
             raise InputError(
                 f"{what} {str(self.folder)!r} holds no frames (.tif, .tiff or .npy files)"
             )
+        _check_frame_names(self.folder, self.files, what)
         exp = self.folder / "exposures.csv"
         df = read_table(
             exp, ["file", "exposure_s"], "exposure", text_columns=["file"], unique=["file"]
@@ -117,6 +171,15 @@ class FrameFolder:
                 f"exposure file {str(exp)!r} lists no exposure_s for {missing[0]}"
                 + (f" and {len(missing) - 1} more frame file(s)" if len(missing) > 1 else "")
                 + "; add a row 'file,exposure_s' for every frame file"
+            )
+        names = {p.name for p in self.files}
+        absent = [f for f in by_file if f not in names]
+        if absent:
+            raise InputError(
+                f"exposure file {str(exp)!r} lists {absent[0]}"
+                + (f" and {len(absent) - 1} more file(s)" if len(absent) > 1 else "")
+                + f", not in {what} {str(self.folder)!r}: a frame file lost or renamed? restore "
+                "it, or delete its row"
             )
         bad = [f for f, t in by_file.items() if not (0.0 < t < 100.0)]
         if bad:

@@ -206,6 +206,13 @@ def measure_ctf(
             f"{saturation_dn:g} DN, first at x = {x[i]:g} px); record it with a shorter exposure"
         )
     y = y - dark_dn
+    level = float(np.median(y[inside])) if inside.any() else float(np.median(y))
+    if not level > 0:
+        raise InputError(
+            f"dark_dn = {dark_dn:g} DN is at or above the profile's median level on the target "
+            f"({level + dark_dn:g} DN): the dark level must be below the bars' signal; check "
+            "dark_dn of the bar file (a dark frame's mean, in the profile's DN)"
+        )
     if register:
         start_px, gsd_mm = register_target(x, y, target, start_px, gsd_mm)
     starts = start_px + target.group_start_mm() / gsd_mm
@@ -224,6 +231,13 @@ def measure_ctf(
                 f"{margin_px:g}-px margins; its bars are too few for the blur"
             )
         i_max, i_min = _group_ctf(x[sel], y[sel], f, s + p_px / 4)
+        if p_px >= 12.0 and i_max < i_min:  # a resolved group dark where it should be white
+            raise ObservationError(
+                f"bar group {g} ({p:g} mm pairs, {p_px:.0f} px) is dark where its white bars "
+                "should be: the profile is mirrored or shifted by half a pair, or pair_mm lists "
+                "the groups in reverse order; give the profile in the target's direction "
+                "(coarse groups first) and check start_px"
+            )
         groups.append(g)
         fs.append(f)
         ctfs.append(float(modulation(i_max, i_min)) / m_in)  # 001 eq. (5) and (4)

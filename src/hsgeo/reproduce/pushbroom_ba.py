@@ -50,6 +50,7 @@ from hsgeo.simulate.pushbroom_campaign import (
 )
 from hsgeo.stats import describe
 from hsgeo.workflows.pushbroom_ba import (  # 002's settings, spelled once in the workflow
+    BLOCK_NAMES,
     FTOL,
     REJECT_K,
     REPORTED_PARAMETERS,
@@ -462,6 +463,9 @@ def run(
             cfg.agl_low_m * cfg.pixel_mm / cfg.c_mean_mm,
             cfg.agl_high_m * cfg.pixel_mm / cfg.c_mean_mm,
         ],
+        # what the data could not determine, said rather than a reason to stop (issue 42)
+        "not_determined_gcp": _not_determined(res),
+        "not_determined_nogcp": _not_determined(res0),
         "total_seconds": time.perf_counter() - t_start,
     }
     extras = {
@@ -509,3 +513,16 @@ def interval_distribution_text(per_seed: dict) -> str:
         dist = ", ".join(f"{a:g} s in {c}" for a, c in zip(vals, cnt, strict=True))
         parts.append(f"τ × {float(k):g}: {dist}")
     return "; ".join(parts)
+
+
+def _not_determined(res) -> dict:
+    """What an adjustment left out or could not determine: the principal distances of bands
+    without observations (fixed at the prior), the tie points their rays do not determine
+    (dropped), the parameters undetermined at the solution (no σ).
+    """
+    c = res.params[BLOCK_NAMES["c"]]
+    return {
+        "fixed_unobserved": [f"{BLOCK_NAMES['c']}[{k}]" for k in np.flatnonzero(~c.free.ravel())],
+        "dropped_points": len(res.dropped_points),
+        "undetermined_parameters": list(res.undetermined_parameters),
+    }

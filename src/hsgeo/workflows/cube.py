@@ -351,6 +351,30 @@ def _stderr_progress(done: int, total: int) -> None:
     sys.stderr.flush()
 
 
+#: The survey's exposure times may lie this factor outside the dark frames' (the dark current
+#: h = a·T + b is extrapolated that far); beyond, a unit is wrong (ms for s) or the dark frames
+#: are another camera's setting
+EXPOSURE_EXTRAPOLATION = 10.0
+
+
+def _check_exposures(frames, dark) -> None:
+    """The survey's exposure times near the dark frames' (issue 42: exposures in ms where s are
+    expected gave a cube with exit 0).
+    """
+    t, td = np.asarray(frames.exposure_s), np.asarray(dark.exposure_s)
+    lo, hi = td.min() / EXPOSURE_EXTRAPOLATION, td.max() * EXPOSURE_EXTRAPOLATION
+    out = (t < lo) | (t > hi)
+    if out.any():
+        f, _ = frames.locate(int(np.flatnonzero(out)[0]))
+        raise InputError(
+            f"{frames.what} {str(frames.folder / 'exposures.csv')!r}: exposure_s of {f.name} is "
+            f"{t[out][0]:g} s, but the dark frames (--dark) span {td.min():g}–{td.max():g} s "
+            f"(the dark current is extrapolated at most {EXPOSURE_EXTRAPOLATION:g}× beyond "
+            "them); give both exposure files in seconds (not ms), or dark frames of the "
+            "survey's exposure times"
+        )
+
+
 def cube_files(
     raw_dir,
     dark_dir,
@@ -395,6 +419,7 @@ def cube_files(
                 f"{what}: frames of {r} × {c} px (rows × columns), but --binning "
                 f"{layout.binning} gives {layout.n_rows} × {layout.n_columns}; check --binning"
             )
+    _check_exposures(frames, dark)
     lam, fwhm = read_wavelengths(Path(raw_dir) / "wavelengths.csv", layout.n_rows)
     res = build_cube(CubeInputs(frames, dark, lam, fwhm), options)
     bar = _stderr_progress if progress is True else (progress or None)

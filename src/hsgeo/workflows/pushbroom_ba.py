@@ -766,6 +766,13 @@ def summary(res, nodes, point_ids, n_observations_2d: int, node_interval_s: floa
         "reason": "not determined by their observations (too few or degenerate rays): held at "
         "their initial values, their observations left out",
     }
+    und = list(getattr(res, "undetermined_parameters", []))
+    out["undetermined_parameters"] = {
+        "parameters": und,
+        "reason": "the normal matrix at the solution does not determine them (a datum defect "
+        "that appeared during the iterations, e.g. every observation of a band rejected): "
+        "their σ is null, the σ of the rest is that of the estimable part",
+    }
     out["fit"] = fit_verdict(res, n_obs)
     return out
 
@@ -791,7 +798,8 @@ def fit_verdict(res, n_observations_2d: int) -> dict:
     dict
         ``sigma0``, ``sigma0_interval_99`` (two-sided 99 % interval under the model),
         ``rejected_share``, ``verdict`` (``"ok"`` or ``"poor"``) and ``reasons``: one sentence
-        per problem, in the terms of the input files.
+        per problem, in the terms of the input files; ``warnings``: what was estimated only in
+        part (parameters the data do not determine at the solution).
     """
     s0 = float(res.sigma0)
     share = float(res.outliers(0).sum()) / max(1, n_observations_2d)
@@ -814,9 +822,19 @@ def fit_verdict(res, n_observations_2d: int) -> dict:
             f"{100 * POOR_FIT_REJECTED_SHARE:.0f} %); the likely causes: a wrong GCP or point_id in"
             " the input tables, or observations in another unit than pixels"
         )
+    warnings = []
+    und = list(getattr(res, "undetermined_parameters", []))
+    if und:
+        names = ", ".join(und[:8]) + (f", … ({len(und)} in all)" if len(und) > 8 else "")
+        warnings.append(
+            f"the data do not determine {names} at the solution: their σ is not given, the σ "
+            "of the rest is that of the estimable part; add observations or GCPs that see "
+            "them, or fix them in the camera file"
+        )
     return {
         "sigma0": s0,
         "sigma0_interval_99": list(res.chi2_interval(0.01)) if res.dof > 0 else None,
+        "warnings": warnings,
         "rejected_share": share,
         "verdict": "poor" if reasons else "ok",
         "reasons": reasons,
