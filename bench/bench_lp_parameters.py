@@ -129,7 +129,7 @@ def _blur_off(scale: float, seed: int) -> np.ndarray:
     from hsgeo.simulate.lp_campaign import LpConfig
 
     obs, truth = simulate(sim_scale(scale), rng=seed, cfg=replace(LpConfig(), motion_blur_m=0.0))
-    ev = evaluate(obs, truth, seed, nogcp=False)
+    ev = evaluate(obs, truth, seed, nogcp=False, both=False)
     tw = exact_twin(ev, obs, truth)
     a, b = _flat(ev["parameters"]), _flat(tw["parameters"])
     return (a["value"] - b["value"]) / a["sigma"]
@@ -139,7 +139,7 @@ def one_seed(seed: int, scale: float, subpixel: bool) -> dict:
     """z of every camera parameter: retrieved vs truth, twin vs truth, retrieved vs twin."""
     t0 = time.perf_counter()
     obs, truth = simulate(sim_scale(scale), rng=seed)
-    ev = evaluate(obs, truth, seed, nogcp=False)
+    ev = evaluate(obs, truth, seed, nogcp=False, both=False)
     tw = exact_twin(ev, obs, truth)
     a, b = _flat(ev["parameters"]), _flat(tw["parameters"])
     out = {

@@ -98,6 +98,24 @@ def test_ground_points_project_back_onto_their_pixels(campaign):
     assert np.max(np.abs(xy[:, 0] - x)) < 1e-6 and np.max(np.abs(xy[:, 1])) < 1e-6
 
 
+def test_a_start_of_exposure_stamp_moves_the_squares_half_a_blur():
+    """exposure_stamp="start": every line rendered half an integration after its stamp, so a
+    square crosses the line (in stamp time) half the blur earlier — 0.5 line at 002's 1/200 s
+    and 67 m/s — while x stays; "middle" (the default) leaves it in place (test above)."""
+    from dataclasses import replace
+
+    cfg = replace(L.LpConfig(), exposure_stamp="start")
+    obs, truth = L.simulate(scale=L.MIN_SCALE, rng=3, cfg=cfg)
+    meas, true = _square_measurements(obs, truth, 0)
+    assert len(meas) >= 10
+    err = meas - true
+    half = 0.5 * cfg.motion_blur_m / cfg.campaign.speed_m_s * cfg.campaign.line_rate_hz
+    assert np.mean(err[:, 0]) == pytest.approx(-half, abs=0.1)
+    assert np.max(np.abs(err[:, 1])) < 0.1
+    with pytest.raises(InputError, match="exposure_stamp"):
+        L.simulate(0.05, cfg=replace(L.LpConfig(), exposure_stamp="end"))
+
+
 def test_bad_config():
     from dataclasses import replace
 

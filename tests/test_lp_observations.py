@@ -227,7 +227,9 @@ def test_end_to_end_within_one_pixel(campaign, retrieved):
     25's 'done'); the squares' centroids all within 1 px; tie points as 002 §4 asks."""
     obs, truth = campaign
     res = retrieved
-    tab = res.table
+    assert res.options.squares_as == "centroid"  # the command's default
+    tab = res.tables_by_squares["centroid"]
+    assert res.table.equals(tab)
     assert list(tab.columns[:7]) == ["point_id", "band", "t_s", "x_px", "y_px", "strip", "line"]
     e, sq = true_image_errors(tab, truth, obs.square_ids)
     assert np.mean(e < 1.0) >= 0.95
@@ -251,12 +253,29 @@ def test_end_to_end_within_one_pixel(campaign, retrieved):
     m = res.matches
     assert (m["kept"] == m["inlier_lp"]).all()
     assert res.counts["all"]["matches"] == len(m)
-    assert res.counts["all"]["observations_adjusted"] == len(ties)
+    n_ties = int((~res.table["point_id"].isin(obs.square_ids)).sum())  # the counts' table
+    assert res.counts["all"]["observations_adjusted"] == n_ties <= len(ties)
     allb = res.all_bands
-    assert res.counts["all"]["observations"] == int((allb["feature"] >= 0).sum()) > len(ties)
+    assert res.counts["all"]["observations"] == int((allb["feature"] >= 0).sum()) > n_ties
     few = m["pair"].map(res.pairs.set_index("pair")["n_matches"]) < 11
     assert not (m["inlier_lp"] | m["inlier_frame"])[few].any()
     assert set(res.timings_s) >= {"scenes", "detection", "matching", "ransac", "squares"}
+    # the squares as 002 measured them: the matcher's tie points on them, at the pixel centre
+    # of their line, one observation per strip and band, far fewer rays than the centroids
+    tp = res.tables_by_squares["tie_point"]
+    on = tp["point_id"].isin(obs.square_ids).to_numpy()
+    assert on.sum() > 0 and on.sum() < sq.sum()
+    j = tp["x_px"].to_numpy()[on] + (obs.n_px_full - 1) / 2
+    assert np.allclose(j, np.round(j))
+    t_tp = np.array([strips[s].t_s[ln] for s, ln in zip(tp.strip, tp.line, strict=True)])
+    assert (tp["t_s"].to_numpy() == t_tp).all()
+    assert not tp[on].duplicated(["point_id", "band", "strip"]).any()
+    e_tp, _ = true_image_errors(tp, truth, obs.square_ids)
+    # BRISK's key points on a 1.2 m square (~4 px) are mostly at its corners, not its centre:
+    # within the square's half-diagonal (~2.6 px) plus the pixel and line rounding
+    assert np.mean(e_tp[on] < 3.5) >= 0.95 and np.median(e_tp[on]) > 0.5
+    # no free tie point of the table lies on a square it was taken for
+    assert tp.loc[~on, "point_id"].str.startswith("tp").all()
 
 
 def test_the_table_feeds_adjust_files(tmp_path, campaign, retrieved):
@@ -378,3 +397,61 @@ def test_one_band_per_feature_groups_within_a_pixel():
     assert keep.tolist() == [False, True, True, False, True]
     with pytest.raises(InputError, match="score"):
         one_band_per_feature(point, strip, line, x, score=[1.0, 2.0])
+
+
+def test_squares_as_tie_points_takes_the_matchers_points_on_a_square():
+    """A tie point whose observations lie on square A's blob in most strips is A's (all its
+    observations, renamed), one per band; one off the blobs, or on them in too few strips, is
+    not; the features of every candidate leave the free tie points."""
+    from hsgeo.workflows._lp_squares import as_tie_points
+
+    rows = []
+    # tp 0 (band 1): on A in strips s0, s1, s2; tp 1 (band 1): on A in s0 only (of 3);
+    # tp 2 (band 3): on A in s0, s1 and off in s2 (majority: a candidate, band 3);
+    # tp 3 (band 1): elsewhere
+    where = {0: [(10, 5.0)] * 3, 1: [(10, 5.0), (50, 40), (60, 50)], 2: [(10, 5.0)] * 2 + [(70, 9)]}
+    where[3] = [(200, 100.0)] * 3
+    # tp 4 (band 2): on A in every strip, at another corner (1.8 px from tp 0): another feature
+    where[4] = [(10, 6.8)] * 3
+    for p, obs in where.items():
+        band = {2: 3, 4: 2}.get(p, 1)
+        for k, (ln, x) in enumerate(obs):
+            rows.append(
+                {
+                    "point_id": f"tp{p}",
+                    "point": p,
+                    "band": band,
+                    "t_s": 0.0,
+                    "x_px": x,
+                    "y_px": 0.0,
+                    "strip": f"s{k}",
+                    "line": ln,
+                    "feature": p,
+                    "adjusted": True,
+                    "x_keypoint_px": x + 0.2,
+                    "line_offset": 0.1,
+                }
+            )
+    ties = pd.DataFrame(rows)
+    blobs = pd.DataFrame(
+        {
+            "point_id": ["A", "A", "A"],
+            "band": [0, 0, 0],
+            "strip": ["s0", "s1", "s2"],
+            "line": [10, 10, 10],
+            "x_px": [5.3, 5.3, 5.3],
+            "line_frac": [10.2, 10.2, 10.2],
+            "box_px": [3, 3, 3],
+        }
+    )
+    got, taken = as_tie_points(ties, blobs, np.zeros(5))
+    assert sorted(got["point"].unique()) == [0, 2]  # tp 4 is on A, but not tp 0's feature
+    assert (got["point_id"] == "A").all() and len(got) == 6
+    assert sorted(taken) == [0, 2, 4]
+    # with tp 4 the best (a lower score breaks the tie), tp 0 and tp 2 leave instead
+    got, _ = as_tie_points(ties, blobs, np.array([1.0, 1.0, 1.0, 1.0, 0.0]))
+    assert sorted(got["point"].unique()) == [4]
+    # farther than half the box + ½ px from every tie point: not on the square
+    far = blobs.assign(x_px=blobs["x_px"] + 5.0)
+    got, taken = as_tie_points(ties, far, np.zeros(5))
+    assert len(got) == 0 and taken.size == 0

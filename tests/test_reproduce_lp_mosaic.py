@@ -50,7 +50,8 @@ def test_squares_within_one_gsd_with_the_adjusted_trajectory(run):
     # the RMS from the per-square errors (an independent recomputation), within 1 GSD
     assert rms_a == pytest.approx(np.sqrt(np.nanmean(np.sum(ea**2, axis=1))))
     assert rms_a <= gsd
-    assert r["square_position_error_rms_m"].verdict == "reproduced"
+    assert r["square_position_error_rms_m"].verdict == "not testable"  # no paper value
+    assert r["square_position_error_rms_m"].reason.startswith("meets our bar")
     # each square found where the adjusted geometry puts it (an independent truth: the true
     # line and pixel that saw it, down the adjusted ray): the measurement errs < 1/2 cell
     d_a = ea - per["expected_adjusted_m"]

@@ -42,6 +42,25 @@ def test_stat_sigma_matches_the_analytic_spread():
     assert np.all(np.isnan(stat_sigma(cov[:1], np.random.default_rng(0))))
 
 
+def test_stat_sigma_of_a_shared_shift():
+    """Check points that share one datum error (a common shift of σ 1 m in H, each alone 1 cm):
+    drawn from the joint covariance, the mean moves by the shift's σ and the STD and NMAD by
+    centimetres; drawn from the per-point blocks alone, the STD's σ is ~0.2 m."""
+    k = 13
+    C = np.zeros((3 * k, 3 * k))
+    for i in range(k):
+        C[3 * i : 3 * i + 3, 3 * i : 3 * i + 3] = np.diag([1e-4, 1e-4, 1e-4])
+    h = np.arange(k) * 3 + 2
+    C[np.ix_(h, h)] += 1.0
+    sig = stat_sigma(C, np.random.default_rng(5), n_draws=2000)
+    i_mean, i_std = P002_STATS.index("mean"), P002_STATS.index("std")
+    i_nmad = P002_STATS.index("nmad")
+    assert sig[2, i_mean] == pytest.approx(1.0, rel=0.08)
+    assert sig[2, i_std] < 0.01 and sig[2, i_nmad] < 0.02
+    blocks = np.array([C[3 * i : 3 * i + 3, 3 * i : 3 * i + 3] for i in range(k)])
+    assert stat_sigma(blocks, np.random.default_rng(5))[2, i_std] > 0.1
+
+
 def test_within_fractions():
     w = within_fractions(np.array([[0.3, 0.4], [0.6, 0.8], [3.0, 0.0], [0.1, 0.1]]))
     assert w == {1.0: 0.75, 0.5: 0.5}
@@ -126,9 +145,24 @@ def test_tables_and_strict_json(rep):
         have = {r.quantity for r in rep.rows_of(t)}
         assert set(qs) <= have, set(qs) - have
     for t in ("002 Table 2 from pixels", "002 Table 3 from pixels"):
-        rows = rep.rows_of(t)
-        assert len(rows) == 18 and all(r.paper is not None for r in rows)
-        assert all(r.sigma is not None and r.sigma > 0 for r in rows)
+        for pre in ("", "square centroids: "):
+            rows = rep.rows_of(pre + t)
+            assert len(rows) == 18 and all(r.paper is not None for r in rows)
+            assert all(r.sigma is not None and r.sigma > 0 for r in rows)
+    rays = {r.quantity: r.reproduced for r in rep.rows_of("check points")}
+    assert rays["rays_per_check_point_mean_tie_point"] < rays["rays_per_check_point_mean_centroid"]
+    # the check points' joint covariance: its diagonal blocks are the engine's, and without
+    # GCPs their heights move together (one datum)
+    from hsgeo.reproduce.lp_judge import joint_point_covariance
+
+    ev = rep.extras["evaluation"]
+    r0 = ev["adjusted_nogcp"].result
+    idx = np.arange(3)
+    J = joint_point_covariance(r0, idx)
+    B = r0.point_covariance(index=idx)
+    for i in range(3):  # the same A_i that make the cross terms give the engine's blocks
+        np.testing.assert_allclose(J[3 * i : 3 * i + 3, 3 * i : 3 * i + 3], B[i], rtol=1e-6)
+    assert J[2, 5] / np.sqrt(J[2, 2] * J[5, 5]) > 0.5
     d = json.loads(rep.to_json())  # allow_nan=False inside: strict
     assert d["chapter"] == "lp-observations" and d["seed"] == 0
     assert all(r["provenance"] in (None, "paper", "derived", "chosen", "tuned") for r in d["rows"])
@@ -150,7 +184,10 @@ def test_done_means_observations_and_parameters(rep):
     the LP fundamental matrix keeps fewer false matches than it was given."""
     acc = {r.quantity: r.reproduced for r in rep.rows_of("retrieval accuracy")}
     assert acc["within_1px_fraction"] >= 0.95
-    assert acc["within_1px_fraction_squares"] >= 0.95
+    # the check points are the matcher's tie points on the squares (at the pixel centre of
+    # their line, judged against the square's surveyed centre: BRISK finds the squares' corners
+    # more than their centres), the GCPs their centroids: fewer within 1 px than tie points
+    assert 0.3 <= acc["within_1px_fraction_squares"] < acc["within_1px_fraction"]
     assert acc["outlier_fraction_after_ransac"] <= acc["outlier_fraction_before_ransac"]
     z = np.array([r.z for r in rep.rows_of("parameters")])
     assert z.size == 3 + 3 + 4 + 7 and np.all(np.isfinite(z))
@@ -179,7 +216,7 @@ def rep7():
 def test_done_means_observations_for_another_seed(rep7):
     acc = {q.quantity: q.reproduced for q in rep7.rows_of("retrieval accuracy")}
     assert acc["within_1px_fraction"] >= 0.95
-    assert acc["within_1px_fraction_squares"] >= 0.95
+    assert 0.3 <= acc["within_1px_fraction_squares"] < acc["within_1px_fraction"]
 
 
 @pytest.mark.slow

@@ -130,18 +130,32 @@ class AdjustmentResult:
         d = np.sqrt(np.diag(self.covariance))
         return self.covariance / np.outer(d, d)
 
-    def point_covariance(self, chunk: int = 20000, index=None) -> np.ndarray:
+    def point_covariance(
+        self, chunk: int = 20000, index=None, *, joint: bool = False
+    ) -> np.ndarray:
         """σ0²·(V⁻¹ + V⁻¹ Wᵀ S⁻¹ W V⁻¹) for every point: ``(n_points, p, p)``.
 
         Computed on first request, in chunks of points to bound the memory. With ``index``
         (point rows), only those points are computed: ``(len(index), p, p)``, not cached.
         Needs the Jacobian of the solution: adjust with ``keep_jacobian=True``.
 
+        With ``joint=True`` (``index`` required), the joint covariance of those points:
+        ``(len(index)·p, len(index)·p)``, ordered point by point (the point's coordinates
+        within), σ0²·(blockdiag V_i⁻¹ + A S⁻¹ Aᵀ) with ``A_i = V_i⁻¹ W_iᵀ`` — the points'
+        block of σ0² times the inverse of the full normal matrix. Its diagonal blocks are the
+        ``joint=False`` blocks; the off-diagonal ones are what points share through the
+        non-point unknowns (e.g. one datum error: a statistic over several points, a mean or a
+        spread, needs them). NaN in the rows and columns of fixed coordinates and of points
+        whose own block is singular.
+
         Raises
         ------
         InputError
-            If the result was computed without ``keep_jacobian=True``.
+            If the result was computed without ``keep_jacobian=True``, or ``joint=True``
+            without ``index``.
         """
+        if joint:
+            return self._joint_point_covariance(index)
         if self._point_cov is not None and index is None:
             return self._point_cov
         pb = self.params.points_block
@@ -165,6 +179,28 @@ class AdjustmentResult:
             out[fixed[:, j], :, j] = np.nan
         if index is None:
             self._point_cov = out
+        return out
+
+    def _joint_point_covariance(self, index) -> np.ndarray:
+        pb = self.params.points_block
+        if pb is None:
+            raise ValueError("this problem has no points block")
+        if index is None:
+            raise InputError(
+                "point_covariance(joint=True) needs index=: the rows of the points whose joint "
+                "covariance is wanted (the full matrix of every point is rarely affordable)"
+            )
+        if self._point_cofactors is None:
+            raise InputError(
+                "the covariance of the points needs the Jacobian of the solution, which this "
+                "result did not keep: adjust again with keep_jacobian=True"
+            )
+        pts = np.atleast_1d(np.asarray(index, dtype=np.int64))
+        s2 = self.sigma0**2 if np.isfinite(self.sigma0) else 1.0
+        out = self._point_cofactors.joint(pts) * s2
+        fixed = (~pb.free[pts]).ravel()
+        out[fixed, :] = np.nan
+        out[:, fixed] = np.nan
         return out
 
     # -- residuals ----------------------------------------------------------------------------

@@ -15,9 +15,7 @@ Two paths form the same equations: the compiled row-compressed kernels
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
 from dataclasses import dataclass
-from functools import partial
 
 import numpy as np
 import scipy.linalg as sla
@@ -538,12 +536,80 @@ def _point_cofactors(
     return out
 
 
-def _point_cofactor_function(
-    ne: _Normal, S_inv: np.ndarray
-) -> Callable[[np.ndarray, int], np.ndarray]:
-    """``f(pts, chunk)`` → the points' cofactor blocks (see :func:`_point_cofactors`).
+def _selected_W(ne: _Normal, pts: np.ndarray) -> np.ndarray:
+    """``W`` restricted to the columns of the (distinct) points ``pts``: dense ``(n_c, k·p)``,
+    point by point. On the compiled path only the rows of those points are read.
+    """
+    p = ne.V.shape[-1]
+    k = pts.size
+    if ne._W is not None or ne.sy is None:
+        cols = (pts[:, None] * p + np.arange(p)).ravel()
+        return ne.W[:, cols].toarray()
+    sy = ne.sy
+    where = np.full(ne.n_pts, -1, dtype=np.int64)
+    where[pts] = np.arange(k)
+    rows = np.flatnonzero((sy.pidx >= 0) & (where[np.maximum(sy.pidx, 0)] >= 0))
+    loc = where[sy.pidx[rows]]
+    Jp_sel = sp.csr_matrix(
+        (
+            sy.Jp[rows].ravel(),
+            (np.repeat(np.arange(rows.size), p), (loc[:, None] * p + np.arange(p)).ravel()),
+        ),
+        shape=(rows.size, k * p),
+    )
+    return (sy.Jc[rows].T @ Jp_sel).toarray()
 
-    The function holds the Jacobian of the solution; the result keeps it only on request
+
+def _joint_point_cofactors(ne: _Normal, S_inv: np.ndarray, pts: np.ndarray) -> np.ndarray:
+    """The joint cofactor matrix of the points ``pts``: ``(k·p, k·p)``, point by point.
+
+    ``blockdiag(V_i⁻¹) + A S⁻¹ Aᵀ`` with ``A_i = V_i⁻¹ W_iᵀ`` — the Schur complement's
+    back-substitution (every point moves with the non-point unknowns through its own ``A_i``);
+    its diagonal blocks are :func:`_point_cofactors`. This is the points' block of the inverse
+    of the full normal matrix. Rows and columns of a point whose ``V`` is singular are NaN.
+    """
+    p = ne.V.shape[-1]
+    uniq, inv = np.unique(np.asarray(pts, dtype=np.int64), return_inverse=True)
+    k = uniq.size
+    V = ne.V[uniq]
+    ev = np.linalg.eigvalsh(V)
+    ok = ev[:, 0] > 1e-12 * np.maximum(ev[:, -1], 1e-300)
+    Vinv = np.zeros_like(V)
+    Vinv[ok] = np.linalg.inv(V[ok])
+    out = np.zeros((k * p, k * p))
+    for i in range(k):
+        out[i * p : (i + 1) * p, i * p : (i + 1) * p] = Vinv[i]
+    if S_inv.shape[0]:
+        Wt = _selected_W(ne, uniq).T.reshape(k, p, -1)  # (k, p, n_c)
+        A = np.einsum("kij,kjc->kic", Vinv, Wt).reshape(k * p, -1)  # V⁻¹ Wᵀ
+        out += A @ S_inv @ A.T
+        out = 0.5 * (out + out.T)
+    bad = np.repeat(~ok, p)
+    out[bad, :] = np.nan
+    out[:, bad] = np.nan
+    sel = (inv[:, None] * p + np.arange(p)).ravel()
+    return out[np.ix_(sel, sel)]
+
+
+class _Cofactors:
+    """The points' cofactors at the solution: ``f(pts, chunk)`` → their blocks
+    (:func:`_point_cofactors`), ``f.joint(pts)`` → their joint matrix
+    (:func:`_joint_point_cofactors`).
+
+    Holds the Jacobian of the solution; the result keeps it only on request
     (``SolverOptions.keep_jacobian``).
     """
-    return partial(_point_cofactors, ne, S_inv)
+
+    def __init__(self, ne: _Normal, S_inv: np.ndarray) -> None:
+        self.ne, self.S_inv = ne, S_inv
+
+    def __call__(self, pts: np.ndarray, chunk: int = 20000) -> np.ndarray:
+        return _point_cofactors(self.ne, self.S_inv, pts, chunk)
+
+    def joint(self, pts: np.ndarray) -> np.ndarray:
+        return _joint_point_cofactors(self.ne, self.S_inv, pts)
+
+
+def _point_cofactor_function(ne: _Normal, S_inv: np.ndarray) -> _Cofactors:
+    """The points' cofactors at the solution (see :class:`_Cofactors`)."""
+    return _Cofactors(ne, S_inv)

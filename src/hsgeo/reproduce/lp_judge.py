@@ -33,6 +33,7 @@ __all__ = [
     "observation_errors_px",
     "within_fractions",
     "check_point_errors",
+    "joint_point_covariance",
 ]
 
 #: A match (or observation) this far (px) from its true image position counts as false (ours:
@@ -75,7 +76,9 @@ def match_errors_px(matches, truth) -> np.ndarray:
     return np.maximum(ea, eb)
 
 
-def observation_errors_px(table, truth, square_ids=(), square_xyz_m=None) -> np.ndarray:
+def observation_errors_px(
+    table, truth, square_ids=(), square_xyz_m=None, *, leave_one_out: bool = False
+) -> np.ndarray:
     """Error ``(dx, dy)`` of every observation of the table against its true image position.
 
     Parameters
@@ -87,6 +90,11 @@ def observation_errors_px(table, truth, square_ids=(), square_xyz_m=None) -> np.
         Ids of the reference squares (their rows are judged against ``square_xyz_m``).
     square_xyz_m : (k, 3) array_like, optional
         The squares' true centres (E, N, U, m).
+    leave_one_out : bool
+        A tie point's observation judged against the median of the ground points of its
+        *other* observations (not its own among them): a reference that does not share the
+        observation it judges (the median of ≥ 3 leans toward each member; the squares are
+        judged against their surveyed centres either way).
 
     Returns
     -------
@@ -114,13 +122,19 @@ def observation_errors_px(table, truth, square_ids=(), square_xyz_m=None) -> np.
         _, inv = np.unique(pid[tie], return_inverse=True)
         order = np.argsort(inv, kind="stable")
         starts = np.r_[0, np.flatnonzero(np.diff(inv[order])) + 1]
-        med = np.array(
-            [
-                np.median(g[order[a:b]], axis=0)
-                for a, b in zip(starts, np.r_[starts[1:], tie.size], strict=True)
-            ]
-        )
-        P[tie] = med[inv]
+        ends = np.r_[starts[1:], tie.size]
+        if leave_one_out:
+            ref = np.empty((tie.size, 3))
+            for a, b in zip(starts, ends, strict=True):
+                rows = order[a:b]
+                for j in range(rows.size):
+                    ref[rows[j]] = np.median(g[np.delete(rows, j)], axis=0)
+            P[tie] = ref
+        else:
+            med = np.array(
+                [np.median(g[order[a:b]], axis=0) for a, b in zip(starts, ends, strict=True)]
+            )
+            P[tie] = med[inv]
     p = truth.camera.project(P, t, truth.trajectory, band)
     out[:, 0] = x - p[:, 0]
     out[:, 1] = y - p[:, 1]
@@ -161,3 +175,17 @@ def check_point_errors(result, point_ids, cp_ids, cp_xyz_true_m):
     idx = np.array([pos[str(cp_ids[j])] for j in keep], dtype=np.int64)
     xyz = np.asarray(cp_xyz_true_m, float)[keep]
     return result.value("points_m")[idx] - xyz, idx, np.asarray(cp_ids)[keep]
+
+
+def joint_point_covariance(result, index) -> np.ndarray:
+    """The joint a-posteriori covariance of some points of an adjustment, ``(3k, 3k)`` (m²,
+    ordered point by point, E, N, H within a point):
+    :meth:`hsgeo.adjust.AdjustmentResult.point_covariance` with ``joint=True``.
+
+    Without GCPs the check points share one datum error — the whole block shifts together —
+    so their heights are strongly correlated: the per-point 3×3 blocks alone make a statistic
+    that does not see that shift (a standard deviation, an NMAD) look as uncertain as one that
+    does (a mean).
+    """
+    idx = np.atleast_1d(np.asarray(index, dtype=np.int64))
+    return np.asarray(result.point_covariance(index=idx, joint=True), float)

@@ -23,9 +23,11 @@ the raw ray, per strip that saw it; the strip whose view is found there within
 :data:`FOUND_WITHIN_M`; the truth only places the window, the position is measured in the
 mosaic).
 
-Both on the simulation's true DSM (:attr:`LpTruth.terrain`: the rendered ground's surface on
-its own grid, where 002 had a 20 cm photogrammetric DSM). Each of the 17 squares is measured in
-each mosaic (:func:`hsgeo.measure.squares.square_centroids`, in the sum of the bands) and
+Both on a DSM with the error of 002's 20 cm photogrammetric DSM (:func:`photogrammetric_dsm`:
+the simulation's true DSM plus a spatially correlated height error of
+:data:`DSM_SIGMA_M`, ours), not on the true DSM the renderer used. Each of the 17 squares is
+measured in each mosaic (:func:`hsgeo.measure.squares.square_centroids`, in the sum of the
+bands) and
 compared with its RTK position (``LpObservations.square_xyz_m``, mapped to EPSG:25832 by
 :mod:`hsgeo.crs`): table ``"002 Fig. 9"``, each row's truth the error the measurement should
 find (where the geometry puts the square, :func:`where_squares_land`, minus its RTK position:
@@ -60,12 +62,17 @@ __all__ = [
     "mosaic_of",
     "square_errors",
     "where_squares_land",
+    "photogrammetric_dsm",
     "TABLE",
     "SEARCH_M",
     "FOUND_WITHIN_M",
 ]
 
 TABLE = "002 Fig. 9"
+#: Height error (σ, m) and its correlation length (m) of the photogrammetric DSM the mosaic is
+#: made on (ours: about 1.5 cells of 002's 20 cm DSM in σ, smooth over a metre — dense image
+#: matching's typical error on open ground; 002 gives none).
+DSM_SIGMA_M, DSM_CORRELATION_M = 0.3, 1.0
 #: Half width of the window searched around each square's expected position, m: the adjusted
 #: geometry is good to a few dm, the next square ≥ 30 m away.
 SEARCH_M = 3.0
@@ -75,7 +82,9 @@ SEARCH_M = 3.0
 FOUND_WITHIN_M = 1.0
 
 
-def mosaic_of(obs, truth, camera, trajectory, *, resolution_m: float, bands_nm=TRUE_COLOUR_NM):
+def mosaic_of(
+    obs, truth, camera, trajectory, *, resolution_m: float, bands_nm=TRUE_COLOUR_NM, terrain=None
+):
     """The mosaic (in memory) of the campaign's strips with this camera and trajectory.
 
     Returns
@@ -85,11 +94,12 @@ def mosaic_of(obs, truth, camera, trajectory, *, resolution_m: float, bands_nm=T
     """
     strips, wl, _ = lp_strips(obs.strips, camera, trajectory, bands_nm, obs.n_px_full)
     names = tuple(f"{w:g} nm" for w in wl)
-    inputs = OrthoInputs(tuple(strips), truth.terrain, names, tuple(float(w) for w in wl))
+    dsm = truth.terrain if terrain is None else terrain
+    inputs = OrthoInputs(tuple(strips), dsm, names, tuple(float(w) for w in wl))
     return orthorectify(inputs, OrthoOptions(resolution_m=resolution_m, frame=SITE_AAS)).compute()
 
 
-def where_squares_land(obs, truth, camera, trajectory, *, band: int = 3):
+def where_squares_land(obs, truth, camera, trajectory, *, band: int = 3, terrain=None):
     """Where each square lands in a mosaic made with ``camera`` and ``trajectory``, once per
     strip that saw it: the line time and pixel that saw its centre (true camera and
     trajectory), sent down the given geometry's ray onto the DSM.
@@ -121,7 +131,8 @@ def where_squares_land(obs, truth, camera, trajectory, *, band: int = 3):
             if not xs.min() <= x <= xs.max():
                 continue
             st = Strip(camera, trajectory, [tt], np.array([[x, 0.0]]), None, {"band": band})
-            enu, _, nadir = geolocate_lines(st, truth.terrain, SITE_AAS)
+            dsm = truth.terrain if terrain is None else terrain
+            enu, _, nadir = geolocate_lines(st, dsm, SITE_AAS)
             xm, ym, _ = SITE_AAS.enu_to_map(*enu.reshape(3))
             seen.append((float(nadir.ravel()[0]), float(xm), float(ym)))
         for j, (_, xm, ym) in enumerate(sorted(seen)):
@@ -187,12 +198,32 @@ def square_errors(mosaic, square_xyz_m, *, search_m: float, search_xy_m=None):
     return rtk, err
 
 
+def photogrammetric_dsm(truth, rng=0, *, sigma_m=DSM_SIGMA_M, correlation_m=DSM_CORRELATION_M):
+    """The simulation's true DSM plus the error of a photogrammetric DSM: Gaussian noise
+    smoothed over ``correlation_m`` and scaled to σ ``sigma_m`` (on the true DSM's grid).
+
+    Returns
+    -------
+    hsgeo.geocode.DemTerrain
+    """
+    from scipy.ndimage import gaussian_filter
+
+    from hsgeo.geocode import DemTerrain
+
+    dem = truth.ground.dsm_dataarray()
+    cell = float(abs(dem["E"].values[1] - dem["E"].values[0]))
+    g = np.random.default_rng(rng)
+    e = gaussian_filter(g.standard_normal(dem.shape), correlation_m / cell, mode="wrap")
+    e *= sigma_m / max(float(e.std()), 1e-12)
+    return DemTerrain(dem + e)
+
+
 def _rms(err) -> float:
     ok = np.all(np.isfinite(err), axis=1)
     return float(np.sqrt(np.mean(np.sum(err[ok] ** 2, axis=1)))) if ok.any() else float("nan")
 
 
-def fig9(obs, truth, adjusted, *, resolution_m: float = P002["fig9_pixel_m"]):
+def fig9(obs, truth, adjusted, *, resolution_m: float = P002["fig9_pixel_m"], rng=0):
     """002 Fig. 9 (module docstring): both mosaics, the squares' errors, table ``"002 Fig. 9"``.
 
     Parameters
@@ -205,6 +236,8 @@ def fig9(obs, truth, adjusted, *, resolution_m: float = P002["fig9_pixel_m"]):
         The adjustment of the observations retrieved from these strips.
     resolution_m : float
         Cell size, m (002: 0.30).
+    rng : int or numpy.random.Generator
+        Seed of the photogrammetric DSM's error (:func:`photogrammetric_dsm`).
 
     Returns
     -------
@@ -223,11 +256,12 @@ def fig9(obs, truth, adjusted, *, resolution_m: float = P002["fig9_pixel_m"]):
         "raw": (obs.camera, obs.navigation),
     }
     mosaics, errors, seconds, expected = {}, {}, {}, {}
+    dsm = photogrammetric_dsm(truth, rng)
     for key, (cam, traj) in runs.items():
         t0 = time.perf_counter()
-        mosaics[key] = mosaic_of(obs, truth, cam, traj, resolution_m=resolution_m)
+        mosaics[key] = mosaic_of(obs, truth, cam, traj, resolution_m=resolution_m, terrain=dsm)
         seconds[key] = time.perf_counter() - t0
-        land = where_squares_land(obs, truth, cam, traj)
+        land = where_squares_land(obs, truth, cam, traj, terrain=dsm)
         if key == "adjusted":  # the window around the RTK position (not steered by the truth)
             rtk, errors[key] = square_errors(mosaics[key], obs.square_xyz_m, search_m=SEARCH_M)
             expected[key] = land[:, 0, :] - rtk
@@ -263,10 +297,12 @@ def _rows(per_square, gsd_m: float) -> list[Row]:
             reproduced=rms_a,
             truth=_rms(np.where(np.isfinite(ea), xa, np.nan)),
             provenance="chosen",
-            verdict="reproduced" if ok else "differs",
-            reason=f"horizontal RMS over the {n_a} squares found in the mosaic with the adjusted "
-            f"trajectory and camera, {'within' if ok else 'beyond'} 1 GSD ({gsd_m:g} m): 002 "
-            "shows the squares 'accurately found in the orthomosaic' (Fig. 9) without a number",
+            verdict="not testable",
+            reason=f"{'meets' if ok else 'misses'} our bar (no paper value, so not a "
+            f"reproduction): horizontal RMS over the {n_a} squares found in the mosaic with the "
+            f"adjusted trajectory and camera on a DSM with a photogrammetric DSM's error, "
+            f"{'within' if ok else 'beyond'} 1 GSD ({gsd_m:g} m); 002 shows the squares "
+            "'accurately found in the orthomosaic' (Fig. 9) without a number",
         ),
         Row(
             TABLE,

@@ -20,7 +20,15 @@ block as a share of 002's 600 m, so the campaign's area fraction is its square (
   true image position before RANSAC, after it (LP-F and frame-F) and after the adjustment's
   rejection; the share of false matches RANSAC keeps;
 * ``"observations per band"``: key points, matches and observations per band;
-* ``"002 Table 1 from pixels"``, ``"002 Table 2 from pixels"``, ``"002 Table 3 from pixels"``;
+* ``"002 Table 1 from pixels"``, ``"002 Table 2 from pixels"``, ``"002 Table 3 from pixels"``:
+  the check points measured as 002 measured them (the matcher's tie points on the squares, at
+  the pixel centre), the GCPs by their centroids; the statistics' σ̂ from the check points'
+  joint covariance (:func:`stat_sigma`);
+* ``"square centroids: 002 Table 2 from pixels"`` (and 3): the same with the check points'
+  blob centroids in every strip and band (context, not a claim);
+* ``"check points"``: rays per check point each way, per tie point, the counts;
+* ``"no-GCP height"``: the mean height without GCPs (joint σ̂), the principal distances' mean
+  error and the height offset it predicts, the c error 002's −1.13 m would mean;
 * ``"parameters"``: the camera parameters against their truth (σ̂, z);
 * ``"unmodelled effect"``: the headline numbers with the motion blur (on in every run) and
   without it (the same campaign rendered again).
@@ -232,14 +240,29 @@ def _band_rows(res, wavelengths_nm) -> list[Row]:
 
 def stat_sigma(cov_m2: np.ndarray, rng, n_draws: int = _N_DRAWS) -> np.ndarray:
     """σ̂ of each statistic of :data:`P002_STATS` of check-point errors drawn from their
-    a-posteriori covariance ``(k, 3, 3)`` (m²): ``(3, 6)`` (E, N, H × statistic), the spread
-    over ``n_draws`` draws. The adjustment's own precision, not a spread over campaigns.
+    a-posteriori covariance: ``(3, 6)`` (E, N, H × statistic), the spread over ``n_draws``
+    draws. The adjustment's own precision, not a spread over campaigns.
+
+    ``cov_m2`` is the joint covariance ``(3k, 3k)`` of the k check points (point by point,
+    :func:`hsgeo.reproduce.lp_judge.joint_point_covariance`): the check points share the
+    adjustment's datum error (without GCPs the whole block shifts together), which moves their
+    mean, median, min and max but not their STD or NMAD. ``(k, 3, 3)`` per-point blocks draw
+    each point alone (independent points: every statistic then sees each point's whole σ).
     """
-    k = cov_m2.shape[0]
-    if k < 2:
-        return np.full((3, len(P002_STATS)), np.nan)
-    L = np.linalg.cholesky(cov_m2 + 1e-18 * np.eye(3))
-    draws = np.einsum("kij,nkj->nki", L, rng.standard_normal((n_draws, k, 3)))
+    cov_m2 = np.asarray(cov_m2, float)
+    if cov_m2.ndim == 3:
+        k = cov_m2.shape[0]
+        if k < 2:
+            return np.full((3, len(P002_STATS)), np.nan)
+        L = np.linalg.cholesky(cov_m2 + 1e-18 * np.eye(3))
+        draws = np.einsum("kij,nkj->nki", L, rng.standard_normal((n_draws, k, 3)))
+    else:
+        k = cov_m2.shape[0] // 3
+        if k < 2:
+            return np.full((3, len(P002_STATS)), np.nan)
+        w, V = np.linalg.eigh(0.5 * (cov_m2 + cov_m2.T))
+        L = V * np.sqrt(np.clip(w, 0.0, None))
+        draws = (rng.standard_normal((n_draws, 3 * k)) @ L.T).reshape(n_draws, k, 3)
     out = np.empty((3, len(P002_STATS)))
     for j in range(3):
         s = np.array([[describe(d)[st] for st in P002_STATS] for d in draws[:, :, j]])
@@ -288,8 +311,133 @@ def _table_rows(ev: dict, seed: int) -> list[Row]:
         if E is None or len(E) < 2:
             continue
         rows += _stats_rows(
-            f"{name} from pixels", ("e", "n", "h"), E, "m", P002[name], stat_sigma(cov, rng)
+            f"{name} from pixels",
+            ("e", "n", "h"),
+            E,
+            "m",
+            P002[name],
+            stat_sigma(cov, rng),
+            reason="check points measured as 002 measured them: the matcher's tie points on "
+            "the squares, at the pixel centre, in the strips and band where it found them",
         )
+    c = ev.get("centroid")
+    if c is not None:
+        for name, E, cov in (
+            ("002 Table 2", c["cp_errors_m"], c["cp_cov_m2"]),
+            ("002 Table 3", c.get("cp_errors_nogcp_m"), c.get("cp_cov_nogcp_m2")),
+        ):
+            if E is None or len(E) < 2:
+                continue
+            extra = _stats_rows(
+                f"square centroids: {name} from pixels",
+                ("e", "n", "h"),
+                E,
+                "m",
+                P002[name],
+                stat_sigma(cov, rng),
+            )
+            for r in extra:
+                r.verdict, r.reason = "not testable", _CENTROIDS
+            rows += extra
+    rows += _ray_rows(ev)
+    return rows
+
+
+_CENTROIDS = (
+    "not 002's measurement (context, not a claim): each square's blob centroid in every strip "
+    "and band that sees it, at sub-pixel x and sub-line time — many more rays than a tie point"
+)
+
+
+def _ray_rows(ev: dict) -> list[Row]:
+    """How many rays each way of measuring gives a check point, beside a tie point's."""
+    T = "check points"
+    tab = ev["retrieval"].table
+    tie = ~ev["is_square"]
+    per_tp = tab.loc[tie].groupby("point_id").size().to_numpy(float)
+    pid = tab["point_id"].astype(str)
+    strips = tab[pid.isin([str(c) for c in ev["cp_ids"]])].groupby("point_id")["strip"].nunique()
+    rows = [
+        Row(T, "rays_per_tie_point_mean", "1", reproduced=float(per_tp.mean())),
+        # a square found in k bands of one strip is k rays along one line (one line rounding)
+        Row(T, "strips_per_check_point_mean_tie_point", "1", reproduced=float(strips.mean())),
+        Row(T, "n_check_points", "1", reproduced=float(len(ev["cp_ids"]))),
+        Row(T, "n_gcps", "1", reproduced=float(len(ev["gcp_ids"]))),
+    ]
+    for way, d in (("tie_point", ev), ("centroid", ev.get("centroid"))):
+        if d is None:
+            continue
+        r = np.asarray(d["cp_rays"], float)
+        rows += [
+            Row(T, f"rays_per_check_point_mean_{way}", "1", reproduced=float(r.mean())),
+            Row(T, f"rays_per_check_point_min_{way}", "1", reproduced=float(r.min())),
+            Row(T, f"rays_per_check_point_max_{way}", "1", reproduced=float(r.max())),
+        ]
+        if way == "centroid":
+            rows.append(Row(T, "n_check_points_centroid", "1", reproduced=float(r.size)))
+    return rows
+
+
+def _height_rows(ev: dict, obs, truth) -> list[Row]:
+    """The no-GCP height offset and its observation-level cause: the principal distance.
+
+    Without GCPs nothing fixes the scale along the rays but the principal distance: a ground
+    point at depth Z is seen at x = c·X/Z, so a c too large by Δc puts the points deeper by
+    Z·Δc/c — the check points' mean height moves by about −AGL·Δc̄/c̄ (Δc̄ the bands' mean
+    error, AGL the observations' mean height above the terrain). Rows: the mean height with its
+    joint σ̂ (truth 0), the bands' mean c error with its σ̂, the offset that c error predicts,
+    and the c error that 002's mean height (Table 3, −1.13 m at 1875 m AGL) would mean.
+    """
+    T = "no-GCP height"
+    E0, C0 = ev.get("cp_errors_nogcp_m"), ev.get("cp_cov_nogcp_m2")
+    r0 = ev.get("adjusted_nogcp")
+    if E0 is None or len(E0) < 2 or r0 is None:
+        return []
+    k = len(E0)
+    h = np.arange(k) * 3 + 2
+    rows = [
+        Row(
+            T,
+            "mean_h_m",
+            "m",
+            reproduced=float(np.mean(E0[:, 2])),
+            sigma=float(np.sqrt(C0[np.ix_(h, h)].sum()) / k),
+            truth=0.0,
+            provenance="chosen",
+        )
+    ]
+    res = r0.result
+    c, s_c = res.value("c_mm").ravel(), res.sigma("c_mm").ravel()
+    seen = np.isfinite(s_c) & (s_c > 0)
+    c_true = np.asarray(truth.camera.c_mm, float)
+    cov, _ = res.covariance_of("c_mm")
+    n = int(seen.sum())
+    dc_mm = float(np.mean(c[seen] - c_true[seen]))
+    sd_dc = float(np.sqrt(np.sum(cov[np.ix_(range(n), range(n))])) / n) if n else None
+    tab = ev["retrieval"].table
+    t = tab["t_s"].to_numpy(float)
+    z_nav = obs.navigation.pose(t)[0][:, 2]
+    agl = float(np.mean(z_nav) - np.mean(obs.square_xyz_m[:, 2]))
+    c_mean = float(np.mean(c_true[seen]))
+    rows += [
+        Row(
+            T,
+            "c_minus_truth_mean_um",
+            "um",
+            reproduced=1e3 * dc_mm,
+            sigma=1e3 * sd_dc,
+            truth=0.0,
+            provenance="chosen",
+        ),
+        Row(T, "agl_of_observations_m", "m", reproduced=agl),
+        Row(T, "mean_h_predicted_from_c_m", "m", reproduced=-agl * dc_mm / c_mean),
+        Row(
+            T,
+            "c_error_of_002_mean_h_um",
+            "um",
+            reproduced=-1e3 * P002["002 Table 3"]["h"][3] / P002["fig9_agl_m"] * c_mean,
+        ),
+    ]
     return rows
 
 
@@ -305,13 +453,14 @@ def _parameter_rows(ev: dict, twin: dict) -> list[Row]:
         pt = twin["parameters"][name][1]
         for j in range(v.size):
             q = lab[j].replace("_rad", "_deg") if unit == "deg" else lab[j]
+            fixed = not (np.isfinite(s[j]) and s[j] > 0)  # a band no observation sees
             rows.append(
                 Row(
                     "parameters",
                     q,
                     unit,
                     reproduced=v[j] * f,
-                    sigma=s[j] * f,
+                    sigma=None if fixed else s[j] * f,
                     truth=pt[j] * f,
                     provenance="derived",
                 )
@@ -329,7 +478,7 @@ def _shift_rows(ev: dict, twin: dict) -> list[Row]:
         pt = twin["parameters"][name][1]
         for j in range(s.size):
             q = lab[j].replace("_rad", "_deg") if unit == "deg" else lab[j]
-            d = (pt[j] - t[j]) / s[j]
+            d = (pt[j] - t[j]) / s[j] if np.isfinite(s[j]) and s[j] > 0 else None
             rows.append(Row("unmodelled effect", f"trajectory_shift_z.{q}", "1", reproduced=d))
             rows.append(
                 Row(
@@ -358,6 +507,7 @@ def _meta(s, obs, truth, ev, lengths, T, off) -> dict:
     res = ev["retrieval"]
     r, r0 = ev["adjusted"], ev.get("adjusted_nogcp")
     z = np.concatenate([(v - t) / sg for _, v, sg, t in ev["parameters"].values()])
+    z = z[np.isfinite(z)]
     parts = {
         str(k): {
             "scenes": int(len(v.scenes)),
@@ -431,25 +581,27 @@ def run(seed: int = 0, scale: float = 1.0, progress=None, unmodelled: bool = Tru
     rows += _accuracy_rows(ev)
     rows += _band_rows(ev["retrieval"], obs.strips[0].wavelengths_nm)
     rows += _table_rows(ev, seed)
+    rows += _height_rows(ev, obs, truth)
     t0 = time.perf_counter()
     twin = exact_twin(ev, obs, truth)
     T["exact_twin"] = time.perf_counter() - t0
     rows += _parameter_rows(ev, twin)
     rows += _shift_rows(ev, twin)
     t0 = time.perf_counter()
-    fig9_rows, mosaic_adj, mosaic_raw, per_square = fig9(obs, truth, ev["adjusted"])
+    fig9_rows, mosaic_adj, mosaic_raw, per_square = fig9(obs, truth, ev["adjusted"], rng=[seed, 9])
     T["fig9"] = time.perf_counter() - t0
     rows += fig9_rows
     off = None
     if unmodelled:
         t0 = time.perf_counter()
         obs0, truth0 = simulate(s, rng=seed, cfg=replace(LpConfig(), motion_blur_m=0.0))
-        off = headline(evaluate(obs0, truth0, seed, nogcp=False, progress=progress))
+        off = headline(evaluate(obs0, truth0, seed, nogcp=False, progress=progress, both=False))
         T["motion_blur_off"] = time.perf_counter() - t0
     rows += _unmodelled_rows(headline(ev), off)
     T["total"] = time.perf_counter() - t_start
     meta = _meta(s, obs, truth, ev, lengths, T, off)
-    z = np.array([r.z for r in rows if r.table == "parameters"])
+    z = np.array([r.z for r in rows if r.table == "parameters" and r.z is not None], float)
+    z = z[np.isfinite(z)]
     meta["share_parameters_within_3sigma_generating"] = meta["share_parameters_within_3sigma"]
     meta["max_abs_z_parameters_generating"] = meta["max_abs_z_parameters"]
     meta["share_parameters_within_3sigma"] = float(np.mean(np.abs(z) <= 3))

@@ -19,6 +19,7 @@ import numpy as np
 from hsgeo.reproduce.lp_judge import (
     OUTLIER_PX,
     check_point_errors,
+    joint_point_covariance,
     match_errors_px,
     observation_errors_px,
     within_fractions,
@@ -29,7 +30,6 @@ from hsgeo.workflows.pushbroom_ba import (
     REPORTED_PARAMETERS,
     CameraPrior,
     PushbroomOptions,
-    adjust_pushbroom,
 )
 
 __all__ = [
@@ -50,7 +50,9 @@ MATCH_SAMPLE = 60_000
 
 def camera_prior(obs, cfg) -> CameraPrior:
     """What the operator knows of the camera and the GNSS/INS (the pushbroom chapter's priors):
-    the nominal c, pixel pitch and principal point, the tape-measured lever arm, the a-priori σ
+    the nominal c and pixel pitch, the calibrated principal point (the truth plus a
+    calibration error, :attr:`hsgeo.simulate.lp_campaign.LpConfig.sigma_pp_calibration_px`),
+    the tape-measured lever arm, the a-priori σ
     of the campaign (:class:`hsgeo.simulate.pushbroom_campaign_types.CampaignConfig`; 002 §4's
     ½ px for the observations).
     """
@@ -59,8 +61,8 @@ def camera_prior(obs, cfg) -> CameraPrior:
         n_bands=len(obs.camera.c_mm),
         pixel_mm=c.pixel_mm,
         c_mm=c.c_nominal_mm,
-        x0_mm=c.x0_mm,
-        y0_mm=c.y0_mm,
+        x0_mm=float(obs.camera.x0_mm),  # the calibrated principal point (not the truth)
+        y0_mm=float(obs.camera.y0_mm),
         lever_arm_m=tuple(obs.camera.lever_arm_m),
         sigma_lever_m=c.sigma_lever_m,
         sigma_pos_m=c.sigma_pos_m,
@@ -129,6 +131,14 @@ def _judge_matches(res, truth, rng) -> dict:
 
 
 def _adjust(res, obs, cam, with_gcp: bool, gcp_ids):
+    """``hsgeo adjust-pushbroom``'s adjustment of the retrieved table (with or without the
+    GCPs), as :func:`~hsgeo.workflows.pushbroom_ba.adjust_pushbroom` sets it up; a band with no
+    observation in the table keeps its a-priori principal distance, fixed (no observation sees
+    it: 002's matcher finds no tie point in it on a small rendered block).
+    """
+    from hsgeo.sensors.pushbroom import BLOCK_NAMES
+    from hsgeo.workflows.pushbroom_ba import PushbroomResult, build_problem, solve
+
     pin = to_pushbroom_inputs(
         res,
         obs.navigation,
@@ -136,21 +146,115 @@ def _adjust(res, obs, cam, with_gcp: bool, gcp_ids):
         gcp_ids if with_gcp else (),
         obs.square_xyz_m[[list(obs.square_ids).index(g) for g in gcp_ids]] if with_gcp else None,
     )
+    opt = PushbroomOptions(keep_jacobian=True)
     t0 = time.perf_counter()
-    out = adjust_pushbroom(pin, PushbroomOptions(keep_jacobian=True))
+    o = pin.observations
+    p, blocks, nodes = build_problem(
+        o,
+        pin.n_points,
+        pin.camera,
+        node_interval_s=opt.node_interval_s,
+        gcp_index=pin.gcp_index,
+        gcp_xyz_m=pin.gcp_xyz_m,
+        t_span_s=pin.t_span_s,
+        node_prior_mean=pin.node_prior_mean,
+        y_as_time=opt.y_as_time,
+    )
+    seen = np.unique(np.asarray(res.table["band"], np.int64))
+    unseen = np.setdiff1d(np.arange(cam.n_bands), seen)
+    if unseen.size:
+        p.fix(BLOCK_NAMES["c"], index=unseen)
+    r = solve(
+        p,
+        blocks,
+        reject_k=opt.reject_k,
+        ftol=opt.ftol,
+        keep_jacobian=True,
+        raise_on_failure=opt.raise_on_failure,
+    )
+    ids = np.arange(pin.n_points) if pin.point_ids is None else pin.point_ids
+    out = PushbroomResult(r, p, blocks, nodes, ids, int(o.point.size), opt.node_interval_s, 0.0)
     return out, pin, time.perf_counter() - t0
 
 
-def _check_points(r, pin, obs, truth, gcp_ids):
-    cp_ids = [s for s in obs.square_ids if s not in gcp_ids]
+def _check_points(r, pin, obs, truth, cp_ids):
+    """Errors ``(k, 3)`` of the check points ``cp_ids`` the table measured, their joint
+    covariance ``(3k, 3k)`` (:func:`~hsgeo.reproduce.lp_judge.joint_point_covariance`) and
+    their ids.
+    """
     k = [list(obs.square_ids).index(s) for s in cp_ids]
     E, idx, measured = check_point_errors(r.result, pin.point_ids, cp_ids, truth.square_xyz_m[k])
-    cov = r.result.point_covariance(index=idx) if idx.size else np.zeros((0, 3, 3))
+    cov = joint_point_covariance(r.result, idx) if idx.size else np.zeros((0, 0))
     return E, cov, measured
 
 
-def evaluate(obs, truth, seed: int, *, nogcp: bool = True, progress=None) -> dict:
+def _rays(table, ids) -> np.ndarray:
+    """Observations (rays: one per strip) of each id in the table."""
+    n = table["point_id"].astype(str).value_counts()
+    return np.array([int(n.get(str(i), 0)) for i in ids], dtype=np.int64)
+
+
+def _squares_judged(res, obs, truth, cam, nogcp: bool) -> dict:
+    """The retrieval's table adjusted with the GCPs it measured (and without any), its check
+    points judged: ``adjusted``, ``pin``, ``gcp_ids``, ``cp_ids``, ``cp_errors_m``,
+    ``cp_cov_m2`` (joint), ``cp_rays`` and the same ``_nogcp`` (002 Table 3's check points:
+    the same 13), ``seconds``.
+    """
+    pid = res.table["point_id"].to_numpy().astype(str)
+    measured = set(pid) & {str(s) for s in obs.square_ids}
+    gcp_ids = [g for g in obs.gcp_ids if g in measured]
+    cps = [s for s in obs.square_ids if s not in obs.gcp_ids]
+    r, pin, sec = _adjust(res, obs, cam, True, gcp_ids)
+    E, cov, cp_ids = _check_points(r, pin, obs, truth, cps)
+    out = {
+        "adjusted": r,
+        "pin": pin,
+        "gcp_ids": gcp_ids,
+        "cp_ids": list(cp_ids),
+        "cp_errors_m": E,
+        "cp_cov_m2": cov,
+        "cp_rays": _rays(res.table, cp_ids),
+        "gcp_rays": _rays(res.table, gcp_ids),
+        "seconds": {"adjust_gcp": sec},
+    }
+    if nogcp:
+        r0, pin0, out["seconds"]["adjust_nogcp"] = _adjust(res, obs, cam, False, gcp_ids)
+        E0, cov0, ids0 = _check_points(r0, pin0, obs, truth, cps)
+        out.update(
+            adjusted_nogcp=r0, cp_errors_nogcp_m=E0, cp_cov_nogcp_m2=cov0, cp_ids_nogcp=list(ids0)
+        )
+    return out
+
+
+def gcps_by_centroid(res, gcp_ids):
+    """The retrieval's table (squares as the matcher found them) with the GCPs' rows taken from
+    the centroid table: the GCPs, the datum, measured alike in both ways of measuring the
+    check points (every strip and band that sees them), so that the two ways differ only in
+    the check points; 002 does not say how its four GCPs were measured, and on a small rendered
+    block the matcher finds few of the corner squares.
+    """
+    import pandas as pd
+
+    tab = res.tables_by_squares.get("tie_point")
+    cen = res.tables_by_squares.get("centroid")
+    if tab is None or cen is None:
+        return res.table
+    g = [str(x) for x in gcp_ids]
+    out = pd.concat(
+        [tab[~tab["point_id"].astype(str).isin(g)], cen[cen["point_id"].astype(str).isin(g)]],
+        ignore_index=True,
+    )
+    return out
+
+
+def evaluate(obs, truth, seed: int, *, nogcp: bool = True, progress=None, both: bool = True):
     """Retrieve (200-line scenes), adjust with (and without) the GCPs, judge against the truth.
+
+    The check points are measured as 002 measured them (the matcher's tie points on them,
+    :attr:`~hsgeo.workflows.lp_observations.LpOptions.squares_as`), the GCPs by their
+    centroids (:func:`gcps_by_centroid`); with ``both`` the same
+    retrieval's table with the squares' blob centroids (every strip and band that sees them)
+    is adjusted and judged too (``ev["centroid"]``, :func:`_squares_judged`).
 
     Returns
     -------
@@ -159,14 +263,20 @@ def evaluate(obs, truth, seed: int, *, nogcp: bool = True, progress=None) -> dic
         (:func:`_judge_matches`), ``obs_errors_px`` ``(n, 2)`` of the table's rows,
         ``is_square`` ``(n,)``, ``rejected`` ``(n,)`` (by the adjustment with GCPs),
         ``adjusted`` / ``adjusted_nogcp`` (:class:`PushbroomResult`), ``cp_errors_m`` /
-        ``cp_errors_nogcp_m`` ``(k, 3)``, ``cp_cov_m2`` / ``cp_cov_nogcp_m2`` ``(k, 3, 3)``,
-        ``cp_ids``, ``gcp_ids`` (the GCPs measured), ``residuals_px`` (tie points kept),
-        ``parameters`` (:func:`parameter_z`), ``timings_s``.
+        ``cp_errors_nogcp_m`` ``(k, 3)``, ``cp_cov_m2`` / ``cp_cov_nogcp_m2`` ``(3k, 3k)``
+        (joint), ``cp_ids``, ``cp_rays``, ``gcp_ids`` (the GCPs measured), ``residuals_px``
+        (tie points kept), ``parameters`` (:func:`parameter_z`), ``centroid`` (the same for
+        the centroid table, with ``both``), ``timings_s``.
     """
+    from dataclasses import replace
+
     rng = np.random.default_rng([seed, 25])
     T = {}
     t0 = time.perf_counter()
-    res = retrieve(retrieval_inputs(obs), LpOptions(rng=seed), progress=progress)
+    # the chapter's check points as 002 measured them (the command's default is the centroids)
+    opts = LpOptions(rng=seed, squares_as="tie_point")
+    res = retrieve(retrieval_inputs(obs), opts, progress=progress)
+    res = replace(res, table=gcps_by_centroid(res, obs.gcp_ids))
     T["retrieve"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     mj = _judge_matches(res, truth, rng)
@@ -175,12 +285,11 @@ def evaluate(obs, truth, seed: int, *, nogcp: bool = True, progress=None) -> dic
     is_sq = np.isin(pid, np.asarray(obs.square_ids, str))
     oerr = observation_errors_px(table, truth, obs.square_ids, truth.square_xyz_m)
     T["judge"] = time.perf_counter() - t0
-    measured = set(pid[is_sq])
-    gcp_ids = [g for g in obs.gcp_ids if g in measured]
     cam = camera_prior(obs, truth.cfg)
-    r, pin, T["adjust_gcp"] = _adjust(res, obs, cam, True, gcp_ids)
+    sj = _squares_judged(res, obs, truth, cam, nogcp)
+    r = sj["adjusted"]
+    T.update(sj["seconds"])
     rejected = np.asarray(r.result.outliers(0), bool)
-    E, cov, cp_ids = _check_points(r, pin, obs, truth, gcp_ids)
     keep = ~rejected & ~is_sq
     out = {
         "retrieval": res,
@@ -188,21 +297,16 @@ def evaluate(obs, truth, seed: int, *, nogcp: bool = True, progress=None) -> dic
         "obs_errors_px": oerr,
         "is_square": is_sq,
         "rejected": rejected,
-        "adjusted": r,
-        "cp_errors_m": E,
-        "cp_cov_m2": cov,
-        "cp_ids": list(cp_ids),
-        "gcp_ids": gcp_ids,
         "residuals_px": r.result.residuals(0).reshape(-1, 2)[keep],
         "parameters": parameter_z(r.result, truth.camera),
         "timings_s": T,
+        **{k: v for k, v in sj.items() if k not in ("seconds", "pin")},
     }
-    if nogcp:
-        r0, pin0, T["adjust_nogcp"] = _adjust(res, obs, cam, False, gcp_ids)
-        # every square is a check point without GCPs; Table 3 keeps 002's 13 check points
-        E0, cov0, ids0 = _check_points(r0, pin0, obs, truth, ())
-        sel = np.isin(ids0, cp_ids)
-        out.update(adjusted_nogcp=r0, cp_errors_nogcp_m=E0[sel], cp_cov_nogcp_m2=cov0[sel])
+    if both and "centroid" in res.tables_by_squares:
+        t0 = time.perf_counter()
+        rc = replace(res, table=res.tables_by_squares["centroid"])
+        out["centroid"] = _squares_judged(rc, obs, truth, cam, nogcp)
+        T["centroid_squares"] = time.perf_counter() - t0
     return out
 
 
@@ -257,6 +361,7 @@ def headline(ev: dict) -> dict:
     r = ev["residuals_px"]
     E = ev["cp_errors_m"]
     z = np.concatenate([(v - t) / s for _, v, s, t in ev["parameters"].values()])
+    z = z[np.isfinite(z)]  # a band's c fixed (no observation) has no σ̂
     return {
         "tie_observations": float((~ev["is_square"]).sum()),
         "within_1px_fraction": w[1.0],

@@ -123,6 +123,17 @@ class LpConfig:
     # period 1/200 s, time stamp at mid-exposure: 67 m/s / 200 = 0.335 m along track); 0: off.
     # Not in the pinhole model of 002 eq. (2) (002 §4 lists it among the unmodelled effects)
     motion_blur_m: float = 67.0 / 200.0
+    # where in the exposure a line's time stamp lies: "middle" (the blur is centred on the
+    # stamped pose and moves no key point) or "start" (the stamp is half an integration
+    # earlier than the blur's centre: every line is rendered at t + ½·motion_blur_m/speed, a
+    # shift along track of half the blur that the estimator, which takes t as the line's
+    # time, does not model; it moves key points by half the blur, opposite for opposite
+    # headings)
+    exposure_stamp: str = "middle"
+    # the principal point the operator has (x0, y0 of the a-priori camera, fixed in the
+    # adjustment as 002's calibrated camera) is off the truth by a calibration error of this σ
+    # per axis (ours: a tenth of a pixel); 0: the truth itself
+    sigma_pp_calibration_px: float = 0.1
     # -- radiometry (ours): DN per unit reflectance per band, one integration time; vegetation
     # (ρ ≈ 0.48) reaches ~90 % of dn_max above the red edge (002 §5.3: "close to saturation")
     dn_max: float = 4095.0
@@ -303,6 +314,13 @@ def _render_strip(cfg: LpConfig, camera, traj, t, cols, ground: Ground, rng) -> 
     return dn
 
 
+def _stamp_offset_s(cfg: LpConfig) -> float:
+    """Time from a line's stamp to the middle of its exposure (0 for a mid-exposure stamp)."""
+    if cfg.exposure_stamp == "middle":
+        return 0.0
+    return 0.5 * cfg.motion_blur_m / cfg.campaign.speed_m_s
+
+
 def _checked(scale, cfg):
     if not (isinstance(scale, (int, float, np.floating)) and np.isfinite(scale)):
         raise InputError(f"scale must be a number in (0, 1], got {scale!r}")
@@ -318,10 +336,21 @@ def _checked(scale, cfg):
             raise InputError(f"LpConfig.{name} must be a positive number, got {v!r}")
     if not all(
         getattr(cfg, k) >= 0
-        for k in ("psf_sigma_m", "motion_blur_m", "read_noise_dn", "mount_motion_rad")
+        for k in (
+            "psf_sigma_m",
+            "motion_blur_m",
+            "read_noise_dn",
+            "mount_motion_rad",
+            "sigma_pp_calibration_px",
+        )
     ):
         raise InputError(
-            "LpConfig: psf_sigma_m, motion_blur_m, read_noise_dn and mount_motion_rad must be ≥ 0"
+            "LpConfig: psf_sigma_m, motion_blur_m, read_noise_dn, mount_motion_rad and "
+            "sigma_pp_calibration_px must be ≥ 0"
+        )
+    if cfg.exposure_stamp not in ("middle", "start"):
+        raise InputError(
+            f"LpConfig.exposure_stamp must be 'middle' or 'start', got {cfg.exposure_stamp!r}"
         )
     nb = len(cfg.campaign.c_offsets_um)
     if len(cfg.dn_per_reflectance) < nb or len(cfg.campaign.wavelengths_nm) != nb:
@@ -374,11 +403,14 @@ def simulate(
     )
     lever_measured = lever + c.sigma_lever_m * rng.standard_normal(3)
     nb = len(cam_true.c_mm)
+    # the operator's calibrated principal point: the truth plus a calibration error (drawn
+    # from a spawned stream, so the campaign's other draws do not move)
+    pp_err = cfg.sigma_pp_calibration_px * c.pixel_mm * rng.spawn(1)[0].standard_normal(2)
     cam_prior = PushbroomCamera(
         c_mm=(c.c_nominal_mm,) * nb,
         pixel_mm=c.pixel_mm,
-        x0_mm=c.x0_mm,
-        y0_mm=c.y0_mm,
+        x0_mm=c.x0_mm + float(pp_err[0]),
+        y0_mm=c.y0_mm + float(pp_err[1]),
         lever_arm_m=tuple(lever_measured),
     )
     times = _line_times(c, plan)
@@ -396,7 +428,8 @@ def simulate(
         if w is not None:
             ls, cs = w
             cols = np.arange(c.pixels_per_line)[cs]
-            lines = _render_strip(cfg, cam_true, traj_true, tt[ls], cols, ground, rng)
+            t_render = tt[ls] + _stamp_offset_s(cfg)
+            lines = _render_strip(cfg, cam_true, traj_true, t_render, cols, ground, rng)
             strips.append(
                 LpStrip(
                     lines,

@@ -27,10 +27,13 @@ import numpy as np
 
 from hsgeo.workflows import _lp_geometry as geo
 
-__all__ = ["predict", "candidates", "choose", "COLUMNS"]
+__all__ = ["predict", "candidates", "choose", "as_tie_points", "COLUMNS", "SQUARES_AS"]
+
+#: How the squares are measured: as the matcher's tie points (002 §4) or by their blobs' centroids.
+SQUARES_AS = ("tie_point", "centroid")
 
 #: Columns of the squares' diagnostics table (:attr:`LpResult.squares`).
-COLUMNS = ["point_id", "band", "strip", "line", "t_s", "x_px", "u", "v", "snr", "ok"]
+COLUMNS = ["point_id", "band", "strip", "line", "t_s", "x_px", "u", "v", "snr", "ok", "box_px"]
 
 
 def predict(strip, inputs, height):
@@ -91,7 +94,7 @@ def choose(cands: list, strip, predicted, inputs, options) -> list:
         i = np.flatnonzero((pair == key) & (d <= tol))
         if i.size == 0:
             continue
-        k, b, _, _, s, uv, ln, xx, _ = cands[i[np.argmin(d[i])]]
+        k, b, _, _, s, uv, ln, xx, box = cands[i[np.argmin(d[i])]]
         rows.append(
             {
                 "point_id": str(inputs.square_ids[k]),
@@ -104,6 +107,7 @@ def choose(cands: list, strip, predicted, inputs, options) -> list:
                 "v": float(uv[1]),
                 "snr": s,
                 "ok": True,
+                "box_px": int(box),
             }
         )
     return rows
@@ -118,3 +122,141 @@ def _time_at(t_s, line) -> float:
     times (:func:`hsgeo.measure.tie_points.one_band_per_feature` says why for tie points).
     """
     return float(np.interp(line, np.arange(t_s.size), t_s))
+
+
+def as_tie_points(ties, centroids, score, *, min_on: int = 2):
+    """The squares as 002 measured them: the matcher's tie points that lie on a square.
+
+    002 §4: the check points are "tie points with known coordinates", found by the key-point
+    matcher like any other and registered at the centre of their pixel (§3.1), "more often
+    identified in the lower spectral bands" (§5.3) — so in the strips and bands where the matcher
+    happens to find them, not in every strip and band that sees them. The square's blob
+    (``centroids``, :func:`choose`) only says where the square is in each strip: a tie
+    point's observation is *on* the square when it lies within half the square's box plus ½ px
+    of the blob's centre (the median over the bands that measured it in that strip), in x and in
+    line. A tie point with at least ``min_on`` observations on one square, and at least half of
+    its observations there, is a candidate; in each band, each square takes the candidate with
+    the most observations on it (then the most observations, then the lowest ``score``), and
+    keeps all its observations, renamed to the square's id — of one ground feature: the best
+    candidate's and another band's only where it found the same feature
+    (:func:`_one_feature`). One tie point per band, as 002's
+    matching is per band: "the reference squares are more often identified in the lower
+    spectral bands and hence provide more observations in the lower spectral bands for the
+    estimation of the principal distance correction" (§5.3) — a square found in k bands is
+    observed k times in the lines where it was found (with their one line rounding).
+
+    Parameters
+    ----------
+    ties : pandas.DataFrame
+        Every band's tie-point observations: ``point_id``, ``point`` (its index), ``strip``,
+        ``line``, ``x_keypoint_px`` (sub-pixel), ``line_offset``, ``feature`` and the table's
+        columns.
+    centroids : pandas.DataFrame
+        The squares' blob measurements (``point_id``, ``band``, ``strip``, ``line``, ``x_px``,
+        ``line_frac``, ``box_px``).
+    score : (n_points,) ndarray
+        Per tie point, lower is better.
+
+    Returns
+    -------
+    rows : pandas.DataFrame
+        The chosen tie points' observations with the square's id as ``point_id``.
+    taken_features : ndarray
+        Features of every candidate tie point (of any square): they are the squares, not free
+        tie points, and leave the adjustment's tie points.
+    """
+    import pandas as pd
+
+    empty = ties.iloc[:0].copy()
+    if len(centroids) == 0 or len(ties) == 0:
+        return empty, np.zeros(0, np.int64)
+    c = (
+        centroids.groupby(["point_id", "strip"])
+        .agg(line=("line_frac", "median"), x=("x_px", "median"), r=("box_px", "max"))
+        .reset_index()
+    )
+    c["r"] = c["r"] / 2 + 0.5
+    line_obs = ties["line"].to_numpy(float) + ties["line_offset"].to_numpy(float)
+    x_obs = ties["x_keypoint_px"].to_numpy(float)
+    strip_obs = ties["strip"].to_numpy().astype(str)
+    on_sq = np.full(len(ties), -1, np.int64)  # index into c of the square it lies on
+    for i, (st, ln, x, r) in enumerate(
+        zip(c["strip"].astype(str), c["line"], c["x"], c["r"], strict=True)
+    ):
+        hit = (strip_obs == st) & (np.abs(line_obs - ln) <= r) & (np.abs(x_obs - x) <= r)
+        on_sq[hit & (on_sq < 0)] = i
+    sq_of_obs = np.where(on_sq >= 0, c["point_id"].to_numpy().astype(str)[np.maximum(on_sq, 0)], "")
+    df = pd.DataFrame({"point": ties["point"].to_numpy(), "sq": sq_of_obs})
+    n_obs = df.groupby("point").size()
+    on = df[df["sq"] != ""].groupby(["point", "sq"]).size().rename("n_on").reset_index()
+    if on.empty:
+        return empty, np.zeros(0, np.int64)
+    on["n_obs"] = n_obs.loc[on["point"]].to_numpy()
+    on = on[(on["n_on"] >= min_on) & (2 * on["n_on"] >= on["n_obs"])]
+    if on.empty:
+        return empty, np.zeros(0, np.int64)
+    on["score"] = np.asarray(score, float)[on["point"].to_numpy()]
+    band = ties.drop_duplicates("point").set_index("point")["band"]
+    on["band"] = band.loc[on["point"].to_numpy()].to_numpy()
+    on = on.sort_values(
+        ["sq", "band", "n_on", "n_obs", "score", "point"], ascending=[1, 1, 0, 0, 1, 1]
+    )
+    chosen = on.drop_duplicates(["sq", "band"]).drop_duplicates("point")
+    on_rows = on_sq >= 0
+    chosen = _one_feature(
+        chosen,
+        ties["point"].to_numpy()[on_rows],
+        strip_obs[on_rows],
+        x_obs[on_rows],
+        line_obs[on_rows],
+    )
+    feats = ties.drop_duplicates("point").set_index("point")["feature"]
+    taken = np.unique(feats.loc[on["point"].to_numpy()].to_numpy()).astype(np.int64)
+    name = dict(zip(chosen["point"], chosen["sq"], strict=True))
+    rows = ties[ties["point"].isin(list(name))].copy()
+    rows["point_id"] = rows["point"].map(name)
+    return rows, taken
+
+
+#: Two bands' tie points on a square are one ground feature when their observations in every
+#: strip both have lie within this distance in x and in line, px.
+SAME_FEATURE_PX = 1.0
+
+
+def _one_feature(chosen, point, strip, x, line):
+    """Per square, the candidates of one ground feature: the best one (most observations on
+    the square, then most observations, then lowest score) and another band's only where it
+    found the same feature (:data:`SAME_FEATURE_PX` in every strip where both lie on the
+    square; ``point``, ``strip``, ``x``, ``line``: the observations on a square).
+
+    A check point is one tie point with known coordinates (002 §4): one ground feature, seen in
+    the bands that found it. BRISK finds a square's corners, not its centre, so tie points of
+    different bands on one square are often different corners, ~1.2 m apart; renamed to one
+    point they are inconsistent observations, which the adjustment's each-iteration rejection
+    peels off a few at a time (at book size, seed 0: 288 of 970 rows over 50 iterations
+    without converging).
+    """
+    import pandas as pd
+
+    pos = (
+        pd.DataFrame({"point": point, "strip": strip, "x": x, "ln": line})
+        .groupby(["point", "strip"])
+        .median()
+    )
+    keep = []
+    for _, grp in chosen.groupby("sq", sort=False):
+        g = grp.sort_values(["n_on", "n_obs", "score", "point"], ascending=[0, 0, 1, 1])
+        best = g["point"].iloc[0]
+        pb = pos.loc[best]
+        keep.append(best)
+        for q in g["point"].iloc[1:]:
+            d = pos.loc[q].join(pb, how="inner", rsuffix="_b")
+            if (
+                len(d)
+                and (
+                    (np.abs(d["x"] - d["x_b"]) <= SAME_FEATURE_PX)
+                    & (np.abs(d["ln"] - d["ln_b"]) <= SAME_FEATURE_PX)
+                ).all()
+            ):
+                keep.append(q)
+    return chosen[chosen["point"].isin(keep)]

@@ -39,10 +39,14 @@ The user's pipeline, truth-free (002 §3.1 steps 2–3, and the reference square
    and scene length) are of those.
 6. **Reference squares** (optional): each square's centre measured in every scene that should
    see it (:func:`hsgeo.measure.targets_lp.square_centroid`), back to line and x, with the
-   square's id. Sub-pixel in both: a centroid measures the centre, not a pixel, so x is its
-   sub-pixel x in the nearest line and ``t_s`` the time of its sub-line row (between two lines'
-   times; ``line`` names the nearest) — no line rounding, which the k bands that see a square
-   in one line would share.
+   square's id (``squares_as="centroid"``, the default). Sub-pixel: a centroid measures the
+   centre, not a pixel, so x is its sub-pixel x in the nearest line and ``t_s`` the time of
+   its sub-line row (between two lines' times; ``line`` names the nearest) — no line
+   rounding, which the k bands that see a square in one line would share. Or as 002 measured
+   them (§4, ``squares_as="tie_point"``, the LP chapter's check points): the tie points the
+   matcher found on a square (step 5's, at the pixel centre of their line, in the strips and
+   band where it found them; :func:`hsgeo.workflows._lp_squares.as_tie_points`), renamed to
+   the square's id; the square's blob only locates it.
 
 The in-memory core :func:`retrieve` (frozen :class:`LpInputs`, :class:`LpOptions` →
 :class:`LpResult`) is what ``hsgeo reproduce lp-observations`` and ``hsgeo lp-observations``
@@ -53,7 +57,7 @@ bundle adjustment through the same table path as ``hsgeo adjust-pushbroom``.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -151,6 +155,12 @@ class LpOptions:
     one_band_per_feature : bool
         The adjustment's table keeps one tie point per ground feature, of the bands that found
         it in the same lines and pixels (module docstring, step 5); False: every band's.
+    squares_as : {"centroid", "tie_point"}
+        The squares in the table by their blobs' centroids in every strip and band that sees
+        them (sub-pixel x and sub-line time; step 6; the default) or as 002 measured them (§4:
+        tie points found by the matcher, at the pixel centre, in the strips and band where it
+        found them; :func:`hsgeo.workflows._lp_squares.as_tie_points`; the LP chapter's
+        check points). Both tables are in :attr:`LpResult.tables_by_squares`.
     """
 
     n_lines_per_scene: int = 200
@@ -170,8 +180,13 @@ class LpOptions:
     max_nav_gap_s: float = 1.0
     rng: int = 0
     one_band_per_feature: bool = True
+    squares_as: str = "centroid"
 
     def __post_init__(self):
+        if self.squares_as not in sq.SQUARES_AS:
+            raise InputError(
+                f"squares_as must be 'tie_point' or 'centroid', got {self.squares_as!r}"
+            )
         if self.ransac not in ("lp", "frame"):
             raise InputError(f"ransac must be 'lp' or 'frame', got {self.ransac!r}")
         if self.x_at not in ("pixel_centre", "subpixel"):
@@ -223,6 +238,9 @@ class LpResult:
     all_bands : pandas.DataFrame
         Every band's tie-point observations (:data:`TABLE_COLUMNS`, then ``feature`` and
         ``adjusted``: in :attr:`table`) and the squares' (feature −1).
+    tables_by_squares : dict
+        ``{"tie_point": table, "centroid": table}``: the adjustment's table with the squares
+        measured each way (:attr:`LpOptions.squares_as`); :attr:`table` is one of them.
     """
 
     table: object
@@ -234,6 +252,7 @@ class LpResult:
     timings_s: dict
     options: LpOptions = field(default_factory=LpOptions)
     all_bands: object = None
+    tables_by_squares: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         """Counts, timings and the options (JSON-ready); the tables stay in the attributes."""
@@ -405,13 +424,18 @@ def retrieve(inputs: LpInputs, options: LpOptions = LpOptions(), progress=None) 
             "texture in these bands (--bands)"
         )
     score = _mean_hamming(point, m, kept)
-    all_bands = _table(inputs, options, keys, point, rows["squares"], score)
-    table = all_bands.loc[all_bands["adjusted"].to_numpy(), list(TABLE_COLUMNS)]
-    table = table.reset_index(drop=True)
+    by_way = _table(inputs, options, keys, point, rows["squares"], score)
+    square_tables = {
+        k: v.loc[v["adjusted"].to_numpy(), list(TABLE_COLUMNS)].reset_index(drop=True)
+        for k, v in by_way.items()
+    }
+    all_bands = by_way[options.squares_as]
+    table = square_tables[options.squares_as]
     matches = _matches_frame(inputs, keys, m, kept, point)
-    return _result(
+    out = _result(
         inputs, options, bands, keys, point, link, (table, all_bands), matches, rows, timings
     )
+    return replace(out, tables_by_squares=square_tables)
 
 
 def _observation_x(x, options, n_px_full):
@@ -435,8 +459,10 @@ def _mean_hamming(point, m, kept) -> np.ndarray:
 
 
 def _table(inputs, options, keys, point, square_rows, score):
-    """Every band's observations: tie points then squares (:data:`TABLE_COLUMNS`, ``feature``,
-    ``adjusted``: one band per feature, or all, :attr:`LpOptions.one_band_per_feature`).
+    """Every band's observations, tie points then squares (:data:`TABLE_COLUMNS`, ``feature``,
+    ``adjusted``: one band per feature, or all, :attr:`LpOptions.one_band_per_feature`), with
+    the squares measured each way (:data:`~hsgeo.workflows._lp_squares.SQUARES_AS`):
+    ``{way: table}``.
     """
     import pandas as pd
 
@@ -464,16 +490,26 @@ def _table(inputs, options, keys, point, square_rows, score):
             "line_offset": keys.uv[obs, 0] - np.rint(keys.uv[obs, 0]),
         }
     )
-    sq = pd.DataFrame(
-        square_rows, columns=["point_id", "band", "strip", "line", "t_s", "x_px", "ok"]
+    sq_rows = pd.DataFrame(square_rows, columns=sq.COLUMNS)
+    sq_rows = sq_rows.loc[sq_rows["ok"].astype(bool)].drop_duplicates(["point_id", "band", "strip"])
+    count = sq_rows.groupby("point_id")["point_id"].transform("size")
+    cen = sq_rows[count >= options.min_square_observations].assign(
+        y_px=0.0, feature=-1, adjusted=True
     )
-    sq = sq.loc[sq["ok"].astype(bool)].drop_duplicates(["point_id", "band", "strip"])
-    count = sq.groupby("point_id")["point_id"].transform("size")
-    sq = sq[count >= options.min_square_observations].assign(y_px=0.0, feature=-1, adjusted=True)
-    table = pd.concat([ties, sq[[*TABLE_COLUMNS, "feature", "adjusted"]]], ignore_index=True)
-    table["band"] = table["band"].astype(np.int64)
-    table["line"] = table["line"].astype(np.int64)
-    return table
+    cols = [*TABLE_COLUMNS, "feature", "adjusted"]
+    out = {"centroid": pd.concat([ties, cen[cols]], ignore_index=True)}
+    # the squares as the matcher found them (002 §4): tie points on the squares' blobs
+    blobs = sq_rows.assign(line_frac=sq_rows["line"] + (sq_rows["u"] - np.round(sq_rows["u"])))
+    on, taken = sq.as_tie_points(ties.assign(point=point[obs]), blobs, score)
+    t2 = ties.copy()
+    t2.loc[np.isin(t2["feature"].to_numpy(), taken), "adjusted"] = False
+    on = on.assign(feature=-1, adjusted=True)
+    out["tie_point"] = pd.concat([t2, on[ties.columns]], ignore_index=True)
+    for k, table in out.items():
+        table["band"] = table["band"].astype(np.int64)
+        table["line"] = table["line"].astype(np.int64)
+        out[k] = table
+    return out
 
 
 def _matches_frame(inputs, keys, m, kept, point):
