@@ -554,6 +554,10 @@ def _ancestors(node: nodes.Node):
         node = node.parent
 
 
+#: An alt text that is a file's path or name (myst-nb's), not a description.
+_PATH_LIKE = re.compile(r"^\S*[/\\]\S*$|\.(png|svg|jpe?g)$", re.IGNORECASE)
+
+
 def _alt_from_captions(doctree: nodes.document) -> None:
     """Every image of a captioned figure without a real alt text (myst-nb writes the output's
     hashed file path) gets its caption as alt text, for screen readers and text browsers.
@@ -565,7 +569,7 @@ def _alt_from_captions(doctree: nodes.document) -> None:
         text = re.sub(r"\s+", " ", captions[0].astext()).strip()
         for image in figure.findall(nodes.image):
             alt = image.get("alt", "")
-            if not alt or alt == image.get("uri") or re.search(r"[/\\]|\.(png|svg|jpe?g)$", alt):
+            if not alt or alt == image.get("uri") or _PATH_LIKE.search(alt):
                 image["alt"] = text
 
 

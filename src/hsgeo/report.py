@@ -548,9 +548,17 @@ def highlight_below(df, limits: dict, *, fmt: str = "{:.1f}", colour: str = "#f4
 _RUNS = re.compile(r"^(.*\S) (\((?:mean of )?\d+(?: runs)?\))$")
 
 
+_HYPHEN_MINUS = re.compile(r"(?:(?<=^)|(?<=[\s(\[=:,;/]))-(?=\d)")
+
+
+def _true_minus(value) -> str:
+    """A text cell with a true minus sign (U+2212) where a hyphen-minus starts a number."""
+    return _HYPHEN_MINUS.sub("\u2212", str(value))
+
+
 def _runs_on_own_line(value) -> str:
     """A number cell's HTML: its "(n runs)" / "(mean of n)" note below the number."""
-    text = str(value)
+    text = _true_minus(value)
     m = _RUNS.match(text)
     return f'{m[1]}<br><span class="hsgeo-runs">{m[2]}</span>' if m else text
 
@@ -625,6 +633,7 @@ def styled(df, numeric: tuple[str, ...] = NUMERIC_COLUMNS):
         style = style.format(_runs_on_own_line, subset=num)
     if text:
         style = style.set_properties(subset=text, **{"text-align": "left"})
+        style = style.format(_true_minus, subset=text)  # "ASF at −20°", as the numbers have
     return style
 
 

@@ -60,7 +60,8 @@ async () => {
   for (const img of main.querySelectorAll("img")) {
     if (img.closest("mjx-container, button, a.headerlink")) continue;
     const alt = (img.getAttribute("alt") || "").trim();
-    if (!alt || /[\/\\]|\.(png|svg|jpe?g)$/i.test(alt)) {
+    // a path: one word with a slash, or a file name (a caption may hold "E/N" or "MTF/CTF")
+    if (!alt || /^\S*[\/\\]\S*$|\.(png|svg|jpe?g)$/i.test(alt)) {
       no_alt.push(describe(img.closest("figure") || img) + " alt «" + alt.slice(0, 40) + "»");
     }
   }
@@ -144,7 +145,9 @@ async () => {
     if (guide) slips.push("the developers' GUIDE «" + guide[0] + "» in " + describe(el));
     const key = t.match(/\b[a-z][a-z0-9]*_[a-z0-9_]*\[[^\]\s]+\]/);
     if (key) slips.push("an internal key «" + key[0] + "» in " + describe(el));
-    const minus = t.match(/(?:^|[\s(\[=:,;])-\d[\d.]*/);
+    // (not in a pandas table a chapter prints as it is: only hsgeo's own tables are typeset)
+    const typeset = !el.closest("table") || el.closest("table.hsgeo-table");
+    const minus = typeset && t.match(/(?:^|[\s(\[=:,;])-\d[\d.]*/);
     if (minus) slips.push("a hyphen for a minus «" + minus[0].trim() + "» in " + describe(el));
   }
   // table cells whose text would touch their neighbour's: no horizontal padding

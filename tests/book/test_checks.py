@@ -87,8 +87,8 @@ CASES = {
         problems_alt_text,
         f'<figure><img src="{PNG_1PX}" alt="../_images/3f2a9c.png"><figcaption>Fig. 1</figcaption>'
         "</figure>",
-        f'<figure><img src="{PNG_1PX}" alt="Fig. 1: a pixel"><figcaption>Fig. 1</figcaption>'
-        "</figure>",
+        f'<figure><img src="{PNG_1PX}" alt="Fig. 1: E/N of a pixel"><figcaption>Fig. 1'
+        "</figcaption></figure>",
     ),
     "nan-in-table": (
         problems_nan,
