@@ -150,6 +150,20 @@ def test_sydney_flight_lands_in_utm_56s_where_pyproj_puts_it(flight, capsys, nav
     assert bias < 0.25 * GSD_M and np.median(e) < 0.25, (bias, np.median(e))
 
 
+def test_etrs89_navigation_outside_europe_maps_to_the_given_crs(flight, capsys):
+    """ETRS89 has no UTM zone at Sydney: the navigation is read into the frame of --crs."""
+    d, argv, _ = flight
+    nav = _geodetic_csv(d)
+    etrs = d / "nav_etrs89.csv"
+    etrs.write_text(nav.read_text().replace("EPSG:4979", "EPSG:4937"))
+    argv = list(argv)
+    argv[argv.index("--trajectory") + 1] = str(etrs)
+    o = d / "o_etrs89.tif"
+    rc = main([*argv, "--vertical", "ellipsoidal", "--crs", "EPSG:32756", "--json", "-o", str(o)])
+    assert rc == 0, capsys.readouterr().out
+    assert json.loads(capsys.readouterr().out)["crs"] == "EPSG:32756"
+
+
 @pytest.mark.parametrize(
     "extra, expect",
     [

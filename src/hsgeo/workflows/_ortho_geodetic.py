@@ -32,11 +32,18 @@ FLOOR_U_M = -500.0
 MARGIN_M = 100.0
 
 
-def read_nav(trajectory, nav_crs, gps_week, site, vertical):
-    """The navigation (:class:`hsgeo.io.Navigation`), the options checked against its kind."""
+def read_nav(trajectory, nav_crs, gps_week, site, vertical, crs=None):
+    """The navigation (:class:`hsgeo.io.Navigation`), the options checked against its kind; a
+    geodetic one's frame maps to the projected ``--crs`` when given (else its centre's UTM zone).
+    """
+    from hsgeo.crs import parse_crs
     from hsgeo.io import read_navigation
 
-    nav = read_navigation(trajectory, crs=nav_crs, gps_week=gps_week)
+    map_crs = None
+    if crs is not None:
+        c = parse_crs(crs)
+        map_crs = c.to_epsg() if c.is_projected else None
+    nav = read_navigation(trajectory, crs=nav_crs, gps_week=gps_week, map_crs=map_crs)
     local = nav.source_crs == "local ENU"
     if local:
         for opt, v in (("--gps-week", gps_week), ("--vertical", vertical)):

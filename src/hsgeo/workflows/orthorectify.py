@@ -319,7 +319,7 @@ def orthorectify_files(
 
     inputs = [*lines, trajectory, sensor, dsm, adjustment, *(line_times or ()), *envi_files(lines)]
     check_outputs(raster_outputs(output, RASTER_FORMATS), inputs, overwrite=overwrite)
-    navigation = geo.read_nav(trajectory, nav_crs, gps_week, site, vertical)
+    navigation = geo.read_nav(trajectory, nav_crs, gps_week, site, vertical, crs)
     geodetic = navigation.source_crs != "local ENU"
     frame = navigation.frame if geodetic else geo.site_frame(site, nav_crs, crs)
     if geodetic and crs is None:
