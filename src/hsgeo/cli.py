@@ -80,6 +80,8 @@ def _cmd_calibrate_frame(args) -> int:
 def _cmd_data(args) -> int:
     from hsgeo.reproduce.data import generate_all
 
+    if args.what not in (None, "flight"):
+        raise InputError(f"{args.what!r}: hsgeo data takes one subject, flight (or none)")
     if args.what == "flight" or args.site is not None:
         return _data_flight(args)
 

@@ -182,7 +182,7 @@ def _data_flight_options(p) -> None:
     p.add_argument(
         "what",
         nargs="?",
-        choices=("flight",),
+        metavar="flight",  # checked by the command, so that an unknown option is named first
         help="flight: write a simulated flight about --site into --out DIR in the formats a "
         "real one is delivered in (ENVI lines + times file, geodetic navigation CSV, a "
         "view-angle sensor file, a DSM GeoTIFF, the targets' true positions; command.txt: "
