@@ -113,3 +113,19 @@ def test_outputs_attach_by_source_so_a_removed_cell_takes_none():
     assert [c.outputs[0]["text"] for c in student.cells] == ["one", "two"]
     assert [c.execution_count for c in student.cells] == [1, 3]
     assert nbformat.validate(student) is None
+
+
+def test_glued_figure_becomes_an_attached_image(tmp_path):
+    import json
+
+    from nbformat.v4 import new_markdown_cell, new_notebook
+
+    glue = tmp_path / "p.glue.json"
+    glue.write_text(json.dumps({"fig_a": {"data": {"image/png": "iVBORw0K", "text/plain": "<F>"}}}))
+    md = "````{glue:figure} fig_a\n:name: fig-a\n\nThe caption.\n````"
+    nb = hsgeo_notebooks.readable_notebook(
+        new_notebook(cells=[new_markdown_cell(md)]), tmp_path / "none.ipynb", glue
+    )
+    cell = nb.cells[0]
+    assert cell.source == "![fig_a](attachment:fig_a.png)\n\nThe caption."
+    assert cell.attachments == {"fig_a.png": {"image/png": "iVBORw0K"}}

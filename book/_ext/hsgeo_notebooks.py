@@ -81,8 +81,22 @@ def _role_text(match: re.Match, glue: dict[str, object]) -> str:
     return m["text"] if m and m["text"] else body
 
 
-def readable_markdown(text: str, glue: dict[str, object]) -> str:
-    """A markdown cell's MyST as plain Markdown: glued values, role texts, titled directives."""
+def glue_images(glue_json: Path) -> dict[str, str]:
+    """The glued figures of a page: key → base64 PNG (myst-nb's ``<page>.glue.json``)."""
+    if not glue_json.is_file():
+        return {}
+    out = {}
+    for key, output in json.loads(glue_json.read_text(encoding="utf-8")).items():
+        png = output.get("data", {}).get("image/png")
+        if png:
+            out[key] = "".join(png) if isinstance(png, list) else png
+    return out
+
+
+def readable_markdown(text: str, glue: dict[str, object], images: dict | None = None) -> str:
+    """A markdown cell's MyST as plain Markdown: glued values, role texts, titled directives;
+    a ``{glue:figure}`` becomes the figure itself (an attachment, ``images`` key → PNG).
+    """
     lines: list[str] = []
     closing: list[str] = []  # fences of the directives open at this point
     in_options = False
@@ -90,6 +104,11 @@ def readable_markdown(text: str, glue: dict[str, object]) -> str:
         m = _FENCE_OPEN.match(line)
         if m:
             if m["name"] == "solution-end":
+                closing.append(m["fence"])
+                in_options = True
+                continue
+            if m["name"].startswith("glue") and images and m["args"].strip() in images:
+                lines.append(f"![{m['args'].strip()}](attachment:{m['args'].strip()}.png)")
                 closing.append(m["fence"])
                 in_options = True
                 continue
@@ -139,9 +158,12 @@ def readable_notebook(nb, executed_ipynb: Path, glue_json: Path):
 
     if executed_ipynb.is_file():
         attach_outputs(nb, nbformat.read(executed_ipynb, as_version=4))
-    glue = glue_texts(glue_json)
+    glue, images = glue_texts(glue_json), glue_images(glue_json)
     for cell in nb.cells:
         if cell.cell_type == "markdown":
-            cell.source = readable_markdown(cell.source, glue)
+            cell.source = readable_markdown(cell.source, glue, images)
+            used = [k for k in images if f"(attachment:{k}.png)" in cell.source]
+            if used:
+                cell["attachments"] = {f"{k}.png": {"image/png": images[k]} for k in used}
     nb.cells = [c for c in nb.cells if c.cell_type != "markdown" or c.source.strip()]
     return nb
