@@ -2747,6 +2747,9 @@ def test_ascii_spellings_of_the_report():
 #: not depend on how busy the machine is.
 _SIGINT_CHILD = """
 import os, signal, sys, threading
+# Ctrl-C as in a terminal: a shell starts background jobs with SIGINT ignored, which Python
+# keeps, so a suite run with `make test &` would see no interrupt at all
+signal.signal(signal.SIGINT, signal.default_int_handler)
 from hsgeo import cli, terminal
 k, delay = int(sys.argv[1]), float(sys.argv[2])
 def printer(stream=None):
@@ -2791,6 +2794,9 @@ def test_ctrl_c_inside_a_compiled_kernel(cmd, inputs: Inputs):
 #: ("part"), or at the k-th task the NetCDF writer completes ("task", k).
 _SIGINT_WRITING_CHILD = """
 import os, signal, sys, tempfile
+# Ctrl-C as in a terminal: a shell starts background jobs with SIGINT ignored, which Python
+# keeps, so a suite run with `make test &` would see no interrupt at all
+signal.signal(signal.SIGINT, signal.default_int_handler)
 from hsgeo import cli
 import hsgeo.io.cube as cube
 where, k = sys.argv[1], int(sys.argv[2])
