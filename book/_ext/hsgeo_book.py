@@ -528,9 +528,6 @@ def _glued_text_without_quotes(doctree: nodes.document) -> None:
         node["classes"] = ["pasted-text"]
 
 
-#: A hyphen-minus written as a minus sign: at the start of a word, before a digit ("-0.8 σ̂",
-#: "(-3.1, 2.0)"), not inside one ("2-3 s", "2026-11-28", "EPSG:25832+5941").
-_HYPHEN_MINUS = re.compile(r"(?:(?<=^)|(?<=[\s(\[=:,;/]))-(?=\d)")
 #: Nodes whose text is code or math, kept as written.
 _VERBATIM = (nodes.literal, nodes.literal_block, nodes.math, nodes.math_block, nodes.raw)
 
@@ -539,13 +536,15 @@ def _true_minus_signs(doctree: nodes.document) -> None:
     """Running text's numbers get a true minus sign (U+2212), as the tables have (glued values
     and sentences formatted with ``:+.2f`` wrote a hyphen); code, math and raw HTML keep theirs.
     """
+    from hsgeo.report import true_minus  # the rule of hsgeo's tables, in one place
+
     for text in list(doctree.findall(nodes.Text)):
-        if not _HYPHEN_MINUS.search(text.astext()):
+        if true_minus(text.astext()) == text.astext():
             continue
         parent = text.parent
         if parent is None or any(isinstance(a, _VERBATIM) for a in _ancestors(parent)):
             continue
-        parent.replace(text, nodes.Text(_HYPHEN_MINUS.sub("\u2212", text.astext())))
+        parent.replace(text, nodes.Text(true_minus(text.astext())))
 
 
 def _ancestors(node: nodes.Node):

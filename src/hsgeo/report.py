@@ -548,17 +548,19 @@ def highlight_below(df, limits: dict, *, fmt: str = "{:.1f}", colour: str = "#f4
 _RUNS = re.compile(r"^(.*\S) (\((?:mean of )?\d+(?: runs)?\))$")
 
 
+#: A hyphen-minus written as a minus sign: at the start of a word, before a digit ("-0.8 σ̂",
+#: "(-3.1, 2.0)"), not inside one ("2-3 s", "2026-11-28", "EPSG:25832+5941").
 _HYPHEN_MINUS = re.compile(r"(?:(?<=^)|(?<=[\s(\[=:,;/]))-(?=\d)")
 
 
-def _true_minus(value) -> str:
+def true_minus(value) -> str:
     """A text cell with a true minus sign (U+2212) where a hyphen-minus starts a number."""
     return _HYPHEN_MINUS.sub("\u2212", str(value))
 
 
 def _runs_on_own_line(value) -> str:
     """A number cell's HTML: its "(n runs)" / "(mean of n)" note below the number."""
-    text = _true_minus(value)
+    text = true_minus(value)
     m = _RUNS.match(text)
     return f'{m[1]}<br><span class="hsgeo-runs">{m[2]}</span>' if m else text
 
@@ -633,7 +635,7 @@ def styled(df, numeric: tuple[str, ...] = NUMERIC_COLUMNS):
         style = style.format(_runs_on_own_line, subset=num)
     if text:
         style = style.set_properties(subset=text, **{"text-align": "left"})
-        style = style.format(_true_minus, subset=text)  # "ASF at −20°", as the numbers have
+        style = style.format(true_minus, subset=text)  # "ASF at −20°", as the numbers have
     return style
 
 
