@@ -375,6 +375,20 @@ def _ray_rows(ev: dict) -> list[Row]:
         ]
         if way == "centroid":
             rows.append(Row(T, "n_check_points_centroid", "1", reproduced=float(r.size)))
+        for gcps in ("", "_nogcp"):  # measured, but the adjustment could not determine them
+            lost = d.get(f"cp_undetermined{gcps}_ids") or []
+            if lost:
+                rows.append(
+                    Row(
+                        table=T,
+                        quantity=f"n_check_points_undetermined_{way}{gcps}",
+                        unit="1",
+                        reproduced=float(len(lost)),
+                        reason="left out of the check-point statistics: the adjustment "
+                        f"{'without' if gcps else 'with'} GCPs could not determine "
+                        f"{', '.join(lost)} (a covariance that is not finite)",
+                    )
+                )
     return rows
 
 

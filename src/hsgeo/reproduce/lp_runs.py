@@ -178,14 +178,24 @@ def _adjust(res, obs, cam, with_gcp: bool, gcp_ids):
 
 
 def _check_points(r, pin, obs, truth, cp_ids):
-    """Errors ``(k, 3)`` of the check points ``cp_ids`` the table measured, their joint
-    covariance ``(3k, 3k)`` (:func:`~hsgeo.reproduce.lp_judge.joint_point_covariance`) and
-    their ids.
+    """Errors ``(k, 3)`` of the check points ``cp_ids`` the table measured and the adjustment
+    determined, their joint covariance ``(3k, 3k)``
+    (:func:`~hsgeo.reproduce.lp_judge.joint_point_covariance`), their ids, and the ids of the
+    measured check points the adjustment could not determine (a covariance that is not finite:
+    e.g. a square seen along one ray only, :attr:`hsgeo.adjust.AdjustmentResult.
+    undetermined_parameters`), which are left out of the statistics and named.
     """
     k = [list(obs.square_ids).index(s) for s in cp_ids]
     E, idx, measured = check_point_errors(r.result, pin.point_ids, cp_ids, truth.square_xyz_m[k])
-    cov = joint_point_covariance(r.result, idx) if idx.size else np.zeros((0, 0))
-    return E, cov, measured
+    if not idx.size:
+        return E, np.zeros((0, 0)), measured, []
+    cov = joint_point_covariance(r.result, idx)
+    ok = np.all(np.isfinite(np.diag(cov).reshape(-1, 3)), axis=1)
+    undetermined = [str(m) for m in measured[~ok]]
+    if not ok.all():
+        keep = np.repeat(ok, 3)
+        E, measured, cov = E[ok], measured[ok], cov[np.ix_(keep, keep)]
+    return E, cov, measured, undetermined
 
 
 def _rays(table, ids) -> np.ndarray:
@@ -197,7 +207,8 @@ def _rays(table, ids) -> np.ndarray:
 def _squares_judged(res, obs, truth, cam, nogcp: bool) -> dict:
     """The retrieval's table adjusted with the GCPs it measured (and without any), its check
     points judged: ``adjusted``, ``pin``, ``gcp_ids``, ``cp_ids``, ``cp_errors_m``,
-    ``cp_cov_m2`` (joint), ``cp_rays`` and the same ``_nogcp`` (002 Table 3's check points:
+    ``cp_cov_m2`` (joint), ``cp_undetermined_ids`` (measured but not determined by the
+    adjustment: left out), ``cp_rays`` and the same ``_nogcp`` (002 Table 3's check points:
     the same 13), ``seconds``.
     """
     pid = res.table["point_id"].to_numpy().astype(str)
@@ -205,7 +216,7 @@ def _squares_judged(res, obs, truth, cam, nogcp: bool) -> dict:
     gcp_ids = [g for g in obs.gcp_ids if g in measured]
     cps = [s for s in obs.square_ids if s not in obs.gcp_ids]
     r, pin, sec = _adjust(res, obs, cam, True, gcp_ids)
-    E, cov, cp_ids = _check_points(r, pin, obs, truth, cps)
+    E, cov, cp_ids, lost = _check_points(r, pin, obs, truth, cps)
     out = {
         "adjusted": r,
         "pin": pin,
@@ -213,15 +224,20 @@ def _squares_judged(res, obs, truth, cam, nogcp: bool) -> dict:
         "cp_ids": list(cp_ids),
         "cp_errors_m": E,
         "cp_cov_m2": cov,
+        "cp_undetermined_ids": lost,
         "cp_rays": _rays(res.table, cp_ids),
         "gcp_rays": _rays(res.table, gcp_ids),
         "seconds": {"adjust_gcp": sec},
     }
     if nogcp:
         r0, pin0, out["seconds"]["adjust_nogcp"] = _adjust(res, obs, cam, False, gcp_ids)
-        E0, cov0, ids0 = _check_points(r0, pin0, obs, truth, cps)
+        E0, cov0, ids0, lost0 = _check_points(r0, pin0, obs, truth, cps)
         out.update(
-            adjusted_nogcp=r0, cp_errors_nogcp_m=E0, cp_cov_nogcp_m2=cov0, cp_ids_nogcp=list(ids0)
+            adjusted_nogcp=r0,
+            cp_errors_nogcp_m=E0,
+            cp_cov_nogcp_m2=cov0,
+            cp_ids_nogcp=list(ids0),
+            cp_undetermined_nogcp_ids=lost0,
         )
     return out
 
