@@ -82,9 +82,9 @@ __all__ = [
     "FTOL",
     "REJECT_K",
     "Y_AS_TIME",
+    "EXTREMES_NOT_COMPARABLE",
+    "c_minus_mean",
 ]
-
-RAD2DEG = 180 / np.pi
 
 
 #: Why the extremes of 002 Table 1 get no verdict (see :func:`_stats_rows`).
@@ -215,7 +215,7 @@ def _table_rows(res, res0, truth, spread, scale):
         extremes=same_size,
     )
     for row in rows:
-        # issue 22: the key-point σ per image axis was tuned to the paper's NMADs (a miss
+        # provenance: the key-point σ per image axis was tuned to the paper's NMADs (a miss
         # beyond 3σ is "differs: tuning missed"); the other statistics follow from our choices
         row.provenance = "tuned" if row.quantity in ("nmad_x_px", "nmad_y_px") else "chosen"
     # -- 002 Tables 2 and 3: check points, m (the same 13 at every scale)
@@ -463,7 +463,7 @@ def run(
             cfg.agl_low_m * cfg.pixel_mm / cfg.c_mean_mm,
             cfg.agl_high_m * cfg.pixel_mm / cfg.c_mean_mm,
         ],
-        # what the data could not determine, said rather than a reason to stop (issue 42)
+        # what the data could not determine, said rather than a reason to stop
         "not_determined_gcp": _not_determined(res),
         "not_determined_nogcp": _not_determined(res0),
         "total_seconds": time.perf_counter() - t_start,

@@ -53,6 +53,10 @@ __all__ = [
     "FramePhotogrammetric",
     "pixel_to_mm",
     "mm_to_pixel",
+    "OPENCV_INTRINSICS",
+    "OPENCV_DISTORTION",
+    "PHOTOGRAMMETRIC_INTERIOR",
+    "PHOTOGRAMMETRIC_DISTORTION",
 ]
 
 POSE_COLUMNS = ("omega_rad", "phi_rad", "kappa_rad", "X0", "Y0", "Z0")
@@ -95,7 +99,7 @@ def camera_coordinates(poses: np.ndarray, view: np.ndarray, X: np.ndarray, jacob
     return Xc, d_pose, Rt
 
 
-def _check_views(name, view, xy, X, n_views_hint=None):
+def _check_views(name, view, xy, X):
     view = np.asarray(view)
     xy = np.asarray(xy, dtype=np.float64)
     if xy.ndim != 2 or xy.shape[1] != 2:

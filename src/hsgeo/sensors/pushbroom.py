@@ -407,23 +407,6 @@ class PushbroomLines(ResidualBlock):
         other._dt_s = np.zeros_like(self._dt_s)
         return other
 
-    def image_mm(self, values):
-        """Modelled image coordinates in mm, ``(m, 2)``."""
-        xy, _ = project(
-            values,
-            self.blocks,
-            self.nodes,
-            self.t_s,
-            self.xyz_nav,
-            self.rpy_nav,
-            self.point,
-            self.band,
-            self.beta0,
-            self.x0_mm,
-            self.y0_mm,
-        )
-        return xy
-
     def evaluate_numpy(self, values, jacobian):
         """:meth:`evaluate` in plain numpy, for the image y of 002 eq. (2) (tests' reference).
 
