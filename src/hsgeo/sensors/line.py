@@ -31,8 +31,9 @@ __all__ = [
     "LinearIFOV",
     "CalibratedLine",
     "LineScanner",
-    "line_time",
     "ray_directions",
+    "BoresightGCP",
+    "calibrate_boresight",
 ]
 
 

@@ -87,6 +87,7 @@ __all__ = [
     "check_minimum_observations",
     "make_parameters",
     "resect",
+    "Resection",
 ]
 
 #: The unit of (ζ − ζ0) in the distortion polynomial: 100 px (see the module docstring).

@@ -43,6 +43,7 @@ __all__ = [
     "register",
     "asf_from_scans",
     "peak_to_peak_percent",
+    "MIN_MEAN_NCC",
 ]
 
 

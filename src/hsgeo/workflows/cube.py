@@ -46,6 +46,7 @@ __all__ = [
     "process_frames",
     "build_cube",
     "cube_files",
+    "EXPOSURE_EXTRAPOLATION",
 ]
 
 
@@ -358,8 +359,8 @@ EXPOSURE_EXTRAPOLATION = 10.0
 
 
 def _check_exposures(frames, dark) -> None:
-    """The survey's exposure times near the dark frames' (issue 42: exposures in ms where s are
-    expected gave a cube with exit 0).
+    """The survey's exposure times near the dark frames' (exposures in ms where s are
+    expected would otherwise give a wrong cube with exit 0).
     """
     t, td = np.asarray(frames.exposure_s), np.asarray(dark.exposure_s)
     lo, hi = td.min() / EXPOSURE_EXTRAPOLATION, td.max() * EXPOSURE_EXTRAPOLATION

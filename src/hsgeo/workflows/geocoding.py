@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from hsgeo.geocode import PlaneTerrain, calibrate_boresight, geocode_observations
-from hsgeo.sensors.line import LineGeometry
+from hsgeo.geocode import PlaneTerrain, geocode_observations
+from hsgeo.sensors.line import LineGeometry, calibrate_boresight
 
 __all__ = ["gcp_deviations"]
 

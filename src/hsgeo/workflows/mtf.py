@@ -35,6 +35,7 @@ __all__ = [
     "mtf_from_edge",
     "bars_files",
     "edge_file",
+    "parse_roi",
 ]
 
 #: The MTF level of the "borderline frequency" (001 §4: the curves fall "to 0.1, with a

@@ -36,6 +36,7 @@ __all__ = [
     "line_strip",
     "lp_strips",
     "MAX_MOSAIC_GIB",
+    "SCHEDULER_TIMEOUT_S",
 ]
 
 #: How long ``--scheduler`` waits for the scheduler to answer, s.

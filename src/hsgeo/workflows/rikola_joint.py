@@ -4,7 +4,7 @@ One exterior orientation per cube (sensor I's camera frame), ``f = a·gap + b`` 
 eq. (2)) plus a per-band deviation ``df`` with a prior, one principal point per sensor, one
 distortion set, sensor II's rotation ``R_I_from_II`` (003 eq. (1)) and the drift of the exterior
 orientation across the bands of a cube (003 §3.4, Fig. 5: a rotation rate per band, zero at the
-middle band :data:`DRIFT_REF_BAND`; issue 37); the residual block is
+middle band :data:`DRIFT_REF_BAND`); the residual block is
 :class:`hsgeo.sensors.rikola.JointCentroids`. :func:`calibrate_joint` sets the problem up (the
 one place it is set up) and adjusts it; :func:`predict_band` predicts a band the model did not
 see; :func:`design_effect` measures how much the observations of one target in the bands of a
