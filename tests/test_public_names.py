@@ -9,6 +9,8 @@ from __future__ import annotations
 import ast
 import importlib
 import inspect
+import pkgutil
+import re
 from pathlib import Path
 
 import pytest
@@ -97,3 +99,46 @@ def test_no_module_re_exports_a_sibling_s_name(name, path):
         if not any(p.startswith("_") for p in home.split(".")):  # a private module's is its own
             foreign.append(f"{n} (from {home})")
     assert not foreign, f"{name}.__all__ re-exports: {foreign}; import them from their module"
+
+
+#: The first author of each paper, as a References entry names it.
+FIRST_AUTHOR = {
+    "000": "Miljković",
+    "001": "Krtalić",
+    "002": "Jonassen",
+    "003": "Tommaselli",
+    "004": "Meister",
+}
+_CITE = re.compile(r"(?<![\w.])(00[0-4])(?=[ ,;:)'’]|$)", re.M)
+
+
+def _cited(package: str) -> list[tuple[str, str, list[str]]]:
+    """``(module, name, papers)`` of every public class and function of ``package``'s modules
+    whose docstring cites a paper (``000`` … ``004``)."""
+    pkg = importlib.import_module(package)
+    out = []
+    for info in pkgutil.iter_modules(pkg.__path__):
+        if info.name.startswith("_"):
+            continue
+        module = importlib.import_module(f"{package}.{info.name}")
+        for n in module.__all__:
+            obj = getattr(module, n)
+            if (inspect.isclass(obj) or inspect.isfunction(obj)) and (
+                obj.__module__ == module.__name__
+            ):
+                papers = sorted(set(_CITE.findall(inspect.getdoc(obj) or "")))
+                if papers:
+                    out.append((module.__name__, n, papers))
+    return out
+
+
+CITED = _cited("hsgeo.workflows") + _cited("hsgeo.sensors")
+
+
+@pytest.mark.parametrize(("module", "name", "papers"), CITED, ids=[f"{m}.{n}" for m, n, _ in CITED])
+def test_a_docstring_citing_a_paper_has_its_references(module, name, papers):
+    doc = inspect.getdoc(getattr(importlib.import_module(module), name))
+    assert "References\n----------" in doc, f"{module}.{name}: add a numpydoc References section"
+    refs = doc.split("References\n----------", 1)[1].split("\n\n")[0]
+    for p in papers:
+        assert FIRST_AUTHOR[p] in refs and f"(paper {p})" in refs, (module, name, p)

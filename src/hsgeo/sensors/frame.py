@@ -308,6 +308,12 @@ class FramePhotogrammetric(_FrameBase):
     blocks : mapping, optional
         Parameter-block names by role (``poses``, ``points``, ``interior``, ``distortion``;
         defaults ``poses``, ``points``, ``interior``, ``distortion_mm``).
+
+    References
+    ----------
+    .. [1] Tommaselli, A. M. G., Santos, L. D., Berveglieri, A., Oliveira, R. A. and Honkavaara, E.
+           (2018). A study on the variations of inner orientation parameters of a hyperspectral
+           frame camera. Int. Arch. Photogramm. Remote Sens. Spatial Inf. Sci. XLII-1 (paper 003).
     """
 
     name = "image points (photogrammetric form)"

@@ -71,6 +71,12 @@ class CubeOptions:
         The diffuse collector's receiving pattern at the light's incidence, F(α).
     f_theta : tuple of float, optional
         The lens's receiving pattern F(θ) at every reflected sample (default: 1).
+
+    References
+    ----------
+    .. [1] Krtalić, A., Miljković, V., Gajski, D. and Racetin, I. (2019). Spatial distortion
+           assessments of a low-cost laboratory and field hyperspectral imaging system. Sensors
+           19(19), 4267 (paper 001).
     """
 
     binning: int = 2
@@ -220,6 +226,12 @@ def process_frames(
     ------
     InputError
         The diffuse collector's signal is saturated in a frame, or holds no light.
+
+    References
+    ----------
+    .. [1] Krtalić, A., Miljković, V., Gajski, D. and Racetin, I. (2019). Spatial distortion
+           assessments of a low-cost laboratory and field hyperspectral imaging system. Sensors
+           19(19), 4267 (paper 001).
     """
     raw = np.asarray(raw_dn)
     t = np.asarray(exposure_s, dtype=float)

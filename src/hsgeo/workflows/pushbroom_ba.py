@@ -93,6 +93,13 @@ class CameraPrior:
     principal distance per band (``c_band_mm``, default ``c_mm`` for every band), the
     distortion of 002 eq. (3) and the boresight (ω, φ, κ on the nominal mount, rad); the
     adjustment starts from them, not from zero. :meth:`camera` is that camera as a sensor.
+
+    References
+    ----------
+    .. [1] Jonassen, V. O., Ressl, C., Pfeifer, N., Kjørsvik, N. S. and Gjevestad, J. G. O. (2024).
+           Bundle adjustment of aerial linear pushbroom hyperspectral images with sub-pixel
+           accuracy. PFG – Journal of Photogrammetry, Remote Sensing and Geoinformation Science
+           (paper 002).
     """
 
     n_bands: int
@@ -155,6 +162,13 @@ def intersect_two_rays(point, origin, direction, n_points, min_angle_deg: float 
     Returns
     -------
     xyz : (n_points, 3) ndarray
+
+    References
+    ----------
+    .. [1] Jonassen, V. O., Ressl, C., Pfeifer, N., Kjørsvik, N. S. and Gjevestad, J. G. O. (2024).
+           Bundle adjustment of aerial linear pushbroom hyperspectral images with sub-pixel
+           accuracy. PFG – Journal of Photogrammetry, Remote Sensing and Geoinformation Science
+           (paper 002).
     """
     point = np.asarray(point)
     order = np.argsort(point, kind="stable")
@@ -290,6 +304,13 @@ def build_problem(
     params : Parameters
     blocks : list of ResidualBlock
     nodes : SplineNodes
+
+    References
+    ----------
+    .. [1] Jonassen, V. O., Ressl, C., Pfeifer, N., Kjørsvik, N. S. and Gjevestad, J. G. O. (2024).
+           Bundle adjustment of aerial linear pushbroom hyperspectral images with sub-pixel
+           accuracy. PFG – Journal of Photogrammetry, Remote Sensing and Geoinformation Science
+           (paper 002).
     """
     if not isinstance(obs, PushbroomObservations):
         raise InputError(
@@ -352,6 +373,13 @@ def solve(
     Returns
     -------
     hsgeo.adjust.AdjustmentResult
+
+    References
+    ----------
+    .. [1] Jonassen, V. O., Ressl, C., Pfeifer, N., Kjørsvik, N. S. and Gjevestad, J. G. O. (2024).
+           Bundle adjustment of aerial linear pushbroom hyperspectral images with sub-pixel
+           accuracy. PFG – Journal of Photogrammetry, Remote Sensing and Geoinformation Science
+           (paper 002).
     """
     from hsgeo.adjust import adjust
 
@@ -409,6 +437,13 @@ class PushbroomInputs:
 class PushbroomOptions:
     """How to adjust: 002's settings (:data:`REJECT_K`, :data:`FTOL`, :data:`Y_AS_TIME`) by
     default, and the node interval of 002 §4.
+
+    References
+    ----------
+    .. [1] Jonassen, V. O., Ressl, C., Pfeifer, N., Kjørsvik, N. S. and Gjevestad, J. G. O. (2024).
+           Bundle adjustment of aerial linear pushbroom hyperspectral images with sub-pixel
+           accuracy. PFG – Journal of Photogrammetry, Remote Sensing and Geoinformation Science
+           (paper 002).
     """
 
     node_interval_s: float = 10.0
@@ -461,6 +496,13 @@ def adjust_pushbroom(
 
     ``hsgeo adjust-pushbroom`` (:func:`adjust_files`) and ``hsgeo reproduce pushbroom-ba`` both
     call this, so 002's solver settings and the set-up exist once.
+
+    References
+    ----------
+    .. [1] Jonassen, V. O., Ressl, C., Pfeifer, N., Kjørsvik, N. S. and Gjevestad, J. G. O. (2024).
+           Bundle adjustment of aerial linear pushbroom hyperspectral images with sub-pixel
+           accuracy. PFG – Journal of Photogrammetry, Remote Sensing and Geoinformation Science
+           (paper 002).
     """
     import time
 

@@ -214,6 +214,12 @@ def calibrate_joint(
         Estimate the drift of the exterior orientation across the bands (a rotation rate
         (dω, dφ, dκ) per band, zero at :data:`DRIFT_REF_BAND`; 003 §3.4, Fig. 5); False holds
         it at zero (the rigid model of 003 eq. (1)).
+
+    References
+    ----------
+    .. [1] Tommaselli, A. M. G., Santos, L. D., Berveglieri, A., Oliveira, R. A. and Honkavaara, E.
+           (2018). A study on the variations of inner orientation parameters of a hyperspectral
+           frame camera. Int. Arch. Photogramm. Remote Sens. Spatial Inf. Sci. XLII-1 (paper 003).
     """
     keep = ~np.isin(obs.band, np.asarray(exclude_bands, int))
     o = obs.select(keep)
