@@ -262,3 +262,11 @@ def test_every_workflow_is_in_both_tables():
 
 def test_contributing_is_linked_from_the_readme():
     assert "CONTRIBUTING.md" in README
+
+
+def test_the_readme_lists_every_make_target():
+    makefile = (ROOT / "Makefile").read_text(encoding="utf-8")
+    targets = re.findall(r"^([a-z][a-z-]*):.*## ", makefile, re.M)
+    assert "test" in targets
+    missing = [t for t in targets if f"| `make {t}` |" not in README]
+    assert not missing, f"README.md's Targets table lacks: {missing}"
