@@ -290,7 +290,7 @@ def add_orthorectify(sub) -> argparse.ArgumentParser:
         "band, distortion, boresight, lever arm). RESULT: hsgeo adjust-pushbroom --json "
         "(camera parameters and node corrections). DSM: a GeoTIFF of ellipsoidal heights with "
         "an EPSG CRS, or a NetCDF height(N, E) in the local frame's metres; or --height, a "
-        f"plane. OUT: {raster_formats_text()}, with the bands' wavelengths and FWHM; "
+        f"plane. OUT ({raster_formats_text()}) with the bands' wavelengths and FWHM; "
         "tiles computed with Dask (--scheduler: on a dask.distributed cluster).",
     )
     p.add_argument("lines", nargs="+", metavar="LINES")

@@ -52,12 +52,12 @@ _ENVI = (".hdr",)
 
 def raster_formats_text() -> str:
     """The formats of :data:`RASTER_FORMATS` in words, for a command's help
-    (``.tif / .tiff (Cloud-Optimized GeoTIFF), .nc (NetCDF (CF-1.8)), ...``).
+    (``.tif / .tiff: Cloud-Optimized GeoTIFF; .nc: NetCDF (CF-1.8); ...``).
     """
     by: dict[str, list[str]] = {}
     for suffix, name in RASTER_FORMATS.items():
         by.setdefault(name, []).append(suffix)
-    return ", ".join(f"{' / '.join(sfx)} ({name})" for name, sfx in by.items())
+    return "; ".join(f"{' / '.join(sfx)}: {name}" for name, sfx in by.items())
 
 
 def envi_data_path(path_hdr) -> Path:
