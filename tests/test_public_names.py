@@ -75,7 +75,6 @@ FACADES = {
     "hsgeo.nist",
     "hsgeo.sensors",
     # split modules: the importers still use the former path
-    "hsgeo.reproduce.pushbroom_ba",  # -> hsgeo.reproduce.pushbroom_runs
     "hsgeo.simulate.pushbroom_campaign",  # -> pushbroom_campaign_types, error_processes
     "hsgeo.workflows.rikola",  # -> rikola_bands, rikola_joint
 }

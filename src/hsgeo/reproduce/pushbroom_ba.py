@@ -23,14 +23,10 @@ import numpy as np
 from hsgeo.errors import InputError
 from hsgeo.papers import P002, P002_STATS
 from hsgeo.report import Reproduction, Row
-from hsgeo.reproduce.pushbroom_runs import (  # re-exported: the public names of this chapter
-    FACTORS,
-    HEIGHT_OFFSET_M,
+from hsgeo.reproduce.pushbroom_runs import (
     MIN_FACTOR_SEEDS,
     RIPPLE_PX,
-    SIGMA_REF_IMAGE_PX,
     adjust_campaign,
-    camera_prior,
     check_point_factors,
     cp_errors,
     factor_rows,
@@ -51,37 +47,16 @@ from hsgeo.simulate.pushbroom_campaign import (
 from hsgeo.stats import describe
 from hsgeo.workflows.pushbroom_ba import (  # 002's settings, spelled once in the workflow
     BLOCK_NAMES,
-    FTOL,
-    REJECT_K,
     REPORTED_PARAMETERS,
-    Y_AS_TIME,
 )
 
 __all__ = [
     "run",
-    "adjust_campaign",
-    "camera_prior",
-    "cp_errors",
-    "pseudo_truth",
     "shift_rows",
     "outlier_detection",
-    "node_interval_study",
-    "check_point_factors",
     "table_spread",
-    "FACTORS",
-    "study_plan",
     "factor_produces",
     "interval_distribution_text",
-    # re-exported (hsgeo.reproduce.pushbroom_runs, hsgeo.workflows.pushbroom_ba)
-    "HEIGHT_OFFSET_M",
-    "SIGMA_REF_IMAGE_PX",
-    "MIN_FACTOR_SEEDS",
-    "RIPPLE_PX",
-    "interval_optima",
-    "optimum_interval",
-    "FTOL",
-    "REJECT_K",
-    "Y_AS_TIME",
     "EXTREMES_NOT_COMPARABLE",
     "c_minus_mean",
 ]
