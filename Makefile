@@ -127,10 +127,11 @@ dist: $(STAMP) ## build the hsgeo wheel into dist/ (pip wheel, offline)
 check-wheel: dist ## install the wheel into a fresh venv and run the README's commands from an empty folder
 	PYTHON=$(PYTHON) .ci/check_wheel.sh
 
-lint: $(STAMP) ## ruff check and format check, and the import contracts of the layout (GUIDE §2)
+lint: $(STAMP) ## ruff check and format check, the import contracts of the layout (GUIDE §2), no dead names (vulture)
 	$(VENV)/bin/ruff check src tests bench
 	$(VENV)/bin/ruff format --check src tests bench
 	$(VENV)/bin/lint-imports --no-cache
+	$(VENV)/bin/vulture src/hsgeo vulture_whitelist.py --min-confidence 60
 
 lock: ## re-resolve the environment from pyproject.toml and rewrite requirements.lock
 	rm -rf $(VENV)

@@ -50,7 +50,8 @@ CORES = {
 def scene(n_lines: int, n_px: int = 900):
     """Two rendered strips (numpy values), the terrain, the frame."""
     from hsgeo.crs import SITE_AAS as F
-    from hsgeo.ortho import MapGrid, MapTerrain, Strip
+    from hsgeo.mapgrid import MapGrid, MapTerrain
+    from hsgeo.ortho import Strip
     from hsgeo.sensors.pushbroom import PushbroomCamera
     from hsgeo.simulate.ortho_scene import SquaresScene, render_lines, straight_flight
 
@@ -97,7 +98,8 @@ def _ground(s, terrain):
 
 
 def _in_memory(strips, terrain, frame):
-    from hsgeo.ortho import MapGrid, resample_swath, strip_footprints
+    from hsgeo.mapgrid import MapGrid
+    from hsgeo.ortho import resample_swath, strip_footprints
 
     allb = np.concatenate(
         [strip_footprints(s, terrain, frame, 256, "EPSG:25832")[1] for s in strips]

@@ -41,9 +41,9 @@ def _problem(scale, seed, with_gcp=True, keep=None):
     the check points' rows and true coordinates are put in it (``cp_index``, ``cp_xyz_m``)
     and which observations carry a simulated gross error (``gross``) before the truth is
     dropped."""
-    from hsgeo.reproduce.pushbroom_ba import Y_AS_TIME, camera_prior
+    from hsgeo.reproduce.pushbroom_runs import camera_prior
     from hsgeo.simulate.pushbroom_campaign import CampaignConfig, simulate
-    from hsgeo.workflows.pushbroom_ba import build_problem
+    from hsgeo.workflows.pushbroom_ba import Y_AS_TIME, build_problem
 
     cfg = CampaignConfig()
     obs, truth = simulate(scale, rng=seed, cfg=cfg)

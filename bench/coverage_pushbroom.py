@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from hsgeo.reproduce.pushbroom_ba import adjust_campaign, cp_errors
+from hsgeo.reproduce.pushbroom_runs import adjust_campaign, cp_errors
 from hsgeo.simulate.pushbroom_campaign import CampaignConfig, simulate
 from hsgeo.stats import nmad
 

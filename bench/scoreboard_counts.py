@@ -18,10 +18,10 @@ import json
 from pathlib import Path
 
 from hsgeo.report import Reproduction
+from hsgeo.reproduce import paper_chapters
 from hsgeo.reproduce.scoreboard import (
     _PAPER_TABLE,
     NOT_CLAIMS,
-    PAPER_CHAPTERS,
     claims_with_chapters,
     counts,
     counts_by,
@@ -31,7 +31,7 @@ from hsgeo.reproduce.scoreboard import (
 
 def load(directory: Path, rejudge: bool) -> dict[str, Reproduction]:
     reps = {}
-    for chapter in PAPER_CHAPTERS:
+    for chapter in paper_chapters():
         path = directory / f"{chapter}.json"
         if not path.is_file() or path.stat().st_size == 0:  # absent, or still being written
             continue
@@ -59,7 +59,7 @@ def main() -> None:
     reps = load(args.directory, args.rejudge and not args.old)
     if args.old:
         rows = []
-        for c in PAPER_CHAPTERS:
+        for c in paper_chapters():
             for r in reps.get(c, Reproduction(c, 0, [])).rows:
                 if (
                     _PAPER_TABLE.match(r.table)

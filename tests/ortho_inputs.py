@@ -13,7 +13,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from hsgeo.crs import SITE_AAS
-from hsgeo.ortho import MapGrid, MapTerrain, Strip
+from hsgeo.mapgrid import MapGrid, MapTerrain
+from hsgeo.ortho import Strip
 from hsgeo.sensors.line import LinearIFOV, LineScanner
 from hsgeo.sensors.pushbroom import PushbroomCamera
 from hsgeo.simulate.ortho_scene import SquaresScene, lazy_cube, render_lines, straight_flight

@@ -29,6 +29,11 @@ def test_linear_matches_lstsq():
     np.testing.assert_allclose(res.sigma0, np.sqrt(s0sq) / 0.1, rtol=1e-10)
     assert res.converged and res.dof == t.size - 2
     assert p.value("ab").tolist() == [0.0, 0.0]  # input untouched
+    # the correlation of intercept and slope: t̄ > 0, so they are anti-correlated
+    C = s0sq * np.linalg.inv(A.T @ A)
+    rho = C[0, 1] / np.sqrt(C[0, 0] * C[1, 1])
+    np.testing.assert_allclose(res.correlation(), [[1.0, rho], [rho, 1.0]], rtol=1e-8)
+    assert rho < -0.8
 
 
 def test_nonlinear_matches_scipy():
@@ -542,8 +547,8 @@ def test_residual_block_roles_are_renamed_by_blocks():
 
 
 def test_sensor_blocks_declare_their_roles():
-    from hsgeo.geocode import BoresightGCP
     from hsgeo.sensors.frame import FrameOpenCV, FramePhotogrammetric
+    from hsgeo.sensors.line import BoresightGCP
     from hsgeo.sensors.line1d import LineObservations
     from hsgeo.sensors.pushbroom import BLOCK_NAMES, PushbroomLines
     from hsgeo.sensors.rikola import JointCentroids, TargetCentroids

@@ -9,15 +9,8 @@ import xarray as xr
 
 from hsgeo import ConvergenceError, InputError, ObservationError
 from hsgeo.adjust.checks import check_jacobian
-from hsgeo.geocode import (
-    BoresightGCP,
-    DemTerrain,
-    PlaneTerrain,
-    calibrate_boresight,
-    geocode_observations,
-    intersect,
-)
-from hsgeo.sensors.line import CalibratedLine, LinearIFOV
+from hsgeo.geocode import DemTerrain, PlaneTerrain, geocode_observations, intersect
+from hsgeo.sensors.line import BoresightGCP, CalibratedLine, LinearIFOV, calibrate_boresight
 from hsgeo.simulate.pula_flight import observe_gcps, simulate_flight
 from hsgeo.simulate.scenarios import load_scenario
 from hsgeo.trajectory import Trajectory

@@ -5,8 +5,9 @@ import pytest
 from ortho_inputs import FRAME, GSD_M, WAVELENGTH_NM, flight, squares_xy
 
 from hsgeo.errors import InputError, ObservationError
+from hsgeo.mapgrid import MapGrid, MapTerrain
 from hsgeo.measure.squares import square_centroids
-from hsgeo.ortho import MapGrid, MapTerrain, Strip, orthomosaic
+from hsgeo.ortho import Strip, orthomosaic
 
 
 def test_map_grid_cells_and_transform():

@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 from ortho_inputs import FRAME, GSD_M, SITE_ARGS, flight
 
-from hsgeo.ortho import MapGrid, Strip, orthomosaic
+from hsgeo.mapgrid import MapGrid
+from hsgeo.ortho import Strip, orthomosaic
 
 
 @pytest.fixture(scope="module")
@@ -69,8 +70,8 @@ def test_a_line_scanner_line_through_the_command(tmp_path, capsys):
     from hsgeo.cli import main
     from hsgeo.io import write_lines
     from hsgeo.io.navigation import write_trajectory
+    from hsgeo.mapgrid import MapTerrain
     from hsgeo.measure.squares import square_centroids
-    from hsgeo.ortho import MapTerrain
 
     fl = flight("line", length_m=120.0)
     s = fl.strips[0]
@@ -139,8 +140,8 @@ def test_a_panoramic_scanner_line_through_the_command(tmp_path, capsys):
     from hsgeo.io import read_sensor, write_lines
     from hsgeo.io.geotiff import write_geotiff
     from hsgeo.io.navigation import write_trajectory
+    from hsgeo.mapgrid import MapTerrain
     from hsgeo.measure.squares import square_centroids
-    from hsgeo.ortho import MapTerrain
     from hsgeo.simulate.ortho_scene import render_lines
 
     ifov_deg = float(np.degrees(GSD_M / (HEIGHT_M + 100.0)))

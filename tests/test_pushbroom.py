@@ -6,10 +6,10 @@ import pytest
 from hsgeo import InputError
 from hsgeo.adjust import adjust, identifiability
 from hsgeo.adjust.checks import analytic_jacobian, check_jacobian
-from hsgeo.sensors.pushbroom import PushbroomLines
+from hsgeo.sensors.pushbroom import PushbroomLines, PushbroomObservations
 from hsgeo.simulate.pushbroom_campaign import CampaignConfig, CampaignObservations, simulate
 from hsgeo.stats import nmad
-from hsgeo.workflows.pushbroom_ba import CameraPrior, PushbroomObservations, build_problem
+from hsgeo.workflows.pushbroom_ba import CameraPrior, build_problem
 
 CFG = CampaignConfig()
 

@@ -30,6 +30,8 @@ def test_fit_dark_matches_polyfit_with_covariance():
         assert m.sigma_a_dn_per_s[i, j] == pytest.approx(np.sqrt(cov[0, 0]), rel=1e-8)
         assert m.sigma_b_dn[i, j] == pytest.approx(np.sqrt(cov[1, 1]), rel=1e-8)
         assert m.cov_ab[i, j] == pytest.approx(cov[0, 1], rel=1e-8)
+        res = frames[:, i, j] - np.polyval(p, t)  # σ0: the residuals' σ, n − 2 dof
+        assert m.sigma0_dn[i, j] == pytest.approx(np.sqrt(res @ res / (t.size - 2)), rel=1e-8)
     assert m.predict(0.2).shape == (6, 7)
 
 
@@ -134,3 +136,10 @@ def test_vegetation_indices_by_hand_and_delta_method():
         assert sv == pytest.approx(np.std(mc), rel=0.1), name
     with pytest.raises(InputError, match="needs reflectance"):
         R.vegetation_index("NDVI", lam[:4], s[:4])
+
+
+def test_every_index_formula_names_the_wavelengths_it_uses():
+    for name, ix in R.INDICES.items():
+        assert ix.name == name and ix.source
+        shown = {float(w) for w in __import__("re").findall(r"R(\d+)", ix.formula)}
+        assert shown == set(ix.wavelengths_nm), (name, ix.formula)

@@ -11,19 +11,19 @@ import pandas as pd
 import pytest
 
 from hsgeo.papers import P002_STATS
-from hsgeo.reproduce import CHAPTERS, chapter_names
+from hsgeo.reproduce import CHAPTERS, chapter_names, paper_chapters
 from hsgeo.reproduce.lp_judge import match_errors_px, observation_errors_px, within_fractions
 from hsgeo.reproduce.lp_observations import SIM_SCALE_AT_1, run, sim_scale, stat_sigma
-from hsgeo.reproduce.scoreboard import CHAPTER_DOCS, PAPER_CHAPTERS
 from hsgeo.simulate.lp_campaign import MIN_SCALE
 
 SMALL = 0.3  # renders 0.105 of the block side, 1.1 % of the campaign
 
 
 def test_registered_and_scale_mapping():
-    assert CHAPTERS["lp-observations"] == "lp_observations"
+    assert CHAPTERS["lp-observations"].module == "lp_observations"
     assert "lp-observations" in chapter_names()
-    assert "lp-observations" in PAPER_CHAPTERS and "lp-observations" in CHAPTER_DOCS
+    assert "lp-observations" in paper_chapters()
+    assert CHAPTERS["lp-observations"].page == "chapters/lp_observations"
     assert sim_scale(1.0) == SIM_SCALE_AT_1 == 0.35
     assert sim_scale(0.5) == pytest.approx(0.175)
     assert sim_scale(0.01) == MIN_SCALE

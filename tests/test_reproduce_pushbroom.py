@@ -7,14 +7,8 @@ import pytest
 
 from hsgeo import InputError
 from hsgeo.papers import P002, P002_STATS
-from hsgeo.reproduce.pushbroom_ba import (
-    EXTREMES_NOT_COMPARABLE,
-    _stats_rows,
-    adjust_campaign,
-    cp_errors,
-    pseudo_truth,
-    table_spread,
-)
+from hsgeo.reproduce.pushbroom_ba import EXTREMES_NOT_COMPARABLE, _stats_rows, table_spread
+from hsgeo.reproduce.pushbroom_runs import adjust_campaign, cp_errors, pseudo_truth
 from hsgeo.simulate.pushbroom_campaign import CampaignConfig, simulate
 from hsgeo.stats import describe
 from hsgeo.workflows.pushbroom_ba import REPORTED_PARAMETERS

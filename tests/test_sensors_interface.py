@@ -6,9 +6,8 @@ import pytest
 
 from hsgeo import InputError
 from hsgeo.distortion import distort_pushbroom_line
-from hsgeo.geocode import ray_directions
 from hsgeo.rotations import R_from_opk, R_from_rpy
-from hsgeo.sensors.line import CalibratedLine, LinearIFOV, LineScanner
+from hsgeo.sensors.line import CalibratedLine, LinearIFOV, LineScanner, ray_directions
 from hsgeo.sensors.mount import Mount, Sensor
 from hsgeo.sensors.pushbroom import (
     BETA0_CAM_FROM_PLATFORM,

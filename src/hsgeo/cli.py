@@ -17,7 +17,7 @@ from hsgeo import terminal
 from hsgeo.errors import ConvergenceError, HsgeoError, InputError
 from hsgeo.terminal import json_text
 
-__all__ = ["main", "EXIT_INTERRUPTED", "EXIT_BROKEN_PIPE"]
+__all__ = ["main", "EXIT_INTERRUPTED", "EXIT_BROKEN_PIPE", "build_parser"]
 
 #: Exit status after Ctrl-C (128 + SIGINT, as a shell reports it).
 EXIT_INTERRUPTED = 130
@@ -91,7 +91,7 @@ def _cmd_data(args) -> int:
 
 
 def _data_flight(args) -> int:
-    """``hsgeo data flight --site LAT,LON --out DIR`` (issue 38)."""
+    """``hsgeo data flight --site LAT,LON --out DIR``: a flight in a real one's formats."""
     import shlex
 
     from hsgeo.io.flight_files import check_flight_outputs, orthorectify_command, write_flight
@@ -401,7 +401,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _json_error(command: str | None, message: str, status: int) -> None:
-    """With ``--json``, every exit path prints one JSON object on standard output (issue 42):
+    """With ``--json``, every exit path prints one JSON object on standard output (one shape):
     a failure is ``{"command", "ok": false, "exit_status", "error"}``, the same line as on
     standard error (which keeps it too).
     """

@@ -10,7 +10,24 @@ import argparse
 
 from hsgeo.validate import option_number
 
-__all__ = ["HsgeoParser", "root_parser", "SUBCOMMANDS"]
+__all__ = [
+    "HsgeoParser",
+    "root_parser",
+    "SUBCOMMANDS",
+    "add_reproduce",
+    "add_calibrate_line",
+    "add_calibrate_frame",
+    "add_data",
+    "add_orthorectify",
+    "add_adjust_pushbroom",
+    "add_lp_observations",
+    "add_adjust_bal",
+    "add_mtf",
+    "add_mtf_edge",
+    "add_cube",
+    "add_asf",
+    "add_versions",
+]
 
 _POSITIVE = option_number(positive=True)
 
@@ -178,7 +195,7 @@ def add_data(sub) -> argparse.ArgumentParser:
 
 
 def _data_flight_options(p) -> None:
-    """``hsgeo data flight --site LAT,LON --out DIR``: a simulated flight (issue 38)."""
+    """``hsgeo data flight --site LAT,LON --out DIR``: a simulated flight."""
     p.add_argument(
         "what",
         nargs="?",
@@ -228,7 +245,7 @@ def _wavelengths(text: str) -> tuple:
 
 
 def _line_times_option(p) -> None:
-    """``--line-times``: the times files of ENVI LINES cubes (issue 38)."""
+    """``--line-times``: the times files of ENVI LINES cubes."""
     p.add_argument(
         "--line-times",
         action="append",
@@ -244,6 +261,8 @@ def _line_times_option(p) -> None:
 
 def add_orthorectify(sub) -> argparse.ArgumentParser:
     """``hsgeo orthorectify``."""
+    from hsgeo.io.raster import RASTER_FORMATS, raster_formats_text
+
     p = sub.add_parser(
         "orthorectify",
         help="orthorectify one line or mosaic many strips of any scanning sensor onto a map "
@@ -271,8 +290,7 @@ def add_orthorectify(sub) -> argparse.ArgumentParser:
         "band, distortion, boresight, lever arm). RESULT: hsgeo adjust-pushbroom --json "
         "(camera parameters and node corrections). DSM: a GeoTIFF of ellipsoidal heights with "
         "an EPSG CRS, or a NetCDF height(N, E) in the local frame's metres; or --height, a "
-        "plane. OUT: .tif (Cloud-Optimized GeoTIFF), .nc (CF-1.8 NetCDF) or .hdr (ENVI; the "
-        "data file beside it without extension), with the bands' wavelengths and FWHM; "
+        f"plane. OUT ({raster_formats_text()}) with the bands' wavelengths and FWHM; "
         "tiles computed with Dask (--scheduler: on a dask.distributed cluster).",
     )
     p.add_argument("lines", nargs="+", metavar="LINES")
@@ -288,7 +306,11 @@ def add_orthorectify(sub) -> argparse.ArgumentParser:
     )
     p.add_argument("--adjustment", metavar="RESULT.json", help="hsgeo adjust-pushbroom --json")
     p.add_argument(
-        "-o", "--output", required=True, metavar="OUT", help="OUT.tif, OUT.nc or OUT.hdr"
+        "-o",
+        "--output",
+        required=True,
+        metavar="OUT",
+        help="OUT" + ", OUT".join(RASTER_FORMATS) + " (the format by the suffix)",
     )
     p.add_argument(
         "--resolution",

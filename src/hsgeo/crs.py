@@ -48,6 +48,7 @@ __all__ = [
     "parse_crs",
     "geographic_3d_crs",
     "use_system_proj_grids",
+    "SYSTEM_PROJ_DATA",
 ]
 
 #: ETRS89 geographic 3D (longitude, latitude, ellipsoidal height).
@@ -227,14 +228,6 @@ class LocalFrame:
             return np.asarray(E), np.asarray(N), np.asarray(U)
         lon, lat, h = self._transformers()[1].transform(x, y, z, direction=inv)
         return self.lonlat_to_enu(lon, lat, h)
-
-    def map_to_lonlat(self, x_m, y_m):
-        """ETRS89 longitude, latitude (degrees) of map coordinates."""
-        from pyproj.enums import TransformDirection
-
-        x, y = np.broadcast_arrays(np.asarray(x_m, float), np.asarray(y_m, float))
-        lon, lat = self._transformers()[1].transform(x, y, direction=TransformDirection.INVERSE)
-        return np.asarray(lon), np.asarray(lat)
 
     # ---- a frame chosen from the data -------------------------------------------------------
     @classmethod

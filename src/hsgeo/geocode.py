@@ -10,10 +10,8 @@ intersected with a plane of constant height in closed form, or with a DEM or DSM
 crossing (:func:`intersect`): the compiled grid traversal of :mod:`hsgeo._raycast`, the one
 intersection of every command and every simulator's renderer.
 
-The 000 line scanner's geometries (``LineGeometry``, ``LinearIFOV``, ``CalibratedLine``,
-``ray_directions``) and its GCP boresight calibration (``BoresightGCP``,
-``calibrate_boresight``) live in :mod:`hsgeo.sensors.line`; they are re-exported here for
-existing callers.
+The 000 line scanner's geometries and its GCP boresight calibration live in
+:mod:`hsgeo.sensors.line`.
 """
 
 from __future__ import annotations
@@ -32,27 +30,14 @@ from hsgeo._raycast import (
 )
 from hsgeo.errors import InputError, ObservationError
 from hsgeo.sensors import as_sensor
-from hsgeo.sensors.line import (
-    BoresightGCP,
-    CalibratedLine,
-    LinearIFOV,
-    LineGeometry,
-    calibrate_boresight,
-    ray_directions,
-)
 
 __all__ = [
-    "LineGeometry",
-    "LinearIFOV",
-    "CalibratedLine",
     "PlaneTerrain",
     "DemTerrain",
     "intersect",
-    "ray_directions",
     "geocode_rays",
     "geocode_observations",
-    "BoresightGCP",
-    "calibrate_boresight",
+    "cast_rays",
 ]
 
 

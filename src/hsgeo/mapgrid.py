@@ -1,7 +1,7 @@
 """A north-up map grid in a projected CRS, and a DSM on such a grid for rays in the local frame.
 
 :class:`MapGrid` is the output grid of :mod:`hsgeo.ortho` (and a DSM's grid): cell edges, cell
-size, the affine transform GDAL writes, pyresample's ``AreaDefinition``. :class:`MapTerrain` is
+size, the affine transform GDAL writes. :class:`MapTerrain` is
 a DSM in the map CRS offered as the terrain of :func:`hsgeo.geocode.intersect` (heights in the
 local east-north-up frame of :class:`hsgeo.crs.LocalFrame`).
 """
@@ -99,20 +99,6 @@ class MapGrid:
         r = self.resolution_m
         return MapGrid(
             self.x_min_m + col0 * r, self.y_max_m - row0 * r, r, col1 - col0, row1 - row0, self.crs
-        )
-
-    def area_definition(self):
-        """The grid as a :class:`pyresample.geometry.AreaDefinition`."""
-        from pyresample.geometry import AreaDefinition
-
-        return AreaDefinition(
-            "hsgeo_grid",
-            "hsgeo map grid",
-            "hsgeo_crs",
-            self.crs,
-            self.width,
-            self.height,
-            self.extent_m,
         )
 
 

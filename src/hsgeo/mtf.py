@@ -63,6 +63,7 @@ __all__ = [
     "BarTarget",
     "mtf_from_esf",
     "crossing_frequency",
+    "K_MAX",
 ]
 
 #: Harmonics kept by default in the series: odd k up to this (beyond, the terms are < 1/K_MAX).

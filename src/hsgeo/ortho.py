@@ -36,11 +36,9 @@ import numpy as np
 
 from hsgeo.errors import InputError
 from hsgeo.geocode import intersect
-from hsgeo.mapgrid import MapGrid, MapTerrain
+from hsgeo.mapgrid import MapGrid
 
 __all__ = [
-    "MapGrid",
-    "MapTerrain",
     "Strip",
     "geolocate_lines",
     "strip_footprints",

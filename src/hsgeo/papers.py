@@ -37,6 +37,7 @@ __all__ = [
     "RIKOLA_TABLE4_ROP_DEG",
     "RIKOLA_TABLE4_GAP_MODEL",
     "band_table",
+    "ASF_004",
 ]
 
 
@@ -411,7 +412,4 @@ P001_CUBE = {
     "source": "001 §2.1, Table 1, §3.2",
 }
 
-#: 001 §3.2: the irrigation variants of the Jadrtovac trial, share of the vines' water need (ET).
-P001_VARIANTS = {"A": 0.50, "B": 0.75, "C": 1.00, "control": 0.0}
-
-__all__ += ["P001_CUBE", "P001_VARIANTS"]
+__all__ += ["P001_CUBE"]

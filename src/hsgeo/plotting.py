@@ -2,7 +2,7 @@
 
 Kept as one file: one concern, matplotlib figures that take and return an Axes and compute
 nothing a chapter reports. The split into ``plotting/`` per chapter (GUIDE §2) was left for
-after issue 21: its 003 (Rikola) functions were being changed in parallel.
+later: its 003 (Rikola) functions were being changed in parallel.
 """
 
 from __future__ import annotations
@@ -31,6 +31,11 @@ __all__ = [
     "solver_scaling",
     "plot_lp_compensation",
     "plot_lp_mosaic",
+    "verdict_bars",
+    "stats_vs_paper",
+    "checkpoint_heights",
+    "per_band_values",
+    "against_interval",
 ]
 
 
@@ -272,7 +277,7 @@ def verdict_bars(ax, per_paper):
     ax.legend(loc="lower right", fontsize=9, frameon=False)
 
 
-# ---- chapters frame_reference and rikola (issue 13): residuals binned over the image and
+# ---- chapters frame_reference and rikola: residuals binned over the image and
 # ---- against wavelength, z-scores with ±1 bars, the relative orientation per band pair
 __all__ += ["iop_against_wavelength", "gcp_deviation_map"]
 __all__ += ["bin_residuals", "binned_residuals", "z_errorbars", "rop_per_pair", "residuals_by_band"]
@@ -589,7 +594,7 @@ def displacement_vs_pixel(ax, zeta_px, displacement_m, *, label=None, color=None
     return ax
 
 
-# ---- chapter pushbroom_ba (issue 13): 002 Tables 1-3 against the paper with ±σ̂ spread, the
+# ---- chapter pushbroom_ba: 002 Tables 1-3 against the paper with ±σ̂ spread, the
 # ---- check-point heights, the per-band principal distances, the node-interval study, factors
 
 

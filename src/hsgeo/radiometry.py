@@ -53,6 +53,7 @@ __all__ = [
     "asf_ratio",
     "even_odd_parts",
     "combine_opposite_crossings",
+    "FULL_SCALE_DN",
 ]
 
 
@@ -157,12 +158,6 @@ class DarkModel:
     def predict(self, exposure_s: float) -> np.ndarray:
         """The dark value h = a·T_exp + b to subtract at this exposure time (001 §2.4)."""
         return self.a_dn_per_s * exposure_s + self.b_dn  # 001 §2.4, h_bg,ij = a_ij·T_exp + b_ij
-
-    def sigma_predict(self, exposure_s: float) -> np.ndarray:
-        """σ̂ of :meth:`predict` (from σ̂_a, σ̂_b and their covariance)."""
-        t = exposure_s
-        var = self.sigma_a_dn_per_s**2 * t * t + 2 * t * self.cov_ab + self.sigma_b_dn**2
-        return np.sqrt(np.maximum(var, 0.0))
 
 
 def fit_dark(frames_dn: Iterable, exposure_s) -> DarkModel:

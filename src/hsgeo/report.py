@@ -63,6 +63,9 @@ __all__ = [
     "as_text",
     "glue_text",
     "from_estimates",
+    "VERDICT_MEANING",
+    "true_minus",
+    "with_data_labels",
 ]
 
 #: The verdicts of a claim (ReScience style). ``by construction``: the truth (or the outcome) is
@@ -761,7 +764,7 @@ class Reproduction:
                 truth=r["truth"],
                 n_runs=r.get("n_runs"),
                 # as judged when written (the same numbers: an override stays one, a computed
-                # verdict equals Row.rule's); "tuned" was the verdict's name before issue 22
+                # verdict equals Row.rule's); "tuned" is the former name of "by construction"
                 verdict=_stored_verdict(r),
                 reason=_stored_reason(r),
                 provenance=r.get("provenance"),
@@ -877,7 +880,7 @@ class Reproduction:
 
 def _stored_verdict(r: dict) -> str | None:
     """The verdict of a row as written by :meth:`Reproduction.to_json` ("tuned" was the verdict's
-    name before issue 22; "context" is recomputed from ``judged_in``).
+    former name, read as "by construction"; "context" is recomputed from ``judged_in``).
     """
     v = {"tuned": "by construction"}.get(r.get("verdict"), r.get("verdict"))
     return None if v == "context" else v

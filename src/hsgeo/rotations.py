@@ -49,6 +49,7 @@ __all__ = [
     "skew",
     "R_small",
     "R_photogrammetric_from_opencv_cam",
+    "ORTHONORMALITY_TOL",
 ]
 
 #: The fixed rotation from north-east-down to east-north-up (E = N_ned[1], N = N_ned[0],

@@ -31,7 +31,18 @@ from numpy.typing import ArrayLike, NDArray
 
 from hsgeo.errors import InputError, ObservationError
 
-__all__ = ["bias", "std", "rms", "nmad", "describe", "describe_table", "lre", "NMAD_SCALE"]
+__all__ = [
+    "bias",
+    "std",
+    "rms",
+    "nmad",
+    "describe",
+    "describe_table",
+    "lre",
+    "NMAD_SCALE",
+    "STATISTICS",
+    "NanPolicy",
+]
 
 #: 1 / Φ⁻¹(3/4): makes the NMAD a consistent estimator of σ for normal data.
 NMAD_SCALE = 1.4826

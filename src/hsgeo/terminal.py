@@ -35,6 +35,7 @@ __all__ = [
     "progress_counter",
     "clear_progress",
     "json_text",
+    "strict_values",
 ]
 
 #: ASCII spellings of the non-ASCII characters hsgeo's reports use.

@@ -80,6 +80,7 @@ __all__ = [
     "corrected_trajectory",
     "bspline_basis",
     "bspline_basis_derivative",
+    "CORRECTION_COLUMNS",
 ]
 
 #: Names of the six corrections per node, in order (positions E, N, U; platform angles).

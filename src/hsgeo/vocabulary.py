@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import re
 
-__all__ = ["LABELS", "UNITS", "WORDS", "quantity_label", "unit_label", "display_unit"]
+__all__ = ["LABELS", "UNITS", "WORDS", "quantity_label", "unit_label", "display_unit", "CONTEXTS"]
 
 _SUP = str.maketrans(
     "-0123456789", "\u207b\u2070\u00b9\u00b2\u00b3\u2074\u2075\u2076\u2077\u2078\u2079"

@@ -20,9 +20,7 @@ import numpy as np
 
 from hsgeo.stats import NMAD_SCALE
 
-__all__: list[str] = []
-
-LOSSES = ("cauchy", "huber")
+__all__: list[str] = ["rho", "scale", "weigh"]
 
 
 def rho(kind: str, s: np.ndarray, c: float) -> tuple[np.ndarray, np.ndarray]:

@@ -94,7 +94,7 @@ class SolverOptions:
         iteration until the first settled iterate, then with least squares (and the outlier
         rejection, if any) to the minimum: gross errors cannot throw their points before
         they are tested. The minimum is that of least squares either way. ``None``: least
-        squares throughout. On the 002 pushbroom block (issue 29) it took 6 iterations
+        squares throughout. On the 002 pushbroom block it took 6 iterations
         against 4 at the paper's size and, with the rejection, rejected 301 good observations
         against 66 (1,060 of 1,304 gross errors against 1,175): the workflow does not use it.
     robust_start_k : float, default 3.0

@@ -25,7 +25,7 @@ from scipy.linalg import lapack
 from hsgeo.adjust.options import SolverOptions
 from hsgeo.adjust.system import _Clock, _Layout, _System
 
-__all__: list[str] = []
+__all__: list[str] = ["NULL_SHARE"]
 
 
 @dataclass

@@ -77,7 +77,7 @@ from hsgeo.adjust.system import _Clock, _evaluate, _Layout, _NonFinite, _System
 from hsgeo.adjust.threads import engine_threads
 from hsgeo.errors import ConvergenceError, DatumError, InputError, ObservationError
 
-__all__ = ["adjust"]
+__all__ = ["adjust", "HOLD_MAX", "THROWN_SHARE", "THROWN_RATIO", "progress_text"]
 
 
 def adjust(
@@ -614,7 +614,7 @@ class _Solve:
         decrease the cost by orders of magnitude and still throw a few weakly intersected
         points far off (at 7× the paper's pushbroom block: a cost 15 times the next
         iterate's); the following steps are then refused because of them, the damping grows
-        by orders of magnitude and decays over many iterations (issue 29).
+        by orders of magnitude and decays over many iterations.
         """
         held = self._hold_points(sy, ne, trial, state, cost, dc, dp, min_share=THROWN_SHARE)
         if held is not None and held[0].cost < trial.cost:
@@ -713,7 +713,7 @@ class _Solve:
         except (np.linalg.LinAlgError, sla.LinAlgError) as exc:
             # a datum defect that appeared during the iterations (e.g. every observation of a
             # parameter rejected): the estimable part keeps its covariance, the rest is named
-            # (issue 42); SolverOptions.strict_covariance raises instead
+            # rather than the whole solve failing; SolverOptions.strict_covariance raises instead
             S_inv, bad, defect = _reduced_estimable_inverse(layout, ne)
             undetermined = [layout.labels_c[i] for i in bad]
             if self.options.strict_covariance or not bad.size:

@@ -140,10 +140,6 @@ class _RowJac:
     def shape(self):
         return (self.cols.shape[0], self.n_cols)
 
-    def _safe_cols(self):
-        # index n_cols (an appended zero) for the empty slots
-        return np.where(self.cols >= 0, self.cols, self.n_cols)
-
     def matvec(self, x: np.ndarray) -> np.ndarray:
         from hsgeo.adjust._fast import matvec
 

@@ -1,4 +1,4 @@
-"""How many threads the engine's compiled kernels and BLAS use, chosen by the work (issue 20).
+"""How many threads the engine's compiled kernels and BLAS use, chosen by the work.
 
 A parallel region of the compiled kernels (numba's OpenMP layer) costs a few microseconds on an
 idle machine, but when another process holds a core the second thread has to wait for it to
@@ -38,7 +38,15 @@ from collections.abc import Iterator
 
 import numba
 
-__all__ = ["PARALLEL_MIN_ROWS", "MAX_CHUNKS", "resolve", "engine_threads", "blas_threads"]
+__all__ = [
+    "PARALLEL_MIN_ROWS",
+    "MAX_CHUNKS",
+    "resolve",
+    "engine_threads",
+    "blas_threads",
+    "pool_size",
+    "chunks",
+]
 
 #: Residual rows (observation components, priors included) from which ``threads="auto"`` runs
 #: the compiled kernels in parallel. Measured with bench/bench_busy_machine.py (2026-11-24,

@@ -10,6 +10,13 @@ from numpy.typing import ArrayLike, NDArray
 from hsgeo.distortion._common import _as_float, _broadcast
 from hsgeo.errors import ConvergenceError, InputError
 
+__all__: list[str] = [
+    "odd_radial_1d",
+    "odd_radial_1d_jacobian",
+    "ideal_from_measured_1d",
+    "measured_from_ideal_1d",
+]
+
 # --------------------------------------------------------------------------- 1D odd radial
 
 

@@ -10,6 +10,8 @@ from numpy.typing import ArrayLike, NDArray
 from hsgeo.distortion._common import _as_float, _as_last, _broadcast, _newton_invert, _stack22
 from hsgeo.errors import InputError
 
+__all__: list[str] = ["distort_opencv", "distort_opencv_jacobian", "undistort_opencv"]
+
 # --------------------------------------------------------------------------- OpenCV form
 
 

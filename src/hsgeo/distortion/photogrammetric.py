@@ -10,6 +10,13 @@ from numpy.typing import ArrayLike, NDArray
 from hsgeo.distortion._common import _as_float, _as_last, _broadcast, _newton_invert, _stack22
 from hsgeo.errors import InputError
 
+__all__: list[str] = [
+    "brown_correction",
+    "brown_correction_jacobian",
+    "ideal_from_measured_mm",
+    "measured_from_ideal_mm",
+]
+
 # --------------------------------------------------------------------------- photogrammetric
 
 

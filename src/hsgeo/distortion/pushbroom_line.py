@@ -9,6 +9,12 @@ from hsgeo._kernels import pushbroom_line_distortion_dcoeff_rows, pushbroom_line
 from hsgeo.distortion._common import _as_float, _as_last, _broadcast, _newton_invert, _stack22
 from hsgeo.errors import InputError
 
+__all__: list[str] = [
+    "distort_pushbroom_line",
+    "distort_pushbroom_line_jacobian",
+    "undistort_pushbroom_line",
+]
+
 # --------------------------------------------------------------------------- 002 line form
 
 

@@ -21,7 +21,7 @@ import numpy as np
 
 from hsgeo.errors import InputError
 
-__all__ = ["BALProblem", "read_bal", "ladybug_path", "CAMERA_COLUMNS"]
+__all__ = ["BALProblem", "read_bal", "ladybug_path", "CAMERA_COLUMNS", "MAX_XY_PX"]
 
 #: The 9 parameters of a BAL camera, in file order.
 CAMERA_COLUMNS = ("rx_rad", "ry_rad", "rz_rad", "tx", "ty", "tz", "f_px", "k1", "k2")

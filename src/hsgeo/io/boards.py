@@ -27,7 +27,14 @@ from pathlib import Path
 from hsgeo.errors import InputError
 from hsgeo.io.config import Key, read_config
 
-__all__ = ["Board", "OPENCV_TUTORIAL_CHARUCO", "LENGTH_UNITS_MM", "BOARD_SCHEMA", "read_board"]
+__all__ = [
+    "Board",
+    "OPENCV_TUTORIAL_CHARUCO",
+    "LENGTH_UNITS_MM",
+    "BOARD_SCHEMA",
+    "read_board",
+    "BOARD_TYPES",
+]
 
 #: Length units OpenCV can be given the board in, in mm.
 LENGTH_UNITS_MM = {"mm": 1.0, "m": 1000.0}

@@ -91,7 +91,7 @@ def write_cube(ds, path, *, inputs=(), progress=None) -> list[Path]:
         # every other variable in memory before the write (they are small: lines × bands):
         # with more than one Dask-backed variable, the order in which the delayed store
         # computes them, and so where each lands in the file, varied from run to run (the
-        # same content in different bytes in 1 of 6 runs, issue 42)
+        # same content in different bytes in 1 of 6 runs)
         for name in list(out.data_vars) + list(out.coords):
             if name != "reflectance" and isinstance(out[name].data, da.Array):
                 # synchronous: a thread pool would receive the SIGINT that atomic_path holds
@@ -143,11 +143,11 @@ def _compute_with_progress(delayed, progress, n_lines):
     from dask.callbacks import Callback
 
     class _Cb(Callback):
-        def _start_state(self, dsk, state):
+        def _start_state(self, _dsk, state):  # dask's Callback protocol
             self._total = max(1, len(state["ready"]) + len(state["waiting"]))
             self._done = 0
 
-        def _posttask(self, key, result, dsk, state, worker_id):
+        def _posttask(self, key, result, _dsk, state, _worker_id):
             self._done += 1
             progress(min(n_lines, int(n_lines * self._done / self._total)), n_lines)
 

@@ -1,4 +1,4 @@
-"""Reading ENVI cubes as line scanners write them (issue 38): the header found under either
+"""Reading ENVI cubes as line scanners write them: the header found under either
 naming, BIL/BIP/BSQ in either byte order after a ``header offset``, memory-mapped (a cube of
 hundreds of GB is never read whole), wavelengths in nm, and the line times.
 
@@ -41,6 +41,8 @@ __all__ = [
     "line_times",
     "open_envi",
     "read_envi_header",
+    "READ_TYPES",
+    "DATA_EXTS",
 ]
 
 #: ENVI ``data type`` codes hsgeo reads (complex types 6 and 9 are refused).

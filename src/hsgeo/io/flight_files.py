@@ -1,6 +1,6 @@
 """The files of a simulated flight, in the formats a real flight delivers them.
 
-What ``hsgeo data flight`` writes (:mod:`hsgeo.simulate.geo_flight`, issue 38):
+What ``hsgeo data flight`` writes (:mod:`hsgeo.simulate.geo_flight`):
 
 ==================  =======================================================================
 ``lines.raw``       the line scanner's ENVI cube, BIL, float32, header ``lines.raw.hdr``
@@ -29,7 +29,7 @@ import numpy as np
 
 from hsgeo.errors import InputError
 
-__all__ = ["FLIGHT_FILES", "write_flight"]
+__all__ = ["FLIGHT_FILES", "write_flight", "orthorectify_command", "check_flight_outputs"]
 
 FLIGHT_FILES = (
     "lines.raw",

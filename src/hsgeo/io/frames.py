@@ -73,8 +73,8 @@ _OTHER_FRAME_SUFFIXES = (".hdr", ".raw", ".img", ".bsq", ".bil", ".bip", ".png",
 
 def _check_frame_names(folder: Path, files: list, what: str) -> None:
     """The frame files are one numbered series: one name pattern, no number missing, and no
-    frames in another format beside them (issue 42: a lost frame, a stray file or ENVI frames
-    were taken silently).
+    frames in another format beside them (a lost frame, a stray file or ENVI frames would
+    otherwise be taken silently).
     """
     import re
 

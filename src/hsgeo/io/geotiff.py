@@ -25,7 +25,7 @@ import numpy as np
 from hsgeo.errors import InputError
 from hsgeo.io._files import atomic_path, check_input_file, check_outputs
 
-__all__ = ["write_cog", "read_dsm", "write_geotiff", "GEOTIFF_FORMATS"]
+__all__ = ["write_cog", "read_dsm", "write_geotiff", "GEOTIFF_FORMATS", "GDAL_CACHE_MB"]
 
 GEOTIFF_FORMATS = {".tif": "GeoTIFF", ".tiff": "GeoTIFF"}
 #: GDAL's block cache while writing, MiB (its default, 5 % of the RAM, would grow with it).
@@ -200,7 +200,7 @@ def read_dsm(path, option: str = "--dsm"):
     -------
     height_m : (rows, cols) float ndarray
         North first; nodata cells are NaN.
-    grid : hsgeo.ortho.MapGrid
+    grid : hsgeo.mapgrid.MapGrid
     """
     import rasterio
     from rasterio.errors import RasterioIOError

@@ -13,7 +13,7 @@ import numpy as np
 from hsgeo.errors import InputError
 from hsgeo.io._files import atomic_path
 
-__all__ = ["read_lines", "write_lines", "line_file_kind", "read_band_widths"]
+__all__ = ["read_lines", "write_lines", "line_file_kind", "read_band_widths", "open_netcdf"]
 
 
 def open_netcdf(path, variable: str, what: str, remedy: str):

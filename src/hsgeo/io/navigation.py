@@ -58,6 +58,17 @@ __all__ = [
     "read_navigation",
     "read_trajectory",
     "write_trajectory",
+    "NAV_LIMITS",
+    "MAX_RATE_DEG_S",
+    "MAX_SPEED_M_S",
+    "SECONDS_PER_WEEK",
+    "SECONDS_PER_DAY",
+    "TIME_COLUMNS",
+    "GEODETIC_COLUMNS",
+    "GEOCENTRIC_COLUMNS",
+    "ATTITUDE_COLUMNS",
+    "MAX_HEADING_COURSE_DEG",
+    "COURSE_MIN_SPEED_M_S",
 ]
 
 #: Columns of the navigation file, in the order the writer uses.

@@ -29,7 +29,16 @@ from hsgeo.errors import InputError
 from hsgeo.io._files import atomic_path, check_outputs
 from hsgeo.io.lines import open_netcdf
 
-__all__ = ["write_raster", "read_dem", "raster_outputs", "RASTER_FORMATS", "envi_data_path"]
+__all__ = [
+    "write_raster",
+    "read_dem",
+    "raster_outputs",
+    "RASTER_FORMATS",
+    "RASTER_WRITERS",
+    "raster_formats_text",
+    "envi_data_path",
+    "cf_dataset",
+]
 
 #: The formats :func:`write_raster` writes, by the output's suffix.
 RASTER_FORMATS = {
@@ -38,8 +47,17 @@ RASTER_FORMATS = {
     ".nc": "NetCDF (CF-1.8)",
     ".hdr": "ENVI (header; the data file beside it has no extension)",
 }
-_NETCDF = (".nc",)
 _ENVI = (".hdr",)
+
+
+def raster_formats_text() -> str:
+    """The formats of :data:`RASTER_FORMATS` in words, for a command's help
+    (``.tif / .tiff: Cloud-Optimized GeoTIFF; .nc: NetCDF (CF-1.8); ...``).
+    """
+    by: dict[str, list[str]] = {}
+    for suffix, name in RASTER_FORMATS.items():
+        by.setdefault(name, []).append(suffix)
+    return "; ".join(f"{' / '.join(sfx)}: {name}" for name, sfx in by.items())
 
 
 def envi_data_path(path_hdr) -> Path:
@@ -81,20 +99,14 @@ def write_raster(
     list of Path
         The files written.
     """
-    from hsgeo.io.geotiff import write_cog
-
     inputs = [p for p in inputs if p is not None]
     check_outputs(raster_outputs(path, RASTER_FORMATS, option), inputs, overwrite=overwrite)
     if da.dims != ("band", "y", "x"):
         raise InputError(f"a map raster must have dimensions (band, y, x), got {da.dims}")
     if da.rio.crs is None:
         raise InputError("the raster has no CRS: write one with da.rio.write_crs")
-    suffix = Path(path).suffix.lower()
-    if suffix in _NETCDF:
-        return [_write_netcdf(da, Path(path), inputs, progress)]
-    if suffix in _ENVI:
-        return _write_envi(da, Path(path), inputs, progress)
-    return [write_cog(da, path, overwrite=True, inputs=inputs, option=option, progress=progress)]
+    write = RASTER_WRITERS[Path(path).suffix.lower()]
+    return write(da, Path(path), inputs, progress, option)
 
 
 def _rows(da, progress):
@@ -168,7 +180,14 @@ def cf_dataset(da, values=None):
     return ds
 
 
-def _write_netcdf(da, path, inputs, progress):
+def _write_cog(da, path, inputs, progress, option) -> list:
+    """Cloud-Optimized GeoTIFF, tile by tile (:func:`hsgeo.io.geotiff.write_cog`)."""
+    from hsgeo.io.geotiff import write_cog
+
+    return [write_cog(da, path, overwrite=True, inputs=inputs, option=option, progress=progress)]
+
+
+def _write_netcdf(da, path, inputs, progress, option) -> list:
     """CF-1.8 NetCDF-4 (h5netcdf), atomically."""
     v = np.empty(da.shape, dtype=np.float32)
     for r0, r1, block in _rows(da, progress):
@@ -180,10 +199,10 @@ def _write_netcdf(da, path, inputs, progress):
         enc["fwhm"] = {"_FillValue": None}
     with atomic_path(path, inputs) as tmp:
         ds.to_netcdf(tmp, engine="h5netcdf", encoding=enc)
-    return path
+    return [path]
 
 
-def _write_envi(da, path_hdr, inputs, progress) -> list:
+def _write_envi(da, path_hdr, inputs, progress, option) -> list:
     """ENVI BSQ float32 in blocks of rows, with map info and the CRS (WKT)."""
     from hsgeo.io.envi import EnviWriter
 
@@ -207,6 +226,18 @@ def _write_envi(da, path_hdr, inputs, progress) -> list:
         for r0, r1, block in _rows(da, progress):
             w[r0:r1, :, :] = block.transpose(1, 2, 0)
     return [w.path, w.header_path]
+
+
+#: The writer of each suffix of :data:`RASTER_FORMATS`: ``write(da, path, inputs, progress,
+#: option) -> list of Path`` (the files written). A new format is one entry here and one in
+#: :data:`RASTER_FORMATS` (CONTRIBUTING.md); tests/test_raster_formats.py reads every one back
+#: with GDAL.
+RASTER_WRITERS = {
+    ".tif": _write_cog,
+    ".tiff": _write_cog,
+    ".nc": _write_netcdf,
+    ".hdr": _write_envi,
+}
 
 
 def read_dem(path):

@@ -63,6 +63,9 @@ __all__ = [
     "read_sensor_tables",
     "model_of",
     "sensor_toml",
+    "BODY",
+    "PUSHBROOM_PRIOR_TABLES",
+    "PUSHBROOM_KEYS",
 ]
 
 #: The largest lever arm taken as metres: no airborne or bench sensor sits 10 m from its

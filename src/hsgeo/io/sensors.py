@@ -30,6 +30,9 @@ __all__ = [
     "read_scanning_sensor",
     "read_band_split",
     "read_frame_layouts",
+    "BAND_SPLIT_SCHEMA",
+    "FRAME_LAYOUT_SCHEMA",
+    "MAX_NODE_CORRECTION",
 ]
 
 #: ``hsgeo geocode --sensor``: a line scanner (000 eq. (2)) and its boresight.

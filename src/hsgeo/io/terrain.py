@@ -33,7 +33,7 @@ import numpy as np
 
 from hsgeo.errors import InputError, ObservationError
 
-__all__ = ["RasterTerrain", "read_terrain"]
+__all__ = ["RasterTerrain", "read_terrain", "MAX_GRID_NODES"]
 
 #: The most nodes of the frame grid read at once (≈ 1.6 GB of working arrays).
 MAX_GRID_NODES = 20_000_000

@@ -43,7 +43,7 @@ def weighted_blob_centroid(excess, near_rc):
     top = float(w.max()) if w.size else 0.0
     if not top > 0:
         return None, None
-    lab, n_lab = label(w > 0.5 * top, structure=_EIGHT)
+    lab, _ = label(w > 0.5 * top, structure=_EIGHT)
     rr, cc = np.nonzero(lab)
     d = np.hypot(rr - near_rc[0], cc - near_rc[1])
     best = lab[rr[np.argmin(d)], cc[np.argmin(d)]]

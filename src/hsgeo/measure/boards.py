@@ -31,7 +31,7 @@ import numpy as np
 from hsgeo.errors import InputError, ObservationError
 from hsgeo.io.boards import Board
 
-__all__ = ["observe_files", "NOMINAL_PIXEL_MM"]
+__all__ = ["observe_files", "NOMINAL_PIXEL_MM", "MAX_HOMOGRAPHY_RMS_SHARE"]
 
 NOMINAL_PIXEL_MM = 0.005
 

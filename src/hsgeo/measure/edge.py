@@ -9,7 +9,7 @@ finite-difference correction (:func:`hsgeo.mtf.mtf_from_esf`).
 
 Frequencies are in cycles per pixel perpendicular to the edge.
 
-A region is measured only if it is what the method assumes (issue 42: real chips deliver the
+A region is measured only if it is what the method assumes (real chips deliver the
 area outside the target set to 0, and an edge measured across that fill gave an LSF narrower
 than a pixel and a wrong MTF with no warning): one straight edge between two plateaus, no fill,
 nodata or clipped level, and a line spread function at least one pixel wide (the pixel aperture
@@ -26,7 +26,16 @@ import numpy as np
 from hsgeo.errors import InputError, ObservationError
 from hsgeo.mtf import mtf_from_esf
 
-__all__ = ["EdgeMeasurement", "check_region", "find_edge_roi", "slanted_edge"]
+__all__ = [
+    "EdgeMeasurement",
+    "check_region",
+    "find_edge_roi",
+    "slanted_edge",
+    "MIN_HALF_WIDTH_PX",
+    "FULL_SPAN_PX",
+    "PLATEAU_TOLERANCE",
+    "MIN_LSF_FWHM_PX",
+]
 
 
 @dataclass(frozen=True)

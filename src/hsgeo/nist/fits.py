@@ -247,7 +247,7 @@ def fit_scipy(
     tol = 1e-15
     # From some of the hard starts scipy's trust region steps into overflow; the fit then fails
     # and is scored as failed (its message says why). numpy's RuntimeWarning on the way would
-    # only print a path and a line of scipy's source into the book's engine page (issue 28).
+    # only print a path and a line of scipy's source into the book's engine page.
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         sol = least_squares(
             fun,

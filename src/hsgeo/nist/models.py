@@ -19,7 +19,7 @@ from hsgeo.adjust import ResidualBlock
 from hsgeo.errors import InputError
 from hsgeo.io.nist_strd import NistProblem
 
-__all__ = ["MODELS", "NistModel", "model_for", "residuals"]
+__all__ = ["MODELS", "NistModel", "model_for", "residuals", "Model"]
 
 Model = Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]
 

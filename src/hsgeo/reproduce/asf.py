@@ -69,6 +69,7 @@ __all__ = [
     "ANGLES_DEG",
     "SHARED",
     "TUNED_CHANNEL",
+    "path_label",
 ]
 
 #: Scan angles of the per-angle rows, deg.

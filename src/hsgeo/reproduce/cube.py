@@ -40,6 +40,7 @@ __all__ = [
     "patch_spectra",
     "rounds_to",
     "speed_tradeoff",
+    "N_HOT_ROWS",
 ]
 
 #: Band groups of the reflectance table (chosen): the usual broad regions of a leaf spectrum.

@@ -26,7 +26,7 @@ import numpy as np
 from hsgeo.io._files import copy_file, make_folder, write_text
 from hsgeo.simulate.scenarios import data_dir, load_scenario
 
-__all__ = ["GENERATORS", "VERIFY_RTOL", "generate_all"]
+__all__ = ["GENERATORS", "VERIFY_RTOL", "generate_all", "default_out"]
 
 #: scenario generator name -> module with its ``generate(config, outdir)`` function.
 GENERATORS = {

@@ -30,6 +30,9 @@ __all__ = [
     "opencv_sigmas",
     "largest_paper_deviation",
     "PIXEL_PITCH_MM",
+    "opencv_calibrate",
+    "SAME_REL",
+    "INTRINSIC_ROWS",
 ]
 
 #: nominal pixel pitch of the tutorial webcam (unknown; it only scales the mm units: f/pitch,
@@ -338,7 +341,7 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
         if r.paper is not None:
             # the "paper" column is OpenCV's result on its own sample images (or its reference
             # file): an independent implementation, nothing of it built into our estimate; the
-            # reference data are our chosen yardstick (issue 22: every verdict row says whence)
+            # reference data are our chosen yardstick (every verdict row says whence)
             r.provenance = "chosen"
     return Reproduction("frame-reference", seed, rows, meta, extras)
 

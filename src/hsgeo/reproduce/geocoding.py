@@ -28,10 +28,11 @@ __all__ = [
     "flight_deviations",
     "displacement_across_track",
     "QUANTITIES",
+    "DEM_ERROR_SIGMA_M",
 ]
 
 QUANTITIES = ("bias_y_m", "bias_x_m", "sigma_y_m", "sigma_x_m")
-#: The effect the geocoding does not model (issue 22, on by default): the height of the field
+#: The effect the geocoding does not model (GUIDE §4, on by default): the height of the field
 #: in the operator's DEM is off by a random error per flight, σ in m (ours: an SRTM-class DEM,
 #: whose error is correlated over a 500 m field, so one offset per flight). The GCP calibration
 #: of the boresight and the geocoding both use the erroneous height; the flight itself images
@@ -206,7 +207,7 @@ def _printed_table_rows(meta: dict) -> list[Row]:
             paper, decimals = P000_GCP_FOOTERS[table][q]
             flag = [f for f in flags if f.where == f"footer {q}"]
             # arithmetic on the paper's own printed deviations: agreement is by construction
-            # (issue 22); a footer that does not follow from them is a finding (an override)
+            # (derived); a footer that does not follow from them is a finding (an override)
             verdict, reason = (
                 ("differs", f"recomputed from the printed deviations: {flag[0]}")
                 if flag

@@ -201,7 +201,7 @@ def exact_pattern_bench(
 def _precision_rows(res, mc: dict, lab: LineLab) -> list[Row]:
     """000 Table 1's σ(ζ0) and σ(c) against our σ̂ (row 1000), with the spread of σ̂ over the
     Monte Carlo's calibrations. The noise behind σ̂ is our rendering and measurement (chosen),
-    not tuned to the paper's σ: an independent outcome (issue 22).
+    not tuned to the paper's σ: an independent outcome.
     """
     c = P000_TABLE1_CALIBRATED
     why = {

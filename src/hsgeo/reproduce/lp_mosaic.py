@@ -31,7 +31,7 @@ bands) and
 compared with its RTK position (``LpObservations.square_xyz_m``, mapped to EPSG:25832 by
 :mod:`hsgeo.crs`): table ``"002 Fig. 9"``, each row's truth the error the measurement should
 find (where the geometry puts the square, :func:`where_squares_land`, minus its RTK position:
-the RTK noise and the geometry's error, none of the measurement's). Issue 26's bar: the RMS of
+the RTK noise and the geometry's error, none of the measurement's). The bar: the RMS of
 the horizontal errors within 1 GSD (the mosaic's cell, 002's 0.30 m) with the adjusted
 trajectory.
 """
@@ -66,6 +66,9 @@ __all__ = [
     "TABLE",
     "SEARCH_M",
     "FOUND_WITHIN_M",
+    "TRUE_COLOUR_NM",
+    "DSM_SIGMA_M",
+    "DSM_CORRELATION_M",
 ]
 
 TABLE = "002 Fig. 9"

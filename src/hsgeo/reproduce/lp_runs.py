@@ -41,6 +41,7 @@ __all__ = [
     "headline",
     "exact_twin",
     "MATCH_SAMPLE",
+    "gcps_by_centroid",
 ]
 
 #: Matches judged against the truth: a random sample of at most this many (the shares' standard

@@ -8,7 +8,7 @@ ISO 12233 (:func:`hsgeo.workflows.mtf.mtf_from_edge`). Every estimate is compare
 analytic MTF of the simulated optics. Every reproduced value is the mean over ``n_runs`` noise
 realisations (the target's sub-pixel position and the operator's start guess change too) and its
 σ the σ of that mean (one realisation's spread / √n_runs), so that z of a mean uses the mean's
-σ (issue 37). The methods' own biases — what the same pipeline gives on noise-free recordings with
+σ (GUIDE §4). The methods' own biases — what the same pipeline gives on noise-free recordings with
 the same distribution of phases and start guesses — are measured for every row (``meta["bias"]``):
 a row beyond 3σ of its truth is either explained by that bias or named.
 

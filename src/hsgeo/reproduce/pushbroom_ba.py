@@ -23,14 +23,10 @@ import numpy as np
 from hsgeo.errors import InputError
 from hsgeo.papers import P002, P002_STATS
 from hsgeo.report import Reproduction, Row
-from hsgeo.reproduce.pushbroom_runs import (  # re-exported: the public names of this chapter
-    FACTORS,
-    HEIGHT_OFFSET_M,
+from hsgeo.reproduce.pushbroom_runs import (
     MIN_FACTOR_SEEDS,
     RIPPLE_PX,
-    SIGMA_REF_IMAGE_PX,
     adjust_campaign,
-    camera_prior,
     check_point_factors,
     cp_errors,
     factor_rows,
@@ -51,40 +47,19 @@ from hsgeo.simulate.pushbroom_campaign import (
 from hsgeo.stats import describe
 from hsgeo.workflows.pushbroom_ba import (  # 002's settings, spelled once in the workflow
     BLOCK_NAMES,
-    FTOL,
-    REJECT_K,
     REPORTED_PARAMETERS,
-    Y_AS_TIME,
 )
 
 __all__ = [
     "run",
-    "adjust_campaign",
-    "camera_prior",
-    "cp_errors",
-    "pseudo_truth",
     "shift_rows",
     "outlier_detection",
-    "node_interval_study",
-    "check_point_factors",
     "table_spread",
-    "FACTORS",
-    "study_plan",
     "factor_produces",
     "interval_distribution_text",
-    # re-exported (hsgeo.reproduce.pushbroom_runs, hsgeo.workflows.pushbroom_ba)
-    "HEIGHT_OFFSET_M",
-    "SIGMA_REF_IMAGE_PX",
-    "MIN_FACTOR_SEEDS",
-    "RIPPLE_PX",
-    "interval_optima",
-    "optimum_interval",
-    "FTOL",
-    "REJECT_K",
-    "Y_AS_TIME",
+    "EXTREMES_NOT_COMPARABLE",
+    "c_minus_mean",
 ]
-
-RAD2DEG = 180 / np.pi
 
 
 #: Why the extremes of 002 Table 1 get no verdict (see :func:`_stats_rows`).
@@ -215,7 +190,7 @@ def _table_rows(res, res0, truth, spread, scale):
         extremes=same_size,
     )
     for row in rows:
-        # issue 22: the key-point σ per image axis was tuned to the paper's NMADs (a miss
+        # provenance: the key-point σ per image axis was tuned to the paper's NMADs (a miss
         # beyond 3σ is "differs: tuning missed"); the other statistics follow from our choices
         row.provenance = "tuned" if row.quantity in ("nmad_x_px", "nmad_y_px") else "chosen"
     # -- 002 Tables 2 and 3: check points, m (the same 13 at every scale)
@@ -463,7 +438,7 @@ def run(
             cfg.agl_low_m * cfg.pixel_mm / cfg.c_mean_mm,
             cfg.agl_high_m * cfg.pixel_mm / cfg.c_mean_mm,
         ],
-        # what the data could not determine, said rather than a reason to stop (issue 42)
+        # what the data could not determine, said rather than a reason to stop
         "not_determined_gcp": _not_determined(res),
         "not_determined_nogcp": _not_determined(res0),
         "total_seconds": time.perf_counter() - t_start,

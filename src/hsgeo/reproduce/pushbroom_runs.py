@@ -4,7 +4,7 @@ One campaign set up and adjusted (:func:`adjust_campaign`, with the operator's
 :func:`camera_prior`) and its check-point errors (:func:`cp_errors`); the node-interval study
 (:func:`node_interval_study`, :func:`interval_optima`) and the check-point factors
 (:func:`check_point_factors`), each of which adjusts many campaigns. Split from
-:mod:`hsgeo.reproduce.pushbroom_ba` (the chapter's tables), which re-exports every name here.
+:mod:`hsgeo.reproduce.pushbroom_ba` (the chapter's tables).
 """
 
 from __future__ import annotations

@@ -20,7 +20,6 @@ from hsgeo.papers import (
 )
 from hsgeo.report import Reproduction, Row
 from hsgeo.reproduce.rikola_analyses import (
-    band_identifiability,
     corner_bias,
     drift_reasons,
     predict_per_band,
@@ -39,7 +38,23 @@ from hsgeo.workflows.rikola import (
     relative_orientation,
 )
 
-__all__ = ["run", "setup", "observe", "campaign", "corner_bias", "band_identifiability"]
+__all__ = [
+    "run",
+    "setup",
+    "observe",
+    "campaign",
+    "SMALL_BANDS",
+    "HELD_OUT",
+    "TABLE3_BANDS",
+    "ROP_CUBE",
+    "held_out",
+    "table3_rows",
+    "rop_rows",
+    "gap_rows",
+    "corner_rows",
+    "joint_rows",
+    "result_rows",
+]
 
 SMALL_BANDS = (1, 2, 5, 8, 10, 11, 12, 15, 16, 20)
 HELD_OUT = (8, 16)  # one band of each sensor, inside the gap range
@@ -218,7 +233,7 @@ def table3_rows(cals: dict, truth) -> list[Row]:
                 v,
                 s,
                 tr[q],
-                # issue 22: the truth is the paper's x0, y0 (band 20: sensor I, band 5: II), or
+                # provenance: the truth is the paper's x0, y0 (band 20: sensor I, band 5: II), or
                 # computed from the paper (f: its gap line + scatter; K, P: the two bands' mean,
                 # K2 = K3 = 0 as "not significant")
                 provenance="derived",

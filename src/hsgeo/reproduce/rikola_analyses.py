@@ -242,7 +242,7 @@ def unmodelled_rows(rows_on: list[Row], rows_off: list[Row], res_on, res_off) ->
 def drift_reasons(rows: list[Row]) -> None:
     """The reason of a "differs" (used only then) of the rows the EOP drift moves: the ROP of
     003 eq. (1) assumes one rigid rotation between the sensors. The joint model estimates the
-    drift (issue 37): a joint row that misses its truth is a failed recovery, said by the rule.
+    drift (003 §3.4): a joint row that misses its truth is a failed recovery, said by the rule.
     """
     for r in rows:
         if r.table == "003 Table 4 ROP" and r.z_paper is not None:

@@ -1,6 +1,6 @@
-"""The claims scoreboard: every numeric claim of the five papers, with its verdict (issue 13).
+"""The claims scoreboard: every numeric claim of the five papers, with its verdict.
 
-One row per published number (issue 37): the rows of the chapters' ``reproduce`` tables whose
+One row per published number (GUIDE §4): the rows of the chapters' ``reproduce`` tables whose
 name starts with the paper's number, ``000``–``004``, one per (published table, quantity). A
 number that more than one chapter reproduces is judged by the chapter that owns it
 (:data:`OWNERS`, with the reason); the other chapters show it as context (verdict ``context``,
@@ -9,7 +9,7 @@ scoreboard lists them beside the owner without counting them. The claims of chap
 be written are marked ``planned``. Verdicts are computed by
 :meth:`hsgeo.report.Row.judge` from the numbers, in the style of ReScience C reproductions:
 *reproduced*, *differs* (with the reason), *by construction* (the truth is the paper's value,
-computed from it or tuned to it: agreement was built in; issue 22), *not testable*, *planned*.
+computed from it or tuned to it: agreement was built in), *not testable*, *planned*.
 Every verdict is explained in a sentence (:data:`hsgeo.report.VERDICT_MEANING`), counted per
 paper and per provenance of the truth, and a verdict a chapter stated against the rule (an
 override) is listed with its reason (:func:`overrides`).
@@ -32,10 +32,10 @@ from hsgeo.report import (
     _format_paper,
     format_value,
 )
+from hsgeo.reproduce import CHAPTERS, paper_chapters
 from hsgeo.vocabulary import display_unit, quantity_label
 
 __all__ = [
-    "PAPER_CHAPTERS",
     "claims_with_reasons",
     "claims",
     "planned_claims",
@@ -44,7 +44,6 @@ __all__ = [
     "counts_by",
     "overrides",
     "PAPERS",
-    "CHAPTER_DOCS",
     "PROVENANCE_GROUPS",
     "provenance_group",
     "claims_with_chapters",
@@ -55,19 +54,11 @@ __all__ = [
     "published_table",
     "owner",
     "mark_context",
+    "NAMED",
+    "NOT_CLAIMS",
+    "context_chapters",
+    "ClaimTable",
 ]
-
-#: The chapters whose tables hold claims of the papers.
-PAPER_CHAPTERS = (
-    "line-calibration",
-    "geocoding",
-    "pushbroom-ba",
-    "lp-observations",
-    "rikola",
-    "mtf",
-    "cube",
-    "asf",
-)
 
 #: The papers as the scoreboard names them (../shared/papers/README.md).
 PAPERS = {
@@ -81,22 +72,9 @@ PAPERS = {
     "004": "the angular sensitivity of the DAEDALUS AADS 1268 whiskbroom scanner",
 }
 
-#: A chapter's name (``hsgeo reproduce``) -> its page in the book, relative to the book's root.
-CHAPTER_DOCS = {
-    "frame-reference": "chapters/frame_reference",
-    "line-calibration": "chapters/line_calibration",
-    "geocoding": "chapters/geocoding",
-    "pushbroom-ba": "chapters/pushbroom_ba",
-    "lp-observations": "chapters/lp_observations",
-    "rikola": "chapters/rikola",
-    "mtf": "chapters/mtf",
-    "cube": "chapters/cube",
-    "asf": "chapters/asf",
-}
-
 #: The provenance groups the scoreboard counts by: the provenances of
 #: :data:`hsgeo.report.PROVENANCES` with ``tuned`` split by whether the tuning met its target
-#: (issue 28), and ``none`` for rows without a simulation (the planned claims).
+#: (a missed tuning is a finding), and ``none`` for rows without a simulation (the planned claims).
 PROVENANCE_GROUPS = ("paper", "derived", "chosen", "tuned (met)", "tuned (missed)", "none")
 
 #: How many claims a paragraph names per verdict before it says "and n more".
@@ -104,7 +82,7 @@ NAMED = 6
 
 _PAPER_TABLE = re.compile(r"^00[0-4] ")
 #: Tables named after a paper that hold experiments rather than claims: the factors table runs
-#: counterfactual campaigns against 002 Table 2's values (issue 15); counting its rows would count
+#: counterfactual campaigns against 002 Table 2's values; counting its rows would count
 #: 002 Table 2's claims again, once per factor.
 NOT_CLAIMS = ("002 check-point factors",)
 
@@ -180,7 +158,7 @@ def claims_with_chapters(reps: dict[str, Reproduction]) -> list[tuple[str | None
     chapter reproduces it, else the first chapter's; then ``(None, row)`` for the planned claims.
     """
     found: dict[tuple[str, str], list[tuple[str, Row]]] = {}
-    for chapter in PAPER_CHAPTERS:
+    for chapter in paper_chapters():
         if chapter in reps:
             for r in reps[chapter].rows:
                 if (
@@ -211,7 +189,7 @@ def context_chapters(reps: dict[str, Reproduction], table: str, quantity: str) -
     ]
     return [
         c
-        for c in PAPER_CHAPTERS
+        for c in paper_chapters()
         if c in reps
         and c not in own
         and any((published_table(r.table), r.quantity) == key for r in reps[c].rows)
@@ -379,7 +357,7 @@ class ClaimTable:
         body = []
         rows = zip(self.data.iterrows(), self.chapters, self.provenance, strict=True)
         for (_, rec), chapter, prov in rows:
-            doc = CHAPTER_DOCS.get(chapter or "")
+            doc = CHAPTERS[chapter].page if chapter in CHAPTERS else None
             claim = escape(rec["claim"])
             if doc:
                 claim = f'<a href="{doc}.html" title="computed in {chapter}">{claim}</a>'
@@ -455,7 +433,7 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
     from hsgeo.reproduce import run as run_chapter
 
     reps, sources = {}, {}
-    for chapter in PAPER_CHAPTERS:
+    for chapter in paper_chapters():
         rep = recorded(chapter)
         how = "recorded by the book build"
         if rep is None:

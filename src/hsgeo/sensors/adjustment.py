@@ -112,6 +112,13 @@ def _mounted(sensor, adj: dict, model: str):
 def adjusted_trajectory(trajectory, adjustment: dict):
     """``trajectory`` with the node corrections of ``adjustment`` (002 eq. (4),
     :func:`hsgeo.trajectory.corrected_trajectory`); unchanged when it has none.
+
+    References
+    ----------
+    .. [1] Jonassen, V. O., Ressl, C., Pfeifer, N., Kjørsvik, N. S. and Gjevestad, J. G. O. (2024).
+           Bundle adjustment of aerial linear pushbroom hyperspectral images with sub-pixel
+           accuracy. PFG – Journal of Photogrammetry, Remote Sensing and Geoinformation Science
+           (paper 002).
     """
     from hsgeo.trajectory import CORRECTION_COLUMNS, SplineNodes, corrected_trajectory
 

@@ -53,6 +53,10 @@ __all__ = [
     "FramePhotogrammetric",
     "pixel_to_mm",
     "mm_to_pixel",
+    "OPENCV_INTRINSICS",
+    "OPENCV_DISTORTION",
+    "PHOTOGRAMMETRIC_INTERIOR",
+    "PHOTOGRAMMETRIC_DISTORTION",
 ]
 
 POSE_COLUMNS = ("omega_rad", "phi_rad", "kappa_rad", "X0", "Y0", "Z0")
@@ -95,7 +99,7 @@ def camera_coordinates(poses: np.ndarray, view: np.ndarray, X: np.ndarray, jacob
     return Xc, d_pose, Rt
 
 
-def _check_views(name, view, xy, X, n_views_hint=None):
+def _check_views(name, view, xy, X):
     view = np.asarray(view)
     xy = np.asarray(xy, dtype=np.float64)
     if xy.ndim != 2 or xy.shape[1] != 2:
@@ -304,6 +308,12 @@ class FramePhotogrammetric(_FrameBase):
     blocks : mapping, optional
         Parameter-block names by role (``poses``, ``points``, ``interior``, ``distortion``;
         defaults ``poses``, ``points``, ``interior``, ``distortion_mm``).
+
+    References
+    ----------
+    .. [1] Tommaselli, A. M. G., Santos, L. D., Berveglieri, A., Oliveira, R. A. and Honkavaara, E.
+           (2018). A study on the variations of inner orientation parameters of a hyperspectral
+           frame camera. Int. Arch. Photogramm. Remote Sens. Spatial Inf. Sci. XLII-1 (paper 003).
     """
 
     name = "image points (photogrammetric form)"

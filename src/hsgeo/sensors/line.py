@@ -31,8 +31,9 @@ __all__ = [
     "LinearIFOV",
     "CalibratedLine",
     "LineScanner",
-    "line_time",
     "ray_directions",
+    "BoresightGCP",
+    "calibrate_boresight",
 ]
 
 
@@ -55,6 +56,11 @@ class LinearIFOV(LineGeometry):
     ``θ = −(ζ − ζ0)·IFOV`` with ``IFOV = 1/c`` (rad per pixel) and no distortion (000 §
     "Verification": "IFOV ... linear function of the distance from the central pixel ... optical
     distortion was neglected").
+
+    References
+    ----------
+    .. [1] Miljković, V., Gajski, D. and Vela, E. (2017). Spatial calibration of the hyperspectral
+           line scanner by the bundle block adjusting method. Geodetski list 2, 127–142 (paper 000).
     """
 
     zeta0_px: float = 485.0
@@ -72,6 +78,11 @@ class CalibratedLine(LineGeometry):
     """The calibrated 1D model of 000 eq. (2) in its ray form (:mod:`hsgeo.sensors.line1d`).
 
     ``ζ = ζ0 − c·tan θ + δ(ζ − ζ0)``, δ the odd 7th-order polynomial in units of 100 px.
+
+    References
+    ----------
+    .. [1] Miljković, V., Gajski, D. and Vela, E. (2017). Spatial calibration of the hyperspectral
+           line scanner by the bundle block adjusting method. Geodetski list 2, 127–142 (paper 000).
     """
 
     zeta0_px: float

@@ -87,6 +87,7 @@ __all__ = [
     "check_minimum_observations",
     "make_parameters",
     "resect",
+    "Resection",
 ]
 
 #: The unit of (ζ − ζ0) in the distortion polynomial: 100 px (see the module docstring).
@@ -122,6 +123,11 @@ def distortion_px(
         K1, K2, K3 in px per unit of ``u`` to the 3rd, 5th, 7th power.
     norm_px : float
         Unit of ``u`` (100 px reproduces the published statements, see the module docstring).
+
+    References
+    ----------
+    .. [1] Miljković, V., Gajski, D. and Vela, E. (2017). Spatial calibration of the hyperspectral
+           line scanner by the bundle block adjusting method. Geodetski list 2, 127–142 (paper 000).
 
     Examples
     --------
@@ -179,6 +185,11 @@ def tan_from_zeta(
     Returns
     -------
     tan_theta : (...) ndarray
+
+    References
+    ----------
+    .. [1] Miljković, V., Gajski, D. and Vela, E. (2017). Spatial calibration of the hyperspectral
+           line scanner by the bundle block adjusting method. Geodetski list 2, 127–142 (paper 000).
     """
     if not (np.isfinite(c_px) and c_px > 0):
         raise InputError(f"c_px must be a positive number, got {c_px!r}")
@@ -250,6 +261,11 @@ def camera_xy(xy_m: ArrayLike, eop: ArrayLike) -> tuple[NDArray, NDArray]:
     xy_m : (n, 2) array_like, m
     eop : (n, 3) or (3,) array_like
         ``x0_m, y0_m, alpha_rad`` for each point (or one station for all).
+
+    References
+    ----------
+    .. [1] Miljković, V., Gajski, D. and Vela, E. (2017). Spatial calibration of the hyperspectral
+           line scanner by the bundle block adjusting method. Geodetski list 2, 127–142 (paper 000).
     """
     xy = np.asarray(xy_m, dtype=float)
     e = np.asarray(eop, dtype=float)
@@ -323,6 +339,11 @@ class LineObservations(ResidualBlock):
         Parameter-block names by role (``eop``, ``zeta0``, ``c``, ``K``, ``xy``; defaults
         ``eop``, ``zeta0_px``, ``c_px``, ``K``, ``xy_m``), see
         :class:`~hsgeo.adjust.ResidualBlock`.
+
+    References
+    ----------
+    .. [1] Miljković, V., Gajski, D. and Vela, E. (2017). Spatial calibration of the hyperspectral
+           line scanner by the bundle block adjusting method. Geodetski list 2, 127–142 (paper 000).
     """
 
     name = "zeta"
@@ -430,6 +451,11 @@ def check_minimum_observations(image, point, control, n_images: int | None = Non
         Which points are control points (known coordinates).
     n_images : int, optional
         Number of images (default: ``max(image) + 1``).
+
+    References
+    ----------
+    .. [1] Miljković, V., Gajski, D. and Vela, E. (2017). Spatial calibration of the hyperspectral
+           line scanner by the bundle block adjusting method. Geodetski list 2, 127–142 (paper 000).
     """
     img = np.asarray(image, dtype=np.int64)
     pt = np.asarray(point, dtype=np.int64)

@@ -55,6 +55,12 @@ class PanoramicScanner:
     active_fraction : float
         Share of the line period during which the mirror sweeps the pixels (a one-faced mirror
         turning once per line: 2·43°/360°); sets :meth:`times`.
+
+    References
+    ----------
+    .. [1] Meister, G., Jupp, D., Rothkirch, A. and Spitzer, H. (1999). Determination of the angular
+           sensitivity of a multispectral line scanner from image data. IGARSS 1999, vol. 1, 458
+           (paper 004).
     """
 
     n_px: int = DAEDALUS_N_PX

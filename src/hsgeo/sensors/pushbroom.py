@@ -174,7 +174,15 @@ def _camera_geometry(
 
 
 def project(values, names, nodes, t_s, xyz_nav, rpy_nav, pidx, band, beta0, x0_mm, y0_mm):
-    """Image coordinates (mm) of every observation (002 eq. 2–4), without derivatives."""
+    """Image coordinates (mm) of every observation (002 eq. 2–4), without derivatives.
+
+    References
+    ----------
+    .. [1] Jonassen, V. O., Ressl, C., Pfeifer, N., Kjørsvik, N. S. and Gjevestad, J. G. O. (2024).
+           Bundle adjustment of aerial linear pushbroom hyperspectral images with sub-pixel
+           accuracy. PFG – Journal of Photogrammetry, Remote Sensing and Geoinformation Science
+           (paper 002).
+    """
     g = _camera_geometry(
         values, names, nodes, t_s, xyz_nav, rpy_nav, pidx, band, beta0, x0_mm, y0_mm
     )
@@ -302,6 +310,13 @@ class PushbroomLines(ResidualBlock):
         Most Newton iterations for the crossing time per evaluation (they stop when the
         correction falls below ``NEWTON_TOL_S``; started from the previous evaluation's
         crossing time, usually after the first).
+
+    References
+    ----------
+    .. [1] Jonassen, V. O., Ressl, C., Pfeifer, N., Kjørsvik, N. S. and Gjevestad, J. G. O. (2024).
+           Bundle adjustment of aerial linear pushbroom hyperspectral images with sub-pixel
+           accuracy. PFG – Journal of Photogrammetry, Remote Sensing and Geoinformation Science
+           (paper 002).
     """
 
     name = "image points"
@@ -406,23 +421,6 @@ class PushbroomLines(ResidualBlock):
         other = super().fresh()
         other._dt_s = np.zeros_like(self._dt_s)
         return other
-
-    def image_mm(self, values):
-        """Modelled image coordinates in mm, ``(m, 2)``."""
-        xy, _ = project(
-            values,
-            self.blocks,
-            self.nodes,
-            self.t_s,
-            self.xyz_nav,
-            self.rpy_nav,
-            self.point,
-            self.band,
-            self.beta0,
-            self.x0_mm,
-            self.y0_mm,
-        )
-        return xy
 
     def evaluate_numpy(self, values, jacobian):
         """:meth:`evaluate` in plain numpy, for the image y of 002 eq. (2) (tests' reference).
@@ -655,6 +653,13 @@ class PushbroomCamera:
     Pixels are ``(x, y)`` px from the line centre (x along the line, y across it; ``y = 0`` on
     the line) with a band each, at a time ``t_s`` each. The :attr:`mount` is the same mount in
     the body frame of a :class:`hsgeo.trajectory.Trajectory` (x forward, y right, z down).
+
+    References
+    ----------
+    .. [1] Jonassen, V. O., Ressl, C., Pfeifer, N., Kjørsvik, N. S. and Gjevestad, J. G. O. (2024).
+           Bundle adjustment of aerial linear pushbroom hyperspectral images with sub-pixel
+           accuracy. PFG – Journal of Photogrammetry, Remote Sensing and Geoinformation Science
+           (paper 002).
     """
 
     c_mm: tuple

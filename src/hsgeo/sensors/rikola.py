@@ -83,6 +83,12 @@ def focal_from_gap_mm(gap_nm, a_mm_per_nm, b_mm):
 
     >>> float(focal_from_gap_mm(1000.0, 1e-4, 9.0))
     9.1
+
+    References
+    ----------
+    .. [1] Tommaselli, A. M. G., Santos, L. D., Berveglieri, A., Oliveira, R. A. and Honkavaara, E.
+           (2018). A study on the variations of inner orientation parameters of a hyperspectral
+           frame camera. Int. Arch. Photogramm. Remote Sens. Spatial Inf. Sci. XLII-1 (paper 003).
     """
     return np.asarray(a_mm_per_nm) * np.asarray(gap_nm, dtype=np.float64) + np.asarray(
         b_mm
@@ -193,6 +199,12 @@ class TargetCentroids(ResidualBlock):
     blocks : mapping, optional
         Parameter-block names by role (``interior``, ``distortion``, ``poses``; defaults
         ``interior``, ``distortion_mm``, ``poses``), see :class:`~hsgeo.adjust.ResidualBlock`.
+
+    References
+    ----------
+    .. [1] Tommaselli, A. M. G., Santos, L. D., Berveglieri, A., Oliveira, R. A. and Honkavaara, E.
+           (2018). A study on the variations of inner orientation parameters of a hyperspectral
+           frame camera. Int. Arch. Photogramm. Remote Sens. Spatial Inf. Sci. XLII-1 (paper 003).
     """
 
     name = "target centroids"
@@ -294,6 +306,12 @@ class JointCentroids(ResidualBlock):
         The band whose camera frame the drift leaves in place (the middle band, 13, by default):
         a choice of parametrisation only — another reference moves the poses and sensor II's
         rotation by a constant rotation and leaves the predictions the same.
+
+    References
+    ----------
+    .. [1] Tommaselli, A. M. G., Santos, L. D., Berveglieri, A., Oliveira, R. A. and Honkavaara, E.
+           (2018). A study on the variations of inner orientation parameters of a hyperspectral
+           frame camera. Int. Arch. Photogramm. Remote Sens. Spatial Inf. Sci. XLII-1 (paper 003).
     """
 
     name = "target centroids (joint model)"

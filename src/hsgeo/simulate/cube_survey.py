@@ -50,6 +50,7 @@ __all__ = [
     "simulate_dark",
     "at_speed",
     "true_reflectance_lines",
+    "CANOPY",
 ]
 
 #: Materials of the scene, in the order of the material map's ids.

@@ -1,5 +1,5 @@
 """A simulated airborne flight about any site on Earth, in the files a real one delivers
-(issue 38, ``hsgeo data flight``).
+(``hsgeo data flight``).
 
 A straight line along a geodesic through the site (WGS 84) at a height above a ground of
 constant ellipsoidal height, the aircraft rolling, pitching and crabbing; a line scanner given
@@ -32,7 +32,15 @@ import numpy as np
 
 from hsgeo.rotations import R_ENU_FROM_NED, R_from_rpy
 
-__all__ = ["FlightConfig", "FlightData", "simulate_flight", "utm_epsg"]
+__all__ = [
+    "FlightConfig",
+    "FlightData",
+    "simulate_flight",
+    "utm_epsg",
+    "NAV_EPSG",
+    "ECEF_EPSG",
+    "view_angles",
+]
 
 #: The navigation's datum: WGS 84 geographic 3D (and its geocentric frame).
 NAV_EPSG, ECEF_EPSG = 4979, 4978
@@ -40,7 +48,7 @@ NAV_EPSG, ECEF_EPSG = 4979, 4978
 
 @dataclass(frozen=True)
 class FlightConfig:
-    """The flight (defaults: the issue's 30 km line at 2 km above the ground).
+    """The flight (defaults: a 30 km line at 2 km above the ground).
 
     Attributes
     ----------

@@ -15,7 +15,7 @@ to the plates and the pattern, blurring with a wavelength-dependent Gaussian PSF
 the pixel, and adding shot noise, read noise and dark current.
 
 An even distortion term outside 000's odd series (``LineLab.even_distortion_px``) is rendered by
-default: the instrument effect the estimator does not model (issue 22).
+default: the instrument effect the estimator does not model (GUIDE §4).
 
 Assumptions (not in the papers, stated in the chapter): the wavelength of a row
 (λ = 430 nm + 0.44 nm·row, so that row 1000 is the 870 nm of 000 Table 1), the tooth pitch (20 mm)
@@ -84,7 +84,7 @@ class LineLab:
     psf_sigma_px: tuple = (0.8, 0.6)  # σ = a + b·((λ − 430)/440)²: blurrier in the NIR (001 §4)
     supersample: int = 8
     zeta_sigma_px: float = 0.05  # a-priori σ of a measured minimum (σ0 rescales it)
-    # the instrument effect the estimator does not model (issue 22, on by default): an even
+    # the instrument effect the estimator does not model (GUIDE §4, on by default): an even
     # distortion term, δ_even = a·((ζ − ζ0)/r_max)², as of a slightly decentred lens or a tilted
     # detector, with a (px) its value at the domain's edge (ours; no odd series of 000 eq. (2)
     # represents it); 0 switches it off

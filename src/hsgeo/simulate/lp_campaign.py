@@ -84,7 +84,7 @@ from hsgeo.trajectory import (
     rph_from_platform_rpy,
 )
 
-__all__ = ["LpConfig", "LpObservations", "LpTruth", "simulate", "MIN_COLUMNS", "MIN_SCALE"]
+__all__ = ["LpConfig", "LpObservations", "LpTruth", "simulate", "MIN_COLUMNS", "MIN_SCALE", "DEG"]
 
 DEG = np.pi / 180
 #: The smallest scale: a 30 m block (the 17 squares, 1.2 m each, still ≥ 7 m apart).

@@ -41,6 +41,8 @@ __all__ = [
     "render_bar_profiles",
     "render_edge",
     "BarRecording",
+    "bar_electrons",
+    "edge_electrons",
 ]
 
 

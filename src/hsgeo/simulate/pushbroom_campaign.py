@@ -34,7 +34,7 @@ Truth and errors:
 * 17 reference squares (4 GCPs, 13 CPs, RTK σ ≈ 1 cm). The 4 GCPs are seen in every strip
   that covers them; the 13 check points, "tie points with known coordinates" (002 §4), are seen
   in as many strips as a tie point (``cp_rays="tie points"``, the default: ≥ 3, 3.88 on
-  average) or, as before issue 22, in every covering strip (``cp_rays="all strips"``, 14–20
+  average) or, as the simulator once did, in every covering strip (``cp_rays="all strips"``, 14–20
   rays; one factor of the check-point factor table).
 
 Beyond the paper (``scale > 1``, for the scaling benchmark): the block grows along track (north),
@@ -96,6 +96,9 @@ __all__ = [
     "simulate",
     "spline_fit",
     "RIDGE",
+    "DEG",
+    "CHUNK_ROWS",
+    "REFERENCE_EN_M",
 ]
 
 DEG = np.pi / 180
@@ -387,7 +390,7 @@ def _true_image_px(
         xy_true_mm = xy_true_mm + (k * (1 + r2))[:, None] * d
     xy_true_px = xy_true_mm / cfg.pixel_mm
     if cfg.distortion_ripple_px and not noise_free:
-        # a distortion residual outside 002 eq. (3) (issue 22): a ripple along the line
+        # a distortion residual outside 002 eq. (3) (not modelled): a ripple along the line
         xy_true_px[:, 0] += distortion_ripple_px(xy_true_px[:, 0], cfg)
     return xy_true_px
 

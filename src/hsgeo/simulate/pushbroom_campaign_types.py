@@ -14,7 +14,6 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from hsgeo.sensors.pushbroom import BLOCK_NAMES, PushbroomObservations
-from hsgeo.simulate.error_processes import _imaged, spline_fit
 from hsgeo.trajectory import SplineNodes
 
 __all__ = [
@@ -23,6 +22,7 @@ __all__ = [
     "CampaignTruth",
     "CP_RAYS",
     "TRAJECTORY_ERRORS",
+    "DEG",
 ]
 
 DEG = np.pi / 180
@@ -84,14 +84,14 @@ class CampaignConfig:
     # ours, TUNED to 002 Table 1: key-point localisation error before the registration at pixel
     # centres, per image axis: x along the line (across track), y across the line (the matched
     # line, i.e. along track). Tuned so that the reprojection NMADs over 8 campaigns at 0.05 of
-    # the tie points meet the paper's 0.32 px (x) and 0.42 px (y) (issue 22: one σ for both
+    # the tie points meet the paper's 0.32 px (x) and 0.42 px (y) (one σ for both
     # axes, 0.35 px, gave 0.283 and 0.456 px, 13σ and 12σ off; these give 0.321 and 0.419 px)
     sigma_keypoint_px: tuple = (0.432, 0.29)
     outlier_share: float = 0.003  # ours: gross errors left after RANSAC
     sigma_gcp_m: float = 0.01  # 002 §4: RTK ≈ 1 cm
     terrain_relief_m: float = 15.0  # ours: tie points between 0 and 15 m above the datum
     mount_motion_rad: float = 0.02 * DEG  # ours: residual motion of the stabilised mount
-    # -- candidate explanations of 002's check-point errors (off by default; issue 15)
+    # -- candidate explanations of 002's check-point errors (off by default: counterfactuals)
     # the 17 reference squares (1.2 m, 002 §4) measured in the images by their centre: None as
     # the tie points; a σ (px): the centre of a 3–4 px square picked with this error
     sigma_ref_image_px: float | None = None
@@ -100,9 +100,9 @@ class CampaignConfig:
     terrain_asl_m: float = 90.0  # ours: Ås (002 §4: 59.665° N, 10.775° E) lies ≈ 90 m a.s.l.
     # the rays of a check point: "tie points" (as many strips as a tie point: 002 §4 calls the
     # CPs "tie points with known coordinates") or "all strips" (every covering strip, the
-    # simulator before issue 22)
+    # simulator's former default, kept as a counterfactual)
     cp_rays: str = "tie points"
-    # -- an instrument effect the estimator does not model (issue 22): a distortion residual
+    # -- an instrument effect the estimator does not model (GUIDE §4): a distortion residual
     # outside 002 eq. (3), a ripple along the line of this amplitude (px) and number of periods
     # over the line, less what the model absorbs (distortion_ripple_px). Off in the scenario's
     # default (the tests' and studies' campaigns); the chapter's campaign switches it on
@@ -180,9 +180,10 @@ class CampaignTruth:
     Notes
     -----
     With ``"spline"`` the node values in :attr:`values` are the exact error; with
-    ``"gauss-markov"`` they are its best least-squares spline fit (:func:`spline_fit`) at the
-    campaign's node interval over the strips (10 Hz samples while imaging), which the
-    adjustment can at best recover; nodes that no strip touches are zero (their prior).
+    ``"gauss-markov"`` they are its best least-squares spline fit
+    (:func:`hsgeo.simulate.error_processes.spline_fit`) at the campaign's node interval over
+    the strips (10 Hz samples while imaging), which the adjustment can at best recover; nodes
+    that no strip touches are zero (their prior).
     """
 
     cfg: CampaignConfig
@@ -218,15 +219,3 @@ class CampaignTruth:
             return f(self.values[BLOCK_NAMES["nodes"]], t_s)
         cs = CubicSpline(self.error_t_s, self.error_samples, axis=0)
         return (cs.derivative() if rate else cs)(np.asarray(t_s, dtype=np.float64))
-
-    def node_fit(self, interval_s: float) -> tuple[SplineNodes, np.ndarray]:
-        """The best spline fit of the true error with nodes every ``interval_s`` over the strips.
-
-        Returns ``(nodes, values (n_nodes, 6))``; with ``"spline"`` at the campaign's own
-        interval this is the exact error.
-        """
-        nodes = SplineNodes(self.nodes.t_start_s, self.nodes.t_end_s, float(interval_s))
-        if self.error_samples is None and interval_s == self.nodes.interval_s:
-            return nodes, np.array(self.values[BLOCK_NAMES["nodes"]])
-        t = _imaged(self.strips, np.arange(self.nodes.t_start_s, self.nodes.t_end_s, 0.1))
-        return nodes, spline_fit(nodes, t, self.nav_error(t))

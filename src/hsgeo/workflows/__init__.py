@@ -21,5 +21,17 @@ module                     what it does
                            ``hsgeo cube``)
 ``bal``                    a "Bundle Adjustment in the Large" problem, Snavely cameras
                            (``hsgeo adjust-bal``)
+``lp_observations``       LP lines → tie-point observations: BRISK, RANSAC on the LP
+                           fundamental matrix (002 §3.1, §4, ``hsgeo lp-observations``)
+``mtf``                    MTF from bar-target profiles (CTF → MTF) and from slanted edges
+                           (001 eq. 4–7, ``hsgeo mtf``, ``hsgeo mtf-edge``)
+``rikola_bands``           the Rikola band by band: targets from pixels, one camera per band (003)
+``rikola_joint``           the Rikola's joint model: all bands in one adjustment (003 §3.5)
+``asf``                    a whiskbroom scanner's angular sensitivity from crossing flight lines
+                           (004, ``hsgeo asf``)
+``asf_checks``             what must hold of the two scans of ``hsgeo asf``
+``asf_flights``            ``hsgeo asf`` from raw scans: georegistration, one ASF per crossing
 =========================  =====================================================================
 """
+
+__all__: list[str] = []

@@ -1,4 +1,4 @@
-"""The strips of ``hsgeo orthorectify`` from ENVI cubes, as line scanners write them (issue 38).
+"""The strips of ``hsgeo orthorectify`` from ENVI cubes, as line scanners write them.
 
 A LINES argument is an ENVI cube when it is not NetCDF (:func:`is_envi`: by content, the
 NetCDF/HDF5 signature, then by suffix): the binary file (``.raw``, ``.dat``, ``.bil`` …), its

@@ -43,6 +43,7 @@ __all__ = [
     "register",
     "asf_from_scans",
     "peak_to_peak_percent",
+    "MIN_MEAN_NCC",
 ]
 
 
@@ -183,6 +184,12 @@ class AsfOptions:
         the other at the same ground point — at a dash's end, where one pixel of registration
         error or the two scans' different footprints put paint in one and asphalt in the
         other. ``None`` averages every sample (004's "average over the width").
+
+    References
+    ----------
+    .. [1] Meister, G., Jupp, D., Rothkirch, A. and Spitzer, H. (1999). Determination of the angular
+           sensitivity of a multispectral line scanner from image data. IGARSS 1999, vol. 1, 458
+           (paper 004).
     """
 
     margin_m: float = 2.0
@@ -331,6 +338,12 @@ def register(
     A coarse search of the common shift (the sum of the windows' normalised cross-correlations
     on a grid of ±``search_m``), then a Lucas–Kanade shift (with gain and offset) per window
     from there; the median of the windows' shifts is the registration.
+
+    References
+    ----------
+    .. [1] Meister, G., Jupp, D., Rothkirch, A. and Spitzer, H. (1999). Determination of the angular
+           sensitivity of a multispectral line scanner from image data. IGARSS 1999, vol. 1, 458
+           (paper 004).
     """
     sampler = sampler or GroundSampler(along)
     bands = list(options.registration_bands or range(cross.values.shape[0]))
@@ -516,7 +529,14 @@ def _disagreeing_samples(c, a, inside, k: float) -> np.ndarray:
 
 
 def asf_from_scans(inputs: AsfInputs, options: AsfOptions = AsfOptions()) -> AsfResult:
-    """The ASF from a cross-runway scan and an along-runway image (004 steps 1–3)."""
+    """The ASF from a cross-runway scan and an along-runway image (004 steps 1–3).
+
+    References
+    ----------
+    .. [1] Meister, G., Jupp, D., Rothkirch, A. and Spitzer, H. (1999). Determination of the angular
+           sensitivity of a multispectral line scanner from image data. IGARSS 1999, vol. 1, 458
+           (paper 004).
+    """
     cross, along = inputs.cross, inputs.along
     if cross.values.shape[0] != along.values.shape[0]:
         raise InputError(

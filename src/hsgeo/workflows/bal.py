@@ -33,7 +33,7 @@ from hsgeo.io.bal import CAMERA_COLUMNS, BALProblem
 from hsgeo.rotations import R_from_rotvec
 from hsgeo.sensors.bal import SnavelyReprojection, in_front
 
-__all__ = ["BALFit", "prepare", "gauge_fix", "adjust_bal", "BAL_OPTIONS"]
+__all__ = ["BALFit", "prepare", "gauge_fix", "adjust_bal", "BAL_OPTIONS", "adjust_bal_file"]
 
 #: Solver settings of ``hsgeo adjust-bal``, as Ceres' Levenberg–Marquardt starts and damps:
 #: initial damping 1e-4 (Ceres' initial trust-region radius 1e4), point blocks damped at every

@@ -46,6 +46,7 @@ __all__ = [
     "process_frames",
     "build_cube",
     "cube_files",
+    "EXPOSURE_EXTRAPOLATION",
 ]
 
 
@@ -70,6 +71,12 @@ class CubeOptions:
         The diffuse collector's receiving pattern at the light's incidence, F(α).
     f_theta : tuple of float, optional
         The lens's receiving pattern F(θ) at every reflected sample (default: 1).
+
+    References
+    ----------
+    .. [1] Krtalić, A., Miljković, V., Gajski, D. and Racetin, I. (2019). Spatial distortion
+           assessments of a low-cost laboratory and field hyperspectral imaging system. Sensors
+           19(19), 4267 (paper 001).
     """
 
     binning: int = 2
@@ -219,6 +226,12 @@ def process_frames(
     ------
     InputError
         The diffuse collector's signal is saturated in a frame, or holds no light.
+
+    References
+    ----------
+    .. [1] Krtalić, A., Miljković, V., Gajski, D. and Racetin, I. (2019). Spatial distortion
+           assessments of a low-cost laboratory and field hyperspectral imaging system. Sensors
+           19(19), 4267 (paper 001).
     """
     raw = np.asarray(raw_dn)
     t = np.asarray(exposure_s, dtype=float)
@@ -358,8 +371,8 @@ EXPOSURE_EXTRAPOLATION = 10.0
 
 
 def _check_exposures(frames, dark) -> None:
-    """The survey's exposure times near the dark frames' (issue 42: exposures in ms where s are
-    expected gave a cube with exit 0).
+    """The survey's exposure times near the dark frames' (exposures in ms where s are
+    expected would otherwise give a wrong cube with exit 0).
     """
     t, td = np.asarray(frames.exposure_s), np.asarray(dark.exposure_s)
     lo, hi = td.min() / EXPOSURE_EXTRAPOLATION, td.max() * EXPOSURE_EXTRAPOLATION

@@ -146,18 +146,6 @@ class FrameCalibration:
         r = self.residuals_px
         return float(np.sqrt(np.mean(np.sum(r**2, axis=1))))
 
-    def per_view_rms_px(self) -> np.ndarray:
-        """RMS reprojection error of each view (px)."""
-        r = self.residuals_px
-        counts = np.array([v.X.shape[0] for v in self.views])
-        edges = np.concatenate([[0], np.cumsum(counts)])
-        return np.array(
-            [
-                np.sqrt(np.mean(np.sum(r[a:b] ** 2, axis=1)))
-                for a, b in zip(edges[:-1], edges[1:], strict=True)
-            ]
-        )
-
     def values(self) -> dict[str, float]:
         """Interior orientation and distortion by name."""
         out = {}

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from hsgeo.geocode import PlaneTerrain, calibrate_boresight, geocode_observations
-from hsgeo.sensors.line import LineGeometry
+from hsgeo.geocode import PlaneTerrain, geocode_observations
+from hsgeo.sensors.line import LineGeometry, calibrate_boresight
 
 __all__ = ["gcp_deviations"]
 
@@ -58,6 +58,11 @@ def gcp_deviations(
         Geocoded minus surveyed E, N, m (000 Tables 2–3: Δy, Δx).
     result : AdjustmentResult
         The boresight calibration.
+
+    References
+    ----------
+    .. [1] Miljković, V., Gajski, D. and Vela, E. (2017). Spatial calibration of the hyperspectral
+           line scanner by the bundle block adjusting method. Geodetski list 2, 127–142 (paper 000).
     """
     gcp_enu_m = np.asarray(gcp_enu_m, dtype=float)
     kw = {"t0_s": t0_s, "line_rate_hz": line_rate_hz}

@@ -75,6 +75,14 @@ def observe_rows(
     image, point : (m,) int ndarrays
         Image index and point index (into ``xy_m``) of each observation.
     zeta_px : (m,) ndarray
+
+    References
+    ----------
+    .. [1] Miljković, V., Gajski, D. and Vela, E. (2017). Spatial calibration of the hyperspectral
+           line scanner by the bundle block adjusting method. Geodetski list 2, 127–142 (paper 000).
+    .. [2] Krtalić, A., Miljković, V., Gajski, D. and Racetin, I. (2019). Spatial distortion
+           assessments of a low-cost laboratory and field hyperspectral imaging system. Sensors
+           19(19), 4267 (paper 001).
     """
     xy = np.asarray(xy_m, dtype=float)
     order = np.argsort(-xy[:, 0], kind="stable")
@@ -109,6 +117,11 @@ def calibrate(params: Parameters, block: LineObservations, *, stages: bool = Tru
     Returns
     -------
     AdjustmentResult
+
+    References
+    ----------
+    .. [1] Miljković, V., Gajski, D. and Vela, E. (2017). Spatial calibration of the hyperspectral
+           line scanner by the bundle block adjusting method. Geodetski list 2, 127–142 (paper 000).
     """
     p = params.copy()
     if stages:
@@ -156,6 +169,11 @@ class LineInputs:
 class LineOptions:
     """Initial inner orientation (000 Table 1 'uncalibrated': 485 / 3600 px), the a-priori σ
     of ζ, outlier rejection and the staged start of :func:`calibrate`.
+
+    References
+    ----------
+    .. [1] Miljković, V., Gajski, D. and Vela, E. (2017). Spatial calibration of the hyperspectral
+           line scanner by the bundle block adjusting method. Geodetski list 2, 127–142 (paper 000).
     """
 
     zeta0_px: float = 485.0
@@ -217,6 +235,11 @@ class LineCalibration:
 def calibrate_line(inputs: LineInputs, options: LineOptions = LineOptions()) -> LineCalibration:
     """Calibrate one spectral line: the minimum-observation rule (000 §4.1), initial exterior
     orientation (given, or resected per image), then :func:`calibrate` in stages.
+
+    References
+    ----------
+    .. [1] Miljković, V., Gajski, D. and Vela, E. (2017). Spatial calibration of the hyperspectral
+           line scanner by the bundle block adjusting method. Geodetski list 2, 127–142 (paper 000).
     """
     xy = np.asarray(inputs.xy_m, dtype=float)
     control = np.ones(len(xy), bool)
@@ -269,6 +292,11 @@ def calibrate_files(
     Returns
     -------
     LineCalibration
+
+    References
+    ----------
+    .. [1] Miljković, V., Gajski, D. and Vela, E. (2017). Spatial calibration of the hyperspectral
+           line scanner by the bundle block adjusting method. Geodetski list 2, 127–142 (paper 000).
     """
     obs = read_table(
         observations,

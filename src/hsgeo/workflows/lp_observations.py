@@ -104,6 +104,13 @@ class LpInputs:
         squares' heights; one of the two is needed).
     n_px_full : int
         Pixels of a full line (002 §4: 1800); ``x_px = j − (n_px_full − 1)/2``.
+
+    References
+    ----------
+    .. [1] Jonassen, V. O., Ressl, C., Pfeifer, N., Kjørsvik, N. S. and Gjevestad, J. G. O. (2024).
+           Bundle adjustment of aerial linear pushbroom hyperspectral images with sub-pixel
+           accuracy. PFG – Journal of Photogrammetry, Remote Sensing and Geoinformation Science
+           (paper 002).
     """
 
     strips: tuple
@@ -161,6 +168,13 @@ class LpOptions:
         tie points found by the matcher, at the pixel centre, in the strips and band where it
         found them; :func:`hsgeo.workflows._lp_squares.as_tie_points`; the LP chapter's
         check points). Both tables are in :attr:`LpResult.tables_by_squares`.
+
+    References
+    ----------
+    .. [1] Jonassen, V. O., Ressl, C., Pfeifer, N., Kjørsvik, N. S. and Gjevestad, J. G. O. (2024).
+           Bundle adjustment of aerial linear pushbroom hyperspectral images with sub-pixel
+           accuracy. PFG – Journal of Photogrammetry, Remote Sensing and Geoinformation Science
+           (paper 002).
     """
 
     n_lines_per_scene: int = 200
@@ -241,6 +255,13 @@ class LpResult:
     tables_by_squares : dict
         ``{"tie_point": table, "centroid": table}``: the adjustment's table with the squares
         measured each way (:attr:`LpOptions.squares_as`); :attr:`table` is one of them.
+
+    References
+    ----------
+    .. [1] Jonassen, V. O., Ressl, C., Pfeifer, N., Kjørsvik, N. S. and Gjevestad, J. G. O. (2024).
+           Bundle adjustment of aerial linear pushbroom hyperspectral images with sub-pixel
+           accuracy. PFG – Journal of Photogrammetry, Remote Sensing and Geoinformation Science
+           (paper 002).
     """
 
     table: object
@@ -698,6 +719,13 @@ def lp_observation_files(
     Returns
     -------
     LpResult
+
+    References
+    ----------
+    .. [1] Jonassen, V. O., Ressl, C., Pfeifer, N., Kjørsvik, N. S. and Gjevestad, J. G. O. (2024).
+           Bundle adjustment of aerial linear pushbroom hyperspectral images with sub-pixel
+           accuracy. PFG – Journal of Photogrammetry, Remote Sensing and Geoinformation Science
+           (paper 002).
     """
     import pandas as pd
 

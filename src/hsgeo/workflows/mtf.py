@@ -35,6 +35,7 @@ __all__ = [
     "mtf_from_edge",
     "bars_files",
     "edge_file",
+    "parse_roi",
 ]
 
 #: The MTF level of the "borderline frequency" (001 §4: the curves fall "to 0.1, with a
@@ -49,6 +50,12 @@ def determined_gsd_mm(gsd_mm: float, f_borderline_cy_px: float) -> float:
     transfers at 10 % modulation is ``gsd_mm / (2 f_borderline)`` mm wide. It equals the
     theoretical GSD for a borderline frequency of 0.5 cy/px (Nyquist). Our definition (001
     does not give one).
+
+    References
+    ----------
+    .. [1] Krtalić, A., Miljković, V., Gajski, D. and Racetin, I. (2019). Spatial distortion
+           assessments of a low-cost laboratory and field hyperspectral imaging system. Sensors
+           19(19), 4267 (paper 001).
     """
     return float(gsd_mm / (2.0 * f_borderline_cy_px))
 
@@ -168,6 +175,12 @@ def mtf_from_bars(inputs: BarInputs, options: BarOptions = BarOptions()) -> MtfR
 
     The series needs the CTF at odd multiples of each frequency: it is interpolated linearly
     between the groups, and taken as 0 above the finest group's frequency.
+
+    References
+    ----------
+    .. [1] Krtalić, A., Miljković, V., Gajski, D. and Racetin, I. (2019). Spatial distortion
+           assessments of a low-cost laboratory and field hyperspectral imaging system. Sensors
+           19(19), 4267 (paper 001).
     """
     m = measure_ctf(
         inputs.x_px,

@@ -36,6 +36,7 @@ __all__ = [
     "line_strip",
     "lp_strips",
     "MAX_MOSAIC_GIB",
+    "SCHEDULER_TIMEOUT_S",
 ]
 
 #: How long ``--scheduler`` waits for the scheduler to answer, s.
@@ -65,6 +66,13 @@ class OrthoOptions:
         Output tile (cells) and lines geolocated together.
     max_gib : float
         The largest raster, GiB of float32.
+
+    References
+    ----------
+    .. [1] Jonassen, V. O., Ressl, C., Pfeifer, N., Kjørsvik, N. S. and Gjevestad, J. G. O. (2024).
+           Bundle adjustment of aerial linear pushbroom hyperspectral images with sub-pixel
+           accuracy. PFG – Journal of Photogrammetry, Remote Sensing and Geoinformation Science
+           (paper 002).
     """
 
     resolution_m: float | None = None

@@ -36,7 +36,6 @@ from hsgeo.trajectory import CORRECTION_COLUMNS, SplineNodes
 
 __all__ = [
     "CameraPrior",
-    "PushbroomObservations",
     "build_problem",
     "solve",
     "REJECT_K",
@@ -54,6 +53,10 @@ __all__ = [
     "observations_from_table",
     "OBS_COLUMNS",
     "GCP_COLUMNS",
+    "read_camera",
+    "summary",
+    "POOR_FIT_SIGMA0_FACTOR",
+    "POOR_FIT_REJECTED_SHARE",
 ]
 
 
@@ -67,7 +70,7 @@ FTOL = 1e-6
 #: ... the chord steps' end (``SolverOptions.chord_end``): the reduced matrix is formed afresh
 #: to confirm convergence as soon as a chord step predicts less than FTOL of the cost, not
 #: 1e-3 of it (the engine's default): one to three iterations fewer (5 → 4 at the paper's
-#: size, 8 → 5 at five times it; issue 29), to the same minimum within FTOL ...
+#: size, 8 → 5 at five times it), to the same minimum within FTOL ...
 CHORD_END = 1.0
 #: ... and the residual across the line as a time (:func:`build_problem`): with the image y of
 #: 002 eq. (2) the principal distance and the pitch corrections are biased (the chapter shows by
@@ -90,6 +93,13 @@ class CameraPrior:
     principal distance per band (``c_band_mm``, default ``c_mm`` for every band), the
     distortion of 002 eq. (3) and the boresight (ω, φ, κ on the nominal mount, rad); the
     adjustment starts from them, not from zero. :meth:`camera` is that camera as a sensor.
+
+    References
+    ----------
+    .. [1] Jonassen, V. O., Ressl, C., Pfeifer, N., Kjørsvik, N. S. and Gjevestad, J. G. O. (2024).
+           Bundle adjustment of aerial linear pushbroom hyperspectral images with sub-pixel
+           accuracy. PFG – Journal of Photogrammetry, Remote Sensing and Geoinformation Science
+           (paper 002).
     """
 
     n_bands: int
@@ -152,6 +162,13 @@ def intersect_two_rays(point, origin, direction, n_points, min_angle_deg: float 
     Returns
     -------
     xyz : (n_points, 3) ndarray
+
+    References
+    ----------
+    .. [1] Jonassen, V. O., Ressl, C., Pfeifer, N., Kjørsvik, N. S. and Gjevestad, J. G. O. (2024).
+           Bundle adjustment of aerial linear pushbroom hyperspectral images with sub-pixel
+           accuracy. PFG – Journal of Photogrammetry, Remote Sensing and Geoinformation Science
+           (paper 002).
     """
     point = np.asarray(point)
     order = np.argsort(point, kind="stable")
@@ -287,6 +304,13 @@ def build_problem(
     params : Parameters
     blocks : list of ResidualBlock
     nodes : SplineNodes
+
+    References
+    ----------
+    .. [1] Jonassen, V. O., Ressl, C., Pfeifer, N., Kjørsvik, N. S. and Gjevestad, J. G. O. (2024).
+           Bundle adjustment of aerial linear pushbroom hyperspectral images with sub-pixel
+           accuracy. PFG – Journal of Photogrammetry, Remote Sensing and Geoinformation Science
+           (paper 002).
     """
     if not isinstance(obs, PushbroomObservations):
         raise InputError(
@@ -308,7 +332,7 @@ def build_problem(
     p = _parameters(P0, nodes, cam, gcp_index, gcp_xyz_m, node_prior_mean)
     # a band without observations (a small block, a band the matcher found nothing in) cannot
     # determine its principal distance: it keeps its a-priori value, and the summary names it
-    # (issue 42: pushbroom-ba at a small --scale stopped on "no observation depends on c_mm[4]")
+    # (a small --scale had stopped on "no observation depends on c_mm[4]")
     unseen = np.setdiff1d(np.arange(cam.n_bands), np.unique(obs.band))
     if unseen.size:
         p.fix(BLOCK_NAMES["c"], index=unseen)
@@ -349,6 +373,13 @@ def solve(
     Returns
     -------
     hsgeo.adjust.AdjustmentResult
+
+    References
+    ----------
+    .. [1] Jonassen, V. O., Ressl, C., Pfeifer, N., Kjørsvik, N. S. and Gjevestad, J. G. O. (2024).
+           Bundle adjustment of aerial linear pushbroom hyperspectral images with sub-pixel
+           accuracy. PFG – Journal of Photogrammetry, Remote Sensing and Geoinformation Science
+           (paper 002).
     """
     from hsgeo.adjust import adjust
 
@@ -360,7 +391,7 @@ def solve(
         progress=progress,
         reject_every_iteration=True,  # 002 §3.4
         # a tie point its rays do not determine is left out and named, not a reason to stop
-        # (issue 42: lp-observations --seed 6062 stopped on one such point)
+        # (lp-observations --seed 6062 had stopped on one such point)
         drop_undetermined_points=True,
         keep_jacobian=keep_jacobian,
         raise_on_failure=raise_on_failure,
@@ -406,6 +437,13 @@ class PushbroomInputs:
 class PushbroomOptions:
     """How to adjust: 002's settings (:data:`REJECT_K`, :data:`FTOL`, :data:`Y_AS_TIME`) by
     default, and the node interval of 002 §4.
+
+    References
+    ----------
+    .. [1] Jonassen, V. O., Ressl, C., Pfeifer, N., Kjørsvik, N. S. and Gjevestad, J. G. O. (2024).
+           Bundle adjustment of aerial linear pushbroom hyperspectral images with sub-pixel
+           accuracy. PFG – Journal of Photogrammetry, Remote Sensing and Geoinformation Science
+           (paper 002).
     """
 
     node_interval_s: float = 10.0
@@ -458,6 +496,13 @@ def adjust_pushbroom(
 
     ``hsgeo adjust-pushbroom`` (:func:`adjust_files`) and ``hsgeo reproduce pushbroom-ba`` both
     call this, so 002's solver settings and the set-up exist once.
+
+    References
+    ----------
+    .. [1] Jonassen, V. O., Ressl, C., Pfeifer, N., Kjørsvik, N. S. and Gjevestad, J. G. O. (2024).
+           Bundle adjustment of aerial linear pushbroom hyperspectral images with sub-pixel
+           accuracy. PFG – Journal of Photogrammetry, Remote Sensing and Geoinformation Science
+           (paper 002).
     """
     import time
 

@@ -92,6 +92,12 @@ def relative_orientation(pose_1, pose_2, cov_1=None, cov_2=None, step: float = 1
     -------
     opk_rad : (3,) ndarray
     cov : (3, 3) ndarray or None
+
+    References
+    ----------
+    .. [1] Tommaselli, A. M. G., Santos, L. D., Berveglieri, A., Oliveira, R. A. and Honkavaara, E.
+           (2018). A study on the variations of inner orientation parameters of a hyperspectral
+           frame camera. Int. Arch. Photogramm. Remote Sens. Spatial Inf. Sci. XLII-1 (paper 003).
     """
 
     def f(a1, a2):
@@ -116,6 +122,12 @@ def relative_orientation(pose_1, pose_2, cov_1=None, cov_2=None, step: float = 1
 def rop_per_cube(cals: dict, cubes, pairs) -> np.ndarray:
     """003 eq. (1) for every pair and cube: ``(n_pairs, n_cubes, 3)`` rad, pairs given as
     (band of sensor II, band of sensor I).
+
+    References
+    ----------
+    .. [1] Tommaselli, A. M. G., Santos, L. D., Berveglieri, A., Oliveira, R. A. and Honkavaara, E.
+           (2018). A study on the variations of inner orientation parameters of a hyperspectral
+           frame camera. Int. Arch. Photogramm. Remote Sens. Spatial Inf. Sci. XLII-1 (paper 003).
     """
     return np.array(
         [
@@ -182,6 +194,12 @@ def mean_relative_orientation(cals: dict, obs: Observations, cubes, pairs, *, ro
     dict with ``rop_all`` (n_pairs, n_cubes, 3) rad, ``rop_pairs`` (n_pairs, 3) rad (mean over
     cubes), ``rop_mean`` (3,) rad, ``rop_mean_sigma`` (3,) rad, ``band_clusters`` (the
     :func:`design_effect` summary) and ``deff_pairs``.
+
+    References
+    ----------
+    .. [1] Tommaselli, A. M. G., Santos, L. D., Berveglieri, A., Oliveira, R. A. and Honkavaara, E.
+           (2018). A study on the variations of inner orientation parameters of a hyperspectral
+           frame camera. Int. Arch. Photogramm. Remote Sens. Spatial Inf. Sci. XLII-1 (paper 003).
     """
     if rop_all is None:
         rop_all = rop_per_cube(cals, cubes, pairs)
@@ -215,6 +233,12 @@ def mean_relative_orientation(cals: dict, obs: Observations, cubes, pairs, *, ro
 def paper_pairs(bands) -> list[tuple[int, int]]:
     """The band pairs (k, k + 10) of 003 §3.4 — band k of sensor II, band k + 10 of sensor I —
     of which both bands are in ``bands``.
+
+    References
+    ----------
+    .. [1] Tommaselli, A. M. G., Santos, L. D., Berveglieri, A., Oliveira, R. A. and Honkavaara, E.
+           (2018). A study on the variations of inner orientation parameters of a hyperspectral
+           frame camera. Int. Arch. Photogramm. Remote Sens. Spatial Inf. Sci. XLII-1 (paper 003).
     """
     have = {int(b) for b in bands}
     return [(k, k + 10) for k in range(1, 11) if k in have and k + 10 in have]
@@ -241,6 +265,12 @@ class RikolaOptions:
         default: the scatter of the per-band focal lengths about their gap line less their σ̂.
     estimate_offset : bool
         Estimate sensor II's projection-centre offset (:func:`calibrate_joint`).
+
+    References
+    ----------
+    .. [1] Tommaselli, A. M. G., Santos, L. D., Berveglieri, A., Oliveira, R. A. and Honkavaara, E.
+           (2018). A study on the variations of inner orientation parameters of a hyperspectral
+           frame camera. Int. Arch. Photogramm. Remote Sens. Spatial Inf. Sci. XLII-1 (paper 003).
     """
 
     sigma_px: float = 0.02

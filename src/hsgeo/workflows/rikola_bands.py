@@ -82,6 +82,12 @@ def detect_targets_in_images(
     Returns
     -------
     Observations, and Observations or None (``compare_refine``)
+
+    References
+    ----------
+    .. [1] Tommaselli, A. M. G., Santos, L. D., Berveglieri, A., Oliveira, R. A. and Honkavaara, E.
+           (2018). A study on the variations of inner orientation parameters of a hyperspectral
+           frame camera. Int. Arch. Photogramm. Remote Sens. Spatial Inf. Sci. XLII-1 (paper 003).
     """
     from hsgeo.measure.aruco import detect_targets, make_detector, to_uint8
 
@@ -155,6 +161,12 @@ def initial_focal_mm(obs: Observations) -> float:
 class BandCalibration:
     """Self-calibration of one band (003 §3.3): ``result`` holds interior, distortion_mm and
     poses (one per cube, rows in ``cubes`` order).
+
+    References
+    ----------
+    .. [1] Tommaselli, A. M. G., Santos, L. D., Berveglieri, A., Oliveira, R. A. and Honkavaara, E.
+           (2018). A study on the variations of inner orientation parameters of a hyperspectral
+           frame camera. Int. Arch. Photogramm. Remote Sens. Spatial Inf. Sci. XLII-1 (paper 003).
     """
 
     band: int
@@ -205,6 +217,12 @@ def band_problem(obs: Observations, band: int, f0_mm: float, sigma_px: float):
     block : TargetCentroids
     cubes : (k,) int ndarray
         The cubes (views) of the band, in the order of the ``poses`` block.
+
+    References
+    ----------
+    .. [1] Tommaselli, A. M. G., Santos, L. D., Berveglieri, A., Oliveira, R. A. and Honkavaara, E.
+           (2018). A study on the variations of inner orientation parameters of a hyperspectral
+           frame camera. Int. Arch. Photogramm. Remote Sens. Spatial Inf. Sci. XLII-1 (paper 003).
     """
     sel = obs.band == band
     if sel.sum() < 10:
@@ -240,6 +258,12 @@ def calibrate_band(
     where the distances between the targets were known (003 §3.2); the initial values are the
     nominal focal length (003 Table 1; ``f0_mm=None``: from ``cv2.initCameraMatrix2D``), the image
     centre, zero distortion and ``solvePnP`` poses.
+
+    References
+    ----------
+    .. [1] Tommaselli, A. M. G., Santos, L. D., Berveglieri, A., Oliveira, R. A. and Honkavaara, E.
+           (2018). A study on the variations of inner orientation parameters of a hyperspectral
+           frame camera. Int. Arch. Photogramm. Remote Sens. Spatial Inf. Sci. XLII-1 (paper 003).
     """
     if f0_mm is None:
         f0_mm = initial_focal_mm(obs.select(obs.band == band))
@@ -255,6 +279,12 @@ def gap_regression(gap_nm, f_mm) -> dict[str, float]:
     -------
     dict with ``a``, ``b``, ``sigma_a``, ``sigma_b`` (from the residual scatter), ``r2`` (0–1)
     and ``s`` (residual standard deviation).
+
+    References
+    ----------
+    .. [1] Tommaselli, A. M. G., Santos, L. D., Berveglieri, A., Oliveira, R. A. and Honkavaara, E.
+           (2018). A study on the variations of inner orientation parameters of a hyperspectral
+           frame camera. Int. Arch. Photogramm. Remote Sens. Spatial Inf. Sci. XLII-1 (paper 003).
     """
     g = np.asarray(gap_nm, float)
     f = np.asarray(f_mm, float)

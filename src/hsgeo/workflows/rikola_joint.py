@@ -4,7 +4,7 @@ One exterior orientation per cube (sensor I's camera frame), ``f = a·gap + b`` 
 eq. (2)) plus a per-band deviation ``df`` with a prior, one principal point per sensor, one
 distortion set, sensor II's rotation ``R_I_from_II`` (003 eq. (1)) and the drift of the exterior
 orientation across the bands of a cube (003 §3.4, Fig. 5: a rotation rate per band, zero at the
-middle band :data:`DRIFT_REF_BAND`; issue 37); the residual block is
+middle band :data:`DRIFT_REF_BAND`); the residual block is
 :class:`hsgeo.sensors.rikola.JointCentroids`. :func:`calibrate_joint` sets the problem up (the
 one place it is set up) and adjusts it; :func:`predict_band` predicts a band the model did not
 see; :func:`design_effect` measures how much the observations of one target in the bands of a
@@ -214,6 +214,12 @@ def calibrate_joint(
         Estimate the drift of the exterior orientation across the bands (a rotation rate
         (dω, dφ, dκ) per band, zero at :data:`DRIFT_REF_BAND`; 003 §3.4, Fig. 5); False holds
         it at zero (the rigid model of 003 eq. (1)).
+
+    References
+    ----------
+    .. [1] Tommaselli, A. M. G., Santos, L. D., Berveglieri, A., Oliveira, R. A. and Honkavaara, E.
+           (2018). A study on the variations of inner orientation parameters of a hyperspectral
+           frame camera. Int. Arch. Photogramm. Remote Sens. Spatial Inf. Sci. XLII-1 (paper 003).
     """
     keep = ~np.isin(obs.band, np.asarray(exclude_bands, int))
     o = obs.select(keep)
