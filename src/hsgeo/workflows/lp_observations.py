@@ -273,6 +273,10 @@ class LpResult:
 # ----------------------------------------------------------------------------------------------
 # The in-memory core
 # ----------------------------------------------------------------------------------------------
+def _nm(wl) -> str:
+    return "[" + ", ".join(f"{v:.6g}" for v in wl) + "] nm"
+
+
 def _check(inputs: LpInputs, options: LpOptions) -> tuple[tuple, float]:
     """Bands and the terrain height; one clear error for what cannot work."""
     from hsgeo.validate import check_navigation_covers
@@ -296,6 +300,15 @@ def _check(inputs: LpInputs, options: LpOptions) -> tuple[tuple, float]:
             + "; give strips of the same bands"
         )
     nb = n_bands.pop()
+    wl0 = np.asarray(strips[0].wavelengths_nm, float)
+    for i, s in zip(ids[1:], strips[1:], strict=True):
+        wl = np.asarray(s.wavelengths_nm, float)
+        if not np.allclose(wl, wl0, rtol=0.0, atol=0.5):  # issue 42: matched band by band
+            raise InputError(
+                f"strip {i}'s bands differ from strip {ids[0]}'s (wavelength_nm "
+                f"{_nm(wl)} against {_nm(wl0)}): a band is matched with the same band of the "
+                "other strips; give strips of the same camera and bands"
+            )
     if nb != n_cam:
         raise InputError(
             f"the strips hold {nb} bands but the camera has {n_cam} principal distances "
@@ -327,7 +340,7 @@ def _check(inputs: LpInputs, options: LpOptions) -> tuple[tuple, float]:
     return bands, float(h)
 
 
-def _check_overlap(inputs: LpInputs, options: LpOptions, height: float) -> None:
+def _check_overlap(inputs: LpInputs, options: LpOptions, height: float) -> list:
     """Some two strips' footprints overlap (before any work; scenes are checked again)."""
     from hsgeo.workflows._lp_geometry import convex_overlap, footprint
 
@@ -347,6 +360,7 @@ def _check_overlap(inputs: LpInputs, options: LpOptions, height: float) -> None:
             "of these lines (the same time scale), and the terrain height (--height) or the "
             "squares (--squares)"
         )
+    return fps
 
 
 def retrieve(inputs: LpInputs, options: LpOptions = LpOptions(), progress=None) -> LpResult:
@@ -715,11 +729,11 @@ def lp_observation_files(
     cam = read_pushbroom_camera(camera)
     ids, xyz = (), None
     if squares is not None:
-        sq = read_table(
+        table = read_table(
             squares, GCP_COLUMNS, "squares", text_columns=("point_id",), unique=("point_id",)
         )
-        ids = tuple(sq["point_id"].astype(str))
-        xyz = sq[["E_m", "N_m", "H_m"]].to_numpy(dtype=float)
+        ids = tuple(table["point_id"].astype(str))
+        xyz = table[["E_m", "N_m", "H_m"]].to_numpy(dtype=float)
     for p, s in zip(scenes, strips, strict=True):
         check_navigation_covers(
             traj.t_s,
@@ -730,6 +744,17 @@ def lp_observation_files(
         )
     n_px = full_line_px(strips, n_px_full)
     inputs = LpInputs(tuple(strips), traj, cam, ids, xyz, height_m, n_px)
+    if squares is not None:  # the squares where the strips see the ground (issue 42)
+        _, height = _check(inputs, options)
+        sq.check_placement(inputs, _check_overlap(inputs, options, height))
     res = retrieve(inputs, options, progress=progress)
+    if squares is not None and res.counts["all"]["squares"] == 0:
+        raise ObservationError(  # issue 42: a navigation shifted in time gave 0 squares, exit 0
+            f"none of the {len(ids)} squares of {str(squares)!r} was found where the navigation "
+            "and the camera put it in the strips: is the navigation on the lines' time scale "
+            "(not shifted), the camera's boresight and lever arm right (degrees, metres), the "
+            "squares' E_m, N_m, H_m in the navigation's frame? (without --squares, give "
+            "--height)"
+        )
     write_table(output, pd.DataFrame(res.table), inputs=[f for f in files if f is not None])
     return res
