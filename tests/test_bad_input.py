@@ -2389,6 +2389,26 @@ for cmd, file in [
     case(cmd, "mistyped", f"{file}-semicolons", "separated by semicolons", [(file, _semicolons)])
 case("mtf", "mistyped", "profiles-tabs", "separated by tabs",
      [("profiles.csv", lambda p: p.write_text(p.read_text().replace(",", "\t")))])  # fmt: skip
+# a file of another format under a table's name: the format named ("binary or not UTF-8")
+
+
+def _parquet_named_csv(p: Path) -> None:
+    import pandas as pd
+
+    df = pd.read_csv(p)
+    p.unlink()
+    df.to_parquet(p)
+
+
+case("mtf", "mistyped", "profiles-parquet-named-csv", "a Parquet table",
+     [("profiles.csv", _parquet_named_csv)])  # fmt: skip
+case("mtf", "mistyped", "profiles-utf-16", "UTF-16",
+     [("profiles.csv", lambda p: p.write_bytes(p.read_text().encode("utf-16")))])  # fmt: skip
+case("mtf", "mistyped", "profiles-a-zip", "ZIP archive",
+     [("profiles.csv", text(b"PK\x03\x04" + BINARY))])  # fmt: skip
+case("mtf", "mistyped", "profiles-csv-named-parquet", "is text",
+     [("profiles.csv", lambda p: shutil.copy(p, p.with_suffix(".parquet")))],
+     argv=_to_parquet_argv("profiles.csv"))  # fmt: skip
 # a Parquet column's stored type: text or dates where numbers are meant (exit 0 before)
 case(
     "adjust-pushbroom", "type", "obs-parquet-t_s-as-text", "stored as",
@@ -2452,6 +2472,15 @@ case(
 case(
     C, "units", "squares-heights-in-mm", "in mm",
     [("squares.csv", _csv_frame(lambda df: df.assign(H_m=df["H_m"] * 1000.0)))],
+)  # fmt: skip
+# a camera unit off by 10: the field of view named (only "too short, poor texture, too far off")
+case(
+    C, "units", "cam-c-in-cm", "field of view",
+    [("cam.toml", toml_set("camera", "c_mm", "4.0"))],
+)  # fmt: skip
+case(
+    C, "units", "cam-pixel-in-10-um", "field of view",
+    [("cam.toml", toml_set("camera", "pixel_mm", "0.065"))],
 )  # fmt: skip
 # orthorectify: a DSM of three bands (band 1 read as heights, exit 0 before)
 C = "orthorectify-strips"

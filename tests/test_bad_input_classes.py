@@ -138,10 +138,33 @@ CLASSES = [
             ("asf", "runway.csv"),
         ]
     ),
+    *(
+        (f"wrong cause: {what} ('binary or not UTF-8 at byte N')", "mtf",
+         f"case:mtf:mistyped:{name}", "mended", "")
+        for what, name in [
+            ("a Parquet table named .csv", "profiles-parquet-named-csv"),
+            ("a UTF-16 CSV", "profiles-utf-16"),
+            ("a ZIP (Excel) file named .csv", "profiles-a-zip"),
+        ]
+    ),
+    ("wrong cause: a CSV named .parquet (pyarrow's 'magic bytes')", "mtf",
+     "case:mtf:mistyped:profiles-csv-named-parquet", "mended", ""),
     ("wrong cause: a table separated by tabs", "mtf",
      "case:mtf:mistyped:profiles-tabs", "mended", ""),
     ("wrong cause: Parquet dates for seconds ('outside [-1e10, 1e10]')", "adjust-pushbroom",
      "case:adjust-pushbroom:type:obs-parquet-t_s-as-dates", "mended", ""),
+    ("wrong cause: c_mm in cm ('too short, poor texture, too far off')", "lp-observations",
+     "case:lp-observations:units:cam-c-in-cm", "mended", "the field of view is named"),
+    ("wrong cause: pixel_mm 10x off ('too short, poor texture, too far off')", "lp-observations",
+     "case:lp-observations:units:cam-pixel-in-10-um", "mended", "the field of view is named"),
+    ("wrong cause: 8-bit profiles ('dark_dn at or above the profile's level')", "mtf",
+     "case:mtf:units:profiles-8-bit", "mended", ""),
+    ("wrong cause: a heading 180° off ('no two strips' / no squares)", "lp-observations",
+     "", "open", "the squares' refusal names the heading among its causes; the navigation "
+     "itself is not checked against the strips' overlap"),
+    ("answer: --height far from the terrain without --squares", "lp-observations", "", "open",
+     "found here (not in the issue): --height 1000 over terrain at 0 m gives 39 instead of "
+     "879 observations, exit 0; nothing in the files tells the terrain height"),
     ("wrong cause: lp-observations with squares that are not in the strips", "lp-observations",
      "case:lp-observations:degenerate:squares-far-off", "mended",
      "an answer without squares (exit 0) before"),

@@ -76,6 +76,17 @@ def _header(text: str) -> list[str]:
     return []
 
 
+def _looks_like_text(path) -> bool:
+    """The file's first kilobyte is UTF-8 text with a line end (a CSV named .parquet)."""
+    with open(path, "rb") as f:
+        head = f.read(1024)
+    try:
+        head.decode("utf-8")
+    except UnicodeDecodeError:
+        return False
+    return b"\0" not in head and b"\n" in head
+
+
 def _parse(path, text, parquet: bool, name: str, columns, text_columns):
     """The table as pandas reads it; a parser error becomes an :class:`InputError`."""
     import pandas as pd
@@ -96,6 +107,10 @@ def _parse(path, text, parquet: bool, name: str, columns, text_columns):
             f"{', '.join(columns)} and one row per record"
         ) from None
     except Exception as exc:  # noqa: BLE001 - any parser error becomes an InputError
+        if parquet and _looks_like_text(path):
+            raise InputError(
+                f"{name} is text (a CSV table?), not Parquet: name it .csv to read it as CSV"
+            ) from None
         kind = "Parquet" if parquet else "CSV"
         msg = " ".join(str(exc).split())
         raise InputError(f"{name} is not a readable {kind} table: {msg}") from None

@@ -273,6 +273,26 @@ class LpResult:
 # ----------------------------------------------------------------------------------------------
 # The in-memory core
 # ----------------------------------------------------------------------------------------------
+#: A line camera's field of view beyond which a unit of c_mm or pixel_mm is the likelier cause.
+WIDE_FOV_DEG = 60.0
+
+
+def _wide_camera(inputs: LpInputs) -> str:
+    """The camera's full-line field of view, named when implausibly wide (issue 42: c_mm or
+    pixel_mm in another unit ended in 'too short, poor texture, or too far off').
+    """
+    c = float(np.atleast_1d(inputs.camera.c_mm)[0])
+    half_mm = 0.5 * inputs.n_px_full * float(inputs.camera.pixel_mm)
+    fov = float(np.degrees(2.0 * np.arctan2(half_mm, c)))
+    if fov <= WIDE_FOV_DEG:
+        return ""
+    return (
+        f"; the camera's field of view across the line is {fov:.0f}° ({inputs.n_px_full} px of "
+        f"pixel_mm {float(inputs.camera.pixel_mm):g} at c_mm {c:g}): is c_mm or pixel_mm in "
+        "another unit?"
+    )
+
+
 def _nm(wl) -> str:
     return "[" + ", ".join(f"{v:.6g}" for v in wl) + "] nm"
 
@@ -415,7 +435,7 @@ def retrieve(inputs: LpInputs, options: LpOptions = LpOptions(), progress=None) 
             f"no pair of overlapping scenes has {MIN_MATCHES} matches (the LP fundamental "
             f"matrix's minimum, 002 §3.1; at most {most}): the scenes are too short "
             "(--scene-lines), the bands too poor in texture, or the navigation or camera too "
-            "far off for the footprints"
+            "far off for the footprints" + _wide_camera(inputs)
         )
     kept = m["lp"] if options.ransac == "lp" else m["frame"]
     t0 = time.perf_counter()
