@@ -2129,8 +2129,8 @@ case(
     [(f, _h5_edit(lambda ds: ds.assign(t_s=ds["t_s"].where(ds["line"] != 3))))],
 )  # fmt: skip
 case(
-    C, "degenerate", f"{f}-t_s-decreasing", "line times must increase",
-    [(f, _h5_edit(lambda ds: ds.assign(t_s=("line", ds["t_s"].values[::-1]))))],
+    C, "degenerate", f"{f}-t_s-out-of-order", "line times must increase",
+    [(f, _h5_edit(lambda ds: ds.assign(t_s=("line", _swap_two(ds["t_s"].values)))))],
 )  # fmt: skip
 case(
     C, "degenerate", f"{f}-zero-lines", f,
@@ -2300,6 +2300,14 @@ case(C, "output", "output-is-directory", "folder", argv=_out("./"))
 case(C, "output", "output-dir-readonly", "writ", argv=lambda a, d: _readonly_tif(a, d))
 
 
+def _swap_two(t):
+    """Two line times exchanged: neither increasing nor decreasing (lines stored last first
+    are read in time order, issue 42)."""
+    t = t.copy()
+    t[[3, 4]] = t[[4, 3]]
+    return t
+
+
 def _drop_attr_lp(ds, a):
     ds.attrs.pop(a, None)
     return ds
@@ -2317,6 +2325,204 @@ def _nan_middle(z):
     n, m = z.shape
     z[n // 2 - 20 : n // 2 + 20, :] = np.nan
     return z
+
+
+# --- issue 42's classes not covered above (tests/test_bad_input_classes.py lists them all) -----
+def _semicolons(p: Path) -> None:
+    """The table as a spreadsheet in a comma-decimal locale saves it: ';' between the columns."""
+    p.write_text(p.read_text().replace(",", ";"))
+
+
+def _as_parquet_text(column: str):
+    """The CSV table as Parquet (same name, .parquet beside it) with ``column`` stored as text."""
+
+    def edit(p: Path) -> None:
+        import pandas as pd
+
+        df = pd.read_csv(p)
+        df[column] = df[column].astype(str)
+        df.to_parquet(p.with_suffix(".parquet"))
+
+    return edit
+
+
+def _as_parquet_datetime(column: str):
+    def edit(p: Path) -> None:
+        import pandas as pd
+
+        df = pd.read_csv(p)
+        df[column] = pd.to_datetime(df[column], unit="s")
+        df.to_parquet(p.with_suffix(".parquet"))
+
+    return edit
+
+
+def _csv_frame(fn):
+    """Rewrite a CSV table through ``fn(DataFrame) -> DataFrame`` (17 digits)."""
+
+    def edit(p: Path) -> None:
+        import pandas as pd
+
+        fn(pd.read_csv(p)).to_csv(p, index=False, float_format="%.17g")
+
+    return edit
+
+
+def _to_parquet_argv(name: str):
+    return lambda a, d: [x.replace(name, Path(name).stem + ".parquet") for x in a]
+
+
+_BORESIGHT_RAD = "[0.005235987755982988, -0.003490658503988659, 0.0017453292519943296]"
+
+# separators other than the comma: the cause, not "rename 'a;b' to 'b'" (a wrong cause before)
+for cmd, file in [
+    ("calibrate-line", "obs.csv"),
+    ("adjust-pushbroom", "obs.csv"),
+    ("adjust-pushbroom", "nav.csv"),
+    ("adjust-pushbroom", "gcp.csv"),
+    ("lp-observations", "squares.csv"),
+    ("lp-observations", "nav.csv"),
+    ("orthorectify-strips", "nav.csv"),
+    ("mtf", "profiles.csv"),
+    ("asf", "runway.csv"),
+]:
+    case(cmd, "mistyped", f"{file}-semicolons", "separated by semicolons", [(file, _semicolons)])
+case("mtf", "mistyped", "profiles-tabs", "separated by tabs",
+     [("profiles.csv", lambda p: p.write_text(p.read_text().replace(",", "\t")))])  # fmt: skip
+# a file of another format under a table's name: the format named ("binary or not UTF-8")
+
+
+def _parquet_named_csv(p: Path) -> None:
+    import pandas as pd
+
+    df = pd.read_csv(p)
+    p.unlink()
+    df.to_parquet(p)
+
+
+case("mtf", "mistyped", "profiles-parquet-named-csv", "a Parquet table",
+     [("profiles.csv", _parquet_named_csv)])  # fmt: skip
+case("mtf", "mistyped", "profiles-utf-16", "UTF-16",
+     [("profiles.csv", lambda p: p.write_bytes(p.read_text().encode("utf-16")))])  # fmt: skip
+case("mtf", "mistyped", "profiles-a-zip", "ZIP archive",
+     [("profiles.csv", text(b"PK\x03\x04" + BINARY))])  # fmt: skip
+case("mtf", "mistyped", "profiles-csv-named-parquet", "is text",
+     [("profiles.csv", lambda p: shutil.copy(p, p.with_suffix(".parquet")))],
+     argv=_to_parquet_argv("profiles.csv"))  # fmt: skip
+# a Parquet column's stored type: text or dates where numbers are meant (exit 0 before)
+case(
+    "adjust-pushbroom", "type", "obs-parquet-t_s-as-text", "stored as",
+    [("obs.csv", _as_parquet_text("t_s"))], argv=_to_parquet_argv("obs.csv"),
+)  # fmt: skip
+case(
+    "adjust-pushbroom", "type", "obs-parquet-t_s-as-dates", "dates or durations",
+    [("obs.csv", _as_parquet_datetime("t_s"))], argv=_to_parquet_argv("obs.csv"),
+)  # fmt: skip
+case(
+    "mtf", "type", "profiles-parquet-intensity-as-text", "stored as",
+    [("profiles.csv", _as_parquet_text("intensity_dn"))], argv=_to_parquet_argv("profiles.csv"),
+)  # fmt: skip
+# mtf: 8-bit profiles against a 12-bit bar file (exit 0, or a dark-level cause, before)
+case(
+    "mtf", "units", "profiles-8-bit", "8-bit",
+    [("profiles.csv", _csv_frame(
+        lambda df: df.assign(intensity_dn=np.minimum(np.round(df["intensity_dn"] / 16), 255))))],
+)  # fmt: skip
+
+
+def _bars_reversed(p: Path) -> None:
+    """The bar file's groups listed fine first (the profile's order is coarse first)."""
+    import re
+
+    def rev(m):
+        return m.group(1) + "[" + ", ".join(v.strip() for v in m.group(2).split(",")[::-1]) + "]"
+
+    text = re.sub(r"(pair_mm = )\[([^\]]*)\]", rev, p.read_text())
+    p.write_text(re.sub(r"(n_pairs = )\[([^\]]*)\]", rev, text))
+
+
+case("mtf", "degenerate", "bars-in-reverse-order", "reverse order", [("bars.toml", _bars_reversed)])
+# lp-observations: answers on wrong input (exit 0 before)
+C = "lp-observations"
+case(
+    C, "mismatch", "strips-other-wavelengths", "bands differ",
+    [("s1.nc", _h5_edit(lambda ds: ds.assign(wavelength_nm=ds["wavelength_nm"] + 30.0)))],
+)  # fmt: skip
+case(
+    C, "degenerate", "nav-gap-under-a-strip", "--max-nav-gap-s",
+    [("nav.csv", _csv_frame(lambda df: df[(df["t_s"] < 304.0) | (df["t_s"] > 305.3)]))],
+)  # fmt: skip
+case(
+    C, "degenerate", "nav-shifted-2-s", "not shifted",
+    [("nav.csv", _csv_frame(lambda df: df.assign(t_s=df["t_s"] + 2.0)))],
+)  # fmt: skip
+case(
+    C, "units", "cam-boresight-in-radians", "are radians",
+    [("cam.toml", toml_set("camera", "boresight_deg", _BORESIGHT_RAD))],
+)  # fmt: skip
+case(
+    C, "degenerate", "squares-far-off", "none of the 17 squares",
+    [("squares.csv", _csv_frame(lambda df: df.assign(E_m=df["E_m"] + 5000.0)))],
+)  # fmt: skip
+case(
+    C, "units", "squares-in-lon-lat", "longitude/latitude",
+    [("squares.csv", _csv_frame(
+        lambda df: df.assign(E_m=10.775 + df["E_m"] / 56e3, N_m=59.665 + df["N_m"] / 111e3)))],
+)  # fmt: skip
+case(
+    C, "units", "squares-heights-in-mm", "in mm",
+    [("squares.csv", _csv_frame(lambda df: df.assign(H_m=df["H_m"] * 1000.0)))],
+)  # fmt: skip
+# a camera unit off by 10: the field of view named (only "too short, poor texture, too far off")
+case(
+    C, "units", "cam-c-in-cm", "field of view",
+    [("cam.toml", toml_set("camera", "c_mm", "4.0"))],
+)  # fmt: skip
+case(
+    C, "units", "cam-pixel-in-10-um", "field of view",
+    [("cam.toml", toml_set("camera", "pixel_mm", "0.065"))],
+)  # fmt: skip
+# orthorectify: a DSM of three bands (band 1 read as heights, exit 0 before)
+C = "orthorectify-strips"
+
+
+def _three_bands(z, t, c):
+    return np.stack([z, z, z]), t, c
+
+
+def _tif_bands_edit(fn):
+    """Rewrite the DSM GeoTIFF through ``fn(z, transform, crs)``, any number of bands."""
+
+    def edit(p: Path) -> None:
+        import rasterio
+
+        with rasterio.open(p) as src:
+            z, t, crs = fn(src.read(1), src.transform, src.crs)
+        z = np.atleast_3d(z) if z.ndim == 3 else z[None]
+        p.unlink()
+        with rasterio.open(
+            p, "w", driver="GTiff", width=z.shape[2], height=z.shape[1], count=z.shape[0],
+            dtype=z.dtype, crs=crs, transform=t,
+        ) as dst:  # fmt: skip
+            dst.write(z)
+
+    return edit
+
+
+case(C, "mistyped", "dsm-three-bands", "3 bands", [("dsm.tif", _tif_bands_edit(_three_bands))])
+
+
+def _scheduler_http(a, d):
+    """--scheduler at a port that answers, but HTTP (a traceback after 20 s before)."""
+    import http.server
+    import threading
+
+    srv = http.server.HTTPServer(("127.0.0.1", 0), http.server.BaseHTTPRequestHandler)
+    threading.Thread(target=srv.serve_forever, daemon=True).start()
+    return opt("--scheduler", f"tcp://127.0.0.1:{srv.server_address[1]}")(a, d)
+
+
+case(C, "options", "scheduler-an-http-port", "--scheduler", argv=_scheduler_http)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -2532,6 +2738,28 @@ BENIGN = [
         lambda a, d: [x.replace("cube.nc", "cube.bil") for x in a] + ["--json"],
     ),
 ]
+
+
+def _last_first(ds):
+    """Lines stored last first, each with its own time (refused before, issue 42)."""
+    return ds.isel(line=slice(None, None, -1))
+
+
+def _nodata_corner(z, t, c):
+    """A DSM with a nodata corner far from the strips (refused before, issue 42)."""
+    z = z.astype(np.float32)
+    z[:5, :5] = np.nan
+    return z, t, c
+
+
+# issue 42's benign inputs that were refused
+BENIGN += [
+    ("lp-observations", "strips-in-another-order", [],
+     lambda a, d: [a[0], a[3], a[1], a[4], a[2], *a[5:]]),
+    ("lp-observations", "strip-stored-last-first", [("s1.nc", _h5_edit(_last_first))], None),
+    ("orthorectify-strips", "strip-stored-last-first", [("s1.nc", _h5_edit(_last_first))], None),
+    ("orthorectify-strips", "dsm-nodata-corner", [("dsm.tif", _tif_edit(_nodata_corner))], None),
+]  # fmt: skip
 
 
 @pytest.mark.parametrize("cmd,name,files,argv", BENIGN, ids=[f"{b[0]}:{b[1]}" for b in BENIGN])

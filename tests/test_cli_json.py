@@ -103,3 +103,60 @@ def test_observation_error_of_mtf_edge_is_json(tmp_path, capsys):
     assert main(["mtf-edge", str(tmp_path / "flat.png"), "--roi", "0,0,64,64", "--json"]) == 2
     out = _one_json(capsys.readouterr().out)
     assert out["ok"] is False and "edge" in out["error"]
+
+
+# --- every other exit path (issue 42): interrupted, a command's own failure, a bug, poor fit --
+
+
+def _handler(command: str) -> str:
+    return "_cmd_" + command.replace("-", "_")
+
+
+@pytest.mark.parametrize("command", sorted(MISSING))
+@pytest.mark.parametrize(
+    "exc, status",
+    [
+        (KeyboardInterrupt(), 130),  # Ctrl-C
+        (SystemError("kernel returned a result with an exception set"), 1),  # a bug
+    ],
+    ids=["interrupted", "internal-error"],
+)
+def test_every_exit_path_is_json(command, exc, status, tmp_path, capsys, monkeypatch):
+    """The command's handler ends in Ctrl-C, or in an exception hsgeo does not know (a bug,
+    which keeps its traceback on standard error): standard output is still one JSON object
+    naming the command and the exit status."""
+    import hsgeo.cli as cli
+
+    def fail(args):
+        raise exc
+
+    monkeypatch.setattr(cli, _handler(command), fail)
+    argv = [a.format(d=tmp_path) for a in MISSING[command]] + ["--json"]
+    if status == 1:
+        with pytest.raises(type(exc)):
+            main(argv)
+    else:
+        assert main(argv) == status
+    out = _one_json(capsys.readouterr().out)
+    assert out["ok"] is False and out["exit_status"] == status and out["command"] == command
+
+
+@pytest.mark.parametrize("command", sorted(MISSING))
+def test_a_commands_own_refusal_is_json(command, tmp_path, capsys, monkeypatch):
+    """An ObservationError or a ConvergenceError raised by the work itself (not by reading the
+    files) is JSON too, with the same line as on standard error."""
+    import hsgeo.cli as cli
+    from hsgeo.errors import ConvergenceError, ObservationError
+
+    argv = [a.format(d=tmp_path) for a in MISSING[command]] + ["--json"]
+    for exc in (ObservationError("no edge in the region"), ConvergenceError("diverged")):
+
+        def fail(args, exc=exc):
+            raise exc
+
+        monkeypatch.setattr(cli, _handler(command), fail)
+        assert main(argv) == 2
+        cap = capsys.readouterr()
+        out = _one_json(cap.out)
+        assert out["ok"] is False and out["exit_status"] == 2
+        assert out["error"] in cap.err and "\n" not in out["error"]

@@ -143,11 +143,38 @@ def read_text(path, what: str, kind: str) -> str:
             raise UnicodeDecodeError("utf-8", data, data.index(b"\0"), len(data), "NUL byte")
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
+        known = _known_format(data[:8])
+        if known:
+            raise InputError(
+                f"{what} {str(path)!r} is {known}, not a {kind} text file; give the {kind} "
+                "file, saved as UTF-8 text"
+            ) from None
         raise InputError(
             f"{what} {str(path)!r} is not a {kind} text file (binary or not UTF-8 at byte "
             f"{exc.start}); give the {kind} file, saved as UTF-8"
         ) from None
     return text
+
+
+#: Leading bytes of formats a text file is mistaken for (issue 42: a Parquet table or an
+#: Excel workbook named .csv, a UTF-16 CSV, were "binary or not UTF-8 at byte N").
+_MAGIC = (
+    (b"PAR1", "a Parquet table (name it .parquet to read it as one)"),
+    (b"PK\x03\x04", "a ZIP archive (an Excel workbook? export the sheet as CSV)"),
+    (b"\xd0\xcf\x11\xe0", "an old Office document (an Excel .xls? export the sheet as CSV)"),
+    (b"\xff\xfe", "UTF-16 text (Excel's 'Unicode text'; save it as UTF-8)"),
+    (b"\xfe\xff", "UTF-16 text (save it as UTF-8)"),
+    (b"\x1f\x8b", "gzip-compressed (decompress it: gunzip)"),
+    (b"\x89HDF", "an HDF5 / NetCDF-4 file"),
+    (b"CDF", "a NetCDF-3 file"),
+)
+
+
+def _known_format(head: bytes) -> str:
+    for magic, name in _MAGIC:
+        if head.startswith(magic):
+            return name
+    return ""
 
 
 def check_outputs(outputs, inputs: Iterable = (), *, overwrite: bool = False) -> list[Path]:

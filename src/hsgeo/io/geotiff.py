@@ -193,6 +193,17 @@ def _no_georeference_warning():
         yield
 
 
+def check_dsm_bands(src, name: str) -> None:
+    """A DSM is one band of heights (issue 42: band 1 of a three-band raster was read as the
+    heights, silently).
+    """
+    if src.count != 1:
+        raise InputError(
+            f"{name}: the raster has {src.count} bands; a DSM has one, the heights in metres "
+            "(is it an image? extract the height band: gdal_translate -b N)"
+        )
+
+
 def read_dsm(path, option: str = "--dsm"):
     """A DSM GeoTIFF: heights (m, above the ellipsoid) and its grid.
 
@@ -226,7 +237,9 @@ def read_dsm(path, option: str = "--dsm"):
                     f"{option} {p}: the DSM must be north-up with square cells, got the "
                     f"transform {tuple(t)[:6]}; warp it (gdalwarp)"
                 )
+            check_dsm_bands(src, f"{option} {p}")
             z = src.read(1, masked=True).astype(float).filled(np.nan)
+            z = z * src.scales[0] + src.offsets[0]  # a scaled-integer DSM: heights in metres
             grid = MapGrid(t.c, t.f, t.a, src.width, src.height, f"EPSG:{src.crs.to_epsg()}")
     except RasterioIOError as exc:
         raise InputError(f"{option} {p}: not a raster GDAL can read ({exc})") from None

@@ -263,7 +263,8 @@ def read_lp_lines(path) -> LpStrip:
     ------
     InputError
         The file is missing or not NetCDF, a variable or attribute is missing, ``lines`` has
-        other dimensions, or the times do not increase strictly (the message names the file).
+        other dimensions, or the times neither increase nor decrease strictly (the message
+        names the file). Lines stored in decreasing time are returned in increasing time.
     """
     return _read(path, None)
 
@@ -340,6 +341,10 @@ def _strip_of(ds, name, lines_per_chunk):
     n_full = _int_attr(ds, "n_px_full", name) if "n_px_full" in ds.attrs else None
     sid = ds.attrs["strip_id"]
     sid = sid.decode() if isinstance(sid, bytes) else str(sid)
+    t_s = np.asarray(ds["t_s"].values, dtype=np.float64)
+    if t_s.size > 1 and np.all(np.diff(t_s) < 0):
+        # lines stored last first (issue 42: refused): each line keeps its own time
+        da, t_s = da.isel(line=slice(None, None, -1)), t_s[::-1].copy()
     if lines_per_chunk is None:
         lines = np.asarray(da.values, dtype=np.float32)
     else:
@@ -347,7 +352,7 @@ def _strip_of(ds, name, lines_per_chunk):
     try:
         return LpStrip(
             lines=lines,
-            t_s=np.asarray(ds["t_s"].values, dtype=np.float64),
+            t_s=t_s,
             col0=col0,
             wavelengths_nm=np.asarray(ds["wavelength_nm"].values, dtype=np.float64),
             strip_id=sid,

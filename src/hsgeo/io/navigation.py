@@ -50,6 +50,7 @@ import numpy as np
 
 from hsgeo.errors import InputError
 from hsgeo.io._files import atomic_path
+from hsgeo.io.tables import _check_separator
 from hsgeo.trajectory import Trajectory
 
 __all__ = [
@@ -336,6 +337,11 @@ def read_navigation(
     if path.suffix.lower() in (".out", ".sbet") or _is_binary(path):
         return _read_sbet_navigation(path, crs, frame, gps_week, map_crs)
     cols = _columns_of(path)
+    _check_separator(
+        f"navigation file {str(path)!r}",
+        cols,
+        ("t_s", "E_m", "N_m", "U_m", *GEODETIC_COLUMNS, *GEOCENTRIC_COLUMNS, *TIME_COLUMNS),
+    )
     geodetic = {"lat_deg", "lon_deg", "X_m", "Y_m", "Z_m", "gps_sow_s", "sod_s"}
     if not geodetic & set(cols) and ({"t_s", "E_m", "N_m", "U_m"} & set(cols)):
         # a local-ENU file (even one that lacks a column: read_trajectory names it)

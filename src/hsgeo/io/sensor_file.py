@@ -600,8 +600,9 @@ def _check_mount(path, table: str, v: dict) -> None:
     round_self = np.abs(nz * 1000.0 - np.round(nz * 1000.0)) < 1e-9
     if np.all(round_deg & ~round_self):
         shown = ", ".join(f"{x:.6g}" for x in np.rad2deg(b))
+        given = ", ".join(f"{x:.17g}" for x in b)
         raise InputError(
-            f"sensor file {path}: [{table}] boresight_deg = {list(b)} are radians (each is a "
+            f"sensor file {path}: [{table}] boresight_deg = [{given}] are radians (each is a "
             f"round number of degrees in radians: [{shown}]°); give degrees: boresight_deg = "
             f"[{shown}]"
         )

@@ -76,6 +76,17 @@ def _header(text: str) -> list[str]:
     return []
 
 
+def _looks_like_text(path) -> bool:
+    """The file's first kilobyte is UTF-8 text with a line end (a CSV named .parquet)."""
+    with open(path, "rb") as f:
+        head = f.read(1024)
+    try:
+        head.decode("utf-8")
+    except UnicodeDecodeError:
+        return False
+    return b"\0" not in head and b"\n" in head
+
+
 def _parse(path, text, parquet: bool, name: str, columns, text_columns):
     """The table as pandas reads it; a parser error becomes an :class:`InputError`."""
     import pandas as pd
@@ -96,6 +107,10 @@ def _parse(path, text, parquet: bool, name: str, columns, text_columns):
             f"{', '.join(columns)} and one row per record"
         ) from None
     except Exception as exc:  # noqa: BLE001 - any parser error becomes an InputError
+        if parquet and _looks_like_text(path):
+            raise InputError(
+                f"{name} is text (a CSV table?), not Parquet: name it .csv to read it as CSV"
+            ) from None
         kind = "Parquet" if parquet else "CSV"
         msg = " ".join(str(exc).split())
         raise InputError(f"{name} is not a readable {kind} table: {msg}") from None
@@ -103,11 +118,51 @@ def _parse(path, text, parquet: bool, name: str, columns, text_columns):
     return df
 
 
+#: Separators other than the comma that spreadsheets write (issue 42: a semicolon-separated
+#: table was told to rename its one header column to a required name).
+_OTHER_SEPARATORS = {";": "semicolons", "\t": "tabs", "|": "vertical bars"}
+
+
+def _check_separator(name: str, header: list[str], columns) -> None:
+    """A header read as one column that another separator splits into the required names is a
+    table separated by that character, not a table lacking those columns.
+    """
+    if len(header) != 1:
+        return
+    for sep, words in _OTHER_SEPARATORS.items():
+        parts = [c.strip() for c in header[0].split(sep)]
+        if len(parts) > 1 and any(c in parts for c in columns):
+            raise InputError(
+                f"{name}: the columns are separated by {words} ({sep!r}), not commas; save it "
+                "as comma-separated CSV with '.' as the decimal mark (or as Parquet)"
+            )
+
+
+def _check_dtype(df, c: str, name: str) -> None:
+    """A Parquet column states its type: a quantity must be stored as numbers (issue 42: text
+    columns were parsed silently, dates and durations read as nanoseconds).
+    """
+    import pandas as pd
+
+    kind = df[c].dtype
+    if pd.api.types.is_datetime64_any_dtype(kind) or pd.api.types.is_timedelta64_dtype(kind):
+        raise InputError(
+            f"{name}, column {c}: holds dates or durations ({kind}), not numbers; store {c} "
+            "as a float column in the unit its name says"
+        )
+    if not (pd.api.types.is_numeric_dtype(kind) and not pd.api.types.is_bool_dtype(kind)):
+        raise InputError(
+            f"{name}, column {c}: stored as {kind} (text), not numbers; store {c} as a float "
+            "column in the unit its name says"
+        )
+
+
 def _check_header(df, name: str, columns, header: list[str]) -> None:
     """Every column once (``header`` as the file spells it: pandas would rename a second
     'zeta_px' to 'zeta_px.1' and read the first silently), every required column present, and
     at least one data row.
     """
+    _check_separator(name, header, columns)
     dup = sorted({c for c in header if header.count(c) > 1}, key=header.index)
     if dup:
         raise InputError(
@@ -247,6 +302,10 @@ def read_table(
         return f"row {row + 1}"
 
     limits = dict(limits or {})
+    if parquet:
+        for c in columns:
+            if c not in text_columns and (_has_unit(c) or c in integer_columns):
+                _check_dtype(df, c, name)
     for c in columns:
         _check_column(df, c, name, where, text_columns, integer_columns, limits)
     for u in unique:

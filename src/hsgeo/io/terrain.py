@@ -145,6 +145,7 @@ def read_terrain(path, frame, bounds, vertical=None, *, cell_m: float | None = N
     from rasterio.errors import RasterioError
 
     from hsgeo.crs import use_system_proj_grids
+    from hsgeo.io.geotiff import check_dsm_bands
 
     use_system_proj_grids()
     path = Path(path)
@@ -159,15 +160,18 @@ def read_terrain(path, frame, bounds, vertical=None, *, cell_m: float | None = N
                     f"{name} has no CRS: assign it (gdal_edit.py -a_srs EPSG:n, with the "
                     "vertical datum, e.g. EPSG:25832+5941)"
                 )
+            check_dsm_bands(src, name)
             horiz, to_datum, vdesc = _crs_chain(name, src.crs.to_wkt(), vertical, frame)
             grid = _frame_grid(src, frame, horiz, (E0, N0, E1, N1), cell_m)
             win, z, affine = _read_window(src, name, horiz, frame, grid)
             nodata = src.nodata
+            scale, offset = float(src.scales[0]), float(src.offsets[0])
     except RasterioError as exc:
         raise InputError(f"{name} cannot be read by GDAL ({exc})") from exc
     source = f"{name} ({horiz.name}; heights {vdesc})"
     if nodata is not None:
         z = np.where(z == nodata, np.nan, z)
+    z = z * scale + offset  # a scaled-integer DSM (GDAL's scale and offset): metres
     U, void = _heights(frame, horiz, to_datum, z, affine, grid)
     if np.all(void):
         raise InputError(f"{name} has no valid height under the lines ({source})")

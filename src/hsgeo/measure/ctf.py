@@ -198,6 +198,12 @@ def measure_ctf(
         raise InputError("start_px must be finite and gsd_mm positive")
     end_px = start_px + target.length_mm() / gsd_mm
     inside = (x >= start_px - 2) & (x <= end_px + 2)
+    if saturation_dn > 255 and np.all(y == np.round(y)) and 0 <= y.min() and y.max() <= 255:
+        raise InputError(  # issue 42: 8-bit profiles were measured against a 12-bit bar file
+            f"the profile holds 8-bit values (whole numbers 0…255, at most {y.max():g} DN) but "
+            f"the bar file's saturation_dn is {saturation_dn:g}: give saturation_dn = 255 and "
+            "dark_dn in the profile's DN (or the profile as recorded, in the bar file's DN)"
+        )
     sat = inside & (y >= saturation_dn)
     if sat.any():
         i = int(np.flatnonzero(sat)[0])

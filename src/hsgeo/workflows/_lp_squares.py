@@ -27,13 +27,80 @@ import numpy as np
 
 from hsgeo.workflows import _lp_geometry as geo
 
-__all__ = ["predict", "candidates", "choose", "as_tie_points", "COLUMNS", "SQUARES_AS"]
+__all__ = [
+    "check_placement",
+    "predict",
+    "candidates",
+    "choose",
+    "as_tie_points",
+    "COLUMNS",
+    "SQUARES_AS",
+]
 
 #: How the squares are measured: as the matcher's tie points (002 §4) or by their blobs' centroids.
 SQUARES_AS = ("tie_point", "centroid")
 
 #: Columns of the squares' diagnostics table (:attr:`LpResult.squares`).
 COLUMNS = ["point_id", "band", "strip", "line", "t_s", "x_px", "u", "v", "snr", "ok", "box_px"]
+
+
+def check_placement(inputs, footprints, margin_m: float = 0.0) -> None:
+    """The squares lie on the ground the strips see, in the navigation's frame and units.
+
+    Issue 42: squares far outside the strips, in longitude/latitude, with E and N swapped or
+    heights in mm gave an answer without the squares (or with blobs that are not them), exit 0.
+    Refused: no square inside any strip's footprint (``footprints``: the strips' quadrilaterals
+    on the terrain plane, :func:`hsgeo.workflows._lp_geometry.footprint`); more squares inside
+    with E and N exchanged; heights that spread over more than the block's width or reach the
+    aircraft.
+
+    Raises
+    ------
+    InputError
+    """
+    from hsgeo.errors import InputError
+
+    xyz = np.asarray(inputs.square_xyz_m, float)
+    n = len(xyz)
+    low = float(np.min(np.asarray(inputs.navigation.xyz_m, float)[:, 2]))
+    if np.max(xyz[:, 2]) >= low:
+        raise InputError(
+            f"the squares (--squares) reach H_m {np.max(xyz[:, 2]):.6g} m, not below the "
+            f"aircraft (U_m down to {low:.6g} m in the navigation): give H_m in metres, in the "
+            "navigation's height system"
+        )
+    width = float(np.max(np.ptp(xyz[:, :2], axis=0))) if n > 1 else 0.0
+    spread = float(np.ptp(xyz[:, 2])) if n > 1 else 0.0
+    if spread > max(width, 10.0):
+        raise InputError(
+            f"the squares' heights (--squares H_m) spread over {spread:.6g} m across a block "
+            f"{width:.6g} m wide: are they in mm? give H_m in metres"
+        )
+
+    def inside(EN):
+        hit = np.zeros(n, bool)
+        for fp in footprints:
+            hit |= geo.inside_convex(EN, fp, margin_m)
+        return int(hit.sum())
+
+    given, swapped = inside(xyz[:, :2]), inside(xyz[:, 1::-1])
+    if given == 0 and swapped == 0:
+        E, N = xyz[:, 0], xyz[:, 1]
+        P = np.concatenate(footprints)
+        raise InputError(
+            f"none of the {n} squares (--squares) lies on the ground the strips see (squares "
+            f"at E {E.min():.6g}…{E.max():.6g}, N {N.min():.6g}…{N.max():.6g} m; the strips "
+            f"cover E {P[:, 0].min():.6g}…{P[:, 0].max():.6g}, N {P[:, 1].min():.6g}…"
+            f"{P[:, 1].max():.6g} m): give E_m, N_m in metres in the navigation's frame (not "
+            "longitude/latitude), the navigation of these lines (on their time scale, not "
+            "shifted; heading in degrees from north), or the squares of these strips"
+        )
+    if swapped > max(2 * given, given + 2):
+        raise InputError(
+            f"{given} of the {n} squares (--squares) lie on the ground the strips see, {swapped} "
+            "with E_m and N_m exchanged: are the columns E_m and N_m swapped? give E_m east "
+            "and N_m north"
+        )
 
 
 def predict(strip, inputs, height):

@@ -294,6 +294,30 @@ class LpResult:
 # ----------------------------------------------------------------------------------------------
 # The in-memory core
 # ----------------------------------------------------------------------------------------------
+#: A line camera's field of view beyond which a unit of c_mm or pixel_mm is the likelier cause.
+WIDE_FOV_DEG = 60.0
+
+
+def _wide_camera(inputs: LpInputs) -> str:
+    """The camera's full-line field of view, named when implausibly wide (issue 42: c_mm or
+    pixel_mm in another unit ended in 'too short, poor texture, or too far off').
+    """
+    c = float(np.atleast_1d(inputs.camera.c_mm)[0])
+    half_mm = 0.5 * inputs.n_px_full * float(inputs.camera.pixel_mm)
+    fov = float(np.degrees(2.0 * np.arctan2(half_mm, c)))
+    if fov <= WIDE_FOV_DEG:
+        return ""
+    return (
+        f"; the camera's field of view across the line is {fov:.0f}° ({inputs.n_px_full} px of "
+        f"pixel_mm {float(inputs.camera.pixel_mm):g} at c_mm {c:g}): is c_mm or pixel_mm in "
+        "another unit?"
+    )
+
+
+def _nm(wl) -> str:
+    return "[" + ", ".join(f"{v:.6g}" for v in wl) + "] nm"
+
+
 def _check(inputs: LpInputs, options: LpOptions) -> tuple[tuple, float]:
     """Bands and the terrain height; one clear error for what cannot work."""
     from hsgeo.validate import check_navigation_covers
@@ -317,6 +341,15 @@ def _check(inputs: LpInputs, options: LpOptions) -> tuple[tuple, float]:
             + "; give strips of the same bands"
         )
     nb = n_bands.pop()
+    wl0 = np.asarray(strips[0].wavelengths_nm, float)
+    for i, s in zip(ids[1:], strips[1:], strict=True):
+        wl = np.asarray(s.wavelengths_nm, float)
+        if not np.allclose(wl, wl0, rtol=0.0, atol=0.5):  # issue 42: matched band by band
+            raise InputError(
+                f"strip {i}'s bands differ from strip {ids[0]}'s (wavelength_nm "
+                f"{_nm(wl)} against {_nm(wl0)}): a band is matched with the same band of the "
+                "other strips; give strips of the same camera and bands"
+            )
     if nb != n_cam:
         raise InputError(
             f"the strips hold {nb} bands but the camera has {n_cam} principal distances "
@@ -348,7 +381,7 @@ def _check(inputs: LpInputs, options: LpOptions) -> tuple[tuple, float]:
     return bands, float(h)
 
 
-def _check_overlap(inputs: LpInputs, options: LpOptions, height: float) -> None:
+def _check_overlap(inputs: LpInputs, options: LpOptions, height: float) -> list:
     """Some two strips' footprints overlap (before any work; scenes are checked again)."""
     from hsgeo.workflows._lp_geometry import convex_overlap, footprint
 
@@ -368,6 +401,7 @@ def _check_overlap(inputs: LpInputs, options: LpOptions, height: float) -> None:
             "of these lines (the same time scale), and the terrain height (--height) or the "
             "squares (--squares)"
         )
+    return fps
 
 
 def retrieve(inputs: LpInputs, options: LpOptions = LpOptions(), progress=None) -> LpResult:
@@ -422,7 +456,7 @@ def retrieve(inputs: LpInputs, options: LpOptions = LpOptions(), progress=None) 
             f"no pair of overlapping scenes has {MIN_MATCHES} matches (the LP fundamental "
             f"matrix's minimum, 002 §3.1; at most {most}): the scenes are too short "
             "(--scene-lines), the bands too poor in texture, or the navigation or camera too "
-            "far off for the footprints"
+            "far off for the footprints" + _wide_camera(inputs)
         )
     kept = m["lp"] if options.ransac == "lp" else m["frame"]
     t0 = time.perf_counter()
@@ -743,11 +777,11 @@ def lp_observation_files(
     cam = read_pushbroom_camera(camera)
     ids, xyz = (), None
     if squares is not None:
-        sq = read_table(
+        table = read_table(
             squares, GCP_COLUMNS, "squares", text_columns=("point_id",), unique=("point_id",)
         )
-        ids = tuple(sq["point_id"].astype(str))
-        xyz = sq[["E_m", "N_m", "H_m"]].to_numpy(dtype=float)
+        ids = tuple(table["point_id"].astype(str))
+        xyz = table[["E_m", "N_m", "H_m"]].to_numpy(dtype=float)
     for p, s in zip(scenes, strips, strict=True):
         check_navigation_covers(
             traj.t_s,
@@ -758,6 +792,17 @@ def lp_observation_files(
         )
     n_px = full_line_px(strips, n_px_full)
     inputs = LpInputs(tuple(strips), traj, cam, ids, xyz, height_m, n_px)
+    if squares is not None:  # the squares where the strips see the ground (issue 42)
+        _, height = _check(inputs, options)
+        sq.check_placement(inputs, _check_overlap(inputs, options, height))
     res = retrieve(inputs, options, progress=progress)
+    if squares is not None and res.counts["all"]["squares"] == 0:
+        raise ObservationError(  # issue 42: a navigation shifted in time gave 0 squares, exit 0
+            f"none of the {len(ids)} squares of {str(squares)!r} was found where the navigation "
+            "and the camera put it in the strips: is the navigation on the lines' time scale "
+            "(not shifted), the camera's boresight and lever arm right (degrees, metres), the "
+            "squares' E_m, N_m, H_m in the navigation's frame? (without --squares, give "
+            "--height)"
+        )
     write_table(output, pd.DataFrame(res.table), inputs=[f for f in files if f is not None])
     return res

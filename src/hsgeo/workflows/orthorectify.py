@@ -41,6 +41,8 @@ __all__ = [
 
 #: How long ``--scheduler`` waits for the scheduler to answer, s.
 SCHEDULER_TIMEOUT_S = 10.0
+#: How long a TCP --scheduler may take to send its handshake (a dask scheduler sends it at once).
+SCHEDULER_GREETING_S = 5.0
 #: The largest raster built, GiB of float32 (a --resolution far finer than the ground pixels).
 MAX_MOSAIC_GIB = 64.0
 
@@ -127,7 +129,7 @@ def orthorectify(inputs: OrthoInputs, options: OrthoOptions = OrthoOptions()):
         raise InputError(str(exc)) from None
 
 
-def _terrain(dsm, height_m, frame, U_m):
+def _terrain(dsm, height_m, frame, U_m, strips=None):
     """The terrain: ``--dsm`` a GeoTIFF (map CRS) or a NetCDF DEM (local frame), or a plane;
     checked to lie below the aircraft (``U_m``: its heights in the navigation).
     """
@@ -159,7 +161,41 @@ def _terrain(dsm, height_m, frame, U_m):
             )
         return DemTerrain(dem)
     z, grid = read_dsm(dsm)
-    return MapTerrain(z, grid, frame, source=f"--dsm {str(dsm)!r}")
+    source = f"--dsm {str(dsm)!r}"
+    void = ~np.isfinite(z)
+    if strips is None or not void.any() or void.all():
+        return MapTerrain(z, grid, frame, source=source)
+    return _terrain_with_voids(z, void, grid, frame, source, strips)
+
+
+def _terrain_with_voids(z, void, grid, frame, source, strips):
+    """A DSM with voids (nodata) away from the lines is accepted (issue 42: a nodata corner far
+    from the strips was refused): the voids take their nearest height, and the lines' edge rays
+    and about 64 whole lines per strip must not meet the ground in a cell touching one.
+    """
+    from scipy.ndimage import distance_transform_edt
+
+    from hsgeo.mapgrid import MapTerrain
+    from hsgeo.workflows._ortho_geodetic import _edge_points
+
+    idx = distance_transform_edt(void, return_distances=False, return_indices=True)
+    terrain = MapTerrain(z[tuple(idx)], grid, frame, source=source)
+    g = _edge_points(strips, terrain, frame, lattice=True)
+    x, y, _ = frame.enu_to_map(g[:, 0], g[:, 1], g[:, 2])
+    r = grid.resolution_m
+    col = (np.asarray(x) - grid.x_min_m) / r - 0.5  # cell-centre coordinates
+    row = (grid.y_max_m - np.asarray(y)) / r - 0.5
+    c0 = np.clip(np.floor(col).astype(int), 0, grid.width - 1)
+    r0 = np.clip(np.floor(row).astype(int), 0, grid.height - 1)
+    c1, r1 = np.minimum(c0 + 1, grid.width - 1), np.minimum(r0 + 1, grid.height - 1)
+    touch = void[r0, c0] | void[r0, c1] | void[r1, c0] | void[r1, c1]
+    if touch.any():
+        raise InputError(
+            f"{source}: {int(void.sum())} cells without a height (nodata or NaN), "
+            f"{int(touch.sum())} of {touch.size} sampled ground points of the lines among "
+            "them: fill them (gdal_fillnodata.py) or give a DSM with heights under the lines"
+        )
+    return terrain
 
 
 def _geodetic_terrain(dsm, height_m, frame, U_m, strips, vertical):
@@ -348,7 +384,7 @@ def orthorectify_files(
     if geodetic:
         terrain = _geodetic_terrain(dsm, height_m, frame, U, strips, vertical)
     else:
-        terrain = _terrain(dsm, height_m, frame, U)
+        terrain = _terrain(dsm, height_m, frame, U, strips)
     names = (
         [f"{w:g} nm" for w in wl] if wl is not None else [str(i) for i in range(strips[0].n_bands)]
     )
@@ -407,6 +443,46 @@ def _check_distinct(lines) -> None:
         seen[key] = p
 
 
+def _probe_scheduler(scheduler: str) -> None:
+    """A TCP ``--scheduler`` must greet as dask's does: its end of the handshake comes first,
+    unasked (issue 42: at an HTTP port, which waits for a request, ``Client(timeout=...)``
+    waited for ever — a TimeoutError traceback after 20 s in an earlier version).
+    """
+    import socket
+
+    from distributed.comm.addressing import parse_address, parse_host_port
+
+    try:
+        scheme, loc = parse_address(scheduler)
+        if scheme != "tcp":
+            return  # tls, ucx, inproc: Client's own checks
+        host, port = parse_host_port(loc)
+    except (ValueError, TypeError):
+        return  # Client names a malformed address itself
+    t = SCHEDULER_GREETING_S
+    try:
+        with socket.create_connection((host, int(port)), timeout=t) as sock:
+            sock.settimeout(t)
+            greeting = sock.recv(8)
+    except TimeoutError:
+        raise InputError(
+            f"--scheduler {scheduler}: a server answers there but sends no dask handshake "
+            f"within {t:g} s (a web server or another service?); give the address of a dask "
+            "scheduler (dask scheduler prints it) or leave the option out"
+        ) from None
+    except OSError as exc:
+        raise InputError(
+            f"--scheduler {scheduler}: no dask scheduler answers there ({type(exc).__name__}: "
+            f"{exc.strerror or exc}); start one (dask scheduler; dask worker ADDRESS) or leave "
+            "the option out"
+        ) from None
+    if not greeting:
+        raise InputError(
+            f"--scheduler {scheduler}: the server there closed the connection without a dask "
+            "handshake; give the address of a dask scheduler or leave the option out"
+        )
+
+
 @contextmanager
 def _client(scheduler):
     """The tiles computed on the ``dask.distributed`` scheduler at ``scheduler`` (None: threads
@@ -420,6 +496,7 @@ def _client(scheduler):
     import dask
     from distributed import Client
 
+    _probe_scheduler(scheduler)
     try:
         client = Client(scheduler, timeout=f"{SCHEDULER_TIMEOUT_S}s", set_as_default=False)
     except (OSError, TimeoutError, ValueError) as exc:
