@@ -179,3 +179,61 @@ def test_bad_input_one_line_exit_2(flight, capsys, extra, expect):
     err = capsys.readouterr().err.strip()
     assert expect in err and "\n" not in err and "Traceback" not in err, err
     assert not out.exists()
+
+
+def _truncated_sbet(d):
+    p = d / "cut.out"
+    p.write_bytes((d / "nav.out").read_bytes()[:-20])  # the last record cut short
+    return ["--trajectory", str(p), "--nav-crs", "EPSG:4979", "--vertical", "ellipsoidal"]
+
+
+def _void_under_the_line(d):
+    import rasterio
+
+    p = d / "void.tif"
+    with rasterio.open(d / "dsm.tif") as src:
+        z, profile = src.read(1), src.profile
+    z[90:110, 90:110] = -9999.0  # ±100 m about the line's centre
+    profile["nodata"] = -9999.0
+    with rasterio.open(p, "w", **profile) as dst:
+        dst.write(z, 1)
+    return ["--dsm", str(p), "--nav-crs", "EPSG:4979", "--vertical", "ellipsoidal"]
+
+
+def _geodetic_csv_cut(d):
+    p = d / "cut.csv"
+    rows = _geodetic_csv(d).read_text().splitlines()
+    rows[40] = ",".join(rows[40].split(",")[:4])  # a record without its attitude
+    p.write_text("\n".join(rows) + "\n")
+    return ["--trajectory", str(p), "--vertical", "ellipsoidal"]
+
+
+@pytest.mark.parametrize(
+    "make, expect",
+    [
+        (_truncated_sbet, r"cut\.out.*truncated"),
+        (_void_under_the_line, r"void\.tif.*void.*(Fill|fill)"),
+        (_geodetic_csv_cut, r"cut\.csv.*line"),
+    ],
+    ids=["truncated-sbet", "dsm-void-under-the-line", "geodetic-csv-short-row"],
+)
+def test_bad_new_formats_one_line_exit_2(flight, capsys, make, expect):
+    """The new formats broken as users break them, through the command: a truncated SBET, a DSM
+    with a void under the line, a geodetic CSV row cut short → one line naming the file and the
+    problem, exit 2, no output."""
+    import re
+
+    d, argv, _ = flight
+    argv = list(argv)
+    extra = make(d)
+    for opt in ("--trajectory", "--dsm"):  # replaced, not repeated
+        if opt in extra:
+            i = argv.index(opt)
+            argv[i + 1] = extra[extra.index(opt) + 1]
+            j = extra.index(opt)
+            extra = extra[:j] + extra[j + 2 :]
+    out = d / "bad_new.tif"
+    assert main([*argv, *extra, "-o", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert re.search(expect, err) and "\n" not in err and "Traceback" not in err, err
+    assert not out.exists()
