@@ -110,6 +110,41 @@ def test_every_model_is_read_from_its_file(case):
         assert callable(getattr(case.sensor, "line_time", None))
 
 
+def test_every_scanning_sensor_has_one_line_time():
+    """One signature for every scanning sensor's ``line_time`` (so a caller need not know the
+    model), and each finds the time at which a point on a pixel's ray was on the line.
+    """
+    import inspect
+
+    sigs = {
+        m.cls.__name__: inspect.signature(m.cls.line_time)
+        for m in MODELS.values()
+        if hasattr(m.cls, "line_time")
+    }
+    scanning = {m.cls.__name__ for m in MODELS.values() if m.kind == "scanning"}
+    assert set(sigs) == scanning, (sigs, scanning)
+    assert len(scanning) == 4  # line scanner, pushbroom, panoramic, view angle
+    shapes = {
+        name: [(q.name, q.kind, q.default) for q in s.parameters.values()]
+        for name, s in sigs.items()
+    }
+    first = next(iter(shapes.values()))
+    for name, shape in shapes.items():
+        assert shape == first, (name, shape, first)
+
+
+def test_line_time_finds_the_time_of_a_point_on_a_pixel_ray(case):
+    if case.kind != "scanning":
+        pytest.skip("a frame sensor has no line time")
+    px = case.px.copy()
+    if px.ndim == 2:  # the pushbroom camera: pixels on the line (image y = 0)
+        px[:, 1] = 0.0
+    o, d = case.rays(px)
+    X = o + np.random.default_rng(2).uniform(*case.range_m, case.n)[:, None] * d
+    t = case.sensor.line_time(X, case.nav, case.t + 0.2, band=case.band)
+    np.testing.assert_allclose(t, case.t, rtol=0, atol=1e-8)
+
+
 def check_round_trip(case, tol_px=1e-8):
     rng = np.random.default_rng(1)
     o, d = case.rays()

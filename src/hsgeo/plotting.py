@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from hsgeo.papers import RIKOLA_BANDS
+from hsgeo.sensors.rikola import focal_from_gap_mm
 
 __all__ = [
     "residual_quiver",
@@ -204,9 +205,9 @@ def plot_gap_model(ax, gaps, f_hat, f_sig, regression, sensor, truth_ab=None):
         gaps, f_hat, yerr=f_sig, fmt="o", color=c, label=f"sensor {'I' if sensor == 1 else 'II'}"
     )
     g = np.linspace(min(gaps) - 10, max(gaps) + 10, 2)
-    ax.plot(g, regression["a"] * g + regression["b"], "-", color=c)
+    ax.plot(g, focal_from_gap_mm(g, regression["a"], regression["b"]), "-", color=c)  # 003 eq. (2)
     if truth_ab is not None:
-        ax.plot(g, truth_ab[0] * g + truth_ab[1], ":", color=c)
+        ax.plot(g, focal_from_gap_mm(g, truth_ab[0], truth_ab[1]), ":", color=c)
     ax.set_xlabel("FPI air gap (nm)")
     ax.set_ylabel("f (mm)")
     return ax

@@ -262,6 +262,30 @@ class FrameOpenCV(_FrameBase):
         return self._pack(r2, dp, dX, extra)
 
 
+def body_frames(poses, view) -> tuple[np.ndarray, np.ndarray]:
+    """Position and ``R_world_from_body`` of the body at each pixel's or point's exposure.
+
+    The one reading of a frame sensor's poses (:class:`FrameCamera`,
+    :class:`hsgeo.sensors.rikola.RikolaCamera`).
+
+    Parameters
+    ----------
+    poses : (n_views, 6) array_like
+        Rows ``(ω, φ, κ, X0, Y0, Z0)`` with ``R_world_from_body = R_from_opk(ω, φ, κ)``.
+    view : (n,) array_like of int
+        The pose of each pixel or point.
+
+    Returns
+    -------
+    xyz_body : (n, 3) ndarray
+    R_world_from_body : (n, 3, 3) ndarray
+    """
+    poses = np.atleast_2d(np.asarray(poses, dtype=float))
+    view = np.asarray(view, dtype=np.int64)
+    R = R_from_opk(poses[:, 0], poses[:, 1], poses[:, 2])[view]  # R_world_from_body
+    return poses[view, 3:6], R
+
+
 def pixel_to_mm(uv_px, image_size, pixel_pitch_mm):
     """Pixel coordinates to mm from the image centre with y up (photogrammetric image frame).
 
@@ -384,10 +408,7 @@ class FrameCamera:
     mount: Mount = field(default_factory=Mount)
 
     def _frames(self, poses, view):
-        poses = np.atleast_2d(np.asarray(poses, dtype=float))
-        view = np.asarray(view, dtype=np.int64)
-        R = R_from_opk(poses[:, 0], poses[:, 1], poses[:, 2])[view]  # R_world_from_body
-        return poses[view, 3:6], R
+        return body_frames(poses, view)
 
     def rays(self, uv_px, poses, view) -> tuple[np.ndarray, np.ndarray]:
         """Origins and unit directions (world frame) of the rays of pixels ``(n, 2)``."""

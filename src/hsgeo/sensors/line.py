@@ -34,6 +34,7 @@ __all__ = [
     "ray_directions",
     "BoresightGCP",
     "calibrate_boresight",
+    "sensor_directions",
 ]
 
 
@@ -96,6 +97,15 @@ class CalibratedLine(LineGeometry):
         return line1d.zeta_from_tan(tan_angle, self.zeta0_px, self.c_px, self.K)
 
 
+def sensor_directions(tan_angle) -> np.ndarray:
+    """Sensor-frame directions ``(0, t, 1)`` ``(n, 3)`` of pixels whose across-track view angle
+    has tangent ``t`` (the one place the line scanner's pixel → camera ray is written; the
+    tangent comes from :meth:`LineGeometry.tan_angle`).
+    """
+    t = np.asarray(tan_angle, dtype=float).ravel()
+    return np.stack([np.zeros_like(t), t, np.ones_like(t)], axis=1)
+
+
 def ray_directions(rpy_rad, tan_angle, R_body_from_sensor=None) -> np.ndarray:
     """Map-frame directions of line-scanner pixels.
 
@@ -114,8 +124,7 @@ def ray_directions(rpy_rad, tan_angle, R_body_from_sensor=None) -> np.ndarray:
         Unnormalised directions ``R_enu_from_ned R_ned_from_body R_body_from_sensor (0, t, 1)``.
     """
     rpy = np.atleast_2d(np.asarray(rpy_rad, dtype=float))
-    t = np.asarray(tan_angle, dtype=float).ravel()
-    d_s = np.stack([np.zeros_like(t), t, np.ones_like(t)], axis=1)
+    d_s = sensor_directions(tan_angle)
     if R_body_from_sensor is not None:
         d_s = d_s @ np.asarray(R_body_from_sensor).T
     R = R_ENU_FROM_NED @ R_from_rpy(rpy[:, 0], rpy[:, 1], rpy[:, 2])
@@ -155,8 +164,7 @@ class LineScanner:
         origins_m : (n, 3) ndarray
         directions : (n, 3) ndarray, unit length
         """
-        t = np.asarray(self.geometry.tan_angle(zeta_px), dtype=float).ravel()
-        d_s = np.stack([np.zeros_like(t), t, np.ones_like(t)], axis=1)
+        d_s = sensor_directions(self.geometry.tan_angle(zeta_px))
         return self.mount.rays_along(d_s, t_s, trajectory)
 
     def _sensor_xyz(self, xyz_map_m, t_s, trajectory) -> np.ndarray:
@@ -169,11 +177,41 @@ class LineScanner:
         return np.column_stack([zeta, self.geometry.c_px * p[:, 0] / p[:, 2]])
 
     def line_time(
-        self, xyz_map_m, trajectory, t_start_s, *, tol_s: float = 1e-10, max_iter: int = 30
+        self,
+        xyz_map_m,
+        trajectory,
+        t_start_s,
+        *,
+        band=None,
+        tol_s: float = 1e-10,
+        max_iter: int = 30,
     ) -> np.ndarray:
         """Time at which each map point lies on the scan line (``across_px = 0``), s.
 
-        Secant iteration from ``t_start_s`` (one per point), within the trajectory's span.
+        Secant iteration from ``t_start_s`` (one per point), within the trajectory's span
+        (:func:`hsgeo.sensors.mount.line_time`; the signature every scanning sensor shares).
+
+        Parameters
+        ----------
+        xyz_map_m : (n, 3) array_like, m
+            Map points.
+        trajectory : hsgeo.trajectory.Trajectory
+        t_start_s : float or (n,) array_like, s
+            Where the secant iteration starts (clipped to the trajectory's span).
+        band : int or (n,) array_like of int, optional
+            Accepted for the shared signature; every band has this one geometry.
+        tol_s : float
+            Convergence threshold on the time step, s.
+        max_iter : int
+
+        Returns
+        -------
+        t_s : (n,) ndarray, s
+
+        Raises
+        ------
+        hsgeo.errors.ConvergenceError
+            A point the line never crosses within ``max_iter`` steps.
         """
 
         def across_px(X, t):
@@ -225,8 +263,7 @@ class BoresightGCP(ResidualBlock):
         self.t_s = t0_s + np.asarray(line, float) / line_rate_hz
         self.zeta_px = np.asarray(zeta_px, dtype=float)
         self.R_mb = nav.R_map_from_body(self.t_s)
-        t = scanner.geometry.tan_angle(zeta_px)
-        self.d_s = np.stack([np.zeros_like(t), t, np.ones_like(t)], axis=1)
+        self.d_s = sensor_directions(scanner.geometry.tan_angle(zeta_px))
         self.gcp_en = gcp[:, :2]
         self.h = height_m
 
@@ -241,7 +278,7 @@ class BoresightGCP(ResidualBlock):
         r = (X[:, :2] - self.gcp_en).ravel()
         if not jacobian:
             return r, None
-        d = np.einsum("nij,jk,nk->ni", self.R_mb, R_from_rpy(*b), self.d_s)  # unnormalised u
+        d = face.mount.directions(self.R_mb, self.d_s)  # u unnormalised: the face's mount
         s = (self.h - o[:, 2]) / d[:, 2]
         dR = dR_drpy(*b)  # (3 angles, 3, 3)
         dd = np.einsum("nij,kjl,nl->nki", self.R_mb, dR, self.d_s)  # (n, 3 angles, 3)

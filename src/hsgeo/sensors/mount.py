@@ -142,8 +142,10 @@ class Sensor(Protocol):
 def line_time(across_px, xyz_map_m, trajectory, t_start_s, tol_s=1e-10, max_iter=30) -> np.ndarray:
     """Secant iteration on ``across_px(X, t) = 0``: when a scanning sensor sees each point, s.
 
-    Shared by the scanning sensors (line, pushbroom, panoramic): ``across_px`` is the point's
-    offset from the scan line at time ``t``.
+    Shared by the scanning sensors (line, pushbroom, panoramic, view angle): ``across_px`` is the
+    point's offset from the scan line at time ``t``. Each offers it with one signature,
+    ``sensor.line_time(xyz_map_m, trajectory, t_start_s, *, band=None, tol_s=1e-10,
+    max_iter=30)`` (``band`` chooses the line of a sensor whose bands differ).
     """
     X = np.atleast_2d(np.asarray(xyz_map_m, dtype=float))
     lo, hi = trajectory.t_s[0], trajectory.t_s[-1]

@@ -151,9 +151,42 @@ class PanoramicScanner:
         return np.einsum("nai,nij->naj", np.stack([dzeta, dacross], axis=1), M)
 
     def line_time(
-        self, xyz_map_m, trajectory, t_start_s, *, tol_s: float = 1e-10, max_iter: int = 30
+        self,
+        xyz_map_m,
+        trajectory,
+        t_start_s,
+        *,
+        band=None,
+        tol_s: float = 1e-10,
+        max_iter: int = 30,
     ) -> np.ndarray:
-        """Time at which each map point lies in the scan plane (``across_px = 0``), s."""
+        """Time at which each map point lies in the scan plane (``across_px = 0``), s.
+
+        Secant iteration from ``t_start_s`` (one per point), within the trajectory's span
+        (:func:`hsgeo.sensors.mount.line_time`; the signature every scanning sensor shares).
+
+        Parameters
+        ----------
+        xyz_map_m : (n, 3) array_like, m
+            Map points.
+        trajectory : hsgeo.trajectory.Trajectory
+        t_start_s : float or (n,) array_like, s
+            Where the secant iteration starts (clipped to the trajectory's span).
+        band : int or (n,) array_like of int, optional
+            Accepted for the shared signature; every channel has this one geometry.
+        tol_s : float
+            Convergence threshold on the time step, s.
+        max_iter : int
+
+        Returns
+        -------
+        t_s : (n,) ndarray, s
+
+        Raises
+        ------
+        hsgeo.errors.ConvergenceError
+            A point the line never crosses within ``max_iter`` steps.
+        """
 
         def across_px(X, t):
             return self.project(X, t, trajectory)[:, 1]

@@ -87,14 +87,13 @@ import numpy as np
 from hsgeo._kernels import pushbroom_image_rows
 from hsgeo.adjust import Indexed, ResidualBlock
 from hsgeo.distortion import (
-    distort_pushbroom_line,
     distort_pushbroom_line_jacobian,
     undistort_pushbroom_line,
 )
 from hsgeo.errors import InputError, ObservationError
 from hsgeo.rotations import R_from_opk, R_from_rpy, dR_dopk, dR_drpy
 from hsgeo.sensors._pushbroom_kernel import _lines_kernel
-from hsgeo.sensors.mount import Mount, line_time
+from hsgeo.sensors.mount import Mount, line_time, unit
 from hsgeo.trajectory import R_BODY_FROM_PLATFORM, SplineNodes, bspline_basis
 
 __all__ = [
@@ -686,10 +685,18 @@ class PushbroomCamera:
         return R_from_opk(*np.asarray(self.boresight_rad, float)) @ np.asarray(self.beta0)
 
     @property
+    def platform_mount(self) -> Mount:
+        """The camera's mount on 002's platform frame (x forward, y left, z up): lever arm
+        ``l^p`` and ``R_platform_from_camera = βᵀ``.
+        """
+        return Mount(np.asarray(self.lever_arm_m, float), self.beta.T)
+
+    @property
     def mount(self) -> Mount:
         """The camera's mount on the trajectory's body frame (lever arm and boresight)."""
         D = R_BODY_FROM_PLATFORM
-        return Mount(D @ np.asarray(self.lever_arm_m, float), D @ self.beta.T)
+        m = self.platform_mount
+        return Mount(D @ m.lever_arm_m, D @ m.R_body_from_sensor)
 
     def _band_c(self, band, n) -> np.ndarray:
         c = np.atleast_1d(np.asarray(self.c_mm, dtype=float))
@@ -720,10 +727,8 @@ class PushbroomCamera:
         n = xy_mm.shape[0]
         d_cam = np.column_stack([xy_mm, self._band_c(band, n)])
         R = np.asarray(R_map_from_platform, dtype=float)
-        d = np.einsum("mij,mj->mi", R, d_cam @ self.beta)  # R βᵀ d_cam
-        d /= np.linalg.norm(d, axis=1, keepdims=True)
-        o = np.asarray(xyz_platform_m, dtype=float) + R @ np.asarray(self.lever_arm_m, float)
-        return o, d
+        m = self.platform_mount  # 002 eq. (4) read backwards: x + R l^p and R βᵀ d_cam
+        return m.origins(xyz_platform_m, R), unit(m.directions(R, d_cam))
 
     def rays(self, xy_px, t_s, trajectory, band=0) -> tuple[np.ndarray, np.ndarray]:
         """Origins (m) and unit directions of the rays of pixels seen at times ``t_s``.
@@ -743,16 +748,26 @@ class PushbroomCamera:
 
     def project_at(self, xyz_map_m, band, xyz_platform_m, R_map_from_platform) -> np.ndarray:
         """Pixels ``(n, 2)`` of map points at given platform poses (002 eq. (2)–(4))."""
-        R = np.asarray(R_map_from_platform, dtype=float)
-        d = np.atleast_2d(np.asarray(xyz_map_m, float)) - np.asarray(xyz_platform_m, float)
-        q = np.einsum("nji,nj->ni", R, d) - np.asarray(self.lever_arm_m, float)  # 002 eq. (4)
-        p = q @ self.beta.T
+        d = np.atleast_2d(np.asarray(xyz_map_m, float) - np.asarray(xyz_platform_m, float))
+        R = np.broadcast_to(np.asarray(R_map_from_platform, dtype=float), (d.shape[0], 3, 3))
+        c = self._band_c(band, d.shape[0])
+        # 002 eq. (3)–(4): the compiled cores the adjustment's kernel calls (hsgeo._kernels)
+        try:
+            _, p, xy, *_ = pushbroom_image_rows(
+                np.ascontiguousarray(R),
+                np.ascontiguousarray(d, dtype=np.float64),
+                np.asarray(self.lever_arm_m, dtype=np.float64),
+                np.ascontiguousarray(self.beta),
+                np.ascontiguousarray(c),
+                np.asarray(self.distortion, dtype=np.float64),
+                float(self.x0_mm),
+                float(self.y0_mm),
+            )
+        except ZeroDivisionError:  # a point in the camera's plane (p^c_z = 0)
+            p = np.zeros((1, 3))
         if np.any(p[:, 2] <= 0):
             raise ObservationError("points behind the pushbroom camera (p^c_z ≤ 0)")
-        c = self._band_c(band, p.shape[0])
-        xy_bar = c[:, None] * p[:, :2] / p[:, 2:3]  # 002 eq. (3), collinearity
-        xy = distort_pushbroom_line(xy_bar, self.distortion)
-        return (xy + np.array([self.x0_mm, self.y0_mm])) / self.pixel_mm
+        return xy / self.pixel_mm
 
     def project(self, xyz_map_m, t_s, trajectory, band=0) -> np.ndarray:
         """Pixels ``(x, y)`` ``(n, 2)`` of map points at times ``t_s`` (y = 0 on the line)."""
@@ -766,15 +781,38 @@ class PushbroomCamera:
         trajectory,
         t_start_s,
         *,
-        band=0,
+        band=None,
         tol_s: float = 1e-10,
         max_iter: int = 30,
     ) -> np.ndarray:
         """Time at which each map point is on the line of ``band`` (image ``y = 0``), s.
 
         Secant iteration from ``t_start_s`` (one per point), within the trajectory's span
-        (:func:`hsgeo.sensors.mount.line_time`, as for the other scanning sensors).
+        (:func:`hsgeo.sensors.mount.line_time`; the signature every scanning sensor shares).
+
+        Parameters
+        ----------
+        xyz_map_m : (n, 3) array_like, m
+            Map points.
+        trajectory : hsgeo.trajectory.Trajectory
+        t_start_s : float or (n,) array_like, s
+            Where the secant iteration starts (clipped to the trajectory's span).
+        band : int or (n,) array_like of int, optional
+            0-based band (its principal distance); None: band 0.
+        tol_s : float
+            Convergence threshold on the time step, s.
+        max_iter : int
+
+        Returns
+        -------
+        t_s : (n,) ndarray, s
+
+        Raises
+        ------
+        hsgeo.errors.ConvergenceError
+            A point the line never crosses within ``max_iter`` steps.
         """
+        band = 0 if band is None else band
 
         def across_px(X, t):
             return self.project(X, t, trajectory, band=band)[:, 1]

@@ -53,11 +53,18 @@ from hsgeo.distortion import (
 )
 from hsgeo.errors import InputError
 from hsgeo.rotations import R_from_opk, dR_dopk
-from hsgeo.sensors.frame import _dproj, camera_coordinates, mm_to_pixel, pixel_to_mm
+from hsgeo.sensors.frame import (
+    _dproj,
+    body_frames,
+    camera_coordinates,
+    mm_to_pixel,
+    pixel_to_mm,
+)
 from hsgeo.sensors.mount import Mount, unit
 
 __all__ = [
     "project_measured_mm",
+    "camera_II_from_I",
     "centroid_model",
     "TargetCentroids",
     "JointCentroids",
@@ -95,6 +102,37 @@ def focal_from_gap_mm(gap_nm, a_mm_per_nm, b_mm):
     )  # 003 eq. (2)
 
 
+def _ideal_mm(Xc, f_mm):
+    """Ideal image coordinates ``−f·q`` (mm) and ``q = (X_c/Z_c, Y_c/Z_c)`` of camera-frame
+    points ``(..., 3)``: the collinearity of 003 (the one place it is coded; ``f_mm`` broadcasts
+    against ``Xc[..., 0]``).
+    """
+    q = Xc[..., :2] / Xc[..., 2:3]
+    return -np.asarray(f_mm, dtype=np.float64)[..., None] * q, q
+
+
+def camera_II_from_I(Xc_rel_mm, rotation_rad):
+    """Points in sensor II's camera frame: ``X_camII = R_I_from_IIᵀ (X_camI − t_I)``.
+
+    The one place the relative orientation of 003 eq. (1) is applied to points: the face
+    (:class:`RikolaCamera`) and the joint block (:class:`JointCentroids`) both call it.
+
+    Parameters
+    ----------
+    Xc_rel_mm : (..., 3) ndarray
+        Points in sensor I's camera frame minus sensor II's projection centre ``t_I``.
+    rotation_rad : (3,) array_like
+        (dω, dφ, dκ) of ``R_I_from_II = R_from_opk(dω, dφ, dκ)``.
+
+    Returns
+    -------
+    X_camII : (..., 3) ndarray
+    R_I_from_II : (3, 3) ndarray
+    """
+    M = R_from_opk(*rotation_rad)  # R_I_from_II
+    return np.einsum("ji,...j->...i", M, Xc_rel_mm), M
+
+
 def project_measured_mm(Xc, f_mm, pp_mm, KP) -> np.ndarray:
     """Measured image coordinates (mm, y up) of camera-frame points.
 
@@ -115,7 +153,7 @@ def project_measured_mm(Xc, f_mm, pp_mm, KP) -> np.ndarray:
     Xc = np.asarray(Xc, dtype=np.float64)
     if np.any(Xc[..., 2] >= 0):
         raise InputError("points behind the camera (the photogrammetric camera looks along −z)")
-    ideal = -np.asarray(f_mm)[..., None] * Xc[..., :2] / Xc[..., 2:3]
+    ideal, _ = _ideal_mm(Xc, f_mm)  # 003 collinearity
     KP = np.asarray(KP, dtype=np.float64)
     return measured_from_ideal_mm(ideal, KP[:3], KP[3:]) + np.asarray(pp_mm)
 
@@ -144,9 +182,8 @@ def centroid_model(Xc, f_mm, pp_mm, KP, jacobian: bool):
             f"{int(np.sum(Xc[..., 2] >= 0))} target corners lie behind the camera (the "
             "photogrammetric camera looks along −z): check the initial poses"
         )
-    q = Xc[..., :2] / Xc[..., 2:3]  # (n, 4, 2)
     f4 = np.asarray(f_mm, dtype=np.float64)[:, None, None]
-    ideal = -f4 * q
+    ideal, q = _ideal_mm(Xc, f4[..., 0])  # (n, 4, 2)
     xbar = measured_from_ideal_mm(ideal, KP[:3], KP[3:])  # 003 collinearity, inverted
     xy = xbar.mean(axis=1) + pp_mm
     if not jacobian:
@@ -383,10 +420,9 @@ class JointCentroids(ResidualBlock):
         XcI = XcI.reshape(n, 4, 3)
         rot = values[nm["rotation"]]
         t = values[nm["offset"]]
-        M = R_from_opk(*rot)  # R_I_from_II
         two = self.srow == 1
         Xs = XcI.copy()  # the sensor's rigid camera frame
-        Xs[two] = np.einsum("ji,nkj->nki", M, XcI[two] - t)  # X_camII = Mᵀ (X_camI − t)
+        Xs[two], M = camera_II_from_I(XcI[two] - t, rot)  # X_camII = Mᵀ (X_camI − t)
         rate = values.get(nm["drift"])
         if rate is None:  # no drift block: the rigid model
             D = dD = None
@@ -512,10 +548,7 @@ class RikolaCamera:
         return f, pp, two
 
     def _frames(self, poses, view):
-        poses = np.atleast_2d(np.asarray(poses, dtype=float))
-        view = np.asarray(view, dtype=np.int64)
-        R = R_from_opk(poses[:, 0], poses[:, 1], poses[:, 2])[view]  # R_world_from_body
-        return poses[view, 3:6], R
+        return body_frames(poses, view)
 
     def rays(self, uv_px, poses, view, band) -> tuple[np.ndarray, np.ndarray]:
         """Origins and unit directions (world frame) of the rays of pixels ``(n, 2)``."""
@@ -541,7 +574,8 @@ class RikolaCamera:
         f, pp, two = self._band(band, X.shape[0])
         X0, R = self._frames(poses, view)
         Xc = self.mount.to_sensor(X, X0, R)  # sensor I's camera frame
-        M = R_from_opk(*self.rotation_rad)
-        Xc[two] = (Xc[two] - np.asarray(self.offset_mm, float)) @ M  # X_camII = Mᵀ (X_camI − t)
+        Xc[two], _ = camera_II_from_I(
+            Xc[two] - np.asarray(self.offset_mm, float), self.rotation_rad
+        )
         xy = project_measured_mm(Xc, f, pp, self.KP)
         return mm_to_pixel(xy, self.image_size, self.pixel_mm)

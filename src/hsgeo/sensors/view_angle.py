@@ -194,7 +194,33 @@ class ViewAngleScanner:
         tol_s: float = 1e-10,
         max_iter: int = 30,
     ) -> np.ndarray:
-        """Time at which each map point lies on the scan line (``along_px = 0``), s."""
+        """Time at which each map point lies on the scan line (``along_px = 0``), s.
+
+        Secant iteration from ``t_start_s`` (one per point), within the trajectory's span
+        (:func:`hsgeo.sensors.mount.line_time`; the signature every scanning sensor shares).
+
+        Parameters
+        ----------
+        xyz_map_m : (n, 3) array_like, m
+            Map points.
+        trajectory : hsgeo.trajectory.Trajectory
+        t_start_s : float or (n,) array_like, s
+            Where the secant iteration starts (clipped to the trajectory's span).
+        band : int or (n,) array_like of int, optional
+            0-based band; required when there is one table per band.
+        tol_s : float
+            Convergence threshold on the time step, s.
+        max_iter : int
+
+        Returns
+        -------
+        t_s : (n,) ndarray, s
+
+        Raises
+        ------
+        hsgeo.errors.ConvergenceError
+            A point the line never crosses within ``max_iter`` steps.
+        """
 
         def along(X, t):
             p = self._sensor_xyz(X, t, trajectory)

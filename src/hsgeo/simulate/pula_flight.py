@@ -25,8 +25,8 @@ from hsgeo.errors import InputError
 from hsgeo.geocode import PlaneTerrain
 from hsgeo.io.navigation import write_trajectory
 from hsgeo.io.tables import write_csv_array
-from hsgeo.rotations import R_from_rpy
 from hsgeo.sensors.line import CalibratedLine, LinearIFOV, LineGeometry
+from hsgeo.sensors.mount import Mount
 from hsgeo.simulate import as_rng
 from hsgeo.trajectory import Trajectory
 
@@ -178,12 +178,11 @@ def gcp_sightings(nav: Trajectory, boresight_rad, gcp_enu_m) -> tuple[np.ndarray
     ``(t_s (n,), tan_angle (n,))``; ``t_s`` is NaN for a GCP that the scan plane does not cross
     during the flight (it is ahead of the first line or behind the last).
     """
-    R_bs = R_from_rpy(*boresight_rad)
+    mount = Mount.from_rpy(boresight_rad)  # the sensors' one mount (no lever arm here)
 
     def sensor_coords(t, X):
         pos, _ = nav.pose(t)
-        R = nav.R_map_from_body(t) @ R_bs  # map<-sensor
-        return np.einsum("nji,nj->ni", R, X - pos)
+        return mount.to_sensor(X, pos, nav.R_map_from_body(t))
 
     lo = np.full(len(gcp_enu_m), nav.t_s[0])
     hi = np.full(len(gcp_enu_m), nav.t_s[-1])
