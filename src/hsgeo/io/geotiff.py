@@ -25,7 +25,14 @@ import numpy as np
 from hsgeo.errors import InputError
 from hsgeo.io._files import atomic_path, check_input_file, check_outputs
 
-__all__ = ["write_cog", "read_dsm", "write_geotiff", "GEOTIFF_FORMATS", "GDAL_CACHE_MB"]
+__all__ = [
+    "write_cog",
+    "read_dsm",
+    "write_geotiff",
+    "check_dsm_bands",
+    "GEOTIFF_FORMATS",
+    "GDAL_CACHE_MB",
+]
 
 GEOTIFF_FORMATS = {".tif": "GeoTIFF", ".tiff": "GeoTIFF"}
 #: GDAL's block cache while writing, MiB (its default, 5 % of the RAM, would grow with it).

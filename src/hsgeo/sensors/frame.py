@@ -44,6 +44,7 @@ from hsgeo.sensors.mount import Mount, unit
 
 __all__ = [
     "FrameCamera",
+    "body_frames",
     "POSE_COLUMNS",
     "camera_coordinates",
     "project_opencv",

@@ -128,6 +128,12 @@ def camera_II_from_I(Xc_rel_mm, rotation_rad):
     -------
     X_camII : (..., 3) ndarray
     R_I_from_II : (3, 3) ndarray
+
+    References
+    ----------
+    .. [1] Tommaselli, A. M. G., Santos, L. D., Berveglieri, A., Oliveira, R. A. and Honkavaara, E.
+           (2018). A study on the variations of inner orientation parameters of a hyperspectral
+           frame camera. Int. Arch. Photogramm. Remote Sens. Spatial Inf. Sci. XLII-1 (paper 003).
     """
     M = R_from_opk(*rotation_rad)  # R_I_from_II
     return np.einsum("ji,...j->...i", M, Xc_rel_mm), M

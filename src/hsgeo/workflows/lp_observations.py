@@ -70,6 +70,7 @@ from hsgeo.workflows._lp_stages import MIN_MATCHES, Keys, match_all, strip_scene
 
 __all__ = [
     "LpInputs",
+    "WIDE_FOV_DEG",
     "LpOptions",
     "LpResult",
     "retrieve",

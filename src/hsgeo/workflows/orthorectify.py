@@ -29,6 +29,7 @@ from hsgeo.workflows._ortho_strips import adjustment_of, line_strip, lp_strips
 
 __all__ = [
     "OrthoInputs",
+    "SCHEDULER_GREETING_S",
     "OrthoOptions",
     "orthorectify",
     "orthorectify_files",
