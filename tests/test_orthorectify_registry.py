@@ -288,3 +288,34 @@ def test_every_model_orthorectifies_its_targets_within_one_gsd(scene, name):
     assert np.all(np.isfinite(err)), f"{name}: a target not found in the output: {err}"
     rms = float(np.sqrt(np.mean(err**2)))
     assert rms <= GSD_M, f"{name}: targets {rms:.3f} m RMS off (1 GSD = {GSD_M} m): {err}"
+
+
+def test_a_tiff_frame_gives_the_raster_of_the_same_envi_frame(tmp_path):
+    """The frame reader takes a (Geo)TIFF as it takes an ENVI file: the same values (3 bands,
+    one NaN) at the same pixels give the identical raster."""
+    import rasterio
+    import xarray as xr
+
+    write_trajectory(tmp_path / "nav.csv", nav())
+    values = np.random.default_rng(1).random((30, 40, 3)).astype(np.float32)
+    values[5, 7, 1] = np.nan
+    write_envi(tmp_path / "f.raw", values)
+    with rasterio.open(
+        tmp_path / "f.tif", "w", driver="GTiff", width=40, height=30, count=3, dtype="float32"
+    ) as dst:
+        dst.write(values.transpose(2, 0, 1))
+    (tmp_path / "t.csv").write_text("file,time_s\nf,5.0\n")
+    (tmp_path / "cv.toml").write_text(
+        sensor_toml("frame-opencv", {"fx_px": 60.0, "fy_px": 60.0, "cx_px": 19.5, "cy_px": 14.5})
+    )
+    from ortho_inputs import SITE_ARGS
+
+    common = ["--frame-times", str(tmp_path / "t.csv"), "--sensor", str(tmp_path / "cv.toml")]
+    common += ["--trajectory", str(tmp_path / "nav.csv"), "--height", "0", *SITE_ARGS, "--quiet"]
+    for f in ("f.raw", "f.tif"):
+        out = tmp_path / f"{f}.nc"
+        assert main(["orthorectify", str(tmp_path / f), *common, "-o", str(out)]) == 0
+    a = xr.open_dataset(tmp_path / "f.raw.nc")["radiance"].values
+    b = xr.open_dataset(tmp_path / "f.tif.nc")["radiance"].values
+    assert a.shape[0] == 3 and np.isfinite(a).mean() > 0.5
+    np.testing.assert_array_equal(a, b)
