@@ -177,6 +177,42 @@ def _envi_lines(d: Path) -> None:
     (d / "times.txt").write_text("".join(f"{float(v)!r}\n" for v in t_l))
 
 
+def _frames(d: Path) -> None:
+    """Two frames of the Rikola (2 bands, 40 x 30 px, ENVI BSQ f0.raw, f1.raw), their exposure
+    table (one row per frame and band), the Rikola's sensor file (turned over to look down),
+    an OpenCV frame camera's sensor file and the navigation, 500 m above a plane at 3 m."""
+    from hsgeo.io.navigation import write_trajectory
+    from hsgeo.trajectory import Trajectory
+
+    d.mkdir()
+    t = np.linspace(0, 10.0, 201)
+    nav = Trajectory(
+        t,
+        np.column_stack([np.zeros(t.size), 20.0 * t, np.full(t.size, 500.0)]),
+        np.column_stack([0.01 * np.sin(t), 0.005 * np.cos(t), np.zeros(t.size)]),
+    )
+    write_trajectory(d / "nav.csv", nav)
+    rng = np.random.default_rng(3)
+    for i in range(2):
+        rng.random((2, 30, 40)).astype("<f4").tofile(d / f"f{i}.raw")
+        (d / f"f{i}.hdr").write_text(
+            "ENVI\nsamples = 40\nlines = 30\nbands = 2\nheader offset = 0\ndata type = 4\n"
+            "interleave = bsq\nbyte order = 0\n"
+        )
+    (d / "frames.csv").write_text(
+        "file,time_s,band\nf0.raw,4.0,1\nf0.raw,4.05,2\nf1.raw,5.0,1\nf1.raw,5.05,2\n"
+    )
+    (d / "rikola.toml").write_text(
+        "[sensor]\nmodel = 'rikola'\nf_band_mm = [8.7, 8.8]\nband_sensor = [1, 2]\n"
+        "bands = [1, 2]\npp_I_mm = [0.0, 0.0]\npp_II_mm = [0.0, 0.0]\n"
+        "image_size_px = [40, 30]\nboresight_deg = [180.0, 0.0, 0.0]\n"
+    )
+    (d / "cv.toml").write_text(
+        "[sensor]\nmodel = 'frame-opencv'\nfx_px = 400.0\nfy_px = 400.0\ncx_px = 19.5\n"
+        "cy_px = 14.5\nimage_size_px = [40, 30]\n"
+    )
+
+
 def _frame(d: Path) -> None:
     d.mkdir()
     for p in sorted((CHARUCO / "images").glob("*.jpg"))[:3]:
@@ -266,6 +302,7 @@ def build_valid(root: Path) -> Path:
     _lp(root / "lp-observations")
     _ortho(root / "orthorectify-strips")
     _envi_lines(root / "orthorectify-envi")
+    _frames(root / "orthorectify-frames")
     return root
 
 
@@ -325,6 +362,27 @@ def base_argv(cmd: str, d: Path) -> list[str]:
             "59.665,10.775",
             "--resolution",
             "0.5",
+            "-o",
+            s(out / "ortho.nc"),
+            "--quiet",
+        ]
+    if cmd == "orthorectify-frames":  # two frames of the Rikola (issue 36)
+        out = d.parent / "out"
+        out.mkdir(exist_ok=True)
+        return [
+            "orthorectify",
+            s(d / "f0.raw"),
+            s(d / "f1.raw"),
+            "--frame-times",
+            s(d / "frames.csv"),
+            "--trajectory",
+            s(d / "nav.csv"),
+            "--sensor",
+            s(d / "rikola.toml"),
+            "--height",
+            "3",
+            "--site",
+            "59.665,10.775",
             "-o",
             s(out / "ortho.nc"),
             "--quiet",
@@ -2033,6 +2091,49 @@ def _bal_points_behind(p: Path):
     centre = -np.einsum("nji,nj->ni", R, C[:, 3:6]).mean(axis=0)
     pts = 2 * centre - prob.points
     p.write_text("\n".join(lines[:n] + [repr(float(v)) for v in pts.ravel()]) + "\n")
+
+
+# --- orthorectify: frames of the Rikola and of an OpenCV camera (issue 36) -------------------
+C = "orthorectify-frames"
+
+
+def _frames_csv(edit):
+    def f(p: Path):
+        p.write_text(edit(p.read_text()))
+
+    return f
+
+
+case(C, "missing", "frame-without-exposure-time", "has no exposure time in --frame-times",
+     [("frames.csv", _frames_csv(lambda t: t.replace("f1.raw,5.0,1\n", "")))])  # fmt: skip
+case(C, "mismatch", "frame-time-outside-the-navigation", "column time_s",
+     [("frames.csv", _frames_csv(lambda t: t.replace("5.0,1", "50.0,1")))])  # fmt: skip
+case(C, "mismatch", "frame-size-not-the-sensors", "image_size_px = [40, 31]",
+     [("rikola.toml", _frames_csv(lambda t: t.replace("[40, 30]", "[40, 31]")))])  # fmt: skip
+case(C, "mismatch", "rikola-band-not-in-the-sensor-file", "names band 7",
+     [("frames.csv", _frames_csv(lambda t: t.replace("4.05,2", "4.05,7")))])  # fmt: skip
+case(C, "mismatch", "rikola-frame-with-a-band-too-many", "a layer of the frame must be a band",
+     [("rikola.toml", _frames_csv(lambda t: t.replace("f_band_mm = [8.7, 8.8]\nband_sensor = "
+                                                     "[1, 2]\nbands = [1, 2]",
+                                                     "f_band_mm = [8.7]\nband_sensor = [1]\n"
+                                                     "bands = [1]"))),
+      ("frames.csv", _frames_csv(lambda t: t.replace("f0.raw,4.05,2\n", "")
+                                           .replace("f1.raw,5.05,2\n", "")))])  # fmt: skip
+case(C, "options", "frame-sensor-given-line-times", "--line-times",
+     argv=flag("--line-times", "x.txt"))  # fmt: skip
+case(C, "missing", "frame-sensor-without-frame-times", "give the frames' exposure times",
+     argv=opt("--frame-times"))  # fmt: skip
+case(C, "missing", "frame-times-without-time_s", "time_s",
+     [("frames.csv", _frames_csv(lambda t: t.replace("time_s", "t")))])  # fmt: skip
+def _sensor(name: str):
+    return lambda a, d: opt("--sensor", str(d / name))(a, d)
+
+
+case(C, "options", "scanning-sensor-given-frame-times", "--frame-times is for the frames",
+     [("pano.toml", text("[sensor]\nmodel = 'panoramic'\nn_px = 40\n"))],
+     argv=_sensor("pano.toml"))  # fmt: skip
+case(C, "mismatch", "opencv-band-column", "column band is for the Rikola",
+     argv=_sensor("cv.toml"))  # fmt: skip
 
 
 # --- orthorectify: LP strips -----------------------------------------------------------------

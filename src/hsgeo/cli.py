@@ -233,6 +233,7 @@ def _cmd_orthorectify(args) -> int:
             gps_week=args.gps_week,
             vertical=args.vertical,
             line_times=args.line_times,
+            frame_times=args.frame_times,
         )
     finally:
         terminal.clear_progress()

@@ -265,8 +265,8 @@ def add_orthorectify(sub) -> argparse.ArgumentParser:
 
     p = sub.add_parser(
         "orthorectify",
-        help="orthorectify one line or mosaic many strips of any scanning sensor onto a map "
-        "grid (COG, NetCDF or ENVI by the output's suffix)",
+        help="orthorectify one line or mosaic many strips of any scanning sensor, or the "
+        "frames of a frame camera, onto a map grid (COG, NetCDF or ENVI by the output's suffix)",
         description="Orthorectify every pixel of every line (the sensor's ray at the line's "
         "time on the trajectory, met with the terrain at its first crossing) and resample it "
         "onto a north-up grid by nearest neighbour (pykdtree): every spectrum stays as "
@@ -277,7 +277,12 @@ def add_orthorectify(sub) -> argparse.ArgumentParser:
         "000 line scanner or x px from the line centre of the 002 camera, attributes t0_s and "
         "line_rate_hz; see hsgeo.io.lines) or LP line files (NetCDF lines(line, column, "
         "band), t_s(line), wavelength_nm(band), attributes col0, strip_id, n_px_full; see "
-        "hsgeo.io.lp_lines); an optional fwhm_nm(band) is carried into the output. NAV: the "
+        "hsgeo.io.lp_lines); an optional fwhm_nm(band) is carried into the output; or, with a "
+        "frame camera's sensor file (frame-opencv, rikola), its frames: one ENVI or TIFF file "
+        "per frame, pixel (u, v) = (column, row) from the centre of the top-left pixel, "
+        "placed by the navigation at the exposure time of --frame-times composed with the "
+        "sensor file's mount, each frame a strip of the mosaic (nearest-nadir: the frame that "
+        "sees the cell most nearly from above). NAV: the "
         "navigation file of every command (t_s, E_m, N_m, U_m, roll_deg, pitch_deg, "
         "heading_deg in the local east-north-up frame about --site, required), or a geodetic "
         "one: a CSV or Parquet (gps_sow_s or sod_s, lat_deg, lon_deg, h_m, roll_deg, pitch_deg, "
@@ -285,9 +290,10 @@ def add_orthorectify(sub) -> argparse.ArgumentParser:
         "--nav-crs required), whose local frame comes from the data and whose output CRS "
         "defaults to the UTM zone of its centre on its datum (see hsgeo.io.read_navigation); "
         "its DSM GeoTIFF may be in any CRS (--vertical for a 2D one) and is read under the "
-        "lines' edge rays followed down to U = -500 m, plus 100 m. SENSOR: TOML, the 000 "
-        "line scanner ([sensor]) or the 002 pushbroom camera ([camera], read in full: c per "
-        "band, distortion, boresight, lever arm). RESULT: hsgeo adjust-pushbroom --json "
+        "lines' edge rays followed down to U = -500 m, plus 100 m. SENSOR: a sensor file "
+        "([sensor] model = ...: line-scanner, pushbroom, panoramic, view-angle, frame-opencv, "
+        "rikola; see hsgeo.io.read_sensor) or the 002 camera file ([camera], read in full: c "
+        "per band, distortion, boresight, lever arm). RESULT: hsgeo adjust-pushbroom --json "
         "(camera parameters and node corrections). DSM: a GeoTIFF of ellipsoidal heights with "
         "an EPSG CRS, or a NetCDF height(N, E) in the local frame's metres; or --height, a "
         f"plane. OUT ({raster_formats_text()}) with the bands' wavelengths and FWHM; "
@@ -376,6 +382,16 @@ def add_orthorectify(sub) -> argparse.ArgumentParser:
         "a vertical CRS such as EPSG:5711 (AHD) or EPSG:5773 (EGM96)",
     )
     _line_times_option(p)
+    p.add_argument(
+        "--frame-times",
+        metavar="TIMES.csv",
+        default=None,
+        help="exposure times of a frame camera's frames (sensor models frame-opencv, rikola; "
+        "LINES are then the frames, one ENVI or TIFF file each): CSV or Parquet with columns "
+        "file (the frame's file name, with or without folder and extension) and time_s (s, "
+        "the navigation's time scale); for the Rikola optionally band (a band number of the "
+        "sensor file: one row per frame and band)",
+    )
     p.add_argument("--scheduler", metavar="ADDRESS", help="dask.distributed scheduler address")
     p.add_argument(
         "--max-gib",

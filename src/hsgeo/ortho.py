@@ -1,4 +1,4 @@
-"""Orthorectification and mosaicking of any scanning sensor's lines onto a map grid with a CRS.
+"""Orthorectification and mosaicking of any sensor's lines or frames onto a map grid with a CRS.
 
 The gridded half of :mod:`hsgeo.geocode` (which meets rays with the terrain): every pixel of
 every line of a :class:`Strip` is geolocated (the sensor's ``rays`` at the line's time on its
@@ -16,7 +16,9 @@ map cell takes the strip's nearest pixel (within the radius of influence). Where
 * ``nearest-nadir`` (the default): the pixel whose ray is closest to the nadir (smallest
   off-nadir angle ``arccos(−d_U)`` of its ray) among the nearest pixels of each strip. The rule
   needs nothing of a particular sensor (it is the ``|x|``-smallest rule of a pushbroom camera on
-  a level platform);
+  a level platform; for the frames of a frame camera, each frame a strip whose lines are its
+  image rows (:attr:`Strip.row_px`), it gives a cell to the frame that sees it most nearly from
+  above);
 * ``first``: the first strip given that covers the cell;
 * ``mean``: the mean, band by band, of the strips' nearest pixels that cover the cell (spectra
   of different strips mixed: for display, not for spectral analysis).
@@ -79,6 +81,11 @@ class Strip:
         What else ``rays`` takes per pixel (``band=`` of a pushbroom camera).
     name : str
         The strip's id, for messages.
+    row_px : (n_lines,) ndarray or None
+        A frame's image rows: line ``i`` is image row ``v = row_px[i]``, added to the second
+        pixel coordinate of ``pixels`` (``(u, 0)``), all lines at the frame's exposure time
+        (:mod:`hsgeo.workflows._ortho_frames`). None: the same pixels in every line (a scanning
+        sensor).
     """
 
     sensor: object
@@ -88,10 +95,19 @@ class Strip:
     values: object
     pixel_kw: dict = field(default_factory=dict)
     name: str = "strip"
+    row_px: np.ndarray | None = None
 
     def __post_init__(self):
         t = np.asarray(self.t_s, dtype=float)
         px = np.asarray(self.pixels, dtype=float)
+        if self.row_px is not None:
+            rows = np.asarray(self.row_px, dtype=float)
+            if rows.shape != t.shape or px.ndim != 2 or px.shape[1] != 2:
+                raise InputError(
+                    f"strip {self.name!r}: row_px must be one row per line ({t.size}) and the "
+                    f"pixels (n_px, 2), got {rows.shape} and {px.shape}"
+                )
+            object.__setattr__(self, "row_px", rows)
         shape = tuple(np.shape(self.values)) if self.values is not None else None
         if shape is not None and (len(shape) != 3 or shape[:2] != (t.size, px.shape[0])):
             raise InputError(
@@ -108,6 +124,18 @@ class Strip:
     @property
     def n_bands(self) -> int:
         return int(np.shape(self.values)[2])
+
+    def line_pixels(self, lines=slice(None), columns=slice(None)):
+        """Times and pixel coordinates of pixels ``columns`` of ``lines``, line by line:
+        ``(t_s (m·k,), pixels (m·k,) or (m·k, 2))`` (a frame's row added, ``row_px``).
+        """
+        t = self.t_s[lines]
+        px = self.pixels[columns]
+        m, k = t.size, px.shape[0]
+        pp = np.tile(px, (m,) + (1,) * (px.ndim - 1))
+        if self.row_px is not None:
+            pp[:, 1] += np.repeat(self.row_px[lines], k)
+        return np.repeat(t, k), pp
 
     def geometry(self) -> Strip:
         """The strip without its values (``values=None``): what a tile's task needs besides
@@ -136,11 +164,8 @@ def geolocate_lines(strip: Strip, terrain, frame, lines=slice(None), columns=sli
     off_nadir_deg : (m, k) ndarray
         Angle between each ray and the downward vertical of the local frame, degrees.
     """
-    t = strip.t_s[lines]
-    px = strip.pixels[columns]
-    m, k = t.size, px.shape[0]
-    tt = np.repeat(t, k)
-    pp = np.tile(px, (m,) + (1,) * (px.ndim - 1))
+    m, k = strip.t_s[lines].size, strip.pixels[columns].shape[0]
+    tt, pp = strip.line_pixels(lines, columns)
     o, d = strip.sensor.rays(pp, tt, strip.trajectory, **strip.pixel_kw)
     X = intersect(o, d, terrain)
     lon, lat, _ = frame.enu_to_lonlat(X[:, 0], X[:, 1], X[:, 2])

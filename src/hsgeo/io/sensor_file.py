@@ -179,7 +179,11 @@ def _frame(v, where):
     from hsgeo.sensors.frame import FrameCamera
 
     intr = (v["fx_px"], v["fy_px"], v["cx_px"], v["cy_px"])
-    return FrameCamera(intr, tuple(v["distortion"]), _mount(v))
+    size = v.get("image_size_px")
+    if size is not None and not all(float(x).is_integer() for x in size):
+        raise InputError(f"{where}: image_size_px = {list(size)} must be whole pixels (w, h)")
+    size = None if size is None else tuple(int(x) for x in size)
+    return FrameCamera(intr, tuple(v["distortion"]), _mount(v), size)
 
 
 def _view_angle(v, where):
@@ -382,6 +386,9 @@ def _models():
                     length=5,
                     default=(0.0, 0.0, 0.0, 0.0, 0.0),
                     doc="k1, k2, p1, p2, k3 (OpenCV order)",
+                ),
+                "image_size_px": Key(
+                    "floats", length=2, positive=True, doc="w, h of the frames, px (optional)"
                 ),
                 **_mount_keys("body"),
             },

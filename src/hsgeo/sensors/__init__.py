@@ -6,7 +6,9 @@
   model of 000 eq. (2) is :mod:`~hsgeo.sensors.line1d`);
 * :mod:`~hsgeo.sensors.pushbroom`: the 002 LP camera (``PushbroomCamera``, ``PushbroomLines``);
 * :mod:`~hsgeo.sensors.frame`, :mod:`~hsgeo.sensors.bal`, :mod:`~hsgeo.sensors.rikola`: frame
-  cameras (``FrameCamera`` offers ``rays`` / ``project`` at given exposure poses);
+  cameras (``FrameCamera`` offers ``rays`` / ``project`` at given exposure poses, and
+  ``rays_along`` a trajectory: :class:`~hsgeo.sensors.mount.OnTrajectory` gives a frame
+  camera the scanning sensors' face for ``hsgeo orthorectify``);
 * :mod:`~hsgeo.sensors.panoramic`: the 004 panoramic (whiskbroom) scanner
   (``PanoramicScanner``): a scanning sensor like ``LineScanner`` whose samples along one scan
   have their own times;

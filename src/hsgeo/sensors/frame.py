@@ -398,6 +398,8 @@ class FrameCamera:
         The camera on its body (a rig): ``R_body_from_sensor`` takes OpenCV camera vectors
         (x right, y down, z forward) to the body. The identity mount makes the poses the
         camera's own.
+    image_size : (int, int) or None
+        Width and height of the frames, px (None: not known; a frame of any size is taken).
 
     The poses are rows ``(ω, φ, κ, X0, Y0, Z0)`` of the body (``R_world_from_body =
     R_from_opk(ω, φ, κ)``, the ``poses`` block of :class:`FrameOpenCV`), ``view`` the pose of
@@ -407,16 +409,30 @@ class FrameCamera:
     intrinsics: tuple
     dist: tuple = (0.0, 0.0, 0.0, 0.0, 0.0)
     mount: Mount = field(default_factory=Mount)
+    image_size: tuple | None = None
 
     def _frames(self, poses, view):
         return body_frames(poses, view)
 
+    def sensor_directions(self, uv_px) -> np.ndarray:
+        """Camera-frame directions ``(n, 3)`` (x right, y down, z forward; not normalised) of
+        pixels ``(n, 2)``: the inverse of OpenCV's pixel map (:func:`normalised_opencv`).
+        """
+        xn = normalised_opencv(uv_px, self.intrinsics, self.dist)
+        return np.column_stack([xn, np.ones(len(xn))])
+
     def rays(self, uv_px, poses, view) -> tuple[np.ndarray, np.ndarray]:
         """Origins and unit directions (world frame) of the rays of pixels ``(n, 2)``."""
-        xn = normalised_opencv(uv_px, self.intrinsics, self.dist)
         X0, R = self._frames(poses, view)
-        d_cam = np.column_stack([xn, np.ones(len(xn))])
+        d_cam = self.sensor_directions(uv_px)
         return self.mount.origins(X0, R), unit(self.mount.directions(R, d_cam))
+
+    def rays_along(self, uv_px, t_s, trajectory) -> tuple[np.ndarray, np.ndarray]:
+        """The rays of pixels ``(n, 2)`` exposed at times ``t_s`` on a body ``trajectory``:
+        the body's pose at each time composed with the mount, as every scanning sensor does
+        (:meth:`hsgeo.sensors.mount.Mount.rays_along`).
+        """
+        return self.mount.rays_along(self.sensor_directions(uv_px), t_s, trajectory)
 
     def project(self, xyz_world, poses, view) -> np.ndarray:
         """Pixels ``(n, 2)`` of world points seen from the poses ``view``."""

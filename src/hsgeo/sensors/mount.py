@@ -35,7 +35,7 @@ import numpy as np
 from hsgeo.errors import ConvergenceError, InputError, ObservationError
 from hsgeo.rotations import R_from_rpy
 
-__all__ = ["Mount", "Sensor", "line_time", "unit"]
+__all__ = ["Mount", "OnTrajectory", "Sensor", "line_time", "unit"]
 
 
 def _matrix3(a, name: str) -> np.ndarray:
@@ -118,6 +118,25 @@ class Mount:
         if np.any(p[:, 2] <= 0):
             raise ObservationError(f"points behind the {sensor} (sensor z ≤ 0)")
         return p
+
+
+@dataclass(frozen=True)
+class OnTrajectory:
+    """A frame camera carried along a body trajectory, with the scanning sensors' face
+    ``rays(pixels, t_s, trajectory, **kw)``: every pixel exposed at its time ``t_s`` (a frame's
+    exposure time), through the camera's ``rays_along`` (the body's pose at that time composed
+    with the camera's :class:`Mount`). What ``hsgeo orthorectify`` geolocates frames with.
+    """
+
+    camera: object
+
+    @property
+    def mount(self) -> Mount:
+        return self.camera.mount
+
+    def rays(self, pixels, t_s, trajectory, **kw) -> tuple[np.ndarray, np.ndarray]:
+        """Origins (m) and unit map-frame directions of pixels ``(n, 2)`` at times ``t_s``."""
+        return self.camera.rays_along(pixels, t_s, trajectory, **kw)
 
 
 def unit(d) -> np.ndarray:

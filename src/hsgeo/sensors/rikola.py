@@ -556,8 +556,10 @@ class RikolaCamera:
     def _frames(self, poses, view):
         return body_frames(poses, view)
 
-    def rays(self, uv_px, poses, view, band) -> tuple[np.ndarray, np.ndarray]:
-        """Origins and unit directions (world frame) of the rays of pixels ``(n, 2)``."""
+    def sensor_directions(self, uv_px, band) -> tuple[np.ndarray, np.ndarray]:
+        """Directions ``(n, 3)`` in sensor I's camera frame (not normalised) of pixels
+        ``(n, 2)`` of ``band``, and which pixels sensor II records (``(n,)`` bool).
+        """
         uv = np.atleast_2d(np.asarray(uv_px, dtype=float))
         f, pp, two = self._band(band, uv.shape[0])
         KP = np.asarray(self.KP, float)
@@ -567,12 +569,32 @@ class RikolaCamera:
         d = np.column_stack([ideal, -f])  # the band's camera frame
         M = R_from_opk(*self.rotation_rad)  # R_I_from_II
         d[two] = d[two] @ M.T
+        return d, two
+
+    def rays(self, uv_px, poses, view, band) -> tuple[np.ndarray, np.ndarray]:
+        """Origins and unit directions (world frame) of the rays of pixels ``(n, 2)``."""
+        d, two = self.sensor_directions(uv_px, band)
         X0, R = self._frames(poses, view)
         o = self.mount.origins(X0, R)
         if np.any(two):
             t = np.broadcast_to(np.asarray(self.offset_mm, float), (int(two.sum()), 3))
             o[two] = o[two] + self.mount.directions(R[two], t)
         return o, unit(self.mount.directions(R, d))
+
+    def rays_along(self, uv_px, t_s, trajectory, band) -> tuple[np.ndarray, np.ndarray]:
+        """The rays of pixels ``(n, 2)`` of ``band`` exposed at times ``t_s`` on a body
+        ``trajectory`` (metres): the body's pose composed with the mount as every scanning
+        sensor does (:meth:`hsgeo.sensors.mount.Mount.rays_along`); sensor II's centre moved by
+        ``offset_mm`` converted to m.
+        """
+        d, two = self.sensor_directions(uv_px, band)
+        o, u = self.mount.rays_along(d, t_s, trajectory)
+        if np.any(two):
+            t2 = np.asarray(t_s, float)[two] if np.ndim(t_s) else np.full(int(two.sum()), t_s)
+            R = trajectory.R_map_from_body(t2)
+            off_m = np.broadcast_to(1e-3 * np.asarray(self.offset_mm, float), (t2.size, 3))
+            o[two] = o[two] + self.mount.directions(R, off_m)
+        return o, u
 
     def project(self, xyz_world, poses, view, band) -> np.ndarray:
         """Pixels ``(n, 2)`` of world points seen from the poses ``view`` in ``band``."""

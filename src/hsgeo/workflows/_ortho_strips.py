@@ -173,10 +173,11 @@ def check_principal_point(sensor, pixel, source, lines) -> None:
 
 def check_view_angles(strip: Strip, source) -> None:
     """The rays of a strip's first line must look down, within 80° of the nadir."""
-    nav, t0_s, pixels = strip.trajectory, strip.t_s[0], strip.pixels
+    nav, t0_s = strip.trajectory, strip.t_s[0]
+    tt, pixels = strip.line_pixels(slice(0, 1))
     with np.errstate(all="ignore"):
         try:
-            _, d = strip.sensor.rays(pixels, np.full(len(pixels), t0_s), nav, **strip.pixel_kw)
+            _, d = strip.sensor.rays(pixels, tt, nav, **strip.pixel_kw)
             ang = np.degrees(np.arccos(np.clip(-d[:, 2], -1.0, 1.0)))
         except HsgeoError:
             ang = np.array([np.nan])

@@ -1,12 +1,17 @@
-"""Orthorectify any scanning sensor's lines, one line or many strips: ``hsgeo orthorectify``.
+"""Orthorectify any sensor of the registry, one line, many strips or a frame camera's frames:
+``hsgeo orthorectify``.
 
 The in-memory core :func:`orthorectify` (:class:`OrthoInputs`, :class:`OrthoOptions` → a lazy
 ``(band, y, x)`` :class:`xarray.DataArray` with a CRS, :func:`hsgeo.ortho.orthomosaic`) is what
 the chapters call; the file front end :func:`orthorectify_files` reads the lines (hsgeo's
 recorded flight line or LP line files: :mod:`hsgeo.workflows._ortho_strips`), the navigation,
-the sensor file (:func:`hsgeo.io.read_sensor`: the 000 line scanner, the 002 pushbroom camera read
-in full — principal distance per band, distortion, boresight and lever arm — or the 004
-panoramic scanner), optionally an ``hsgeo adjust-pushbroom --json`` result (applied by
+the sensor file (:func:`hsgeo.io.read_sensor`, any model of :data:`hsgeo.io.sensor_file.MODELS`:
+the 000 line scanner, the 002 pushbroom camera read in full — principal distance per band,
+distortion, boresight and lever arm —, the 004 panoramic scanner, a view-angle table, or a
+frame camera, ``frame-opencv`` or ``rikola``, whose frames, one ENVI or TIFF file each, are
+placed at their exposure times of ``--frame-times``: :mod:`hsgeo.workflows._ortho_frames`;
+every sensor through the same first-crossing intersection and mosaic), optionally an
+``hsgeo adjust-pushbroom --json`` result (applied by
 :func:`hsgeo.sensors.adjusted`), and the terrain (a DSM GeoTIFF in the map CRS, a DEM
 NetCDF in the local frame, or a plane); checks them all before the work; and writes the raster
 in the format of the output's suffix through the one writer :func:`hsgeo.io.raster.write_raster`
@@ -97,6 +102,9 @@ class OrthoInputs:
     wavelength_nm: tuple = ()
     fwhm_nm: tuple = ()
     meta: dict = field(default_factory=dict)
+    #: The output band each strip fills (one-band strips of a sensor whose bands have their
+    #: own geometry, the Rikola's); empty: every strip fills every band.
+    layers: tuple = ()
 
 
 def orthorectify(inputs: OrthoInputs, options: OrthoOptions = OrthoOptions()):
@@ -111,23 +119,67 @@ def orthorectify(inputs: OrthoInputs, options: OrthoOptions = OrthoOptions()):
     """
     if options.frame is None:
         raise InputError("OrthoOptions.frame: give the navigation's local frame (hsgeo.crs)")
+    kw = {
+        "crs": options.crs,
+        "rule": options.mosaic,
+        "tile_px": options.tile_px,
+        "lines_per_block": options.lines_per_block,
+    }
+    bands = {
+        "band_names": list(inputs.band_names) or None,
+        "wavelength_nm": list(inputs.wavelength_nm) or None,
+        "fwhm_nm": list(inputs.fwhm_nm) or None,
+    }
     try:
-        return orthomosaic(
-            inputs.strips,
-            inputs.terrain,
-            options.frame,
-            resolution_m=options.resolution_m,
-            crs=options.crs,
-            band_names=list(inputs.band_names) or None,
-            wavelength_nm=list(inputs.wavelength_nm) or None,
-            fwhm_nm=list(inputs.fwhm_nm) or None,
-            rule=options.mosaic,
-            tile_px=options.tile_px,
-            lines_per_block=options.lines_per_block,
-            max_gib=options.max_gib,
-        )
+        if not inputs.layers:
+            return orthomosaic(
+                inputs.strips,
+                inputs.terrain,
+                options.frame,
+                resolution_m=options.resolution_m,
+                max_gib=options.max_gib,
+                **bands,
+                **kw,
+            )
+        return _layered(inputs, options, bands, kw)
     except ObservationError as exc:
         raise InputError(str(exc)) from None
+
+
+def _layered(inputs: OrthoInputs, options: OrthoOptions, bands: dict, kw: dict):
+    """Strips of one band each (``inputs.layers``): one :func:`~hsgeo.ortho.orthomosaic` per
+    output band on the grid of all the strips' footprints (the first, lazy call of all strips
+    together sets it and checks its size), stacked along ``band``.
+    """
+    import xarray as xr
+
+    layers = np.asarray(inputs.layers)
+    every = orthomosaic(
+        inputs.strips,
+        inputs.terrain,
+        options.frame,
+        resolution_m=options.resolution_m,
+        max_gib=options.max_gib / max(int(layers.max()) + 1, 1),
+        **kw,
+    )
+    from hsgeo.mapgrid import MapGrid
+
+    res = float(every.attrs["resolution_m"])
+    x, y = every["x"].values, every["y"].values
+    crs = options.crs or f"EPSG:{options.frame.map_epsg}"
+    grid = MapGrid(float(x[0]) - res / 2, float(y[0]) + res / 2, res, x.size, y.size, crs)
+    parts = []
+    for k in range(int(layers.max()) + 1):
+        strips = [s for s, lay in zip(inputs.strips, layers, strict=True) if lay == k]
+        parts.append(orthomosaic(strips, inputs.terrain, options.frame, grid=grid, **kw))
+    out = xr.concat(parts, dim="band", combine_attrs="override")
+    names = bands["band_names"] or [str(k) for k in range(len(parts))]
+    out = out.assign_coords(band=[str(b) for b in names])
+    for key in ("wavelength_nm", "fwhm_nm"):
+        if bands[key] is not None:
+            out = out.assign_coords({key: ("band", np.asarray(bands[key], dtype=float))})
+    out.attrs["strips"] = ",".join(s.name for s in inputs.strips)
+    return out.rio.write_crs(grid.crs).rio.write_transform(grid.transform)
 
 
 def _terrain(dsm, height_m, frame, U_m, strips=None):
@@ -274,6 +326,27 @@ def _read_strips(lines, nav, sensor, args):
     return strips, wl, fw, None
 
 
+def _strips_of(lines, nav, sensor, args):
+    """The strips of LINES: a frame camera's frames (:mod:`hsgeo.workflows._ortho_frames`) or
+    a scanning sensor's lines; ``(strips, layers, wavelength_nm, fwhm_nm, n_px_full, names)``.
+    """
+    from hsgeo.workflows._ortho_frames import frame_strips, is_frame_sensor
+
+    if is_frame_sensor(sensor):
+        strips, layers, wl, fw, names = frame_strips(lines, sensor, nav, args)
+        return strips, layers, wl, fw, None, names
+    if args["frame_times"] is not None:
+        raise InputError(
+            f"--frame-times is for the frames of a frame camera; the sensor file "
+            f"{str(args['sensor'])!r} is a scanning sensor, whose lines carry their times (or "
+            "take --line-times): leave --frame-times out"
+        )
+    strips, wl, fw, n_px_full = _read_strips(lines, nav, sensor, args)
+    n_b = strips[0].n_bands
+    names = [f"{w:g} nm" for w in wl] if wl is not None else [str(i) for i in range(n_b)]
+    return strips, (), wl, fw, n_px_full, names
+
+
 def _check_nav(strips, nav, trajectory, max_nav_gap_s, adjustment) -> None:
     """The navigation covers every strip's lines; the adjustment's node span too."""
     from hsgeo.validate import check_navigation_covers
@@ -326,6 +399,7 @@ def orthorectify_files(
     gps_week: int | None = None,
     vertical: str | None = None,
     line_times=None,
+    frame_times=None,
 ) -> dict:
     """Orthorectify line files into one raster (see ``hsgeo orthorectify --help``).
 
@@ -343,6 +417,12 @@ def orthorectify_files(
 
     LINES may be ENVI cubes (:mod:`hsgeo.workflows._ortho_envi`), their line times from
     ``line_times`` (one times file per cube) or their headers.
+
+    With a frame camera's sensor file (models ``frame-opencv`` and ``rikola``), LINES are its
+    frames, one ENVI or TIFF file each (:mod:`hsgeo.io.frame_images`), and ``frame_times``
+    the exposure table (columns ``file``, ``time_s``; for the Rikola optionally ``band``): each
+    frame is placed by the navigation at its exposure time composed with the sensor file's
+    mount, and mosaicked with the others by ``mosaic`` (:mod:`hsgeo.workflows._ortho_frames`).
     """
     from hsgeo.io import read_sensor
     from hsgeo.io._files import check_outputs
@@ -362,7 +442,8 @@ def orthorectify_files(
         raise InputError(f"--mosaic {mosaic!r}: give one of {', '.join(MOSAIC_RULES)}")
     from hsgeo.workflows._ortho_envi import envi_files
 
-    inputs = [*lines, trajectory, sensor, dsm, adjustment, *(line_times or ()), *envi_files(lines)]
+    inputs = [*lines, trajectory, sensor, dsm, adjustment, *(line_times or ()), frame_times]
+    inputs += envi_files(lines)
     check_outputs(raster_outputs(output, RASTER_FORMATS), inputs, overwrite=overwrite)
     navigation = geo.read_nav(trajectory, nav_crs, gps_week, site, vertical, crs)
     geodetic = navigation.source_crs != "local ENU"
@@ -376,8 +457,9 @@ def orthorectify_files(
         msg = str(exc)
         raise InputError("--" + msg if msg.startswith("adjustment:") else msg) from None
     args = {"line_pixels": line_pixels, "bands": bands, "band": band, "sensor": sensor}
-    args["line_times"] = line_times
-    strips, wl, fw, n_px_full = _read_strips(lines, nav, cam, args)
+    args.update(line_times=line_times, frame_times=frame_times, trajectory=trajectory)
+    args["max_nav_gap_s"] = max_nav_gap_s
+    strips, layers, wl, fw, n_px_full, names = _strips_of(lines, nav, cam, args)
     _check_nav(strips, nav, trajectory, max_nav_gap_s, adj)
     for s in strips:
         check_view_angles(s, sensor)
@@ -386,9 +468,6 @@ def orthorectify_files(
         terrain = _geodetic_terrain(dsm, height_m, frame, U, strips, vertical)
     else:
         terrain = _terrain(dsm, height_m, frame, U, strips)
-    names = (
-        [f"{w:g} nm" for w in wl] if wl is not None else [str(i) for i in range(strips[0].n_bands)]
-    )
     opts = OrthoOptions(
         resolution_m=resolution_m,
         mosaic=mosaic,
@@ -404,6 +483,7 @@ def orthorectify_files(
             tuple(names),
             tuple(wl) if wl is not None else (),
             tuple(fw) if fw is not None else (),
+            layers=layers,
         ),
         opts,
     )
