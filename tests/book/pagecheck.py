@@ -14,10 +14,15 @@ from urllib.parse import unquote, urlparse
 #: Viewport widths (px) of a phone and of a desktop screen.
 NARROW_PX = 400
 WIDE_PX = 1400
+#: The most rows a table a reader sees may have (a longer one goes under a toggle, issue 40).
+MAX_TABLE_ROWS = 20
+#: The most words of a paper's statement on the scoreboard and the landing page.
+MAX_STATEMENT_WORDS = 80
 
 # One pass over the page, after MathJax: everything below is measured, nothing is inferred.
 _FACTS_JS = r"""
 async () => {
+  const MAX_ROWS = __MAX_ROWS__;
   if (window.MathJax && MathJax.startup && MathJax.startup.promise) {
     await MathJax.startup.promise;
   }
@@ -182,11 +187,74 @@ async () => {
           + (beyond[0].getAttribute("data-label") || "?") + "»)" : ""));
     }
   }
+  // long tables and empty columns (issue 40): a table a reader sees (not one under a toggle,
+  // <details>, where a long table belongs) has at most MAX_ROWS rows, and no column whose every
+  // cell is "—"
+  const long_tables = [];
+  const empty_columns = [];
+  for (const table of main.querySelectorAll("table")) {
+    if (table.closest("pre, .highlight, mjx-container")) continue;
+    const body = [...table.querySelectorAll("tr")].filter((tr) => tr.querySelector("td"));
+    if (!table.closest("details") && body.length > MAX_ROWS) {
+      long_tables.push(describe(table) + ": " + body.length + " rows");
+    }
+    const heads = [...(table.querySelector("thead tr:last-child") || {children: []}).children]
+      .map((th) => (th.textContent || "").trim());
+    const n = Math.max(0, ...body.map((tr) => tr.children.length));
+    for (let j = 0; j < n && body.length; j++) {
+      const vals = body.map((tr) => ((tr.children[j] || {}).textContent || "").trim());
+      if (vals.every((v) => v === "—")) {
+        empty_columns.push(describe(table) + ": column «" + (heads[j] || j) + "» is all —");
+      }
+    }
+  }
+  // every "differs" with a cause: in a table with a verdict column and a reason column (why,
+  // reason, cause), a row judged "differs" gives more than its distance from the paper
+  const uncaused = [];
+  for (const table of main.querySelectorAll("table")) {
+    const heads = [...(table.querySelector("thead tr:last-child") || {children: []}).children]
+      .map((th) => (th.textContent || "").trim().toLowerCase());
+    const iv = heads.indexOf("verdict");
+    const iw = heads.findIndex((h) => /^(why|reason|cause)\b/.test(h));
+    if (iv < 0 || iw < 0) continue;
+    for (const tr of table.querySelectorAll("tr")) {
+      const cells = tr.children;
+      if (!tr.querySelector("td") || cells.length <= Math.max(iv, iw)) continue;
+      if (!/^differs?\b/.test(cells[iv].textContent.trim())) continue;
+      const why = cells[iw].textContent.trim();
+      const bare = new RegExp("^(tuning missed:\\s*)?[\\d.]+σ̂? (off|from the paper)('s value)?"
+        + "\\.?(\\s*\\([^)]*\\))?\\.?$");
+      if (!why || why === "—" || bare.test(why)) {
+        uncaused.push(describe(table) + ": «" + cells[0].textContent.trim().slice(0, 40)
+          + "» differs, why «" + why.slice(0, 50) + "»");
+      }
+    }
+  }
+  // Python reprs in what a reader reads (prose and outputs, not the code cells)
+  const reprs = [];
+  for (const [re, what] of [
+    [/\barray\(/, "a numpy array repr"], [/np\.(float|int)\d*\(/, "a numpy scalar repr"],
+    [/<hsgeo\./, "an hsgeo object repr"], [/\{'/, "a dict repr"],
+  ]) {
+    const m = seen.match(re);
+    if (m) reprs.push(what + ": …" + seen.slice(Math.max(0, m.index - 40), m.index + 50) + "…");
+  }
+  // the per-paper statements of the scoreboard and the landing page: words each
+  const statements = [...main.querySelectorAll(".hsgeo-statement")].map((el) => {
+    const t = (el.textContent || "").replace(/\s+/g, " ").trim();
+    return {text: t.slice(0, 80), words: t ? t.split(" ").length : 0};
+  });
   const hrefs = [...document.querySelectorAll("a[href]")].map((a) => a.getAttribute("href"));
   const downloads = hrefs.filter((h) => /\.ipynb$/.test(h));
   const sources = hrefs.filter((h) => /_sources\/.*\.md$/.test(h));
   return {
     title: document.title,
+    display_math: main.querySelectorAll("mjx-container[display='true']").length,
+    long_tables: long_tables.slice(0, 8),
+    empty_columns: empty_columns.slice(0, 8),
+    uncaused: uncaused.slice(0, 8),
+    reprs: reprs,
+    statements: statements,
     math_sources: main.querySelectorAll(".math, span.math, div.math").length,
     mathjax_output: main.querySelectorAll("mjx-container").length,
     mathjax_src: [...document.querySelectorAll("script[src]")]
@@ -240,7 +308,7 @@ def page_facts(browser, path: Path, width_px: int) -> dict:
     )
     try:
         page.goto(path.resolve().as_uri(), wait_until="load")
-        facts = page.evaluate(_FACTS_JS)
+        facts = page.evaluate(_FACTS_JS.replace("__MAX_ROWS__", str(MAX_TABLE_ROWS)))
         page.wait_for_timeout(100)  # let late font and component loads report
     finally:
         context.close()
@@ -365,3 +433,42 @@ def problems_version_footer(facts: dict) -> list[str]:
     if re.search(r"hsgeo \d+\.\d+", facts["footer"]):
         return []
     return [f"no hsgeo version in the footer: «{facts['footer'].strip()[:80]}»"]
+
+
+def problems_display_equations(facts: dict, minimum: int = 2) -> list[str]:
+    """At least ``minimum`` display equations typeset by MathJax (a chapter that teaches its
+    equations shows them)."""
+    if facts["display_math"] >= minimum:
+        return []
+    return [f"{facts['display_math']} typeset display equations, fewer than {minimum}"]
+
+
+def problems_long_tables(facts: dict) -> list[str]:
+    """No table in view longer than :data:`MAX_TABLE_ROWS` rows, none with an all-"—" column."""
+    return [f"table too long: {d}" for d in facts["long_tables"]] + [
+        f"empty column: {d}" for d in facts["empty_columns"]
+    ]
+
+
+def problems_reprs(facts: dict) -> list[str]:
+    """No Python repr (``array(``, ``np.float64(``, ``<hsgeo.``, ``{'``) in what a reader reads."""
+    return [f"Python repr, {d}" for d in facts["reprs"]]
+
+
+def problems_differs_cause(facts: dict) -> list[str]:
+    """Every row judged "differs" (in a table with a reason column) says why, not only how far."""
+    return [f"differs without a cause: {d}" for d in facts["uncaused"]]
+
+
+def problems_statements(facts: dict, minimum: int = 0) -> list[str]:
+    """Each per-paper statement (``.hsgeo-statement``) has at most :data:`MAX_STATEMENT_WORDS`
+    words, none is empty, and the page has at least ``minimum`` of them."""
+    out = [
+        f"statement of {s['words']} words (> {MAX_STATEMENT_WORDS}): «{s['text']}…»"
+        for s in facts["statements"]
+        if s["words"] > MAX_STATEMENT_WORDS
+    ]
+    out += ["an empty statement" for s in facts["statements"] if s["words"] == 0]
+    if len(facts["statements"]) < minimum:
+        out.append(f"{len(facts['statements'])} per-paper statements, fewer than {minimum}")
+    return out

@@ -28,16 +28,21 @@ from pagecheck import (
     problems_captions,
     problems_cell_padding,
     problems_clipped,
+    problems_differs_cause,
+    problems_display_equations,
     problems_equations,
     problems_exercises,
     problems_glue_slips,
     problems_ipynb,
     problems_leaks,
+    problems_long_tables,
     problems_md_source,
     problems_nan,
     problems_offline,
     problems_page_width,
+    problems_reprs,
     problems_result_tables,
+    problems_statements,
     problems_version_footer,
 )
 
@@ -59,6 +64,21 @@ def _page(tmp_path: Path, name: str, body: str) -> Path:
         encoding="utf-8",
     )
     return path
+
+
+def _table(n_rows: int) -> str:
+    rows = "".join(f"<tr><td>q{i}</td><td>{i}</td></tr>" for i in range(n_rows))
+    return f"<table><thead><tr><th>q</th><th>v</th></tr></thead><tbody>{rows}</tbody></table>"
+
+
+def _verdicts(*rows: tuple[str, str]) -> str:
+    body = "".join(
+        f"<tr><td>c{i}</td><td>{v}</td><td>{w}</td></tr>" for i, (v, w) in enumerate(rows)
+    )
+    return (
+        "<table><thead><tr><th>claim</th><th>verdict</th><th>why</th></tr></thead>"
+        f"<tbody>{body}</tbody></table>"
+    )
 
 
 # (check, defective body, repaired body)
@@ -176,6 +196,62 @@ CASES = {
         problems_version_footer,
         "<footer>Built by hand</footer>",
         "<footer>Built with hsgeo 0.1.0</footer>",
+    ),
+    "too-few-display-equations": (
+        problems_display_equations,
+        '<p>The LP camera has no equation.</p><mjx-container display="true">u</mjx-container>',
+        '<mjx-container display="true">u</mjx-container>'
+        '<mjx-container display="true">v</mjx-container>',
+    ),
+    "table-over-20-rows": (
+        problems_long_tables,
+        _table(21),
+        _table(20) + "<details><summary>all rows</summary>" + _table(56) + "</details>",
+    ),
+    "all-dash-column": (
+        problems_long_tables,
+        "<table><thead><tr><th>q</th><th>observation level</th></tr></thead><tbody>"
+        "<tr><td>a</td><td>—</td></tr><tr><td>b</td><td>—</td></tr></tbody></table>",
+        "<table><thead><tr><th>q</th><th>observation level</th></tr></thead><tbody>"
+        "<tr><td>a</td><td>—</td></tr><tr><td>b</td><td>0.12</td></tr></tbody></table>",
+    ),
+    "array-repr": (
+        problems_reprs,
+        "<p>the shifts are array([0.1, 0.2]) px</p>",
+        "<p>the shifts are 0.1 and 0.2 px</p>",
+    ),
+    "numpy-scalar-repr": (
+        problems_reprs,
+        '<div class="cell_output"><pre>np.float64(0.34)</pre></div>',
+        '<div class="cell_output"><pre>0.34</pre></div>',
+    ),
+    "hsgeo-object-repr": (
+        problems_reprs,
+        "<p>&lt;hsgeo.report.Reproduction object at 0x7f&gt;</p>",
+        "<p>the reproduction of lp-observations</p>",
+    ),
+    "dict-repr": (
+        problems_reprs,
+        "<p>counts {'all': 42682}</p>",
+        "<p>counts: 42,682 in all (a set {a, b} in words is fine)</p>",
+    ),
+    "differs-without-cause": (
+        problems_differs_cause,
+        _verdicts(("differs", "12.4σ from the paper (σ̂)")),
+        _verdicts(
+            ("differs", "check points measured as 002 measured them: the matcher's tie points"),
+            ("reproduced", "within 2σ of the paper (σ̂)"),
+        ),
+    ),
+    "differs-without-any-reason": (
+        problems_differs_cause,
+        _verdicts(("differs", "—")),
+        _verdicts(("not testable", "—")),
+    ),
+    "statement-over-80-words": (
+        problems_statements,
+        '<p class="hsgeo-statement">' + "word " * 81 + "</p>",
+        '<p class="hsgeo-statement">' + "word " * 80 + "</p>",
     ),
     "network-request": (
         problems_offline,
@@ -339,6 +415,10 @@ def test_synthetic_chapter_passes_every_check(browser, demo_book, width):
         + problems_cell_padding(facts)
         + problems_version_footer(facts)
         + problems_result_tables(facts)
+        + problems_long_tables(facts)
+        + problems_reprs(facts)
+        + problems_differs_cause(facts)
+        + problems_statements(facts)
     )
     assert problems == []
     # the checks saw what they check, so passing is not vacuous

@@ -23,16 +23,21 @@ from pagecheck import (
     problems_captions,
     problems_cell_padding,
     problems_clipped,
+    problems_differs_cause,
+    problems_display_equations,
     problems_equations,
     problems_exercises,
     problems_glue_slips,
     problems_ipynb,
     problems_leaks,
+    problems_long_tables,
     problems_md_source,
     problems_nan,
     problems_offline,
     problems_page_width,
+    problems_reprs,
     problems_result_tables,
+    problems_statements,
     problems_version_footer,
 )
 
@@ -60,6 +65,11 @@ def _toc_docs() -> list[str]:
 
 DOCS = _toc_docs()
 CHAPTERS = [doc for doc in DOCS if doc.startswith("chapters/")]
+#: Chapters that must typeset their equations (issue 40: the LP chapter teaches four).
+EQUATION_CHAPTERS = ["chapters/lp_observations"]
+#: Pages with one statement per paper (the scoreboard and the landing page).
+STATEMENT_PAGES = ["scoreboard", "intro"]
+N_PAPERS = 5
 _FACTS: dict[tuple[str, int], dict] = {}
 
 
@@ -173,3 +183,32 @@ def test_every_chapter_is_in_the_toc():
     """The chapter checks cover every chapter file (a new chapter cannot escape them)."""
     on_disk = sorted(f"chapters/{p.stem}" for p in (BOOK / "chapters").glob("*.md"))
     assert sorted(CHAPTERS) == on_disk
+
+
+@_params(DOCS, WIDE_PX)
+def test_tables_short_and_without_empty_columns(facts):
+    """No table in view over 20 rows (a long one goes under a toggle), no all-"—" column."""
+    _check(problems_long_tables(facts), facts)
+
+
+@_params(DOCS, WIDE_PX)
+def test_no_python_reprs(facts):
+    """No ``array(``, ``np.float64(``, ``<hsgeo.`` or ``{'`` in the prose or the outputs."""
+    _check(problems_reprs(facts), facts)
+
+
+@_params(DOCS, WIDE_PX)
+def test_every_differs_has_a_cause(facts):
+    _check(problems_differs_cause(facts), facts)
+
+
+@_params(EQUATION_CHAPTERS, WIDE_PX)
+def test_chapter_typesets_its_equations(facts):
+    """At least two display equations typeset by MathJax."""
+    _check(problems_display_equations(facts, minimum=2), facts)
+
+
+@_params(STATEMENT_PAGES, WIDE_PX)
+def test_per_paper_statements(facts):
+    """One statement per paper, each of at most 80 words."""
+    _check(problems_statements(facts, minimum=N_PAPERS), facts)
