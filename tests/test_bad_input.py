@@ -39,9 +39,11 @@ CHARUCO = ROOT / "src/hsgeo/data/reference/opencv-charuco"
 
 def _line(d: Path) -> None:
     from hsgeo.reproduce.line_calibration import generate
+    from hsgeo.simulate.line_lab import LineLabScenario
+    from hsgeo.simulate.scenarios import ScenarioInfo
 
     d.mkdir()
-    generate({"scenario": {"generator": "line_lab", "seed": 4}, "calibration": {"row": 1000}}, d)
+    generate(LineLabScenario(ScenarioInfo("line_lab", 4)), d)
     (d / "line_lab_observations.csv").rename(d / "obs.csv")
     (d / "line_lab_control.csv").rename(d / "control.csv")
     (d / "line_lab_truth.csv").unlink()

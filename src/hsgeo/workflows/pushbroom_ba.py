@@ -507,14 +507,14 @@ def read_camera(path) -> CameraPrior:
     """
     from hsgeo.io.sensor_file import read_sensor, read_sensor_tables
 
-    name, cfg, table = read_sensor_tables(path)
+    name, tables, table = read_sensor_tables(path)
     if name != "pushbroom":
         raise InputError(
             f"camera file {path}: model {name!r}; hsgeo adjust-pushbroom adjusts the 002 "
             'pushbroom camera: give a sensor file with model = "pushbroom"'
         )
     camera = read_sensor(path)
-    cam, nav = cfg["sensor"], cfg["gnss_ins"]
+    cam, nav = tables["sensor"], tables["gnss_ins"]
     c = tuple(float(v) for v in camera.c_mm)
     kw = {
         "n_bands": len(c),
@@ -533,10 +533,11 @@ def read_camera(path) -> CameraPrior:
         kw["sigma_pos_m"] = nav["sigma_pos_m"]
     if "sigma_att_deg" in nav:
         kw["sigma_att_rad"] = tuple(np.deg2rad(nav["sigma_att_deg"]))
-    if "sigma_px" in cfg["observations"]:
-        kw["sigma_obs_px"] = cfg["observations"]["sigma_px"]
-    if "sigma_m" in cfg["gcp"]:
-        kw["sigma_gcp_m"] = cfg["gcp"]["sigma_m"]
+    obs, gcp = tables["observations"], tables["gcp"]
+    if "sigma_px" in obs:
+        kw["sigma_obs_px"] = obs["sigma_px"]
+    if "sigma_m" in gcp:
+        kw["sigma_gcp_m"] = gcp["sigma_m"]
     return CameraPrior(**kw)
 
 

@@ -43,6 +43,7 @@ __all__ = [
 #: The Rikola FPI2015's band split (band, sensor, FPI air gap), an instrument description read
 #: by :func:`hsgeo.io.read_band_split` (``hsgeo/data/instruments/rikola_fpi2015.toml``).
 BANDS = read_band_split()
+BANDS.setflags(write=False)
 
 
 def detect_targets_in_images(
