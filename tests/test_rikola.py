@@ -268,12 +268,12 @@ def test_rendered_image_is_measured_without_the_truth(cfg, truth):
         plate.corners(),
         plate.ids,
         size,
-        float(cam["pixel_mm"]),
+        float(cam.pixel_mm),
         dictionary=plate.dictionary,
     )
     assert cmp_ is None and len(obs.target) > 10
     assert "expected" not in {f.name for f in dataclasses.fields(obs)}
-    true_px = mm_to_pixel(truth.project(0, 5, plate.corners()[obs.target]), size, cam["pixel_mm"])
+    true_px = mm_to_pixel(truth.project(0, 5, plate.corners()[obs.target]), size, cam.pixel_mm)
     assert np.median(np.abs(obs.corners_px - true_px)) < 0.5
 
 
