@@ -123,7 +123,7 @@ def _data_flight(args) -> int:
 def _cmd_adjust_pushbroom(args) -> int:
     from hsgeo.workflows.pushbroom_ba import adjust_files
 
-    out = adjust_files(
+    res = adjust_files(
         args.observations,
         args.trajectory,
         args.camera,
@@ -133,8 +133,8 @@ def _cmd_adjust_pushbroom(args) -> int:
         y_as_time=not args.image_y,
         max_nav_gap_s=args.max_nav_gap_s,
     )
-    res = out.pop("_result")
-    print(json_text(out) if args.json else res.report(max_block_size=20))
+    out = res.to_dict()
+    print(json_text(out) if args.json else res.result.report(max_block_size=20))
     fit = out["fit"]
     warnings = fit.get("warnings", [])
     if fit["verdict"] == "poor" and not args.accept_poor_fit:

@@ -552,7 +552,7 @@ def adjust_files(
     progress=None,
     y_as_time: bool = Y_AS_TIME,
     max_nav_gap_s: float = 1.0,
-) -> dict:
+) -> PushbroomResult:
     """Adjust a user's pushbroom observations (``hsgeo adjust-pushbroom``).
 
     Parameters
@@ -582,10 +582,11 @@ def adjust_files(
 
     Returns
     -------
-    dict
-        Summary, the camera parameters with σ̂, the node corrections, the adjusted points and
-        ``fit``, the plausibility verdict of :func:`fit_verdict` (``hsgeo adjust-pushbroom`` exits
-        2 on a poor fit unless ``--accept-poor-fit``).
+    PushbroomResult
+        The in-memory core's result (:func:`adjust_pushbroom`): ``to_dict()`` gives the
+        summary, the camera parameters with σ̂, the node corrections, the adjusted points and
+        ``fit``, the plausibility verdict of :func:`fit_verdict` (``hsgeo adjust-pushbroom``
+        exits 2 on a poor fit unless ``--accept-poor-fit``); ``result`` the engine's.
     """
     from hsgeo.io.navigation import read_trajectory
 
@@ -610,10 +611,7 @@ def adjust_files(
         y_as_time=y_as_time,
         raise_on_failure=False,  # no convergence is a verdict of the fit (fit_verdict)
     )
-    r = adjust_pushbroom(inputs, options, progress=progress)
-    out = r.to_dict()
-    out["_result"] = r.result
-    return out
+    return adjust_pushbroom(inputs, options, progress=progress)
 
 
 def observations_from_table(
