@@ -250,7 +250,8 @@ def _cmd_orthorectify(args) -> int:
 def _cmd_adjust_bal(args) -> int:
     from hsgeo.workflows.bal import adjust_bal_file
 
-    out = adjust_bal_file(args.file, progress=None if args.json else terminal.progress_printer())
+    fit = adjust_bal_file(args.file, progress=None if args.json else terminal.progress_printer())
+    out = fit.to_dict()
     if args.json:
         print(json_text(out))
     else:
@@ -270,12 +271,9 @@ def _cmd_mtf(args) -> int:
 
     out = bars_files(args.profiles, args.bars)
     if args.json:
-        d = {"profiles": [{"row": r, **res.to_dict()} for r, res in out.items()]}
-        if len(out) == 1:
-            d = next(iter(d["profiles"]))
-        print(json_text(d))
+        print(json_text(out.to_dict()))
         return 0
-    for r, res in out.items():
+    for r, res in out.by_row.items():
         head = "profile" if r is None else f"row {r}"
         if res.borderline_cy_px == res.borderline_cy_px:  # not NaN
             border = (
