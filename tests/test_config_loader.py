@@ -155,3 +155,19 @@ def test_the_solver_constants_are_options():
     for bad in ({"hold_max": -1}, {"thrown_share": 0.0}, {"thrown_ratio": float("inf")}):
         with pytest.raises(InputError, match=next(iter(bad))):
             SolverOptions(**bad)
+
+
+def test_no_configuration_is_read_as_a_raw_dict():
+    """Scenarios are dataclasses: no ``cfg["…"]`` in the package (issue's measure: 55 → 0)."""
+    from pathlib import Path
+
+    import hsgeo
+
+    src = Path(hsgeo.__file__).parent
+    hits = [
+        f"{p.relative_to(src)}:{i}"
+        for p in sorted(src.rglob("*.py"))
+        for i, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1)
+        if 'cfg["' in line
+    ]
+    assert not hits, hits
