@@ -171,3 +171,33 @@ def test_no_configuration_is_read_as_a_raw_dict():
         if 'cfg["' in line
     ]
     assert not hits, hits
+
+
+@dataclass(frozen=True)
+class _Checked:
+    n_views: int = 3
+
+    def __post_init__(self):
+        if self.n_views < 2:
+            raise InputError(f"n_views must be at least 2, got {self.n_views}")
+
+
+@dataclass(frozen=True)
+class _Outer:
+    inner: _Scenario
+    checked: _Checked = _Checked()
+
+
+def test_nested_tables_and_the_dataclass_own_checks_are_named():
+    with pytest.raises(InputError) as e:
+        load_dataclass(
+            _Outer,
+            {
+                "inner": {"flight": {"height_agl_m": 1.0, "sped_m_s": 2.0}},
+                "checked": {"n_views": 1},
+            },
+            "f.toml",
+        )
+    msg = str(e.value)
+    assert "[inner.flight] sped_m_s: unknown key; did you mean 'speed_m_s'?" in msg, msg
+    assert "[checked] n_views must be at least 2, got 1" in msg, msg

@@ -294,15 +294,19 @@ def _field_kind(hint) -> tuple[str | None, type | None, bool]:
     raise TypeError(f"unsupported configuration type {hint!r}")
 
 
-def _load(cls, table: Mapping, where: str, problems: list):
-    """``cls`` from one TOML table (nested tables for dataclass fields); problems appended."""
+def _load(cls, table: Mapping, path: str, problems: list):
+    """``cls`` from one TOML table (nested tables for dataclass fields) at the dotted table
+    ``path`` (``""``: the file's top level); problems appended.
+    """
     import dataclasses
     import typing
 
     hints = typing.get_type_hints(cls)
     fields = [f for f in dataclasses.fields(cls) if f.init]
     names = [f.name for f in fields]
+    where = f"[{path}]" if path else ""
     prefix = f"{where} " if where else ""
+    n_before = len(problems)
     for k in table:
         if k not in names:
             what = "table" if isinstance(table[k], Mapping) else "key"
@@ -317,10 +321,10 @@ def _load(cls, table: Mapping, where: str, problems: list):
         has_default = (
             f.default is not dataclasses.MISSING or f.default_factory is not dataclasses.MISSING
         )
-        here = f"{where}.{f.name}" if where else f.name
+        here = f"{path}.{f.name}" if path else f.name
         if f.name not in table:
             if sub is not None and not has_default and not optional:
-                kwargs[f.name] = _load(sub, {}, f"[{here}]", problems)
+                kwargs[f.name] = _load(sub, {}, here, problems)
             elif not has_default:
                 doc = f.metadata.get("key", Key("str")).doc
                 problems.append(
@@ -333,15 +337,19 @@ def _load(cls, table: Mapping, where: str, problems: list):
             if not isinstance(v, Mapping):
                 problems.append(f"{prefix}{f.name}: must be a table [{here}], got {v!r}")
                 continue
-            kwargs[f.name] = _load(sub, v, f"[{here}]", problems)
+            kwargs[f.name] = _load(sub, v, here, problems)
             continue
         key = f.metadata.get("key", Key(kind))
         out = _value(v, _with_unit_limit(key, f.name), f"{prefix}{f.name}", problems)
         if out is not None:
             kwargs[f.name] = out
-    if problems:
+    if len(problems) > n_before:
         return None
-    return cls(**kwargs)
+    try:
+        return cls(**kwargs)
+    except InputError as exc:  # a check of the dataclass itself (__post_init__)
+        problems.append(f"{prefix}{exc}")
+        return None
 
 
 def load_dataclass(cls, table: Mapping | None, what: str = "configuration"):
