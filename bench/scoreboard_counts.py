@@ -14,6 +14,7 @@ the counts by verdict, by paper and by provenance as JSON.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 from pathlib import Path
 
@@ -38,14 +39,14 @@ def load(directory: Path, rejudge: bool) -> dict[str, Reproduction]:
         d = json.loads(path.read_text(encoding="utf-8"))
         rep = Reproduction.from_json(path.read_text(encoding="utf-8"))
         if rejudge:
-            for row, raw in zip(rep.rows, d["rows"], strict=True):
+            for i, (row, raw) in enumerate(zip(rep.rows, d["rows"], strict=True)):
                 if not raw.get("override") and row.verdict != "planned":
-                    row.verdict, row.reason = None, ""
                     # a reason the chapter set for its differs/not testable stays with the row
-                    if raw.get("verdict") in ("differs", "not testable") and not raw.get(
+                    keep = raw.get("verdict") in ("differs", "not testable") and not raw.get(
                         "reason", ""
-                    ).startswith(("tuning missed", "recovery failed")):
-                        row.reason = raw.get("reason") or ""
+                    ).startswith(("tuning missed", "recovery failed"))
+                    reason = (raw.get("reason") or "") if keep else ""
+                    rep.rows[i] = dataclasses.replace(row, verdict=None, reason=reason)
         reps[chapter] = mark_context(chapter, rep)
     return reps
 
@@ -66,8 +67,7 @@ def main() -> None:
                     and r.table not in NOT_CLAIMS
                     and r.paper is not None
                 ):
-                    r.judged_in = None
-                    rows.append(r)
+                    rows.append(dataclasses.replace(r, judged_in=None))
     else:
         rows = [r for _, r in claims_with_chapters(reps)]
     out = {

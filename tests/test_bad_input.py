@@ -39,9 +39,11 @@ CHARUCO = ROOT / "src/hsgeo/data/reference/opencv-charuco"
 
 def _line(d: Path) -> None:
     from hsgeo.reproduce.line_calibration import generate
+    from hsgeo.simulate.line_lab import LineLabScenario
+    from hsgeo.simulate.scenarios import ScenarioInfo
 
     d.mkdir()
-    generate({"scenario": {"generator": "line_lab", "seed": 4}, "calibration": {"row": 1000}}, d)
+    generate(LineLabScenario(ScenarioInfo("line_lab", 4)), d)
     (d / "line_lab_observations.csv").rename(d / "obs.csv")
     (d / "line_lab_control.csv").rename(d / "control.csv")
     (d / "line_lab_truth.csv").unlink()
@@ -2125,6 +2127,8 @@ case(C, "missing", "frame-sensor-without-frame-times", "give the frames' exposur
      argv=opt("--frame-times"))  # fmt: skip
 case(C, "missing", "frame-times-without-time_s", "time_s",
      [("frames.csv", _frames_csv(lambda t: t.replace("time_s", "t")))])  # fmt: skip
+
+
 def _sensor(name: str):
     return lambda a, d: opt("--sensor", str(d / name))(a, d)
 

@@ -111,7 +111,7 @@ def test_simulated_bench_truth_within_3_sigma(seed):
 
 def test_simulated_bench_noise_free():
     cfg = load_scenario("frame_bench")
-    cfg["camera"]["sigma_px"] = 0.0
+    cfg = dataclasses.replace(cfg, camera=dataclasses.replace(cfg.camera, sigma_px=0.0))
     sim, sim_truth = simulate(cfg, 5)
     cal = calibrate_opencv(_views(sim), (640, 480))
     truth = np.concatenate([sim_truth.intrinsics, sim_truth.distortion])

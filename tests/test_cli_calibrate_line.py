@@ -4,12 +4,14 @@ import pytest
 
 from hsgeo.cli import main
 from hsgeo.reproduce.line_calibration import generate
+from hsgeo.simulate.line_lab import LineLabScenario
+from hsgeo.simulate.scenarios import ScenarioInfo
 
 
 @pytest.fixture(scope="module")
 def files(tmp_path_factory):
     d = tmp_path_factory.mktemp("line")
-    generate({"scenario": {"generator": "line_lab", "seed": 4}, "calibration": {"row": 1000}}, d)
+    generate(LineLabScenario(ScenarioInfo("line_lab", 4)), d)
     return d
 
 

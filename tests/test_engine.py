@@ -754,15 +754,14 @@ def test_points_held_to_save_a_refused_step(monkeypatch):
         p.fix("stations")
         res[hold] = adjust(p, Bearings(st, pt, th, 1e-3), hold_points=hold)
     assert any(held)  # (only called with hold_points=True)
-    assert max(counts) <= SV.HOLD_MAX
+    assert max(counts) <= SolverOptions().hold_max == 3
     # with the cap at one hold per point the same minimum is reached too
-    monkeypatch.setattr(SV, "HOLD_MAX", 1)
     counts.clear()
     p = Parameters()
     p.add("stations", S.copy())
     p.add("points", P0.copy(), points=True)
     p.fix("stations")
-    capped = adjust(p, Bearings(st, pt, th, 1e-3))
+    capped = adjust(p, Bearings(st, pt, th, 1e-3), hold_max=1)
     assert counts and max(counts) == 1
     np.testing.assert_allclose(capped.cost_history[-1], res[False].cost_history[-1], rtol=1e-9)
     np.testing.assert_allclose(res[True].cost_history[-1], res[False].cost_history[-1], rtol=1e-9)

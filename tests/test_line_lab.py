@@ -2,6 +2,7 @@ import numpy as np
 import pytest
 
 from hsgeo import InputError
+from hsgeo.io.config import load_dataclass
 from hsgeo.papers import P000_TABLE1_CALIBRATED, P001_TABLE2
 from hsgeo.reproduce.line_calibration import (
     IOP_NAMES,
@@ -11,6 +12,8 @@ from hsgeo.reproduce.line_calibration import (
 )
 from hsgeo.sensors import line1d
 from hsgeo.simulate import line_lab as LL
+from hsgeo.simulate.line_lab import LineLabScenario
+from hsgeo.simulate.scenarios import ScenarioInfo
 
 LAB = LL.LineLab()
 
@@ -78,7 +81,7 @@ def test_calibration_within_3_sigma_of_truth(seed, row):
 
 
 def test_generate_writes_cli_files(tmp_path):
-    cfg = {"scenario": {"generator": "line_lab", "seed": 1}, "calibration": {"row": 1000}}
+    cfg = LineLabScenario(ScenarioInfo("line_lab", 1))
     paths = generate(cfg, tmp_path)
     assert [p.name for p in paths] == [
         "line_lab_observations.csv",
@@ -86,8 +89,9 @@ def test_generate_writes_cli_files(tmp_path):
         "line_lab_truth.csv",
     ]
     assert paths[0].read_text().splitlines()[0] == "image,point,zeta_px"
-    with pytest.raises(InputError, match=r"line-lab settings \[lab\] bogus: unknown key"):
-        LL.LineLab.from_config({"bogus": 1})
+    with pytest.raises(InputError, match=r"line-lab settings: bogus: unknown key"):
+        load_dataclass(LL.LineLab, {"bogus": 1}, "line-lab settings")
     with pytest.raises(InputError, match="distance_mm: unknown key; did you mean 'distance_m'"):
-        LL.LineLab.from_config({"distance_mm": 3.0})
-    assert LL.LineLab.from_config({"azimuths_deg": [-45.0, 0.0]}).azimuths_deg == (-45.0, 0.0)
+        load_dataclass(LL.LineLab, {"distance_mm": 3.0})
+    lab = load_dataclass(LL.LineLab, {"azimuths_deg": [-45.0, 0.0]})
+    assert lab.azimuths_deg == (-45.0, 0.0)

@@ -301,7 +301,7 @@ def test_the_table_feeds_adjust_files(tmp_path, campaign, retrieved):
     ).to_csv(tmp_path / "gcp.csv", index=False)
     out = adjust_files(
         tmp_path / "obs.parquet", tmp_path / "nav.csv", tmp_path / "cam.toml", tmp_path / "gcp.csv"
-    )
+    ).to_dict()
     assert out["converged"]
     assert out["n_observations_2d"] == len(retrieved.table)
     assert out["fit"]["rejected_share"] < 0.05

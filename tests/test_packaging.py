@@ -150,7 +150,7 @@ def test_scenarios_found_in_the_package_outside_the_repository(tmp_path, monkeyp
     monkeypatch.chdir(empty)
     monkeypatch.setattr(scenarios, "__file__", str(fake))
     assert scenarios.data_dir() == pkg / "data" / "scenarios"
-    assert scenarios.load_scenario("pula_flight")["scenario"]["generator"] == "pula_flight"
+    assert scenarios.load_scenario("pula_flight").scenario.generator == "pula_flight"
     (pkg / "data" / "scenarios" / "pula_flight.toml").unlink()
     with pytest.raises(scenarios.InputError, match="make dist"):
         scenarios.data_dir()

@@ -1,6 +1,8 @@
 """The simulated airborne flight (hsgeo.simulate.pula_flight): every seed gives a flight that
 images all GCPs within the calibrated swath, deterministically."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -34,8 +36,8 @@ def test_the_seed_whose_first_draw_lost_a_gcp_now_works():
     assert truth.n_draws == 2
     # independent check: the true sensor's inverse model accepts every GCP's noise-free ζ, and
     # the measured ζ lie within the usable swath (± the measurement noise)
-    half = cfg["scanner"]["usable_half_width_px"]
-    assert np.all(np.abs(obs.zeta_px - cfg["sensor_truth"]["zeta0_px"]) < half + 2.0)
+    half = cfg.scanner.usable_half_width_px
+    assert np.all(np.abs(obs.zeta_px - cfg.sensor_truth.zeta0_px) < half + 2.0)
     n_lines = truth.true_nav.t_s[-1] * truth.line_rate_hz
     assert np.all((obs.line > 0) & (obs.line < n_lines))
     # deterministic: the same seed gives the same bytes, redraw included
@@ -57,7 +59,7 @@ def test_a_first_draw_is_kept_as_drawn():
     rng = np.random.default_rng(3)
     nav, _, _ = _true_trajectory(cfg, rng)
     rec = _recorded(nav, cfg, rng)
-    bs = rng.normal(0, np.deg2rad(cfg["flight"]["boresight_sigma_deg"]), 3)
+    bs = rng.normal(0, np.deg2rad(cfg.flight.boresight_sigma_deg), 3)
     assert bs.tobytes() == truth.boresight_rad.tobytes()
     assert rec.xyz_m.tobytes() == obs.recorded_nav.xyz_m.tobytes()
 
@@ -81,7 +83,8 @@ def test_gcps_in_swath_agrees_with_the_inverse_model():
 
 def test_a_field_that_does_not_fit_the_swath_is_a_clear_error():
     cfg = load_scenario("pula_flight")
-    cfg["field"]["across_px"] = [-600.0] + list(cfg["field"]["across_px"][1:])
+    field = replace(cfg.field, across_px=(-600.0, *cfg.field.across_px[1:]))
+    cfg = replace(cfg, field=field)
     assert gcp_field(cfg)[1].shape == (10, 3) and true_sensor(cfg).c_px > 0
     with pytest.raises(InputError, match=rf"{MAX_FLIGHT_DRAWS} draws.*across_px"):
         simulate_flight(cfg, 0)

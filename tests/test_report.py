@@ -1,5 +1,6 @@
 """hsgeo.report: z, verdicts, agreement words, number formatting and strict JSON."""
 
+import dataclasses
 import json
 import math
 
@@ -10,49 +11,74 @@ from hsgeo.report import Reproduction, Row, agreement, format_rows, format_value
 
 
 def test_z_is_deviation_from_truth_in_sigmas():
-    r = Row("t", "c", "px", reproduced=10.5, sigma=0.25, truth=10.0)
+    r = Row(table="t", quantity="c", unit="px", reproduced=10.5, sigma=0.25, truth=10.0)
     assert r.z == pytest.approx(2.0)
-    assert Row("t", "c", "px", reproduced=1.0, truth=1.0).z is None  # no σ: no z
+    assert (
+        Row(table="t", quantity="c", unit="px", reproduced=1.0, truth=1.0).z is None
+    )  # no σ: no z
 
 
 def test_verdicts_follow_the_numbers():
     # truth = paper: agreement with the paper is by construction, the reason gives the recovery
-    v, why = Row("t", "c", "px", paper=3539, reproduced=3541, sigma=1.0, truth=3539).judge()
+    v, why = Row(
+        table="t", quantity="c", unit="px", paper=3539, reproduced=3541, sigma=1.0, truth=3539
+    ).judge()
     assert v == "by construction" and "within 2σ" in why
     # independent outcome: judged by the combined σ of ours and the paper's
-    assert Row("t", "q", "m", paper=1.0, paper_sigma=0.3, reproduced=1.5, sigma=0.4).judge()[0] == (
-        "reproduced"
-    )  # |z| = 0.5 / 0.5 = 1
-    v, why = Row("t", "q", "m", paper=1.0, reproduced=3.0, sigma=0.5, n_runs=20).judge()
+    assert Row(
+        table="t", quantity="q", unit="m", paper=1.0, paper_sigma=0.3, reproduced=1.5, sigma=0.4
+    ).judge()[0] == ("reproduced")  # |z| = 0.5 / 0.5 = 1
+    v, why = Row(
+        table="t", quantity="q", unit="m", paper=1.0, reproduced=3.0, sigma=0.5, n_runs=20
+    ).judge()
     assert v == "differs" and "4.0σ" in why and "20 runs" in why
-    assert Row("t", "q", "m", paper=1.0, reproduced=1.1).judge()[0] == "not testable"
-    assert Row("t", "q", "m", paper=1.0).judge()[0] == "not testable"
-    assert Row("t", "q", "m", reproduced=1.0).judge() == (None, "")
-    assert Row("t", "q", "m", paper=1.0, verdict="planned", reason="004").judge() == (
+    assert (
+        Row(table="t", quantity="q", unit="m", paper=1.0, reproduced=1.1).judge()[0]
+        == "not testable"
+    )
+    assert Row(table="t", quantity="q", unit="m", paper=1.0).judge()[0] == "not testable"
+    assert Row(table="t", quantity="q", unit="m", reproduced=1.0).judge() == (None, "")
+    assert Row(
+        table="t", quantity="q", unit="m", paper=1.0, verdict="planned", reason="004"
+    ).judge() == (
         "planned",
         "004",
     )
     with pytest.raises(InputError, match="use one of"):
-        Row("t", "q", "m", verdict="fine", reason="x")
+        Row(table="t", quantity="q", unit="m", verdict="fine", reason="x")
 
 
 def test_provenance_decides_what_counts_as_reproduced():
     # GUIDE §4: agreement built in (paper, derived, tuned) is never "reproduced"
     for prov in ("paper", "derived", "tuned"):
         r = Row(
-            "t", "q", "m", paper=1.0, paper_sigma=0.3, reproduced=1.1, sigma=0.1, provenance=prov
+            table="t",
+            quantity="q",
+            unit="m",
+            paper=1.0,
+            paper_sigma=0.3,
+            reproduced=1.1,
+            sigma=0.1,
+            provenance=prov,
         )
         assert r.judge()[0] == "by construction", prov
     # the same numbers from a chosen assumption are an independent outcome
     r = Row(
-        "t", "q", "m", paper=1.0, paper_sigma=0.3, reproduced=1.1, sigma=0.1, provenance="chosen"
+        table="t",
+        quantity="q",
+        unit="m",
+        paper=1.0,
+        paper_sigma=0.3,
+        reproduced=1.1,
+        sigma=0.1,
+        provenance="chosen",
     )
     assert r.judge()[0] == "reproduced"
     # a tuning that missed by more than 3σ differs (002 Table 1 NMAD x before issue 22)
     v, why = Row(
-        "t",
-        "nmad_x_px",
-        "px",
+        table="t",
+        quantity="nmad_x_px",
+        unit="px",
         paper=0.32,
         reproduced=0.283,
         sigma=0.0028,
@@ -61,70 +87,120 @@ def test_provenance_decides_what_counts_as_reproduced():
     ).judge()
     assert v == "differs" and why.startswith("tuning missed") and "8 runs" in why
     # a derived truth that misses the paper differs too, with the chapter's reason if it gave one
-    r = Row("t", "q", "m", paper=1.0, reproduced=2.0, sigma=0.1, provenance="derived", reason="R")
+    r = Row(
+        table="t",
+        quantity="q",
+        unit="m",
+        paper=1.0,
+        reproduced=2.0,
+        sigma=0.1,
+        provenance="derived",
+        reason="R",
+    )
     assert r.judge() == ("differs", "R") and not r.overridden
     # tuned without any σ: by construction within 10 % of the paper, said so
-    v, why = Row("t", "q", "m", paper=1.0, reproduced=1.08, provenance="tuned").judge()
+    v, why = Row(
+        table="t", quantity="q", unit="m", paper=1.0, reproduced=1.08, provenance="tuned"
+    ).judge()
     assert v == "by construction" and "no σ" in why
 
 
 def test_a_tuning_without_sigma_that_misses_by_more_than_ten_percent_missed():
     # 003 Table 4's R²: 82.99 % against the paper's 54.4 % read "tuned (met)" before issue 37
-    v, why = Row("t", "R2", "%", paper=54.4, reproduced=82.99, provenance="tuned").judge()
+    v, why = Row(
+        table="t", quantity="R2", unit="%", paper=54.4, reproduced=82.99, provenance="tuned"
+    ).judge()
     assert v == "differs" and why.startswith("tuning missed") and "53 %" in why
-    assert Row("t", "R2", "%", paper=54.4, reproduced=59.0, provenance="tuned").judge()[0] == (
-        "by construction"
-    )  # 8.5 % off
-    assert Row("t", "R2", "%", paper=54.4, reproduced=60.0, provenance="tuned").judge()[0] == (
-        "differs"
-    )  # 10.3 % off
+    assert Row(
+        table="t", quantity="R2", unit="%", paper=54.4, reproduced=59.0, provenance="tuned"
+    ).judge()[0] == ("by construction")  # 8.5 % off
+    assert Row(
+        table="t", quantity="R2", unit="%", paper=54.4, reproduced=60.0, provenance="tuned"
+    ).judge()[0] == ("differs")  # 10.3 % off
 
 
 def test_a_paper_valued_truth_recovered_beyond_three_sigma_is_a_failed_recovery():
     # 003's joint model before issue 37: x0 recovered 15.4σ̂ from its truth (= the paper's value)
     kw = dict(paper=-0.0475, paper_sigma=0.0008, truth=-0.0475, sigma=0.0004)
-    v, why = Row("t", "x0", "mm", reproduced=-0.0475 + 15.4 * 0.0004, **kw).judge()
+    v, why = Row(
+        table="t", quantity="x0", unit="mm", reproduced=-0.0475 + 15.4 * 0.0004, **kw
+    ).judge()
     assert v == "differs" and why.startswith("recovery failed") and "15.4σ̂" in why
     # the same recovery within 3σ̂ (and within 3σ of the paper) is agreement built in
-    assert Row("t", "x0", "mm", reproduced=-0.0475 + 2.5 * 0.0004, **kw).judge()[0] == (
-        "by construction"
-    )
+    assert Row(
+        table="t", quantity="x0", unit="mm", reproduced=-0.0475 + 2.5 * 0.0004, **kw
+    ).judge()[0] == ("by construction")
     # a derived truth too; a tuned one is judged against the paper only
-    d = Row("t", "q", "m", paper=1.0, paper_sigma=1.0, truth=1.1, reproduced=1.5, sigma=0.1)
-    d.provenance = "derived"
+    d = Row(
+        table="t",
+        quantity="q",
+        unit="m",
+        paper=1.0,
+        paper_sigma=1.0,
+        truth=1.1,
+        reproduced=1.5,
+        sigma=0.1,
+    )
+    d = dataclasses.replace(d, provenance="derived")
     assert d.judge()[0] == "differs" and d.judge()[1].startswith("recovery failed")
-    d.provenance = "tuned"
+    d = dataclasses.replace(d, provenance="tuned")
     assert d.judge()[0] == "by construction"
     # a tuned truth that meets the paper, estimated beyond 3σ̂ of it: the recovery failed, not
     # the tuning (the slanted edge's borderline frequency: 0.3022 ± 0.0006 against 0.3)
-    e = Row("t", "f", "cy/px", paper=0.3, reproduced=0.3022, sigma=0.0006, truth=0.3000,
-            n_runs=24, mean_of_runs=True, provenance="tuned")  # fmt: skip
+    e = Row(
+        table="t",
+        quantity="f",
+        unit="cy/px",
+        paper=0.3,
+        reproduced=0.3022,
+        sigma=0.0006,
+        truth=0.3000,
+        n_runs=24,
+        mean_of_runs=True,
+        provenance="tuned",
+    )
     assert e.judge()[0] == "differs" and e.judge()[1].startswith("recovery failed")
-    e.truth = 0.3020  # the tuning missed and the estimate recovered it
+    e = dataclasses.replace(e, truth=0.3020)  # the tuning missed and the estimate recovered it
     assert e.judge()[1].startswith("tuning missed")
 
 
 def test_no_verdict_from_fewer_than_eight_runs():
     kw = dict(paper=1.0, paper_sigma=0.3, reproduced=1.1, sigma=0.1, provenance="chosen")
-    v, why = Row("t", "nmad", "m", n_runs=3, **kw).judge()
+    v, why = Row(table="t", quantity="nmad", unit="m", n_runs=3, **kw).judge()
     assert v == "not testable" and "only 3 runs" in why and "at least 8" in why
-    assert Row("t", "nmad", "m", n_runs=8, **kw).judge()[0] == "reproduced"
+    assert Row(table="t", quantity="nmad", unit="m", n_runs=8, **kw).judge()[0] == "reproduced"
     # a paper-valued row is not "by construction" on 7 runs either
-    assert Row("t", "q", "m", paper=1.0, reproduced=1.0, sigma=0.1, truth=1.0, n_runs=7).judge()[
-        0
-    ] == ("not testable")
+    assert Row(
+        table="t", quantity="q", unit="m", paper=1.0, reproduced=1.0, sigma=0.1, truth=1.0, n_runs=7
+    ).judge()[0] == ("not testable")
 
 
 def test_a_reproduced_whose_sigma_exceeds_half_the_paper_is_not_testable():
     # a σ of 0.6 m against the paper's 0.95 m: |z| < 3 for anything between −0.8 and 2.7 m
-    r = Row("t", "nmad_h", "m", paper=0.95, reproduced=0.109, sigma=0.6, provenance="chosen")
+    r = Row(
+        table="t",
+        quantity="nmad_h",
+        unit="m",
+        paper=0.95,
+        reproduced=0.109,
+        sigma=0.6,
+        provenance="chosen",
+    )
     v, why = r.judge()
     assert v == "not testable" and "half the paper's value" in why
     # its z is not shown, neither in the table nor in the JSON
-    r.truth = 0.2
+    r = dataclasses.replace(r, truth=0.2)
     assert r.z is not None
     assert format_rows([r]).iloc[0]["z"] == "—" and r.as_dict()["z"] is None
-    ok = Row("t", "nmad_h", "m", paper=0.95, reproduced=0.9, sigma=0.4, provenance="chosen")
+    ok = Row(
+        table="t",
+        quantity="nmad_h",
+        unit="m",
+        paper=0.95,
+        reproduced=0.9,
+        sigma=0.4,
+        provenance="chosen",
+    )
     assert ok.judge()[0] == "reproduced"  # 0.4 < 0.475
 
 
@@ -143,16 +219,16 @@ def test_the_z_of_a_mean_uses_the_means_sigma():
     back = Reproduction.from_json(Reproduction("x", 0, [mean]).to_json()).rows[0]
     assert back.mean_of_runs and back.sigma == pytest.approx(mean.sigma)
     with pytest.raises(InputError, match="needs n_runs"):
-        Row("t", "q", "m", reproduced=1.0, sigma=0.1, mean_of_runs=True)
+        Row(table="t", quantity="q", unit="m", reproduced=1.0, sigma=0.1, mean_of_runs=True)
 
 
 def test_overrides_need_a_reason_and_are_marked():
     with pytest.raises(InputError, match="without a reason"):
-        Row("t", "q", "m", paper=1.0, reproduced=1.0, verdict="not testable")
+        Row(table="t", quantity="q", unit="m", paper=1.0, reproduced=1.0, verdict="not testable")
     r = Row(
-        "t",
-        "bias",
-        "m",
+        table="t",
+        quantity="bias",
+        unit="m",
         paper=0.0,
         paper_sigma=0.1,
         reproduced=0.5,
@@ -164,13 +240,36 @@ def test_overrides_need_a_reason_and_are_marked():
     assert r.rule()[0] == "differs" and r.judge() == ("not testable", "removed by the boresight")
     assert r.overridden and r.as_dict()["override"] is True
     # a stated verdict equal to the rule's is no override; "planned" is a status, not one
-    same = Row("t", "q", "m", paper=1.0, reproduced=1.0, verdict="not testable", reason="x")
+    same = Row(
+        table="t",
+        quantity="q",
+        unit="m",
+        paper=1.0,
+        reproduced=1.0,
+        verdict="not testable",
+        reason="x",
+    )
     assert not same.overridden
-    assert not Row("t", "q", "m", paper=1.0, verdict="planned", reason="004").overridden
+    assert not Row(
+        table="t", quantity="q", unit="m", paper=1.0, verdict="planned", reason="004"
+    ).overridden
     back = Reproduction.from_json(Reproduction("x", 0, [r, same]).to_json())
     assert [b.overridden for b in back.rows] == [True, False]
     # a record written before issue 22 (verdict "tuned") still reads
-    old = Reproduction("x", 0, [Row("t", "c", "px", 1.0, None, 1.0, truth=1.0)]).to_json()
+    old = Reproduction(
+        "x",
+        0,
+        [
+            Row(
+                table="t",
+                quantity="c",
+                unit="px",
+                paper=1.0,
+                reproduced=1.0,
+                truth=1.0,
+            )
+        ],
+    ).to_json()
     old = old.replace('"by construction"', '"tuned"')
     assert Reproduction.from_json(old).rows[0].judge()[0] == "by construction"
 
@@ -187,7 +286,7 @@ def test_agreement_words():
 
 def test_summarize_counts_and_sign_test():
     rows = [
-        Row("t", f"c{i}", "mm", reproduced=-z, sigma=1.0, truth=0.0)
+        Row(table="t", quantity=f"c{i}", unit="mm", reproduced=-z, sigma=1.0, truth=0.0)
         for i, z in enumerate([0.5, 1.2, 2.0, 3.3, 0.1, 0.7, 1.9])
     ]
     s = summarize(rows)
@@ -208,7 +307,9 @@ def test_format_value_rounds_to_sigma_and_marks_absent():
 
 
 def test_table_has_no_nan_and_fixed_columns():
-    rows = [Row("t", "c", "px", paper=3539, paper_sigma=14, reproduced=float("nan"))]
+    rows = [
+        Row(table="t", quantity="c", unit="px", paper=3539, paper_sigma=14, reproduced=float("nan"))
+    ]
     df = format_rows(rows)
     assert list(df.columns) == [
         "quantity",
@@ -228,7 +329,7 @@ def test_json_is_strict_and_carries_the_verdict():
     rep = Reproduction(
         "x",
         0,
-        [Row("t", "c", "px", paper=1.0, reproduced=math.inf)],
+        [Row(table="t", quantity="c", unit="px", paper=1.0, reproduced=math.inf)],
         meta={"a": float("nan"), "b": [1.0, float("inf")]},
     )
     d = json.loads(rep.to_json())  # strict: would fail on NaN with parse_constant
@@ -240,25 +341,68 @@ def test_json_is_strict_and_carries_the_verdict():
 
 
 def test_paper_values_print_at_most_six_digits_and_verdict_list():
-    rows = [Row("OpenCV", "fx_px", "px", paper=657.466978102434, reproduced=657.47, sigma=19.9)]
+    rows = [
+        Row(
+            table="OpenCV",
+            quantity="fx_px",
+            unit="px",
+            paper=657.466978102434,
+            reproduced=657.47,
+            sigma=19.9,
+        )
+    ]
     assert format_rows(rows).iloc[0]["paper"] == "657.467"
-    assert format_rows([Row("t", "K1", "1/mm2", paper=-0.00414)]).iloc[0]["paper"] == "−0.00414"
-    rep = Reproduction("x", 0, rows + [Row("t", "q", "m", reproduced=1.0)])
+    assert (
+        format_rows([Row(table="t", quantity="K1", unit="1/mm2", paper=-0.00414)]).iloc[0]["paper"]
+        == "−0.00414"
+    )
+    rep = Reproduction("x", 0, rows + [Row(table="t", quantity="q", unit="m", reproduced=1.0)])
     v = rep.verdicts().data
     assert list(v["quantity"]) == ["focal length fx"] and v.iloc[0]["verdict"] == "reproduced"
 
 
 def test_provenance_is_checked_and_survives_json():
     with pytest.raises(InputError, match="provenance 'guessed'"):
-        Row("T", "c", "px", provenance="guessed")
-    rep = Reproduction("x", 0, [Row("T", "c", "px", 1.0, 0.1, 1.1, 0.1, 1.0, provenance="tuned")])
+        Row(table="T", quantity="c", unit="px", provenance="guessed")
+    rep = Reproduction(
+        "x",
+        0,
+        [
+            Row(
+                table="T",
+                quantity="c",
+                unit="px",
+                paper=1.0,
+                paper_sigma=0.1,
+                reproduced=1.1,
+                sigma=0.1,
+                truth=1.0,
+                provenance="tuned",
+            )
+        ],
+    )
     back = Reproduction.from_json(rep.to_json())
     assert back.rows[0].provenance == "tuned"
     assert '"provenance": "tuned"' in rep.to_json()
 
 
 def test_shown_tables_pad_cells_and_right_align_numbers():
-    rep = Reproduction("x", 0, [Row("T", "c_px", "px", 3539, 14, 3538.2, 0.9, 3539.0)])
+    rep = Reproduction(
+        "x",
+        0,
+        [
+            Row(
+                table="T",
+                quantity="c_px",
+                unit="px",
+                paper=3539,
+                paper_sigma=14,
+                reproduced=3538.2,
+                sigma=0.9,
+                truth=3539.0,
+            )
+        ],
+    )
     html = rep.show("T").to_html()
     assert "padding: 0.3em 0.5em" in html  # cells never touch their neighbours
     # every body cell names its column (the phone's cards), the verdict included
@@ -271,7 +415,19 @@ def test_shown_tables_pad_cells_and_right_align_numbers():
 
 
 def test_sigma_over_runs_shows_its_count_below_the_number():
-    rows = [Row("T", "c_px", "px", 3539, 14, 3538.2, 0.9, 3539.0, n_runs=24)]
+    rows = [
+        Row(
+            table="T",
+            quantity="c_px",
+            unit="px",
+            paper=3539,
+            paper_sigma=14,
+            reproduced=3538.2,
+            sigma=0.9,
+            truth=3539.0,
+            n_runs=24,
+        )
+    ]
     html = Reproduction("x", 0, rows).show("T").to_html()
     assert '<br><span class="hsgeo-runs">(24 runs)</span>' in html
     assert "(24 runs)" in Reproduction("x", 0, rows).to_text()  # the text tables unchanged
@@ -319,9 +475,33 @@ def test_row_lookup_and_verdict_counts():
     from hsgeo.errors import InputError
 
     rows = [
-        Row("T", "a", "px", paper=1.0, reproduced=1.0, sigma=0.1, provenance="chosen"),
-        Row("T", "b", "px", paper=1.0, reproduced=5.0, sigma=0.1, provenance="chosen"),
-        Row("T", "c", "px", paper=2.0, reproduced=2.05, sigma=0.1, provenance="chosen"),
+        Row(
+            table="T",
+            quantity="a",
+            unit="px",
+            paper=1.0,
+            reproduced=1.0,
+            sigma=0.1,
+            provenance="chosen",
+        ),
+        Row(
+            table="T",
+            quantity="b",
+            unit="px",
+            paper=1.0,
+            reproduced=5.0,
+            sigma=0.1,
+            provenance="chosen",
+        ),
+        Row(
+            table="T",
+            quantity="c",
+            unit="px",
+            paper=2.0,
+            reproduced=2.05,
+            sigma=0.1,
+            provenance="chosen",
+        ),
     ]
     rep = Reproduction("x", 0, rows)
     assert rep.row("T", "b") is rows[1]

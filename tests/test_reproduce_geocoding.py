@@ -78,7 +78,7 @@ def test_displacement_matches_the_rays_on_a_level_flight():
     sensors = {"calibrated": true_sensor(cfg), "uncalibrated": nominal_sensor(cfg)}
     zero = {k: np.zeros(3) for k in sensors}
     d = displacement_across_track(obs, sensors, zero, cfg)
-    H = cfg["flight"]["height_agl_m"]
+    H = cfg.flight.height_agl_m
     expect = H * (
         sensors["calibrated"].tan_angle(d["zeta_px"])
         - sensors["uncalibrated"].tan_angle(d["zeta_px"])

@@ -107,7 +107,14 @@ def test_factor_produces_needs_agreement_and_a_gain_over_the_base():
 
     def row(rep, sigma=0.1):
         return Row(
-            "F", "q", "m", paper=1.0, reproduced=rep, sigma=sigma, n_runs=8, provenance="chosen"
+            table="F",
+            quantity="q",
+            unit="m",
+            paper=1.0,
+            reproduced=rep,
+            sigma=sigma,
+            n_runs=8,
+            provenance="chosen",
         )
 
     rows = {("gauss_markov", "q"): row(1.5), ("good", "q"): row(1.05), ("same", "q"): row(1.45)}

@@ -261,19 +261,19 @@ def test_rendered_image_is_measured_without_the_truth(cfg, truth):
     r = Renderer(cfg, truth)
     img = r.render(0, 5, 7)
     assert isinstance(img, np.ndarray) and img.dtype == np.uint16
-    plate, cam = r.plate, cfg["camera"]
-    size = (int(cam["width_px"]), int(cam["height_px"]))
+    plate, cam = r.plate, cfg.camera
+    size = (int(cam.width_px), int(cam.height_px))
     obs, cmp_ = detect_targets_in_images(
         [((0, 5), img)],
         plate.corners(),
         plate.ids,
         size,
-        float(cam["pixel_mm"]),
+        float(cam.pixel_mm),
         dictionary=plate.dictionary,
     )
     assert cmp_ is None and len(obs.target) > 10
     assert "expected" not in {f.name for f in dataclasses.fields(obs)}
-    true_px = mm_to_pixel(truth.project(0, 5, plate.corners()[obs.target]), size, cam["pixel_mm"])
+    true_px = mm_to_pixel(truth.project(0, 5, plate.corners()[obs.target]), size, cam.pixel_mm)
     assert np.median(np.abs(obs.corners_px - true_px)) < 0.5
 
 
@@ -376,38 +376,38 @@ def test_chapter_parameters_are_the_scenario_and_the_paper(cfg):
     cell = next(c for c in jupytext.read(md, fmt="md:myst").cells if c.cell_type == "code")
     p: dict = {}
     exec(compile(cell.source, "rikola.md parameters", "exec"), p)  # noqa: S102
-    cam, gm = cfg["camera"], cfg["gap_model"]
-    assert (cam["width_px"], cam["height_px"], cam["pixel_mm"]) == (
+    cam, gm = cfg.camera, cfg.gap_model
+    assert (cam.width_px, cam.height_px, cam.pixel_mm) == (
         p["width_px"],
         p["height_px"],
         p["pixel_mm"],
     )
     for s in (1, 2):
-        a, b = gm[f"a_sensor{s}_mm_per_nm"], gm[f"b_sensor{s}_mm"]
+        a, b = getattr(gm, f"a_sensor{s}_mm_per_nm"), getattr(gm, f"b_sensor{s}_mm")
         assert (a, b) == (p[f"a_sensor{s}_mm_per_nm"], p[f"b_sensor{s}_mm"])
         assert (a, b) == (
             RIKOLA_TABLE4_GAP_MODEL[s]["a_mm_per_nm"][0],
             RIKOLA_TABLE4_GAP_MODEL[s]["b_mm"][0],
         )
-    assert tuple(cam["pp_sensor1_mm"]) == p["pp_sensor1_mm"]
-    assert tuple(cam["pp_sensor2_mm"]) == p["pp_sensor2_mm"]
+    assert tuple(cam.pp_sensor1_mm) == p["pp_sensor1_mm"]
+    assert tuple(cam.pp_sensor2_mm) == p["pp_sensor2_mm"]
     assert p["pp_sensor1_mm"] == tuple(RIKOLA_TABLE3[20][k][0] for k in ("x0_mm", "y0_mm"))
     assert p["pp_sensor2_mm"] == tuple(RIKOLA_TABLE3[5][k][0] for k in ("x0_mm", "y0_mm"))
     k1 = np.mean([RIKOLA_TABLE3[b]["K1_per_mm2"][0] for b in (5, 20)])
-    assert cam["K1_per_mm2"] == p["K1_per_mm2"] == pytest.approx(k1, rel=1e-12)
-    assert (cam["P1_per_mm"], cam["P2_per_mm"]) == (p["P1_per_mm"], p["P2_per_mm"])
-    mis = cfg["misalignment"]
-    rop = tuple(mis[k] for k in ("domega_deg", "dphi_deg", "dkappa_deg"))
+    assert cam.K1_per_mm2 == p["K1_per_mm2"] == pytest.approx(k1, rel=1e-12)
+    assert (cam.P1_per_mm, cam.P2_per_mm) == (p["P1_per_mm"], p["P2_per_mm"])
+    mis = cfg.misalignment
+    rop = (mis.domega_deg, mis.dphi_deg, mis.dkappa_deg)
     assert rop == p["rop_deg"] == tuple(RIKOLA_TABLE4_ROP_MEAN_DEG)
-    assert cfg["geometry"]["n_cubes"] == p["n_cubes_paper"] == 20
-    assert cfg["measure"]["sigma_px"] == p["sigma_px"]
-    assert cfg["eop_drift"]["dphi_deg_per_band"] == p["dphi_deg_per_band"]
+    assert cfg.geometry.n_cubes == p["n_cubes_paper"] == 20
+    assert cfg.measure.sigma_px == p["sigma_px"]
+    assert cfg.eop_drift.dphi_deg_per_band == p["dphi_deg_per_band"]
     assert p["scale"] == 1.0 and isinstance(p["SEED"], int)
 
 
 # --- the unmodelled effect: the drift of the EOPs across the bands (003 Fig. 5) ----------------
 def _without_drift_section(cfg):
-    return {k: v for k, v in cfg.items() if k != "eop_drift"}
+    return dataclasses.replace(cfg, eop_drift=None)
 
 
 def test_eop_drift_off_is_the_bench_without_it_bitwise(cfg, truth):
@@ -433,8 +433,8 @@ def test_eop_drift_moves_the_rop_and_the_image_as_expected(cfg):
     camera, zero at the reference band."""
     on = make_truth(cfg, np.random.default_rng([7, 0]), n_cubes=8)
     off = make_truth(cfg, np.random.default_rng([7, 0]), n_cubes=8, eop_drift=False)
-    slope = np.deg2rad(cfg["eop_drift"]["dphi_deg_per_band"])
-    ref = cfg["eop_drift"]["reference_band"]
+    slope = np.deg2rad(cfg.eop_drift.dphi_deg_per_band)
+    ref = cfg.eop_drift.reference_band
     for k in (2, 5, 9):
         for c in (0, 4):
             ang, _ = relative_orientation(on.band_pose(c, k + 10), on.band_pose(c, k))
@@ -521,7 +521,7 @@ def test_rikola_camera_projects_as_the_simulator():
     t = make_truth(cfg, np.random.default_rng([2, 0]), n_cubes=3, eop_drift=False)
     t.offset_mm = np.array([0.4, -0.3, 0.2])
     cam = _camera(t)
-    X = Plate.from_config(cfg["plate"]).corners().reshape(-1, 3)
+    X = cfg.plate.corners().reshape(-1, 3)
     for c, b in ((0, 3), (1, 14), (2, 25)):
         view = np.full(len(X), c)
         ref = mm_to_pixel(t.project(c, b, X), (1017, 648), 0.0055)

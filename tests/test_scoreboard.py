@@ -24,9 +24,9 @@ def test_claims_are_the_paper_tables_plus_planned():
         0,
         [
             Row(
-                "000 Table 1",
-                "c",
-                "px",
+                table="000 Table 1",
+                quantity="c",
+                unit="px",
                 paper=3539,
                 paper_sigma=14,
                 reproduced=3541,
@@ -34,12 +34,16 @@ def test_claims_are_the_paper_tables_plus_planned():
                 truth=3539,
                 provenance="paper",
             ),
-            Row("000 Table 1", "unpublished", "px", reproduced=1.0),  # no paper value
-            Row("distortion magnitudes", "d", "px", paper=1.0, reproduced=1.0),  # not a paper
             Row(
-                "002 Table 2",
-                "nmad_h_m",
-                "m",
+                table="000 Table 1", quantity="unpublished", unit="px", reproduced=1.0
+            ),  # no paper value
+            Row(
+                table="distortion magnitudes", quantity="d", unit="px", paper=1.0, reproduced=1.0
+            ),  # not a paper
+            Row(
+                table="002 Table 2",
+                quantity="nmad_h_m",
+                unit="m",
                 paper=0.99,
                 reproduced=0.3,
                 sigma=0.05,
@@ -47,9 +51,9 @@ def test_claims_are_the_paper_tables_plus_planned():
                 provenance="chosen",
             ),
             Row(
-                "002 Table 2",
-                "mean_h_m",
-                "m",
+                table="002 Table 2",
+                quantity="mean_h_m",
+                unit="m",
                 paper=-0.78,
                 reproduced=0.0,
                 sigma=0.05,
@@ -59,7 +63,13 @@ def test_claims_are_the_paper_tables_plus_planned():
                 reason="an override, for the test",
             ),
             # an experiment against 002 Table 2's values, not a claim of its own
-            Row("002 check-point factors", "rtk.cp_nmad_h_m", "m", paper=0.99, reproduced=0.5),
+            Row(
+                table="002 check-point factors",
+                quantity="rtk.cp_nmad_h_m",
+                unit="m",
+                paper=0.99,
+                reproduced=0.5,
+            ),
         ],
     )
     rows = claims({"line-calibration": rep})
@@ -109,16 +119,23 @@ def test_cube_chapter_claims_reach_the_scoreboard():
         0,
         [
             Row(
-                "001 §3.2",
-                "speed S of eq. (8)",
-                "mm/s",
+                table="001 §3.2",
+                quantity="speed S of eq. (8)",
+                unit="mm/s",
                 paper=33.0,
                 reproduced=34.15,
                 verdict="differs",
                 reason="eq. (8)",
                 provenance="derived",
             ),
-            Row("reflectance", "panel, NIR", "1", reproduced=0.5, sigma=1e-4, truth=0.5),
+            Row(
+                table="reflectance",
+                quantity="panel, NIR",
+                unit="1",
+                reproduced=0.5,
+                sigma=1e-4,
+                truth=0.5,
+            ),
         ],
     )
     rows = claims({"cube": rep})
@@ -133,12 +150,24 @@ def _board_rows():
             "pushbroom-ba",
             0,
             [
-                Row("002 Table 1", "nmad_x_px", reproduced=0.321, provenance="tuned", **tuned),
-                Row("002 Table 1", "nmad_y_px", reproduced=0.283, provenance="tuned", **tuned),
                 Row(
-                    "002 Table 2",
-                    "nmad_h_m",
-                    "m",
+                    table="002 Table 1",
+                    quantity="nmad_x_px",
+                    reproduced=0.321,
+                    provenance="tuned",
+                    **tuned,
+                ),
+                Row(
+                    table="002 Table 1",
+                    quantity="nmad_y_px",
+                    reproduced=0.283,
+                    provenance="tuned",
+                    **tuned,
+                ),
+                Row(
+                    table="002 Table 2",
+                    quantity="nmad_h_m",
+                    unit="m",
                     paper=0.99,
                     reproduced=0.98,
                     sigma=0.05,
@@ -167,7 +196,16 @@ def test_paper_paragraph_is_computed_from_the_verdicts():
     assert "NMAD" in text and "tuning missed: 10.3σ from the paper" in text
     assert "were tuned to meet the paper" in text
     assert "nmad_" not in text  # claims in a reader's words, never internal keys
-    planned = [Row("004 text", "asf_pct", "%", paper=15.0, verdict="planned", reason="not yet")]
+    planned = [
+        Row(
+            table="004 text",
+            quantity="asf_pct",
+            unit="%",
+            paper=15.0,
+            verdict="planned",
+            reason="not yet",
+        )
+    ]
     assert paper_paragraph(planned, "004") == "Of its 1 claim, 1 is planned. Planned: not yet."
     assert paper_paragraph(rows, "009") == "No claim of paper 009 is in the book yet."
 
@@ -192,7 +230,19 @@ def test_compact_table_has_one_short_line_per_claim_with_a_link():
     assert html.count('<a href="chapters/pushbroom_ba.html"') == 3 and html.count("<tr>") == 4
     assert 'data-label="reproduced ± σ">0.2830 ± 0.0020</td>' in html  # a card's labels
     assert "tuned (missed)" in html
-    planned = [(None, Row("004 text", "asf_pct", "%", paper=15.0, verdict="planned", reason="-"))]
+    planned = [
+        (
+            None,
+            Row(
+                table="004 text",
+                quantity="asf_pct",
+                unit="%",
+                paper=15.0,
+                verdict="planned",
+                reason="-",
+            ),
+        )
+    ]
     assert compact_table(planned, "004").data["chapter"].eq("—").all()  # planned: no page yet
 
 
@@ -205,10 +255,19 @@ def test_asf_chapter_claims_replace_the_planned_004_rows():
         "asf",
         0,
         [
-            Row("004 text", q, u, paper=v, reproduced=v, provenance="paper")
+            Row(table="004 text", quantity=q, unit=u, paper=v, reproduced=v, provenance="paper")
             for q, (v, u) in ASF_004.items()
         ]
-        + [Row("004 ASF", "ASF at +40°, channel 1", "1", reproduced=0.96, sigma=0.001, truth=0.96)],
+        + [
+            Row(
+                table="004 ASF",
+                quantity="ASF at +40°, channel 1",
+                unit="1",
+                reproduced=0.96,
+                sigma=0.001,
+                truth=0.96,
+            )
+        ],
     )
     rows = claims({"asf": rep})
     assert [r.quantity for r in rows] == list(ASF_004)
@@ -219,9 +278,33 @@ def test_claims_with_reasons_lists_one_papers_claims_with_their_verdicts():
     from hsgeo.reproduce.scoreboard import claims_with_reasons
 
     rows = [
-        Row("000 Table 1", "c_px", "px", paper=1.0, reproduced=1.0, sigma=0.1, provenance="chosen"),
-        Row("001 Table 2", "c_px", "px", paper=1.0, reproduced=9.0, sigma=0.1, provenance="chosen"),
-        Row("000 Table 3", "dx_m", "m", paper=1.0, reproduced=5.0, sigma=0.1, provenance="chosen"),
+        Row(
+            table="000 Table 1",
+            quantity="c_px",
+            unit="px",
+            paper=1.0,
+            reproduced=1.0,
+            sigma=0.1,
+            provenance="chosen",
+        ),
+        Row(
+            table="001 Table 2",
+            quantity="c_px",
+            unit="px",
+            paper=1.0,
+            reproduced=9.0,
+            sigma=0.1,
+            provenance="chosen",
+        ),
+        Row(
+            table="000 Table 3",
+            quantity="dx_m",
+            unit="m",
+            paper=1.0,
+            reproduced=5.0,
+            sigma=0.1,
+            provenance="chosen",
+        ),
     ]
     df = claims_with_reasons(Reproduction("scoreboard", 0, rows), "000")
     assert list(df.columns) == ["claim", "verdict", "why", "judged in"]
@@ -235,8 +318,16 @@ def test_each_published_number_is_judged_once_by_its_owner():
     from hsgeo.reproduce.scoreboard import OWNERS, context_chapters, mark_context
 
     def row(table, q, rep):
-        return Row(table, q, "px", paper=0.32, reproduced=rep, sigma=0.01, n_runs=8,
-                   provenance="chosen")  # fmt: skip
+        return Row(
+            table=table,
+            quantity=q,
+            unit="px",
+            paper=0.32,
+            reproduced=rep,
+            sigma=0.01,
+            n_runs=8,
+            provenance="chosen",
+        )
 
     pb = Reproduction("pushbroom-ba", 0, [row("002 Table 1", "nmad_x_px", 0.40)])
     lp = Reproduction("lp-observations", 0, [row("002 Table 1 from pixels", "nmad_x_px", 0.33)])

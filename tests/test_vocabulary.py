@@ -74,8 +74,20 @@ def test_line_scanner_k_have_their_real_unit():
 
 def test_tables_show_labels_and_the_json_keeps_the_keys():
     rows = [
-        Row("002 Fig. 8", "c_minus_mean_band0_450nm_um", "um", reproduced=1.5, sigma=0.4),
-        Row("002 Fig. 8", "K1 line100 in 1sigma", "fraction", reproduced=0.68, sigma=0.03),
+        Row(
+            table="002 Fig. 8",
+            quantity="c_minus_mean_band0_450nm_um",
+            unit="um",
+            reproduced=1.5,
+            sigma=0.4,
+        ),
+        Row(
+            table="002 Fig. 8",
+            quantity="K1 line100 in 1sigma",
+            unit="fraction",
+            reproduced=0.68,
+            sigma=0.03,
+        ),
     ]
     rep = Reproduction("x", 0, rows)
     before = rep.to_json()

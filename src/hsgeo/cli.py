@@ -123,7 +123,7 @@ def _data_flight(args) -> int:
 def _cmd_adjust_pushbroom(args) -> int:
     from hsgeo.workflows.pushbroom_ba import adjust_files
 
-    out = adjust_files(
+    res = adjust_files(
         args.observations,
         args.trajectory,
         args.camera,
@@ -133,8 +133,8 @@ def _cmd_adjust_pushbroom(args) -> int:
         y_as_time=not args.image_y,
         max_nav_gap_s=args.max_nav_gap_s,
     )
-    res = out.pop("_result")
-    print(json_text(out) if args.json else res.report(max_block_size=20))
+    out = res.to_dict()
+    print(json_text(out) if args.json else res.result.report(max_block_size=20))
     fit = out["fit"]
     warnings = fit.get("warnings", [])
     if fit["verdict"] == "poor" and not args.accept_poor_fit:
@@ -251,7 +251,8 @@ def _cmd_orthorectify(args) -> int:
 def _cmd_adjust_bal(args) -> int:
     from hsgeo.workflows.bal import adjust_bal_file
 
-    out = adjust_bal_file(args.file, progress=None if args.json else terminal.progress_printer())
+    fit = adjust_bal_file(args.file, progress=None if args.json else terminal.progress_printer())
+    out = fit.to_dict()
     if args.json:
         print(json_text(out))
     else:
@@ -271,12 +272,9 @@ def _cmd_mtf(args) -> int:
 
     out = bars_files(args.profiles, args.bars)
     if args.json:
-        d = {"profiles": [{"row": r, **res.to_dict()} for r, res in out.items()]}
-        if len(out) == 1:
-            d = next(iter(d["profiles"]))
-        print(json_text(d))
+        print(json_text(out.to_dict()))
         return 0
-    for r, res in out.items():
+    for r, res in out.by_row.items():
         head = "profile" if r is None else f"row {r}"
         if res.borderline_cy_px == res.borderline_cy_px:  # not NaN
             border = (

@@ -219,7 +219,9 @@ def ctf_band_limited(mtf, f_cy_px, nyquist_cy_px: float = 0.5, k_max: int = K_MA
 
 
 _PRINTED_K = np.array([1, 3, 5, 7, 11])
+_PRINTED_K.setflags(write=False)
 _PRINTED_SIGN = np.array([1.0, 1.0, -1.0, 1.0, 1.0])
+_PRINTED_SIGN.setflags(write=False)
 
 
 def ctf_from_mtf_printed(mtf, f_cy_px):

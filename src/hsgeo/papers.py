@@ -225,6 +225,7 @@ RIKOLA_BANDS = np.array(
         ("fwhm_nm", "f8"),
     ],
 )
+RIKOLA_BANDS.setflags(write=False)
 
 #: 003 Table 3: IOP of band 5 (sensor II) and band 20 (sensor I), value and σ, with the
 #: photogrammetric parameterisation (f, x0, y0 in mm; k1-k3 in mm^-2, mm^-4, mm^-6; p1, p2 in
@@ -271,6 +272,7 @@ RIKOLA_TABLE4_ROP_DEG = np.array(
         (-0.08946, 0.201233, -0.00671),
     ]
 )
+RIKOLA_TABLE4_ROP_DEG.setflags(write=False)
 #: 003 Table 4 (first), "Average" row: (dω, dφ, dκ) in degrees.
 RIKOLA_TABLE4_ROP_MEAN_DEG = (-0.08516, 0.173765, -0.00747)
 

@@ -124,9 +124,12 @@ def _clean(x) -> float | None:
     return x if math.isfinite(x) else None
 
 
-@dataclass
+@dataclass(frozen=True, kw_only=True)
 class Row:
     """One quantity of a table: paper | reproduced | σ̂ | truth, with z and a verdict (GUIDE §5).
+
+    Frozen and built by keyword (``Row(table=..., quantity=..., unit=..., paper=...)``); a
+    changed copy is :func:`dataclasses.replace`.
 
     Parameters
     ----------
@@ -216,7 +219,14 @@ class Row:
             rep = float(v[0]) if n else None
             sigma = sd
         return cls(
-            table, quantity, unit, reproduced=rep, sigma=sigma, n_runs=n, mean_of_runs=mean, **kw
+            table=table,
+            quantity=quantity,
+            unit=unit,
+            reproduced=rep,
+            sigma=sigma,
+            n_runs=n,
+            mean_of_runs=mean,
+            **kw,
         )
 
     @property
@@ -760,7 +770,7 @@ class Reproduction:
         fields = ("table", "quantity", "unit", "paper", "paper_sigma", "reproduced", "sigma")
         rows = [
             Row(
-                *(r[k] for k in fields),
+                **{k: r[k] for k in fields},
                 truth=r["truth"],
                 n_runs=r.get("n_runs"),
                 # as judged when written (the same numbers: an override stays one, a computed
@@ -898,6 +908,13 @@ def from_estimates(name: str, result) -> Reproduction:
     groups. ``hsgeo calibrate-frame`` prints this, and the chapter shows it.
     """
     rows = [
-        Row(e.group, e.name, e.unit, None, None, e.value, e.sigma, None) for e in result.estimates
+        Row(
+            table=e.group,
+            quantity=e.name,
+            unit=e.unit,
+            reproduced=e.value,
+            sigma=e.sigma,
+        )
+        for e in result.estimates
     ]
     return Reproduction(name, 0, rows, result.meta)

@@ -56,6 +56,7 @@ __all__ = [
 #: U = −D); a proper rotation (det +1) and its own inverse.
 R_ENU_FROM_NED = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
 R_ENU_FROM_NED.setflags(write=False)
+R_ENU_FROM_NED.setflags(write=False)
 
 #: Tolerance on max |RᵀR − I| accepted by the ``*_from_R`` functions.
 ORTHONORMALITY_TOL = 1e-6

@@ -325,6 +325,7 @@ class Trajectory:
 #: y left, z up): ``xyz_body = R_BODY_FROM_PLATFORM @ xyz_platform`` (its own inverse).
 R_BODY_FROM_PLATFORM = np.diag([1.0, -1.0, -1.0])
 R_BODY_FROM_PLATFORM.setflags(write=False)
+R_BODY_FROM_PLATFORM.setflags(write=False)
 
 
 def _angles3(a, name: str) -> np.ndarray:

@@ -86,8 +86,18 @@ class SolverOptions:
         With a points block: a step refused because of a few points (at most 0.1 % of them
         carrying 90 % of the excess of the actual over the linearly predicted squared
         residuals) is tried again with those points held in place before the damping grows;
-        a point at most 3 times a solve (its full step would otherwise keep the convergence
-        test from passing).
+        a point at most ``hold_max`` times a solve (its full step would otherwise keep the
+        convergence test from passing).
+    hold_max : int, default 3
+        With ``hold_points``: most times one point is held in place in a solve.
+    thrown_ratio : float, default 1000
+        With ``hold_points``: an accepted step before the first settled iterate is tried again
+        with a few points held (at most 0.1 % of them) when their rows' excess over the linear
+        prediction exceeds ``thrown_ratio`` times the points' median excess ...
+    thrown_share : float, default 0.25
+        ... and sums to at least ``thrown_share`` of the step's cost (at 7× the paper's
+        pushbroom block two points carried 1.2e8 of a 7.2e7 cost, the median point 3; at 1× no
+        point passes 1000 times the median).
     robust_start : {None, "cauchy", "huber"}, default None
         Iterate with a robust loss ``ρ`` of each group's squared whitened residual (Ceres'
         ``CauchyLoss``/``HuberLoss``, as COLMAP's bundle adjustment does) from the first
@@ -167,6 +177,9 @@ class SolverOptions:
     settled: float = 1e-2
     chord_end: float = 1e-3
     hold_points: bool = True
+    hold_max: int = 3
+    thrown_ratio: float = 1000.0
+    thrown_share: float = 0.25
     robust_start: str | None = None
     robust_start_k: float = 3.0
     check_datum: bool = True
@@ -181,7 +194,7 @@ class SolverOptions:
     blas_threads: int = 1
 
     def __post_init__(self) -> None:
-        for name in ("max_iter", "max_reject_rounds", "blas_threads"):
+        for name in ("max_iter", "max_reject_rounds", "blas_threads", "hold_max"):
             v = getattr(self, name)
             if isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers.Integral) or v < 0:
                 raise InputError(f"SolverOptions.{name} must be a non-negative integer, got {v!r}")
@@ -196,6 +209,8 @@ class SolverOptions:
             "chord_end",
             "rank_rtol",
             "robust_start_k",
+            "thrown_ratio",
+            "thrown_share",
         )
         for name in positive:
             v = getattr(self, name)

@@ -77,7 +77,7 @@ from hsgeo.adjust.system import _Clock, _evaluate, _Layout, _NonFinite, _System
 from hsgeo.adjust.threads import engine_threads
 from hsgeo.errors import ConvergenceError, DatumError, InputError, ObservationError
 
-__all__ = ["adjust", "HOLD_MAX", "THROWN_SHARE", "THROWN_RATIO", "progress_text"]
+__all__ = ["adjust", "progress_text"]
 
 
 def adjust(
@@ -184,17 +184,6 @@ def _adjust(params, blocks, opts: SolverOptions, progress) -> AdjustmentResult:
     return result
 
 
-#: Most times one point is held in place to save a refused step (see _Solve._hold_points).
-HOLD_MAX = 3
-#: An accepted step before the first settled iterate is tried again with a few points held
-#: (at most 0.1 % of them) when their rows' excess over the linear prediction exceeds
-#: THROWN_RATIO times the points' median excess and sums to at least THROWN_SHARE of the
-#: step's cost (see _Solve._hold_thrown; at 7× the paper's pushbroom block two points carried
-#: 1.2e8 of a 7.2e7 cost, the median point 3; at 1× no point passes 1000 times the median).
-THROWN_SHARE = 0.25
-THROWN_RATIO = 1000.0
-
-
 @dataclass(frozen=True)
 class _Outcome:
     """How one minimisation (a pass of the LM loop) ended."""
@@ -244,7 +233,7 @@ class _Solve:
         self.total_iter = 0
         self.each = options.reject_k is not None and options.reject_every_iteration
         self.D_max: np.ndarray | None = None  # damping_diagonal="max": the running maximum
-        self.hold_count: dict[int, int] = {}  # times each point was held (at most HOLD_MAX)
+        self.hold_count: dict[int, int] = {}  # times each point was held (at most options.hold_max)
         self.dropped_points: list[int] = []  # SolverOptions.drop_undetermined_points
         self.dropped_rows = [np.zeros(b.m, dtype=bool) for b in blocks]  # ... their rows
         self.settled_seen = False  # an iterate was settled (accepted steps no longer held)
@@ -607,8 +596,8 @@ class _Solve:
 
     def _hold_thrown(self, sy, ne, trial, state, cost, dc, dp, accepted):
         """An accepted step that threw a few points: the same step with them held, if that
-        costs less (see :meth:`_hold_points`; ``THROWN_SHARE``). Returns ``(trial, actual,
-        pred, rho)`` of the step taken, the parameters at it.
+        costs less (see :meth:`_hold_points`; ``SolverOptions.thrown_share``). Returns
+        ``(trial, actual, pred, rho)`` of the step taken, the parameters at it.
 
         Before the first settled iterate a Gauss–Newton step from poor initial values can
         decrease the cost by orders of magnitude and still throw a few weakly intersected
@@ -616,7 +605,9 @@ class _Solve:
         iterate's); the following steps are then refused because of them, the damping grows
         by orders of magnitude and decays over many iterations.
         """
-        held = self._hold_points(sy, ne, trial, state, cost, dc, dp, min_share=THROWN_SHARE)
+        held = self._hold_points(
+            sy, ne, trial, state, cost, dc, dp, min_share=self.options.thrown_share
+        )
         if held is not None and held[0].cost < trial.cost:
             return held
         self.layout.set_state(state)
@@ -652,10 +643,10 @@ class _Solve:
             return None
         if min_share is not None:
             # an accepted step: the points whose excess stands out from the points' typical
-            # excess by THROWN_RATIO, if they carry min_share of the new cost (the spread
+            # excess by options.thrown_ratio, if they carry min_share of the new cost (the spread
             # excess of every point's curvature can be as large as the thrown points' at a
             # long block's first step: a share of the total would then name them all)
-            big = pos[pos > THROWN_RATIO * float(np.median(pos))]
+            big = pos[pos > self.options.thrown_ratio * float(np.median(pos))]
             k = big.size
             if not k or big.sum() < min_share * trial.cost:
                 return None
@@ -664,7 +655,7 @@ class _Solve:
         if k > max(1, dp.shape[0] // 1000):
             return None  # the model fails broadly: more damping, as usual
         held = np.argsort(-per_pt, kind="stable")[:k]
-        if any(self.hold_count.get(int(i), 0) >= HOLD_MAX for i in held):
+        if any(self.hold_count.get(int(i), 0) >= self.options.hold_max for i in held):
             # a point whose Gauss–Newton step keeps failing is not held again: its full step
             # would keep the convergence test from passing; the damping takes over
             return None

@@ -156,7 +156,7 @@ def read_text(path, what: str, kind: str) -> str:
     return text
 
 
-#: Leading bytes of formats a text file is mistaken for (issue 42: a Parquet table or an
+#: Leading bytes of formats a text file is mistaken for (a Parquet table or an
 #: Excel workbook named .csv, a UTF-16 CSV, were "binary or not UTF-8 at byte N").
 _MAGIC = (
     (b"PAR1", "a Parquet table (name it .parquet to read it as one)"),

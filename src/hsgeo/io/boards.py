@@ -202,8 +202,8 @@ def read_board(path) -> Board:
     import cv2
 
     path = Path(path)
-    cfg = read_config(path, BOARD_SCHEMA, "board file", required_tables=("board",))
-    b = cfg["board"]
+    tables = read_config(path, BOARD_SCHEMA, "board file", required_tables=("board",))
+    b = tables["board"]
     keys, other = (_CHARUCO, _GRID) if b["type"] == "charuco" else (_GRID, _CHARUCO)
     missing = [k for k in keys if k not in b]
     stray = [k for k in other if k in b and k not in keys]
@@ -220,7 +220,7 @@ def read_board(path) -> Board:
         )
     if problems:
         raise InputError(f"board file {path}: " + "; ".join(problems))
-    pixel = cfg["camera"].get("pixel_mm")
+    pixel = tables["camera"].get("pixel_mm")
     make = Board.charuco if b["type"] == "charuco" else Board.aruco_grid
     try:
         return make(*(b[k] for k in keys), b["dictionary"], pixel)

@@ -1,6 +1,22 @@
 """TOML configuration files with a schema: unknown keys are errors with a suggestion.
 
-A schema maps table names to :class:`Key` descriptions::
+The one loader of a configuration is :func:`read_dataclass`: a frozen dataclass is the schema
+(its fields the keys, a nested dataclass field a table, the field defaults the defaults, the
+type hints the types, ``field(metadata={"key": Key(...)})`` the units and limits), and the file
+becomes an instance of it::
+
+    @dataclass(frozen=True)
+    class Flight:
+        height_agl_m: float = 1000.0
+
+    @dataclass(frozen=True)
+    class Scenario:
+        flight: Flight = Flight()
+
+    cfg = read_dataclass("flight.toml", Scenario, "scenario")   # cfg.flight.height_agl_m
+
+Instrument files whose tables are read into plain values use the older form, a schema that
+maps table names to :class:`Key` descriptions::
 
     SCHEMA = {"sensor": {"c_px": Key("float", required=True, doc="principal distance, px")}}
 
@@ -21,9 +37,17 @@ from pathlib import Path
 from hsgeo.errors import InputError
 from hsgeo.validate import unit_limits
 
-__all__ = ["Key", "read_toml", "read_config", "closest", "did_you_mean", "dataclass_from_table"]
+__all__ = [
+    "Key",
+    "read_toml",
+    "read_config",
+    "read_dataclass",
+    "load_dataclass",
+    "closest",
+    "did_you_mean",
+]
 
-_KINDS = ("float", "int", "str", "floats")
+_KINDS = ("float", "int", "str", "floats", "ints", "bool")
 
 
 @dataclass(frozen=True)
@@ -32,8 +56,9 @@ class Key:
 
     Attributes
     ----------
-    kind : {"float", "int", "str", "floats"}
-        ``"floats"`` is an array of numbers (of ``length`` entries, if given).
+    kind : {"float", "int", "str", "floats", "ints", "bool"}
+        ``"floats"`` is an array of numbers, ``"ints"`` one of whole numbers (of ``length``
+        entries, if given).
     required : bool
         A missing required key is an error.
     default : object, optional
@@ -113,17 +138,26 @@ def _number(v, key: Key, where: str, problems: list) -> float | None:
     return float(v)
 
 
+def _integer(v, key: Key, where: str, problems: list) -> int | None:
+    if isinstance(v, bool) or not isinstance(v, int):
+        problems.append(f"{where}: expected a whole number, got {v!r}")
+        return None
+    if key.positive and v <= 0:
+        problems.append(f"{where}: must be positive, got {v!r}")
+        return None
+    return int(v)
+
+
 def _value(v, key: Key, where: str, problems: list):
     if key.kind == "float":
         return _number(v, key, where, problems)
     if key.kind == "int":
-        if isinstance(v, bool) or not isinstance(v, int):
-            problems.append(f"{where}: expected a whole number, got {v!r}")
+        return _integer(v, key, where, problems)
+    if key.kind == "bool":
+        if not isinstance(v, bool):
+            problems.append(f"{where}: expected true or false, got {v!r}")
             return None
-        if key.positive and v <= 0:
-            problems.append(f"{where}: must be positive, got {v!r}")
-            return None
-        return int(v)
+        return v
     if key.kind == "str":
         if not isinstance(v, str):
             problems.append(f"{where}: expected a string in quotes, got {v!r}")
@@ -135,15 +169,25 @@ def _value(v, key: Key, where: str, problems: list):
             )
             return None
         return v
-    # floats
+    # floats, ints
     if not isinstance(v, (list, tuple)):
         problems.append(f"{where}: expected an array of numbers like [1.0, 2.0], got {v!r}")
         return None
     if key.length is not None and len(v) != key.length:
         problems.append(f"{where}: needs {key.length} numbers, got {len(v)}")
         return None
-    out = [_number(x, key, f"{where}[{i}]", problems) for i, x in enumerate(v)]
+    one = _number if key.kind == "floats" else _integer
+    out = [one(x, key, f"{where}[{i}]", problems) for i, x in enumerate(v)]
     return None if any(x is None for x in out) else tuple(out)
+
+
+def _with_unit_limit(key: Key, name: str) -> Key:
+    """``key`` with the plausible range of the unit ``name`` ends in, unless it has a limit."""
+    if key.limit is None and key.kind in ("float", "floats"):
+        lim = unit_limits(name)
+        if lim is not None:
+            return replace(key, limit=lim[1])
+    return key
 
 
 def read_config(
@@ -202,10 +246,7 @@ def read_config(
                 )
         for k, key in keys.items():
             where = f"[{t}] {k}"
-            if key.limit is None and key.kind in ("float", "floats"):
-                lim = unit_limits(k)
-                if lim is not None:
-                    key = replace(key, limit=lim[1])
+            key = _with_unit_limit(key, k)
             if k in table:
                 v = _value(table[k], key, where, problems)
                 if v is not None:
@@ -222,24 +263,135 @@ def read_config(
     return out
 
 
-def dataclass_from_table(cls, table: Mapping | None, what: str):
-    """The dataclass ``cls`` with its defaults replaced by the entries of a TOML table.
+_SCALAR_KINDS = {float: "float", int: "int", str: "str", bool: "bool"}
 
-    The fields of ``cls`` are the table's schema: an unknown key is an error that names the
-    closest field (all unknown keys in one message); arrays become tuples. ``what`` names the
-    table in the message (``"scenario line_lab [lab]"``).
+
+def _field_kind(hint) -> tuple[str | None, type | None, bool]:
+    """``(kind, dataclass, optional)`` of a field's type hint: a :class:`Key` kind for a
+    value, or the dataclass of a nested table; ``optional``: the hint admits ``None``.
     """
     import dataclasses
+    import types
+    import typing
 
-    if not table:
-        return cls()
-    names = [f.name for f in dataclasses.fields(cls)]
-    bad = [k for k in table if k not in names]
-    if bad:
-        raise InputError(
-            "; ".join(
-                f"{what} {k}: unknown key{did_you_mean(k, names)} (known: {', '.join(names)})"
-                for k in bad
+    optional = False
+    origin = typing.get_origin(hint)
+    if origin in (typing.Union, types.UnionType):
+        args = [a for a in typing.get_args(hint) if a is not type(None)]
+        optional = len(args) < len(typing.get_args(hint))
+        if len(args) != 1:
+            raise TypeError(f"unsupported configuration type {hint!r}")
+        hint = args[0]
+        origin = typing.get_origin(hint)
+    if isinstance(hint, type) and dataclasses.is_dataclass(hint):
+        return None, hint, optional
+    if hint in _SCALAR_KINDS:
+        return _SCALAR_KINDS[hint], None, optional
+    if origin is tuple:
+        args = typing.get_args(hint)
+        if args and args[0] in (float, int):
+            return ("floats" if args[0] is float else "ints"), None, optional
+    raise TypeError(f"unsupported configuration type {hint!r}")
+
+
+def _load(cls, table: Mapping, path: str, problems: list):
+    """``cls`` from one TOML table (nested tables for dataclass fields) at the dotted table
+    ``path`` (``""``: the file's top level); problems appended.
+    """
+    import dataclasses
+    import typing
+
+    hints = typing.get_type_hints(cls)
+    fields = [f for f in dataclasses.fields(cls) if f.init]
+    names = [f.name for f in fields]
+    where = f"[{path}]" if path else ""
+    prefix = f"{where} " if where else ""
+    n_before = len(problems)
+    for k in table:
+        if k not in names:
+            what = "table" if isinstance(table[k], Mapping) else "key"
+            name = f"[{k}]" if what == "table" and not where else k
+            problems.append(
+                f"{prefix}{name}: unknown {what}{did_you_mean(k, names)} "
+                f"(known: {', '.join(names)})"
             )
+    kwargs = {}
+    for f in fields:
+        kind, sub, optional = _field_kind(hints[f.name])
+        has_default = (
+            f.default is not dataclasses.MISSING or f.default_factory is not dataclasses.MISSING
         )
-    return cls(**{k: tuple(v) if isinstance(v, list) else v for k, v in table.items()})
+        here = f"{path}.{f.name}" if path else f.name
+        if f.name not in table:
+            if sub is not None and not has_default and not optional:
+                kwargs[f.name] = _load(sub, {}, here, problems)
+            elif not has_default:
+                doc = f.metadata.get("key", Key("str")).doc
+                problems.append(
+                    f"{prefix}{f.name}: missing; add `{f.name} = ...`"
+                    + (f" ({doc})" if doc else "")
+                )
+            continue
+        v = table[f.name]
+        if sub is not None:
+            if not isinstance(v, Mapping):
+                problems.append(f"{prefix}{f.name}: must be a table [{here}], got {v!r}")
+                continue
+            kwargs[f.name] = _load(sub, v, here, problems)
+            continue
+        key = f.metadata.get("key", Key(kind))
+        out = _value(v, _with_unit_limit(key, f.name), f"{prefix}{f.name}", problems)
+        if out is not None:
+            kwargs[f.name] = out
+    if len(problems) > n_before:
+        return None
+    try:
+        return cls(**kwargs)
+    except InputError as exc:  # a check of the dataclass itself (__post_init__)
+        problems.append(f"{prefix}{exc}")
+        return None
+
+
+def load_dataclass(cls, table: Mapping | None, what: str = "configuration"):
+    """The dataclass ``cls`` from a mapping read from TOML (see :func:`read_dataclass`).
+
+    ``what`` names the source in the message (``"scenario file data_synthetic/x.toml"``).
+    """
+    problems: list[str] = []
+    out = _load(cls, table or {}, "", problems)
+    if problems:
+        raise InputError(f"{what}: " + "; ".join(problems))
+    return out
+
+
+def read_dataclass(path, cls, what: str = "file"):
+    """Read a TOML file into the frozen dataclass ``cls``: the one loader of a configuration.
+
+    Parameters
+    ----------
+    path : str or Path
+    cls : dataclass type
+        The schema. Each field is a key; a field whose type is a dataclass is a table
+        ``[name]`` (nested as deep as the dataclasses are); ``X | None`` is an optional key or
+        table. Field types: ``float``, ``int``, ``str``, ``bool``, ``tuple[float, ...]``,
+        ``tuple[int, ...]``, a dataclass. Absent keys take the field's default; a field
+        without a default is required. ``field(metadata={"key": Key(...)})`` adds a doc, a
+        length, ``positive``, ``choices`` or a ``limit``; numbers of a field named with a unit
+        (``_px``, ``_m``, ``_deg`` …) must lie in that unit's plausible range
+        (:data:`hsgeo.validate.UNIT_LIMITS`).
+    what : str
+        The file's role, for messages (``"scenario file"``).
+
+    Returns
+    -------
+    instance of ``cls``
+
+    Raises
+    ------
+    InputError
+        One error naming the file and listing every problem: unknown tables or keys (with the
+        closest known name, :func:`difflib.get_close_matches`), missing required keys, values
+        of the wrong type, NaN, infinite or implausible numbers.
+    """
+    path = Path(path)
+    return load_dataclass(cls, read_toml(path, what), f"{what} {path}")

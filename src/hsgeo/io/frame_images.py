@@ -1,4 +1,4 @@
-"""Frames of a frame camera for ``hsgeo orthorectify`` (issue 36): the images and their times.
+"""Frames of a frame camera for ``hsgeo orthorectify``: the images and their times.
 
 **A frame** is one image file per exposure, as frame cameras and their software write them:
 

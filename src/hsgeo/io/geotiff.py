@@ -201,7 +201,7 @@ def _no_georeference_warning():
 
 
 def check_dsm_bands(src, name: str) -> None:
-    """A DSM is one band of heights (issue 42: band 1 of a three-band raster was read as the
+    """A DSM is one band of heights (band 1 of a three-band raster was read as the
     heights, silently).
     """
     if src.count != 1:

@@ -343,7 +343,7 @@ def _strip_of(ds, name, lines_per_chunk):
     sid = sid.decode() if isinstance(sid, bytes) else str(sid)
     t_s = np.asarray(ds["t_s"].values, dtype=np.float64)
     if t_s.size > 1 and np.all(np.diff(t_s) < 0):
-        # lines stored last first (issue 42: refused): each line keeps its own time
+        # lines stored last first (once refused): each line keeps its own time
         da, t_s = da.isel(line=slice(None, None, -1)), t_s[::-1].copy()
     if lines_per_chunk is None:
         lines = np.asarray(da.values, dtype=np.float32)

@@ -60,8 +60,8 @@ def read_bars(path):
     """The bar file: ``(BarTarget, profile settings dict)``."""
     from hsgeo.mtf import BarTarget
 
-    cfg = read_config(path, BARS_SCHEMA, "bar file", required_tables=("target", "profile"))
-    t = cfg["target"]
+    tables = read_config(path, BARS_SCHEMA, "bar file", required_tables=("target", "profile"))
+    t = tables["target"]
     if len(t["pair_mm"]) != len(t["n_pairs"]):
         raise InputError(
             f"bar file {path}: [target] pair_mm has {len(t['pair_mm'])} groups, n_pairs "
@@ -76,7 +76,7 @@ def read_bars(path):
         )
     except InputError as exc:
         raise InputError(f"bar file {path}: [target] {exc}") from None
-    return target, cfg["profile"]
+    return target, tables["profile"]
 
 
 def read_profiles(path) -> dict:

@@ -213,8 +213,8 @@ def read_band_split(path=None) -> np.ndarray:
 
     if path is None:
         path = Path(__file__).parent.parent / "data" / "instruments" / "rikola_fpi2015.toml"
-    cfg = read_config(path, BAND_SPLIT_SCHEMA, "instrument file", required_tables=("bands",))
-    b, n = cfg["bands"], cfg["instrument"]["n_sensors"]
+    tables = read_config(path, BAND_SPLIT_SCHEMA, "instrument file", required_tables=("bands",))
+    b, n = tables["bands"], tables["instrument"]["n_sensors"]
     lengths = {len(b[k]) for k in ("band", "sensor", "gap_nm")}
     band, sensor = np.asarray(b["band"]), np.asarray(b["sensor"])
     problems = []
@@ -272,8 +272,8 @@ def read_frame_layouts(path=None) -> dict:
 
     if path is None:
         path = Path(__file__).parent.parent / "data" / "instruments" / "imspector_v9_pixelfly.toml"
-    cfg = read_config(path, FRAME_LAYOUT_SCHEMA, "instrument file", required_tables=("frame",))
-    f = cfg["frame"]
+    tables = read_config(path, FRAME_LAYOUT_SCHEMA, "instrument file", required_tables=("frame",))
+    f = tables["frame"]
     counts = ("binning", "n_rows", "n_columns", "n_reflected_columns", "n_incident_columns")
     problems = []
     if len({len(v) for v in f.values()}) != 1:
@@ -302,8 +302,8 @@ def read_frame_layouts(path=None) -> dict:
         for i, b in enumerate(f["binning"])
     }
     return {
-        "name": cfg["instrument"]["name"],
-        "bits": cfg["instrument"]["bits"],
+        "name": tables["instrument"]["name"],
+        "bits": tables["instrument"]["bits"],
         "layouts": layouts,
     }
 

@@ -118,7 +118,7 @@ def _parse(path, text, parquet: bool, name: str, columns, text_columns):
     return df
 
 
-#: Separators other than the comma that spreadsheets write (issue 42: a semicolon-separated
+#: Separators other than the comma that spreadsheets write (a semicolon-separated
 #: table was told to rename its one header column to a required name).
 _OTHER_SEPARATORS = {";": "semicolons", "\t": "tabs", "|": "vertical bars"}
 
@@ -139,7 +139,7 @@ def _check_separator(name: str, header: list[str], columns) -> None:
 
 
 def _check_dtype(df, c: str, name: str) -> None:
-    """A Parquet column states its type: a quantity must be stored as numbers (issue 42: text
+    """A Parquet column states its type: a quantity must be stored as numbers (text
     columns were parsed silently, dates and durations read as nanoseconds).
     """
     import pandas as pd

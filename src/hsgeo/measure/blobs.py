@@ -17,6 +17,7 @@ import numpy as np
 __all__ = ["weighted_blob_centroid"]
 
 _EIGHT = np.ones((3, 3), bool)
+_EIGHT.setflags(write=False)
 
 
 def weighted_blob_centroid(excess, near_rc):

@@ -199,7 +199,7 @@ def measure_ctf(
     end_px = start_px + target.length_mm() / gsd_mm
     inside = (x >= start_px - 2) & (x <= end_px + 2)
     if saturation_dn > 255 and np.all(y == np.round(y)) and 0 <= y.min() and y.max() <= 255:
-        raise InputError(  # issue 42: 8-bit profiles were measured against a 12-bit bar file
+        raise InputError(  # 8-bit profiles were once measured against a 12-bit bar file
             f"the profile holds 8-bit values (whole numbers 0…255, at most {y.max():g} DN) but "
             f"the bar file's saturation_dn is {saturation_dn:g}: give saturation_dn = 255 and "
             "dark_dn in the profile's DN (or the profile as recorded, in the bar file's DN)"

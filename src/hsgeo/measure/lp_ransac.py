@@ -115,6 +115,7 @@ __all__ = [
 MIN_CORRESPONDENCES = 11
 #: Non-zero entries of F (row-major indices into the flattened 4×4): all but the 2×2 block.
 _NONZERO = np.array([r * 4 + s for r in range(4) for s in range(4) if not (r < 2 and s < 2)])
+_NONZERO.setflags(write=False)
 #: A sample whose design has σ₁₁/σ₁ below this is degenerate (rank < 11).
 _RANK_TOL = 1e-9
 

@@ -187,15 +187,32 @@ def _asf_rows(res, true_n, th, n_runs) -> list[Row]:
     usable = res[0].usable
     err = 100 * np.abs(A - true_n[None])[:, :, usable].max(axis=2)  # (runs, bands)
     for b in range(A.shape[1]):
-        rows.append(Row("004 ASF", f"max |ASF − truth|, channel {b + 1}", "%", None, None,
-                        float(err[0, b]), float(err[:, b].std(ddof=1)), None, n_runs=n_runs,
-                        provenance="chosen"))  # fmt: skip
+        rows.append(
+            Row(
+                table="004 ASF",
+                quantity=f"max |ASF − truth|, channel {b + 1}",
+                unit="%",
+                reproduced=float(err[0, b]),
+                sigma=float(err[:, b].std(ddof=1)),
+                n_runs=n_runs,
+                provenance="chosen",
+            )
+        )
     for b in range(A.shape[1]):
         for ang in ANGLES_DEG:
             j = int(np.argmin(np.abs(np.rad2deg(th) - ang)))
-            rows.append(Row("004 ASF", f"ASF at {ang:+.0f}°, channel {b + 1}", "1", None, None,
-                            float(A[0, b, j]), float(A[:, b, j].std(ddof=1)),
-                            float(true_n[b, j]), n_runs=n_runs, provenance="chosen"))  # fmt: skip
+            rows.append(
+                Row(
+                    table="004 ASF",
+                    quantity=f"ASF at {ang:+.0f}°, channel {b + 1}",
+                    unit="1",
+                    reproduced=float(A[0, b, j]),
+                    sigma=float(A[:, b, j].std(ddof=1)),
+                    truth=float(true_n[b, j]),
+                    n_runs=n_runs,
+                    provenance="chosen",
+                )
+            )
     return rows
 
 
@@ -204,11 +221,18 @@ def _variation_rows(res, true_n, n_runs) -> list[Row]:
     pp = np.array([r.peak_to_peak_percent for r in res])
     t = peak_to_peak_percent(true_n, usable, res[0].smooth_px)
     return [
-        Row("004 variation", f"peak-to-peak ASF, channel {b + 1}", "%", None, None,
-            float(pp[0, b]), float(pp[:, b].std(ddof=1)), float(t[b]), n_runs=n_runs,
-            provenance="tuned" if b == TUNED_CHANNEL else "chosen")
+        Row(
+            table="004 variation",
+            quantity=f"peak-to-peak ASF, channel {b + 1}",
+            unit="%",
+            reproduced=float(pp[0, b]),
+            sigma=float(pp[:, b].std(ddof=1)),
+            truth=float(t[b]),
+            n_runs=n_runs,
+            provenance="tuned" if b == TUNED_CHANNEL else "chosen",
+        )
         for b in range(pp.shape[1])
-    ]  # fmt: skip
+    ]
 
 
 def _text_rows(res, true_n, gc, scene, n_runs) -> list[Row]:
@@ -225,50 +249,125 @@ def _text_rows(res, true_n, gc, scene, n_runs) -> list[Row]:
     lab = "the 1994 integrating-sphere measurement is not simulated (004 Fig. 1, laboratory)"
     q = {k: v for k, v in ASF_004.items()}
     return [
-        Row("004 text", "ASF variation, largest channel", "%",
-            q["ASF variation, largest channel"][0], None, float(pp[0]), float(pp.std(ddof=1)),
-            float(t_pp), n_runs=n_runs, provenance="tuned"),
-        Row("004 text", "lab ASF max-min, channels 2-9", "%",
-            q["lab ASF max-min, channels 2-9"][0], verdict="not testable", reason=lab,
-            provenance="paper"),
-        Row("004 text", "lab ASF max-min, channel 1", "%", q["lab ASF max-min, channel 1"][0],
-            verdict="not testable", reason=lab, provenance="paper"),
-        Row("004 text", "angular pixel size", "deg", q["angular pixel size"][0], None, ifov, None,
-            scene.sensor.ifov_deg, provenance="paper"),
-        Row("004 text", "nadir GSD at 300 m", "m", q["nadir GSD at 300 m"][0], None,
-            float(gsd[0]), None, float(gsd_true), provenance="derived", verdict="differs",
+        Row(
+            table="004 text",
+            quantity="ASF variation, largest channel",
+            unit="%",
+            paper=q["ASF variation, largest channel"][0],
+            reproduced=float(pp[0]),
+            sigma=float(pp.std(ddof=1)),
+            truth=float(t_pp),
+            n_runs=n_runs,
+            provenance="tuned",
+        ),
+        Row(
+            table="004 text",
+            quantity="lab ASF max-min, channels 2-9",
+            unit="%",
+            paper=q["lab ASF max-min, channels 2-9"][0],
+            verdict="not testable",
+            reason=lab,
+            provenance="paper",
+        ),
+        Row(
+            table="004 text",
+            quantity="lab ASF max-min, channel 1",
+            unit="%",
+            paper=q["lab ASF max-min, channel 1"][0],
+            verdict="not testable",
+            reason=lab,
+            provenance="paper",
+        ),
+        Row(
+            table="004 text",
+            quantity="angular pixel size",
+            unit="deg",
+            paper=q["angular pixel size"][0],
+            reproduced=ifov,
+            truth=scene.sensor.ifov_deg,
+            provenance="paper",
+        ),
+        Row(
+            table="004 text",
+            quantity="nadir GSD at 300 m",
+            unit="m",
+            paper=q["nadir GSD at 300 m"][0],
+            reproduced=float(gsd[0]),
+            truth=float(gsd_true),
+            provenance="derived",
+            verdict="differs",
             reason=f"300 m × tan 0.12° = {gsd_true:.3f} m (the sampling interval), measured "
             f"{gsd[0]:.3f} m on the georegistered scan; the paper's 'about 0.7 m' lies "
             f"{above_pct:.0f} % above its own numbers (perhaps a footprint wider"
-            " than the sampling interval, which 004 does not give)"),
-        Row("004 text", "runway width", "px", q["runway width"][0], None,
-            float(scene.runway_width_m / gsd[0]), None, float(scene.runway_width_m / gsd_true),
-            provenance="tuned"),
-        Row("004 text", "registration accuracy", "px", q["registration accuracy"][0], None,
-            float(scatter[0]), float(scatter.std(ddof=1)), None, n_runs=n_runs,
-            provenance="chosen", verdict="not testable",
+            " than the sampling interval, which 004 does not give)",
+        ),
+        Row(
+            table="004 text",
+            quantity="runway width",
+            unit="px",
+            paper=q["runway width"][0],
+            reproduced=float(scene.runway_width_m / gsd[0]),
+            truth=float(scene.runway_width_m / gsd_true),
+            provenance="tuned",
+        ),
+        Row(
+            table="004 text",
+            quantity="registration accuracy",
+            unit="px",
+            paper=q["registration accuracy"][0],
+            reproduced=float(scatter[0]),
+            sigma=float(scatter.std(ddof=1)),
+            n_runs=n_runs,
+            provenance="chosen",
+            verdict="not testable",
             reason="not the same quantity: ours is the scatter between registration windows on "
             "ideal simulated landmarks (sharp, unchanged between the flights), the paper's an "
-            "estimate of the accuracy on real ones"),
-    ]  # fmt: skip
+            "estimate of the accuracy on real ones",
+        ),
+    ]
 
 
 def _registration_rows(res, truth, n_runs) -> list[Row]:
     r0 = res[0].registration
     S = np.array([r.registration.shift_m for r in res])
     rows = [
-        Row("004 registration", f"shift of the along image, {k}", "m", None, None,
-            float(S[0, i]), float(r0.sigma_m[i]), float(truth.shift_m[i]), provenance="chosen")
+        Row(
+            table="004 registration",
+            quantity=f"shift of the along image, {k}",
+            unit="m",
+            reproduced=float(S[0, i]),
+            sigma=float(r0.sigma_m[i]),
+            truth=float(truth.shift_m[i]),
+            provenance="chosen",
+        )
         for i, k in enumerate(("E", "N"))
-    ]  # fmt: skip
+    ]
     rows += [
-        Row("004 registration", f"spread of the shift over the noise runs, {k}", "m", None, None,
-            float(S[:, i].std(ddof=1)), n_runs=n_runs)
+        Row(
+            table="004 registration",
+            quantity=f"spread of the shift over the noise runs, {k}",
+            unit="m",
+            reproduced=float(S[:, i].std(ddof=1)),
+            n_runs=n_runs,
+        )
         for i, k in enumerate(("E", "N"))
-    ]  # fmt: skip
-    rows.append(Row("004 registration", "windows used", "1", None, None, float(r0.n_windows)))
-    rows.append(Row("004 registration", "σ̂ of the shift (from the windows)", "px", None, None,
-                    float(r0.sigma_px)))  # fmt: skip
+    ]
+    rows.append(
+        Row(
+            table="004 registration",
+            quantity="windows used",
+            unit="1",
+            reproduced=float(r0.n_windows),
+        )
+    )
+    rows.append(
+        Row(
+            table="004 registration",
+            quantity="σ̂ of the shift (from the windows)",
+            unit="px",
+            reproduced=float(r0.sigma_px),
+        )
+    )
     return rows
 
 
@@ -293,10 +392,26 @@ def _leak_rows(th, asf_true, lam, brdf, brdf_rev, combined, truth_b, hw) -> list
         ("BRDF, two opposite crossings", combined, (ce, co)),
     ):
         e, o = parts_err(a)
-        rows.append(Row("004 BRDF leak", f"even part: max error, {label}", "%", None, None,
-                        float(e), None, float(pred[0]), provenance="chosen"))  # fmt: skip
-        rows.append(Row("004 BRDF leak", f"odd part: max error, {label}", "%", None, None,
-                        float(o), None, float(pred[1]), provenance="chosen"))  # fmt: skip
+        rows.append(
+            Row(
+                table="004 BRDF leak",
+                quantity=f"even part: max error, {label}",
+                unit="%",
+                reproduced=float(e),
+                truth=float(pred[0]),
+                provenance="chosen",
+            )
+        )
+        rows.append(
+            Row(
+                table="004 BRDF leak",
+                quantity=f"odd part: max error, {label}",
+                unit="%",
+                reproduced=float(o),
+                truth=float(pred[1]),
+                provenance="chosen",
+            )
+        )
     return rows
 
 
@@ -372,11 +487,18 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
         + _registration_rows(res, truth, n_runs)
         + _leak_rows(th, truth.asf, res[0].asf, res_b.asf, res_r.asf, combined, truth_b, hw)
         + [
-            Row("unmodelled effect", f"max |ASF − truth| over channels, {k}", "%", None, None,
-                v, sd, n_runs=n_runs, provenance="chosen")
+            Row(
+                table="unmodelled effect",
+                quantity=f"max |ASF − truth| over channels, {k}",
+                unit="%",
+                reproduced=v,
+                sigma=sd,
+                n_runs=n_runs,
+                provenance="chosen",
+            )
             for k, v, sd in unmod
         ]
-    )  # fmt: skip
+    )
     meta = {
         "n_runs": n_runs,
         "n_px": int(th.size),

@@ -178,9 +178,9 @@ def _hot_rows(res, truth, seed) -> list[Row]:
     for i, j in pick:
         rows.append(
             Row(
-                "hot pixels",
-                f"a, hot pixel ({i}, {j})",
-                "DN/s",
+                table="hot pixels",
+                quantity=f"a, hot pixel ({i}, {j})",
+                unit="DN/s",
                 reproduced=dark.a_dn_per_s[i, j],
                 sigma=dark.sigma_a_dn_per_s[i, j],
                 truth=truth.a_dn_per_s[i, j],
@@ -189,9 +189,9 @@ def _hot_rows(res, truth, seed) -> list[Row]:
         )
         rows.append(
             Row(
-                "hot pixels",
-                f"b, hot pixel ({i}, {j})",
-                "DN",
+                table="hot pixels",
+                quantity=f"b, hot pixel ({i}, {j})",
+                unit="DN",
                 reproduced=dark.b_dn[i, j],
                 sigma=dark.sigma_b_dn[i, j],
                 truth=truth.b_dn[i, j],
@@ -207,9 +207,9 @@ def _hot_rows(res, truth, seed) -> list[Row]:
         share = float(np.mean(np.abs(est - tru) <= 3 * sig))
         rows.append(
             Row(
-                "hot pixels",
-                f"share of pixels with {what} within 3σ̂",
-                "1",
+                table="hot pixels",
+                quantity=f"share of pixels with {what} within 3σ̂",
+                unit="1",
                 reproduced=share,
                 truth=expect,
                 provenance="derived",
@@ -219,9 +219,9 @@ def _hot_rows(res, truth, seed) -> list[Row]:
     found, true = res.hot, truth.hot
     rows.append(
         Row(
-            "hot pixels",
-            "hot pixels detected",
-            "1",
+            table="hot pixels",
+            quantity="hot pixels detected",
+            unit="1",
             reproduced=float((found & true).sum() / max(true.sum(), 1)),
             truth=1.0,
             provenance="chosen",
@@ -230,9 +230,9 @@ def _hot_rows(res, truth, seed) -> list[Row]:
     )
     rows.append(
         Row(
-            "hot pixels",
-            "false hot pixels",
-            "px",
+            table="hot pixels",
+            quantity="false hot pixels",
+            unit="px",
             reproduced=float((found & ~true).sum()),
             truth=0.0,
             provenance="chosen",
@@ -248,9 +248,9 @@ def _reflectance_rows(groups, truth_bands, lam) -> list[Row]:
         sel = (lam >= lo) & (lam <= hi)
         rows.append(
             Row(
-                "reflectance",
-                f"{name}, {g} ({lo:.0f}–{hi:.0f} nm)",
-                "1",
+                table="reflectance",
+                quantity=f"{name}, {g} ({lo:.0f}–{hi:.0f} nm)",
+                unit="1",
                 reproduced=m,
                 sigma=s,
                 truth=float(truth_bands[name][sel].mean()),
@@ -271,9 +271,9 @@ def _index_rows(spectra, truth_bands, lam, table="vegetation indices") -> list[R
             tru = R.vegetation_index(name, lam, truth_bands[v])
             rows.append(
                 Row(
-                    table,
-                    f"{name}, variant {v}",
-                    "1",
+                    table=table,
+                    quantity=f"{name}, variant {v}",
+                    unit="1",
                     reproduced=float(val),
                     sigma=sig,
                     truth=float(tru),
@@ -305,9 +305,9 @@ def _paper_rows(cfg: CS.CubeSurvey) -> list[Row]:
         )
         out.append(
             Row(
-                "001 §3.2",
-                q,
-                "mm" if "GSD" in q else "mm/s",
+                table="001 §3.2",
+                quantity=q,
+                unit="mm" if "GSD" in q else "mm/s",
                 paper=paper,
                 reproduced=val,
                 # arithmetic on the paper's numbers agrees by construction (report.Row.rule);
@@ -336,9 +336,9 @@ def _unmodelled_rows(cfg, seed, base_spectra, base_groups, truth_bands, lam) -> 
         for how, (m, s) in (("without", base_groups[name, g]), ("with", groups[name, g])):
             rows.append(
                 Row(
-                    "unmodelled effect",
-                    f"{name}, {g} reflectance, {how} the error",
-                    "1",
+                    table="unmodelled effect",
+                    quantity=f"{name}, {g} reflectance, {how} the error",
+                    unit="1",
                     reproduced=m,
                     sigma=s,
                     truth=tru,
@@ -351,9 +351,9 @@ def _unmodelled_rows(cfg, seed, base_spectra, base_groups, truth_bands, lam) -> 
             v, s = R.vegetation_index(name, lam, sp[0], sigma=sp[1])
             rows.append(
                 Row(
-                    "unmodelled effect",
-                    f"{name}, variant A, {how} the error",
-                    "1",
+                    table="unmodelled effect",
+                    quantity=f"{name}, variant A, {how} the error",
+                    unit="1",
                     reproduced=float(v),
                     sigma=s,
                     truth=tru,

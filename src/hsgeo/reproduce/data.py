@@ -131,7 +131,7 @@ def generate_all(
     with tempfile.TemporaryDirectory() as tmp:
         for toml in sorted(ddir.glob("*.toml")):
             cfg = load_scenario(toml.stem)
-            mod = importlib.import_module(GENERATORS[cfg["scenario"]["generator"]])
+            mod = importlib.import_module(GENERATORS[cfg.scenario.generator])
             for path in mod.generate(cfg, Path(tmp)):
                 dest = out / path.name
                 if dest.is_file():

@@ -12,6 +12,7 @@ Three experiments:
 
 from __future__ import annotations
 
+from dataclasses import replace
 from importlib import resources
 
 import numpy as np
@@ -180,14 +181,21 @@ def _chessboard_rows(extras: dict) -> list[Row]:
     t = "OpenCV chessboard"
     for q in ("fx_px", "k1", "k2", "k3"):
         rows.append(
-            Row(t, q, "px" if q.endswith("px") else "1", paper=ref[q], reproduced=v[q], sigma=s[q])
+            Row(
+                table=t,
+                quantity=q,
+                unit="px" if q.endswith("px") else "1",
+                paper=ref[q],
+                reproduced=v[q],
+                sigma=s[q],
+            )
         )
     verdict, why = _same(cal.rms_px, ref["rms_px"], "the RMS residuals")
     rows.append(
         Row(
-            t,
-            "rms_px",
-            "px",
+            table=t,
+            quantity="rms_px",
+            unit="px",
             paper=ref["rms_px"],
             reproduced=cal.rms_px,
             verdict=verdict,
@@ -201,7 +209,15 @@ def _chessboard_rows(extras: dict) -> list[Row]:
     for (q, unit), s_cv in zip(INTRINSIC_ROWS, sd_cv, strict=True):
         verdict, why = _same(sd_hs[q], s_cv, "the σ̂")
         rows.append(
-            Row(t, f"σ({q})", unit, paper=s_cv, reproduced=sd_hs[q], verdict=verdict, reason=why)
+            Row(
+                table=t,
+                quantity=f"σ({q})",
+                unit=unit,
+                paper=s_cv,
+                reproduced=sd_hs[q],
+                verdict=verdict,
+                reason=why,
+            )
         )
     pg = calibrate_photogrammetric(
         views, size, PIXEL_PITCH_MM, fix_principal_point=True, zero_decentering=True
@@ -209,10 +225,12 @@ def _chessboard_rows(extras: dict) -> list[Row]:
     t = "two forms of Brown's model (chessboard)"
     f_pg, sf_pg = pg.values()["f_mm"] / PIXEL_PITCH_MM, pg.sigmas()["f_mm"] / PIXEL_PITCH_MM
     rows += [
-        Row(t, "f_px_opencv_form", "px", reproduced=v["fx_px"], sigma=s["fx_px"]),
-        Row(t, "f_px_photogrammetric_form", "px", reproduced=f_pg, sigma=sf_pg),
-        Row(t, "rms_px_opencv_form", "px", reproduced=cal.rms_px),
-        Row(t, "rms_px_photogrammetric_form", "px", reproduced=pg.rms_px),
+        Row(
+            table=t, quantity="f_px_opencv_form", unit="px", reproduced=v["fx_px"], sigma=s["fx_px"]
+        ),
+        Row(table=t, quantity="f_px_photogrammetric_form", unit="px", reproduced=f_pg, sigma=sf_pg),
+        Row(table=t, quantity="rms_px_opencv_form", unit="px", reproduced=cal.rms_px),
+        Row(table=t, quantity="rms_px_photogrammetric_form", unit="px", reproduced=pg.rms_px),
     ]
     extras["chessboard"] = {
         "views": views,
@@ -246,10 +264,20 @@ def _charuco_rows(extras: dict) -> list[Row]:
     hv, hs = ccal.values(), ccal.sigmas()
     t = "OpenCV ChArUco"
     for q, unit in INTRINSIC_ROWS:
-        rows.append(Row(t, q, unit, paper=cv_vals[q], reproduced=hv[q], sigma=hs[q]))
+        rows.append(
+            Row(table=t, quantity=q, unit=unit, paper=cv_vals[q], reproduced=hv[q], sigma=hs[q])
+        )
     verdict, why = _same(ccal.rms_px, rms_cv, "the RMS residuals")
     rows.append(
-        Row(t, "rms_px", "px", paper=rms_cv, reproduced=ccal.rms_px, verdict=verdict, reason=why)
+        Row(
+            table=t,
+            quantity="rms_px",
+            unit="px",
+            paper=rms_cv,
+            reproduced=ccal.rms_px,
+            verdict=verdict,
+            reason=why,
+        )
     )
     cm, cd = cref["camera_matrix"], cref["distortion_coefficients"].ravel()
     extras["charuco"] = {
@@ -275,12 +303,14 @@ def _charuco_rows(extras: dict) -> list[Row]:
     t = "OpenCV ChArUco 2021 file"
     r21 = extras["charuco"]["reference_2021"]
     for q, unit in INTRINSIC_ROWS:
-        rows.append(Row(t, q, unit, paper=r21[q], reproduced=hv[q], sigma=hs[q]))
+        rows.append(
+            Row(table=t, quantity=q, unit=unit, paper=r21[q], reproduced=hv[q], sigma=hs[q])
+        )
     rows.append(
         Row(
-            t,
-            "rms_px",
-            "px",
+            table=t,
+            quantity="rms_px",
+            unit="px",
             paper=r21["rms_px"],
             reproduced=ccal.rms_px,
             verdict="differs" if abs(ccal.rms_px / r21["rms_px"] - 1) > SAME_REL else "reproduced",
@@ -308,8 +338,10 @@ def _bench_rows(seed: int, extras: dict) -> list[Row]:
     sv, ss = scal.values(), scal.sigmas()
     t = "simulated bench"
     for q, unit in INTRINSIC_ROWS:
-        rows.append(Row(t, q, unit, reproduced=sv[q], sigma=ss[q], truth=truth[q]))
-    rows.append(Row(t, "sigma0", "1", reproduced=scal.result.sigma0, truth=1.0))
+        rows.append(
+            Row(table=t, quantity=q, unit=unit, reproduced=sv[q], sigma=ss[q], truth=truth[q])
+        )
+    rows.append(Row(table=t, quantity="sigma0", unit="1", reproduced=scal.result.sigma0, truth=1.0))
     extras["bench"] = {
         "calibration": scal,
         "truth": truth,
@@ -337,12 +369,10 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
             "charuco": extras["charuco"]["hsgeo"].result.iterations,
         },
     }
-    for r in rows:
-        if r.paper is not None:
-            # the "paper" column is OpenCV's result on its own sample images (or its reference
-            # file): an independent implementation, nothing of it built into our estimate; the
-            # reference data are our chosen yardstick (every verdict row says whence)
-            r.provenance = "chosen"
+    # the "paper" column is OpenCV's result on its own sample images (or its reference
+    # file): an independent implementation, nothing of it built into our estimate; the
+    # reference data are our chosen yardstick (every verdict row says whence)
+    rows = [replace(r, provenance="chosen") if r.paper is not None else r for r in rows]
     return Reproduction("frame-reference", seed, rows, meta, extras)
 
 

@@ -10,13 +10,20 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from hsgeo.gcp import deviation_table, recompute_printed_table
 from hsgeo.papers import P000_GCP_FOOTERS
 from hsgeo.report import Reproduction, Row, agreement
 from hsgeo.sensors.line import CalibratedLine
-from hsgeo.simulate.pula_flight import FlightObservations, nominal_sensor, simulate_flight
+from hsgeo.simulate.pula_flight import (
+    FlightObservations,
+    PulaFlightScenario,
+    nominal_sensor,
+    simulate_flight,
+)
 from hsgeo.simulate.scenarios import load_scenario
 from hsgeo.stats import nmad
 from hsgeo.workflows.geocoding import gcp_deviations
@@ -88,7 +95,7 @@ def displacement_across_track(obs: FlightObservations, sensors: dict, boresights
     sensors, boresights : dict
         ``{"calibrated": ..., "uncalibrated": ...}``: the sensor models and their boresights
         (roll, pitch, yaw) [rad].
-    cfg : dict
+    cfg : PulaFlightScenario
         The scenario (``scanner.usable_half_width_px``, ``sensor_truth.zeta0_px``).
 
     Returns
@@ -102,8 +109,8 @@ def displacement_across_track(obs: FlightObservations, sensors: dict, boresights
     from hsgeo.ortho import ground_points
     from hsgeo.sensors import as_sensor
 
-    half = cfg["scanner"]["usable_half_width_px"]
-    z0 = round(cfg["sensor_truth"]["zeta0_px"])
+    half = cfg.scanner.usable_half_width_px
+    z0 = round(cfg.sensor_truth.zeta0_px)
     zeta = np.arange(z0 - half, z0 + half + 1, dtype=float)
     n_lines = int((obs.recorded_nav.t_s[-1] - obs.t0_s) * obs.line_rate_hz)
     t_s = obs.t0_s + np.arange(n_lines) / obs.line_rate_hz
@@ -130,7 +137,7 @@ def displacement_across_track(obs: FlightObservations, sensors: dict, boresights
 
 
 def monte_carlo(
-    cfg: dict,
+    cfg: PulaFlightScenario,
     sensors: dict,
     n_flights: int,
     seed: int,
@@ -186,9 +193,9 @@ def _unmodelled_rows(mc_on: dict, mc_off: dict, n: int) -> list[Row]:
         for q, v in cols.items():
             rows.append(
                 Row(
-                    "unmodelled effect",
-                    f"dem_error_{state}.{q}",
-                    "1" if "ratio" in q else "m",
+                    table="unmodelled effect",
+                    quantity=f"dem_error_{state}.{q}",
+                    unit="1" if "ratio" in q else "m",
                     reproduced=float(np.median(v)),
                     sigma=float(nmad(v)),
                     n_runs=n,
@@ -219,9 +226,9 @@ def _printed_table_rows(meta: dict) -> list[Row]:
             )
             rows.append(
                 Row(
-                    table,
-                    q,
-                    "m",
+                    table=table,
+                    quantity=q,
+                    unit="m",
                     paper=paper,
                     reproduced=summary[q],
                     verdict=verdict,
@@ -237,14 +244,14 @@ def _printed_table_rows(meta: dict) -> list[Row]:
 def _simulated_rows(cfg, mc, n: int) -> list[Row]:
     """The simulated flights' σ against 000 Tables 2 and 3 (uncalibrated and calibrated)."""
     rows: list[Row] = []
-    height = cfg["flight"]["height_agl_m"]
+    height = cfg.flight.height_agl_m
     for name, paper_table in (("uncalibrated", "000 Table 2"), ("calibrated", "000 Table 3")):
         for k, q in enumerate(QUANTITIES):
             v = mc[name][:, k]
             row = Row(
-                f"simulated, {name}",
-                q,
-                "m",
+                table=f"simulated, {name}",
+                quantity=q,
+                unit="m",
                 paper=P000_GCP_FOOTERS[paper_table][q][0],
                 reproduced=float(np.median(v)),
                 sigma=float(nmad(v)),
@@ -255,17 +262,19 @@ def _simulated_rows(cfg, mc, n: int) -> list[Row]:
             )
             if q.startswith("bias"):
                 # the boresight is calibrated on the same GCPs: the mean deviation is ≈ 0
-                row.verdict, row.reason = (
-                    "not testable",
-                    "the boresight is calibrated on the same GCPs, which removes the mean "
+                row = replace(
+                    row,
+                    verdict="not testable",
+                    reason="the boresight is calibrated on the same GCPs, which removes the mean "
                     f"deviation by construction (spread over {n} flights "
                     f"{row.sigma:.1g} m)",
                 )
             elif row.z_paper is not None and abs(row.z_paper) > 3:
-                row.reason = (
-                    f"tuning missed: the flight (height {height:g} m, not in 000) was chosen so "
-                    f"that the σ are of the size of 000 Tables 2–3; {agreement(row.z_paper)} "
-                    f"of the paper (spread over {n} flights)"
+                row = replace(
+                    row,
+                    reason=f"tuning missed: the flight (height {height:g} m, not in 000) was "
+                    f"chosen so that the σ are of the size of 000 Tables 2–3; "
+                    f"{agreement(row.z_paper)} of the paper (spread over {n} flights)",
                 )
             rows.append(row)
     return rows
@@ -283,15 +292,24 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
     n = max(20, round(200 * scale))
     mc = monte_carlo(cfg, sensors, n, seed)
     # the inner orientation used for the calibrated geocoding: the line-calibration estimate
-    st = cfg["sensor_truth"]
+    st = cfg.sensor_truth
     for q, v, sg, t in zip(
         ("zeta0_px", "c_px", "K1", "K2", "K3"),
         (cal.zeta0_px, cal.c_px, *cal.K),
         np.r_[cal_res.sigma("zeta0_px"), cal_res.sigma("c_px"), cal_res.sigma("K")],
-        (st["zeta0_px"], st["c_px"], *st["K"]),
+        (st.zeta0_px, st.c_px, *st.K),
         strict=True,
     ):
-        rows.append(Row("calibrated IOP", q, "px", reproduced=v, sigma=float(sg), truth=float(t)))
+        rows.append(
+            Row(
+                table="calibrated IOP",
+                quantity=q,
+                unit="px",
+                reproduced=v,
+                sigma=float(sg),
+                truth=float(t),
+            )
+        )
     rows += _simulated_rows(cfg, mc, n)
     ratio = mc["uncalibrated"][:, 2:] / mc["calibrated"][:, 2:]
     # the unmodelled effect: the same flights with an exact DEM
@@ -301,9 +319,9 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
     for k, (q, axis) in enumerate((("sigma_ratio_y", "y"), ("sigma_ratio_x", "x"))):
         rows.append(
             Row(
-                "simulated, ratio",
-                q,
-                "1",
+                table="simulated, ratio",
+                quantity=q,
+                unit="1",
                 # the ratio of the printed σ, to the printed precision's worth of digits
                 paper=round(p2[f"sigma_{axis}_m"][0] / p3[f"sigma_{axis}_m"][0], 3),
                 reproduced=float(np.median(ratio[:, k])),
@@ -321,8 +339,8 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
             "reproduced": "median over the simulated flights; sigma: NMAD of the per-flight values",
             "fraction_ratio_above_2": [float(np.mean(ratio[:, k] > 2)) for k in range(2)],
             "calibrated_iop": {"zeta0_px": cal.zeta0_px, "c_px": cal.c_px, "K": list(cal.K)},
-            "flight_height_agl_m": cfg["flight"]["height_agl_m"],
-            "gsd_across_m": cfg["flight"]["height_agl_m"] / cfg["sensor_truth"]["c_px"],
+            "flight_height_agl_m": cfg.flight.height_agl_m,
+            "gsd_across_m": cfg.flight.height_agl_m / cfg.sensor_truth.c_px,
             "dem_error_sigma_m": DEM_ERROR_SIGMA_M,
             "unmodelled_effect": (
                 f"the field's height in the DEM off by a random error per flight, σ "

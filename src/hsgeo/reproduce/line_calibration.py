@@ -25,7 +25,7 @@ from hsgeo.papers import (
 from hsgeo.report import Reproduction, Row
 from hsgeo.sensors import line1d
 from hsgeo.simulate import as_rng
-from hsgeo.simulate.line_lab import LineLab, pattern_points, record, stations
+from hsgeo.simulate.line_lab import LineLab, LineLabScenario, pattern_points, record, stations
 from hsgeo.workflows.line_calibration import (
     LineInputs,
     LineOptions,
@@ -213,9 +213,9 @@ def _precision_rows(res, mc: dict, lab: LineLab) -> list[Row]:
     rows = []
     for j, (q, paper) in enumerate((("zeta0_px", c.zeta0_sigma_px), ("c_px", c.c_sigma_px))):
         row = Row(
-            "000 Table 1",
-            f"sigma_{q}",
-            "px",
+            table="000 Table 1",
+            quantity=f"sigma_{q}",
+            unit="px",
             paper=paper,
             reproduced=float(res.sigma(q)),
             sigma=float(np.std(mc["sigma"][:, j], ddof=1)),
@@ -223,9 +223,10 @@ def _precision_rows(res, mc: dict, lab: LineLab) -> list[Row]:
             provenance="chosen",
         )
         zp = row.z_paper
-        row.reason = (
-            f"{abs(zp):.0f}σ from the paper's σ (spread of σ̂ over {row.n_runs} runs; a-priori "
-            f"σ of a minimum {lab.zeta_sigma_px:g} px): {why[q]}"
+        row = replace(
+            row,
+            reason=f"{abs(zp):.0f}σ from the paper's σ (spread of σ̂ over {row.n_runs} runs; "
+            f"a-priori σ of a minimum {lab.zeta_sigma_px:g} px): {why[q]}",
         )
         rows.append(row)
     return rows
@@ -246,9 +247,9 @@ def _unmodelled_rows(mc_on: dict, mc_off: dict) -> list[Row]:
             z = m["z"][:, j]
             rows.append(
                 Row(
-                    "unmodelled effect",
-                    f"even_distortion_{state}.mean_z_{q}",
-                    "1",
+                    table="unmodelled effect",
+                    quantity=f"even_distortion_{state}.mean_z_{q}",
+                    unit="1",
                     reproduced=float(np.mean(z)),
                     sigma=float(np.std(z, ddof=1) / np.sqrt(n)),
                     n_runs=n,
@@ -257,9 +258,9 @@ def _unmodelled_rows(mc_on: dict, mc_off: dict) -> list[Row]:
             cov = float(np.mean(np.abs(z) <= 3))
             rows.append(
                 Row(
-                    "unmodelled effect",
-                    f"even_distortion_{state}.{q}_within_3sigma",
-                    "fraction",
+                    table="unmodelled effect",
+                    quantity=f"even_distortion_{state}.{q}_within_3sigma",
+                    unit="fraction",
                     reproduced=cov,
                     sigma=float(np.sqrt(0.9973 * 0.0027 / n)),
                     n_runs=n,
@@ -268,9 +269,9 @@ def _unmodelled_rows(mc_on: dict, mc_off: dict) -> list[Row]:
         s0 = np.asarray(m["sigma0"])
         rows.append(
             Row(
-                "unmodelled effect",
-                f"even_distortion_{state}.sigma0",
-                "1",
+                table="unmodelled effect",
+                quantity=f"even_distortion_{state}.sigma0",
+                unit="1",
                 reproduced=float(np.mean(s0)),
                 sigma=float(np.std(s0, ddof=1)),
                 n_runs=n,
@@ -288,12 +289,11 @@ def _iop_table_rows(results: dict, sims: dict) -> list[Row]:
     for q, val in (("zeta0_px uncalibrated", u.zeta0_px), ("c_px uncalibrated", u.c_px)):
         rows.append(
             Row(
-                "000 Table 1",
-                q,
-                "px",
-                val,
-                None,
-                val,
+                table="000 Table 1",
+                quantity=q,
+                unit="px",
+                paper=val,
+                reproduced=val,
                 verdict="by construction",
                 reason=start,
                 provenance="paper",
@@ -310,7 +310,19 @@ def _iop_table_rows(results: dict, sims: dict) -> list[Row]:
     ]
     units = ["px", "px", "px", "px", "px"]
     for q, un, (pv, ps), vi, si, ti in zip(IOP_NAMES, units, paper, v, s, t, strict=True):
-        rows.append(Row("000 Table 1", q, un, pv, ps, vi, si, ti, provenance="paper"))
+        rows.append(
+            Row(
+                table="000 Table 1",
+                quantity=q,
+                unit=un,
+                paper=pv,
+                paper_sigma=ps,
+                reproduced=vi,
+                sigma=si,
+                truth=ti,
+                provenance="paper",
+            )
+        )
     # 001 Table 2
     for pr in P001_TABLE2:
         v, s = _iop(results[pr.row_px])
@@ -324,11 +336,19 @@ def _iop_table_rows(results: dict, sims: dict) -> list[Row]:
         ]
         for q, (pv, ps), vi, si, ti in zip(IOP_NAMES, paper, v, s, t, strict=True):
             row = Row(
-                "001 Table 2", f"{q} line{pr.row_px}", "px", pv, ps, vi, si, ti, provenance="paper"
+                table="001 Table 2",
+                quantity=f"{q} line{pr.row_px}",
+                unit="px",
+                paper=pv,
+                paper_sigma=ps,
+                reproduced=vi,
+                sigma=si,
+                truth=ti,
+                provenance="paper",
             )
             if not row.truth_is_paper():
                 # row 1000's truth is 000 Table 1, which 001 Table 2 prints rounded
-                row.provenance = "derived"
+                row = replace(row, provenance="derived")
             rows.append(row)
     return rows
 
@@ -350,12 +370,11 @@ def _distortion_magnitude_rows() -> list[Row]:
         paper_v, quote = st[q]
         rows.append(
             Row(
-                "distortion magnitudes",
-                q,
-                "px",
-                paper_v,
-                None,
-                val,
+                table="distortion magnitudes",
+                quantity=q,
+                unit="px",
+                paper=paper_v,
+                reproduced=val,
                 verdict="by construction",
                 provenance="derived",
                 reason=(
@@ -377,9 +396,9 @@ def _coverage_rows(lab, mc: dict, n_mc: int) -> list[Row]:
             for q, f in zip(IOP_NAMES, cov, strict=True):
                 rows.append(
                     Row(
-                        "Monte Carlo coverage",
-                        f"{q} line{r} in {k}sigma",
-                        "fraction",
+                        table="Monte Carlo coverage",
+                        quantity=f"{q} line{r} in {k}sigma",
+                        unit="fraction",
                         reproduced=f,
                         # binomial spread of a fraction over n_mc runs at the nominal rate
                         sigma=float(np.sqrt(p_k * (1 - p_k) / n_mc)),
@@ -433,14 +452,14 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
     )
 
 
-def generate(cfg: dict, outdir: Path) -> list[Path]:
+def generate(cfg: LineLabScenario, outdir: Path) -> list[Path]:
     """``make data`` (generator ``line_lab``): observations and control points of one
     calibration (row 1000), as CSV in
     the formats ``hsgeo calibrate-line`` reads, and the truth.
     """
-    lab = LineLab.from_config(cfg.get("lab"))
-    row = int(cfg.get("calibration", {}).get("row", 1000))
-    sim = simulate_observations(lab, row, int(cfg["scenario"]["seed"]))
+    lab = cfg.lab
+    row = int(cfg.calibration.row)
+    sim = simulate_observations(lab, row, int(cfg.scenario.seed))
     ids = sim["point_ids"]
     obs = write_csv_lines(
         outdir / "line_lab_observations.csv",

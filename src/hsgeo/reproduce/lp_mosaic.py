@@ -293,10 +293,9 @@ def _rows(per_square, gsd_m: float) -> list[Row]:
     ok = bool(rms_a <= gsd_m)
     rows = [
         Row(
-            TABLE,
-            "square_position_error_rms_m",
-            "m",
-            paper=None,
+            table=TABLE,
+            quantity="square_position_error_rms_m",
+            unit="m",
             reproduced=rms_a,
             truth=_rms(np.where(np.isfinite(ea), xa, np.nan)),
             provenance="chosen",
@@ -308,9 +307,9 @@ def _rows(per_square, gsd_m: float) -> list[Row]:
             "'accurately found in the orthomosaic' (Fig. 9) without a number",
         ),
         Row(
-            TABLE,
-            "square_position_error_rms_raw_m",
-            "m",
+            table=TABLE,
+            quantity="square_position_error_rms_raw_m",
+            unit="m",
             reproduced=rms_r,
             truth=_rms(np.where(np.isfinite(er), xr, np.nan)),
             provenance="chosen",
@@ -318,16 +317,22 @@ def _rows(per_square, gsd_m: float) -> list[Row]:
             reason="the contrast: the GNSS/INS navigation and the a-priori camera (002 gives no "
             f"such mosaic); {int(np.all(np.isfinite(er), axis=1).sum())} squares found",
         ),
-        Row(TABLE, "squares_found", "1", reproduced=float(n_a), provenance="chosen"),
+        Row(
+            table=TABLE,
+            quantity="squares_found",
+            unit="1",
+            reproduced=float(n_a),
+            provenance="chosen",
+        ),
     ]
     for k, sid in enumerate(per_square["square_ids"]):
         for key, e, x in (("", ea[k], xa[k]), ("_raw", er[k], xr[k])):
             if np.all(np.isfinite(e)):
                 rows.append(
                     Row(
-                        TABLE,
-                        f"square_error{key}_m.{sid}",
-                        "m",
+                        table=TABLE,
+                        quantity=f"square_error{key}_m.{sid}",
+                        unit="m",
                         reproduced=float(np.hypot(*e)),
                         truth=float(np.hypot(*x)) if np.all(np.isfinite(x)) else None,
                         provenance="chosen",

@@ -34,6 +34,7 @@ from hsgeo.report import Reproduction, Row
 from hsgeo.simulate.mtf_target import (
     BarRecording,
     MtfBench,
+    MtfBenchScenario,
     bar_electrons,
     edge_electrons,
     mtf_true,
@@ -207,9 +208,17 @@ def _fig9_rows(bench, sim, n_runs) -> list[Row]:
         for f in F_TABLE:
             k = int(np.argmin(np.abs(fg - f)))
             rows.append(
-                Row("001 Fig. 9", f"MTF line {r} at {f:g} cy/px", "1", None, None, mean[k], sd[k],
-                    float(mtf_true(bench, r, f)), **_of_mean(n_runs), provenance="chosen")
-            )  # fmt: skip
+                Row(
+                    table="001 Fig. 9",
+                    quantity=f"MTF line {r} at {f:g} cy/px",
+                    unit="1",
+                    reproduced=mean[k],
+                    sigma=sd[k],
+                    truth=float(mtf_true(bench, r, f)),
+                    **_of_mean(n_runs),
+                    provenance="chosen",
+                )
+            )
     # 001 §4: "borderline frequency of around 0.3 cy/px for blue, and to 0.6 cy/px for NIR"
     for r, key in ((100, "borderline_blue_cy_px"), (1000, "borderline_nir_cy_px")):
         j = LINES.index(r)
@@ -219,18 +228,32 @@ def _fig9_rows(bench, sim, n_runs) -> list[Row]:
             m, s = _stats(b)
             # σ(λ) was tuned so that the true MTF falls to 0.1 at the paper's value: agreement
             # with the paper is by construction (report.Row.rule), recovery is the outcome
-            row = Row("001 Fig. 9", f"borderline frequency (MTF 0.1) line {r}", "cy/px",
-                      P001_MTF[key], None, m, s, truth, **_of_mean(n_runs),
-                      provenance="tuned")  # fmt: skip
+            row = Row(
+                table="001 Fig. 9",
+                quantity=f"borderline frequency (MTF 0.1) line {r}",
+                unit="cy/px",
+                paper=P001_MTF[key],
+                reproduced=m,
+                sigma=s,
+                truth=truth,
+                **_of_mean(n_runs),
+                provenance="tuned",
+            )
         else:
             fmax = float(sim["ctf_f"].max())
             m_end = float(np.nanmean(sim["mtf_bars"][:, j, -1]))
-            row = Row("001 Fig. 9", f"borderline frequency (MTF 0.1) line {r}", "cy/px",
-                      P001_MTF[key], None, None, None, truth, **_of_mean(n_runs),
-                      verdict="not testable",
-                      reason=f"beyond the finest bars ({fmax:.2f} cy/px), where the MTF is still "
-                      f"{m_end:.2f}: bars cannot show it (the slanted edge can, see its table)",
-                      provenance="tuned")  # fmt: skip
+            row = Row(
+                table="001 Fig. 9",
+                quantity=f"borderline frequency (MTF 0.1) line {r}",
+                unit="cy/px",
+                paper=P001_MTF[key],
+                truth=truth,
+                **_of_mean(n_runs),
+                verdict="not testable",
+                reason=f"beyond the finest bars ({fmax:.2f} cy/px), where the MTF is still "
+                f"{m_end:.2f}: bars cannot show it (the slanted edge can, see its table)",
+                provenance="tuned",
+            )
         rows.append(row)
     j = LINES.index(100)
     f0 = float(sim["ctf_f"].min())
@@ -238,13 +261,21 @@ def _fig9_rows(bench, sim, n_runs) -> list[Row]:
     f07 = crossing_frequency(np.r_[0, F_GRID], np.r_[1, np.nanmean(sim["mtf_bars"][:, j], 0)], 0.7)
     mean, sd = _stats(m0)
     rows.append(
-        Row("001 Fig. 9", f"MTF line 100 at {F_GRID[0]:g} cy/px ('initial value')", "1",
-            P001_MTF["mtf_initial"], None, mean, sd, float(mtf_true(bench, 100, F_GRID[0])),
-            **_of_mean(n_runs), provenance="chosen",
+        Row(
+            table="001 Fig. 9",
+            quantity=f"MTF line 100 at {F_GRID[0]:g} cy/px ('initial value')",
+            unit="1",
+            paper=P001_MTF["mtf_initial"],
+            reproduced=mean,
+            sigma=sd,
+            truth=float(mtf_true(bench, 100, F_GRID[0])),
+            **_of_mean(n_runs),
+            provenance="chosen",
             reason=f"an MTF normalised at zero frequency (001 eq. 4) is near 1 at the coarsest "
             f"bars ({f0:.3f} cy/px); it falls to 0.7 at {f07:.2f} cy/px on line 100 - the paper's "
-            "curves start there, or carry a contrast loss (see 'unmodelled effect')")
-    )  # fmt: skip
+            "curves start there, or carry a contrast loss (see 'unmodelled effect')",
+        )
+    )
     return rows
 
 
@@ -257,43 +288,90 @@ def _edge_rows(bench, sim, n_runs) -> list[Row]:
         for f in (*F_TABLE, 0.6, 0.75):
             k = int(np.argmin(np.abs(fe - f)))
             rows.append(
-                Row("slanted edge", f"MTF line {r} at {f:g} cy/px", "1", None, None, mean[k],
-                    sd[k], float(mtf_true(bench, r, f, ang)), **_of_mean(n_runs),
-                    provenance="chosen")
-            )  # fmt: skip
+                Row(
+                    table="slanted edge",
+                    quantity=f"MTF line {r} at {f:g} cy/px",
+                    unit="1",
+                    reproduced=mean[k],
+                    sigma=sd[k],
+                    truth=float(mtf_true(bench, r, f, ang)),
+                    **_of_mean(n_runs),
+                    provenance="chosen",
+                )
+            )
         m, s = _stats(sim["fwhm"][:, j])
-        rows.append(Row("slanted edge", f"LSF FWHM line {r}", "px", None, None, m, s, None,
-                        **_of_mean(n_runs), provenance="chosen"))  # fmt: skip
+        rows.append(
+            Row(
+                table="slanted edge",
+                quantity=f"LSF FWHM line {r}",
+                unit="px",
+                reproduced=m,
+                sigma=s,
+                **_of_mean(n_runs),
+                provenance="chosen",
+            )
+        )
     for r in (100, 1000):  # the method's own bias: a noise-free edge (Hamming window, bins)
         e = slanted_edge(edge_electrons(bench, r))
         for f in (0.1, 0.2):
             rows.append(
-                Row("slanted edge", f"MTF line {r} at {f:g} cy/px, noise-free edge", "1", None,
-                    None, float(np.interp(f, e.f_cy_px, e.mtf)), None,
-                    float(mtf_true(bench, r, f, ang)), provenance="chosen")
-            )  # fmt: skip
+                Row(
+                    table="slanted edge",
+                    quantity=f"MTF line {r} at {f:g} cy/px, noise-free edge",
+                    unit="1",
+                    reproduced=float(np.interp(f, e.f_cy_px, e.mtf)),
+                    truth=float(mtf_true(bench, r, f, ang)),
+                    provenance="chosen",
+                )
+            )
     for r, key in ((100, "borderline_blue_cy_px"), (1000, "borderline_nir_cy_px")):
         j = TABLE_LINES.index(r)
         m, s = _stats(sim["borderline_edge"][:, j])
         truth = _truth_borderline(bench, r, ang)
         rows.append(
-            Row("slanted edge", f"borderline frequency (MTF 0.1) line {r}", "cy/px",
-                P001_MTF[key], None, m, s, truth, **_of_mean(n_runs), provenance="tuned")
-        )  # fmt: skip
+            Row(
+                table="slanted edge",
+                quantity=f"borderline frequency (MTF 0.1) line {r}",
+                unit="cy/px",
+                paper=P001_MTF[key],
+                reproduced=m,
+                sigma=s,
+                truth=truth,
+                **_of_mean(n_runs),
+                provenance="tuned",
+            )
+        )
     return rows
 
 
 def _table3_rows(bench, sim, n_runs) -> list[Row]:
     g = bench.gsd_mm
     rows = [
-        Row("001 Table 3", "theoretical GSDv, binning 1", "mm", GSD_001_TABLE3_MM["theoretical"],
-            None, g, None, g, provenance="derived")  # (1.7 m × 0.333)/1170: arithmetic
-    ]  # fmt: skip
+        Row(
+            table="001 Table 3",
+            quantity="theoretical GSDv, binning 1",
+            unit="mm",
+            paper=GSD_001_TABLE3_MM["theoretical"],
+            reproduced=g,
+            truth=g,
+            provenance="derived",
+        )  # (1.7 m × 0.333)/1170: arithmetic
+    ]
     # the lines of one run share the target's phase and the start guess: the runs' means are the
     # independent values
     m, s = _stats(np.nanmean(sim["gsd_fit"], axis=1))
-    rows.append(Row("001 Table 3", "GSDv fitted to the bar edges", "mm", None, None, m, s, g,
-                    **_of_mean(n_runs), provenance="derived"))  # fmt: skip
+    rows.append(
+        Row(
+            table="001 Table 3",
+            quantity="GSDv fitted to the bar edges",
+            unit="mm",
+            reproduced=m,
+            sigma=s,
+            truth=g,
+            **_of_mean(n_runs),
+            provenance="derived",
+        )
+    )
     for r in TABLE_LINES:
         paper = GSD_001_TABLE3_MM["actual"][r]
         j = LINES.index(r)
@@ -317,30 +395,39 @@ def _table3_rows(bench, sim, n_runs) -> list[Row]:
                 "edge can (next row)"
             )
         rows.append(
-            Row("001 Table 3", f"determined GSDv line {r} (bars)", "mm", paper, None, mean, sd,
-                truth, **_of_mean(n_runs), reason=why, provenance="chosen")
-        )  # fmt: skip
+            Row(
+                table="001 Table 3",
+                quantity=f"determined GSDv line {r} (bars)",
+                unit="mm",
+                paper=paper,
+                reproduced=mean,
+                sigma=sd,
+                truth=truth,
+                **_of_mean(n_runs),
+                reason=why,
+                provenance="chosen",
+            )
+        )
         k = TABLE_LINES.index(r)
         e = g / (2 * sim["borderline_edge"][:, k])
         mean, sd = _stats(e)
         truth_e = determined_gsd_mm(g, _truth_borderline(bench, r, bench.edge_angle_deg))
         rows.append(
             Row(
-                "001 Table 3",
-                f"determined GSDv line {r} (slanted edge)",
-                "mm",
-                paper,
-                None,
-                mean,
-                sd,
-                truth_e,
+                table="001 Table 3",
+                quantity=f"determined GSDv line {r} (slanted edge)",
+                unit="mm",
+                paper=paper,
+                reproduced=mean,
+                sigma=sd,
+                truth=truth_e,
                 n_runs=n_runs,
                 mean_of_runs=True,
                 reason=why_edge,
                 provenance="chosen",
             )
         )
-    return rows  # fmt: skip
+    return rows
 
 
 def _ctf_as_mtf_rows(bench, sim, n_runs) -> list[Row]:
@@ -351,9 +438,18 @@ def _ctf_as_mtf_rows(bench, sim, n_runs) -> list[Row]:
         for f in F_TABLE:
             c = np.array([np.interp(f, fc, run[j]) for run in sim["ctf"]])
             mean, sd = _stats(c)
-            rows.append(Row("CTF as MTF", f"CTF taken as MTF, line {r} at {f:g} cy/px", "1",
-                            None, None, mean, sd, float(mtf_true(bench, r, f)), **_of_mean(n_runs),
-                            provenance="chosen"))  # fmt: skip
+            rows.append(
+                Row(
+                    table="CTF as MTF",
+                    quantity=f"CTF taken as MTF, line {r} at {f:g} cy/px",
+                    unit="1",
+                    reproduced=mean,
+                    sigma=sd,
+                    truth=float(mtf_true(bench, r, f)),
+                    **_of_mean(n_runs),
+                    provenance="chosen",
+                )
+            )
     return rows
 
 
@@ -482,8 +578,15 @@ def _printed_rows(bench, sim) -> list[Row]:
             (f"max |eq. 7 as printed − MTF|, line {r}", e7),
             (f"max |CTF − MTF| (exact), line {r}", ecm),
         ):
-            rows.append(Row("001 eq. 6-7 as printed", q, "1", None, None, float(v), None, None,
-                            provenance="chosen"))  # fmt: skip
+            rows.append(
+                Row(
+                    table="001 eq. 6-7 as printed",
+                    quantity=q,
+                    unit="1",
+                    reproduced=float(v),
+                    provenance="chosen",
+                )
+            )
     return rows
 
 
@@ -501,14 +604,12 @@ def _unmodelled_rows(bench, sim, sim_glare, n_runs) -> list[Row]:
                 mean, sd = _stats(s["mtf_bars"][:, j, k])
                 rows.append(
                     Row(
-                        "unmodelled effect",
-                        f"bars: MTF line {r} at {f:g} cy/px, {name} glare",
-                        "1",
-                        None,
-                        None,
-                        mean,
-                        sd,
-                        float(mtf_true(bench, r, f)),
+                        table="unmodelled effect",
+                        quantity=f"bars: MTF line {r} at {f:g} cy/px, {name} glare",
+                        unit="1",
+                        reproduced=mean,
+                        sigma=sd,
+                        truth=float(mtf_true(bench, r, f)),
                         n_runs=n_runs,
                         mean_of_runs=True,
                         provenance="chosen",
@@ -517,20 +618,18 @@ def _unmodelled_rows(bench, sim, sim_glare, n_runs) -> list[Row]:
                 mean, sd = _stats(s["mtf_edge"][:, je, ke])
                 rows.append(
                     Row(
-                        "unmodelled effect",
-                        f"edge: MTF line {r} at {f:g} cy/px, {name} glare",
-                        "1",
-                        None,
-                        None,
-                        mean,
-                        sd,
-                        float(mtf_true(bench, r, f, bench.edge_angle_deg)),
+                        table="unmodelled effect",
+                        quantity=f"edge: MTF line {r} at {f:g} cy/px, {name} glare",
+                        unit="1",
+                        reproduced=mean,
+                        sigma=sd,
+                        truth=float(mtf_true(bench, r, f, bench.edge_angle_deg)),
                         n_runs=n_runs,
                         mean_of_runs=True,
                         provenance="chosen",
                     )
                 )
-    return rows  # fmt: skip
+    return rows
 
 
 def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
@@ -569,7 +668,7 @@ def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
     )
 
 
-def generate(cfg: dict, outdir) -> list:
+def generate(cfg: MtfBenchScenario, outdir) -> list:
     """``make data`` (generator ``mtf_bench``): bar profiles of the lines of 001 Table 3 and the
     bar file, in the formats ``hsgeo mtf`` reads, and the analytic MTF (the truth).
     """
@@ -578,8 +677,8 @@ def generate(cfg: dict, outdir) -> list:
     from hsgeo.io.mtf import write_bars, write_columns, write_profiles
 
     bench = MtfBench()
-    rows = [int(r) for r in cfg.get("bars", {}).get("rows", TABLE_LINES)]
-    rec = render_bar_profiles(bench, rows, int(cfg["scenario"]["seed"]))
+    rows = [int(r) for r in cfg.bars.rows]
+    rec = render_bar_profiles(bench, rows, int(cfg.scenario.seed))
     out = Path(outdir)
     prof = write_profiles(out / "mtf_bench_profiles.csv", rows, rec.x_px, rec.profiles_dn)
     profile = {"gsd_mm": rec.gsd_mm, "start_px": round(rec.start_px, 1),

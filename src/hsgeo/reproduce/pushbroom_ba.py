@@ -80,11 +80,17 @@ def _stats_rows(table, names, data, unit, paper, spread=None, n_runs=None, extre
     for i, (nm, col) in enumerate(zip(names, data.T, strict=True)):
         d = describe(col)
         for k, st in enumerate(P002_STATS):
-            row = Row(table, f"{st}_{nm}_{unit}", unit, paper=paper[nm][k], reproduced=d[st])
+            row = Row(
+                table=table,
+                quantity=f"{st}_{nm}_{unit}",
+                unit=unit,
+                paper=paper[nm][k],
+                reproduced=d[st],
+            )
             if spread is not None:
-                row.sigma, row.n_runs = float(spread[i, k]), n_runs
+                row = replace(row, sigma=float(spread[i, k]), n_runs=n_runs)
             if not extremes and st in ("min", "max"):
-                row.verdict, row.reason = "not testable", EXTREMES_NOT_COMPARABLE
+                row = replace(row, verdict="not testable", reason=EXTREMES_NOT_COMPARABLE)
             rows.append(row)
     return rows
 
@@ -189,16 +195,17 @@ def _table_rows(res, res0, truth, spread, scale):
         ns,
         extremes=same_size,
     )
-    for row in rows:
-        # provenance: the key-point σ per image axis was tuned to the paper's NMADs (a miss
-        # beyond 3σ is "differs: tuning missed"); the other statistics follow from our choices
-        row.provenance = "tuned" if row.quantity in ("nmad_x_px", "nmad_y_px") else "chosen"
+    # provenance: the key-point σ per image axis was tuned to the paper's NMADs (a miss
+    # beyond 3σ is "differs: tuning missed"); the other statistics follow from our choices
+    rows = [
+        replace(row, provenance="tuned" if row.quantity in ("nmad_x_px", "nmad_y_px") else "chosen")
+        for row in rows
+    ]
     # -- 002 Tables 2 and 3: check points, m (the same 13 at every scale)
     E_gcp, E_nogcp = cp_errors(res, truth), cp_errors(res0, truth)
     for name, E in (("002 Table 2", E_gcp), ("002 Table 3", E_nogcp)):
         rows += _stats_rows(name, ("e", "n", "h"), E, "m", P002[name], sg[name], ns)
-    for row in rows:
-        row.provenance = row.provenance or "chosen"
+    rows = [replace(row, provenance=row.provenance or "chosen") for row in rows]
     return rows, r_px, E_gcp, E_nogcp
 
 
@@ -212,9 +219,9 @@ def _fig8_rows(res, truth, cfg, pseudo=None):
     for b, wl in enumerate(cfg.wavelengths_nm):
         rows.append(
             Row(
-                "002 Fig. 8",
-                f"c_minus_mean_band{b}_{wl:.0f}nm_um",
-                "um",
+                table="002 Fig. 8",
+                quantity=f"c_minus_mean_band{b}_{wl:.0f}nm_um",
+                unit="um",
                 reproduced=d_um[b],
                 sigma=s_um[b],
                 truth=t_um[b],
@@ -223,9 +230,9 @@ def _fig8_rows(res, truth, cfg, pseudo=None):
         )
     rows.append(
         Row(
-            "002 Fig. 8",
-            "max_abs_c_minus_mean_um",
-            "um",
+            table="002 Fig. 8",
+            quantity="max_abs_c_minus_mean_um",
+            unit="um",
             paper=P002["fig8_max_abs_diff_um"],
             reproduced=np.max(np.abs(d_um)),
             truth=np.max(np.abs(t_gen_um)),
@@ -237,9 +244,9 @@ def _fig8_rows(res, truth, cfg, pseudo=None):
     shift = np.max(np.abs(d_um)) * 1e-3 / c_mean * half_px  # chromatic shift at the line's end
     rows.append(
         Row(
-            "002 Fig. 8",
-            "chromatic_shift_at_edge_px",
-            "px",
+            table="002 Fig. 8",
+            quantity="chromatic_shift_at_edge_px",
+            unit="px",
             paper=P002["chromatic_shift_px"],
             reproduced=shift,
             truth=np.max(np.abs(t_gen_um)) * 1e-3 / truth.values["c_mm"].mean() * half_px,
@@ -264,9 +271,9 @@ def _parameter_rows(res, truth, obs, pseudo=None):
             qn = lab[j].replace("_rad", "_deg") if unit == "deg" else lab[j]
             par.append(
                 Row(
-                    "parameters",
-                    qn,
-                    unit,
+                    table="parameters",
+                    quantity=qn,
+                    unit=unit,
                     reproduced=v[j] * f,
                     sigma=s[j] * f,
                     truth=t[j] * f,
@@ -285,9 +292,9 @@ def _parameter_rows(res, truth, obs, pseudo=None):
     for j in range(nv.size):
         rows.append(
             Row(
-                "parameters",
-                lab[j],
-                "m" if j % 6 < 3 else "rad",
+                table="parameters",
+                quantity=lab[j],
+                unit="m" if j % 6 < 3 else "rad",
                 reproduced=nv.ravel()[j],
                 sigma=ns_.ravel()[j],
                 truth=nt.ravel()[j],
@@ -340,7 +347,14 @@ def shift_rows(res, truth, pseudo) -> list[Row]:
         d = (pseudo["values"][name] - truth.values[name]).ravel() / res.sigma(name).ravel()
         for j in range(d.size):
             qn = lab[j].replace("_rad", "_deg") if unit == "deg" else lab[j]
-            rows.append(Row("unmodelled effect", f"ripple_shift_z.{qn}", "1", reproduced=d[j]))
+            rows.append(
+                Row(
+                    table="unmodelled effect",
+                    quantity=f"ripple_shift_z.{qn}",
+                    unit="1",
+                    reproduced=d[j],
+                )
+            )
     return rows
 
 

@@ -383,9 +383,9 @@ def factor_rows(fac: dict) -> list[Row]:
         for j, q in enumerate(_CP_QUANTITIES):
             rows.append(
                 Row(
-                    "002 check-point factors",
-                    f"{key}.{q}",
-                    "m" if q.endswith("_m") else "1",
+                    table="002 check-point factors",
+                    quantity=f"{key}.{q}",
+                    unit="m" if q.endswith("_m") else "1",
                     paper=paper[j],
                     reproduced=float(np.mean(v[:, j])),
                     sigma=float(np.std(v[:, j], ddof=1)) if len(v) > 1 else None,
@@ -411,9 +411,9 @@ def unmodelled_rows(fac: dict) -> list[Row]:
             unit = "px" if q.endswith("_px") else ("m" if q.endswith("_m") else "1")
             rows.append(
                 Row(
-                    "unmodelled effect",
-                    f"ripple_{state}.{q}",
-                    unit,
+                    table="unmodelled effect",
+                    quantity=f"ripple_{state}.{q}",
+                    unit=unit,
                     reproduced=float(np.mean(cols[:, j])),
                     sigma=float(np.std(cols[:, j], ddof=1)) if len(cols) > 1 else None,
                     n_runs=len(cols),
@@ -446,20 +446,45 @@ def interval_rows(study: list[dict], optima: dict) -> list[Row]:
     for d in study:
         dt = f"{d['interval_s']:g}s"
         rows += [
-            Row("node interval", f"reprojection_nmad_x_{dt}_px", "px", reproduced=d["nmad_x_px"]),
-            Row("node interval", f"reprojection_nmad_y_{dt}_px", "px", reproduced=d["nmad_y_px"]),
-            Row("node interval", f"cp_rms_en_{dt}_m", "m", reproduced=d["cp_rms_en_m"]),
-            Row("node interval", f"cp_rms_h_{dt}_m", "m", reproduced=d["cp_rms_h_m"]),
-            Row("node interval", f"tp_rms_en_{dt}_m", "m", reproduced=d["tp_rms_en_m"]),
-            Row("node interval", f"seconds_{dt}", "s", reproduced=d["seconds"]),
+            Row(
+                table="node interval",
+                quantity=f"reprojection_nmad_x_{dt}_px",
+                unit="px",
+                reproduced=d["nmad_x_px"],
+            ),
+            Row(
+                table="node interval",
+                quantity=f"reprojection_nmad_y_{dt}_px",
+                unit="px",
+                reproduced=d["nmad_y_px"],
+            ),
+            Row(
+                table="node interval",
+                quantity=f"cp_rms_en_{dt}_m",
+                unit="m",
+                reproduced=d["cp_rms_en_m"],
+            ),
+            Row(
+                table="node interval",
+                quantity=f"cp_rms_h_{dt}_m",
+                unit="m",
+                reproduced=d["cp_rms_h_m"],
+            ),
+            Row(
+                table="node interval",
+                quantity=f"tp_rms_en_{dt}_m",
+                unit="m",
+                reproduced=d["tp_rms_en_m"],
+            ),
+            Row(table="node interval", quantity=f"seconds_{dt}", unit="s", reproduced=d["seconds"]),
         ]
     for f, opt in optima.items():
         opt = np.asarray(opt, dtype=float)
         rows.append(
             Row(
-                "node interval",
-                f"optimum_interval_tau_x{f:g}_s",
-                "s",
+                table="node interval",
+                quantity=f"optimum_interval_tau_x{f:g}_s",
+                unit="s",
                 paper=10.0,  # 002 §4: "the trajectory segmentation time step was set to 10 s"
                 reproduced=float(np.median(opt)),
                 sigma=float(np.std(opt, ddof=1)) if opt.size > 1 else None,

@@ -7,6 +7,8 @@
 from __future__ import annotations
 
 import time
+from dataclasses import replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -28,6 +30,9 @@ from hsgeo.reproduce.rikola_analyses import (
 )
 from hsgeo.sensors.frame import mm_to_pixel
 from hsgeo.sensors.rikola import focal_from_gap_mm
+
+if TYPE_CHECKING:
+    from hsgeo.simulate.rikola import RikolaBenchScenario
 from hsgeo.workflows.rikola import (
     RikolaOptions,
     calibrate_joint,
@@ -63,7 +68,7 @@ ROP_CUBE = 0  # 003 Table 4 (first) uses the bands of one cube
 
 
 def observe(
-    cfg: dict,
+    cfg: RikolaBenchScenario,
     truth,
     seed: int,
     cubes,
@@ -94,8 +99,8 @@ def observe(
 
     r = Renderer(cfg, truth)
     plate = r.plate
-    cam = cfg["camera"]
-    size = (int(cam["width_px"]), int(cam["height_px"]))
+    cam = cfg.camera
+    size = (int(cam.width_px), int(cam.height_px))
     obj = plate.corners()
     expected, images = {}, {}
     keep = set(map(tuple, keep_images))
@@ -106,7 +111,7 @@ def observe(
                 img = r.render(c, b, seed)
                 if (c, b) in keep:
                     images[(c, b)] = img
-                true_px = mm_to_pixel(truth.project(c, b, obj), size, cam["pixel_mm"])
+                true_px = mm_to_pixel(truth.project(c, b, obj), size, cam.pixel_mm)
                 inside = np.all((true_px > 2) & (true_px < np.array(size) - 3), axis=(1, 2))
                 expected[(c, b)] = int(inside.sum())
                 yield (c, b), img
@@ -116,7 +121,7 @@ def observe(
         obj,
         plate.ids,
         size,
-        float(cam["pixel_mm"]),
+        float(cam.pixel_mm),
         dictionary=plate.dictionary,
         refine=refine,
         compare_refine=compare_refine,
@@ -133,7 +138,7 @@ def setup(seed: int = 0, scale: float = 1.0, *, eop_drift: bool = True):
     from hsgeo.simulate.scenarios import load_scenario
 
     cfg = load_scenario("rikola_bench")
-    n_full = int(cfg["geometry"]["n_cubes"])
+    n_full = int(cfg.geometry.n_cubes)
     if scale >= 1.0:
         n_cubes, bands = n_full, tuple(int(b) for b in RIKOLA_BANDS["band"])
     else:
@@ -143,7 +148,9 @@ def setup(seed: int = 0, scale: float = 1.0, *, eop_drift: bool = True):
     return cfg, truth, list(range(n_cubes)), list(bands)
 
 
-def campaign(cfg: dict, truth, seed: int, cubes, bands, *, contour: bool = True) -> dict:
+def campaign(
+    cfg: RikolaBenchScenario, truth, seed: int, cubes, bands, *, contour: bool = True
+) -> dict:
     """Render and measure the bench, then calibrate it as a user would
     (:func:`hsgeo.workflows.rikola.calibrate_rikola`) and predict the held-out bands.
 
@@ -153,7 +160,7 @@ def campaign(cfg: dict, truth, seed: int, cubes, bands, *, contour: bool = True)
     ``result`` (:class:`~hsgeo.workflows.rikola.RikolaResult`), ``held`` (RMS per held-out band
     and route) and ``seconds``.
     """
-    sigma_px = float(cfg["measure"]["sigma_px"])
+    sigma_px = float(cfg.measure.sigma_px)
     t0 = time.time()
     obs, obs_contour, images, expected = observe(
         cfg,
@@ -225,45 +232,46 @@ def table3_rows(cals: dict, truth) -> list[Row]:
             pv, ps = RIKOLA_TABLE3[b][q]
             unit = q.split("_", 1)[1] if "_" in q else ""
             row = Row(
-                "003 Table 3",
-                f"{q.split('_')[0]}_band{b}",
-                unit.replace("per_", "1/"),
-                pv,
-                ps,
-                v,
-                s,
-                tr[q],
+                table="003 Table 3",
+                quantity=f"{q.split('_')[0]}_band{b}",
+                unit=unit.replace("per_", "1/"),
+                paper=pv,
+                paper_sigma=ps,
+                reproduced=v,
+                sigma=s,
+                truth=tr[q],
                 # provenance: the truth is the paper's x0, y0 (band 20: sensor I, band 5: II), or
                 # computed from the paper (f: its gap line + scatter; K, P: the two bands' mean,
                 # K2 = K3 = 0 as "not significant")
                 provenance="derived",
             )
             if row.truth_is_paper():
-                row.provenance = "paper"
+                row = replace(row, provenance="paper")
             if q == "f_mm" and row.z_paper is not None:
                 # used only if the verdict is "differs"
-                row.reason = (
-                    f"{abs(row.z_paper):.1f}σ from the paper: the simulated f of a band is the "
-                    "paper's gap line (003 Table 4) plus a random scatter, not its Table 3 value"
+                row = replace(
+                    row,
+                    reason=f"{abs(row.z_paper):.1f}σ from the paper: the simulated f of a band "
+                    "is the paper's gap line (003 Table 4) plus a random scatter, not its "
+                    "Table 3 value",
                 )
             if q[0] in "KP" and row.z_paper is not None:
                 # used only if the verdict is "differs": the truth is one set for all bands
-                row.reason = (
-                    f"{abs(row.z_paper):.1f}σ from the paper: the simulation has one distortion "
-                    "set for all bands (means of 003 Table 3's bands 5 and 20; K2 = K3 = 0), "
-                    "and the paper's two bands differ from each other"
+                row = replace(
+                    row,
+                    reason=f"{abs(row.z_paper):.1f}σ from the paper: the simulation has one "
+                    "distortion set for all bands (means of 003 Table 3's bands 5 and 20; "
+                    "K2 = K3 = 0), and the paper's two bands differ from each other",
                 )
             rows.append(row)
         rows.append(
             Row(
-                "003 Table 3",
-                f"sigma0_sq_band{b}",
-                "",
-                RIKOLA_TABLE3_SIGMA0_SQ[b],
-                None,
-                c.result.sigma0**2,
-                None,
-                1.0,
+                table="003 Table 3",
+                quantity=f"sigma0_sq_band{b}",
+                unit="",
+                paper=RIKOLA_TABLE3_SIGMA0_SQ[b],
+                reproduced=c.result.sigma0**2,
+                truth=1.0,
                 verdict="not testable",
                 reason="σ0² scales with the a-priori σ of a centroid; the paper's was 1 in an "
                 "unstated unit",
@@ -291,14 +299,13 @@ def rop_rows(res, obs, truth) -> tuple[list[Row], dict]:
     rop_mean, rop_mean_sigma = rel["rop_mean"], rel["rop_mean_sigma"]
     rows = [
         Row(
-            "003 Table 4 ROP",
-            q,
-            "deg",
-            RIKOLA_TABLE4_ROP_MEAN_DEG[i],
-            None,
-            np.rad2deg(rop_mean[i]),
-            np.rad2deg(rop_mean_sigma[i]),
-            np.rad2deg(truth.rotation_rad[i]),
+            table="003 Table 4 ROP",
+            quantity=q,
+            unit="deg",
+            paper=RIKOLA_TABLE4_ROP_MEAN_DEG[i],
+            reproduced=np.rad2deg(rop_mean[i]),
+            sigma=np.rad2deg(rop_mean_sigma[i]),
+            truth=np.rad2deg(truth.rotation_rad[i]),
             provenance="paper",
         )
         for i, q in enumerate(("domega_deg", "dphi_deg", "dkappa_deg"))
@@ -325,34 +332,34 @@ def gap_rows(res, truth) -> tuple[list[Row], dict]:
         tg = truth.gap_model[s - 1]
         rows += [
             Row(
-                t,
-                f"a_sensor{s}_mm_per_nm",
-                "mm/nm",
-                *pm["a_mm_per_nm"],
-                reg["a"],
-                reg["sigma_a"],
-                tg[0],
+                table=t,
+                quantity=f"a_sensor{s}_mm_per_nm",
+                unit="mm/nm",
+                paper=pm["a_mm_per_nm"][0],
+                paper_sigma=pm["a_mm_per_nm"][1],
+                reproduced=reg["a"],
+                sigma=reg["sigma_a"],
+                truth=tg[0],
                 provenance="paper",
-            ),  # fmt: skip
+            ),
             Row(
-                t,
-                f"b_sensor{s}_mm",
-                "mm",
-                *pm["b_mm"],
-                reg["b"],
-                reg["sigma_b"],
-                tg[1],
+                table=t,
+                quantity=f"b_sensor{s}_mm",
+                unit="mm",
+                paper=pm["b_mm"][0],
+                paper_sigma=pm["b_mm"][1],
+                reproduced=reg["b"],
+                sigma=reg["sigma_b"],
+                truth=tg[1],
                 provenance="paper",
-            ),  # fmt: skip
+            ),
             Row(
-                t,
-                f"r2_sensor{s}",
-                "%",
-                pm["r2_percent"],
-                None,
-                100 * reg["r2"],
-                None,
-                100 * reg_truth[s]["r2"],
+                table=t,
+                quantity=f"r2_sensor{s}",
+                unit="%",
+                paper=pm["r2_percent"],
+                reproduced=100 * reg["r2"],
+                truth=100 * reg_truth[s]["r2"],
                 # the scatter of f about the gap line was chosen to give the paper's R² in
                 # expectation (rikola_bench.toml)
                 provenance="tuned",
@@ -370,10 +377,15 @@ def corner_rows(biases: dict) -> list[Row]:
         cs = np.array([v["centroid_sd_px"] for v in bb.values()])
         t = "003 §3.2 corners and centroids"
         rows += [
-            Row(t, f"corner_shift_min_{name}", "px", reproduced=float(o.min())),
-            Row(t, f"corner_shift_max_{name}", "px", reproduced=float(o.max())),
-            Row(t, f"centroid_bias_max_{name}", "px", reproduced=float(np.abs(cm).max())),
-            Row(t, f"centroid_sd_{name}", "px", reproduced=float(cs.mean())),
+            Row(table=t, quantity=f"corner_shift_min_{name}", unit="px", reproduced=float(o.min())),
+            Row(table=t, quantity=f"corner_shift_max_{name}", unit="px", reproduced=float(o.max())),
+            Row(
+                table=t,
+                quantity=f"centroid_bias_max_{name}",
+                unit="px",
+                reproduced=float(np.abs(cm).max()),
+            ),
+            Row(table=t, quantity=f"centroid_sd_{name}", unit="px", reproduced=float(cs.mean())),
         ]
     return rows
 
@@ -395,51 +407,59 @@ def joint_rows(joint, truth) -> list[Row]:
         paper = RIKOLA_TABLE4_GAP_MODEL[s + 1]["a_mm_per_nm" if k == 0 else "b_mm"]
         rows.append(
             Row(
-                t,
-                q,
-                u,
-                paper[0],
-                paper[1],
-                gm[s, k],
-                sg[s, k],
-                truth.gap_model[s, k],
+                table=t,
+                quantity=q,
+                unit=u,
+                paper=paper[0],
+                paper_sigma=paper[1],
+                reproduced=gm[s, k],
+                sigma=sg[s, k],
+                truth=truth.gap_model[s, k],
                 provenance="paper",
-            )  # fmt: skip
+            )
         )
     pp, spp = R.value("pp_mm").ravel(), R.sigma("pp_mm").ravel()
     for i, q in enumerate(("x0_sensor1_mm", "y0_sensor1_mm", "x0_sensor2_mm", "y0_sensor2_mm")):
         paper = RIKOLA_TABLE3[20 if i < 2 else 5]["x0_mm" if i % 2 == 0 else "y0_mm"]
         rows.append(
             Row(
-                t,
-                q,
-                "mm",
-                paper[0],
-                paper[1],
-                pp[i],
-                spp[i],
-                truth.pp_mm.ravel()[i],
+                table=t,
+                quantity=q,
+                unit="mm",
+                paper=paper[0],
+                paper_sigma=paper[1],
+                reproduced=pp[i],
+                sigma=spp[i],
+                truth=truth.pp_mm.ravel()[i],
                 provenance="paper",
-            )  # fmt: skip
+            )
         )
     KP, sKP = R.value("distortion_mm"), R.sigma("distortion_mm")
     for i, q in enumerate(("K1_per_mm2", "K2_per_mm4", "K3_per_mm6", "P1_per_mm", "P2_per_mm")):
         unit = q.split("_", 1)[1].replace("per_", "1/")
-        rows.append(Row(t, q, unit, None, None, KP[i], sKP[i], truth.KP[i]))
+        rows.append(
+            Row(
+                table=t,
+                quantity=q,
+                unit=unit,
+                reproduced=KP[i],
+                sigma=sKP[i],
+                truth=truth.KP[i],
+            )
+        )
     rot, srot = R.value("sensor2_rotation"), R.sigma("sensor2_rotation")
     for i, q in enumerate(("domega_deg", "dphi_deg", "dkappa_deg")):
         rows.append(
             Row(
-                t,
-                q,
-                "deg",
-                RIKOLA_TABLE4_ROP_MEAN_DEG[i],
-                None,
-                np.rad2deg(rot[i]),
-                np.rad2deg(srot[i]),
-                np.rad2deg(truth.rotation_rad[i]),
+                table=t,
+                quantity=q,
+                unit="deg",
+                paper=RIKOLA_TABLE4_ROP_MEAN_DEG[i],
+                reproduced=np.rad2deg(rot[i]),
+                sigma=np.rad2deg(srot[i]),
+                truth=np.rad2deg(truth.rotation_rad[i]),
                 provenance="paper",
-            )  # fmt: skip
+            )
         )
     # the drift of the EOPs across the bands (003 §3.4, Fig. 5, printed without values): the
     # joint model's rate per band against the simulated one (zero without the drift)
@@ -447,12 +467,37 @@ def joint_rows(joint, truth) -> list[Row]:
     d = truth.drift_rad
     true_rate = np.zeros(3) if d is None else d[1] - d[0]  # linear in the band number
     for i, q in enumerate(("domega", "dphi", "dkappa")):
-        rows.append(Row(t, f"drift_{q}_deg_per_band", "deg", None, None, np.rad2deg(rate[i]),
-                        np.rad2deg(srate[i]), np.rad2deg(true_rate[i])))  # fmt: skip
+        rows.append(
+            Row(
+                table=t,
+                quantity=f"drift_{q}_deg_per_band",
+                unit="deg",
+                reproduced=np.rad2deg(rate[i]),
+                sigma=np.rad2deg(srate[i]),
+                truth=np.rad2deg(true_rate[i]),
+            )
+        )
     off, soff = R.value("sensor2_offset_mm"), R.sigma("sensor2_offset_mm")
     for i, q in enumerate(("tx_mm", "ty_mm", "tz_mm")):
-        rows.append(Row(t, q, "mm", None, None, off[i], soff[i], truth.offset_mm[i]))
-    rows.append(Row(t, "sigma0", "", None, None, R.result.sigma0, None, 1.0))
+        rows.append(
+            Row(
+                table=t,
+                quantity=q,
+                unit="mm",
+                reproduced=off[i],
+                sigma=soff[i],
+                truth=truth.offset_mm[i],
+            )
+        )
+    rows.append(
+        Row(
+            table=t,
+            quantity="sigma0",
+            unit="",
+            reproduced=R.result.sigma0,
+            truth=1.0,
+        )
+    )
     return rows
 
 
@@ -469,7 +514,12 @@ def result_rows(c: dict, truth) -> tuple[list[Row], dict]:
     rows += joint_rows(res.joint, truth)
     for h, v in c["held"].items():
         rows += [
-            Row("held-out band", f"rms_band{h}_{k}", "px", None, None, x, None, None)
+            Row(
+                table="held-out band",
+                quantity=f"rms_band{h}_{k}",
+                unit="px",
+                reproduced=x,
+            )
             for k, x in v.items()
         ]
     return rows, {"rop": rop, "regression_truth": reg_truth}
@@ -500,13 +550,13 @@ def run(seed: int = 0, scale: float = 1.0, *, unmodelled: bool = True) -> Reprod
         rows_off, _ = result_rows(c_off, truth_off)
         rows += unmodelled_rows(rows, rows_off, c["result"], c_off["result"])
         c["seconds"]["unmodelled_off"] = time.time() - t0
-        slope = float(cfg["eop_drift"]["dphi_deg_per_band"])
+        slope = float(cfg.eop_drift.dphi_deg_per_band)
         meta["unmodelled_effect"] = (
             f"the drift of the EOPs across the bands of a cube (003 Fig. 5): φ of each band's "
             f"camera frame changes by {slope:g}° a band (chosen, rikola_bench.toml [eop_drift])"
         )
         meta["eop_drift_dphi_deg_per_band"] = slope
-        drift_reasons(rows)
+        rows = drift_reasons(rows)
     pairs, rel = res.pairs, res.relative
     # wall times vary from run to run: they stay out of the (bit-reproducible) JSON
     extras = {

@@ -10,6 +10,8 @@ the corner displacement with exposure (§3.2) and the rank of a band's design; a
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from hsgeo.adjust import identifiability
@@ -218,8 +220,14 @@ def unmodelled_rows(rows_on: list[Row], rows_off: list[Row], res_on, res_off) ->
             if q == "rms_px":
                 r = res.joint.residuals_px
                 rms = float(np.sqrt(np.mean(np.sum(r**2, axis=1))))
-                out.append(Row("unmodelled effect", f"eop_drift_{state}.joint.rms_px", "px",
-                               reproduced=rms))  # fmt: skip
+                out.append(
+                    Row(
+                        table="unmodelled effect",
+                        quantity=f"eop_drift_{state}.joint.rms_px",
+                        unit="px",
+                        reproduced=rms,
+                    )
+                )
                 continue
             if (t, q) not in by:
                 continue
@@ -228,9 +236,9 @@ def unmodelled_rows(rows_on: list[Row], rows_off: list[Row], res_on, res_off) ->
             name = f"eop_drift_{state}.{ctx}{q}"
             out.append(
                 Row(
-                    "unmodelled effect",
-                    name,
-                    r.unit,
+                    table="unmodelled effect",
+                    quantity=name,
+                    unit=r.unit,
                     reproduced=r.reproduced,
                     sigma=r.sigma,
                     truth=r.truth,
@@ -239,18 +247,23 @@ def unmodelled_rows(rows_on: list[Row], rows_off: list[Row], res_on, res_off) ->
     return out
 
 
-def drift_reasons(rows: list[Row]) -> None:
-    """The reason of a "differs" (used only then) of the rows the EOP drift moves: the ROP of
-    003 eq. (1) assumes one rigid rotation between the sensors. The joint model estimates the
-    drift (003 §3.4): a joint row that misses its truth is a failed recovery, said by the rule.
+def drift_reasons(rows: list[Row]) -> list[Row]:
+    """``rows`` with the reason of a "differs" (used only then) of the rows the EOP drift
+    moves: the ROP of 003 eq. (1) assumes one rigid rotation between the sensors. The joint
+    model estimates the drift: a joint row that misses its truth is a failed recovery, said by
+    the rule.
     """
-    for r in rows:
-        if r.table == "003 Table 4 ROP" and r.z_paper is not None:
-            r.reason = (
-                f"{abs(r.z_paper):.1f}σ from the paper: the simulated drift of the EOPs across "
-                "the bands (003 Fig. 5), which the one rigid rotation between the sensors does "
-                "not model, moves it (table 'unmodelled effect')"
-            )
+    return [
+        replace(
+            r,
+            reason=f"{abs(r.z_paper):.1f}σ from the paper: the simulated drift of the EOPs "
+            "across the bands (003 Fig. 5), which the one rigid rotation between the sensors "
+            "does not model, moves it (table 'unmodelled effect')",
+        )
+        if r.table == "003 Table 4 ROP" and r.z_paper is not None
+        else r
+        for r in rows
+    ]
 
 
 def centroid_gaps_px(truth, obs: Observations, band: int, pixel_mm: float) -> np.ndarray:

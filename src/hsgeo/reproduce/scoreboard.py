@@ -136,10 +136,13 @@ def mark_context(chapter: str, rep: Reproduction) -> Reproduction:
     (:attr:`hsgeo.report.Row.judged_in`); :func:`hsgeo.reproduce.run` calls it for every chapter.
     Returns ``rep``.
     """
+    rows = []
     for r in rep.rows:
         own = owner(r.table) if _PAPER_TABLE.match(r.table) else None
         if own is not None and own != chapter and r.paper is not None:
-            r.judged_in = own
+            r = replace(r, judged_in=own)
+        rows.append(r)
+    rep.rows[:] = rows
     return rep
 
 

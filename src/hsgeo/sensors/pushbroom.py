@@ -108,6 +108,7 @@ __all__ = [
 #: Nominal camera-from-platform rotation (platform x forward, y left, z up → camera x right,
 #: y backward, z down).
 BETA0_CAM_FROM_PLATFORM = np.array([[0.0, -1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
+BETA0_CAM_FROM_PLATFORM.setflags(write=False)
 
 #: Default parameter-block names of :class:`PushbroomLines` by role (its ``BLOCKS``).
 BLOCK_NAMES = MappingProxyType(
@@ -265,8 +266,11 @@ class PushbroomObservations:
         return self.xyz_rate_nav_m_s is not None
 
 
-#: ``cols`` of PushbroomLines._kernel when no gradient is accumulated
-_NO_COLS = (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), 0)
+def _no_cols():
+    """``cols`` of PushbroomLines._kernel when no gradient is accumulated (fresh, writable
+    arrays: the compiled kernel's signature is that of writable ones).
+    """
+    return (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), 0)
 
 
 class PushbroomLines(ResidualBlock):
@@ -382,7 +386,7 @@ class PushbroomLines(ResidualBlock):
         self.nodes = nodes
         self.pixel_mm = float(pixel_mm)
         self.x0_mm, self.y0_mm = float(x0_mm), float(y0_mm)
-        self.beta0 = np.asarray(beta0, dtype=np.float64)
+        self.beta0 = np.array(beta0, dtype=np.float64)  # a writable copy, as the kernels take
         index, u = nodes.piece(self.t_s)
         self._basis = (index, bspline_basis(u))
         self._u0 = np.ascontiguousarray(u)  # the kernel's Newton moves along this piece
@@ -615,7 +619,7 @@ class PushbroomLines(ResidualBlock):
             w_row,
             fw,
             np.zeros((2, 0, 0)) if gd is None else gd,
-            *(_NO_COLS if cols is None else cols),
+            *(_no_cols() if cols is None else cols),
         )
 
 

@@ -56,10 +56,13 @@ SPECTRA = np.array(
         [0.860, 0.875, 0.880, 0.885, 0.885, 0.880, 0.870],  # white reference square
     ]
 )
+SPECTRA.setflags(write=False)
 #: Strength of the within-field texture per material (relative brightness σ).
 _TEXTURE = np.array([0.10, 0.14, 0.18, 0.16, 0.25, 0.06, 0.08, 0.0])
+_TEXTURE.setflags(write=False)
 #: Amplitude of the row pattern per field material (grass, crop, soil, stubble).
 _ROWS = np.array([0.04, 0.30, 0.12, 0.22])
+_ROWS.setflags(write=False)
 
 
 # ------------------------------------------------------------------------------ compiled cores

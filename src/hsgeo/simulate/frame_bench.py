@@ -7,17 +7,87 @@ one of the ``frame-reference`` chapter; the poses are random but seeded.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from hsgeo.io.config import Key
 from hsgeo.io.tables import write_csv_array
 from hsgeo.rotations import R_from_opk, opk_from_R
 from hsgeo.sensors.frame import project_opencv
 from hsgeo.simulate import as_rng
+from hsgeo.simulate.scenarios import ScenarioInfo
 
-__all__ = ["BenchObservations", "BenchTruth", "board_points", "simulate", "generate"]
+__all__ = [
+    "BenchCamera",
+    "BenchBoard",
+    "BenchGeometry",
+    "FrameBenchScenario",
+    "BenchObservations",
+    "BenchTruth",
+    "board_points",
+    "simulate",
+    "generate",
+]
+
+
+@dataclass(frozen=True)
+class BenchCamera:
+    """``[camera]`` of ``frame_bench.toml``: the true camera (OpenCV model) and its noise.
+
+    Attributes
+    ----------
+    width_px, height_px : int
+        Image size, px.
+    fx_px, fy_px, cx_px, cy_px : float
+        Focal lengths and principal point, px (OpenCV convention).
+    distortion : tuple of 5 float
+        k1, k2, p1, p2, k3 (OpenCV).
+    sigma_px : float
+        Noise of a measured corner, px.
+    """
+
+    width_px: int
+    height_px: int
+    fx_px: float
+    fy_px: float
+    cx_px: float
+    cy_px: float
+    distortion: tuple[float, ...] = field(
+        metadata={"key": Key("floats", length=5, doc="k1 k2 p1 p2 k3")}
+    )
+    sigma_px: float = field(metadata={"key": Key("float", doc="noise of a corner, px")})
+
+
+@dataclass(frozen=True)
+class BenchBoard:
+    """``[board]``: a chessboard of ``nx`` × ``ny`` inner corners, ``square_mm`` apart."""
+
+    nx: int = field(metadata={"key": Key("int", positive=True)})
+    ny: int = field(metadata={"key": Key("int", positive=True)})
+    square_mm: float = field(metadata={"key": Key("float", positive=True)})
+
+
+@dataclass(frozen=True)
+class BenchGeometry:
+    """``[geometry]``: ``n_views`` views from ``distance_mm`` (min, max), tilted up to
+    ``max_tilt_deg``.
+    """
+
+    n_views: int = field(metadata={"key": Key("int", positive=True)})
+    distance_mm: tuple[float, ...] = field(metadata={"key": Key("floats", length=2)})
+    max_tilt_deg: float
+
+
+@dataclass(frozen=True)
+class FrameBenchScenario:
+    """``data_synthetic/frame_bench.toml`` (:func:`hsgeo.simulate.scenarios.load_scenario`)."""
+
+    scenario: ScenarioInfo
+    camera: BenchCamera
+    board: BenchBoard
+    geometry: BenchGeometry
 
 
 @dataclass(frozen=True)
@@ -81,13 +151,13 @@ def board_points(nx: int, ny: int, square: float) -> np.ndarray:
     return np.column_stack([square * (k % nx), square * (k // nx), np.zeros(k.size)])
 
 
-def simulate(cfg: dict, rng) -> tuple[BenchObservations, BenchTruth]:
+def simulate(cfg: FrameBenchScenario, rng) -> tuple[BenchObservations, BenchTruth]:
     """Noisy observations and the truth of the bench.
 
     Parameters
     ----------
-    cfg : dict
-        The ``frame_bench`` scenario (``[camera]``, ``[board]``, ``[geometry]``).
+    cfg : FrameBenchScenario
+        The ``frame_bench`` scenario (``load_scenario("frame_bench")``).
     rng : int or numpy.random.Generator
 
     Returns
@@ -96,17 +166,17 @@ def simulate(cfg: dict, rng) -> tuple[BenchObservations, BenchTruth]:
     truth : BenchTruth
     """
     rng = as_rng(rng)
-    cam, board, geo = cfg["camera"], cfg["board"], cfg["geometry"]
-    X = board_points(board["nx"], board["ny"], board["square_mm"])
+    cam, board, geo = cfg.camera, cfg.board, cfg.geometry
+    X = board_points(board.nx, board.ny, board.square_mm)
     centre = X.mean(axis=0)
     poses, views, pts, uv = [], [], [], []
-    w, h = cam["width_px"], cam["height_px"]
-    intr = np.array([cam["fx_px"], cam["fy_px"], cam["cx_px"], cam["cy_px"]])
-    dist = np.array(cam["distortion"])
-    while len(poses) < geo["n_views"]:
+    w, h = cam.width_px, cam.height_px
+    intr = np.array([cam.fx_px, cam.fy_px, cam.cx_px, cam.cy_px])
+    dist = np.array(cam.distortion)
+    while len(poses) < geo.n_views:
         # camera on a sphere around the board centre, looking at it, with a random roll
-        dist_mm = rng.uniform(*geo["distance_mm"])
-        tilt = np.deg2rad(rng.uniform(0, geo["max_tilt_deg"]))
+        dist_mm = rng.uniform(*geo.distance_mm)
+        tilt = np.deg2rad(rng.uniform(0, geo.max_tilt_deg))
         azi = rng.uniform(0, 2 * np.pi)
         C = centre + dist_mm * np.array(
             [np.sin(tilt) * np.cos(azi), np.sin(tilt) * np.sin(azi), -np.cos(tilt)]
@@ -127,21 +197,21 @@ def simulate(cfg: dict, rng) -> tuple[BenchObservations, BenchTruth]:
             pts.append(np.arange(len(X)))
             uv.append(p)
     uv_true = np.concatenate(uv)
-    noisy = uv_true + cam["sigma_px"] * rng.standard_normal(uv_true.shape)
+    noisy = uv_true + cam.sigma_px * rng.standard_normal(uv_true.shape)
     obs = BenchObservations(
         X,
         np.concatenate(views),
         np.concatenate(pts),
         noisy,
         (int(w), int(h)),
-        float(cam["sigma_px"]),
+        float(cam.sigma_px),
     )
     return obs, BenchTruth(np.array(poses), intr, dist, uv_true)
 
 
-def generate(cfg: dict, outdir: Path) -> list[Path]:
+def generate(cfg: FrameBenchScenario, outdir: Path) -> list[Path]:
     """Write ``frame_bench_observations.csv`` and ``frame_bench_truth.csv``."""
-    sim, truth = simulate(cfg, cfg["scenario"]["seed"])
+    sim, truth = simulate(cfg, cfg.scenario.seed)
     obs = outdir / "frame_bench_observations.csv"
     X = sim.X_mm[sim.point]
     table = np.column_stack([sim.view, sim.point, X, sim.uv_px])

@@ -34,9 +34,12 @@ from hsgeo.errors import InputError
 from hsgeo.papers import P000_TABLE1_CALIBRATED, P001_SENSOR, P001_TABLE2
 from hsgeo.sensors import line1d
 from hsgeo.simulate import as_rng
+from hsgeo.simulate.scenarios import ScenarioInfo
 
 __all__ = [
     "LineLab",
+    "LineLabScenario",
+    "LineCalibrationRow",
     "true_iop",
     "wavelength_nm",
     "stations",
@@ -61,7 +64,11 @@ class LineLab:
     lambda0_nm: float = 430.0  # 001 Table 1, spectral range starts at 430 nm
     dlambda_nm_per_row: float = 0.44  # assumption: row 1000 = 870 nm (000 §4.1 / 001 Table 2)
     distance_m: float = 3.0  # 001 §3.1 "at a distance of 3 m"
-    azimuths_deg: tuple = (-45.0, 0.0, 45.0)  # 000 §4.1: rays intersect as close to 90° as possible
+    azimuths_deg: tuple[float, ...] = (
+        -45.0,
+        0.0,
+        45.0,
+    )  # 000 §4.1: rays intersect as close to 90° as possible
     station_sigma_m: float = 0.005  # assumption: tripod placed on marks to ±5 mm
     alpha_sigma_deg: float = 0.1  # assumption: pointed to ±0.1°
     tooth_pitch_m: float = 0.02  # assumption (000 Fig. 4 not in the text)
@@ -81,7 +88,10 @@ class LineLab:
     offset_dn: float = 50.0
     dark_e: float = 20.0  # dark current during the exposure
     read_e: float = 12.0
-    psf_sigma_px: tuple = (0.8, 0.6)  # σ = a + b·((λ − 430)/440)²: blurrier in the NIR (001 §4)
+    psf_sigma_px: tuple[float, ...] = (
+        0.8,
+        0.6,
+    )  # σ = a + b·((λ − 430)/440)²: blurrier in the NIR (001 §4)
     supersample: int = 8
     zeta_sigma_px: float = 0.05  # a-priori σ of a measured minimum (σ0 rescales it)
     # the instrument effect the estimator does not model (GUIDE §4, on by default): an even
@@ -90,17 +100,25 @@ class LineLab:
     # represents it); 0 switches it off
     even_distortion_px: float = 0.1
     seed: int = 0
-    rows: tuple = field(default=(100, 300, 500, 1000))  # 001 Table 2
+    rows: tuple[int, ...] = field(default=(100, 300, 500, 1000))  # 001 Table 2
 
-    @classmethod
-    def from_config(cls, cfg: dict | None) -> LineLab:
-        """From the ``[lab]`` table of ``data_synthetic/line_lab.toml``: its entries override
-        the defaults; the fields are the schema (:func:`hsgeo.io.config.dataclass_from_table`,
-        unknown keys are errors with a suggestion).
-        """
-        from hsgeo.io.config import dataclass_from_table
 
-        return dataclass_from_table(cls, cfg, "line-lab settings [lab]")
+@dataclass(frozen=True)
+class LineCalibrationRow:
+    """``[calibration]`` of ``line_lab.toml``: the spectral line of the written calibration."""
+
+    row: int = 1000  # 000 Table 1 (870 nm) and 001 Table 2's last row
+
+
+@dataclass(frozen=True)
+class LineLabScenario:
+    """``data_synthetic/line_lab.toml`` (:func:`hsgeo.simulate.scenarios.load_scenario`): its
+    ``[lab]`` entries override :class:`LineLab`'s defaults (the fields are the schema).
+    """
+
+    scenario: ScenarioInfo
+    calibration: LineCalibrationRow = LineCalibrationRow()
+    lab: LineLab = LineLab()
 
 
 def wavelength_nm(row, lab: LineLab = LineLab()):

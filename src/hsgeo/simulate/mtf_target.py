@@ -32,9 +32,12 @@ from hsgeo.mtf import BarTarget, mtf_gaussian, mtf_pixel
 from hsgeo.papers import P001_MTF, P001_SENSOR
 from hsgeo.simulate import as_rng
 from hsgeo.simulate.line_lab import LineLab, spectral_level, wavelength_nm
+from hsgeo.simulate.scenarios import ScenarioInfo
 
 __all__ = [
     "MtfBench",
+    "MtfBenchScenario",
+    "BarRows",
     "paper_target",
     "sigma_px",
     "mtf_true",
@@ -77,7 +80,7 @@ class MtfBench:
     n_frames: int = 4  # chosen: the static target's profiles are the mean of 4 frames
     stray_light: float = 0.0  # unmodelled effect: veiling glare, fraction of the mean signal
     edge_angle_deg: float = 5.0  # chosen (ISO 12233 recommends about 5°)
-    edge_shape_px: tuple = (256, 64)  # chosen region of the rendered edge: rows, columns
+    edge_shape_px: tuple[int, ...] = (256, 64)  # chosen region of the rendered edge: rows, columns
 
     @property
     def gsd_mm(self) -> float:
@@ -96,6 +99,23 @@ class MtfBench:
     @property
     def saturation_dn(self) -> float:
         return float(2 ** P001_SENSOR["bits"] - 1)
+
+
+@dataclass(frozen=True)
+class BarRows:
+    """``[bars]`` of ``mtf_bench.toml``: the spectral lines whose bar profiles are written."""
+
+    rows: tuple[int, ...] = (100, 500, 700, 1000)  # 001 Table 3
+
+
+@dataclass(frozen=True)
+class MtfBenchScenario:
+    """``data_synthetic/mtf_bench.toml`` (:func:`hsgeo.simulate.scenarios.load_scenario`); the
+    bench itself is :class:`MtfBench`'s defaults.
+    """
+
+    scenario: ScenarioInfo
+    bars: BarRows = BarRows()
 
 
 def sigma_px(bench: MtfBench, row) -> np.ndarray:

@@ -16,21 +16,33 @@ Every function takes ``rng``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from hsgeo.errors import InputError
 from hsgeo.geocode import PlaneTerrain
+from hsgeo.io.config import Key
 from hsgeo.io.navigation import write_trajectory
 from hsgeo.io.tables import write_csv_array
+from hsgeo.papers import P000_TABLE1_CALIBRATED, P000_TABLE1_UNCALIBRATED
 from hsgeo.sensors.line import CalibratedLine, LinearIFOV, LineGeometry
 from hsgeo.sensors.mount import Mount
 from hsgeo.simulate import as_rng
+from hsgeo.simulate.scenarios import ScenarioInfo
 from hsgeo.trajectory import Trajectory
 
 __all__ = [
+    "PulaFlightScenario",
+    "FlightSensorTruth",
+    "FlightSensorNominal",
+    "FlightScanner",
+    "FlightImu",
+    "FlightGnss",
+    "FlightPath",
+    "GcpField",
+    "FlightMeasurement",
     "FlightObservations",
     "FlightTruth",
     "simulate_flight",
@@ -45,6 +57,109 @@ __all__ = [
     "true_sensor",
     "nominal_sensor",
 ]
+
+
+def _floats(n: int | None = None, doc: str = ""):
+    return field(metadata={"key": Key("floats", length=n, doc=doc)})
+
+
+@dataclass(frozen=True)
+class FlightSensorTruth:
+    """``[sensor_truth]``: the calibrated inner orientation at 870 nm (000 Table 1)."""
+
+    zeta0_px: float = P000_TABLE1_CALIBRATED.zeta0_px
+    c_px: float = P000_TABLE1_CALIBRATED.c_px
+    K: tuple[float, ...] = (
+        P000_TABLE1_CALIBRATED.K1,
+        P000_TABLE1_CALIBRATED.K2,
+        P000_TABLE1_CALIBRATED.K3,
+    )
+
+
+@dataclass(frozen=True)
+class FlightSensorNominal:
+    """``[sensor_nominal]``: the uncalibrated model of Jakšić (2009), 000 Table 1."""
+
+    zeta0_px: float = P000_TABLE1_UNCALIBRATED.zeta0_px
+    c_px: float = P000_TABLE1_UNCALIBRATED.c_px
+
+
+@dataclass(frozen=True)
+class FlightScanner:
+    """``[scanner]``: line rate (Hz) and the pixels used either side of ζ0 (000 Fig. 7)."""
+
+    line_rate_hz: float = field(metadata={"key": Key("float", positive=True)})
+    usable_half_width_px: float = field(metadata={"key": Key("float", positive=True)})
+
+
+@dataclass(frozen=True)
+class FlightImu:
+    """``[imu]``: rate and errors of the IMU (001 §2.1)."""
+
+    rate_hz: float = field(metadata={"key": Key("float", positive=True)})
+    attitude_noise_deg: float
+    attitude_bias_deg: float
+    heading_drift_deg_per_s: float
+
+
+@dataclass(frozen=True)
+class FlightGnss:
+    """``[gnss]``: constant bias, random walk and white noise of the GNSS positions."""
+
+    bias_m: float
+    random_walk_m_per_sqrt_s: float
+    white_m: float
+
+
+@dataclass(frozen=True)
+class FlightPath:
+    """``[flight]``: height, speed, heading and motion of the flight line (chosen)."""
+
+    height_agl_m: float
+    speed_m_s: float = field(metadata={"key": Key("float", positive=True)})
+    heading_deg: float
+    start_EN_m: tuple[float, ...] = _floats(2)
+    strip_length_m: float = field(metadata={"key": Key("float", positive=True)})
+    attitude_motion_deg: tuple[float, ...] = _floats(3, "roll, pitch, heading amplitudes")
+    attitude_period_s: tuple[float, ...] = _floats(3, "roll, pitch, heading periods")
+    lateral_wander_m: float
+    height_wander_m: float
+    boresight_sigma_deg: float
+
+
+@dataclass(frozen=True)
+class GcpField:
+    """``[field]``: the GCPs, across track in nominal px and along track in m, on a flat field
+    of ``height_m``.
+    """
+
+    gcp_id: tuple[int, ...]
+    across_px: tuple[float, ...]
+    along_m: tuple[float, ...]
+    height_m: float
+
+
+@dataclass(frozen=True)
+class FlightMeasurement:
+    """``[measurement]``: σ of a GCP's measured ζ (px) and line (lines)."""
+
+    sigma_px: float
+    sigma_line: float
+
+
+@dataclass(frozen=True)
+class PulaFlightScenario:
+    """``data_synthetic/pula_flight.toml`` (:func:`hsgeo.simulate.scenarios.load_scenario`)."""
+
+    scenario: ScenarioInfo
+    scanner: FlightScanner
+    imu: FlightImu
+    gnss: FlightGnss
+    flight: FlightPath
+    field: GcpField
+    measurement: FlightMeasurement
+    sensor_truth: FlightSensorTruth = FlightSensorTruth()
+    sensor_nominal: FlightSensorNominal = FlightSensorNominal()
 
 
 @dataclass(frozen=True)
@@ -117,55 +232,55 @@ class FlightTruth:
     n_draws: int = 1
 
 
-def gcp_field(cfg: dict) -> tuple[np.ndarray, np.ndarray]:
+def gcp_field(cfg: PulaFlightScenario) -> tuple[np.ndarray, np.ndarray]:
     """GCP ids and (E, N, U) from the scenario's ``[field]`` table."""
-    f, fl = cfg["field"], cfg["flight"]
-    ids = np.asarray(f["gcp_id"], dtype=int)
-    h = np.deg2rad(fl["heading_deg"])
+    f, fl = cfg.field, cfg.flight
+    ids = np.asarray(f.gcp_id, dtype=int)
+    h = np.deg2rad(fl.heading_deg)
     u = np.array([np.sin(h), np.cos(h)])  # along track (E, N)
     w = np.array([np.cos(h), -np.sin(h)])  # across track, to the right
-    across_m = np.asarray(f["across_px"]) * fl["height_agl_m"] / cfg["sensor_truth"]["c_px"]
-    EN = np.asarray(fl["start_EN_m"]) + np.outer(f["along_m"], u) + np.outer(across_m, w)
-    return ids, np.column_stack([EN, np.full(len(ids), f["height_m"])])
+    across_m = np.asarray(f.across_px) * fl.height_agl_m / cfg.sensor_truth.c_px
+    EN = np.asarray(fl.start_EN_m) + np.outer(f.along_m, u) + np.outer(across_m, w)
+    return ids, np.column_stack([EN, np.full(len(ids), f.height_m)])
 
 
-def _true_trajectory(cfg: dict, rng) -> tuple[Trajectory, float, float]:
-    fl = cfg["flight"]
-    v, H = fl["speed_m_s"], fl["height_agl_m"] + cfg["field"]["height_m"]
-    heading = np.deg2rad(fl["heading_deg"])
-    length = fl["strip_length_m"]
+def _true_trajectory(cfg: PulaFlightScenario, rng) -> tuple[Trajectory, float, float]:
+    fl = cfg.flight
+    v, H = fl.speed_m_s, fl.height_agl_m + cfg.field.height_m
+    heading = np.deg2rad(fl.heading_deg)
+    length = fl.strip_length_m
     T = length / v
-    t = np.arange(0.0, T + 1e-9, 1.0 / cfg["imu"]["rate_hz"])
+    t = np.arange(0.0, T + 1e-9, 1.0 / cfg.imu.rate_hz)
     u = np.array([np.sin(heading), np.cos(heading)])  # flight direction in (E, N)
-    start = np.array(fl["start_EN_m"])
+    start = np.array(fl.start_EN_m)
     # attitude motion: a few sinusoids per axis with random phases (helicopter-like)
-    amp = np.deg2rad(np.array(fl["attitude_motion_deg"]))
-    per = np.array(fl["attitude_period_s"])
+    amp = np.deg2rad(np.array(fl.attitude_motion_deg))
+    per = np.array(fl.attitude_period_s)
     ph = rng.uniform(0, 2 * np.pi, 3)
     rph = np.stack([amp[k] * np.sin(2 * np.pi * t / per[k] + ph[k]) for k in range(3)], axis=1)
     rph[:, 2] += heading  # roll, pitch, heading (NED)
     s = v * t
-    lateral = fl["lateral_wander_m"] * np.sin(2 * np.pi * t / (2.5 * per[0]) + ph[1])
+    lateral = fl.lateral_wander_m * np.sin(2 * np.pi * t / (2.5 * per[0]) + ph[1])
     EN = start + s[:, None] * u + lateral[:, None] * np.array([u[1], -u[0]])
-    U = H + fl["height_wander_m"] * np.sin(2 * np.pi * t / (3 * per[1]) + ph[2])
+    U = H + fl.height_wander_m * np.sin(2 * np.pi * t / (3 * per[1]) + ph[2])
     return Trajectory(t, np.column_stack([EN, U]), rph), T, H
 
 
-def _recorded(nav: Trajectory, cfg: dict, rng) -> Trajectory:
+def _recorded(nav: Trajectory, cfg: PulaFlightScenario, rng) -> Trajectory:
     """Add GNSS and IMU errors (001 §2.1: iVRU-RSSC attitude resolution < 0.01°)."""
-    g, imu = cfg["gnss"], cfg["imu"]
+    g, imu = cfg.gnss, cfg.imu
     n = nav.t_s.size
     dt = np.diff(nav.t_s, prepend=nav.t_s[0])
-    pos_bias = rng.normal(0, g["bias_m"], 3)
+    pos_bias = rng.normal(0, g.bias_m, 3)
     steps = rng.normal(0, 1, (n, 3)) * np.sqrt(dt)[:, None]
-    walk = np.cumsum(steps, axis=0) * g["random_walk_m_per_sqrt_s"]
-    pos = nav.xyz_m + pos_bias + walk + rng.normal(0, g["white_m"], (n, 3))
-    att_bias = rng.normal(0, np.deg2rad(imu["attitude_bias_deg"]), 3)
+    walk = np.cumsum(steps, axis=0) * g.random_walk_m_per_sqrt_s
+    pos = nav.xyz_m + pos_bias + walk + rng.normal(0, g.white_m, (n, 3))
+    att_bias = rng.normal(0, np.deg2rad(imu.attitude_bias_deg), 3)
     att = (
         nav.roll_pitch_heading_rad
         + att_bias
-        + rng.normal(0, np.deg2rad(imu["attitude_noise_deg"]), (n, 3))
-        + np.deg2rad(imu["heading_drift_deg_per_s"]) * nav.t_s[:, None] * np.array([0, 0, 1])
+        + rng.normal(0, np.deg2rad(imu.attitude_noise_deg), (n, 3))
+        + np.deg2rad(imu.heading_drift_deg_per_s) * nav.t_s[:, None] * np.array([0, 0, 1])
     )
     return Trajectory(nav.t_s, pos, att)
 
@@ -239,23 +354,23 @@ def gcps_in_swath(t_s, tan_angle, sensor: LineGeometry, half_width_px: float) ->
     return np.isfinite(t_s) & (tan >= edges.min()) & (tan <= edges.max())
 
 
-def nominal_sensor(cfg: dict) -> LinearIFOV:
+def nominal_sensor(cfg: PulaFlightScenario) -> LinearIFOV:
     """The uncalibrated model of Jakšić (2009) from ``[sensor_nominal]``."""
-    s = cfg["sensor_nominal"]
-    return LinearIFOV(s["zeta0_px"], s["c_px"])
+    s = cfg.sensor_nominal
+    return LinearIFOV(s.zeta0_px, s.c_px)
 
 
-def true_sensor(cfg: dict) -> CalibratedLine:
+def true_sensor(cfg: PulaFlightScenario) -> CalibratedLine:
     """The true sensor from ``[sensor_truth]`` (000 Table 1, calibrated)."""
-    s = cfg["sensor_truth"]
-    return CalibratedLine(s["zeta0_px"], s["c_px"], tuple(s["K"]))
+    s = cfg.sensor_truth
+    return CalibratedLine(s.zeta0_px, s.c_px, tuple(s.K))
 
 
 #: Draws of one flight before :func:`simulate_flight` gives up on a scenario (see there).
 MAX_FLIGHT_DRAWS = 100
 
 
-def simulate_flight(cfg: dict, rng) -> tuple[FlightObservations, FlightTruth]:
+def simulate_flight(cfg: PulaFlightScenario, rng) -> tuple[FlightObservations, FlightTruth]:
     """One flight over the field (see the module docstring): ``(observations, truth)``.
 
     **Rejection.** A flight whose random attitude motion and boresight put a GCP outside the
@@ -279,24 +394,24 @@ def simulate_flight(cfg: dict, rng) -> tuple[FlightObservations, FlightTruth]:
     ids, enu = gcp_field(cfg)
     sensor = true_sensor(cfg)
     nav, rec, bs, t_s, tan, n_draws = _draw_imaging_flight(cfg, rng, sensor, enu)
-    rate = cfg["scanner"]["line_rate_hz"]
-    m = cfg["measurement"]
-    line, zeta = _measured(t_s, tan, sensor, 0.0, rate, rng, m["sigma_line"], m["sigma_px"])
-    h = cfg["field"]["height_m"]
+    rate = cfg.scanner.line_rate_hz
+    m = cfg.measurement
+    line, zeta = _measured(t_s, tan, sensor, 0.0, rate, rng, m.sigma_line, m.sigma_px)
+    h = cfg.field.height_m
     obs = FlightObservations(rec, 0.0, rate, ids, enu.copy(), line, zeta, h, nominal_sensor(cfg))
     return obs, FlightTruth(nav, sensor, bs, enu, h, 0.0, rate, n_draws)
 
 
-def _draw_imaging_flight(cfg: dict, rng, sensor, gcp_enu_m):
+def _draw_imaging_flight(cfg: PulaFlightScenario, rng, sensor, gcp_enu_m):
     """Draw (true trajectory, recorded navigation, boresight) until every GCP is imaged within
     the usable swath: ``(nav, recorded, boresight, t_s, tan, n_draws)`` (see
     :func:`simulate_flight`, **Rejection**).
     """
-    half = cfg["scanner"]["usable_half_width_px"]
+    half = cfg.scanner.usable_half_width_px
     for n_draws in range(1, MAX_FLIGHT_DRAWS + 1):
         nav, _, _ = _true_trajectory(cfg, rng)
         rec = _recorded(nav, cfg, rng)
-        bs = rng.normal(0, np.deg2rad(cfg["flight"]["boresight_sigma_deg"]), 3)
+        bs = rng.normal(0, np.deg2rad(cfg.flight.boresight_sigma_deg), 3)
         t_s, tan = gcp_sightings(nav, bs, gcp_enu_m)
         if np.all(gcps_in_swath(t_s, tan, sensor, half)):
             return nav, rec, bs, t_s, tan, n_draws
@@ -307,9 +422,9 @@ def _draw_imaging_flight(cfg: dict, rng, sensor, gcp_enu_m):
     )
 
 
-def generate(cfg: dict, outdir: Path) -> list[Path]:
+def generate(cfg: PulaFlightScenario, outdir: Path) -> list[Path]:
     """``make data``: the recorded navigation and GCP observations of the scenario's seed."""
-    fl, _ = simulate_flight(cfg, cfg["scenario"]["seed"])
+    fl, _ = simulate_flight(cfg, cfg.scenario.seed)
     nav = write_trajectory(outdir / "pula_flight_navigation.csv", fl.recorded_nav)
     obs = outdir / "pula_flight_gcp_observations.csv"
     write_csv_array(
@@ -341,7 +456,9 @@ def airfield_scene(E_m, N_m, gcp_enu_m=None, target_m: float = 3.0) -> np.ndarra
     return val
 
 
-def render_line_image(truth: FlightTruth, cfg: dict, rng=None, *, noise: float = 0.005):
+def render_line_image(
+    truth: FlightTruth, cfg: PulaFlightScenario, rng=None, *, noise: float = 0.005
+):
     """What the scanner records along the flight: ``(n_lines, n_px)`` radiance and the ζ of the
     columns (pixel centres ζ0 ± usable half width), rendered with the *true* navigation, boresight
     and sensor, with Gaussian noise.
@@ -351,8 +468,8 @@ def render_line_image(truth: FlightTruth, cfg: dict, rng=None, *, noise: float =
     from hsgeo.sensors import as_sensor
 
     rng = as_rng(0 if rng is None else rng)
-    half = cfg["scanner"]["usable_half_width_px"]
-    z0 = round(cfg["sensor_truth"]["zeta0_px"])
+    half = cfg.scanner.usable_half_width_px
+    z0 = round(cfg.sensor_truth.zeta0_px)
     zeta = np.arange(z0 - half, z0 + half + 1, dtype=float)
     n_lines = int((fl.true_nav.t_s[-1] - fl.t0_s) * fl.line_rate_hz)
     ground = ground_points(

@@ -18,7 +18,7 @@ cubes and bands (the reduced size of the tests) renders the same pixels as the f
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
 
@@ -26,13 +26,23 @@ import numpy as np
 
 from hsgeo.distortion import brown_correction
 from hsgeo.errors import InputError
+from hsgeo.io.config import Key
 from hsgeo.io.tables import write_csv_array
-from hsgeo.papers import RIKOLA_BANDS
+from hsgeo.papers import RIKOLA_BANDS, RIKOLA_CAMERA
 from hsgeo.rotations import R_from_opk, opk_from_R
 from hsgeo.sensors.frame import pixel_to_mm
 from hsgeo.sensors.rikola import focal_from_gap_mm, project_measured_mm
+from hsgeo.simulate.scenarios import ScenarioInfo
 
 __all__ = [
+    "RikolaBenchScenario",
+    "BenchCameraRikola",
+    "GapModel",
+    "Misalignment",
+    "BenchGeometryRikola",
+    "BenchRadiometry",
+    "BenchMeasure",
+    "EopDrift",
     "Plate",
     "RikolaTruth",
     "make_truth",
@@ -72,11 +82,6 @@ class Plate:
     white: float = 0.85
     black: float = 0.06
     background: float = 0.30
-
-    @classmethod
-    def from_config(cls, cfg: dict) -> Plate:
-        keys = cls.__dataclass_fields__
-        return cls(**{k: v for k, v in cfg.items() if k in keys})
 
     def cv_dictionary(self):
         import cv2
@@ -221,6 +226,116 @@ class RikolaTruth:
         return project_measured_mm(Xc, f, np.array([x0, y0]), self.KP)
 
 
+def _floats(n: int, doc: str = ""):
+    return field(metadata={"key": Key("floats", length=n, doc=doc)})
+
+
+@dataclass(frozen=True)
+class BenchCameraRikola:
+    """``[camera]`` of ``rikola_bench.toml``: 003 Tables 1 and 3 (one distortion set, §3.5).
+
+    Image size and pixel pitch default to 003 Table 1 (:data:`hsgeo.papers.RIKOLA_CAMERA`).
+    """
+
+    pp_sensor1_mm: tuple[float, ...] = _floats(2, "x0, y0 of sensor I, mm")
+    pp_sensor2_mm: tuple[float, ...] = _floats(2, "x0, y0 of sensor II, mm")
+    K1_per_mm2: float
+    K2_per_mm4: float
+    K3_per_mm6: float
+    P1_per_mm: float
+    P2_per_mm: float
+    width_px: int = RIKOLA_CAMERA["width_px"]
+    height_px: int = RIKOLA_CAMERA["height_px"]
+    pixel_mm: float = field(
+        default=RIKOLA_CAMERA["pixel_mm"],
+        metadata={"key": Key("float", positive=True, doc="pixel pitch, mm")},
+    )
+
+
+@dataclass(frozen=True)
+class GapModel:
+    """``[gap_model]``: f = a·gap + b per sensor (003 eq. (2), Table 4) and the scatter about it."""
+
+    a_sensor1_mm_per_nm: float
+    b_sensor1_mm: float
+    a_sensor2_mm_per_nm: float
+    b_sensor2_mm: float
+    scatter_sensor1_mm: float
+    scatter_sensor2_mm: float
+
+
+@dataclass(frozen=True)
+class Misalignment:
+    """``[misalignment]``: ``R_I_from_II`` = R(dω, dφ, dκ) in degrees and the offset, mm."""
+
+    domega_deg: float
+    dphi_deg: float
+    dkappa_deg: float
+    offset_mm: tuple[float, ...] = _floats(3)
+
+
+@dataclass(frozen=True)
+class BenchGeometryRikola:
+    """``[geometry]``: the cube poses (003 §3.1: twenty cubes)."""
+
+    n_cubes: int = field(metadata={"key": Key("int", positive=True)})
+    distance_mm: tuple[float, ...] = _floats(2, "min, max")
+    tilt_deg: tuple[float, ...] = _floats(2, "min, max")
+    aim_offset_mm: tuple[float, ...] = _floats(2)
+    roll_jitter_deg: float
+    min_targets: int
+
+
+@dataclass(frozen=True)
+class BenchRadiometry:
+    """``[radiometry]``: the band's DN model and PSF (chosen; see the scenario file)."""
+
+    full_dn: float
+    response_peak_nm: float
+    response_width_nm: float
+    dark_dn: float
+    electrons_per_dn: float
+    read_noise_dn: float
+    max_dn: int
+    psf0_px: float
+    psf1_px: float
+    supersample: int = field(metadata={"key": Key("int", positive=True)})
+
+
+@dataclass(frozen=True)
+class BenchMeasure:
+    """``[measure]``: a-priori σ of a centroid coordinate, px."""
+
+    sigma_px: float
+
+
+@dataclass(frozen=True)
+class EopDrift:
+    """``[eop_drift]``: φ of each band falls by ``dphi_deg_per_band``, zero at
+    ``reference_band`` (003 §3.4, Fig. 5; :func:`eop_drift_rad`).
+    """
+
+    dphi_deg_per_band: float
+    reference_band: int = 13
+
+
+@dataclass(frozen=True)
+class RikolaBenchScenario:
+    """``data_synthetic/rikola_bench.toml`` (:func:`hsgeo.simulate.scenarios.load_scenario`);
+    ``eop_drift`` None: no drift.
+    """
+
+    scenario: ScenarioInfo
+    camera: BenchCameraRikola
+    gap_model: GapModel
+    misalignment: Misalignment
+    plate: Plate
+    geometry: BenchGeometryRikola
+    radiometry: BenchRadiometry
+    measure: BenchMeasure
+    eop_drift: EopDrift | None = None
+
+
 def _look_at(C, P, roll_rad):
     """R_world_from_cam for a camera at C looking at P (camera z backward), rolled about z."""
     z = (C - P) / np.linalg.norm(C - P)
@@ -230,7 +345,7 @@ def _look_at(C, P, roll_rad):
     return np.column_stack([x, y, z]) @ R_from_opk(0.0, 0.0, roll_rad)
 
 
-def eop_drift_rad(cfg: dict, bands) -> np.ndarray:
+def eop_drift_rad(cfg: RikolaBenchScenario, bands) -> np.ndarray:
     """The drift of the exterior orientation across the bands of a cube, ``(n_bands, 3)`` rad.
 
     003 §3.4 on its Fig. 5: the EOPs of the bands of one static cube vary, "estimated values of
@@ -241,22 +356,22 @@ def eop_drift_rad(cfg: dict, bands) -> np.ndarray:
     joint model, which assume one rigid rotation between the sensors and one pose per cube, do
     not model it.
     """
-    d = cfg.get("eop_drift", {})
-    slope = np.deg2rad(float(d.get("dphi_deg_per_band", 0.0)))
+    d = cfg.eop_drift if cfg.eop_drift is not None else EopDrift(0.0)
+    slope = np.deg2rad(float(d.dphi_deg_per_band))
     out = np.zeros((len(bands), 3))
-    out[:, 1] = slope * (np.asarray(bands["band"], float) - float(d.get("reference_band", 13)))
+    out[:, 1] = slope * (np.asarray(bands["band"], float) - float(d.reference_band))
     return out
 
 
 def make_truth(
-    cfg: dict, rng, n_cubes: int | None = None, *, eop_drift: bool = True
+    cfg: RikolaBenchScenario, rng, n_cubes: int | None = None, *, eop_drift: bool = True
 ) -> RikolaTruth:
     """The camera and the cube poses of a scenario (``data_synthetic/rikola_bench.toml``).
 
     Parameters
     ----------
-    cfg : dict
-        The scenario configuration.
+    cfg : RikolaBenchScenario
+        The scenario configuration (``load_scenario("rikola_bench")``).
     rng : int or Generator
         Seed of the truth (band scatter, poses).
     n_cubes : int, optional
@@ -268,40 +383,32 @@ def make_truth(
     from hsgeo.simulate import as_rng
 
     rng = as_rng(rng)
-    cam, gm, mis, geo = cfg["camera"], cfg["gap_model"], cfg["misalignment"], cfg["geometry"]
+    cam, gm, mis, geo = cfg.camera, cfg.gap_model, cfg.misalignment, cfg.geometry
     bands = RIKOLA_BANDS.copy()
     ab = np.array(
         [
-            [gm["a_sensor1_mm_per_nm"], gm["b_sensor1_mm"]],
-            [gm["a_sensor2_mm_per_nm"], gm["b_sensor2_mm"]],
+            [gm.a_sensor1_mm_per_nm, gm.b_sensor1_mm],
+            [gm.a_sensor2_mm_per_nm, gm.b_sensor2_mm],
         ]
     )
-    scatter = np.array([gm["scatter_sensor1_mm"], gm["scatter_sensor2_mm"]])
+    scatter = np.array([gm.scatter_sensor1_mm, gm.scatter_sensor2_mm])
     s = bands["sensor"] - 1
     # 003 eq. (2) plus a scatter about the line
     f = focal_from_gap_mm(bands["gap_nm"], ab[s, 0], ab[s, 1])
     f = f + scatter[s] * rng.standard_normal(len(bands))
-    pp = np.array([cam["pp_sensor1_mm"], cam["pp_sensor2_mm"]], dtype=float)
-    KP = np.array(
-        [
-            cam["K1_per_mm2"],
-            cam["K2_per_mm4"],
-            cam["K3_per_mm6"],
-            cam["P1_per_mm"],
-            cam["P2_per_mm"],
-        ]
-    )
-    rot = np.deg2rad([mis["domega_deg"], mis["dphi_deg"], mis["dkappa_deg"]])
-    plate = Plate.from_config(cfg["plate"])
+    pp = np.array([cam.pp_sensor1_mm, cam.pp_sensor2_mm], dtype=float)
+    KP = np.array([cam.K1_per_mm2, cam.K2_per_mm4, cam.K3_per_mm6, cam.P1_per_mm, cam.P2_per_mm])
+    rot = np.deg2rad([mis.domega_deg, mis.dphi_deg, mis.dkappa_deg])
+    plate = cfg.plate
     truth = RikolaTruth(
-        bands, f, pp, KP, rot, np.asarray(mis["offset_mm"], float), np.zeros((0, 6)), ab, scatter
+        bands, f, pp, KP, rot, np.asarray(mis.offset_mm, float), np.zeros((0, 6)), ab, scatter
     )
-    n = geo["n_cubes"] if n_cubes is None else int(n_cubes)
+    n = geo.n_cubes if n_cubes is None else int(n_cubes)
     if n < 1:
         raise InputError(f"n_cubes must be at least 1, got {n}")
     centre = plate.centres().mean(axis=0)
     X = plate.corners().reshape(-1, 3)
-    w, h, px = cam["width_px"], cam["height_px"], cam["pixel_mm"]
+    w, h, px = cam.width_px, cam.height_px, cam.pixel_mm
     half = np.array([(w - 1) / 2 - 8, (h - 1) / 2 - 8]) * px  # 8 px margin
     poses = []
     k = 0
@@ -309,42 +416,40 @@ def make_truth(
         k += 1
         if k > 1000 * n:
             raise InputError("could not place the cubes: widen geometry.distance_mm or tilt_deg")
-        D = rng.uniform(*geo["distance_mm"])
-        tilt = np.deg2rad(rng.uniform(*geo["tilt_deg"]))
+        D = rng.uniform(*geo.distance_mm)
+        tilt = np.deg2rad(rng.uniform(*geo.tilt_deg))
         azi = rng.uniform(0, 2 * np.pi)
-        aim = centre + np.r_[rng.uniform(-1, 1, 2) * geo["aim_offset_mm"], 0.0]
+        aim = centre + np.r_[rng.uniform(-1, 1, 2) * geo.aim_offset_mm, 0.0]
         C = aim + D * np.array(
             [np.sin(tilt) * np.cos(azi), np.sin(tilt) * np.sin(azi), np.cos(tilt)]
         )
-        roll = np.deg2rad(90.0 * (len(poses) % 4) + rng.uniform(-1, 1) * geo["roll_jitter_deg"])
+        roll = np.deg2rad(90.0 * (len(poses) % 4) + rng.uniform(-1, 1) * geo.roll_jitter_deg)
         R = _look_at(C, aim, roll)
         Xc = (X - C) @ R
         xy = project_measured_mm(Xc, f.max(), pp[0], KP).reshape(-1, 4, 2)
         inside = np.all(np.abs(xy) < half, axis=(1, 2))
-        if inside.sum() >= geo["min_targets"]:
+        if inside.sum() >= geo.min_targets:
             poses.append(np.concatenate([opk_from_R(R), C]))
     truth.poses = np.array(poses)
-    if eop_drift and "eop_drift" in cfg:
+    if eop_drift and cfg.eop_drift is not None:
         truth.drift_rad = eop_drift_rad(cfg, bands)
     return truth
 
 
-def band_radiometry(cfg: dict, band: int) -> dict:
+def band_radiometry(cfg: RikolaBenchScenario, band: int) -> dict:
     """White level, black level and PSF of a band (003 §3.2: FWHM sets the exposure)."""
-    rad, plate = cfg["radiometry"], cfg["plate"]
+    rad, plate = cfg.radiometry, cfg.plate
     r = np.flatnonzero(RIKOLA_BANDS["band"] == band)
     if r.size != 1:
         raise InputError(f"no band {band}; the Rikola bands are 1–25 (003 Table 2)")
     b = RIKOLA_BANDS[r[0]]
-    resp = np.exp(
-        -0.5 * ((b["wavelength_nm"] - rad["response_peak_nm"]) / rad["response_width_nm"]) ** 2
-    )
-    scale = rad["full_dn"] * b["fwhm_nm"] / RIKOLA_BANDS["fwhm_nm"].max() * resp
-    psf = rad["psf0_px"] + rad["psf1_px"] * ((b["wavelength_nm"] - 680.0) / 160.0) ** 2
+    resp = np.exp(-0.5 * ((b["wavelength_nm"] - rad.response_peak_nm) / rad.response_width_nm) ** 2)
+    scale = rad.full_dn * b["fwhm_nm"] / RIKOLA_BANDS["fwhm_nm"].max() * resp
+    psf = rad.psf0_px + rad.psf1_px * ((b["wavelength_nm"] - 680.0) / 160.0) ** 2
     return {
         "scale_dn": float(scale),
-        "white_dn": float(scale * plate["white"] + rad["dark_dn"]),
-        "black_dn": float(scale * plate["black"] + rad["dark_dn"]),
+        "white_dn": float(scale * plate.white + rad.dark_dn),
+        "black_dn": float(scale * plate.black + rad.dark_dn),
         "psf_px": float(psf),
     }
 
@@ -354,25 +459,25 @@ class Renderer:
 
     Parameters
     ----------
-    cfg : dict
+    cfg : RikolaBenchScenario
         Scenario configuration.
     truth : RikolaTruth
     """
 
-    def __init__(self, cfg: dict, truth: RikolaTruth):
+    def __init__(self, cfg: RikolaBenchScenario, truth: RikolaTruth):
         self.cfg, self.truth = cfg, truth
-        self.plate = Plate.from_config(cfg["plate"])
+        self.plate = cfg.plate
         self._grids: dict[int, np.ndarray] = {}
 
     def _grid(self, sensor: int) -> np.ndarray:
         if sensor not in self._grids:
-            cam = self.cfg["camera"]
-            s = int(self.cfg["radiometry"]["supersample"])
-            w, h = cam["width_px"], cam["height_px"]
+            cam = self.cfg.camera
+            s = int(self.cfg.radiometry.supersample)
+            w, h = cam.width_px, cam.height_px
             u = (np.arange(w * s) + 0.5) / s - 0.5
             v = (np.arange(h * s) + 0.5) / s - 0.5
             uu, vv = np.meshgrid(u, v)
-            xy = pixel_to_mm(np.stack([uu, vv], axis=-1), (w, h), cam["pixel_mm"])
+            xy = pixel_to_mm(np.stack([uu, vv], axis=-1), (w, h), cam.pixel_mm)
             xbar = xy - self.truth.pp_mm[sensor - 1]
             ideal = xbar + brown_correction(xbar, self.truth.KP[:3], self.truth.KP[3:])
             self._grids[sensor] = ideal.astype(np.float32)
@@ -409,34 +514,36 @@ class Renderer:
             borderMode=cv2.BORDER_CONSTANT,
             borderValue=float(pl.background),
         )
-        s = int(self.cfg["radiometry"]["supersample"])
+        s = int(self.cfg.radiometry.supersample)
         psf = band_radiometry(self.cfg, band)["psf_px"]
         fine = cv2.GaussianBlur(fine, (0, 0), sigmaX=psf * s, sigmaY=psf * s)
-        cam = self.cfg["camera"]
-        return cv2.resize(fine, (cam["width_px"], cam["height_px"]), interpolation=cv2.INTER_AREA)
+        cam = self.cfg.camera
+        return cv2.resize(fine, (cam.width_px, cam.height_px), interpolation=cv2.INTER_AREA)
 
     def render(self, cube: int, band: int, seed: int) -> np.ndarray:
         """The band's raw image in DN (uint16, 12 bit) with shot and read noise."""
         rng = np.random.default_rng([int(seed), 1, int(cube), int(band)])
-        rad = self.cfg["radiometry"]
+        rad = self.cfg.radiometry
         br = band_radiometry(self.cfg, band)
         signal = self.reflectance(cube, band).astype(np.float64) * br["scale_dn"]
-        sd = np.sqrt(signal / rad["electrons_per_dn"] + rad["read_noise_dn"] ** 2)
-        dn = rad["dark_dn"] + signal + sd * rng.standard_normal(signal.shape)
-        return np.clip(np.rint(dn), 0, rad["max_dn"]).astype(np.uint16)
+        sd = np.sqrt(signal / rad.electrons_per_dn + rad.read_noise_dn**2)
+        dn = rad.dark_dn + signal + sd * rng.standard_normal(signal.shape)
+        return np.clip(np.rint(dn), 0, rad.max_dn).astype(np.uint16)
 
 
-def render_band(cfg: dict, truth: RikolaTruth, cube: int, band: int, seed: int) -> np.ndarray:
+def render_band(
+    cfg: RikolaBenchScenario, truth: RikolaTruth, cube: int, band: int, seed: int
+) -> np.ndarray:
     """One band of one cube (see :class:`Renderer`; use a Renderer for many images)."""
     return Renderer(cfg, truth).render(cube, band, seed)
 
 
-def generate(cfg: dict, outdir: Path) -> list[Path]:
+def generate(cfg: RikolaBenchScenario, outdir: Path) -> list[Path]:
     """``make data``: the truth of the bench (bands and cube poses), as CSV.
 
     The images themselves are rendered by the ``rikola`` chapter (``hsgeo reproduce rikola``).
     """
-    truth = make_truth(cfg, np.random.default_rng([cfg["scenario"]["seed"], 0]))
+    truth = make_truth(cfg, np.random.default_rng([cfg.scenario.seed, 0]))
     bands = outdir / "rikola_bench_truth_bands.csv"
     pp = truth.pp_mm[truth.bands["sensor"] - 1]
     table = np.column_stack(

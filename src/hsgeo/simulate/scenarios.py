@@ -2,16 +2,46 @@
 
 Each ``data_synthetic/<name>.toml`` has a ``[scenario]`` table with ``generator`` (see
 :mod:`hsgeo.reproduce.data`, which writes ``data_synthetic/generated/``) and ``seed``; the rest of
-the file is the scenario's configuration, every value citing its source.
+the file is the scenario's configuration, every value citing its source. :func:`load_scenario`
+reads it into the frozen dataclass of its generator (:data:`SCENARIOS`) with the one loader of
+configurations, :func:`hsgeo.io.config.read_dataclass` (unknown keys are errors with a
+suggestion); change a value with :func:`dataclasses.replace`.
 """
 
 from __future__ import annotations
 
+import importlib
+from dataclasses import dataclass
 from pathlib import Path
 
 from hsgeo.errors import InputError
 
-__all__ = ["data_dir", "load_scenario"]
+__all__ = ["data_dir", "load_scenario", "scenario_class", "ScenarioInfo", "SCENARIOS"]
+
+#: scenario generator name -> ``"module:Class"``: the frozen dataclass its file is read into.
+SCENARIOS = {
+    "frame_bench": "hsgeo.simulate.frame_bench:FrameBenchScenario",
+    "line_lab": "hsgeo.simulate.line_lab:LineLabScenario",
+    "mtf_bench": "hsgeo.simulate.mtf_target:MtfBenchScenario",
+    "pula_flight": "hsgeo.simulate.pula_flight:PulaFlightScenario",
+    "rikola": "hsgeo.simulate.rikola:RikolaBenchScenario",
+}
+
+
+@dataclass(frozen=True)
+class ScenarioInfo:
+    """The ``[scenario]`` table of every scenario file.
+
+    Attributes
+    ----------
+    generator : str
+        Which simulator the file configures (a key of :data:`SCENARIOS`).
+    seed : int
+        Seed of the data that ``make data`` writes.
+    """
+
+    generator: str
+    seed: int
 
 
 def data_dir() -> Path:
@@ -36,15 +66,39 @@ def data_dir() -> Path:
     )
 
 
-def load_scenario(name: str) -> dict:
-    """The configuration of ``data_synthetic/<name>.toml`` as a dict."""
+def scenario_class(generator: str) -> type:
+    """The frozen dataclass of a generator's scenario files (:data:`SCENARIOS`)."""
+    from hsgeo.io.config import did_you_mean
+
+    if generator not in SCENARIOS:
+        raise InputError(
+            f"unknown scenario generator {generator!r}{did_you_mean(generator, SCENARIOS)} "
+            f"(known: {', '.join(SCENARIOS)})"
+        )
+    module, name = SCENARIOS[generator].split(":")
+    return getattr(importlib.import_module(module), name)
+
+
+def load_scenario(name: str):
+    """The configuration of ``data_synthetic/<name>.toml``: a frozen dataclass of its
+    generator (:data:`SCENARIOS`), read by :func:`hsgeo.io.config.read_dataclass`.
+    """
     path = data_dir() / f"{name}.toml"
     if not path.is_file():
         known = sorted(p.stem for p in data_dir().glob("*.toml"))
         raise InputError(f"no scenario {name!r} in {data_dir()}; known: {known}")
-    from hsgeo.io import read_toml
+    from hsgeo.io.config import load_dataclass, read_toml
 
-    cfg = read_toml(path, "scenario")
-    if "scenario" not in cfg or "generator" not in cfg["scenario"]:
-        raise InputError(f"{path}: missing [scenario] table with a 'generator' entry")
-    return cfg
+    raw = read_toml(path, "scenario")
+    info = raw.get("scenario")
+    if not isinstance(info, dict) or not isinstance(info.get("generator"), str):
+        raise InputError(
+            f"scenario file {path}: missing [scenario] table with a 'generator' entry; add "
+            f"[scenario] generator = one of {', '.join(repr(g) for g in SCENARIOS)}"
+        )
+    where = f"scenario file {path}"
+    try:
+        cls = scenario_class(info["generator"])
+    except InputError as exc:
+        raise InputError(f"{where}: [scenario] generator: {exc}") from None
+    return load_dataclass(cls, raw, where)

@@ -1,4 +1,4 @@
-"""The strips of ``hsgeo orthorectify`` from frames of a frame camera (issue 36).
+"""The strips of ``hsgeo orthorectify`` from frames of a frame camera.
 
 The frame models of the sensor registry (``frame-opencv``:
 :class:`~hsgeo.sensors.frame.FrameCamera`; ``rikola``: :class:`~hsgeo.sensors.rikola.

@@ -61,6 +61,8 @@ class BALFit:
     fixed : list of (int, int)
         The gauge: (camera, column) entries of the cameras block held fixed.
     n_cameras, n_points : int
+    file : str, optional
+        The BAL file adjusted (:func:`adjust_bal_file`); None for a problem given in memory.
         Size of the problem as read.
     """
 
@@ -72,6 +74,7 @@ class BALFit:
     fixed: list
     n_cameras: int = 0
     n_points: int = 0
+    file: str | None = None
 
     @property
     def iterations(self) -> int:
@@ -86,7 +89,8 @@ class BALFit:
         their camera), ``initial_cost`` and ``final_cost`` (½ Σ r², px²), ``iterations``,
         ``seconds`` (solver), ``converged``, ``message``, ``gauge``.
         """
-        return {
+        out = {} if self.file is None else {"file": self.file}
+        return out | {
             "n_cameras": self.n_cameras,
             "n_points": self.n_points,
             "n_observations": self.n_observations,
@@ -193,17 +197,19 @@ def adjust_bal(
     )
 
 
-def adjust_bal_file(path, options: SolverOptions | None = None, *, progress=None) -> dict:
+def adjust_bal_file(path, options: SolverOptions | None = None, *, progress=None) -> BALFit:
     """Read a BAL file (``.txt`` or ``.txt.bz2``), adjust it, and summarise (``hsgeo adjust-bal``):
     the file front end of :func:`adjust_bal`.
 
     Returns
     -------
-    dict
-        ``file`` and :meth:`BALFit.to_dict`.
+    BALFit
+        :func:`adjust_bal`'s result with ``file`` set (its :meth:`BALFit.to_dict` names it).
     """
+    from dataclasses import replace
+
     from hsgeo.io.bal import read_bal
 
     problem = read_bal(path)
     fit = adjust_bal(problem, options, progress=progress)
-    return {"file": str(path), **fit.to_dict()}
+    return replace(fit, file=str(path))

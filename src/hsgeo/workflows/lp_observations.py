@@ -300,7 +300,7 @@ WIDE_FOV_DEG = 60.0
 
 
 def _wide_camera(inputs: LpInputs) -> str:
-    """The camera's full-line field of view, named when implausibly wide (issue 42: c_mm or
+    """The camera's full-line field of view, named when implausibly wide (c_mm or
     pixel_mm in another unit ended in 'too short, poor texture, or too far off').
     """
     c = float(np.atleast_1d(inputs.camera.c_mm)[0])
@@ -345,7 +345,7 @@ def _check(inputs: LpInputs, options: LpOptions) -> tuple[tuple, float]:
     wl0 = np.asarray(strips[0].wavelengths_nm, float)
     for i, s in zip(ids[1:], strips[1:], strict=True):
         wl = np.asarray(s.wavelengths_nm, float)
-        if not np.allclose(wl, wl0, rtol=0.0, atol=0.5):  # issue 42: matched band by band
+        if not np.allclose(wl, wl0, rtol=0.0, atol=0.5):  # matched band by band
             raise InputError(
                 f"strip {i}'s bands differ from strip {ids[0]}'s (wavelength_nm "
                 f"{_nm(wl)} against {_nm(wl0)}): a band is matched with the same band of the "
@@ -793,12 +793,12 @@ def lp_observation_files(
         )
     n_px = full_line_px(strips, n_px_full)
     inputs = LpInputs(tuple(strips), traj, cam, ids, xyz, height_m, n_px)
-    if squares is not None:  # the squares where the strips see the ground (issue 42)
+    if squares is not None:  # the squares where the strips see the ground
         _, height = _check(inputs, options)
         sq.check_placement(inputs, _check_overlap(inputs, options, height))
     res = retrieve(inputs, options, progress=progress)
     if squares is not None and res.counts["all"]["squares"] == 0:
-        raise ObservationError(  # issue 42: a navigation shifted in time gave 0 squares, exit 0
+        raise ObservationError(  # a navigation shifted in time gave 0 squares and exit 0
             f"none of the {len(ids)} squares of {str(squares)!r} was found where the navigation "
             "and the camera put it in the strips: is the navigation on the lines' time scale "
             "(not shifted), the camera's boresight and lever arm right (degrees, metres), the "

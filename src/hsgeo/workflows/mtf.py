@@ -34,6 +34,7 @@ __all__ = [
     "mtf_from_bars",
     "mtf_from_edge",
     "bars_files",
+    "BarProfilesResult",
     "edge_file",
     "parse_roi",
 ]
@@ -236,8 +237,28 @@ def mtf_from_edge(inputs: EdgeInputs, options: EdgeOptions = EdgeOptions()) -> M
     )
 
 
-def bars_files(profiles, bars, options: BarOptions = BarOptions()) -> dict:
-    """``hsgeo mtf``: every profile of the file → ``{row: MtfResult}`` (row None if single)."""
+@dataclass(frozen=True)
+class BarProfilesResult:
+    """The MTF of every profile of a profile file (:func:`bars_files`).
+
+    Attributes
+    ----------
+    by_row : dict
+        ``{row: MtfResult}``, in the file's order; the row is None for a file of one profile.
+    """
+
+    by_row: dict
+
+    def to_dict(self) -> dict:
+        """``{"profiles": [{"row": row, **MtfResult.to_dict()}, ...]}``, or the one profile's
+        dict (with its ``row``) for a file of one profile.
+        """
+        d = {"profiles": [{"row": r, **res.to_dict()} for r, res in self.by_row.items()]}
+        return d["profiles"][0] if len(self.by_row) == 1 else d
+
+
+def bars_files(profiles, bars, options: BarOptions = BarOptions()) -> BarProfilesResult:
+    """``hsgeo mtf``: the MTF of every profile of the file (:class:`BarProfilesResult`)."""
     from hsgeo.errors import ObservationError
     from hsgeo.io.mtf import read_bars, read_profiles
 
@@ -252,7 +273,7 @@ def bars_files(profiles, bars, options: BarOptions = BarOptions()) -> dict:
         except (ObservationError, InputError) as exc:
             where = f"profile file {profiles}" + ("" if row is None else f", row {row}")
             raise type(exc)(f"{where}: {exc}") from None
-    return out
+    return BarProfilesResult(out)
 
 
 def parse_roi(text: str | None) -> tuple | None:

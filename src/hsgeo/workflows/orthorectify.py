@@ -222,7 +222,7 @@ def _terrain(dsm, height_m, frame, U_m, strips=None):
 
 
 def _terrain_with_voids(z, void, grid, frame, source, strips):
-    """A DSM with voids (nodata) away from the lines is accepted (issue 42: a nodata corner far
+    """A DSM with voids (nodata) away from the lines is accepted (a nodata corner far
     from the strips was refused): the voids take their nearest height, and the lines' edge rays
     and about 64 whole lines per strip must not meet the ground in a cell touching one.
     """
@@ -526,7 +526,7 @@ def _check_distinct(lines) -> None:
 
 def _probe_scheduler(scheduler: str) -> None:
     """A TCP ``--scheduler`` must greet as dask's does: its end of the handshake comes first,
-    unasked (issue 42: at an HTTP port, which waits for a request, ``Client(timeout=...)``
+    unasked (at an HTTP port, which waits for a request, ``Client(timeout=...)``
     waited for ever — a TimeoutError traceback after 20 s in an earlier version).
     """
     import socket

@@ -552,14 +552,14 @@ def read_camera(path) -> CameraPrior:
     """
     from hsgeo.io.sensor_file import read_sensor, read_sensor_tables
 
-    name, cfg, table = read_sensor_tables(path)
+    name, tables, table = read_sensor_tables(path)
     if name != "pushbroom":
         raise InputError(
             f"camera file {path}: model {name!r}; hsgeo adjust-pushbroom adjusts the 002 "
             'pushbroom camera: give a sensor file with model = "pushbroom"'
         )
     camera = read_sensor(path)
-    cam, nav = cfg["sensor"], cfg["gnss_ins"]
+    cam, nav = tables["sensor"], tables["gnss_ins"]
     c = tuple(float(v) for v in camera.c_mm)
     kw = {
         "n_bands": len(c),
@@ -578,10 +578,11 @@ def read_camera(path) -> CameraPrior:
         kw["sigma_pos_m"] = nav["sigma_pos_m"]
     if "sigma_att_deg" in nav:
         kw["sigma_att_rad"] = tuple(np.deg2rad(nav["sigma_att_deg"]))
-    if "sigma_px" in cfg["observations"]:
-        kw["sigma_obs_px"] = cfg["observations"]["sigma_px"]
-    if "sigma_m" in cfg["gcp"]:
-        kw["sigma_gcp_m"] = cfg["gcp"]["sigma_m"]
+    obs, gcp = tables["observations"], tables["gcp"]
+    if "sigma_px" in obs:
+        kw["sigma_obs_px"] = obs["sigma_px"]
+    if "sigma_m" in gcp:
+        kw["sigma_gcp_m"] = gcp["sigma_m"]
     return CameraPrior(**kw)
 
 
@@ -596,7 +597,7 @@ def adjust_files(
     progress=None,
     y_as_time: bool = Y_AS_TIME,
     max_nav_gap_s: float = 1.0,
-) -> dict:
+) -> PushbroomResult:
     """Adjust a user's pushbroom observations (``hsgeo adjust-pushbroom``).
 
     Parameters
@@ -626,10 +627,11 @@ def adjust_files(
 
     Returns
     -------
-    dict
-        Summary, the camera parameters with σ̂, the node corrections, the adjusted points and
-        ``fit``, the plausibility verdict of :func:`fit_verdict` (``hsgeo adjust-pushbroom`` exits
-        2 on a poor fit unless ``--accept-poor-fit``).
+    PushbroomResult
+        The in-memory core's result (:func:`adjust_pushbroom`): ``to_dict()`` gives the
+        summary, the camera parameters with σ̂, the node corrections, the adjusted points and
+        ``fit``, the plausibility verdict of :func:`fit_verdict` (``hsgeo adjust-pushbroom``
+        exits 2 on a poor fit unless ``--accept-poor-fit``); ``result`` the engine's.
     """
     from hsgeo.io.navigation import read_trajectory
 
@@ -654,10 +656,7 @@ def adjust_files(
         y_as_time=y_as_time,
         raise_on_failure=False,  # no convergence is a verdict of the fit (fit_verdict)
     )
-    r = adjust_pushbroom(inputs, options, progress=progress)
-    out = r.to_dict()
-    out["_result"] = r.result
-    return out
+    return adjust_pushbroom(inputs, options, progress=progress)
 
 
 def observations_from_table(

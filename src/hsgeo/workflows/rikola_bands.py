@@ -43,6 +43,7 @@ __all__ = [
 #: The Rikola FPI2015's band split (band, sensor, FPI air gap), an instrument description read
 #: by :func:`hsgeo.io.read_band_split` (``hsgeo/data/instruments/rikola_fpi2015.toml``).
 BANDS = read_band_split()
+BANDS.setflags(write=False)
 
 
 def detect_targets_in_images(
@@ -205,7 +206,7 @@ class BandCalibration:
     def residuals_px(self) -> np.ndarray:
         return self.result.residuals(0).reshape(-1, 2) / self.block_pixel_mm * [1.0, -1.0]
 
-    block_pixel_mm: float = 0.0055
+    block_pixel_mm: float  # the observations' pixel pitch, mm (no default: the user's camera)
 
 
 def band_problem(obs: Observations, band: int, f0_mm: float, sigma_px: float):

@@ -1,0 +1,203 @@
+"""The one configuration loader (hsgeo.io.config.read_dataclass): a frozen dataclass is the
+schema of a TOML file; every scenario file is read into its dataclass."""
+
+import dataclasses
+import shutil
+from dataclasses import dataclass, field
+
+import pytest
+
+from hsgeo import InputError
+from hsgeo.io.config import Key, load_dataclass, read_dataclass
+from hsgeo.simulate.scenarios import SCENARIOS, data_dir, load_scenario, scenario_class
+
+
+@dataclass(frozen=True)
+class _Flight:
+    height_agl_m: float
+    speed_m_s: float = 15.0
+    start_EN_m: tuple[float, ...] = field(
+        default=(0.0, 0.0), metadata={"key": Key("floats", length=2)}
+    )
+    gcp_id: tuple[int, ...] = ()
+    n_lines: int = field(default=10, metadata={"key": Key("int", positive=True)})
+    reverse: bool = False
+
+
+@dataclass(frozen=True)
+class _Noise:
+    sigma_px: float = 0.3
+
+
+@dataclass(frozen=True)
+class _Scenario:
+    flight: _Flight
+    noise: _Noise = _Noise()
+    drift: _Noise | None = None
+    name: str = "x"
+
+
+def _write(tmp_path, text):
+    p = tmp_path / "s.toml"
+    p.write_text(text, encoding="utf-8")
+    return p
+
+
+def test_a_file_becomes_its_frozen_dataclass_with_the_defaults(tmp_path):
+    p = _write(tmp_path, "[flight]\nheight_agl_m = 1000\ngcp_id = [2, 3]\nreverse = true\n")
+    s = read_dataclass(p, _Scenario, "scenario file")
+    assert s == _Scenario(_Flight(1000.0, gcp_id=(2, 3), reverse=True))
+    assert isinstance(s.flight.height_agl_m, float) and s.flight.start_EN_m == (0.0, 0.0)
+    assert s.noise == _Noise() and s.drift is None
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        s.flight.speed_m_s = 1.0  # type: ignore[misc]
+    assert read_dataclass(
+        _write(tmp_path, "[flight]\nheight_agl_m = 1.0\n[drift]\nsigma_px = 2.0\n"), _Scenario
+    ).drift == _Noise(2.0)
+
+
+@pytest.mark.parametrize(
+    "text, needle",
+    [
+        (
+            "[flight]\nheigth_agl_m = 1.0\n",
+            "[flight] heigth_agl_m: unknown key; did you mean 'height_agl_m'?",
+        ),
+        (
+            "[flight]\nheight_agl_m = 1.0\n[noize]\nsigma_px = 1.0\n",
+            "[noize]: unknown table; did you mean 'noise'?",
+        ),
+        ("[noise]\nsigma_px = 1.0\n", "[flight] height_agl_m: missing"),
+        ('[flight]\nheight_agl_m = "high"\n', "[flight] height_agl_m: expected a number"),
+        ("[flight]\nheight_agl_m = 1e12\n", "[flight] height_agl_m: 1000000000000.0 is outside"),
+        ("[flight]\nheight_agl_m = 1.0\nstart_EN_m = [1.0]\n", "start_EN_m: needs 2 numbers"),
+        ("[flight]\nheight_agl_m = 1.0\ngcp_id = [1.5]\n", "gcp_id[0]: expected a whole number"),
+        ("[flight]\nheight_agl_m = 1.0\nn_lines = 0\n", "n_lines: must be positive"),
+        ("[flight]\nheight_agl_m = 1.0\nreverse = 1\n", "reverse: expected true or false"),
+        ("flight = 3\n", "flight: must be a table [flight]"),
+        ("[flight]\nheight_agl_m = nan\n", "height_agl_m: must be a finite number"),
+    ],
+)
+def test_every_problem_names_the_file_and_the_key(tmp_path, text, needle):
+    p = _write(tmp_path, text)
+    with pytest.raises(InputError) as e:
+        read_dataclass(p, _Scenario, "scenario file")
+    msg = str(e.value)
+    assert msg.startswith(f"scenario file {p}: ") and needle in msg, msg
+
+
+def test_all_problems_at_once():
+    with pytest.raises(InputError) as e:
+        load_dataclass(_Scenario, {"flight": {"heigt_agl_m": 1.0, "speed_m_s": "x"}}, "f.toml")
+    msg = str(e.value)
+    assert "heigt_agl_m: unknown key" in msg and "speed_m_s: expected a number" in msg
+    assert "height_agl_m: missing" in msg
+
+
+def test_every_scenario_file_loads_into_its_dataclass():
+    stems = sorted(p.stem for p in data_dir().glob("*.toml"))
+    assert len(stems) >= 5
+    for stem in stems:
+        cfg = load_scenario(stem)
+        assert type(cfg) is scenario_class(cfg.scenario.generator)
+        assert dataclasses.is_dataclass(cfg) and type(cfg).__dataclass_params__.frozen
+    assert set(SCENARIOS) >= {load_scenario(s).scenario.generator for s in stems}
+
+
+def test_the_file_wins_over_the_defaults_and_the_defaults_are_the_papers():
+    from hsgeo.papers import P000_TABLE1_CALIBRATED as T1
+    from hsgeo.papers import RIKOLA_CAMERA
+    from hsgeo.simulate.pula_flight import FlightSensorTruth
+    from hsgeo.simulate.rikola import BenchCameraRikola
+
+    assert FlightSensorTruth() == load_scenario("pula_flight").sensor_truth
+    assert FlightSensorTruth().K == (T1.K1, T1.K2, T1.K3)
+    cam = load_scenario("rikola_bench").camera
+    assert cam.pixel_mm == RIKOLA_CAMERA["pixel_mm"] == BenchCameraRikola.pixel_mm
+    assert load_scenario("line_lab").lab.even_distortion_px == 0.0  # the file's, not the default
+
+
+def test_a_typo_in_a_scenario_file_is_a_clear_error(tmp_path, monkeypatch):
+    d = tmp_path / "data_synthetic"
+    d.mkdir()
+    text = (data_dir() / "pula_flight.toml").read_text(encoding="utf-8")
+    (d / "pula_flight.toml").write_text(text.replace("height_agl_m", "heigth_agl_m"))
+    shutil.copy(data_dir() / "frame_bench.toml", d / "frame_bench.toml")
+    (d / "other.toml").write_text('[scenario]\ngenerator = "pula_flite"\nseed = 1\n')
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(InputError, match=r"pula_flight.toml: \[flight\] heigth_agl_m: unknown key; "
+                       r"did you mean 'height_agl_m'\?"):  # fmt: skip
+        load_scenario("pula_flight")
+    with pytest.raises(InputError, match="generator: unknown scenario generator 'pula_flite'; "
+                       "did you mean 'pula_flight'"):  # fmt: skip
+        load_scenario("other")
+    assert load_scenario("frame_bench").board.nx == 9
+
+
+def test_row_is_frozen_and_built_by_keyword():
+    from hsgeo.report import Row
+
+    with pytest.raises(TypeError):
+        Row("t", "q", "m")  # type: ignore[misc]
+    r = Row(table="t", quantity="q", unit="m", paper=1.0)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        r.paper = 2.0  # type: ignore[misc]
+    assert dataclasses.replace(r, paper=2.0).paper == 2.0 and r.paper == 1.0
+
+
+def test_the_solver_constants_are_options():
+    import hsgeo.adjust.solver as SV
+    from hsgeo.adjust import SolverOptions
+
+    o = SolverOptions()
+    assert (o.hold_max, o.thrown_share, o.thrown_ratio) == (3, 0.25, 1000.0)
+    assert not any(hasattr(SV, n) for n in ("HOLD_MAX", "THROWN_SHARE", "THROWN_RATIO"))
+    for bad in ({"hold_max": -1}, {"thrown_share": 0.0}, {"thrown_ratio": float("inf")}):
+        with pytest.raises(InputError, match=next(iter(bad))):
+            SolverOptions(**bad)
+
+
+def test_no_configuration_is_read_as_a_raw_dict():
+    """Scenarios are dataclasses: no ``cfg["…"]`` in the package (issue's measure: 55 → 0)."""
+    from pathlib import Path
+
+    import hsgeo
+
+    src = Path(hsgeo.__file__).parent
+    hits = [
+        f"{p.relative_to(src)}:{i}"
+        for p in sorted(src.rglob("*.py"))
+        for i, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1)
+        if 'cfg["' in line
+    ]
+    assert not hits, hits
+
+
+@dataclass(frozen=True)
+class _Checked:
+    n_views: int = 3
+
+    def __post_init__(self):
+        if self.n_views < 2:
+            raise InputError(f"n_views must be at least 2, got {self.n_views}")
+
+
+@dataclass(frozen=True)
+class _Outer:
+    inner: _Scenario
+    checked: _Checked = _Checked()
+
+
+def test_nested_tables_and_the_dataclass_own_checks_are_named():
+    with pytest.raises(InputError) as e:
+        load_dataclass(
+            _Outer,
+            {
+                "inner": {"flight": {"height_agl_m": 1.0, "sped_m_s": 2.0}},
+                "checked": {"n_views": 1},
+            },
+            "f.toml",
+        )
+    msg = str(e.value)
+    assert "[inner.flight] sped_m_s: unknown key; did you mean 'speed_m_s'?" in msg, msg
+    assert "[checked] n_views must be at least 2, got 1" in msg, msg
