@@ -209,7 +209,7 @@ def _cmd_orthorectify(args) -> int:
 
     progress = None if args.quiet else terminal.progress_counter("raster tiles")
     try:
-        out = orthorectify_files(
+        res = orthorectify_files(
             args.lines,
             args.trajectory,
             args.sensor,
@@ -237,6 +237,7 @@ def _cmd_orthorectify(args) -> int:
         )
     finally:
         terminal.clear_progress()
+    out = res.to_dict()
     if args.json:
         print(json_text(out))
     else:

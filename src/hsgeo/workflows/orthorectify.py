@@ -24,7 +24,7 @@ measured (nearest neighbour); where strips overlap the mosaic rule decides
 from __future__ import annotations
 
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
@@ -36,6 +36,7 @@ __all__ = [
     "OrthoInputs",
     "SCHEDULER_GREETING_S",
     "OrthoOptions",
+    "OrthoResult",
     "orthorectify",
     "orthorectify_files",
     "adjustment_of",
@@ -90,6 +91,36 @@ class OrthoOptions:
     tile_px: int = 512
     lines_per_block: int = 256
     max_gib: float = MAX_MOSAIC_GIB
+
+
+@dataclass(frozen=True)
+class OrthoResult:
+    """What ``hsgeo orthorectify`` wrote: the output and its files, the grid (CRS, cell size,
+    width × height cells, the cell centres' x and y range in the CRS's units), the bands, the
+    strips (or frames) mosaicked by the rule ``mosaic``, whether an adjustment was applied, the
+    navigation's CRS and the Dask scheduler used (None: threads).
+    """
+
+    output: str
+    files: tuple
+    crs: str
+    resolution_m: float
+    mosaic: str
+    width: int
+    height: int
+    x_m: tuple
+    y_m: tuple
+    bands: tuple
+    strips: tuple
+    line_pixels: int | None
+    adjusted: bool
+    navigation: str | None
+    scheduler: str | None
+
+    def to_dict(self) -> dict:
+        """Plain JSON-ready values (what ``hsgeo orthorectify --json`` prints)."""
+        d = {f.name: getattr(self, f.name) for f in fields(self)}
+        return {k: list(v) if isinstance(v, tuple) else v for k, v in d.items()}
 
 
 @dataclass(frozen=True)
@@ -400,13 +431,14 @@ def orthorectify_files(
     vertical: str | None = None,
     line_times=None,
     frame_times=None,
-) -> dict:
+) -> OrthoResult:
     """Orthorectify line files into one raster (see ``hsgeo orthorectify --help``).
 
     Every check comes before the work: the output (its suffix names the format; refused if it
     exists, unless ``overwrite``, or if it is an input), the inputs, the bands, the navigation
     covering every line, the view angles, the terrain below the aircraft and covering every
-    strip's footprint, the raster's size. Returns a summary (grid, bands, strips, file).
+    strip's footprint, the raster's size. Returns an :class:`OrthoResult` (grid, bands,
+    strips, files).
 
     A local-ENU navigation needs ``site`` (LAT, LON[, H], the frame's origin on the datum
     ``nav_crs``, default WGS 84); the output CRS defaults to the UTM zone of the site on that
@@ -490,23 +522,23 @@ def orthorectify_files(
     with _client(scheduler):
         written = write_raster(ortho, output, overwrite=overwrite, inputs=inputs, progress=progress)
     x, y = ortho["x"].values, ortho["y"].values
-    return {
-        "output": str(output),
-        "files": [str(p) for p in written],
-        "crs": str(ortho.rio.crs),
-        "resolution_m": float(ortho.attrs["resolution_m"]),
-        "mosaic": mosaic,
-        "width": int(x.size),
-        "height": int(y.size),
-        "x_m": [float(x.min()), float(x.max())],
-        "y_m": [float(y.min()), float(y.max())],
-        "bands": names,
-        "strips": [s.name for s in strips],
-        "line_pixels": n_px_full,
-        "adjusted": adjustment is not None,
-        "navigation": navigation.source_crs,
-        "scheduler": scheduler,
-    }
+    return OrthoResult(
+        output=str(output),
+        files=tuple(str(p) for p in written),
+        crs=str(ortho.rio.crs),
+        resolution_m=float(ortho.attrs["resolution_m"]),
+        mosaic=mosaic,
+        width=int(x.size),
+        height=int(y.size),
+        x_m=(float(x.min()), float(x.max())),
+        y_m=(float(y.min()), float(y.max())),
+        bands=tuple(names),
+        strips=tuple(s.name for s in strips),
+        line_pixels=n_px_full,
+        adjusted=adjustment is not None,
+        navigation=navigation.source_crs,
+        scheduler=scheduler,
+    )
 
 
 def _check_distinct(lines) -> None:
