@@ -1,4 +1,4 @@
-"""hsgeo.ortho: any sensor's strips -> map grid (pyresample) -> mosaic -> COG (rasterio)."""
+"""hsgeo.ortho: any sensor's strips -> map grid (pykdtree) -> mosaic -> COG (rasterio)."""
 
 import numpy as np
 import pytest

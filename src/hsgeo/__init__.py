@@ -43,7 +43,6 @@ def show_versions() -> str:
         "h5py",
         "distributed",
         "pyproj",
-        "pyresample",
         "rasterio",
         "rioxarray",
         "spectral",
