@@ -8,6 +8,7 @@ problems (empty when the page passes), so that a failing test names the page and
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from urllib.parse import unquote, urlparse
 
@@ -281,6 +282,10 @@ async () => {
       .map((el) => el.textContent || "").join(" "),
     exercises: main.querySelectorAll(".exercise").length,
     solutions: main.querySelectorAll(".solution").length,
+    // per-chapter numbering: the page's number and its figures', tables' and exercises' labels
+    chapter_number: ((main.querySelector("h1 .section-number") || {}).textContent || "").trim(),
+    caption_numbers: [...main.querySelectorAll(".caption-number")]
+      .map((el) => (el.textContent || "").trim()).slice(0, 200),
   };
 }
 """
@@ -400,6 +405,17 @@ def problems_exercises(facts: dict) -> list[str]:
     if facts["solutions"] < 1:
         out.append("no {solution}")
     return out
+
+
+def problems_numbering(facts: dict) -> list[str]:
+    """A chapter has its number, and its figures, tables and exercises are numbered within it
+    ("Exercise 4.2" on chapter 4, not "Exercise 21" counted across the book)."""
+    num = facts["chapter_number"].rstrip(".")
+    if not num:
+        return ["the chapter has no number (numbered: true on its part in book/_toc.yml)"]
+    within = re.compile(rf"(?<![\d.]){re.escape(num)}\.\d+")
+    bad = [c for c in facts["caption_numbers"] if not within.search(c)]
+    return [f"numbered across the book, not within chapter {num}: «{c}»" for c in bad[:8]]
 
 
 def problems_leaks(facts: dict) -> list[str]:

@@ -38,6 +38,7 @@ from pagecheck import (
     problems_long_tables,
     problems_md_source,
     problems_nan,
+    problems_numbering,
     problems_offline,
     problems_page_width,
     problems_reprs,
@@ -129,6 +130,19 @@ CASES = {
         problems_exercises,
         '<div class="exercise">Do it.</div>',
         '<div class="exercise">Do it.</div><div class="solution">Done.</div>',
+    ),
+    "numbered-across-the-book": (
+        problems_numbering,
+        '<h1><span class="section-number">4. </span>MTF</h1>'
+        '<div class="exercise"><p><span class="caption-number">Exercise 21 </span></p></div>',
+        '<h1><span class="section-number">4. </span>MTF</h1>'
+        '<div class="exercise"><p><span class="caption-number">Exercise 4.1 </span></p></div>',
+    ),
+    "chapter-without-number": (
+        problems_numbering,
+        '<h1>MTF</h1><figure><span class="caption-number">Fig. 1 </span></figure>',
+        '<h1><span class="section-number">4. </span>MTF</h1>'
+        '<figure><span class="caption-number">Fig. 4.1 </span></figure>',
     ),
     "numpy-repr": (
         problems_leaks,

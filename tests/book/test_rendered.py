@@ -33,6 +33,7 @@ from pagecheck import (
     problems_long_tables,
     problems_md_source,
     problems_nan,
+    problems_numbering,
     problems_offline,
     problems_page_width,
     problems_reprs,
@@ -177,6 +178,12 @@ def test_chapter_md_download(facts):
 @_params(CHAPTERS, WIDE_PX)
 def test_chapter_exercise_with_solution(facts):
     _check(problems_exercises(facts), facts)
+
+
+@_params(CHAPTERS, WIDE_PX)
+def test_chapter_numbered_within(facts):
+    """Figures, tables and exercises numbered within their chapter (Exercise 4.2)."""
+    _check(problems_numbering(facts), facts)
 
 
 def test_every_chapter_is_in_the_toc():
