@@ -247,3 +247,20 @@ def test_chapter_typesets_its_equations(facts):
 def test_per_paper_statements(facts):
     """One statement per paper, each of at most 80 words."""
     _check(problems_statements(facts, minimum=N_PAPERS), facts)
+
+
+def test_search_shows_snippets_offline(browser):
+    """The search page, read from disk with the network blocked, lists results for a word of
+    the chapters with a snippet of text under each (book/_ext/hsgeo_search.py)."""
+    context = browser.new_context(viewport={"width": WIDE_PX, "height": 900}, offline=True)
+    try:
+        page = context.new_page()
+        page.goto((HTML / "search.html").as_uri() + "?q=boresight")
+        page.wait_for_selector("#search-results li", timeout=30_000)
+        page.wait_for_timeout(1500)  # the snippets come after the titles
+        n_results = page.locator("#search-results li").count()
+        n_snippets = page.locator("#search-results li p.context").count()
+    finally:
+        context.close()
+    assert n_results >= 3, f"{n_results} search results for 'boresight'"
+    assert n_snippets == n_results, f"{n_snippets} of {n_results} results with a snippet"
