@@ -94,3 +94,41 @@ def test_a_mean_is_judged_by_the_means_sigma_and_its_bias_is_named(rep):
     # 001 Table 3's "differs" name the definition of the determined GSD they rest on
     for q in ("determined GSDv line 100 (bars)", "determined GSDv line 1000 (slanted edge)"):
         assert "our definition of the determined GSD" in rep.row("001 Table 3", q).judge()[1]
+
+
+def test_bias_sentence_does_not_blame_noise_where_the_mtf_is_large():
+    """The noise's upward bias (about σ_noise²/(2 MTF)) explains rows left beyond 3σ only where
+    the true MTF is small; rows left at a large MTF are named as unexplained, with their z."""
+    from hsgeo.report import Reproduction, Row
+    from hsgeo.reproduce.mtf import NOISE_BIAS_MTF, bias_sentence
+
+    small, large = "MTF line 500 at 0.6 cy/px", "MTF line 1000 at 0.4 cy/px"
+    rows = [
+        Row(
+            table="slanted edge",
+            quantity=q,
+            unit="1",
+            reproduced=t + 0.01,
+            sigma=0.001,
+            truth=t,
+            n_runs=8,
+            mean_of_runs=True,
+        )
+        for q, t in ((small, 0.0002), (large, 0.3686))
+    ]
+    bias = {
+        "n": 2,
+        "n_within_3": 0,
+        "n_within_3_bias": 0,
+        "max_abs_bias": 0.0,
+        "unexplained": [small, large],
+        "rows": {small: (10.0, 10.0, 0.0), large: (10.0, 10.0, 0.0)},
+    }
+    rep = Reproduction(
+        "mtf", 0, rows, {"n_runs": 8, "n_noise_free": 8, "bias": {"slanted edge": bias}}
+    )
+    text = bias_sentence(rep, "slanted edge")
+    assert "noise adds" in text and f"exceeds {NOISE_BIAS_MTF:g} ({large} +10.0σ)" in text
+    assert "no bias of ours explains them" in text
+    bias["unexplained"] = [small]
+    assert "no bias of ours" not in bias_sentence(rep, "slanted edge")
