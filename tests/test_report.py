@@ -522,3 +522,86 @@ def test_highlight_below_shades_only_the_cells_under_their_columns_limit():
     assert f"#{tid}_row0_col2, #{tid}_row1_col1 {{" in style and style.count("_row") == 2
     assert style.count("background-color: #f4b6b6") == 1
     assert ">5.5<" in html and ">7.0<" in html and ">3.5<" in html
+
+
+def test_no_reproduced_rests_on_few_runs_or_a_sigma_over_half_the_paper():
+    """Issue 37's scoreboard bar, over every combination of the numbers a row can carry: a
+    "reproduced" has a spread from at least 8 runs (or an adjustment's σ̂) and σ at most half
+    the paper's value; a chapter cannot state "reproduced", and a file that stored one is
+    rejudged from its numbers when read."""
+    import itertools
+
+    from hsgeo.report import MIN_RUNS, PROVENANCES, SIGMA_OVER_PAPER
+
+    n_reproduced = 0
+    for n_runs, sigma, psig, prov, mean, truth, rep in itertools.product(
+        (None, 2, 3, 7, 8, 24),
+        (None, 0.01, 0.2, 0.49, 0.51, 2.0),
+        (None, 0.05, 0.6),
+        (None, *PROVENANCES),
+        (False, True),
+        (None, 1.0, 1.3),
+        (1.0, 1.05, 1.9),
+    ):
+        if mean and not n_runs:
+            continue
+        r = Row(
+            table="t",
+            quantity="q",
+            unit="m",
+            paper=1.0,
+            paper_sigma=psig,
+            reproduced=rep,
+            sigma=sigma,
+            truth=truth,
+            n_runs=n_runs,
+            provenance=prov,
+            mean_of_runs=mean,
+        )
+        if r.judge()[0] != "reproduced":
+            continue
+        n_reproduced += 1
+        assert n_runs is None or n_runs >= MIN_RUNS, r
+        assert sigma is None or sigma <= SIGMA_OVER_PAPER * 1.0, r
+        assert prov in (None, "chosen") and truth != 1.0, r  # never agreement built in
+    assert n_reproduced > 100  # the grid does reach the verdict
+    with pytest.raises(InputError, match="could not fail"):  # nor may a chapter state one
+        Row(
+            table="t",
+            quantity="q",
+            unit="m",
+            paper=1.0,
+            reproduced=1.0,
+            sigma=0.1,
+            n_runs=3,
+            verdict="reproduced",
+            reason="looks right",
+        )
+    with pytest.raises(InputError, match="could not fail"):
+        Row(
+            table="t",
+            quantity="q",
+            unit="m",
+            paper=1.0,
+            reproduced=1.0,
+            sigma=0.6,
+            verdict="reproduced",
+            reason="looks right",
+        )
+    # a record whose stored "reproduced" the current rules do not allow reads as they judge
+    few = Row(
+        table="t",
+        quantity="q",
+        unit="m",
+        paper=1.0,
+        paper_sigma=0.05,
+        reproduced=1.0,
+        sigma=0.1,
+        n_runs=8,
+        provenance="chosen",
+    )
+    text = Reproduction("x", 0, [few]).to_json()
+    assert json.loads(text)["rows"][0]["verdict"] == "reproduced"
+    old = text.replace('"n_runs": 8', '"n_runs": 3')
+    assert Reproduction.from_json(old).rows[0].judge()[0] == "not testable"
+    assert Reproduction.from_json(text).rows[0].judge()[0] == "reproduced"

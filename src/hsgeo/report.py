@@ -86,9 +86,9 @@ VERDICT_MEANING = {
     "tuned so that the outcome meets them: agreement was built in and is not counted as "
     "reproduced (the reason gives how well the estimate recovered its truth)",
     "not testable": "there is no reproduced value, or neither side has a σ to judge a "
-    "difference by, or our σ comes from fewer than 8 runs, or it exceeds half the paper's value "
-    "(a comparison that could not fail), or the chapter states why the comparison carries no "
-    "information; no z is shown",
+    "difference by, or our value or σ rests on fewer than 8 runs, or our σ exceeds half the "
+    "paper's value (a comparison that could not fail), or the chapter states why the "
+    "comparison carries no information; no z is shown",
     "planned": "the chapter that reproduces the claim is not written yet",
 }
 
@@ -180,6 +180,15 @@ class Row:
     def __post_init__(self):
         if self.verdict is not None and self.verdict not in VERDICTS:
             raise InputError(f"verdict {self.verdict!r} of {self.quantity}: use one of {VERDICTS}")
+        if self.verdict == "reproduced" and not _reproduced_bar(
+            self.n_runs, self.sigma, self.paper
+        ):
+            raise InputError(
+                f"verdict 'reproduced' of {self.quantity} is stated for a value that rests on "
+                f"{self.n_runs} runs or whose σ ({self.sigma}) exceeds half the paper's value "
+                f"({self.paper}): such a comparison could not fail; leave verdict unset "
+                "(Row.rule judges it 'not testable')"
+            )
         if self.verdict is not None and not self.reason:
             raise InputError(
                 f"verdict {self.verdict!r} of {self.quantity} is stated without a reason: a "
@@ -282,8 +291,8 @@ class Row:
         In this order:
 
         1. None for a row without a paper value; ``not testable`` without a reproduced value, or
-           when its σ is a spread over fewer than :data:`MIN_RUNS` runs (such a σ decides
-           nothing);
+           when it rests on fewer than :data:`MIN_RUNS` runs (``n_runs``, with or without a σ:
+           such a value decides nothing);
         2. when the truth is the paper's value (provenance ``paper``, or truth = paper), was
            computed from the paper's values (``derived``) or tuned to meet them (``tuned``):
            ``differs`` beyond 3σ of the paper ("tuning missed" for ``tuned``, "recovery failed"
@@ -305,10 +314,15 @@ class Row:
             return None, ""
         if _clean(self.reproduced) is None:
             return "not testable", self.reason or "no reproduced value"
-        if self.n_runs is not None and self.n_runs < MIN_RUNS and _clean(self.sigma) is not None:
+        if self.n_runs is not None and self.n_runs < MIN_RUNS:
+            # with or without a σ: a value from fewer runs decides nothing (without a σ it
+            # would be judged by the paper's σ alone, on one or two campaigns)
             return "not testable", self.reason or (
                 f"its σ is the spread over only {self.n_runs} runs; a verdict needs at least "
                 f"{MIN_RUNS}"
+                if _clean(self.sigma) is not None
+                else f"it rests on only {self.n_runs} runs, without a σ; a verdict needs at "
+                f"least {MIN_RUNS}"
             )
         zp = self.z_paper
         spread = self._spread_words()
@@ -888,17 +902,37 @@ class Reproduction:
         return "\n".join(out)
 
 
+def _reproduced_bar(n_runs, sigma, paper) -> bool:
+    """True when a "reproduced" may rest on these numbers: at least :data:`MIN_RUNS` runs (or
+    none, an adjustment's σ̂) and σ at most :data:`SIGMA_OVER_PAPER` of the paper's value.
+    """
+    s, p = _clean(sigma), _clean(paper)
+    if n_runs is not None and n_runs < MIN_RUNS:
+        return False
+    return s is None or p is None or s <= SIGMA_OVER_PAPER * abs(p)
+
+
+def _rejudged(r: dict) -> bool:
+    """A stored "reproduced" that the bar of :func:`_reproduced_bar` no longer allows (a file
+    written under older rules): read without its verdict, so that :meth:`Row.rule` judges it.
+    """
+    return r.get("verdict") == "reproduced" and not _reproduced_bar(
+        r.get("n_runs"), r.get("sigma"), r.get("paper")
+    )
+
+
 def _stored_verdict(r: dict) -> str | None:
     """The verdict of a row as written by :meth:`Reproduction.to_json` ("tuned" was the verdict's
-    former name, read as "by construction"; "context" is recomputed from ``judged_in``).
+    former name, read as "by construction"; "context" is recomputed from ``judged_in``, and so is
+    a "reproduced" the current bar does not allow).
     """
     v = {"tuned": "by construction"}.get(r.get("verdict"), r.get("verdict"))
-    return None if v == "context" else v
+    return None if v == "context" or _rejudged(r) else v
 
 
 def _stored_reason(r: dict) -> str:
-    """The reason stored with the verdict (none for a context row: it is recomputed)."""
-    return "" if r.get("verdict") == "context" else (r.get("reason") or "")
+    """The reason stored with the verdict (none for a recomputed one)."""
+    return "" if r.get("verdict") == "context" or _rejudged(r) else (r.get("reason") or "")
 
 
 def from_estimates(name: str, result) -> Reproduction:
