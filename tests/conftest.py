@@ -13,7 +13,8 @@ def _compile_pushbroom_kernels() -> None:
     pytest-xdist workers reaching the pushbroom engine at the same time both compiled its 24
     kernels: 137 CPU-s each (issue 41, measured on a cold cache: tests/test_kernels.py and
     tests/test_pushbroom.py 163 CPU-s cold, 26 warm). Compiled once here, before the workers
-    start, every worker loads them from the cache; with a warm cache this costs ≈ 2 CPU-s.
+    start, every worker loads them from the cache: 19 of the 24 kernels, 123.7 CPU-s with an
+    empty cache, 6.9 CPU-s with a warm one (bench/results/test_suite_cost.json).
     """
     from hsgeo.adjust import adjust
     from hsgeo.simulate.pushbroom_campaign import CampaignConfig, simulate
@@ -34,7 +35,9 @@ def _compile_pushbroom_kernels() -> None:
         gcp_index=obs.gcp_index,
         gcp_xyz_m=obs.gcp_xyz_m,
     )
-    adjust(params, blocks)
+    # with rejection (robust leverages) and the points' covariance: their kernels too
+    res = adjust(params, blocks, reject_k=5.0, reject_every_iteration=True, keep_jacobian=True)
+    res.point_covariance()
 
 
 def pytest_configure(config):
