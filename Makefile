@@ -45,13 +45,22 @@ proj-data: ## install Debian's proj-data (PROJ's geoid grids: EGM96) if missing 
 data: $(STAMP) ## regenerate data_synthetic/generated from the scenario TOMLs and verify the SHA-256 manifest
 	$(PY) -m hsgeo.cli data --verify
 
+# The suite runs on TEST_WORKERS processes (pytest-xdist; `make test TEST_WORKERS=0` runs it in
+# this one). `--dist loadfile` gives each process whole files: a module's shared fixtures (one
+# simulated campaign, one reproduction) are computed once, and the chapters run in the book's
+# order in one process, so the scoreboard reads the records of the chapters before it. The
+# compiled kernels (numba, cache=True) are cached beside the sources (__pycache__) and shared by
+# every process, so a fresh clone compiles each kernel once (both processes may race on the first).
+TEST_WORKERS ?= 2
+TEST_XDIST = $(if $(filter 0,$(TEST_WORKERS)),,-n $(TEST_WORKERS) --dist loadfile)
+
 test: $(STAMP) proj-data ## the docstrings' examples (doctest) and the whole test suite, chapters included
 	$(PY) -m hsgeo.cli data --verify
 	$(PY) -m pytest -q -p no:cacheprovider --doctest-modules src/hsgeo
-	$(PY) -m pytest -q tests
+	$(PY) -m pytest -q $(TEST_XDIST) tests
 
 test-fast: $(STAMP) proj-data ## the test suite without the chapter executions and slow Monte Carlo tests
-	$(PY) -m pytest -q -m "not slow" --ignore=tests/test_chapters.py tests
+	$(PY) -m pytest -q $(TEST_XDIST) -m "not slow" --ignore=tests/test_chapters.py tests
 
 # The execution cache is keyed on each chapter's code only: when the library or the scenarios
 # change, the cached outputs would be stale, so the cache is dropped then.

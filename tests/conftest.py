@@ -1,4 +1,48 @@
+import os
 import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).parent))
+
+
+def _compile_pushbroom_kernels() -> None:
+    """One tiny pushbroom adjustment: numba compiles the engine's kernels into its cache.
+
+    The kernels (``cache=True``) are cached beside the sources and shared by every process, but
+    on a fresh clone each process that calls one before it is cached compiles it itself. Two
+    pytest-xdist workers reaching the pushbroom engine at the same time both compiled its 24
+    kernels: 137 CPU-s each (issue 41, measured on a cold cache: tests/test_kernels.py and
+    tests/test_pushbroom.py 163 CPU-s cold, 26 warm). Compiled once here, before the workers
+    start, every worker loads them from the cache: 19 of the 24 kernels, 123.7 CPU-s with an
+    empty cache, 6.9 CPU-s with a warm one (bench/results/test_suite_cost.json).
+    """
+    from hsgeo.adjust import adjust
+    from hsgeo.simulate.pushbroom_campaign import CampaignConfig, simulate
+    from hsgeo.workflows.pushbroom_ba import CameraPrior, build_problem
+
+    obs, _ = simulate(0.001, rng=3)
+    cfg = CampaignConfig()
+    cam = CameraPrior(
+        n_bands=len(cfg.c_offsets_um), x0_mm=cfg.x0_mm, lever_arm_m=tuple(obs.lever_arm_m)
+    )
+    params, blocks, _ = build_problem(
+        obs.lines,
+        obs.n_points,
+        cam,
+        node_interval_s=10.0,
+        t_span_s=obs.t_span_s,
+        node_prior_mean=obs.node_prior_mean,
+        gcp_index=obs.gcp_index,
+        gcp_xyz_m=obs.gcp_xyz_m,
+    )
+    # with rejection (robust leverages) and the points' covariance: their kernels too
+    res = adjust(params, blocks, reject_k=5.0, reject_every_iteration=True, keep_jacobian=True)
+    res.point_covariance()
+
+
+def pytest_configure(config):
+    # Only in pytest-xdist's controller (`make test` runs two workers): a worker has
+    # `workerinput`, a single-process run has no `numprocesses`.
+    workers = getattr(config.option, "numprocesses", None)
+    if workers and not hasattr(config, "workerinput") and not os.environ.get("HSGEO_NO_WARMUP"):
+        _compile_pushbroom_kernels()
