@@ -106,3 +106,21 @@ def test_counts_c_against_the_twin_and_groups_strips():
 def test_no_runs_is_refused():
     with pytest.raises(ValueError, match="no runs"):
         checkpoint_campaigns({"stats": list(P002_STATS), "runs": []})
+
+
+def test_the_recorded_bench_reads():
+    """The committed bench result (the chapter reads it): every campaign has ≥ 2 check points
+    with and without GCPs, σ̂ finite and positive, and the count it claims."""
+    import json
+    from pathlib import Path
+
+    f = Path(__file__).parents[1] / "bench" / "results" / "lp_checkpoints_seeds.json"
+    if not f.exists():
+        pytest.skip("bench/results/lp_checkpoints_seeds.json not recorded")
+    doc = json.loads(f.read_text())
+    out = checkpoint_campaigns(doc)
+    assert out["n_campaigns"] == len(doc["seeds"]) == len(set(doc["seeds"]))
+    assert min(out["n_check_points"]) >= 2 and min(out["n_check_points_nogcp"]) >= 2
+    s = np.array(out["mean_h_nogcp_sigma_m"] + out["table3.std_h"]["sigma_m"])
+    assert np.all(np.isfinite(s) & (s > 0))
+    assert out["enough"] == (out["n_campaigns"] >= 8)
