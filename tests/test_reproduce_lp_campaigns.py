@@ -47,7 +47,12 @@ def _campaigns(n: int, k: int = 9, s_point: float = 0.3, s_shift: float = 2.0, s
         runs.append(
             {
                 "seed": seed_i,
-                "tie_point": {"rays": [6] * k, "table2": tab, "table3": tab},
+                "tie_point": {
+                    "rays": [6] * k,
+                    "table2": tab,
+                    "table3": tab,
+                    "cp_errors_nogcp_m": E.tolist(),
+                },
                 "twin_nogcp_mean_h_m": 0.0,
                 "c": {
                     "truth_mm": c_true.tolist(),
@@ -89,6 +94,8 @@ def test_joint_sigma_gives_z_of_unit_spread_and_blocks_do_not():
     # the mean height: 2 m of shift over a joint σ̂ that knows it, within 3σ̂ nearly always
     assert out["mean_h_nogcp_within"] >= 195
     assert out["enough"] and out["n_campaigns"] == 200
+    # nine normal errors: the farthest from their median is within a few NMADs
+    assert 0 < np.median(out["h_farthest_over_nmad"]) < 4
 
 
 def test_counts_c_against_the_twin_and_groups_strips():

@@ -101,7 +101,9 @@ def checkpoint_campaigns(doc: dict, way: str = "tie_point") -> dict:
         :func:`_z_spread` with the joint σ̂ and ``"{table}.{stat}_h.blocks"`` with the per-point
         blocks' σ̂; ``mean_h_nogcp_m``, ``mean_h_nogcp_sigma_m``, ``mean_h_nogcp_z`` (per
         campaign) and ``mean_h_nogcp_within`` (campaigns with |z| ≤ :data:`Z_LIMIT`);
-        ``twin_mean_h_nogcp_m``; ``c_minus_twin_nogcp_um`` (per campaign, the mean over the
+        ``twin_mean_h_nogcp_m``; ``h_farthest_m`` / ``h_farthest_over_nmad`` (per campaign
+        without GCPs, the largest |H − median H| of a check point, and over the NMAD);
+        ``c_minus_twin_nogcp_um`` (per campaign, the mean over the
         bands the observations see),
         ``c_minus_twin_nogcp_z`` (per campaign, the band of largest |z|), ``c_within`` (campaigns
         whose every band is within); ``c_minus_truth_nogcp_um``; ``corr_mean_h_c`` (mean height
@@ -133,6 +135,15 @@ def checkpoint_campaigns(doc: dict, way: str = "tie_point") -> dict:
             sg = np.array([r[way][tab][kind] for r in runs], float)
             for st, i in (("std", i_std), ("nmad", i_nmad)):
                 out[f"{tab}.{st}_h{suffix}"] = _z_spread(S, sg, i)
+    # a check point far from the rest (a blunder no covariance predicts) moves the STD, not
+    # the NMAD: per campaign the largest |H − median H| and its multiple of the NMAD
+    far, far_x = [], []
+    for r in runs:
+        eh = np.asarray(r[way]["cp_errors_nogcp_m"], float)[:, 2]
+        d = np.abs(eh - np.median(eh))
+        far.append(float(d.max()))
+        far_x.append(float(d.max() / r[way]["table3"]["stats"][2][i_nmad]))
+    out.update(h_farthest_m=far, h_farthest_over_nmad=far_x)
     mh = np.array([r[way]["table3"]["stats"][2][i_mean] for r in runs], float)
     smh = np.array([r[way]["table3"]["mean_h_sigma_joint"] for r in runs], float)
     z = mh / smh
