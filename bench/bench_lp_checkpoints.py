@@ -12,7 +12,8 @@ rays per check point; the no-GCP mean height and its σ̂ (joint); the principal
 against the truth and against the exact twin (with and without GCPs); the observations' share
 within 1 px of the median of their own tie point's rays and of the median of the *other* rays
 (leave-one-out); and the observations' mean error per strip (flying height, heading), the
-observation-level place a height offset would come from. Summaries over the seeds: the spread
+observation-level place a height offset would come from, and in thirds of x across the line.
+Summaries over the seeds: the spread
 of the z of STD and NMAD (against the seeds' mean) with each σ̂. Writes
 ``bench/results/lp_checkpoints_seeds.json``.
 """
@@ -85,6 +86,27 @@ def _per_strip(ev, obs) -> list:
     return out
 
 
+def _across(ev) -> list:
+    """Mean observation error (x, y px) of the tie points' observations in thirds of x across
+    the line (the column: a c or principal-point error grows with x, a heading error does not)."""
+    tab = ev["retrieval"].table
+    tie = ~ev["is_square"]
+    x = tab["x_px"].to_numpy(float)[tie]
+    e = ev["obs_errors_px"][tie]
+    q = np.quantile(x, [0.0, 1 / 3, 2 / 3, 1.0])
+    b = np.clip(np.searchsorted(q, x, side="right") - 1, 0, 2)
+    return [
+        {
+            "x_mean_px": float(x[b == i].mean()),
+            "n": int(np.sum(b == i)),
+            "mean_dx_px": float(e[b == i, 0].mean()),
+            "mean_dy_px": float(e[b == i, 1].mean()),
+        }
+        for i in range(3)
+        if np.any(b == i)
+    ]
+
+
 def one_seed(seed: int, scale: float) -> dict:
     t0 = time.perf_counter()
     rng = np.random.default_rng([seed, 37])
@@ -105,6 +127,7 @@ def one_seed(seed: int, scale: float) -> dict:
         "within_half_px_leave_one_out": within_fractions(loo[tie])[0.5],
         "rays_per_tie_point": float(res.table.loc[tie].groupby("point_id").size().mean()),
         "per_strip": _per_strip(ev, obs),
+        "across_line": _across(ev),
     }
     for way in WAYS:
         d = ev if way == "tie_point" else ev["centroid"]
