@@ -3391,3 +3391,9 @@ def test_toml_and_netcdf_from_a_pipe(cmd, inputs: Inputs):
     with open(d / "lines.nc", "rb") as fh:
         p = _run_sub([*argv, "--overwrite"], stdin=fh)
     assert p.returncode == 0, p.stderr
+# issue 42: a heading 180° off (mirrored ground points and exit 0 before) — geo38
+for _cmd in ("lp-observations", "adjust-pushbroom"):
+    case(
+        _cmd, "units", "nav-heading-180-off", "opposite to the course",
+        [("nav.csv", lambda p: _add_to_column(p, "heading_deg", 180.0))],
+    )  # fmt: skip

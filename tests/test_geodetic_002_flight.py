@@ -47,19 +47,52 @@ def _rpy(R):
     )
 
 
+_LD = np.longdouble
+_PI = _LD("3.14159265358979323846264338327950288")
+_GRS80_A_M, _GRS80_F = _LD(6378137), 1 / _LD("298.257222101")
+
+
+def _enu_to_geodetic_exact(enu_m, frame):
+    """ENU (m) about the frame's origin → latitude, longitude (degrees), ellipsoidal height (m)
+    on GRS80, in ``longdouble``: the topocentric inverse (EPSG 9837) and the geocentric inverse
+    iterated on latitude (Bowring's fixed point, 8 steps: converged to ≈ 1e-18 rad). The test's
+    own code, written from the EPSG guidance; PROJ's ``+inv +proj=cart`` used before is a
+    one-step approximation 6.7e-8 m off here."""
+    a, f = _GRS80_A_M, _GRS80_F
+    e2 = f * (2 - f)
+
+    def cart(lam, phi, h):
+        n = a / np.sqrt(1 - e2 * np.sin(phi) ** 2)
+        return np.stack(
+            [(n + h) * np.cos(phi) * np.cos(lam), (n + h) * np.cos(phi) * np.sin(lam),
+             (n * (1 - e2) + h) * np.sin(phi)], -1)  # fmt: skip
+
+    lam0 = _LD(repr(float(frame.lon_deg))) * _PI / 180
+    phi0 = _LD(repr(float(frame.lat_deg))) * _PI / 180
+    x0 = cart(lam0, phi0, _LD(repr(float(frame.h_m))))
+    sl, cl, sp, cp = np.sin(lam0), np.cos(lam0), np.sin(phi0), np.cos(phi0)
+    R = np.array([[-sl, -sp * cl, cp * cl], [cl, -sp * sl, cp * sl], [0, cp, sp]], dtype=_LD)
+    X, Y, Z = (x0 + np.asarray(enu_m, float).astype(_LD) @ R.T).T
+    p = np.hypot(X, Y)
+    phi = np.arctan2(Z, p * (1 - e2))
+    for _ in range(8):
+        n = a / np.sqrt(1 - e2 * np.sin(phi) ** 2)
+        h = p / np.cos(phi) - n
+        phi = np.arctan2(Z, p * (1 - e2 * n / (n + h)))
+    n = a / np.sqrt(1 - e2 * np.sin(phi) ** 2)
+    h = p / np.cos(phi) - n
+    back = cart(np.arctan2(Y, X), phi, h)  # the forward, to state the inverse's closure
+    closure_m = float(np.max(np.abs(back - np.stack([X, Y, Z], -1))))
+    assert closure_m < 1e-11, closure_m
+    deg = 180 / _PI
+    return tuple(np.asarray(v, float) for v in (phi * deg, np.arctan2(Y, X) * deg, h))
+
+
 def _geodetic_csv(path, traj, frame):
     """The local-frame trajectory as a geodetic navigation CSV (ETRS89, EPSG:4937)."""
-    from pyproj import Transformer
-
     from hsgeo.rotations import R_ENU_FROM_NED, R_from_rpy
 
-    topo = Transformer.from_pipeline(
-        "+proj=pipeline "
-        f"+step +inv +proj=topocentric +lat_0={frame.lat_deg!r} +lon_0={frame.lon_deg!r} "
-        f"+h_0={frame.h_m!r} +ellps=GRS80 +step +inv +proj=cart +ellps=GRS80 "
-        "+step +proj=unitconvert +xy_in=rad +xy_out=deg"
-    )
-    lon, lat, h = (np.asarray(v) for v in topo.transform(*traj.xyz_m.T))
+    lat, lon, h = _enu_to_geodetic_exact(traj.xyz_m, frame)
     a = traj.roll_pitch_heading_rad
     R_frame_enu_from_body = R_ENU_FROM_NED @ R_from_rpy(a[:, 0], a[:, 1], a[:, 2])
     R_ecef_from_frame_enu = _R_ecef_from_enu(frame.lon_deg, frame.lat_deg)
