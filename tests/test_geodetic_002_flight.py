@@ -188,11 +188,15 @@ def test_the_lp_chapter_rows_through_the_geodetic_path(tmp_path, monkeypatch):
     campaign's navigation replaced by the geodetic path's, against the plain run (paper, σ,
     reproduced and truth, as ``bench/compare_reproductions.py`` compares).
 
-    Measured (39 min wall under load 14, both runs): 264 rows, largest relative change
-    2.7e-6, on a row near zero — 'square centroids: 002 Table 2 from pixels' mean_n_m
-    0.0029974245 → 0.0029974325 m (8e-9 m). Not the issue's 1e-9: the navigation comes back
-    6.7e-8 m off (PROJ's ``cart`` inverse), and a few-mm mean moves by nanometres. The bound
-    asserted is the measured one's order (1e-5), so a real change of the path still fails."""
+    Measured with the former path (navigation 6.7e-8 m off: PROJ's one-step ``cart`` inverse in
+    the writer; 39 min wall under load 14, both runs): 264 rows, largest relative change 2.7e-6,
+    on a row near zero — 'square centroids: 002 Table 2 from pixels' mean_n_m 0.0029974245 →
+    0.0029974325 m (8e-9 m). With the exact writer and the extended-precision reader the
+    navigation is 8.7e-10 m off. 1e-9 *relative* is not reachable on such a row through any
+    file: it asks 3e-12 m of a 3-mm mean, while a float64 latitude in degrees steps by 7.9e-10 m
+    at 59.7° N (the file's floor). The bound asserted stays the former measured order (1e-5), so
+    a real change of the path still fails; the rows are judged, in the report of issue 38, by
+    their absolute change against that floor."""
     from dataclasses import replace
 
     import hsgeo.reproduce.lp_observations as chapter
