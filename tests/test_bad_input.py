@@ -2704,6 +2704,42 @@ def _outputs(argv) -> list[str]:
     return out
 
 
+# issue 42: a heading 180° off (mirrored ground points and exit 0 before) — geo38
+for _cmd in ("lp-observations", "adjust-pushbroom"):
+    case(
+        _cmd, "units", "nav-heading-180-off", "opposite to the course",
+        [("nav.csv", lambda p: _add_to_column(p, "heading_deg", 180.0))],
+    )  # fmt: skip
+
+
+# issue 38's formats (geo38): a per-band view-angle file of the wrong band count (was refused
+# as 'line 152 repeats line 2': the band column was not part of a row), a header line period of 0
+def _angles_per_band(n_bands: int):
+    def edit(p: Path):
+        import pandas as pd
+
+        t = pd.read_csv(p)
+        pd.concat([t.assign(band=b) for b in range(n_bands)]).to_csv(p, index=False)
+
+    return edit
+
+
+def _without_line_times(a, d):
+    i = a.index("--line-times")
+    return a[:i] + a[i + 2 :]
+
+
+case(
+    "orthorectify-envi", "mismatch", "angles-per-band-3-for-2-bands", "3 view-angle tables",
+    [("angles.csv", _angles_per_band(3))],
+)  # fmt: skip
+case(
+    "orthorectify-envi", "range", "hdr-line-period-0", "must be a positive number",
+    [("cube.hdr", chain_edits(_hdr_set("start time_s", "0.0"), _hdr_set("line period_s", "0")))],
+    argv=_without_line_times,
+)  # fmt: skip
+
+
 @pytest.mark.parametrize("case", CASES, ids=[c.id for c in CASES])
 def test_bad_input(case: Case, inputs: Inputs, capsys):
     if "readonly" in case.name and os.geteuid() == 0:

@@ -64,8 +64,12 @@ CLASSES = [
      "case:lp-observations:degenerate:nav-gap-under-a-strip", "added", ""),
     ("answer: navigation shifted in time", "lp-observations",
      "case:lp-observations:degenerate:nav-shifted-2-s", "mended",
-     "a shift of 0.2 s (12 m) is still measured: the squares are found within their search "
-     "window, as under a boresight error; only the adjustment can tell"),
+     "a 2 s shift is refused (0 squares found). A 0.2 s shift (12 m at 60 m/s) is "
+     "undetectable in principle at constant speed and height: it moves every ground point "
+     "v·Δt along the flight, as a pitch boresight of v·Δt/h does, in both flight directions "
+     "alike; the adjustment absorbs it into the pitch boresight and σ̂0 stays normal. The "
+     "user's check: adjust-pushbroom's pitch boresight against the sensor's calibration "
+     "(0.2 s at 60 m/s and 1 km: 0.69°), or strips flown at two speeds or heights"),
     ("answer: a camera boresight in radians under _deg", "lp-observations",
      "case:lp-observations:units:cam-boresight-in-radians", "added",
      "the message showed np.float64(...) reprs: mended"),
@@ -73,15 +77,19 @@ CLASSES = [
      "case:lp-observations:degenerate:squares-far-off", "mended", ""),
     ("answer: squares with E/N swapped", "lp-observations",
      "test:test_bad_input_classes.py::test_squares_with_e_and_n_swapped", "mended",
-     "refused where the exchange moves them off the strips; the simulated block is nearly "
-     "symmetric about E = N, so there the swapped ids land on other squares: open"),
+     "refused where the exchange moves them off the strips. Where the block is symmetric "
+     "about E = N the swapped table is a relabelling of the squares: undetectable in "
+     "principle (the images and the table stay consistent, adjust-pushbroom --gcp with the "
+     "same table fits as well). The user's check: one square's id against its surveyed "
+     "place on a map"),
     ("answer: squares in longitude/latitude", "lp-observations",
      "case:lp-observations:units:squares-in-lon-lat", "mended", ""),
     ("answer: squares' heights in mm", "lp-observations",
      "case:lp-observations:units:squares-heights-in-mm", "mended", ""),
-    ("answer: lines holding NaN", "orthorectify", "", "open",
-     "a NaN sample is mosaicked as an empty cell even where another strip has data "
-     "(hsgeo.ortho's mosaic rule: a numerical path this change does not touch)"),
+    ("answer: lines holding NaN", "orthorectify",
+     "test:test_bad_input_classes.py::test_a_nan_sample_yields_to_another_strips_data",
+     "mended", "a NaN sample yields to another strip's complete one under every rule "
+     "(hsgeo.ortho.mosaic_tile); a cell no other strip covers keeps its finite bands"),
     ("answer: navigation gaps", "orthorectify",
      "case:orthorectify-strips:degenerate:nav-gap", "before", ""),
     ("answer: a three-band DSM", "orthorectify",
@@ -160,11 +168,17 @@ CLASSES = [
     ("wrong cause: 8-bit profiles ('dark_dn at or above the profile's level')", "mtf",
      "case:mtf:units:profiles-8-bit", "mended", ""),
     ("wrong cause: a heading 180° off ('no two strips' / no squares)", "lp-observations",
-     "", "open", "the squares' refusal names the heading among its causes; the navigation "
-     "itself is not checked against the strips' overlap"),
+     "case:lp-observations:units:nav-heading-180-off", "mended",
+     "the navigation's heading is checked against its course over ground (median over the "
+     "moving records): opposite → refused naming heading_deg; also adjust-pushbroom "
+     "(case adjust-pushbroom:units:nav-heading-180-off)"),
     ("answer: --height far from the terrain without --squares", "lp-observations", "", "open",
      "found here (not in the issue): --height 1000 over terrain at 0 m gives 39 instead of "
-     "879 observations, exit 0; nothing in the files tells the terrain height"),
+     "879 observations, exit 0. Nothing in the inputs states the terrain height; it is "
+     "detectable only from the tie points themselves (their rays' intersections lie at the "
+     "true height), which lp-observations does not triangulate: not mended here. The "
+     "user's check: the count of observations against a run with --squares, or "
+     "adjust-pushbroom's adjusted points' H_m against --height"),
     ("wrong cause: lp-observations with squares that are not in the strips", "lp-observations",
      "case:lp-observations:degenerate:squares-far-off", "mended",
      "an answer without squares (exit 0) before"),
@@ -308,6 +322,39 @@ def test_navigation_in_radians_names_the_unit(cmd, inputs, capsys):  # noqa: F81
     rc, out, err = run_cli([*base_argv(cmd, d), "--json", "--accept-poor-fit"], capsys)
     assert rc == 0, err
     assert json.loads(out)["fit"]["verdict"] == "poor"
+
+
+@pytest.mark.parametrize("rule", ["nearest-nadir", "first", "mean"])
+def test_a_nan_sample_yields_to_another_strips_data(rule, monkeypatch):
+    """Issue 42 'lines holding NaN': where one strip's sample is NaN (a dropped pixel) and
+    another strip covers the cell, the mosaic takes the other's value, under every rule; a
+    cell only the NaN strip covers keeps its finite bands (nearest-nadir, first) or the
+    bands' own means. The rule alone: the strips' resampled swaths stand in (monkeypatched)."""
+    import hsgeo.ortho as O
+
+    nan = np.nan
+    # two strips, 1 x 3 cells, 2 bands; strip A nearer nadir (rank 1) but NaN in cell 0
+    swaths = {
+        "A": (np.array([[[nan, 1.0, 1.0]], [[nan, 1.0, nan]]], np.float32), np.ones((1, 3))),
+        "B": (np.array([[[2.0, 2.0, 9.0]], [[2.0, 2.0, 9.0]]], np.float32),
+              np.array([[5.0, 5.0, np.inf]])),
+    }  # fmt: skip
+    order = ["A", "B"]  # mosaic_tile resamples the strips in this order
+    one_pixel = (None, np.zeros((1, 2)), np.zeros(1))  # (ground, lon/lat, rank) of one pixel
+    monkeypatch.setattr(O, "geolocate_lines", lambda *a: one_pixel)
+    monkeypatch.setattr(O, "resample_swath", lambda *a: swaths[order.pop(0)])
+    grid = SimpleNamespace(height=1, width=3)
+    parts = [(k, [(0, 1, np.zeros((1, 1, 2), np.float32))]) for k in ("A", "B")]
+    out = O.mosaic_tile(grid, parts, None, SimpleNamespace(datum_epsg=4979), 1.0, 2, rule)
+    got = out[:, 0, :]
+    # cell 0: A is NaN in both bands → B's 2.0; cell 1: both complete → A (nearer nadir, or
+    # first) or their mean; cell 2: only A covers it, band 1 NaN → A's finite band kept
+    want = {
+        "nearest-nadir": [[2.0, 1.0, 1.0], [2.0, 1.0, nan]],
+        "first": [[2.0, 1.0, 1.0], [2.0, 1.0, nan]],
+        "mean": [[2.0, 1.5, 1.0], [2.0, 1.5, nan]],
+    }[rule]
+    np.testing.assert_allclose(got, np.array(want, np.float32), equal_nan=True)
 
 
 def counts() -> str:

@@ -132,6 +132,8 @@ def _cmd_adjust_pushbroom(args) -> int:
         progress=terminal.progress_printer(),
         y_as_time=not args.image_y,
         max_nav_gap_s=args.max_nav_gap_s,
+        nav_crs=args.nav_crs,
+        site=args.site,
     )
     out = res.to_dict()
     print(json_text(out) if args.json else res.result.report(max_block_size=20))
@@ -180,6 +182,8 @@ def _cmd_lp_observations(args) -> int:
         overwrite=args.overwrite,
         progress=terminal.stage_printer(),
         n_px_full=args.line_pixels,
+        nav_crs=args.nav_crs,
+        site=args.site,
     )
     terminal.clear_progress()
     d = res.to_dict()

@@ -431,6 +431,7 @@ def add_adjust_pushbroom(sub) -> argparse.ArgumentParser:
     )
     p.add_argument("--camera", required=True, help="camera and prior σ (TOML)")
     p.add_argument("--gcp", help="ground control points table (optional)")
+    _geodetic_navigation_options(p, "--gcp")
     p.add_argument(
         "--max-nav-gap-s",
         type=_POSITIVE,
@@ -515,6 +516,7 @@ def add_lp_observations(sub) -> argparse.ArgumentParser:
         help="RANSAC inlier threshold, px (default 1)",
     )
     p.add_argument("--squares", metavar="SQUARES.csv", help="reference squares (see above)")
+    _geodetic_navigation_options(p, "--squares")
     p.add_argument(
         "--height",
         type=option_number(lo=-1e4, hi=1e4),
@@ -544,6 +546,28 @@ def add_lp_observations(sub) -> argparse.ArgumentParser:
     )
     p.add_argument("--json", action="store_true", help="a JSON summary instead of text")
     return p
+
+
+def _geodetic_navigation_options(p, table: str) -> None:
+    """``--nav-crs`` and ``--site`` of the line scanners' commands (issue 38)."""
+    p.add_argument(
+        "--nav-crs",
+        metavar="EPSG:n",
+        help="the CRS of a navigation as delivered instead of the local-ENU file: a geodetic "
+        "CSV or Parquet (gps_sow_s [gps_week] or sod_s, lat_deg, lon_deg, h_m ellipsoidal, "
+        "roll_deg, pitch_deg, heading_deg against the NED at each record; or X_m, Y_m, Z_m "
+        "geocentric) or an Applanix SBET (.out); e.g. EPSG:4979 (WGS 84), EPSG:4937 (ETRS89). "
+        "A CSV may name it in a first line '# crs: EPSG:4979'. Its times are the lines' and the "
+        "observations' time scale",
+    )
+    p.add_argument(
+        "--site",
+        type=_site,
+        metavar="LAT,LON[,H]",
+        help="with a geodetic navigation: the origin of the local east-north-up frame "
+        f"(degrees, ellipsoidal m, on the navigation's datum) in which {table}'s E_m, N_m, H_m "
+        "are given (required with " + table + "; default the navigation's centre)",
+    )
 
 
 def _band_list(text: str) -> tuple:

@@ -204,6 +204,54 @@ class LocalFrame:
         )
         return np.asarray(E), np.asarray(N), np.asarray(U)
 
+    def lonlat_to_enu_precise(self, lon_deg, lat_deg, h_m):
+        """ENU (m) of geodetic points, computed in extended precision (a navigation's records).
+
+        The same conversion as :meth:`lonlat_to_enu` (geodetic → geocentric on the datum's
+        ellipsoid, then the topocentric rotation about the origin, EPSG Guidance Note 7-2,
+        methods 9602 and 9836), written out in ``numpy.longdouble`` (x87 80-bit on x86-64: 64-bit
+        mantissa) because in float64 the geocentric coordinates of ≈ 6.4e6 m carry ≈ 1e-9 m of
+        rounding into every E, N, U. Here the result is the float64 nearest to the exact one
+        (measured against a 1e-12 m iterated inverse in ``tests/test_geodetic_002_flight.py``);
+        on a platform whose ``longdouble`` is float64 it is as good as PROJ's.
+
+        Parameters
+        ----------
+        lon_deg, lat_deg : array_like, degrees
+            On the frame's datum.
+        h_m : array_like, m
+            Ellipsoidal height.
+
+        Returns
+        -------
+        E_m, N_m, U_m : ndarray (float64)
+        """
+        ld = np.longdouble
+        a_m, f = self._ellipsoid()
+        lon, lat, h = np.broadcast_arrays(
+            *(np.asarray(v, dtype=float).astype(ld) for v in (lon_deg, lat_deg, h_m))
+        )
+        X, Y, Z = _geocentric_ld(lon, lat, h, a_m, f)
+        o = [
+            np.asarray([v], dtype=float).astype(ld) for v in (self.lon_deg, self.lat_deg, self.h_m)
+        ]
+        X0, Y0, Z0 = _geocentric_ld(*o, a_m, f)
+        dX, dY, dZ = X - X0, Y - Y0, Z - Z0
+        lam0, phi0 = (v * (_PI_LD / 180) for v in o[:2])
+        sl, cl, sp, cp = np.sin(lam0), np.cos(lam0), np.sin(phi0), np.cos(phi0)
+        E = -sl * dX + cl * dY  # EPSG method 9836: the rows of R_ecef_from_enu(origin)ᵀ
+        N = -sp * cl * dX - sp * sl * dY + cp * dZ
+        U = cp * cl * dX + cp * sl * dY + sp * dZ
+        return tuple(np.asarray(v, dtype=np.float64) for v in (E, N, U))
+
+    def _ellipsoid(self) -> tuple[float, float]:
+        """Semi-major axis (m) and flattening of the datum's ellipsoid (as :meth:`_ellps`)."""
+        if int(self.datum_epsg) == ETRS89_GEOGRAPHIC_3D:
+            return 6378137.0, 1 / np.longdouble("298.257222101")  # GRS80
+        self._ellps()
+        e = self.datum_crs.ellipsoid
+        return e.semi_major_metre, 1 / np.longdouble(repr(e.inverse_flattening))
+
     # ---- ENU <-> map CRS ---------------------------------------------------------------------
     def enu_to_map(self, E_m, N_m, U_m):
         """Map coordinates (x east, y north in m; z the ellipsoidal height) of ENU points."""
@@ -369,6 +417,23 @@ def _R_ecef_from_enu(lon_deg, lat_deg) -> np.ndarray:
     north = np.stack([-sp * cl, -sp * sl, cp], axis=-1)
     up = np.stack([cp * cl, cp * sl, sp], axis=-1)
     return np.stack([east, north, up], axis=-1)
+
+
+#: π in extended precision.
+_PI_LD = np.longdouble("3.14159265358979323846264338327950288")
+
+
+def _geocentric_ld(lon_deg, lat_deg, h_m, a_m, f):
+    """Geocentric X, Y, Z (m) of geodetic points in ``numpy.longdouble`` (EPSG method 9602)."""
+    lam, phi = lon_deg * (_PI_LD / 180), lat_deg * (_PI_LD / 180)
+    e2 = f * (2 - f)
+    sp, cp = np.sin(phi), np.cos(phi)
+    n_m = np.longdouble(a_m) / np.sqrt(1 - e2 * sp * sp)  # prime vertical radius of curvature
+    return (
+        (n_m + h_m) * cp * np.cos(lam),
+        (n_m + h_m) * cp * np.sin(lam),
+        (n_m * (1 - e2) + h_m) * sp,
+    )
 
 
 #: The 002 site, Ås (Norway): 59.665° N, 10.775° E (002 §2), map CRS ETRS89 / UTM 32N.

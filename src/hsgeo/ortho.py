@@ -298,6 +298,10 @@ def ground_points(
     return out
 
 
+#: Added to the rank of a cell whose sample holds NaN in a band: any complete sample wins.
+_INCOMPLETE_RANK = 1e3
+
+
 def mosaic_tile(
     grid: MapGrid, parts, terrain, frame, radius_m: float, n_bands: int, rule="nearest-nadir"
 ):
@@ -321,7 +325,7 @@ def mosaic_tile(
     best = np.full((n_bands, grid.height, grid.width), np.nan, dtype=np.float32)
     best_rank = np.full((grid.height, grid.width), np.inf)
     total = np.zeros((n_bands, grid.height, grid.width)) if rule == "mean" else None
-    count = np.zeros((grid.height, grid.width)) if rule == "mean" else None
+    count = np.zeros((n_bands, grid.height, grid.width)) if rule == "mean" else None
     for strip, blocks in parts:
         ll, vals, ranks = [], [], []
         for a, b, v in blocks:
@@ -338,19 +342,24 @@ def mosaic_tile(
             frame.datum_epsg,
         )
         covered = np.isfinite(r)
+        # issue 42: a NaN sample (a dropped pixel) yields to another strip's complete one
+        r = np.where(covered & np.any(np.isnan(v), axis=0), r + _INCOMPLETE_RANK, r)
         if rule == "mean":
-            total[:, covered] += v[:, covered]
-            count[covered] += 1
+            ok = covered & np.isfinite(v)
+            total[ok] += v[ok]
+            count[ok] += 1
             continue
         if rule == "first":
-            win = covered & ~np.isfinite(best_rank)
+            win = covered & (
+                ~np.isfinite(best_rank) | ((best_rank >= _INCOMPLETE_RANK) & (r < _INCOMPLETE_RANK))
+            )
         else:  # nearest-nadir: the ray nearest to nadir
             win = r < best_rank
         best[:, win] = v[:, win]
         best_rank[win] = r[win]
     if rule == "mean":
         seen = count > 0
-        best[:, seen] = (total[:, seen] / count[seen]).astype(np.float32)
+        best[seen] = (total[seen] / count[seen]).astype(np.float32)
     return best
 
 

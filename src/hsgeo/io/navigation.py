@@ -70,6 +70,8 @@ __all__ = [
     "ATTITUDE_COLUMNS",
     "MAX_HEADING_COURSE_DEG",
     "COURSE_MIN_SPEED_M_S",
+    "check_heading_follows_course",
+    "read_line_navigation",
 ]
 
 #: Columns of the navigation file, in the order the writer uses.
@@ -540,7 +542,7 @@ def _to_frame(
     if epsg != int(frame.datum_epsg):
         tr = Transformer.from_crs(crs3d, frame.datum_crs, always_xy=True)
         lon, lat, h = (np.asarray(v) for v in tr.transform(lon, lat, h))
-    enu = np.column_stack(frame.lonlat_to_enu(lon, lat, h))
+    enu = np.column_stack(frame.lonlat_to_enu_precise(lon, lat, h))
     _check_records(name, lines, t, enu, ang_deg, "latitude, longitude, height", tcol)
     _check_heading(name, enu, t, ang_deg[:, 2])
     a = np.deg2rad(ang_deg)
@@ -552,7 +554,34 @@ def _to_frame(
     return Navigation(Trajectory(t, enu, rph), frame, scale, week, src_name)
 
 
-def _check_heading(name, enu, t, heading_deg) -> None:
+def check_heading_follows_course(traj: Trajectory, name: str) -> None:
+    """Refuse a local-ENU navigation whose heading does not follow its course over ground.
+
+    For the line scanners' commands (``lp-observations``, ``adjust-pushbroom``): their
+    platform flies forward, so where it moves faster than :data:`COURSE_MIN_SPEED_M_S` the
+    heading is the course within a crab angle (:data:`MAX_HEADING_COURSE_DEG`). Refused here: a
+    heading opposite to the course (more than 180° − that angle off; issue 42: exit 0 with
+    mirrored ground points before). A heading otherwise off (radians, from east) is left to the
+    adjustment, whose poor fit names the angle unit (``adjust-pushbroom``). Not applied by
+    :func:`read_trajectory` itself: a multirotor carrying a frame camera may fly sideways.
+
+    Parameters
+    ----------
+    traj : Trajectory
+    name : str
+        The file in the user's words, e.g. ``"navigation file 'nav.csv'"``.
+
+    Raises
+    ------
+    InputError
+        Naming the file, the column heading_deg and the remedy.
+    """
+    _check_heading(
+        name, traj.xyz_m, traj.t_s, np.rad2deg(traj.roll_pitch_heading_rad[:, 2]), opposite=True
+    )
+
+
+def _check_heading(name, enu, t, heading_deg, opposite: bool = False) -> None:
     """The heading follows the course over ground (within a crab angle) where the platform
     moves: else the heading column is not a true heading in degrees.
     """
@@ -565,10 +594,81 @@ def _check_heading(name, enu, t, heading_deg) -> None:
     hmid = 0.5 * (heading_deg[1:] + heading_deg[:-1])
     d = np.abs((hmid - course + 180.0) % 360.0 - 180.0)[moving]
     med = float(np.median(d))
-    if med > MAX_HEADING_COURSE_DEG:
+    if med > 180.0 - MAX_HEADING_COURSE_DEG:  # issue 42: a heading 180° off
+        raise InputError(
+            f"{name}, column heading_deg: the heading is opposite to the course over ground "
+            f"({med:.1f}° off, median over {d.size} moving records): the sensor would look "
+            "backwards and every ground point lands mirrored. Give the true heading of the body's "
+            "x axis (forward), in degrees clockwise from north: add 180° if it is the reverse"
+        )
+    if med > MAX_HEADING_COURSE_DEG and not opposite:
         raise InputError(
             f"{name}, column heading_deg: the heading differs from the course over ground by "
             f"{med:.1f}° (median over {d.size} moving records; an aircraft crabs by less than "
             f"{MAX_HEADING_COURSE_DEG:g}°). Give the true heading in degrees, clockwise from "
             "north (not radians, not a yaw from east, not a wander-frame heading)"
         )
+
+
+def read_line_navigation(path, *, crs=None, site=None, frame_needed_by: str | None = None):
+    """The navigation of the line scanners' commands (``lp-observations``, ``adjust-pushbroom``)
+    in a local frame: a local-ENU file as read, or a navigation as delivered (a geodetic CSV
+    or Parquet, an Applanix SBET; :func:`read_navigation`) carried into a local frame.
+
+    Parameters
+    ----------
+    path : str or path-like
+    crs : str or int, optional
+        ``--nav-crs``: the geodetic navigation's CRS (an SBET's is required; a CSV's may be its
+        ``# crs:`` line).
+    site : (lat_deg, lon_deg[, h_m]), optional
+        ``--site``: the origin of the local frame, on the navigation's datum, in which the
+        commands' other tables (GCPs, squares: ``E_m, N_m, H_m``) are given. Without it the
+        frame is about the navigation's centre.
+    frame_needed_by : str, optional
+        The option whose table is in the local frame (``"--gcp"``, ``"--squares"``): a geodetic
+        navigation then needs ``site``, else those coordinates would be taken in a frame the
+        user never saw.
+
+    Returns
+    -------
+    traj : Trajectory
+        Times as in the file (GPS seconds of week or of day: the lines' and the observations'
+        time scale must be the same), positions E, N, U in the frame, attitude against its NED.
+    frame : hsgeo.crs.LocalFrame or None
+        None for a local-ENU file.
+
+    Raises
+    ------
+    InputError
+        As :func:`read_navigation`; ``--nav-crs``/``--site`` given with a local-ENU file; a
+        geodetic navigation with local-frame GCPs or squares but no ``--site``; a heading that
+        does not follow the course (:func:`check_heading_follows_course`).
+    """
+    from hsgeo.crs import LocalFrame
+
+    path = Path(path)
+    name = f"navigation file {str(path)!r}"
+    nav = read_navigation(path, crs=crs)
+    if nav.source_crs == "local ENU":
+        if crs is not None or site is not None:
+            opt = "--nav-crs" if crs is not None else "--site"
+            raise InputError(
+                f"{opt} is for a navigation as delivered (latitude, longitude, height or an "
+                f"SBET), but {name} is already in a local east-north-up frame (t_s, E_m, N_m, "
+                f"U_m): drop {opt}"
+            )
+        check_heading_follows_course(nav.trajectory, name)
+        return nav.trajectory, None
+    if site is None and frame_needed_by is not None:
+        raise InputError(
+            f"{name} is geodetic ({nav.source_crs}), but the table of {frame_needed_by} has "
+            "E_m, N_m, H_m in a local east-north-up frame: give its origin as --site LAT,LON[,H] "
+            f"(degrees and ellipsoidal metres on the navigation's datum, EPSG:"
+            f"{int(nav.frame.datum_epsg)})"
+        )
+    if site is not None:
+        lat, lon, *h = (float(v) for v in site)
+        frame = LocalFrame(lat, lon, h[0] if h else 0.0, None, int(nav.frame.datum_epsg))
+        nav = read_navigation(path, crs=crs, frame=frame)
+    return nav.trajectory, nav.frame

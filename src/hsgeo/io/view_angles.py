@@ -50,14 +50,14 @@ def read_view_angles(path) -> tuple[np.ndarray, np.ndarray]:
     from hsgeo.io.tables import read_table
 
     what = f"view-angle table {str(path)!r}"
-    head = read_table(
-        path,
-        ["pixel", "across_deg", "along_deg"],
-        "view-angle",
-        integer_columns=["pixel"],
-        limits={"across_deg": (-89.0, 89.0), "along_deg": (-89.0, 89.0)},
+    kw = dict(
+        integer_columns=["pixel"], limits={"across_deg": (-89.0, 89.0), "along_deg": (-89.0, 89.0)}
     )
+    cols = ["pixel", "across_deg", "along_deg"]
+    head = read_table(path, cols, "view-angle", unique_rows=False, **kw)
     has_band = "band" in head.columns
+    if not has_band:  # a row given twice, named by its lines (one per band is not a repeat)
+        head = read_table(path, cols, "view-angle", **kw)
     if has_band:
         try:
             bands = np.asarray(head["band"], dtype=float)

@@ -726,6 +726,8 @@ def lp_observation_files(
     overwrite: bool = False,
     progress=None,
     n_px_full: int | None = None,
+    nav_crs=None,
+    site=None,
 ) -> LpResult:
     """``hsgeo lp-observations``: LP line files → the observation table of ``adjust-pushbroom``.
 
@@ -734,7 +736,9 @@ def lp_observation_files(
     scenes : sequence of path
         LP line files (:mod:`hsgeo.io.lp_lines`), one strip each.
     trajectory : path
-        The navigation file of every command (:mod:`hsgeo.io.navigation`).
+        The navigation file of every command (:mod:`hsgeo.io.navigation`), or one as delivered
+        (geodetic CSV or Parquet, Applanix SBET: :func:`hsgeo.io.navigation.read_line_navigation`
+        with ``nav_crs`` and ``site``, the origin of the squares' frame).
     camera : path
         The camera TOML of ``hsgeo adjust-pushbroom`` (:func:`hsgeo.io.read_pushbroom_camera`:
         ``c_band_mm`` or ``c_mm``, ``pixel_mm``, ``boresight_deg``, ``lever_arm_m`` …).
@@ -764,9 +768,10 @@ def lp_observation_files(
     """
     import pandas as pd
 
-    from hsgeo.io import read_pushbroom_camera, read_table, read_trajectory
+    from hsgeo.io import read_pushbroom_camera, read_table
     from hsgeo.io._files import check_outputs
     from hsgeo.io.lp_lines import full_line_px, read_lp_lines
+    from hsgeo.io.navigation import read_line_navigation
     from hsgeo.io.tables import TABLE_FORMATS, write_table
     from hsgeo.validate import check_navigation_covers
     from hsgeo.workflows.pushbroom_ba import GCP_COLUMNS
@@ -774,7 +779,12 @@ def lp_observation_files(
     files = [*scenes, trajectory, camera, squares]
     check_outputs([(output, "-o/--output", TABLE_FORMATS)], files, overwrite=overwrite)
     strips = [read_lp_lines(p) for p in scenes]
-    traj = read_trajectory(trajectory)
+    traj, _ = read_line_navigation(
+        trajectory,
+        crs=nav_crs,
+        site=site,
+        frame_needed_by="--squares" if squares is not None else None,
+    )
     cam = read_pushbroom_camera(camera)
     ids, xyz = (), None
     if squares is not None:

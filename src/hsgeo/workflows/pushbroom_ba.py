@@ -597,6 +597,8 @@ def adjust_files(
     progress=None,
     y_as_time: bool = Y_AS_TIME,
     max_nav_gap_s: float = 1.0,
+    nav_crs=None,
+    site=None,
 ) -> PushbroomResult:
     """Adjust a user's pushbroom observations (``hsgeo adjust-pushbroom``).
 
@@ -624,6 +626,12 @@ def adjust_files(
         CSV or Parquet with ``point_id, E_m, N_m, H_m`` (points of the observation table).
     max_nav_gap_s : float
         The longest gap between navigation records interpolated across (s).
+    nav_crs : str or int, optional
+        The CRS of a navigation as delivered (geodetic CSV or Parquet, Applanix SBET; see
+        :func:`hsgeo.io.navigation.read_line_navigation`): ``--nav-crs``.
+    site : (lat_deg, lon_deg[, h_m]), optional
+        The origin of the local frame of the GCPs (``--site``); required with a geodetic
+        navigation and ``gcp``.
 
     Returns
     -------
@@ -633,7 +641,7 @@ def adjust_files(
         ``fit``, the plausibility verdict of :func:`fit_verdict` (``hsgeo adjust-pushbroom``
         exits 2 on a poor fit unless ``--accept-poor-fit``); ``result`` the engine's.
     """
-    from hsgeo.io.navigation import read_trajectory
+    from hsgeo.io.navigation import read_line_navigation
 
     obs_df = read_table(  # the files in this order: the first bad one is reported
         observations,
@@ -642,7 +650,9 @@ def adjust_files(
         text_columns=("point_id",),
         integer_columns=("band",),
     )
-    traj = read_trajectory(trajectory)
+    traj, _ = read_line_navigation(
+        trajectory, crs=nav_crs, site=site, frame_needed_by="--gcp" if gcp is not None else None
+    )
     cam = read_camera(camera)
     obs, ids = _observations(obs_df, observations, trajectory, traj, cam, max_nav_gap_s)
     _check_node_memory(obs.t_s, node_interval_s)
