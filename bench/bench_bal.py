@@ -61,6 +61,42 @@ THREADS = 1
 PROBLEM = "BAL Ladybug problem-49-7776-pre (Agarwal et al. 2010)"
 
 
+def _cpu_model() -> str | None:
+    """The processor's model name (``/proc/cpuinfo``; None where there is none)."""
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.lower().startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or None
+
+
+def _blas() -> list[dict]:
+    """The BLAS libraries loaded with numpy and scipy, with the core type each chose
+    (threadpoolctl's ``internal_api``, ``architecture``, ``version``, ``num_threads``): a
+    lead that depends on the machine (e.g. OpenBLAS' kernels for one core type) shows here.
+    """
+    import numpy  # noqa: F401
+    import scipy.linalg  # noqa: F401
+    from threadpoolctl import threadpool_info
+
+    keys = ("user_api", "internal_api", "architecture", "version", "num_threads", "prefix")
+    return [{k: d.get(k) for k in keys} for d in threadpool_info() if d.get("user_api") == "blas"]
+
+
+def _machine_info() -> dict:
+    """The machine the figures were measured on, recorded beside them (issue 41)."""
+    return {
+        "cpu_model": _cpu_model(),
+        "cpus": os.cpu_count(),
+        "python": platform.python_version(),
+        "platform": platform.machine(),
+        "blas": _blas(),
+        "loadavg_at_end": list(os.getloadavg()),
+    }
+
+
 def _problem():
     from hsgeo.io.bal import ladybug_path, read_bal
     from hsgeo.workflows.bal import prepare
@@ -265,6 +301,7 @@ def main(argv=None) -> None:
         }[args.case]
         out = fn()
         out["peak_rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+        out["blas"] = _blas()  # the core type this case's BLAS chose, in its own process
         print(json.dumps(out))
         return
     import importlib.util
@@ -346,6 +383,14 @@ def main(argv=None) -> None:
         "pycolmap": c["pycolmap"],
         "machine": f"{platform.machine()}, {os.cpu_count()} cores, {platform.python_version()}",
         "load_average": os.getloadavg()[0],
+        # the CPU model and the BLAS core type beside the figures: the lead over Ceres was
+        # 1.29x on one machine and 0.92x on another of the same kind (issue 41)
+        "cpu_model": _cpu_model(),
+        "blas_hsgeo": h.get("blas"),
+        "blas_ceres_process": c.get("blas"),
+        "machine_info": _machine_info(),
+        "cpu_speedup_to_ceres_cost": None if cpu_to is None else ce_cpu / cpu_to,
+        "goal_cpu_speedup_min": 1.5,
     }
     (HERE / "results").mkdir(exist_ok=True)
     path = HERE / "results" / "bal.json"
