@@ -11,6 +11,11 @@ What the ground is made of (all drawn from one ``numpy.random.Generator``):
   **buildings** (rotated rectangles with a two-tone gabled roof, a few metres high on the DSM);
 * the **white reference squares** on a grass patch, rasterised with their exact cell coverage
   (anti-aliased), so that the blurred square's centroid is its centre;
+* optionally, small white **point targets** (``targets_en_m``, :attr:`LpConfig.target_side_m`
+  squares of about two pixels, exact cell coverage, painted over the texture): features whose
+  ground centre is known, for judging the matcher's observations against an independent
+  reference (:mod:`hsgeo.reproduce.lp_targets`); none by default, and with none the ground is
+  the same to the bit;
 * a gently undulating **terrain** under it all (the DSM, with the buildings' height steps).
 
 The reflectance of each material in each band is :data:`SPECTRA` (ours, typical shapes:
@@ -281,9 +286,27 @@ def _box_weights(width_cells: float) -> np.ndarray:
     return w / w.sum()
 
 
-def _reflectance(cfg, r: _Raster, squares_en, wavelengths_nm, rng) -> np.ndarray:
+def _coverage(r: _Raster, centres_en, side_m: float) -> np.ndarray:
+    """Share of each raster cell covered by any of the axis-aligned squares of side ``side_m``
+    centred at ``centres_en`` (exact, :func:`_square_coverage`), ``(n, n)`` float32.
+    """
+    cov = np.zeros(r.shape, np.float32)
+    s = side_m
+    for c in centres_en:
+        hit = r.cells(
+            lambda e, nn: np.ones(np.broadcast(e, nn).shape, bool),
+            (c[0] - s, c[0] + s, c[1] - s, c[1] + s),
+        )
+        if hit is not None:
+            sl, _ = hit
+            cov[sl] = np.maximum(cov[sl], _square_coverage(r.E[sl[1]], r.N[sl[0]], r.cell, c, s))
+    return cov
+
+
+def _reflectance(cfg, r: _Raster, squares_en, wavelengths_nm, rng, targets_en=()) -> np.ndarray:
     """Blurred reflectance per band, ``(n_bands, n, n)`` float32: material spectra × brightness
-    × (1 + texture), the white squares mixed in by their exact coverage, then the PSF.
+    × (1 + texture), the white squares (and point targets) mixed in by their exact coverage,
+    then the PSF.
     """
     from scipy.ndimage import convolve1d, gaussian_filter
 
@@ -292,16 +315,9 @@ def _reflectance(cfg, r: _Raster, squares_en, wavelengths_nm, rng) -> np.ndarray
     spectra = _spectra(wavelengths_nm)
     mod = np.clip(r.bright * (1 + _TEXTURE[r.material] * tex), 0.05, 3.0)
     del tex
-    cov = np.zeros(r.shape, np.float32)
-    s = cfg.square_side_m
-    for c in squares_en:
-        hit = r.cells(
-            lambda e, nn: np.ones(np.broadcast(e, nn).shape, bool),
-            (c[0] - s, c[0] + s, c[1] - s, c[1] + s),
-        )
-        if hit is not None:
-            sl, _ = hit
-            cov[sl] = np.maximum(cov[sl], _square_coverage(r.E[sl[1]], r.N[sl[0]], r.cell, c, s))
+    cov = _coverage(r, squares_en, cfg.square_side_m)
+    if len(targets_en):
+        cov = np.maximum(cov, _coverage(r, targets_en, cfg.target_side_m))
     white = spectra[MATERIALS.index("white")]
     refl = np.empty((spectra.shape[1],) + r.shape, np.float32)
     for b in range(refl.shape[0]):
@@ -314,7 +330,9 @@ def _reflectance(cfg, r: _Raster, squares_en, wavelengths_nm, rng) -> np.ndarray
     return refl
 
 
-def make_ground(cfg, half_m: float, squares_en_m, wavelengths_nm, rng) -> tuple[Ground, np.ndarray]:
+def make_ground(
+    cfg, half_m: float, squares_en_m, wavelengths_nm, rng, targets_en_m=()
+) -> tuple[Ground, np.ndarray]:
     """Draw and rasterise the ground over ``[-half_m, half_m]²`` (plus ``cfg.ground_margin_m``).
 
     Parameters
@@ -328,12 +346,18 @@ def make_ground(cfg, half_m: float, squares_en_m, wavelengths_nm, rng) -> tuple[
         Centres of the white squares (E, N), m.
     wavelengths_nm : (n_bands,) sequence
     rng : numpy.random.Generator
+    targets_en_m : (t, 2) array_like
+        Centres of the point targets (E, N), m (squares of ``cfg.target_side_m``); none by
+        default (the ground is then the same to the bit, the generator's draws unchanged).
 
     Returns
     -------
     ground : Ground
     squares_h_m : (k,) ndarray
         DSM height at each square's centre (flat grass there).
+    targets_xyz_m : (t', 3) ndarray
+        The point targets painted (those on open ground, :func:`_open_ground`): centre E, N
+        and the DSM height there.
     """
     ext = half_m + cfg.ground_margin_m
     sq = np.asarray(squares_en_m, dtype=float).reshape(-1, 2)
@@ -350,10 +374,40 @@ def make_ground(cfg, half_m: float, squares_en_m, wavelengths_nm, rng) -> tuple[
             MATERIALS.index("grass"),
             1.0,
         )
-    refl = _reflectance(cfg, r, sq, wavelengths_nm, rng)
+    tg = _open_ground(r, np.asarray(targets_en_m, dtype=float).reshape(-1, 2), sq)
+    refl = _reflectance(cfg, r, sq, wavelengths_nm, rng, tg)
     ground = Ground(-ext, -ext, r.cell, refl, r.material, dsm, float(cfg.dsm_cell_m))
     squares_h = dsm_height(ground, sq[:, 0], sq[:, 1]) if len(sq) else np.zeros(0)
-    return ground, squares_h
+    targets = np.column_stack([tg, dsm_height(ground, tg[:, 0], tg[:, 1]) if len(tg) else []])
+    return ground, squares_h, targets.reshape(-1, 3)
+
+
+#: A point target is painted only where no roof lies within this distance (m: the DSM's height
+#: step would occlude it from some strips and make its height ill-defined) and no reference
+#: square's centre within the second (m: ten pixels, clear of the square's blob).
+_TARGET_CLEAR_M, _TARGET_FROM_SQUARE_M = 1.5, 3.0
+
+
+def _open_ground(r: _Raster, targets_en, squares_en) -> np.ndarray:
+    """The targets that lie on open ground: no roof within :data:`_TARGET_CLEAR_M`, no square
+    within :data:`_TARGET_FROM_SQUARE_M`; ``(t', 2)``.
+    """
+    keep = []
+    roof = MATERIALS.index("roof")
+    d = _TARGET_CLEAR_M
+    for c in targets_en:
+        if len(squares_en) and np.min(np.hypot(*(squares_en - c).T)) < _TARGET_FROM_SQUARE_M:
+            continue
+        hit = r.cells(
+            lambda e, nn, c=c: (e - c[0]) ** 2 + (nn - c[1]) ** 2 <= d * d,
+            (c[0] - d, c[0] + d, c[1] - d, c[1] + d),
+        )
+        if hit is None:
+            continue
+        sl, m = hit
+        if not np.any(r.material[sl][m] == roof):
+            keep.append(c)
+    return np.asarray(keep, dtype=float).reshape(-1, 2)
 
 
 def _terrain(cfg, De, Dn, rng) -> np.ndarray:

@@ -134,6 +134,13 @@ class LpConfig:
     # adjustment as 002's calibrated camera) is off the truth by a calibration error of this σ
     # per axis (ours: a tenth of a pixel); 0: the truth itself
     sigma_pp_calibration_px: float = 0.1
+    # point targets (ours; for judging the matcher against features of known position,
+    # :mod:`hsgeo.reproduce.lp_targets`): white squares of ``target_side_m`` (about two pixels)
+    # on a jittered grid of this spacing over the block, on open ground (no roof within 1.5 m,
+    # no reference square within 3 m), their positions drawn from a spawned stream so that the
+    # campaign's other draws do not move; 0 (the default): none, the chapter's campaign
+    target_spacing_m: float = 0.0
+    target_side_m: float = 0.6
     # -- radiometry (ours): DN per unit reflectance per band, one integration time; vegetation
     # (ρ ≈ 0.48) reaches ~90 % of dn_max above the red edge (002 §5.3: "close to saturation")
     dn_max: float = 4095.0
@@ -200,6 +207,9 @@ class LpTruth:
     nav_error : callable
         ``nav_error(t_s) -> (m, 6)``: true minus navigation (E, N, H m; platform roll, pitch,
         yaw rad).
+    target_xyz_m : (t, 3) ndarray
+        Centres of the point targets (E, N, and the DSM height there, m); none unless
+        :attr:`LpConfig.target_spacing_m` > 0.
     """
 
     trajectory: Trajectory
@@ -211,6 +221,7 @@ class LpTruth:
     plan: list
     strip_index: np.ndarray
     nav_error: object = None
+    target_xyz_m: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
 
     def ground_points(self, t_s, x_px, band) -> np.ndarray:
         """True ground point (E, N, U, m) seen by pixels ``x_px`` of the lines at ``t_s``.
@@ -330,7 +341,14 @@ def _checked(scale, cfg):
             f"below {MIN_SCALE} the 17 squares crowd a block of under 30 m), got {scale}"
         )
     cfg = cfg or LpConfig()
-    for name in ("ground_cell_m", "dsm_cell_m", "field_size_m", "dn_max", "electrons_per_dn"):
+    for name in (
+        "ground_cell_m",
+        "dsm_cell_m",
+        "field_size_m",
+        "dn_max",
+        "electrons_per_dn",
+        "target_side_m",
+    ):
         v = getattr(cfg, name)
         if not (np.isfinite(v) and v > 0):
             raise InputError(f"LpConfig.{name} must be a positive number, got {v!r}")
@@ -342,11 +360,12 @@ def _checked(scale, cfg):
             "read_noise_dn",
             "mount_motion_rad",
             "sigma_pp_calibration_px",
+            "target_spacing_m",
         )
     ):
         raise InputError(
-            "LpConfig: psf_sigma_m, motion_blur_m, read_noise_dn, mount_motion_rad and "
-            "sigma_pp_calibration_px must be ≥ 0"
+            "LpConfig: psf_sigma_m, motion_blur_m, read_noise_dn, mount_motion_rad, "
+            "sigma_pp_calibration_px and target_spacing_m must be ≥ 0"
         )
     if cfg.exposure_stamp not in ("middle", "start"):
         raise InputError(
@@ -418,7 +437,8 @@ def simulate(
     # the squares (002's layout shrunk with the block) and the ground
     half = c.area_m / 2 * scale
     sq_en = (np.asarray(REFERENCE_EN_M, float) + rng.uniform(-20, 20, (17, 2))) * scale
-    ground, sq_h = make_ground(cfg, half, sq_en, c.wavelengths_nm[:nb], rng)
+    tg_en = _target_grid(cfg, half, rng)
+    ground, sq_h, tg_xyz = make_ground(cfg, half, sq_en, c.wavelengths_nm[:nb], rng, tg_en)
     sq_true = np.column_stack([sq_en, sq_h])
     sq_rtk = sq_true + c.sigma_gcp_m * rng.standard_normal(sq_true.shape)
     h_mean = float(ground.dsm.mean())
@@ -464,5 +484,19 @@ def simulate(
         plan=plan,
         strip_index=np.asarray(index, dtype=np.int64),
         nav_error=nav_err,
+        target_xyz_m=tg_xyz,
     )
     return obs, truth
+
+
+def _target_grid(cfg: LpConfig, half_m: float, rng) -> np.ndarray:
+    """Centres (E, N) of the point targets: a grid of ``cfg.target_spacing_m`` over the block
+    (half a spacing in from its edges), each jittered by up to a quarter spacing, from a spawned
+    stream (the campaign's own draws do not move); ``(0, 2)`` when the spacing is 0.
+    """
+    s = cfg.target_spacing_m
+    if s <= 0:
+        return np.zeros((0, 2))
+    g = np.arange(-half_m + s / 2, half_m - s / 2 + 1e-9, s)
+    en = np.stack(np.meshgrid(g, g, indexing="xy"), axis=-1).reshape(-1, 2)
+    return en + rng.spawn(1)[0].uniform(-s / 4, s / 4, en.shape)
