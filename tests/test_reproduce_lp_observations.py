@@ -209,7 +209,7 @@ def test_same_seed_same_rows(rep):
 
 @pytest.fixture(scope="module")
 def rep7():
-    return run(seed=7, scale=SMALL, unmodelled=False)
+    return run(seed=7, scale=SMALL, unmodelled=False, judges=False)
 
 
 @pytest.mark.slow
