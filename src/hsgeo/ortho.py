@@ -7,8 +7,10 @@ local ENU frame, then longitude and latitude on the frame's datum by
 :class:`hsgeo.crs.LocalFrame`), and the swath is resampled onto a :class:`MapGrid` in the map CRS
 (EPSG:25832 for 002) by nearest
 neighbour within a radius of influence (every spectrum stays as it was measured, as is usual for
-imaging spectrometers), found by pykdtree (pyresample's kd-tree) in the grid's own metres
-(:func:`resample_swath` says why not through pyresample's geographic path).
+imaging spectrometers), found in the grid's own metres: by a compiled bucket search in the
+tiles of :func:`orthomosaic` (:func:`hsgeo._nearest.nearest_cells`, the answer of a kd-tree at a
+tenth of its cost), by pykdtree (pyresample's kd-tree) in :func:`resample_swath` (which says
+why not through pyresample's geographic path).
 
 **Mosaic rules** (:data:`MOSAIC_RULES`, ``hsgeo orthorectify --mosaic``). Within one strip a
 map cell takes the strip's nearest pixel (within the radius of influence). Where strips overlap:
@@ -24,10 +26,13 @@ map cell takes the strip's nearest pixel (within the radius of influence). Where
   of different strips mixed: for display, not for spectral analysis).
 
 **Chunks.** :func:`orthomosaic` returns an :class:`xarray.DataArray` ``(band, y, x)`` backed by
-Dask, one chunk per output tile. A tile's task geolocates only the line blocks whose footprint
-(the geolocated perimeter of the block, plus the radius of influence) meets the tile, from the
-lines of those blocks alone: the cube may be a lazily generated Dask array larger than memory,
-and the same graph runs on the threaded scheduler or on a ``dask.distributed`` cluster.
+Dask, one chunk per output tile. Each line block is geolocated once, by its own task
+(:func:`block_ground`: map x, y and off-nadir angle of its pixels, the poses computed once per
+line); a tile's task takes the blocks whose footprint (the geolocated perimeter of the block,
+plus the radius of influence) meets the tile, with their lines alone, finds each cell's
+nearest pixel once for all bands and applies the rule: the cube may be a lazily generated
+Dask array larger than memory, and the same graph runs on the threaded scheduler or on a
+``dask.distributed`` cluster.
 """
 
 from __future__ import annotations
@@ -36,6 +41,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from hsgeo._perline import PerLine as _PerLine
 from hsgeo.errors import InputError
 from hsgeo.geocode import intersect
 from hsgeo.mapgrid import MapGrid
@@ -47,6 +53,7 @@ __all__ = [
     "resample_swath",
     "orthomosaic",
     "mosaic_tile",
+    "block_ground",
     "ground_points",
     "OFF_NADIR_NAME",
     "MOSAIC_RULES",
@@ -166,7 +173,8 @@ def geolocate_lines(strip: Strip, terrain, frame, lines=slice(None), columns=sli
     """
     m, k = strip.t_s[lines].size, strip.pixels[columns].shape[0]
     tt, pp = strip.line_pixels(lines, columns)
-    o, d = strip.sensor.rays(pp, tt, strip.trajectory, **strip.pixel_kw)
+    nav = _PerLine(strip.trajectory, strip.t_s[lines], tt, k)
+    o, d = strip.sensor.rays(pp, tt, nav, **strip.pixel_kw)
     X = intersect(o, d, terrain)
     lon, lat, _ = frame.enu_to_lonlat(X[:, 0], X[:, 1], X[:, 2])
     off = np.degrees(np.arccos(np.clip(-d[:, 2], -1.0, 1.0)))
@@ -298,22 +306,42 @@ def ground_points(
     return out
 
 
+def block_ground(strip: Strip, terrain, frame, lines: tuple, crs: str) -> np.ndarray:
+    """Map x, y (in ``crs``, m) and off-nadir angle (degrees) of every pixel of a line block.
+
+    :func:`geolocate_lines` of lines ``line0 … line1 - 1`` (``lines``), the longitude and
+    latitude taken to ``crs`` (pyproj): what every tile the block meets shares (one task per
+    block in :func:`orthomosaic`'s graph: the geometry is never recomputed per tile or band).
+
+    Returns
+    -------
+    (3, m * k) float64 ndarray
+        Rows x, y, off-nadir angle; pixels line by line.
+    """
+    from hsgeo.crs import lonlat_to_crs
+
+    _, lonlat, off = geolocate_lines(strip, terrain, frame, slice(*lines))
+    ll = lonlat.reshape(-1, 2)
+    x, y = lonlat_to_crs(crs, ll[:, 0], ll[:, 1], frame.datum_epsg)
+    return np.stack([np.asarray(x, float), np.asarray(y, float), off.ravel()])
+
+
 #: Added to the rank of a cell whose sample holds NaN in a band: any complete sample wins.
 _INCOMPLETE_RANK = 1e3
 
 
-def mosaic_tile(
-    grid: MapGrid, parts, terrain, frame, radius_m: float, n_bands: int, rule="nearest-nadir"
-):
-    """One output tile: each strip's lines that meet it, resampled, mosaicked by ``rule``.
+def mosaic_tile(grid: MapGrid, parts, radius_m: float, n_bands: int, rule="nearest-nadir"):
+    """One output tile: each strip's pixels near it, resampled, mosaicked by ``rule``.
 
     Parameters
     ----------
     grid : MapGrid
         The tile.
-    parts : list of (Strip, [(line0, line1, values_block), ...])
-        Per strip (its geometry) the line blocks that meet the tile and their values
-        ``(m, n_px, n_bands)``.
+    parts : list of ([ground, ...], [values, ...])
+        Per strip the line blocks that meet the tile: their :func:`block_ground` ``(3, m·k)``
+        and their values ``(m, k, n_bands)``.
+    radius_m : float
+        Radius of influence.
     rule : str
         Where strips overlap (:data:`MOSAIC_RULES`): ``"nearest-nadir"``, ``"first"``,
         ``"mean"``.
@@ -321,58 +349,61 @@ def mosaic_tile(
     Returns
     -------
     (n_bands, height, width) float32 ndarray, NaN where no strip covers the cell.
+
+    Notes
+    -----
+    A cell takes each strip's nearest pixel within ``radius_m`` (the compiled bucket search
+    :func:`hsgeo._nearest.nearest_cells`: the kd-tree's answer), every band at once.
     """
-    best = np.full((n_bands, grid.height, grid.width), np.nan, dtype=np.float32)
-    best_rank = np.full((grid.height, grid.width), np.inf)
-    total = np.zeros((n_bands, grid.height, grid.width)) if rule == "mean" else None
-    count = np.zeros((n_bands, grid.height, grid.width)) if rule == "mean" else None
-    for strip, blocks in parts:
-        ll, vals, ranks = [], [], []
-        for a, b, v in blocks:
-            _, lonlat, off = geolocate_lines(strip, terrain, frame, slice(a, b))
-            ll.append(lonlat.reshape(-1, 2))
-            vals.append(np.asarray(v, dtype=np.float32).reshape(-1, n_bands))
-            ranks.append(off.ravel())
-        v, r = resample_swath(
-            np.concatenate(ll),
-            np.concatenate(vals),
-            np.concatenate(ranks),
-            grid,
-            radius_m,
-            frame.datum_epsg,
-        )
-        covered = np.isfinite(r)
-        # issue 42: a NaN sample (a dropped pixel) yields to another strip's complete one
-        r = np.where(covered & np.any(np.isnan(v), axis=0), r + _INCOMPLETE_RANK, r)
-        if rule == "mean":
-            ok = covered & np.isfinite(v)
-            total[ok] += v[ok]
-            count[ok] += 1
+    from hsgeo._nearest import nearest_cells
+
+    n_cells = grid.height * grid.width
+    best = np.full((n_cells, n_bands), np.nan, dtype=np.float32)
+    best_rank = np.full(n_cells, np.inf)
+    total = np.zeros((n_cells, n_bands)) if rule == "mean" else None
+    count = np.zeros((n_cells, n_bands)) if rule == "mean" else None
+    for grounds, values in parts:
+        g = grounds[0] if len(grounds) == 1 else np.concatenate(grounds, axis=1)
+        pix = nearest_cells(grid.x_m, grid.y_m, g[0], g[1], radius_m)
+        cell = np.flatnonzero(pix >= 0)
+        pix = pix[cell]
+        v = _gather(values, pix, n_bands)
+        # a NaN sample (a dropped pixel) yields to another strip's complete one
+        r = g[2][pix] + np.where(np.isnan(v).any(axis=1), _INCOMPLETE_RANK, 0.0)
+        if rule == "mean":  # per band, over the strips whose sample is finite
+            ok = np.isfinite(v)
+            total[cell] += np.where(ok, v, 0.0)
+            count[cell] += ok
             continue
         if rule == "first":
-            win = covered & (
-                ~np.isfinite(best_rank) | ((best_rank >= _INCOMPLETE_RANK) & (r < _INCOMPLETE_RANK))
-            )
+            held = best_rank[cell]
+            keep = ~np.isfinite(held) | ((held >= _INCOMPLETE_RANK) & (r < _INCOMPLETE_RANK))
         else:  # nearest-nadir: the ray nearest to nadir
-            win = r < best_rank
-        best[:, win] = v[:, win]
-        best_rank[win] = r[win]
+            keep = r < best_rank[cell]
+        best[cell[keep]] = v[keep]
+        best_rank[cell[keep]] = r[keep]
     if rule == "mean":
         seen = count > 0
         best[seen] = (total[seen] / count[seen]).astype(np.float32)
-    return best
+    return np.ascontiguousarray(best.T).reshape(n_bands, grid.height, grid.width)
 
 
-def _tile_task(grid, layout, terrain, frame, radius_m, n_bands, rule, *arrays):
-    """:func:`mosaic_tile` with flat arguments (``layout``: per strip its number of blocks and
-    their line ranges; ``arrays``: per strip its geometry, then its blocks' values).
+def _gather(values, pix, n_bands: int) -> np.ndarray:
+    """``(len(pix), n_bands)`` float32: the pixels ``pix`` of the blocks' values, in order."""
+    flats = [np.asarray(v).reshape(-1, n_bands) for v in values]
+    flat = flats[0] if len(flats) == 1 else np.concatenate(flats)
+    return flat[pix].astype(np.float32, copy=False)
+
+
+def _tile_task(grid, layout, radius_m, n_bands, rule, *arrays):
+    """:func:`mosaic_tile` with flat arguments (``layout``: per strip its number of blocks;
+    ``arrays``: per strip its blocks' ground, then their values).
     """
     parts, k = [], 0
-    for ranges in layout:
-        geom, vals = arrays[k], arrays[k + 1 : k + 1 + len(ranges)]
-        parts.append((geom, [(a, b, v) for (a, b), v in zip(ranges, vals, strict=True)]))
-        k += 1 + len(ranges)
-    return mosaic_tile(grid, parts, terrain, frame, radius_m, n_bands, rule)
+    for n in layout:
+        parts.append((arrays[k : k + n], arrays[k + n : k + 2 * n]))
+        k += 2 * n
+    return mosaic_tile(grid, parts, radius_m, n_bands, rule)
 
 
 def orthomosaic(
@@ -482,21 +513,28 @@ def _check_size(grid: MapGrid, n_bands: int, spacing_m: float, max_gib: float | 
 
 
 def _mosaic_array(strips, foot, grid, terrain, frame, radius_m, tile_px, lines_per_block, rule):
-    """The Dask array ``(n_bands, height, width)``: one task per tile (:func:`mosaic_tile`)."""
+    """The Dask array ``(n_bands, height, width)``: one task per line block that geolocates it
+    (:func:`block_ground`), one per tile that mosaics the blocks meeting it
+    (:func:`mosaic_tile`).
+    """
     import dask
     import dask.array as dsa
 
     n_bands = strips[0].n_bands
     g_terrain, g_frame = dask.delayed(terrain, pure=True), dask.delayed(frame, pure=True)
-    # one key per strip's geometry, shared by the tiles (dask would unpack a Strip dataclass
-    # with its values and make every tile depend on every chunk of the cube)
-    g_strips = [dask.delayed(s.geometry(), pure=True) for s in strips]
     values = [
         s.values
         if isinstance(s.values, dsa.Array)
         else dsa.from_array(np.asarray(s.values), chunks=(lines_per_block, -1, -1))
         for s in strips
     ]
+    # one key per strip's geometry (dask would unpack a Strip dataclass with its values and make
+    # every task depend on every chunk of the cube), one task per block's ground
+    ground = []
+    for s, (blocks, _) in zip(strips, foot, strict=True):
+        g_strip = dask.delayed(s.geometry(), pure=True)
+        task = dask.delayed(block_ground, pure=True)
+        ground.append([task(g_strip, g_terrain, g_frame, ab, grid.crs) for ab in blocks])
     rows = []
     for r0 in range(0, grid.height, tile_px):
         r1 = min(grid.height, r0 + tile_px)
@@ -506,21 +544,20 @@ def _mosaic_array(strips, foot, grid, terrain, frame, radius_m, tile_px, lines_p
             tile = grid.window(r0, r1, c0, c1)
             x0, y0, x1, y1 = tile.extent_m
             layout, args = [], []
-            for s, v, (blocks, bbox) in zip(g_strips, values, foot, strict=True):
-                hit = (
+            for g, v, (blocks, bbox) in zip(ground, values, foot, strict=True):
+                hit = np.flatnonzero(
                     (bbox[:, 0] - radius_m < x1)
                     & (bbox[:, 2] + radius_m > x0)
                     & (bbox[:, 1] - radius_m < y1)
                     & (bbox[:, 3] + radius_m > y0)
                 )
-                ranges = [blocks[i] for i in np.flatnonzero(hit)]
-                if ranges:
-                    layout.append(ranges)
-                    args += [s, *(v[a:b] for a, b in ranges)]
+                if hit.size:
+                    layout.append(int(hit.size))
+                    args += [g[i] for i in hit] + [v[slice(*blocks[i])] for i in hit]
             shape = (n_bands, r1 - r0, c1 - c0)
             if layout:
                 task = dask.delayed(_tile_task, pure=True)(
-                    tile, layout, g_terrain, g_frame, radius_m, n_bands, rule, *args
+                    tile, layout, radius_m, n_bands, rule, *args
                 )
                 row.append(dsa.from_delayed(task, shape, dtype=np.float32))
             else:
@@ -546,7 +583,7 @@ def _as_dataarray(data, grid, strips, bands, radius_m, rule):
         coords=coords,
         name="radiance",
         attrs={
-            "resampling": "nearest neighbour (pykdtree in the grid's CRS)",
+            "resampling": "nearest neighbour (in the grid's CRS)",
             "mosaic_rule": MOSAIC_RULES[rule],
             "radius_of_influence_m": float(radius_m),
             "resolution_m": grid.resolution_m,
