@@ -269,7 +269,7 @@ def add_orthorectify(sub) -> argparse.ArgumentParser:
         "frames of a frame camera, onto a map grid (COG, NetCDF or ENVI by the output's suffix)",
         description="Orthorectify every pixel of every line (the sensor's ray at the line's "
         "time on the trajectory, met with the terrain at its first crossing) and resample it "
-        "onto a north-up grid by nearest neighbour (pykdtree): every spectrum stays as "
+        "onto a north-up grid by nearest neighbour in the grid's metres: every spectrum stays as "
         "measured. Where strips overlap, --mosaic decides: nearest-nadir (default: the pixel "
         "whose ray is nearest to the nadir), first (the first LINES file that covers the "
         "cell), mean (band by band, of the strips' nearest pixels). LINES: hsgeo's recorded "
