@@ -325,28 +325,24 @@ def test_navigation_in_radians_names_the_unit(cmd, inputs, capsys):  # noqa: F81
 
 
 @pytest.mark.parametrize("rule", ["nearest-nadir", "first", "mean"])
-def test_a_nan_sample_yields_to_another_strips_data(rule, monkeypatch):
+def test_a_nan_sample_yields_to_another_strips_data(rule):
     """Issue 42 'lines holding NaN': where one strip's sample is NaN (a dropped pixel) and
     another strip covers the cell, the mosaic takes the other's value, under every rule; a
     cell only the NaN strip covers keeps its finite bands (nearest-nadir, first) or the
-    bands' own means. The rule alone: the strips' resampled swaths stand in (monkeypatched)."""
+    bands' own means. The rule alone: each strip is one line block of three ground pixels."""
     import hsgeo.ortho as O
+    from hsgeo.mapgrid import MapGrid
 
     nan = np.nan
-    # two strips, 1 x 3 cells, 2 bands; strip A nearer nadir (rank 1) but NaN in cell 0
-    swaths = {
-        "A": (np.array([[[nan, 1.0, 1.0]], [[nan, 1.0, nan]]], np.float32), np.ones((1, 3))),
-        "B": (np.array([[[2.0, 2.0, 9.0]], [[2.0, 2.0, 9.0]]], np.float32),
-              np.array([[5.0, 5.0, np.inf]])),
-    }  # fmt: skip
-    order = ["A", "B"]  # mosaic_tile resamples the strips in this order
-    one_pixel = (None, np.zeros((1, 2)), np.zeros(1))  # (ground, lon/lat, rank) of one pixel
-    monkeypatch.setattr(O, "geolocate_lines", lambda *a: one_pixel)
-    monkeypatch.setattr(O, "resample_swath", lambda *a: swaths[order.pop(0)])
-    grid = SimpleNamespace(height=1, width=3)
-    parts = [(k, [(0, 1, np.zeros((1, 1, 2), np.float32))]) for k in ("A", "B")]
-    out = O.mosaic_tile(grid, parts, None, SimpleNamespace(datum_epsg=4979), 1.0, 2, rule)
-    got = out[:, 0, :]
+    grid = MapGrid(0.0, 1.0, 1.0, 3, 1, "EPSG:32632")  # cell centres x 0.5, 1.5, 2.5; y 0.5
+    # ground (x, y, off-nadir angle) of each strip's three pixels, and their (1, 3, 2) values:
+    # strip A nearer nadir (1°) but NaN in cell 0; B (5°) covers cells 0 and 1 only
+    ground_a = np.array([[0.5, 1.5, 2.5], [0.5, 0.5, 0.5], [1.0, 1.0, 1.0]])
+    ground_b = np.array([[0.5, 1.5, 99.0], [0.5, 0.5, 0.5], [5.0, 5.0, 5.0]])
+    values_a = np.array([[[nan, nan], [1.0, 1.0], [1.0, nan]]], np.float32)
+    values_b = np.array([[[2.0, 2.0], [2.0, 2.0], [9.0, 9.0]]], np.float32)
+    parts = [([ground_a], [values_a]), ([ground_b], [values_b])]
+    got = O.mosaic_tile(grid, parts, 0.6, 2, rule)[:, 0, :]
     # cell 0: A is NaN in both bands → B's 2.0; cell 1: both complete → A (nearer nadir, or
     # first) or their mean; cell 2: only A covers it, band 1 NaN → A's finite band kept
     want = {
