@@ -583,10 +583,10 @@ def check_heading_follows_course(traj: Trajectory, name: str) -> None:
 
 def _follows_in_radians(heading, course_deg) -> bool:
     """The heading column read as radians follows the course (a heading of 3.14 on a line
-    flown south is π, not 3.14°): every value within ±2π and, converted, within the crab angle.
+    flown south is π, not 3.14°; unwrapped values such as −3π too): converted, within the crab
+    angle. Asked only of a heading that is opposite to the course read as degrees, which a
+    heading in degrees that also follows the course as radians is not.
     """
-    if not np.all(np.abs(heading) <= 2 * np.pi + 0.1):  # unwrapped a little past ±2π
-        return False
     d = np.abs((np.degrees(heading) - course_deg + 180.0) % 360.0 - 180.0)
     return bool(np.median(d) <= MAX_HEADING_COURSE_DEG)
 
