@@ -304,15 +304,21 @@ def lp_lines() -> list[dict]:
         {
             "line": "|mean H| without GCPs and c − c_twin within 3σ̂ in ≥ 7 of 8 campaigns, or "
             "a named cause that reproduces the offset",
-            "status": "met" if h_in >= 7 and c_in >= 7 else "short",
+            # a bar that can hardly fail is not met: σ̂ of the mean height is metres to tens of
+            # metres at the bench's block size, and c − c_twin is judged with the retrieved σ̂
+            "status": "met"
+            if h_in >= 7 and c_in >= 7 and max(cp["mean_h_nogcp_sigma_m"]) < 1.13
+            else "short",
             "evidence": {
                 "file": str(cp_file.relative_to(RESULTS.parent.parent)),
                 "mean_h_within_3sigma": h_in,
                 "c_minus_twin_within_3sigma": c_in,
                 "mean_h_sigma_m": cp["mean_h_nogcp_sigma_m"],
                 "corr_mean_h_with_c_error": cp["corr_mean_h_c"],
-                "caveat": "at --scale 0.05 the σ̂ of the mean height is 4–54 m, so this bar "
-                "is weak; c − c_twin is judged with the retrieved σ̂, not the difference's",
+                "why_short": "within 3σ̂ in every campaign, but σ̂ of the mean height is "
+                + f"{min(cp['mean_h_nogcp_sigma_m']):.0f}–{max(cp['mean_h_nogcp_sigma_m']):.0f} m "
+                "at this block size (002's offset: 1.13 m), so the bar can hardly fail; "
+                "c − c_twin is judged with the retrieved σ̂, not the difference's",
             },
         },
     ]
