@@ -122,12 +122,18 @@ def test_an_envi_cube_gives_the_netcdf_lines_raster(tmp_path):
 
 def test_envi_lines_refused_by_name(tmp_path, capsys):
     """A times file shorter than the lines, --line-times for NetCDF lines, a count of times
-    files unlike the cubes', and a mix of ENVI and NetCDF LINES: exit 2, the file named."""
+    files unlike the cubes', a mix of ENVI and NetCDF LINES, and a cube of some columns of a
+    wider line (header ``x start`` > 1: its samples are not the sensor's pixels 0…n−1): exit
+    2, the file named."""
     argv, t = _scene(tmp_path, n_lines=20)
     np.savetxt(tmp_path / "short.txt", t[:-1])
     cube, nc = str(tmp_path / "cube.raw"), str(tmp_path / "lines.nc")
+    (tmp_path / "part.raw").write_bytes((tmp_path / "cube.raw").read_bytes())
+    (tmp_path / "part.hdr").write_text((tmp_path / "cube.hdr").read_text() + "x start = 101\n")
     out = ["-o", str(tmp_path / "o.nc")]
+    times = ["--line-times", str(tmp_path / "times.txt")]
     cases = [
+        ([str(tmp_path / "part.raw"), *argv, *times], "x start = 101"),
         ([cube, *argv, "--line-times", str(tmp_path / "short.txt")], "short.txt"),
         ([nc, *argv, "--line-times", str(tmp_path / "times.txt")], "--line-times"),
         ([cube, *argv], "no line times"),

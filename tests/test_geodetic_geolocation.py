@@ -130,17 +130,19 @@ def _targets(fl, lat0, lon0):
     return tlon, tlat, k, np.array(body)
 
 
-def _orthorectified(site, tmp_path, dsm=None, vertical="ellipsoidal"):
+def _orthorectified(site, tmp_path, dsm=None, vertical="ellipsoidal", crs=None):
     """The targets of the site's flight located through hsgeo (SBET → navigation → DSM →
     ray/terrain intersection → output CRS): ``(x, y)`` in the output CRS, the truth there by
-    pyproj alone, the navigation. ``dsm(path)`` writes the DSM (default the UTM one)."""
-    from pyproj import Transformer
+    pyproj alone, the navigation. ``dsm(path)`` writes the DSM (default the UTM one); ``crs``
+    the requested output CRS (default the UTM zone of the data, as ``--crs`` absent)."""
+    from pyproj import CRS, Transformer
 
     lat0, lon0 = SITES[site]
     fl = _flight(lat0, lon0)
     nav = read_navigation(_sbet(tmp_path / "sbet.out", *fl), crs="EPSG:4979")
     out = default_output_crs(nav.frame.lon_deg, nav.frame.lat_deg, 4979)
     assert nav.frame.map_epsg == out.to_epsg()
+    out = out if crs is None else CRS.from_user_input(crs)
     E, N, _ = nav.trajectory.xyz_m.T
     bounds = (E.min() - 600, N.min() - 1600, E.max() + 600, N.max() + 1600)
     path = tmp_path / "dsm.tif"

@@ -184,6 +184,7 @@ def _cmd_lp_observations(args) -> int:
         n_px_full=args.line_pixels,
         nav_crs=args.nav_crs,
         site=args.site,
+        line_times=args.line_times,
     )
     terminal.clear_progress()
     d = res.to_dict()

@@ -244,18 +244,22 @@ def _wavelengths(text: str) -> tuple:
     return out
 
 
-def _line_times_option(p) -> None:
-    """``--line-times``: the times files of ENVI LINES cubes."""
+def _line_times_option(p, lines: str = "LINES", pixels: str | None = None) -> None:
+    """``--line-times``: the times files of ENVI cubes among the command's ``lines``."""
+    if pixels is None:
+        pixels = (
+            "zeta = s of a line scanner or view-angle sensor, x = s - (samples - 1)/2 px of the "
+            "002 camera"
+        )
     p.add_argument(
         "--line-times",
         action="append",
         metavar="TIMES",
         default=None,
-        help="line times of an ENVI LINES cube: a file of one time (s, the navigation's time "
-        "scale) per line, or a CSV with a t_s column; once per cube, in the order of LINES "
-        "(default: the header's start time and line period). LINES may be ENVI cubes (BIL/BIP/"
-        "BSQ, name.hdr or name.ext.hdr beside name.raw/.dat/.bil …): sample s is zeta = s of "
-        "a line scanner or view-angle sensor, x = s - (samples - 1)/2 px of the 002 camera",
+        help=f"line times of an ENVI {lines} cube: a file of one time (s, the navigation's time "
+        f"scale) per line, or a CSV with a t_s column; once per cube, in the order of {lines} "
+        f"(default: the header's start time and line period). {lines} may be ENVI cubes (BIL/"
+        "BIP/BSQ, name.hdr or name.ext.hdr beside name.raw/.dat/.bil …): sample s is " + pixels,
     )
 
 
@@ -483,7 +487,8 @@ def add_lp_observations(sub) -> argparse.ArgumentParser:
         "lines and pixels, one tie point is written (--all-bands: every band's). SCENES: LP "
         "line files, one strip each (NetCDF, see "
         "hsgeo.io.lp_lines: lines(line, column, band) DN, t_s(line), wavelength_nm(band), "
-        "attributes col0, strip_id and optionally n_px_full). NAV: the navigation file of "
+        "attributes col0, strip_id and optionally n_px_full; or ENVI cubes with wavelengths "
+        "in the header and their line times, see --line-times). NAV: the navigation file of "
         "every command, CSV or "
         "Parquet with t_s, E_m, N_m, U_m, roll_deg, pitch_deg, heading_deg (see "
         "hsgeo.io.navigation). CAMERA: the camera TOML of hsgeo adjust-pushbroom (one band "
@@ -493,7 +498,12 @@ def add_lp_observations(sub) -> argparse.ArgumentParser:
         "adjust-pushbroom --gcp). OUT: the observation table point_id, band, t_s, x_px, y_px "
         "(+ strip, line), .parquet or .csv: it feeds hsgeo adjust-pushbroom unchanged.",
     )
-    p.add_argument("scenes", nargs="+", metavar="SCENES", help="LP line files (NetCDF)")
+    p.add_argument(
+        "scenes",
+        nargs="+",
+        metavar="SCENES",
+        help="LP line files (NetCDF) or ENVI cubes, one strip each",
+    )
     p.add_argument("--trajectory", required=True, metavar="NAV", help="navigation file (see above)")
     p.add_argument("--camera", required=True, metavar="CAMERA.toml", help="camera (TOML)")
     p.add_argument("-o", "--output", required=True, metavar="OUT.parquet")
@@ -541,6 +551,13 @@ def add_lp_observations(sub) -> argparse.ArgumentParser:
         "rounding, so adjusted as independent they make σ̂ too small)",
     )
     _lp_line_options(p)
+    _line_times_option(
+        p,
+        "SCENES",
+        "x = x0 + s - (n - 1)/2 px, x0 the header's 'x start' - 1 (0 without it) and n the "
+        "full line's pixels (--line-pixels; else the samples without 'x start', 1800 with "
+        "it); the strip's id is the file's name without extension",
+    )
     p.add_argument(
         "--overwrite", action="store_true", help="replace an existing output (default: refuse)"
     )

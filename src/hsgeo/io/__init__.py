@@ -45,7 +45,7 @@ from hsgeo.io.boards import Board, read_board
 from hsgeo.io.config import Key, read_config, read_toml
 from hsgeo.io.envi import read_envi, write_envi
 from hsgeo.io.envi_read import line_times, open_envi
-from hsgeo.io.line_cube import open_line_strip, read_line_cube
+from hsgeo.io.line_cube import open_line_strip, read_line_cube, read_line_strips
 from hsgeo.io.lines import read_lines, write_lines
 from hsgeo.io.lp_lines import LpStrip, read_lp_lines, write_lp_lines
 from hsgeo.io.navigation import (
@@ -109,6 +109,7 @@ __all__ = [
     "line_times",
     "read_line_cube",
     "open_line_strip",
+    "read_line_strips",
     "write_envi",
     "read_opencv_storage",
     "read_nist_strd",

@@ -4,7 +4,8 @@ any other name) with its line times.
 
 :func:`read_line_cube` gives a lazy ``(line, sample, band)`` DataArray; :func:`open_line_strip`
 gives the :class:`~hsgeo.io.lp_lines.LpStrip` that ``hsgeo lp-observations`` and ``hsgeo
-orthomosaic`` take, so that a front end reads either format through one call.
+orthomosaic`` take, so that a front end reads either format through one call;
+:func:`read_line_strips` reads a command's LINES (one times file per ENVI cube) into memory.
 
 **No-data.** A value equal to the header's ``data ignore value`` becomes NaN (the values are
 float32 in both results); ``info["ignore_value"]`` keeps the header's value.
@@ -18,7 +19,7 @@ import numpy as np
 
 from hsgeo.errors import InputError
 
-__all__ = ["NETCDF_SUFFIXES", "open_line_strip", "read_line_cube"]
+__all__ = ["NETCDF_SUFFIXES", "open_line_strip", "read_line_cube", "read_line_strips"]
 
 #: Suffixes read as hsgeo's NetCDF lines; every other name is read as an ENVI cube.
 NETCDF_SUFFIXES = (".nc", ".nc4", ".netcdf")
@@ -52,6 +53,25 @@ def _lazy_float32(cube, lines_per_chunk: int):
     return out
 
 
+def _x_start(cube) -> int:
+    """``col0`` of an ENVI cube: its header's ``x start`` − 1 (ENVI's 1-based image coordinate
+    of the first sample: a cube holding columns of a wider line), 0 without it.
+    """
+    v = cube.header.get("x start")
+    if v is None:
+        return 0
+    try:
+        x = float(v.strip().strip("{}"))
+    except ValueError:
+        x = float("nan")
+    if not (np.isfinite(x) and x == int(x) and x >= 1):
+        raise InputError(
+            f"ENVI header {str(cube.header_path)!r}: x start = {v!r} must be a whole number "
+            "≥ 1 (the 1-based column of the first sample in the full line)"
+        )
+    return int(x) - 1
+
+
 def read_line_cube(path, times=None, *, lines_per_chunk: int = 256):
     """Read recorded lines (ENVI cube, or hsgeo's NetCDF lines by suffix), lazily.
 
@@ -76,7 +96,9 @@ def read_line_cube(path, times=None, *, lines_per_chunk: int = 256):
     info : dict
         ``format`` ("envi" or "netcdf"), ``data_path``, ``header_path`` (ENVI), ``header``
         (ENVI entries), ``ignore_value``, ``interleave``, ``col0``, ``strip_id``,
-        ``n_px_full``.
+        ``n_px_full``. An ENVI cube's ``col0`` is its header's ``x start`` − 1 (ENVI's 1-based
+        column of the first sample; 0 without it), its ``n_px_full`` the samples without
+        ``x start`` (the cube is the full line), None with it (the full line not said).
 
     Raises
     ------
@@ -117,6 +139,7 @@ def read_line_cube(path, times=None, *, lines_per_chunk: int = 256):
         t = line_times(cube, times)
         data = _lazy_float32(cube, lines_per_chunk)
         wl, fw = cube.wavelength_nm, cube.fwhm_nm
+        col0 = _x_start(cube)
         info = {
             "format": "envi",
             "data_path": cube.data_path,
@@ -124,9 +147,9 @@ def read_line_cube(path, times=None, *, lines_per_chunk: int = 256):
             "header": cube.header,
             "ignore_value": cube.ignore_value,
             "interleave": cube.interleave,
-            "col0": 0,
+            "col0": col0,
             "strip_id": cube.data_path.stem,
-            "n_px_full": int(data.shape[1]),
+            "n_px_full": int(data.shape[1]) if "x start" not in cube.header else None,
         }
     n_b = int(data.shape[2])
     nan = np.full(n_b, np.nan)
@@ -155,8 +178,9 @@ def open_line_strip(path, times=None, *, lines_per_chunk: int = 256):
     Returns
     -------
     LpStrip
-        Its ``lines`` a Dask array; for an ENVI cube ``col0`` = 0, ``n_px_full`` = samples,
-        ``strip_id`` the file's name without extension. A cube without wavelengths is refused
+        Its ``lines`` a Dask array; for an ENVI cube ``col0`` and ``n_px_full`` as
+        :func:`read_line_cube` says (without ``x start``: 0 and the samples), ``strip_id`` the
+        file's name without extension. A cube without wavelengths is refused
         (the LP strip needs one per band).
     """
     p = Path(path)
@@ -184,3 +208,48 @@ def open_line_strip(path, times=None, *, lines_per_chunk: int = 256):
         )
     except InputError as exc:
         raise InputError(f"ENVI file {str(info['data_path'])!r}: {exc}") from None
+
+
+def read_line_strips(paths, line_times=None, *, option: str = "--line-times"):
+    """A command's recorded lines, each file hsgeo's NetCDF or an ENVI cube, into memory.
+
+    Parameters
+    ----------
+    paths : sequence of str or Path
+        The files (:func:`read_line_cube`: NetCDF by suffix, any other name an ENVI cube).
+    line_times : sequence of (str, Path or None), optional
+        One times file per file of ``paths``, in their order (None: every ENVI cube's header
+        start time and line period; NetCDF lines carry their own ``t_s``).
+    option : str
+        The command's option of the times files, for the messages.
+
+    Returns
+    -------
+    list of LpStrip
+        With numpy lines (float32, the ENVI ``data ignore value`` as NaN).
+
+    Raises
+    ------
+    InputError
+        A count of times files unlike the files', or as :func:`open_line_strip`.
+    """
+    paths = list(paths)
+    times = [None] * len(paths) if line_times is None else list(line_times)
+    if len(times) != len(paths):
+        raise InputError(
+            f"{option} is given {len(times)} time(s) for {len(paths)} line files; give one times "
+            f"file per ENVI cube, in the order of the line files (or no {option}: the headers' "
+            "start time and line period)"
+        )
+    out = []
+    for p, t in zip(paths, times, strict=True):
+        if Path(p).suffix.lower() in NETCDF_SUFFIXES and t is None:
+            from hsgeo.io.lp_lines import read_lp_lines
+
+            out.append(read_lp_lines(p))
+            continue
+        from dataclasses import replace
+
+        strip = open_line_strip(p, t)
+        out.append(replace(strip, lines=np.asarray(strip.lines.compute(), dtype=np.float32)))
+    return out

@@ -128,6 +128,12 @@ def envi_strips(lines, sensor, nav, *, sensor_path, bands_nm=None, band=None, li
     for p, times in zip(lines, _times_per_cube(lines, line_times), strict=True):
         cube, info = read_line_cube(p, times)
         who = repr(str(p))
+        if info["col0"]:  # sample s is ζ = s / x of a full line (module docstring)
+            raise InputError(
+                f"LINES {who}: its header's x start = {info['col0'] + 1} says the cube holds "
+                "columns of a wider line; orthorectify takes full lines (x start = 1): give "
+                "the full lines, or the strip as hsgeo's NetCDF lines with col0 and n_px_full"
+            )
         n_l, n_s, n_b = (int(v) for v in cube.shape)
         if n_l < 2 or n_s < 2:
             raise InputError(

@@ -728,13 +728,17 @@ def lp_observation_files(
     n_px_full: int | None = None,
     nav_crs=None,
     site=None,
+    line_times=None,
 ) -> LpResult:
     """``hsgeo lp-observations``: LP line files → the observation table of ``adjust-pushbroom``.
 
     Parameters
     ----------
     scenes : sequence of path
-        LP line files (:mod:`hsgeo.io.lp_lines`), one strip each.
+        The lines of one strip each: hsgeo's NetCDF LP line files (:mod:`hsgeo.io.lp_lines`)
+        or ENVI cubes as line scanners write them (BIL/BIP/BSQ, ``name.hdr`` or
+        ``name.ext.hdr``; :func:`hsgeo.io.read_line_strips`): sample s at x = s − (samples −
+        1)/2 px unless ``n_px_full`` says the full line is wider, strip id the file's stem.
     trajectory : path
         The navigation file of every command (:mod:`hsgeo.io.navigation`), or one as delivered
         (geodetic CSV or Parquet, Applanix SBET: :func:`hsgeo.io.navigation.read_line_navigation`
@@ -754,6 +758,9 @@ def lp_observation_files(
         Pixels of a full line (``--line-pixels``); overrides the files' ``n_px_full``
         attribute (default: that attribute, else 1800 px, 002 §4:
         :func:`hsgeo.io.lp_lines.full_line_px`, the convention ``hsgeo orthorectify`` shares).
+    line_times : sequence of path, optional
+        ``--line-times``: one times file per ENVI cube of ``scenes`` (one time per line, the
+        navigation's time scale); default each header's start time and line period.
 
     Returns
     -------
@@ -770,15 +777,16 @@ def lp_observation_files(
 
     from hsgeo.io import read_pushbroom_camera, read_table
     from hsgeo.io._files import check_outputs
-    from hsgeo.io.lp_lines import full_line_px, read_lp_lines
+    from hsgeo.io.line_cube import read_line_strips
+    from hsgeo.io.lp_lines import full_line_px
     from hsgeo.io.navigation import read_line_navigation
     from hsgeo.io.tables import TABLE_FORMATS, write_table
     from hsgeo.validate import check_navigation_covers
     from hsgeo.workflows.pushbroom_ba import GCP_COLUMNS
 
-    files = [*scenes, trajectory, camera, squares]
+    files = [*scenes, *(line_times or ()), trajectory, camera, squares]
     check_outputs([(output, "-o/--output", TABLE_FORMATS)], files, overwrite=overwrite)
-    strips = [read_lp_lines(p) for p in scenes]
+    strips = read_line_strips(scenes, line_times)
     traj, _ = read_line_navigation(
         trajectory,
         crs=nav_crs,
