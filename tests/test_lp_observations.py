@@ -455,3 +455,60 @@ def test_squares_as_tie_points_takes_the_matchers_points_on_a_square():
     far = blobs.assign(x_px=blobs["x_px"] + 5.0)
     got, taken = as_tie_points(ties, far, np.zeros(5))
     assert len(got) == 0 and taken.size == 0
+
+
+def test_a_check_point_keeps_one_place_of_its_square_in_every_strip():
+    """Issue 37: a tie point on a square joining its NE corner in two strips with the SW corner
+    in a third (or lying off the square in a fourth) made metres of check-point height. With
+    the key points' and blobs' ground positions given, only the observations at the place of
+    the square most of them share stay; without them (the old rule) every one stayed."""
+    from hsgeo.workflows._lp_squares import CORNER_TOLERANCE, as_tie_points
+
+    strips = ["s0", "s1", "s2", "s3"]
+    # one tie point (band 1): on square A in s0, s1, s2 (s2: the opposite corner), off in s3
+    ties = pd.DataFrame(
+        {
+            "point_id": "tp0",
+            "point": 0,
+            "band": 1,
+            "t_s": 0.0,
+            "x_px": [5.0, 5.0, 5.0, 40.0],
+            "y_px": 0.0,
+            "strip": strips,
+            "line": [10, 10, 10, 60],
+            "feature": 0,
+            "adjusted": True,
+            "x_keypoint_px": [5.0, 5.0, 5.0, 40.0],
+            "line_offset": 0.0,
+        }
+    )
+    blobs = pd.DataFrame(
+        {
+            "point_id": "A",
+            "band": 0,
+            "strip": strips[:3],
+            "line": 10,
+            "x_px": 5.3,
+            "line_frac": 10.2,
+            "box_px": 4,
+        }
+    )
+    centre = np.array([[100.0, 200.0]] * 3)
+    # ground positions: NE corner (+0.6, +0.6) of the 1.2 m square in s0, s1; SW in s2
+    ties_en = np.array([[100.6, 200.6], [100.55, 200.62], [99.4, 199.4], [130.0, 180.0]])
+    old, _ = as_tie_points(ties, blobs, np.zeros(1))
+    assert sorted(old["strip"]) == strips  # the old rule: every observation, renamed
+    got, taken = as_tie_points(
+        ties, blobs, np.zeros(1), ties_en_m=ties_en, centroids_en_m=centre, square_size_m=1.2
+    )
+    assert sorted(got["strip"]) == ["s0", "s1"] and (got["point_id"] == "A").all()
+    assert taken.tolist() == [0]
+    # a tolerance of half the side: the midpoint between two corners (not a tuned number)
+    assert CORNER_TOLERANCE == 0.5
+    # one observation left at the shared place: fewer than two rays, no check point
+    lone = ties_en.copy()
+    lone[1] = [99.4, 200.6]
+    got, _ = as_tie_points(
+        ties, blobs, np.zeros(1), ties_en_m=lone, centroids_en_m=centre, square_size_m=1.2
+    )
+    assert len(got) == 0
