@@ -32,9 +32,11 @@ import numpy as np
 from hsgeo.papers import P002_STATS
 from hsgeo.reproduce.lp_judge import observation_errors_px, within_fractions
 from hsgeo.reproduce.lp_observations import sim_scale, stat_sigma
-from hsgeo.reproduce.lp_runs import _adjust, camera_prior, evaluate, exact_twin
+from hsgeo.reproduce.lp_runs import _adjust, camera_prior, evaluate, exact_twin, parameter_z
+from hsgeo.reproduce.lp_targets import N_DRAWS, twin_difference
 from hsgeo.simulate.lp_campaign import simulate
 from hsgeo.stats import describe
+from hsgeo.workflows._lp_squares import CORNER_TOLERANCE
 
 WAYS = ("tie_point", "centroid")
 
@@ -170,6 +172,16 @@ def one_seed(seed: int, scale: float) -> dict:
         },
     }
     out["twin_nogcp_mean_h_m"] = float(np.mean(E0t[:, 2]))
+    # without GCPs, retrieved − twin in the σ of the difference (Monte Carlo over the
+    # retrieval's observation errors, each point's with a random sign; lp_targets), with the
+    # check points' mean height and the mean c of every draw: the c–H coupling, numerically
+    tw0 = {"adjusted": r0t, "parameters": parameter_z(r0t.result, truth.camera)}
+    td0 = twin_difference(ev, obs, truth, tw0, n_draws=N_DRAWS, rng=[seed, 41], gcp=False)
+    out["nogcp_twin_mc"] = {
+        k: (np.asarray(v, float).tolist() if k != "labels" else list(map(str, v)))
+        for k, v in td0.items()
+        if k not in ("draws", "method", "gcp")
+    }
     out["parameters_vs_twin_z"] = float(
         np.sqrt(
             np.mean(
@@ -262,6 +274,9 @@ def write(runs, scale, out, wall_s) -> dict:
         "sim_scale": sim_scale(scale),
         "seeds": [r["seed"] for r in runs],
         "stats": list(P002_STATS),
+        # issue 37: the check points keep one place of their square in every strip
+        # (hsgeo.workflows._lp_squares.as_tie_points' corner test, CORNER_TOLERANCE)
+        "corner_test_tolerance_of_side": CORNER_TOLERANCE,
         "summary": _summary(runs),
         "runs": runs,
         "wall_s": wall_s,
