@@ -33,8 +33,6 @@ __all__ = [
     "candidates",
     "choose",
     "as_tie_points",
-    "ground_en",
-    "CORNER_TOLERANCE",
     "COLUMNS",
     "SQUARES_AS",
 ]
@@ -193,45 +191,7 @@ def _time_at(t_s, line) -> float:
     return float(np.interp(line, np.arange(t_s.size), t_s))
 
 
-def ground_en(inputs, strip_ids, line_frac, x_px, height_m: float) -> np.ndarray:
-    """E, N ``(n, 2)`` on the plane at ``height_m`` of image positions (fractional line of the
-    strip ``strip_ids``, x px) from the navigation and the a-priori camera (band 0).
-
-    For :func:`as_tie_points`' corner test: the *difference* of two such points a square apart
-    is what matters, and the a-priori camera's errors (a boresight off by tenths of a degree,
-    c by a few per mille) move it by millimetres.
-    """
-    strip_ids = np.asarray(strip_ids).astype(str)
-    line_frac = np.asarray(line_frac, float)
-    x_px = np.asarray(x_px, float)
-    out = np.full((strip_ids.size, 2), np.nan)
-    for s in inputs.strips:
-        m = strip_ids == str(s.strip_id)
-        if not m.any():
-            continue
-        t = np.asarray(s.t_s, float)
-        t_at = np.interp(line_frac[m], np.arange(t.size), t)
-        out[m] = geo.ground_points(inputs.camera, x_px[m], t_at, inputs.navigation, 0, height_m)[
-            :, :2
-        ]
-    return out
-
-
-#: A check point's key point must lie at the same place of its square in every strip, within
-#: this share of the square's side on the ground (:func:`as_tie_points`).
-CORNER_TOLERANCE = 0.5
-
-
-def as_tie_points(
-    ties,
-    centroids,
-    score,
-    *,
-    min_on: int = 2,
-    ties_en_m=None,
-    centroids_en_m=None,
-    square_size_m: float = 1.2,
-):
+def as_tie_points(ties, centroids, score, *, min_on: int = 2):
     """The squares as 002 measured them: the matcher's tie points that lie on a square.
 
     002 §4: the check points are "tie points with known coordinates", found by the key-point
@@ -263,25 +223,6 @@ def as_tie_points(
         ``line_frac``, ``box_px``).
     score : (n_points,) ndarray
         Per tie point, lower is better.
-    min_on : int
-        A candidate lies on the square in at least this many strips (and keeps at least this
-        many observations after the corner test).
-    ties_en_m, centroids_en_m : (len(ties), 2), (len(centroids), 2) ndarray, optional
-        E, N on the terrain plane of each observation's key point (sub-pixel x, fractional line)
-        and of each blob centre (:func:`ground_en`). Given, a chosen tie point keeps only the
-        observations that lie on its square **at the same place of it**: its key point's offset
-        from the square's blob centre on the ground within :data:`CORNER_TOLERANCE` ·
-        ``square_size_m`` of the median offset over its observations on the square. BRISK
-        finds a square's corners, and a corner of a bright square looks like any other once
-        BRISK has turned its descriptor upright: the matcher links the NE corner in one strip
-        with the SW corner in another, a 1.2–1.7 m disparity that RANSAC's epipolar test passes
-        when it lies along the epipolar line (across the track between side-by-side strips)
-        and that the intersection turns into metres of height; observations off the square
-        (half of a candidate's may be) are of another feature. Both are dropped from the
-        check point — the measurement's identification, before any adjustment, the same rule
-        for every square (tolerance: half the side, the midpoint between two corners).
-    square_size_m : float
-        Side of the squares (002 §4: 1.2 m).
 
     Returns
     -------
@@ -339,59 +280,9 @@ def as_tie_points(
     feats = ties.drop_duplicates("point").set_index("point")["feature"]
     taken = np.unique(feats.loc[on["point"].to_numpy()].to_numpy()).astype(np.int64)
     name = dict(zip(chosen["point"], chosen["sq"], strict=True))
-    sel = ties["point"].isin(list(name)).to_numpy().copy()
-    if ties_en_m is not None and centroids_en_m is not None:
-        sel &= _same_place(
-            ties, sq_of_obs, name, on_sq, c, centroids, ties_en_m, centroids_en_m,
-            CORNER_TOLERANCE * square_size_m, min_on,
-        )  # fmt: skip
-    rows = ties[sel].copy()
+    rows = ties[ties["point"].isin(list(name))].copy()
     rows["point_id"] = rows["point"].map(name)
     return rows, taken
-
-
-def _same_place(ties, sq_of_obs, name, on_sq, c, centroids, ties_en, cen_en, tol_m, min_on):
-    """Rows of ``ties`` kept by :func:`as_tie_points`' corner test (its docstring): on the
-    chosen square, at the median place of it (within ``tol_m`` on the ground), at least
-    ``min_on`` of them per tie point.
-    """
-    import pandas as pd
-
-    ce = (
-        pd.DataFrame(
-            {
-                "point_id": centroids["point_id"].astype(str).to_numpy(),
-                "strip": centroids["strip"].astype(str).to_numpy(),
-                "e": np.asarray(cen_en, float)[:, 0],
-                "n": np.asarray(cen_en, float)[:, 1],
-            }
-        )
-        .groupby(["point_id", "strip"])
-        .median()
-    )
-    centre = ce.loc[list(zip(c["point_id"].astype(str), c["strip"].astype(str), strict=True))]
-    centre = centre.to_numpy()  # (len(c), 2): each (square, strip)'s blob centre, E, N
-    pts = ties["point"].to_numpy()
-    want = np.array([name.get(p, "") for p in pts])
-    keep = (want != "") & (sq_of_obs == want)
-    d = np.full((len(ties), 2), np.nan)
-    d[keep] = np.asarray(ties_en, float)[keep] - centre[on_sq[keep]]
-    for p in np.unique(pts[keep]):
-        m = keep & (pts == p)
-        dm = d[m]
-        # the place most observations share (a vote, as :func:`choose`'s offset): each
-        # observation's neighbours within the tolerance; the best supported, then the one
-        # nearest the median, is the feature's place, and the mean of its group its offset
-        near = np.hypot(*(dm[:, None, :] - dm[None, :, :]).transpose(2, 0, 1)) <= tol_m
-        sup = near.sum(axis=1)
-        med = np.median(dm, axis=0)
-        best = np.lexsort((np.hypot(*(dm - med).T), -sup))[0]
-        ref = dm[near[best]].mean(axis=0)
-        ok = np.hypot(*(dm - ref).T) <= tol_m
-        keep[np.flatnonzero(m)[~ok]] = False
-        if ok.sum() < min_on:
-            keep[pts == p] = False
-    return keep
 
 
 #: Two bands' tie points on a square are one ground feature when their observations in every

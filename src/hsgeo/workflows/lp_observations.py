@@ -480,7 +480,7 @@ def retrieve(inputs: LpInputs, options: LpOptions = LpOptions(), progress=None) 
             "texture in these bands (--bands)"
         )
     score = _mean_hamming(point, m, kept)
-    by_way = _table(inputs, options, keys, point, rows["squares"], score, height)
+    by_way = _table(inputs, options, keys, point, rows["squares"], score)
     square_tables = {
         k: v.loc[v["adjusted"].to_numpy(), list(TABLE_COLUMNS)].reset_index(drop=True)
         for k, v in by_way.items()
@@ -514,7 +514,7 @@ def _mean_hamming(point, m, kept) -> np.ndarray:
     return np.where(c > 0, np.bincount(p, h[same], minlength=n) / np.maximum(c, 1), np.inf)
 
 
-def _table(inputs, options, keys, point, square_rows, score, height=None):
+def _table(inputs, options, keys, point, square_rows, score):
     """Every band's observations, tie points then squares (:data:`TABLE_COLUMNS`, ``feature``,
     ``adjusted``: one band per feature, or all, :attr:`LpOptions.one_band_per_feature`), with
     the squares measured each way (:data:`~hsgeo.workflows._lp_squares.SQUARES_AS`):
@@ -556,19 +556,7 @@ def _table(inputs, options, keys, point, square_rows, score, height=None):
     out = {"centroid": pd.concat([ties, cen[cols]], ignore_index=True)}
     # the squares as the matcher found them (002 §4): tie points on the squares' blobs
     blobs = sq_rows.assign(line_frac=sq_rows["line"] + (sq_rows["u"] - np.round(sq_rows["u"])))
-    en = {}
-    if height is not None and len(blobs):  # the corner test (as_tie_points) on the ground
-        line_obs = ties["line"].to_numpy(float) + ties["line_offset"].to_numpy(float)
-        en = {
-            "ties_en_m": sq.ground_en(
-                inputs, ties["strip"], line_obs, ties["x_keypoint_px"], height
-            ),
-            "centroids_en_m": sq.ground_en(
-                inputs, blobs["strip"], blobs["line_frac"], blobs["x_px"], height
-            ),
-            "square_size_m": options.square_size_m,
-        }
-    on, taken = sq.as_tie_points(ties.assign(point=point[obs]), blobs, score, **en)
+    on, taken = sq.as_tie_points(ties.assign(point=point[obs]), blobs, score)
     t2 = ties.copy()
     t2.loc[np.isin(t2["feature"].to_numpy(), taken), "adjusted"] = False
     on = on.assign(feature=-1, adjusted=True)
