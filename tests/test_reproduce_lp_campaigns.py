@@ -163,3 +163,30 @@ def test_c_minus_twin_is_judged_in_the_sigma_of_the_difference_and_the_coupling_
     assert out["mean_h_residual_within"] == 8
     # without the bench's Monte Carlo (an older file): nothing claimed
     assert "c_within_mc" not in checkpoint_campaigns(_campaigns(3))
+
+
+def test_the_no_gcp_heights_scale_with_the_flying_height():
+    """Issue 37, traced on seed 1 of bench_lp_checkpoints: the two check points "metres from
+    the rest" (−46.3 and −45.6 m against −33.5 m) were the two seen only from the 2500 m
+    strips; without GCPs a c error moves heights by −AGL·Δc/c, 4/3 as far from 2500 m. Heights
+    k·AGL (k = −1.8 %) plus 0.5 m noise: the fit recovers k, and the STD about it is the noise's,
+    not the metres of the flying-height mix."""
+    rng = np.random.default_rng(5)
+    doc = _campaigns(8)
+    for r in doc["runs"]:
+        a = np.array([1875.0] * 7 + [2500.0] * 2)
+        h = -0.018 * a + 0.5 * rng.standard_normal(9)
+        E = np.asarray(r["tie_point"]["cp_errors_nogcp_m"], float)
+        E[:, 2] = h
+        r["tie_point"]["cp_errors_nogcp_m"] = E.tolist()
+        r["tie_point"]["table3"] = {**r["tie_point"]["table3"]}
+        st = [list(x) for x in r["tie_point"]["table3"]["stats"]]
+        st[2][I_STD] = float(np.std(h, ddof=1))
+        r["tie_point"]["table3"]["stats"] = st
+        r["tie_point"]["cp_agl_nogcp_m"] = a.tolist()
+    out = checkpoint_campaigns(doc)
+    assert out["agl_k"] == pytest.approx([-0.018] * 8, abs=0.001)
+    assert np.all(np.array(out["std_h_m"]) > 4.0)  # the mix: metres
+    assert np.all(np.array(out["std_h_after_agl_m"]) < 1.0)  # about k·AGL: the noise
+    assert out["agl_mix_campaigns"] == 8
+    assert "agl_k" not in checkpoint_campaigns(_campaigns(3))  # not recorded: nothing claimed

@@ -27,6 +27,7 @@ from __future__ import annotations
 import numpy as np
 
 from hsgeo.report import MIN_RUNS
+from hsgeo.stats import nmad
 
 __all__ = ["checkpoint_campaigns", "Z_LIMIT"]
 
@@ -79,6 +80,41 @@ def _per_group(runs) -> list[dict]:
         }
         for (h, d), (n, sx, sy) in sorted(acc.items())
     ]
+
+
+def _flying_height_cause(runs, way: str, i_std: int) -> dict:
+    """The no-GCP heights' scale with the flying height, per campaign (issue 37).
+
+    Without GCPs a principal-distance error Δc moves every point along its rays by
+    −AGL·Δc/c (the no-GCP height rows, :func:`hsgeo.reproduce.lp_observations._height_rows`):
+    a check point observed only from the 2500 m strips moves 2500/1875 = 4/3 as far as one
+    seen from the 1875 m strips — metres apart when Δc̄ is tens of metres of height, a point
+    "far from the rest" that is no blunder. Fitted per campaign through the origin, H_i ≈ k ·
+    AGL_i (AGL_i: the mean flying height above the squares of the lines that observe check
+    point i, the bench's ``cp_agl_nogcp_m``): ``agl_k`` (k, m of height per m of AGL, i.e.
+    −Δc/c), ``std_h_after_agl_m`` (the STD of H_i − k·AGL_i) beside ``std_h_m``, and
+    ``h_farthest_after_agl_over_nmad``. Empty when the bench did not record the heights.
+    """
+    if not all(r[way].get("cp_agl_nogcp_m") for r in runs):
+        return {}
+    k_, s0, s1, far = [], [], [], []
+    for r in runs:
+        h = np.asarray(r[way]["cp_errors_nogcp_m"], float)[:, 2]
+        a = np.asarray(r[way]["cp_agl_nogcp_m"], float)
+        k = float(np.sum(a * h) / np.sum(a * a))
+        e = h - k * a
+        k_.append(k)
+        s0.append(float(r[way]["table3"]["stats"][2][i_std]))
+        s1.append(float(np.std(e, ddof=1)) if e.size > 1 else float("nan"))
+        d = np.abs(e - np.median(e))
+        far.append(float(d.max() / nmad(e)) if nmad(e) > 0 else float("nan"))
+    return {
+        "agl_k": k_,
+        "std_h_m": s0,
+        "std_h_after_agl_m": s1,
+        "h_farthest_after_agl_over_nmad": far,
+        "agl_mix_campaigns": int(sum(np.ptp(r[way]["cp_agl_nogcp_m"]) > 100 for r in runs)),
+    }
 
 
 def _twin_monte_carlo(runs) -> dict:
@@ -214,6 +250,7 @@ def checkpoint_campaigns(doc: dict, way: str = "tie_point") -> dict:
         far.append(float(d.max()))
         far_x.append(float(d.max() / r[way]["table3"]["stats"][2][i_nmad]))
     out.update(h_farthest_m=far, h_farthest_over_nmad=far_x)
+    out.update(_flying_height_cause(runs, way, i_std))
     mh = np.array([r[way]["table3"]["stats"][2][i_mean] for r in runs], float)
     smh = np.array([r[way]["table3"]["mean_h_sigma_joint"] for r in runs], float)
     z = mh / smh
