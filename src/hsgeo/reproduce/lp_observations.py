@@ -30,8 +30,9 @@ block as a share of 002's 600 m, so the campaign's area fraction is its square (
 * ``"no-GCP height"``: the mean height without GCPs (joint σ̂), the principal distances' mean
   error and the height offset it predicts, the c error 002's −1.13 m would mean;
 * ``"parameters"``: the camera parameters against their truth (σ̂, z);
-* ``"unmodelled effect"``: the headline numbers with the motion blur (on in every run) and
-  without it (the same campaign rendered again).
+* ``"unmodelled effect"``: the headline numbers with the motion blur (on in every run),
+  without it, and with each line stamped at the start of its exposure (the same campaign
+  rendered again each time; the stamp moves key points, the symmetric blur does not).
 """
 
 from __future__ import annotations
