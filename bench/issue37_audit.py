@@ -280,7 +280,8 @@ def _trace() -> dict | None:
         "file": str(f[0].relative_to(RESULTS.parent.parent)),
         "seed": d["seed"],
         "check_points": [
-            {k: p[k] for k in ("id", "h_error_m", "agl_m", "strips")} for p in d["check_points"]
+            {k: p[k] for k in ("id", "h_error_m", "agl_m", "strips", "ground_offset_from_centre_m")}
+            for p in d["check_points"]
         ],
         "fit_k_h_per_agl": d["fit_k_h_per_agl"],
         "std_h_m": d["std_h_m"],
@@ -423,7 +424,16 @@ def lp_lines() -> list[dict]:
                     )
                     if k in cp
                 },
-                "why_short": None
+                "why_short": (
+                    None
+                    if n >= 8
+                    and cp["c_within_mc"] >= 7
+                    and cp["mean_h_residual_within"] >= 7
+                    and np.median(np.abs(cp["coupling_corr"])) >= 0.9
+                    else f"{n} campaigns with the Monte Carlo; c within in "
+                    f"{cp['c_within_mc']}, mean-height residual after the c coupling within in "
+                    f"{cp['mean_h_residual_within']}"
+                )
                 if mc
                 else "within 3σ̂ in every campaign, but σ̂ of the mean height is "
                 + f"{min(cp['mean_h_nogcp_sigma_m']):.0f}–{max(cp['mean_h_nogcp_sigma_m']):.0f} m "
