@@ -168,6 +168,21 @@ def _flat_parameters(pz) -> tuple[list, np.ndarray, np.ndarray]:
     return lab, v, s
 
 
+def _mean_h_error(r, cp_ids, h_true_m) -> float:
+    """Mean height error (m) of the check points ``cp_ids`` an adjustment determined."""
+    pos = {str(v): j for j, v in enumerate(r.point_ids)}
+    have = [j for j, i in enumerate(cp_ids) if i in pos]
+    z = r.result.value("points_m")[[pos[cp_ids[j]] for j in have], 2]
+    return float(np.mean(z - h_true_m[have])) if have else float("nan")
+
+
+def _c_mean(r) -> float:
+    """Mean principal distance (mm) over the bands an adjustment estimated."""
+    c, sc = r.result.value("c_mm").ravel(), r.result.sigma("c_mm").ravel()
+    ok = np.isfinite(sc) & (sc > 0)
+    return float(np.mean(c[ok]))
+
+
 def twin_difference(
     ev: dict,
     obs,
@@ -237,16 +252,9 @@ def twin_difference(
     h_true = np.asarray(truth.square_xyz_m, float)[k_cp, 2]
 
     def mean_h(r):
-        pos = {str(v): j for j, v in enumerate(r.point_ids)}
-        have = [j for j, i in enumerate(cp) if i in pos]
-        z = r.result.value("points_m")[[pos[cp[j]] for j in have], 2]
-        return float(np.mean(z - h_true[have])) if have else float("nan")
+        return _mean_h_error(r, cp, h_true)
 
-    def c_mean(r):
-        c, sc = r.result.value("c_mm").ravel(), r.result.sigma("c_mm").ravel()
-        ok = np.isfinite(sc) & (sc > 0)
-        return float(np.mean(c[ok]))
-
+    c_mean = _c_mean
     mh_draws, c_draws = [], []
     if method not in ("sign", "resample"):
         raise ValueError(f"method must be 'sign' or 'resample', got {method!r}")
