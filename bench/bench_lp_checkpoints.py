@@ -269,7 +269,12 @@ def main(argv=None) -> dict:
     a = ap.parse_args(argv)
     if a.merge:
         docs = [json.loads(Path(f).read_text()) for f in a.merge]
-        runs = sorted((r for d in docs for r in d["runs"]), key=lambda r: r["seed"])
+        # one run per seed (the first file's, when a seed was run twice)
+        by_seed = {}
+        for d in docs:
+            for r in d["runs"]:
+                by_seed.setdefault(r["seed"], r)
+        runs = [by_seed[k] for k in sorted(by_seed)]
         return write(runs, docs[0]["scale"], a.out, sum(d["wall_s"] for d in docs))
     t0 = time.perf_counter()
     runs = []
