@@ -327,11 +327,13 @@ def lp_lines() -> list[dict]:
                 "a few per cent of a core)",
                 "h_farthest_over_nmad": cp["h_farthest_over_nmad"],
                 "h_farthest_m": cp["h_farthest_m"],
-                "named_cause": "not a blunder of the measurement: without GCPs a principal-"
-                "distance error moves every point along its rays by −AGL·Δc/c, so a check point "
-                "seen only from the 2500 m strips moves 4/3 as far as one seen from 1875 m — "
-                "metres apart when the block's c error is tens of metres of height; the joint "
-                "σ̂ of the STD holds that term only as far as the retrieved σ̂ of c does",
+                "named_cause": "in part: without GCPs a principal-distance error moves every "
+                "point along its rays by −AGL·Δc/c, so a check point seen only from the 2500 m "
+                "strips moves 4/3 as far as one seen from 1875 m (traced on seed 1: no blunder "
+                "of the measurement). The fit H ≈ k·AGL per campaign "
+                "(h_farthest_after_agl_over_nmad) removes the far point where the check points "
+                "mix flying heights; where it does not (the others), the far point is not "
+                "traced here",
                 "traced": _trace(),
                 **{
                     k: cp[k]
