@@ -32,7 +32,8 @@ import numpy as np
 from hsgeo.papers import P002_STATS
 from hsgeo.reproduce.lp_judge import observation_errors_px, within_fractions
 from hsgeo.reproduce.lp_observations import sim_scale, stat_sigma
-from hsgeo.reproduce.lp_runs import _adjust, camera_prior, evaluate, exact_twin
+from hsgeo.reproduce.lp_runs import _adjust, camera_prior, evaluate, exact_twin, parameter_z
+from hsgeo.reproduce.lp_targets import N_DRAWS, twin_difference
 from hsgeo.simulate.lp_campaign import simulate
 from hsgeo.stats import describe
 
@@ -107,6 +108,18 @@ def _across(ev) -> list:
     ]
 
 
+def _agl(res, d, obs) -> list:
+    """Per no-GCP check point, the mean height above the squares (navigation) of the lines
+    that observe it in the table it was adjusted from (``res`` None: the centroid table)."""
+    if res is None:
+        return []
+    tab = res.table  # evaluate's: the check points as tie points, the GCPs by centroid
+    pid = tab["point_id"].astype(str).to_numpy()
+    z = obs.navigation.pose(tab["t_s"].to_numpy(float))[0][:, 2]
+    h0 = float(np.mean(obs.square_xyz_m[:, 2]))
+    return [float(np.mean(z[pid == str(c)]) - h0) for c in d["cp_ids_nogcp"]]
+
+
 def one_seed(seed: int, scale: float) -> dict:
     t0 = time.perf_counter()
     rng = np.random.default_rng([seed, 37])
@@ -138,6 +151,9 @@ def one_seed(seed: int, scale: float) -> dict:
             "table2": _table(d["cp_errors_m"], d["cp_cov_m2"], rng),
             "table3": _table(d["cp_errors_nogcp_m"], d["cp_cov_nogcp_m2"], rng),
             "cp_errors_nogcp_m": np.asarray(d["cp_errors_nogcp_m"]).tolist(),
+            # the mean flying height above the squares of the strips each no-GCP check point
+            # is observed in (issue 37: the no-GCP height offset scales with it)
+            "cp_agl_nogcp_m": _agl(ev["retrieval"] if way == "tie_point" else None, d, obs),
         }
     # principal distances: retrieved, twin (with GCPs), and without GCPs both
     c_true = np.asarray(truth.camera.c_mm, float)
@@ -170,6 +186,16 @@ def one_seed(seed: int, scale: float) -> dict:
         },
     }
     out["twin_nogcp_mean_h_m"] = float(np.mean(E0t[:, 2]))
+    # without GCPs, retrieved − twin in the σ of the difference (Monte Carlo over the
+    # retrieval's observation errors, each point's with a random sign; lp_targets), with the
+    # check points' mean height and the mean c of every draw: the c–H coupling, numerically
+    tw0 = {"adjusted": r0t, "parameters": parameter_z(r0t.result, truth.camera)}
+    td0 = twin_difference(ev, obs, truth, tw0, n_draws=N_DRAWS, rng=[seed, 41], gcp=False)
+    out["nogcp_twin_mc"] = {
+        k: (np.asarray(v, float).tolist() if k != "labels" else list(map(str, v)))
+        for k, v in td0.items()
+        if k not in ("draws", "method", "gcp")
+    }
     out["parameters_vs_twin_z"] = float(
         np.sqrt(
             np.mean(
@@ -243,7 +269,12 @@ def main(argv=None) -> dict:
     a = ap.parse_args(argv)
     if a.merge:
         docs = [json.loads(Path(f).read_text()) for f in a.merge]
-        runs = sorted((r for d in docs for r in d["runs"]), key=lambda r: r["seed"])
+        # one run per seed (the first file's, when a seed was run twice)
+        by_seed = {}
+        for d in docs:
+            for r in d["runs"]:
+                by_seed.setdefault(r["seed"], r)
+        runs = [by_seed[k] for k in sorted(by_seed)]
         return write(runs, docs[0]["scale"], a.out, sum(d["wall_s"] for d in docs))
     t0 = time.perf_counter()
     runs = []

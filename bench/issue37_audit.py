@@ -19,6 +19,8 @@ import json
 import time
 from pathlib import Path
 
+import numpy as np
+
 RESULTS = Path(__file__).resolve().parent / "results"
 
 
@@ -236,20 +238,56 @@ def rikola(runs: list[dict]) -> dict:
     }
 
 
-def lp_blur() -> dict:
+def lp_blur(lp_runs: list[dict]) -> dict:
+    """Met when a ``hsgeo reproduce lp-observations --json`` output carries the third
+    campaign's rows (``stamp_start.*``, stamped at the start of the exposure) and they move
+    the tie observations along the track (RMS y error up by ≥ 0.1 px on the blur-on run)."""
+    moved = []
+    for d in lp_runs:
+        q = {r["quantity"]: r["reproduced"] for r in d["rows"] if r["table"] == "unmodelled effect"}
+        a, b = q.get("stamp_start.rms_y_error_px"), q.get("motion_blur_on.rms_y_error_px")
+        if a is not None and b is not None:
+            moved.append({"seed": d["seed"], "rms_y_start_px": a, "rms_y_middle_px": b})
+    ok = bool(moved) and all(m["rms_y_start_px"] - m["rms_y_middle_px"] >= 0.1 for m in moved)
     return {
         "line": "(what to build, bars that can fail) the LP blur time-stamped at the start of "
         "exposure, so that it moves key points, or another effect that does",
-        "status": "short",
+        "status": "met" if ok else "short",
         "evidence": {
             "files": "src/hsgeo/simulate/lp_campaign.py LpConfig.exposure_stamp ('start' renders "
             "each line half an integration late: squares cross 0.5 line early, x unmoved — "
             "tests/test_lp_campaign.py::test_a_start_of_exposure_stamp_moves_the_squares_half_a_"
-            "blur); book/chapters/lp_observations.md names it and leaves it as an exercise",
-            "why_short": "the default stays 'middle' and the chapter's unmodelled-effect table "
-            "still runs the symmetric blur (it moves no key point); the LP chapter is owned by "
-            "the lp helpers, not changed here",
+            "blur); src/hsgeo/reproduce/lp_observations.py run(): the unmodelled-effect table's "
+            "third campaign, stamped at the start (rows stamp_start.*, with the tie "
+            "observations' rms_x/rms_y_error_px), shown in the chapter's table beside the blur "
+            "on/off columns",
+            "runs_with_stamp_start_rows": moved,
+            "why_short": None
+            if ok
+            else "no lp-observations.json among --runs carries stamp_start rows (the chapter's "
+            "run was not repeated on this branch), or they do not move the key points",
         },
+    }
+
+
+def _trace() -> dict | None:
+    """bench/lp_checkpoint_trace.py's record (one campaign traced point by point), if run."""
+    f = sorted(RESULTS.glob("lp_checkpoint_trace_seed*.json"))
+    if not f:
+        return None
+    d = json.loads(f[0].read_text(encoding="utf-8"))
+    return {
+        "file": str(f[0].relative_to(RESULTS.parent.parent)),
+        "seed": d["seed"],
+        "check_points": [
+            {k: p[k] for k in ("id", "h_error_m", "agl_m", "strips", "ground_offset_from_centre_m")}
+            for p in d["check_points"]
+        ],
+        "fit_k_h_per_agl": d["fit_k_h_per_agl"],
+        "std_h_m": d["std_h_m"],
+        "std_h_after_agl_m": d["std_h_after_agl_m"],
+        "farthest_over_nmad": d["farthest_over_nmad"],
+        "farthest_after_agl_over_nmad": d["farthest_after_agl_over_nmad"],
     }
 
 
@@ -259,14 +297,17 @@ def lp_lines() -> list[dict]:
     from hsgeo.reproduce.lp_campaigns import checkpoint_campaigns
 
     cp_file, jd_file = RESULTS / "lp_checkpoints_seeds.json", RESULTS / "lp_judges_seeds.json"
-    cp = checkpoint_campaigns(json.loads(cp_file.read_text(encoding="utf-8")))
-    jd = json.loads(jd_file.read_text(encoding="utf-8"))["summary"]
+    cp_doc = json.loads(cp_file.read_text(encoding="utf-8"))
+    cp = checkpoint_campaigns(cp_doc)
+    jd_doc = json.loads(jd_file.read_text(encoding="utf-8"))
+    jd, jd_runs = jd_doc["summary"], jd_doc["runs"]
     sd = {k: cp[f"table3.{k}_h"]["sd_z"] for k in ("std", "nmad")}
     n = cp["n_campaigns"]
     ok_sd = all(abs(v - 1.0) <= 0.3 for v in sd.values())
     within = jd["seeds_meeting_95pct_vs_targets"]
     rms = jd["rms_z_sigma_of_difference"]
     h_in, c_in = cp["mean_h_nogcp_within"], cp["c_within"]
+    mc = "c_within_mc" in cp  # the bench's no-GCP Monte Carlo of retrieved − twin
     return [
         {
             "line": "Over 8 campaigns: the z of std_h and nmad_h from pixels has a standard "
@@ -277,9 +318,34 @@ def lp_lines() -> list[dict]:
                 "n_campaigns": n,
                 "sd_z_std_h_table3_joint": sd["std"],
                 "sd_z_nmad_h_table3_joint": sd["nmad"],
-                "why": "one check point metres from the rest in 5 of 8 campaigns (farthest "
-                "over NMAD: " + ", ".join(f"{v:.1f}" for v in cp["h_farthest_over_nmad"]) + "): "
-                "the STD takes it whole; no covariance predicts a blunder",
+                "why_short": None
+                if ok_sd and n >= 8
+                else "the SD of z is outside 1 ± 0.3: the farthest check points are the ones "
+                "seen from the other flying height (named_cause, traced); the bench records "
+                "each check point's AGL (cp_agl_nogcp_m) from this branch on — its file here "
+                "predates that, not re-run (the shared machine's load of 12–26 left a seed "
+                "a few per cent of a core)",
+                "h_farthest_over_nmad": cp["h_farthest_over_nmad"],
+                "h_farthest_m": cp["h_farthest_m"],
+                "named_cause": "in part: without GCPs a principal-distance error moves every "
+                "point along its rays by −AGL·Δc/c, so a check point seen only from the 2500 m "
+                "strips moves 4/3 as far as one seen from 1875 m (traced on seed 1: no blunder "
+                "of the measurement). The fit H ≈ k·AGL per campaign "
+                "(h_farthest_after_agl_over_nmad) removes the far point where the check points "
+                "mix flying heights; where it does not (the others), the far point is not "
+                "traced here",
+                "traced": _trace(),
+                **{
+                    k: cp[k]
+                    for k in (
+                        "agl_k",
+                        "std_h_m",
+                        "std_h_after_agl_m",
+                        "h_farthest_after_agl_over_nmad",
+                        "agl_mix_campaigns",
+                    )
+                    if k in cp
+                },
             },
         },
         {
@@ -290,6 +356,25 @@ def lp_lines() -> list[dict]:
                 "file": str(jd_file.relative_to(RESULTS.parent.parent)),
                 "seeds_meeting_95pct_vs_point_targets": within,
                 "within_1px_vs_targets_per_seed": jd["within_1px_vs_targets_per_seed"],
+                # the same observations against the median of their own tie point's rays and
+                # against the others' (leave-one-out): they agree with each other
+                "within_1px_same_observations_vs_median_per_seed": [
+                    r["within_median_on_targets_1px"] for r in jd_runs
+                ],
+                "within_1px_same_observations_vs_leave_one_out_per_seed": [
+                    r["within_leave_one_out_on_targets_1px"] for r in jd_runs
+                ],
+                "named_cause": "the failing observations are consistent with their own tie "
+                "point's other rays (leave-one-out ≥ "
+                f"{100 * min(r['within_leave_one_out_on_targets_1px'] for r in jd_runs):.1f} % "
+                "within 1 px on the same observations in every campaign) but their feature "
+                "is not the target's recorded "
+                "centre: a 0.6 m (2 px) bright square is found by BRISK at a corner or edge, "
+                "0.3–0.4 m from its centre, and a tie point counts as on a target up to "
+                "ON_TARGET_M = 0.6 m from it (lp_targets.py) — the reference, not the "
+                "measurement, is off by up to ~1.5 px; not mended here (a target whose "
+                "recorded centre is where a corner detector fires, and a re-run of "
+                "bench_lp_judges.py, did not fit the session's CPU)",
             },
         },
         {
@@ -306,19 +391,57 @@ def lp_lines() -> list[dict]:
             "a named cause that reproduces the offset",
             # a bar that can hardly fail is not met: σ̂ of the mean height is metres to tens of
             # metres at the bench's block size, and c − c_twin is judged with the retrieved σ̂
+            # met: c − c_twin within 3σ of the *difference* (Monte Carlo) in ≥ 7 of 8, and the
+            # named cause — the c–H coupling the draws show — leaves a mean-height residual
+            # within 3σ of the draws' scatter about their regression in ≥ 7 of 8, with |corr|
+            # ≥ 0.9 (a bar of centimetres to decimetres, not tens of metres)
             "status": "met"
-            if h_in >= 7 and c_in >= 7 and max(cp["mean_h_nogcp_sigma_m"]) < 1.13
+            if n >= 8
+            and mc
+            and cp["c_within_mc"] >= 7
+            and cp["mean_h_residual_within"] >= 7
+            and np.median(np.abs(cp["coupling_corr"])) >= 0.9
             else "short",
             "evidence": {
                 "file": str(cp_file.relative_to(RESULTS.parent.parent)),
+                "n_campaigns": n,
                 "mean_h_within_3sigma": h_in,
-                "c_minus_twin_within_3sigma": c_in,
+                "c_minus_twin_within_3sigma_retrieved_sigma": c_in,
                 "mean_h_sigma_m": cp["mean_h_nogcp_sigma_m"],
                 "corr_mean_h_with_c_error": cp["corr_mean_h_c"],
-                "why_short": "within 3σ̂ in every campaign, but σ̂ of the mean height is "
+                **{
+                    k: cp.get(k)
+                    for k in (
+                        "c_within_mc",
+                        "c_minus_twin_nogcp_z_mc",
+                        "mean_h_minus_twin_m",
+                        "mean_h_minus_twin_sigma_m",
+                        "mean_h_minus_twin_within",
+                        "coupling_corr",
+                        "coupling_slope_m_per_um",
+                        "mean_h_predicted_from_c_m",
+                        "mean_h_residual_m",
+                        "mean_h_residual_sigma_m",
+                        "mean_h_residual_within",
+                    )
+                    if k in cp
+                },
+                "why_short": (
+                    None
+                    if n >= 8
+                    and cp["c_within_mc"] >= 7
+                    and cp["mean_h_residual_within"] >= 7
+                    and np.median(np.abs(cp["coupling_corr"])) >= 0.9
+                    else f"{n} campaigns with the Monte Carlo; c within in "
+                    f"{cp['c_within_mc']}, mean-height residual after the c coupling within in "
+                    f"{cp['mean_h_residual_within']}"
+                )
+                if mc
+                else "within 3σ̂ in every campaign, but σ̂ of the mean height is "
                 + f"{min(cp['mean_h_nogcp_sigma_m']):.0f}–{max(cp['mean_h_nogcp_sigma_m']):.0f} m "
-                "at this block size (002's offset: 1.13 m), so the bar can hardly fail; "
-                "c − c_twin is judged with the retrieved σ̂, not the difference's",
+                "at this block size (002's offset: 1.13 m), so the bar can hardly fail; the "
+                "bench file predates the no-GCP Monte Carlo of retrieved − twin "
+                "(bench_lp_checkpoints.py nogcp_twin_mc): re-run it",
             },
         },
     ]
@@ -335,6 +458,11 @@ def main() -> None:
         for d in args.runs
         if (d / "rikola.json").is_file() and (d / "rikola.json").stat().st_size
     ]
+    lp = [
+        json.loads((d / "lp-observations.json").read_text(encoding="utf-8"))
+        for d in args.runs
+        if (d / "lp-observations.json").is_file() and (d / "lp-observations.json").stat().st_size
+    ]
     entries = [
         *lp_lines(),
         scoreboard(),
@@ -343,7 +471,7 @@ def main() -> None:
         mtf_edge(),
         counts_note(),
         rikola(rik),
-        lp_blur(),
+        lp_blur(lp),
     ]
     out = {
         "what": "issue 37's done-means lines measured on main 268652f (+ this branch's mends)",

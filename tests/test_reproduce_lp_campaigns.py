@@ -131,3 +131,62 @@ def test_the_recorded_bench_reads():
     s = np.array(out["mean_h_nogcp_sigma_m"] + out["table3.std_h"]["sigma_m"])
     assert np.all(np.isfinite(s) & (s > 0))
     assert out["enough"] == (out["n_campaigns"] >= 8)
+
+
+def test_c_minus_twin_is_judged_in_the_sigma_of_the_difference_and_the_coupling_named():
+    """Issue 37: c − c_twin was judged in the retrieval's σ̂ (1 µm here: z = 1, 'within'); in
+    the σ of the difference (0.2 µm from the Monte Carlo) it is 5σ off and fails. The draws'
+    mean heights follow their mean c (H = −0.05 m/µm · c): the coupling's correlation and
+    slope are recovered, the retrieval's height offset from the twin is the c error's
+    prediction, and the residual is judged in the draws' scatter about the line."""
+    rng = np.random.default_rng(3)
+    doc = _campaigns(8)
+    for r in doc["runs"]:
+        cd = 40.3 + 1e-3 * 0.2 * rng.standard_normal(16)  # mm; σ 0.2 µm about the twin
+        hd = -0.05 * 1e3 * (cd - 40.3) + 0.002 * rng.standard_normal(16)
+        r["nogcp_twin_mc"] = {
+            "labels": [f"c_mm[{b}]" for b in range(7)],
+            "z": [5.0] * 6 + [float("nan")],
+            "mean_h_m": -0.05 * 1.0,  # c 1 µm off: −0.05 m
+            "mean_h_twin_m": 0.0,
+            "mean_h_draws_m": hd.tolist(),
+            "c_mean_draws_mm": cd.tolist(),
+            "c_mean_mm": 40.301,
+            "c_mean_twin_mm": 40.3,
+        }
+    out = checkpoint_campaigns(doc)
+    assert out["c_within"] == 8  # the old judge: the retrieval's σ̂ passes every campaign
+    assert out["c_within_mc"] == 0 and out["c_minus_twin_nogcp_z_mc"] == pytest.approx([5.0] * 8)
+    assert np.all(np.array(out["coupling_corr"]) < -0.9)
+    assert out["coupling_slope_m_per_um"] == pytest.approx([-0.05] * 8, abs=0.01)
+    assert out["mean_h_predicted_from_c_m"] == pytest.approx([-0.05] * 8, abs=0.01)
+    assert out["mean_h_residual_within"] == 8
+    # without the bench's Monte Carlo (an older file): nothing claimed
+    assert "c_within_mc" not in checkpoint_campaigns(_campaigns(3))
+
+
+def test_the_no_gcp_heights_scale_with_the_flying_height():
+    """Issue 37, traced on seed 1 of bench_lp_checkpoints: the two check points "metres from
+    the rest" (−46.3 and −45.6 m against −33.5 m) were the two seen only from the 2500 m
+    strips; without GCPs a c error moves heights by −AGL·Δc/c, 4/3 as far from 2500 m. Heights
+    k·AGL (k = −1.8 %) plus 0.5 m noise: the fit recovers k, and the STD about it is the noise's,
+    not the metres of the flying-height mix."""
+    rng = np.random.default_rng(5)
+    doc = _campaigns(8)
+    for r in doc["runs"]:
+        a = np.array([1875.0] * 7 + [2500.0] * 2)
+        h = -0.018 * a + 0.5 * rng.standard_normal(9)
+        E = np.asarray(r["tie_point"]["cp_errors_nogcp_m"], float)
+        E[:, 2] = h
+        r["tie_point"]["cp_errors_nogcp_m"] = E.tolist()
+        r["tie_point"]["table3"] = {**r["tie_point"]["table3"]}
+        st = [list(x) for x in r["tie_point"]["table3"]["stats"]]
+        st[2][I_STD] = float(np.std(h, ddof=1))
+        r["tie_point"]["table3"]["stats"] = st
+        r["tie_point"]["cp_agl_nogcp_m"] = a.tolist()
+    out = checkpoint_campaigns(doc)
+    assert out["agl_k"] == pytest.approx([-0.018] * 8, abs=0.001)
+    assert np.all(np.array(out["std_h_m"]) > 4.0)  # the mix: metres
+    assert np.all(np.array(out["std_h_after_agl_m"]) < 1.0)  # about k·AGL: the noise
+    assert out["agl_mix_campaigns"] == 8
+    assert "agl_k" not in checkpoint_campaigns(_campaigns(3))  # not recorded: nothing claimed

@@ -205,6 +205,7 @@ def test_same_seed_same_rows(rep):
     on = [r.as_dict() for r in rep.rows if r.quantity.startswith("motion_blur_on.")]
     assert on == [r.as_dict() for r in again.rows if r.quantity.startswith("motion_blur_on.")]
     assert not any(r.quantity.startswith("motion_blur_off.") for r in again.rows)
+    assert not any(r.quantity.startswith("stamp_start.") for r in again.rows)
 
 
 @pytest.fixture(scope="module")
@@ -266,3 +267,21 @@ def test_exact_twin_is_exact_and_judges_the_parameters(rep7):
     for r, s in zip(rows, shift, strict=True):
         assert s.quantity.endswith(r.quantity)
         assert s.reproduced == pytest.approx((r.truth - gen[f"generating.{r.quantity}"]) / r.sigma)
+
+
+def test_the_unmodelled_table_runs_an_effect_that_moves_key_points():
+    """Issue 37: the blur on/off rows moved no key point (a blur symmetric about the stamp);
+    the table now carries a third campaign, stamped at the start of the exposure, and the
+    headline has the tie observations' RMS error across the line (along the track), where a
+    stamp offset shows."""
+    from hsgeo.reproduce.lp_observations import _unmodelled_rows
+
+    h = {"within_1px_fraction": 0.97, "rms_y_error_px": 0.3, "cp_nmad_h_m": 0.1}
+    rows = _unmodelled_rows(h, {**h, "rms_y_error_px": 0.29}, {**h, "rms_y_error_px": 0.6})
+    q = {r.quantity: r for r in rows}
+    assert set(q) == {
+        f"{s}.{k}" for s in ("motion_blur_on", "motion_blur_off", "stamp_start") for k in h
+    }
+    assert q["stamp_start.rms_y_error_px"].unit == "px"
+    assert q["stamp_start.cp_nmad_h_m"].unit == "m"
+    assert all(r.table == "unmodelled effect" for r in rows)

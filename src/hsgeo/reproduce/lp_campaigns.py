@@ -27,6 +27,7 @@ from __future__ import annotations
 import numpy as np
 
 from hsgeo.report import MIN_RUNS
+from hsgeo.stats import nmad
 
 __all__ = ["checkpoint_campaigns", "Z_LIMIT"]
 
@@ -79,6 +80,111 @@ def _per_group(runs) -> list[dict]:
         }
         for (h, d), (n, sx, sy) in sorted(acc.items())
     ]
+
+
+def _flying_height_cause(runs, way: str, i_std: int) -> dict:
+    """The no-GCP heights' scale with the flying height, per campaign (issue 37).
+
+    Without GCPs a principal-distance error Δc moves every point along its rays by
+    −AGL·Δc/c (the no-GCP height rows, :func:`hsgeo.reproduce.lp_observations._height_rows`):
+    a check point observed only from the 2500 m strips moves 2500/1875 = 4/3 as far as one
+    seen from the 1875 m strips — metres apart when Δc̄ is tens of metres of height, a point
+    "far from the rest" that is no blunder. Fitted per campaign through the origin, H_i ≈ k ·
+    AGL_i (AGL_i: the mean flying height above the squares of the lines that observe check
+    point i, the bench's ``cp_agl_nogcp_m``): ``agl_k`` (k, m of height per m of AGL, i.e.
+    −Δc/c), ``std_h_after_agl_m`` (the STD of H_i − k·AGL_i) beside ``std_h_m``, and
+    ``h_farthest_after_agl_over_nmad``. Empty when the bench did not record the heights.
+    """
+    if not all(r[way].get("cp_agl_nogcp_m") for r in runs):
+        return {}
+    k_, s0, s1, far = [], [], [], []
+    for r in runs:
+        h = np.asarray(r[way]["cp_errors_nogcp_m"], float)[:, 2]
+        a = np.asarray(r[way]["cp_agl_nogcp_m"], float)
+        k = float(np.sum(a * h) / np.sum(a * a))
+        e = h - k * a
+        k_.append(k)
+        s0.append(float(r[way]["table3"]["stats"][2][i_std]))
+        s1.append(float(np.std(e, ddof=1)) if e.size > 1 else float("nan"))
+        d = np.abs(e - np.median(e))
+        far.append(float(d.max() / nmad(e)) if nmad(e) > 0 else float("nan"))
+    return {
+        "agl_k": k_,
+        "std_h_m": s0,
+        "std_h_after_agl_m": s1,
+        "h_farthest_after_agl_over_nmad": far,
+        "agl_mix_campaigns": int(sum(np.ptp(r[way]["cp_agl_nogcp_m"]) > 100 for r in runs)),
+    }
+
+
+def _twin_monte_carlo(runs) -> dict:
+    """Without GCPs, retrieved − twin in the σ of the difference, per campaign.
+
+    From the bench's ``nogcp_twin_mc`` (:func:`hsgeo.reproduce.lp_targets.twin_difference`
+    with ``gcp=False``):
+
+    * ``c_minus_twin_nogcp_z_mc``: the band of largest |z| of c − c_twin in the σ of the
+      difference, and ``c_within_mc`` (campaigns whose every band is within :data:`Z_LIMIT`);
+    * ``mean_h_minus_twin_m`` and its σ (RMS over the draws of draw − twin), ``..._z``,
+      ``mean_h_minus_twin_within``;
+    * the **c–H coupling** the draws show: ``coupling_corr`` (correlation over the draws of
+      the check points' mean height with the bands' mean c), ``coupling_slope_m_per_um``
+      (regression slope, m of height per µm of c), and ``mean_h_predicted_from_c_m`` = slope ·
+      (c̄ − c̄_twin): the height offset from the twin that the c error alone predicts, with
+      ``mean_h_residual_m`` (what the c error leaves) and its σ
+      (``mean_h_residual_sigma_m``, the draws' scatter about their regression line).
+
+    Empty when the runs have no ``nogcp_twin_mc`` (an older bench file).
+    """
+    mc = [r.get("nogcp_twin_mc") for r in runs]
+    if not runs or not all(mc):
+        return {}
+    zc, cin, dh, sh, zh, corr, slope, pred, resid, sres = ([] for _ in range(10))
+    for m in mc:
+        lab = list(m["labels"])
+        ic = [i for i, q in enumerate(lab) if q.startswith("c_mm")]
+        z = np.asarray(m["z"], float)[ic]
+        z = z[np.isfinite(z)]
+        zc.append(float(z[np.argmax(np.abs(z))]) if z.size else float("nan"))
+        cin.append(bool(z.size) and bool(np.all(np.abs(z) <= Z_LIMIT)))
+        hd = np.asarray(m["mean_h_draws_m"], float)
+        cd = 1e3 * np.asarray(m["c_mean_draws_mm"], float)  # µm
+        d = float(m["mean_h_m"] - m["mean_h_twin_m"])
+        s = float(np.sqrt(np.mean((hd - m["mean_h_twin_m"]) ** 2)))
+        dh.append(d)
+        sh.append(s)
+        zh.append(d / s if s > 0 else float("nan"))
+        ok = np.isfinite(hd) & np.isfinite(cd)
+        if ok.sum() > 2 and np.std(cd[ok]) > 0:
+            b = float(np.polyfit(cd[ok], hd[ok], 1)[0])
+            r = float(np.corrcoef(cd[ok], hd[ok])[0, 1])
+            e = hd[ok] - m["mean_h_twin_m"] - b * (cd[ok] - 1e3 * m["c_mean_twin_mm"])
+            sr = float(np.sqrt(np.mean(e**2)))
+        else:
+            b = r = sr = float("nan")
+        p = b * 1e3 * (m["c_mean_mm"] - m["c_mean_twin_mm"])
+        slope.append(b)
+        corr.append(r)
+        pred.append(float(p))
+        resid.append(float(d - p))
+        sres.append(sr)
+    zh_a = np.array(zh)
+    res_z = np.array(resid) / np.array(sres)
+    return {
+        "c_minus_twin_nogcp_z_mc": zc,
+        "c_within_mc": int(np.sum(cin)),
+        "mean_h_minus_twin_m": dh,
+        "mean_h_minus_twin_sigma_m": sh,
+        "mean_h_minus_twin_z": zh,
+        "mean_h_minus_twin_within": int(np.sum(np.abs(zh_a) <= Z_LIMIT)),
+        "coupling_corr": corr,
+        "coupling_slope_m_per_um": slope,
+        "mean_h_predicted_from_c_m": pred,
+        "mean_h_residual_m": resid,
+        "mean_h_residual_sigma_m": sres,
+        "mean_h_residual_z": res_z.tolist(),
+        "mean_h_residual_within": int(np.sum(np.abs(res_z) <= Z_LIMIT)),
+    }
 
 
 def checkpoint_campaigns(doc: dict, way: str = "tie_point") -> dict:
@@ -144,6 +250,7 @@ def checkpoint_campaigns(doc: dict, way: str = "tie_point") -> dict:
         far.append(float(d.max()))
         far_x.append(float(d.max() / r[way]["table3"]["stats"][2][i_nmad]))
     out.update(h_farthest_m=far, h_farthest_over_nmad=far_x)
+    out.update(_flying_height_cause(runs, way, i_std))
     mh = np.array([r[way]["table3"]["stats"][2][i_mean] for r in runs], float)
     smh = np.array([r[way]["table3"]["mean_h_sigma_joint"] for r in runs], float)
     z = mh / smh
@@ -167,6 +274,7 @@ def checkpoint_campaigns(doc: dict, way: str = "tie_point") -> dict:
         dc.append(float(1e3 * np.mean(vi[ok] - tri[ok])))
     dc = np.array(dc)
     both = np.std(mh) > 0 and np.std(dc) > 0
+    out.update(_twin_monte_carlo(runs))
     out.update(
         c_minus_twin_nogcp_um=dct,
         c_minus_twin_nogcp_z=zc,

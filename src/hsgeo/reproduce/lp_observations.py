@@ -30,8 +30,9 @@ block as a share of 002's 600 m, so the campaign's area fraction is its square (
 * ``"no-GCP height"``: the mean height without GCPs (joint σ̂), the principal distances' mean
   error and the height offset it predicts, the c error 002's −1.13 m would mean;
 * ``"parameters"``: the camera parameters against their truth (σ̂, z);
-* ``"unmodelled effect"``: the headline numbers with the motion blur (on in every run) and
-  without it (the same campaign rendered again).
+* ``"unmodelled effect"``: the headline numbers with the motion blur (on in every run),
+  without it, and with each line stamped at the start of its exposure (the same campaign
+  rendered again each time; the stamp moves key points, the symmetric blur does not).
 """
 
 from __future__ import annotations
@@ -579,9 +580,15 @@ def _shift_rows(ev: dict, twin: dict) -> list[Row]:
     return rows
 
 
-def _unmodelled_rows(on: dict, off: dict | None) -> list[Row]:
+def _unmodelled_rows(on: dict, off: dict | None, start: dict | None = None) -> list[Row]:
+    """Rows ``motion_blur_on.*`` (the chapter's campaign: blur, mid-exposure stamp),
+    ``motion_blur_off.*`` (rendered again without the blur) and ``stamp_start.*`` (rendered
+    again with the blur and each line stamped at the start of its exposure,
+    :attr:`~hsgeo.simulate.lp_campaign.LpConfig.exposure_stamp`: the effect that moves key
+    points, half the blur along the track, opposite on opposite headings).
+    """
     rows = []
-    for state, h in (("on", on), ("off", off)):
+    for name, h in (("motion_blur_on", on), ("motion_blur_off", off), ("stamp_start", start)):
         if h is None:
             continue
         for q, v in h.items():
@@ -589,7 +596,7 @@ def _unmodelled_rows(on: dict, off: dict | None) -> list[Row]:
             rows.append(
                 Row(
                     table="unmodelled effect",
-                    quantity=f"motion_blur_{state}.{q}",
+                    quantity=f"{name}.{q}",
                     unit=unit,
                     reproduced=v,
                 )
@@ -646,7 +653,9 @@ def _meta(s, obs, truth, ev, lengths, T, off) -> dict:
         "mount_motion_deg": float(np.rad2deg(cfg.mount_motion_rad)),
         "unmodelled_effect": "motion blur of the line's integration along track "
         f"({cfg.motion_blur_m:.3f} m box), not in 002 eq. (2); on in every run, off in the "
-        "table's 'off' rows (the same campaign rendered again)" + ("" if off else " (not run)"),
+        "table's 'off' rows (the same campaign rendered again); and the line's time stamp at "
+        "the start of its exposure ('stamp_start' rows, the same campaign rendered again: "
+        "key points move half the blur along the track)" + ("" if off else " (not run)"),
         "timings_s": T,
         "retrieval_timings_s": {
             k: (float(np.sum(v)) if isinstance(v, list) else float(v))
@@ -705,13 +714,19 @@ def run(
     fig9_rows, mosaic_adj, mosaic_raw, per_square = fig9(obs, truth, ev["adjusted"], rng=[seed, 9])
     T["fig9"] = time.perf_counter() - t0
     rows += fig9_rows
-    off = None
+    off = start = None
     if unmodelled:
         t0 = time.perf_counter()
         obs0, truth0 = simulate(s, rng=seed, cfg=replace(LpConfig(), motion_blur_m=0.0))
         off = headline(evaluate(obs0, truth0, seed, nogcp=False, progress=progress, both=False))
         T["motion_blur_off"] = time.perf_counter() - t0
-    rows += _unmodelled_rows(headline(ev), off)
+        # issue 37: a symmetric blur moves no key point; a stamp at the start of the exposure
+        # does (half the blur along the track, opposite on opposite headings)
+        t0 = time.perf_counter()
+        obs1, truth1 = simulate(s, rng=seed, cfg=replace(LpConfig(), exposure_stamp="start"))
+        start = headline(evaluate(obs1, truth1, seed, nogcp=False, progress=progress, both=False))
+        T["stamp_start"] = time.perf_counter() - t0
+    rows += _unmodelled_rows(headline(ev), off, start)
     T["total"] = time.perf_counter() - t_start
     meta = _meta(s, obs, truth, ev, lengths, T, off)
     z = np.array([r.z for r in rows if r.table == "parameters" and r.z is not None], float)

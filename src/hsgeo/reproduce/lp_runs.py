@@ -383,6 +383,10 @@ def headline(ev: dict) -> dict:
         "tie_observations": float((~ev["is_square"]).sum()),
         "within_1px_fraction": w[1.0],
         "within_half_px_fraction": w[0.5],
+        # where the key points are, not only how sharp: the RMS of the tie observations' error
+        # along the line (x) and across it (y, the track: a time-stamp offset moves it)
+        "rms_x_error_px": float(np.sqrt(np.nanmean(e[:, 0] ** 2))),
+        "rms_y_error_px": float(np.sqrt(np.nanmean(e[:, 1] ** 2))),
         "outlier_fraction_after_ransac": ev["matches"]["outlier_lp"],
         "nmad_x_px": float(nmad(r[:, 0])),
         "nmad_y_px": float(nmad(r[:, 1])),

@@ -168,8 +168,31 @@ def _flat_parameters(pz) -> tuple[list, np.ndarray, np.ndarray]:
     return lab, v, s
 
 
+def _mean_h_error(r, cp_ids, h_true_m) -> float:
+    """Mean height error (m) of the check points ``cp_ids`` an adjustment determined."""
+    pos = {str(v): j for j, v in enumerate(r.point_ids)}
+    have = [j for j, i in enumerate(cp_ids) if i in pos]
+    z = r.result.value("points_m")[[pos[cp_ids[j]] for j in have], 2]
+    return float(np.mean(z - h_true_m[have])) if have else float("nan")
+
+
+def _c_mean(r) -> float:
+    """Mean principal distance (mm) over the bands an adjustment estimated."""
+    c, sc = r.result.value("c_mm").ravel(), r.result.sigma("c_mm").ravel()
+    ok = np.isfinite(sc) & (sc > 0)
+    return float(np.mean(c[ok]))
+
+
 def twin_difference(
-    ev: dict, obs, truth, twin: dict, *, n_draws: int = N_DRAWS, rng=0, method: str = "sign"
+    ev: dict,
+    obs,
+    truth,
+    twin: dict,
+    *,
+    n_draws: int = N_DRAWS,
+    rng=0,
+    method: str = "sign",
+    gcp: bool = True,
 ) -> dict:
     """σ of retrieved − twin by Monte Carlo over the retrieval's observation noise (module
     docstring).
@@ -189,6 +212,10 @@ def twin_difference(
         ``"sign"``: each point's own errors with one random sign per point (module docstring);
         ``"resample"``: every observation's error drawn with replacement from the errors of
         its kind (tie points, check-point squares, GCPs).
+    gcp : bool
+        The adjustment with the GCPs (``ev["parameters"]`` against ``twin["parameters"]``) or
+        without them (``ev["adjusted_nogcp"]`` against the twin adjusted without GCPs,
+        ``twin["adjusted"]``; and the check points' mean height, ``mean_h_*``).
 
     Returns
     -------
@@ -197,7 +224,9 @@ def twin_difference(
         (RMS over the draws of draw − twin), ``sigma_retrieved`` (the retrieved σ̂), ``z``
         (difference / σ of the difference; NaN for a fixed parameter), ``z_retrieved_sigma``
         (difference / retrieved σ̂, the chapter's former judge), ``draws`` ``(n_draws, p)``,
-        ``n_draws``, ``failed_draws``.
+        ``n_draws``, ``failed_draws``; without GCPs also ``mean_h_m`` (the retrieval's
+        check points' mean height error), ``mean_h_twin_m``, ``mean_h_draws_m`` (per draw)
+        and ``c_mean_draws_mm`` (per draw, the mean principal distance over the bands seen).
     """
     from hsgeo.reproduce.lp_runs import _adjust, camera_prior, parameter_z
 
@@ -213,8 +242,20 @@ def twin_difference(
     groups = [~is_sq, is_sq & ~is_gcp, is_gcp]
     finite = np.all(np.isfinite(err), axis=1)
     cam = camera_prior(obs, truth.cfg)
-    lab, v_ret, s_ret = _flat_parameters(ev["parameters"])
+    if gcp:
+        lab, v_ret, s_ret = _flat_parameters(ev["parameters"])
+    else:
+        lab, v_ret, s_ret = _flat_parameters(parameter_z(ev["adjusted_nogcp"].result, truth.camera))
     _, v_twin, _ = _flat_parameters(twin["parameters"])
+    cp = [str(x) for x in ev.get("cp_ids_nogcp", [])] if not gcp else []
+    k_cp = [list(map(str, obs.square_ids)).index(i) for i in cp]
+    h_true = np.asarray(truth.square_xyz_m, float)[k_cp, 2]
+
+    def mean_h(r):
+        return _mean_h_error(r, cp, h_true)
+
+    c_mean = _c_mean
+    mh_draws, c_draws = [], []
     if method not in ("sign", "resample"):
         raise ValueError(f"method must be 'sign' or 'resample', got {method!r}")
     _, cluster = np.unique(pid, return_inverse=True)
@@ -234,11 +275,14 @@ def twin_difference(
         t["x_px"] = base["x_px"].to_numpy(float) + noise[:, 0]
         t["y_px"] = base["y_px"].to_numpy(float) + noise[:, 1]
         try:
-            r, _, _ = _adjust(replace(res, table=t), obs, cam, True, ev["gcp_ids"])
+            r, _, _ = _adjust(replace(res, table=t), obs, cam, gcp, ev["gcp_ids"])
         except Exception:  # noqa: BLE001 - a draw the solver cannot adjust is counted, not fatal
             failed += 1
             continue
         draws.append(_flat_parameters(parameter_z(r.result, truth.camera))[1])
+        if not gcp:
+            mh_draws.append(mean_h(r))
+            c_draws.append(c_mean(r))
     D = np.array(draws).reshape(-1, v_ret.size) - v_twin
     sd = np.sqrt(np.mean(D**2, axis=0)) if D.shape[0] else np.full(v_ret.size, np.nan)
     fixed = ~(np.isfinite(s_ret) & (s_ret > 0))
@@ -247,7 +291,19 @@ def twin_difference(
     with np.errstate(invalid="ignore", divide="ignore"):
         z = d / sd
         z_r = d / s_ret
+    extra = {}
+    if not gcp:
+        extra = {
+            "mean_h_m": mean_h(ev["adjusted_nogcp"]),
+            "mean_h_twin_m": mean_h(twin["adjusted"]),
+            "mean_h_draws_m": np.array(mh_draws),
+            "c_mean_draws_mm": np.array(c_draws),
+            "c_mean_mm": c_mean(ev["adjusted_nogcp"]),
+            "c_mean_twin_mm": c_mean(twin["adjusted"]),
+        }
     return {
+        **extra,
+        "gcp": gcp,
         "labels": lab,
         "difference": d,
         "sigma_difference": sd,
