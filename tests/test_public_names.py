@@ -65,8 +65,7 @@ def test_the_check_sees_every_kind_of_definition():
 
 
 #: Modules whose ``__all__`` re-exports names a sibling module defines: a package's facade
-#: (its ``__init__``) and the former paths of modules split in two, kept until their importers
-#: move (each is a name with two import paths).
+#: (its ``__init__``) only. A module split in two keeps no re-export of the other's names.
 FACADES = {
     "hsgeo",
     "hsgeo.adjust",
@@ -74,9 +73,6 @@ FACADES = {
     "hsgeo.io",
     "hsgeo.nist",
     "hsgeo.sensors",
-    # split modules: the importers still use the former path
-    "hsgeo.simulate.pushbroom_campaign",  # -> pushbroom_campaign_types, error_processes
-    "hsgeo.workflows.rikola",  # -> rikola_bands, rikola_joint
 }
 
 

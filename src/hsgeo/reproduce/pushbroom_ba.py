@@ -38,11 +38,11 @@ from hsgeo.reproduce.pushbroom_runs import (
     study_plan,
     unmodelled_rows,
 )
-from hsgeo.simulate.pushbroom_campaign import (
+from hsgeo.simulate.pushbroom_campaign import simulate
+from hsgeo.simulate.pushbroom_campaign_types import (
     CampaignConfig,
     CampaignObservations,
     CampaignTruth,
-    simulate,
 )
 from hsgeo.stats import describe
 from hsgeo.workflows.pushbroom_ba import (  # 002's settings, spelled once in the workflow

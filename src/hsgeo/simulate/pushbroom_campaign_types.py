@@ -2,7 +2,7 @@
 published values and the simulation's own choices), :class:`CampaignObservations` (what the
 adjustment may use) and :class:`CampaignTruth` (what only :mod:`hsgeo.reproduce` compares with).
 
-The simulator is :mod:`hsgeo.simulate.pushbroom_campaign`, which re-exports every name here.
+The simulator is :mod:`hsgeo.simulate.pushbroom_campaign`; import these names from here.
 """
 
 from __future__ import annotations
