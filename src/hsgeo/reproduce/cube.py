@@ -364,8 +364,8 @@ def _unmodelled_rows(cfg, seed, base_spectra, base_groups, truth_bands, lam) -> 
 
 def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
     """Simulate, build, write, read back and compare; the chapter's tables."""
-    survey = load_scenario("cube_survey").survey  # data_synthetic/cube_survey.toml, scale 1
-    cfg = replace(survey, length_m=max(0.12, survey.length_m * scale))
+    base = load_scenario("cube_survey").survey  # data_synthetic/cube_survey.toml, scale 1
+    cfg = replace(base, length_m=max(0.12, base.length_m * scale))
     t0 = time.perf_counter()
     res, frames, truth = survey(cfg, seed)
     lam = res.cube["wavelength_nm"].values
