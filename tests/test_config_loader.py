@@ -298,3 +298,20 @@ def test_the_paper_s_defaults_are_written_once_in_papers(literal):
         )
         hits = re.findall(rf"(?<![\w.]){re.escape(literal)}(?![\w])", code)
         assert not hits, f"{name} spells the paper's {literal}; take it from hsgeo.papers"
+
+
+def test_a_scenario_that_writes_files_needs_its_seed(tmp_path, monkeypatch):
+    """[scenario] seed is optional for a chapter's in-memory scenario only: ``hsgeo data`` names
+    the file and the key of a generator's scenario without one (before writing anything)."""
+    from hsgeo.reproduce.data import generate_all
+
+    d = tmp_path / "data_synthetic"
+    d.mkdir()
+    text = (data_dir() / "mtf_bench.toml").read_text(encoding="utf-8")
+    (d / "mtf_bench.toml").write_text(text.replace("seed = 20261124\n", ""))
+    shutil.copy(data_dir() / "cube_survey.toml", d / "cube_survey.toml")  # no seed: in-memory
+    monkeypatch.chdir(tmp_path)
+    assert load_scenario("cube_survey").scenario.seed is None
+    with pytest.raises(InputError, match=r"mtf_bench.toml: \[scenario\] seed: missing"):
+        generate_all(out=tmp_path / "gen")
+    assert not any((tmp_path / "gen").iterdir())
