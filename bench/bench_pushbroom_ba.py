@@ -42,7 +42,8 @@ def _problem(scale, seed, with_gcp=True, keep=None):
     and which observations carry a simulated gross error (``gross``) before the truth is
     dropped."""
     from hsgeo.reproduce.pushbroom_runs import camera_prior
-    from hsgeo.simulate.pushbroom_campaign import CampaignConfig, simulate
+    from hsgeo.simulate.pushbroom_campaign import simulate
+    from hsgeo.simulate.pushbroom_campaign_types import CampaignConfig
     from hsgeo.workflows.pushbroom_ba import Y_AS_TIME, build_problem
 
     cfg = CampaignConfig()

@@ -1,7 +1,8 @@
 """The Rikola joint model with the EOP drift across the bands (issue 37.7): recovery over seeds.
 
 The simulator rotates each band's camera frame by φ = dφ·(band − 13) (003 §3.4, Fig. 5;
-``rikola_bench.toml [eop_drift]``); the joint model (:func:`hsgeo.workflows.rikola.calibrate_joint`)
+``rikola_bench.toml [eop_drift]``); the joint model
+(:func:`hsgeo.workflows.rikola_joint.calibrate_joint`)
 now estimates a rotation rate (dω, dφ, dκ) per band. For each seed this script renders and
 measures a small bench (8 cubes, the chapter's ten small-scale bands), calibrates the bands, and
 adjusts the joint model with the drift estimated and held at zero; it reports z = (estimate −
@@ -27,8 +28,8 @@ from hsgeo.adjust import identifiability
 from hsgeo.reproduce.rikola import SMALL_BANDS, observe
 from hsgeo.simulate.rikola import make_truth
 from hsgeo.simulate.scenarios import load_scenario
-from hsgeo.workflows.rikola import calibrate_band, calibrate_joint
-from hsgeo.workflows.rikola_joint import DRIFT_REF_BAND
+from hsgeo.workflows.rikola_bands import calibrate_band
+from hsgeo.workflows.rikola_joint import DRIFT_REF_BAND, calibrate_joint
 
 
 def truth_values(truth, j) -> dict:

@@ -23,7 +23,8 @@ from pathlib import Path
 import numpy as np
 
 from hsgeo.reproduce.pushbroom_runs import adjust_campaign, cp_errors
-from hsgeo.simulate.pushbroom_campaign import CampaignConfig, simulate
+from hsgeo.simulate.pushbroom_campaign import simulate
+from hsgeo.simulate.pushbroom_campaign_types import CampaignConfig
 from hsgeo.stats import nmad
 
 CAMERA = ("boresight_rad", "lever_arm_m", "distortion", "c_mm")

@@ -17,7 +17,8 @@ def _compile_pushbroom_kernels() -> None:
     empty cache, 6.9 CPU-s with a warm one (bench/results/test_suite_cost.json).
     """
     from hsgeo.adjust import adjust
-    from hsgeo.simulate.pushbroom_campaign import CampaignConfig, simulate
+    from hsgeo.simulate.pushbroom_campaign import simulate
+    from hsgeo.simulate.pushbroom_campaign_types import CampaignConfig
     from hsgeo.workflows.pushbroom_ba import CameraPrior, build_problem
 
     obs, _ = simulate(0.001, rng=3)

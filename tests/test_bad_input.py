@@ -53,7 +53,8 @@ def _pushbroom(d: Path) -> None:
     import pandas as pd
 
     from hsgeo.io.navigation import write_trajectory
-    from hsgeo.simulate.pushbroom_campaign import CampaignConfig, simulate
+    from hsgeo.simulate.pushbroom_campaign import simulate
+    from hsgeo.simulate.pushbroom_campaign_types import CampaignConfig
     from hsgeo.trajectory import Trajectory, rph_from_platform_rpy
 
     d.mkdir()

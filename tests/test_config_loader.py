@@ -112,8 +112,12 @@ def test_the_file_wins_over_the_defaults_and_the_defaults_are_the_papers():
 
     assert FlightSensorTruth() == load_scenario("pula_flight").sensor_truth
     assert FlightSensorTruth().K == (T1.K1, T1.K2, T1.K3)
+    from hsgeo.sensors.rikola import RikolaCamera
+
     cam = load_scenario("rikola_bench").camera
     assert cam.pixel_mm == RIKOLA_CAMERA["pixel_mm"] == BenchCameraRikola.pixel_mm
+    assert RikolaCamera.pixel_mm == RIKOLA_CAMERA["pixel_mm"]
+    assert RikolaCamera.image_size == (RIKOLA_CAMERA["width_px"], RIKOLA_CAMERA["height_px"])
     assert load_scenario("line_lab").lab.even_distortion_px == 0.0  # the file's, not the default
 
 
@@ -201,3 +205,113 @@ def test_nested_tables_and_the_dataclass_own_checks_are_named():
     msg = str(e.value)
     assert "[inner.flight] sped_m_s: unknown key; did you mean 'speed_m_s'?" in msg, msg
     assert "[checked] n_views must be at least 2, got 1" in msg, msg
+
+
+def _same(a, b) -> bool:
+    """Equal values of equal types, field by field (arrays by their elements)."""
+    import numpy as np
+
+    if dataclasses.is_dataclass(a):
+        return type(a) is type(b) and all(
+            _same(getattr(a, f.name), getattr(b, f.name)) for f in dataclasses.fields(a)
+        )
+    if isinstance(a, np.ndarray):
+        return isinstance(b, np.ndarray) and np.array_equal(a, b)
+    if isinstance(a, tuple):
+        return isinstance(b, tuple) and len(a) == len(b) and all(map(_same, a, b))
+    return type(a) is type(b) and a == b
+
+
+#: Each chapter's scenario file, the table its chapter reads and that table's dataclass.
+CHAPTER_SCENARIOS = {
+    "pushbroom_campaign": ("campaign", "hsgeo.simulate.pushbroom_campaign_types:CampaignConfig"),
+    "asf_runway": ("scene", "hsgeo.simulate.asf_runway:RunwayScene"),
+    "cube_survey": ("survey", "hsgeo.simulate.cube_survey:CubeSurvey"),
+    "mtf_bench": ("bench", "hsgeo.simulate.mtf_target:MtfBench"),
+}
+
+
+@pytest.mark.parametrize("stem", sorted(CHAPTER_SCENARIOS))
+def test_a_chapter_scenario_file_is_its_dataclass_and_repeats_no_paper_value(stem):
+    """The chapter reads its scenario from data_synthetic/<stem>.toml: the file's values are the
+    dataclass's defaults (so the chapter's rows are those of the defaults, bit for bit), and the
+    file leaves out every field whose default is a paper's value (written once, in papers.py)."""
+    import importlib
+    import inspect
+    import re
+    import tomllib
+
+    table, target = CHAPTER_SCENARIOS[stem]
+    module, name = target.split(":")
+    cls = getattr(importlib.import_module(module), name)
+    cfg = load_scenario(stem)
+    assert _same(getattr(cfg, table), cls()), f"{stem}.toml [{table}] differs from {name}()"
+    keys = tomllib.loads((data_dir() / f"{stem}.toml").read_text(encoding="utf-8"))[table]
+    assert len(keys) >= 5, f"{stem}.toml [{table}] states only {sorted(keys)}"
+    src = inspect.getsource(cls)
+    from_papers = set(
+        re.findall(r"^    (\w+): [^=\n]+= [^\n]*\b(?:P00\d\w*|ASF_004\w*)\[", src, re.M)
+    )
+    assert from_papers, f"{name} takes no default from hsgeo.papers"
+    assert not from_papers & set(keys), f"{stem}.toml repeats the paper's {from_papers & set(keys)}"
+
+
+def test_a_misspelt_key_of_a_chapter_scenario_is_named_with_a_suggestion(tmp_path, monkeypatch):
+    d = tmp_path / "data_synthetic"
+    d.mkdir()
+    text = (data_dir() / "pushbroom_campaign.toml").read_text(encoding="utf-8")
+    (d / "pushbroom_campaign.toml").write_text(text.replace("turn_s =", "trun_s ="))
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(InputError, match=r"pushbroom_campaign.toml: \[campaign\] trun_s: unknown "
+                       r"key; did you mean 'turn_s'\?"):  # fmt: skip
+        load_scenario("pushbroom_campaign")
+
+
+#: A paper's value and the modules whose dataclasses take it from hsgeo.papers (or, where the
+#: import contracts keep papers out of a workflow's reach, from the sensor that types it once:
+#: hsgeo.sensors.rikola.RikolaCamera): none of them may spell it again (the Rikola pitch was once
+#: typed in four places).
+WRITTEN_ONCE = {
+    "0.0055": ("hsgeo.io.sensor_file", "hsgeo.simulate.rikola"),
+    "1017": ("hsgeo.io.sensor_file", "hsgeo.simulate.rikola"),
+    "0.0065": ("hsgeo.simulate.pushbroom_campaign_types",),
+    "40.3": ("hsgeo.simulate.pushbroom_campaign_types",),
+    "1875": ("hsgeo.simulate.pushbroom_campaign_types",),
+    "113758": ("hsgeo.simulate.pushbroom_campaign_types",),
+    "441587": ("hsgeo.simulate.pushbroom_campaign_types",),
+}
+
+
+@pytest.mark.parametrize("literal", sorted(WRITTEN_ONCE))
+def test_the_paper_s_defaults_are_written_once_in_papers(literal):
+    import importlib
+    import inspect
+    import re
+
+    import hsgeo.papers
+
+    assert re.search(rf"(?<![\w.]){re.escape(literal)}(?![\w])", inspect.getsource(hsgeo.papers))
+    for name in WRITTEN_ONCE[literal]:
+        code = "\n".join(
+            line.split("#", 1)[0]
+            for line in inspect.getsource(importlib.import_module(name)).splitlines()
+        )
+        hits = re.findall(rf"(?<![\w.]){re.escape(literal)}(?![\w])", code)
+        assert not hits, f"{name} spells the paper's {literal}; take it from hsgeo.papers"
+
+
+def test_a_scenario_that_writes_files_needs_its_seed(tmp_path, monkeypatch):
+    """[scenario] seed is optional for a chapter's in-memory scenario only: ``hsgeo data`` names
+    the file and the key of a generator's scenario without one (before writing anything)."""
+    from hsgeo.reproduce.data import generate_all
+
+    d = tmp_path / "data_synthetic"
+    d.mkdir()
+    text = (data_dir() / "mtf_bench.toml").read_text(encoding="utf-8")
+    (d / "mtf_bench.toml").write_text(text.replace("seed = 20261124\n", ""))
+    shutil.copy(data_dir() / "cube_survey.toml", d / "cube_survey.toml")  # no seed: in-memory
+    monkeypatch.chdir(tmp_path)
+    assert load_scenario("cube_survey").scenario.seed is None
+    with pytest.raises(InputError, match=r"mtf_bench.toml: \[scenario\] seed: missing"):
+        generate_all(out=tmp_path / "gen")
+    assert not any((tmp_path / "gen").iterdir())

@@ -65,8 +65,7 @@ def test_the_check_sees_every_kind_of_definition():
 
 
 #: Modules whose ``__all__`` re-exports names a sibling module defines: a package's facade
-#: (its ``__init__``) and the former paths of modules split in two, kept until their importers
-#: move (each is a name with two import paths).
+#: (its ``__init__``) only. A module split in two keeps no re-export of the other's names.
 FACADES = {
     "hsgeo",
     "hsgeo.adjust",
@@ -74,9 +73,6 @@ FACADES = {
     "hsgeo.io",
     "hsgeo.nist",
     "hsgeo.sensors",
-    # split modules: the importers still use the former path
-    "hsgeo.simulate.pushbroom_campaign",  # -> pushbroom_campaign_types, error_processes
-    "hsgeo.workflows.rikola",  # -> rikola_bands, rikola_joint
 }
 
 
@@ -98,6 +94,41 @@ def test_no_module_re_exports_a_sibling_s_name(name, path):
         if not any(p.startswith("_") for p in home.split(".")):  # a private module's is its own
             foreign.append(f"{n} (from {home})")
     assert not foreign, f"{name}.__all__ re-exports: {foreign}; import them from their module"
+
+
+def re_exported(source: str, listed) -> list[str]:
+    """Names of ``listed`` (a module's ``__all__``) that the module binds by a top-level
+    ``from hsgeo.<public module> import name``: a second import path (constants included)."""
+    out = []
+    for node in ast.parse(source).body:
+        if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("hsgeo"):
+            if any(p.startswith("_") for p in node.module.split(".")):
+                continue  # a private module's names are its importer's own
+            out += [
+                f"{a.name} (from {node.module})"
+                for a in node.names
+                if (a.asname or a.name) in listed
+            ]
+    return out
+
+
+@pytest.mark.parametrize(("name", "path"), MODULES, ids=[m for m, _ in MODULES])
+def test_no_module_re_exports_an_imported_name(name, path):
+    """The import statements themselves: a constant (``R_ENU_FROM_NED``) re-exported by a module
+    is a second import path as much as a function is (the check above sees classes and functions
+    only)."""
+    if name in FACADES:
+        return
+    listed = getattr(importlib.import_module(name), "__all__", [])
+    again = re_exported(path.read_text(encoding="utf-8"), listed)
+    assert not again, f"{name}.__all__ re-exports {again}; import them from their module"
+
+
+def test_the_import_check_sees_a_re_exported_constant():
+    src = "from hsgeo.rotations import R_ENU_FROM_NED\nfrom hsgeo._kernels import k\nA = 1\n"
+    assert re_exported(src, ["R_ENU_FROM_NED", "k", "A"]) == [
+        "R_ENU_FROM_NED (from hsgeo.rotations)"
+    ]
 
 
 #: The first author of each paper, as a References entry names it.

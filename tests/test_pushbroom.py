@@ -7,7 +7,8 @@ from hsgeo import InputError
 from hsgeo.adjust import adjust, identifiability
 from hsgeo.adjust.checks import analytic_jacobian, check_jacobian
 from hsgeo.sensors.pushbroom import PushbroomLines, PushbroomObservations
-from hsgeo.simulate.pushbroom_campaign import CampaignConfig, CampaignObservations, simulate
+from hsgeo.simulate.pushbroom_campaign import simulate
+from hsgeo.simulate.pushbroom_campaign_types import CampaignConfig, CampaignObservations
 from hsgeo.stats import nmad
 from hsgeo.workflows.pushbroom_ba import CameraPrior, build_problem
 

@@ -8,7 +8,8 @@ import pytest
 from fingerprint import arrays, assert_same, fingerprint
 
 from hsgeo import InputError
-from hsgeo.simulate.pushbroom_campaign import RIDGE, gauss_markov, simulate, spline_fit
+from hsgeo.simulate.error_processes import RIDGE, gauss_markov, spline_fit
+from hsgeo.simulate.pushbroom_campaign import simulate
 from hsgeo.trajectory import SplineNodes
 
 
@@ -81,7 +82,8 @@ def test_refraction_moves_image_points_radially_by_the_standard_amount():
     the image point moves outward by K(r + r³/c²): ≤ 0.02 px at the line's end (5.85 mm)."""
     from dataclasses import replace
 
-    from hsgeo.simulate.pushbroom_campaign import CampaignConfig, refraction_k
+    from hsgeo.simulate.error_processes import refraction_k
+    from hsgeo.simulate.pushbroom_campaign_types import CampaignConfig
 
     assert abs(refraction_k(1965.0, 90.0) * 1e6 - 19.52) < 0.01
     cfg = CampaignConfig()
@@ -99,7 +101,7 @@ def test_refraction_moves_image_points_radially_by_the_standard_amount():
 def test_reference_squares_measured_by_their_centre():
     from dataclasses import replace
 
-    from hsgeo.simulate.pushbroom_campaign import CampaignConfig
+    from hsgeo.simulate.pushbroom_campaign_types import CampaignConfig
 
     cfg = CampaignConfig()
     (o0, _), (o1, t1) = (
@@ -120,7 +122,7 @@ def test_check_points_see_as_many_strips_as_tie_points():
     a tie point's ray count; cp_rays="all strips" keeps every covering strip (the GCPs always)."""
     from dataclasses import replace
 
-    from hsgeo.simulate.pushbroom_campaign import CampaignConfig
+    from hsgeo.simulate.pushbroom_campaign_types import CampaignConfig
 
     cfg = CampaignConfig()
     counts = {}
@@ -144,7 +146,8 @@ def test_distortion_ripple_is_added_along_the_line_only():
     is orthogonal over the line to what the estimator absorbs (1, x, x², x³, x⁵)."""
     from dataclasses import replace
 
-    from hsgeo.simulate.pushbroom_campaign import CampaignConfig, distortion_ripple_px
+    from hsgeo.simulate.pushbroom_campaign import distortion_ripple_px
+    from hsgeo.simulate.pushbroom_campaign_types import CampaignConfig
 
     off = replace(CampaignConfig(), distortion_ripple_px=0.0)
     o0, t0 = simulate(0.002, rng=3, cfg=off)
@@ -182,7 +185,7 @@ MAIN_2366FB0 = {
 def _main_cfg():
     from dataclasses import replace
 
-    from hsgeo.simulate.pushbroom_campaign import CampaignConfig
+    from hsgeo.simulate.pushbroom_campaign_types import CampaignConfig
 
     return replace(CampaignConfig(), **MAIN_2366FB0)
 
@@ -212,7 +215,8 @@ def test_long_block_beyond_the_paper():
     24 strips lengthened by 600 m · (scale − 1), the same per-point statistics (002 §4)."""
     from dataclasses import replace
 
-    from hsgeo.simulate.pushbroom_campaign import CampaignConfig, block_length_m
+    from hsgeo.simulate.pushbroom_campaign import block_length_m
+    from hsgeo.simulate.pushbroom_campaign_types import CampaignConfig
 
     cfg0 = CampaignConfig()
     cfg = replace(cfg0, n_tie_points_full=4000)  # few tie points: fast, same geometry
@@ -255,7 +259,7 @@ def test_long_block_noise_free_is_identifiable_and_recovers_the_truth():
     from test_pushbroom import _problem
 
     from hsgeo.adjust import adjust, identifiability
-    from hsgeo.simulate.pushbroom_campaign import CampaignConfig
+    from hsgeo.simulate.pushbroom_campaign_types import CampaignConfig
 
     cfg = replace(CampaignConfig(), n_tie_points_full=100)
     obs, truth = simulate(3.0, rng=11, noise_free=True, trajectory_error="spline", cfg=cfg)

@@ -9,7 +9,8 @@ from hsgeo import InputError
 from hsgeo.papers import P002, P002_STATS
 from hsgeo.reproduce.pushbroom_ba import EXTREMES_NOT_COMPARABLE, _stats_rows, table_spread
 from hsgeo.reproduce.pushbroom_runs import adjust_campaign, cp_errors, pseudo_truth
-from hsgeo.simulate.pushbroom_campaign import CampaignConfig, simulate
+from hsgeo.simulate.pushbroom_campaign import simulate
+from hsgeo.simulate.pushbroom_campaign_types import CampaignConfig
 from hsgeo.stats import describe
 from hsgeo.workflows.pushbroom_ba import REPORTED_PARAMETERS
 

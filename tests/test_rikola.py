@@ -23,13 +23,9 @@ from hsgeo.sensors.rikola import (
 )
 from hsgeo.simulate.rikola import Plate, Renderer, make_truth
 from hsgeo.simulate.scenarios import load_scenario
-from hsgeo.workflows.rikola import (
-    calibrate_band,
-    calibrate_joint,
-    detect_targets_in_images,
-    gap_regression,
-    relative_orientation,
-)
+from hsgeo.workflows.rikola import relative_orientation
+from hsgeo.workflows.rikola_bands import calibrate_band, detect_targets_in_images, gap_regression
+from hsgeo.workflows.rikola_joint import calibrate_joint
 
 
 @pytest.fixture(scope="module")
@@ -346,7 +342,7 @@ def test_joint_model_recovers_the_truth_with_the_eop_drift_on(cfg):
 
 
 def test_design_effect_recovers_cluster_correlation():
-    from hsgeo.workflows.rikola import design_effect
+    from hsgeo.workflows.rikola_joint import design_effect
 
     rng = np.random.default_rng(1)
     cl = np.repeat(np.arange(4000), 6)

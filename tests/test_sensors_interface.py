@@ -42,8 +42,92 @@ def wavy_nav(H=1500.0, T=30.0, v=60.0):
     return Trajectory(t, xyz, rph)
 
 
-def test_every_sensor_has_the_interface():
-    assert isinstance(LineScanner(CAL), Sensor) and isinstance(CAM, Sensor)
+#: The one face (hsgeo.sensors.mount): the leading arguments of ``project`` and the arguments
+#: after the pixels of ``rays``, by the kind of a registered model.
+FACE = {
+    "scanning": (("xyz_map_m", "t_s", "trajectory"), ("t_s", "trajectory")),
+    "frame": (("xyz_world", "poses", "view"), ("poses", "view")),
+}
+
+
+def face_problems(sensor, kind: str) -> list[str]:
+    """What ``sensor`` lacks of the face of its ``kind`` (empty: it has the face)."""
+    import inspect
+
+    problems = []
+    if not isinstance(sensor, Sensor):
+        return [f"{type(sensor).__name__}: no rays() and project()"]
+    project_args, ray_args = FACE[kind]
+    got = list(inspect.signature(sensor.project).parameters)
+    if tuple(got[: len(project_args)]) != project_args:
+        problems.append(f"project{tuple(got)}: expected the arguments {project_args} first")
+    got = list(inspect.signature(sensor.rays).parameters)
+    if tuple(got[1 : 1 + len(ray_args)]) != ray_args:
+        problems.append(f"rays{tuple(got)}: expected (pixels, {', '.join(ray_args)}, ...)")
+    if not isinstance(getattr(sensor, "mount", None), Mount):
+        problems.append("no .mount (lever arm and boresight, hsgeo.sensors.mount.Mount)")
+    if kind == "scanning" and not callable(getattr(sensor, "line_time", None)):
+        problems.append("a scanning sensor without line_time()")
+    return problems
+
+
+def registered_sensor(name, tmp_path):
+    from hsgeo.io import read_sensor
+    from hsgeo.io.sensor_file import MODELS, sensor_toml
+
+    p = tmp_path / f"{name}.toml"
+    p.write_text(sensor_toml(name, MODELS[name].example))
+    return read_sensor(p)
+
+
+def _model_names():
+    from hsgeo.io.sensor_file import MODELS
+
+    return sorted(MODELS)
+
+
+@pytest.mark.parametrize("name", _model_names())
+def test_every_registered_sensor_offers_the_one_face(name, tmp_path):
+    """Every model of the registry, read from its example file, has rays/project with the face's
+    arguments, a Mount, and (if it scans) line_time; a new model that breaks the face fails."""
+    from hsgeo.io.sensor_file import MODELS
+
+    sensor = registered_sensor(name, tmp_path)
+    assert not face_problems(sensor, MODELS[name].kind), face_problems(sensor, MODELS[name].kind)
+
+
+def test_the_face_check_fails_on_sensors_that_break_the_face():
+    """The check can fail: each of these breaks the face in one way and is caught."""
+
+    class NoRays:
+        mount = Mount()
+
+        def project(self, xyz_map_m, t_s, trajectory):
+            return xyz_map_m
+
+    class SwappedProject(NoRays):
+        def project(self, t_s, xyz_map_m, trajectory):
+            return xyz_map_m
+
+        def rays(self, zeta_px, t_s, trajectory):
+            return zeta_px, zeta_px
+
+    class NoMount(SwappedProject):
+        mount = None
+
+        def project(self, xyz_map_m, t_s, trajectory):
+            return xyz_map_m
+
+    class NoLineTime(NoMount):
+        mount = Mount()
+
+    assert face_problems(NoRays(), "scanning") == ["NoRays: no rays() and project()"]
+    assert face_problems(SwappedProject(), "scanning")[0].startswith("project(")
+    assert face_problems(NoMount(), "scanning")[0].startswith("no .mount")
+    assert face_problems(NoLineTime(), "scanning") == ["a scanning sensor without line_time()"]
+    assert face_problems(NoLineTime(), "frame")[0].startswith("project(")
+    assert face_problems(LineScanner(CAL), "frame")  # a scanner's arguments are not a frame's
+    assert face_problems(CAM, "scanning") == []
 
 
 @pytest.mark.parametrize("geom", [CAL, LinearIFOV(485.0, 3600.0)])

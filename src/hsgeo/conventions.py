@@ -58,9 +58,7 @@ Randomness
     Sub-streams are derived with ``numpy.random.SeedSequence([seed, i])``.
 """
 
-from hsgeo.rotations import R_ENU_FROM_NED
-
-__all__ = ["R_ENU_FROM_NED", "PIXEL_ORIGIN"]
+__all__ = ["PIXEL_ORIGIN"]
 
 #: The coordinate of the centre of the first pixel (OpenCV convention).
 PIXEL_ORIGIN = 0.0

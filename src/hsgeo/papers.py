@@ -352,6 +352,27 @@ P002 = {
 
 __all__ += ["P002_STATS", "P002"]
 
+#: 002 §4 and Fig. 8: the aerial campaign's flight, camera and a-priori σ, as printed; the
+#: simulated campaign's defaults (:class:`hsgeo.simulate.pushbroom_campaign_types.CampaignConfig`).
+P002_CAMPAIGN = {
+    "pixels_per_line": 1800,  # 002 §4: HySpex VNIR-1800, 1800 px
+    "pixel_mm": 0.0065,  # 002 §4: 6.5 µm
+    "c_nominal_mm": 40.0,  # 002 §4: initial principal distance 4 cm
+    "c_mean_mm": 40.3,  # 002 Fig. 8: mean of the estimated principal distances
+    "speed_m_s": 67.0,  # 002 §4
+    "line_rate_hz": 200.0,  # 002 §4: 200 lines ≈ 1 s
+    "area_m": 600.0,  # 002 §4: 600 m × 600 m
+    "agl_low_m": 1875.0,  # 002 §4: 8 flight lines at 1875 m AGL
+    "agl_high_m": 2500.0,  # 002 §4: 4 flight lines at 2500 m AGL
+    "node_interval_s": 10.0,  # 002 §4: trajectory correction nodes every 10 s
+    # 002 §4: "a positional STD of < 1.3 cm in each of east and north, and < 2.0 cm in height"
+    "sigma_pos_m": (0.013, 0.013, 0.020),
+    "sigma_obs_px": 0.5,  # 002 §4: observation precision 1/2 px
+    "sigma_gcp_m": 0.01,  # 002 §4: RTK ≈ 1 cm
+}
+
+__all__ += ["P002_CAMPAIGN"]
+
 
 # ---- claims of the chapters still to be written (the scoreboard lists them as planned) ----
 
@@ -378,6 +399,15 @@ P001_MTF = {
     "source": "001 §2.3, §3.1, §4, Table 3, Fig. 9",
 }
 __all__ += ["P001_MTF", "GSD_001_TABLE3_MM"]
+
+#: 004: the flights over the runway, as printed; the simulated scene's defaults
+#: (:class:`hsgeo.simulate.asf_runway.RunwayScene`).
+ASF_004_FLIGHT = {
+    "height_m": 300.0,  # 004: "ground resolution at a flight height of 300 m"
+    "sun_zenith_deg": 40.0,  # 004: "The sun angle of i = 40°"
+    "reflectance_variation": 0.10,  # 004: "deviations of up to 20 %" (±10 %)
+}
+__all__ += ["ASF_004_FLIGHT"]
 
 #: 004 (abstract and text): the DAEDALUS AADS 1268's numbers: (value, unit).
 ASF_004 = {

@@ -435,10 +435,18 @@ def _models():
                     doc="sensor II's centre in sensor I's frame, mm",
                 ),
                 "image_size_px": Key(
-                    "floats", length=2, default=(1017.0, 648.0), positive=True, doc="w, h, px"
+                    "floats",
+                    length=2,
+                    default=tuple(float(n) for n in RikolaCamera.image_size),
+                    positive=True,
+                    doc="w, h, px",
                 ),
                 "pixel_mm": Key(
-                    "float", default=0.0055, positive=True, limit=1.0, doc="pixel pitch, mm"
+                    "float",
+                    default=RikolaCamera.pixel_mm,
+                    positive=True,
+                    limit=1.0,
+                    doc="pixel pitch, mm",
                 ),
                 **_mount_keys("body"),
             },

@@ -51,6 +51,7 @@ from hsgeo.simulate.asf_runway import (
     navigation,
     simulate_runway,
 )
+from hsgeo.simulate.scenarios import load_scenario
 from hsgeo.workflows.asf import (
     AsfInputs,
     AsfOptions,
@@ -429,7 +430,7 @@ def _max_err(res, true_n):
 
 def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
     """The chapter's numbers. ``scale`` sets the noise realisations: max(4, round(12·scale))."""
-    scene = RunwayScene()
+    scene = load_scenario("asf_runway").scene  # data_synthetic/asf_runway.toml
     options = AsfOptions()
     hw = options.nadir_halfwidth_deg
     n_runs = max(4, int(round(12 * scale)))

@@ -28,6 +28,7 @@ from hsgeo.io.cube import read_cube, write_cube
 from hsgeo.papers import P001_CUBE
 from hsgeo.report import Reproduction, Row
 from hsgeo.simulate import cube_survey as CS
+from hsgeo.simulate.scenarios import load_scenario
 from hsgeo.workflows.cube import CubeInputs, CubeOptions, build_cube
 
 __all__ = [
@@ -60,8 +61,6 @@ COLLECTOR_ERROR = 0.03
 #: Hot pixels drawn for the table (with 40 rows, 95 % within 3σ̂ fails only when 3 or more of
 #: them lie beyond 3σ̂: 0.5 % of the seeds for a Student t with 18 degrees of freedom).
 N_HOT_ROWS = 20
-
-_LENGTH_M = 0.6  # along-track length at scale 1 (the paper's sections are 2.4 m long)
 
 
 class ArrayFrames:
@@ -365,7 +364,8 @@ def _unmodelled_rows(cfg, seed, base_spectra, base_groups, truth_bands, lam) -> 
 
 def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
     """Simulate, build, write, read back and compare; the chapter's tables."""
-    cfg = CS.CubeSurvey(length_m=max(0.12, _LENGTH_M * scale))
+    base = load_scenario("cube_survey").survey  # data_synthetic/cube_survey.toml, scale 1
+    cfg = replace(base, length_m=max(0.12, base.length_m * scale))
     t0 = time.perf_counter()
     res, frames, truth = survey(cfg, seed)
     lam = res.cube["wavelength_nm"].values

@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from hsgeo.errors import InputError
 from hsgeo.io._files import copy_file, make_folder, write_text
 from hsgeo.simulate.scenarios import data_dir, load_scenario
 
@@ -78,8 +79,6 @@ def _check_out(out: Path, *, repo: bool, overwrite: bool, default: bool) -> None
     """The output folder, checked before any work (``--out``)."""
     import os
 
-    from hsgeo.errors import InputError
-
     # the folder as the user named it: --out DIR, or the default they never typed
     name = f"{out} (where hsgeo data writes without --out)" if default else f"--out {out}"
     if out.exists() and not out.is_dir():
@@ -131,6 +130,13 @@ def generate_all(
     with tempfile.TemporaryDirectory() as tmp:
         for toml in sorted(ddir.glob("*.toml")):
             cfg = load_scenario(toml.stem)
+            if cfg.scenario.generator not in GENERATORS:
+                continue  # a chapter's in-memory scenario: it writes no files
+            if cfg.scenario.seed is None:
+                raise InputError(
+                    f"scenario file {toml}: [scenario] seed: missing; add `seed = ...` (the seed "
+                    "of the files it generates)"
+                )
             mod = importlib.import_module(GENERATORS[cfg.scenario.generator])
             for path in mod.generate(cfg, Path(tmp)):
                 dest = out / path.name

@@ -42,6 +42,7 @@ from hsgeo.simulate.mtf_target import (
     render_bar_profiles,
     render_edge,
 )
+from hsgeo.simulate.scenarios import load_scenario
 from hsgeo.workflows.mtf import (
     BORDERLINE_LEVEL,
     BarInputs,
@@ -640,7 +641,7 @@ def _unmodelled_rows(bench, sim, sim_glare, n_runs) -> list[Row]:
 
 def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
     """The chapter's numbers. ``scale`` sets the noise realisations: max(8, round(24·scale))."""
-    bench = MtfBench()
+    bench = load_scenario("mtf_bench").bench  # data_synthetic/mtf_bench.toml [bench]
     n_runs = max(8, int(round(24 * scale)))
     sim = simulate_runs(bench, n_runs, seed)
     glare = replace(bench, stray_light=STRAY_LIGHT)
@@ -682,7 +683,7 @@ def generate(cfg: MtfBenchScenario, outdir) -> list:
 
     from hsgeo.io.mtf import write_bars, write_columns, write_profiles
 
-    bench = MtfBench()
+    bench = cfg.bench
     rows = [int(r) for r in cfg.bars.rows]
     rec = render_bar_profiles(bench, rows, int(cfg.scenario.seed))
     out = Path(outdir)

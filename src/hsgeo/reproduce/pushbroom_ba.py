@@ -38,12 +38,13 @@ from hsgeo.reproduce.pushbroom_runs import (
     study_plan,
     unmodelled_rows,
 )
-from hsgeo.simulate.pushbroom_campaign import (
+from hsgeo.simulate.pushbroom_campaign import simulate
+from hsgeo.simulate.pushbroom_campaign_types import (
     CampaignConfig,
     CampaignObservations,
     CampaignTruth,
-    simulate,
 )
+from hsgeo.simulate.scenarios import load_scenario
 from hsgeo.stats import describe
 from hsgeo.workflows.pushbroom_ba import (  # 002's settings, spelled once in the workflow
     BLOCK_NAMES,
@@ -374,7 +375,8 @@ def run(
     """
     t_start = time.perf_counter()
     plan = study_plan(scale) if plan is None else plan
-    cfg = replace(CampaignConfig(), distortion_ripple_px=ripple_px)
+    campaign = load_scenario("pushbroom_campaign").campaign  # its data_synthetic TOML
+    cfg = replace(campaign, distortion_ripple_px=ripple_px)
     obs, truth = simulate(scale, rng=seed, cfg=cfg)
     res, p, blocks, info = adjust_campaign(obs, cfg, with_gcp=True, progress=progress, truth=truth)
     res0, _, _, info0 = adjust_campaign(obs, cfg, with_gcp=False, progress=progress)

@@ -17,12 +17,11 @@ import numpy as np
 from hsgeo.adjust import identifiability
 from hsgeo.papers import P002, P002_STATS
 from hsgeo.report import Row
-from hsgeo.simulate.pushbroom_campaign import (
+from hsgeo.simulate.pushbroom_campaign import noise_free_twin, simulate
+from hsgeo.simulate.pushbroom_campaign_types import (
     CampaignConfig,
     CampaignObservations,
     CampaignTruth,
-    noise_free_twin,
-    simulate,
 )
 from hsgeo.stats import nmad
 from hsgeo.workflows.pushbroom_ba import (  # 002's settings, spelled once in the workflow

@@ -33,15 +33,9 @@ from hsgeo.sensors.rikola import focal_from_gap_mm
 
 if TYPE_CHECKING:
     from hsgeo.simulate.rikola import RikolaBenchScenario
-from hsgeo.workflows.rikola import (
-    RikolaOptions,
-    calibrate_joint,
-    calibrate_rikola,
-    detect_targets_in_images,
-    gap_regression,
-    predict_band,
-    relative_orientation,
-)
+from hsgeo.workflows.rikola import RikolaOptions, calibrate_rikola, relative_orientation
+from hsgeo.workflows.rikola_bands import detect_targets_in_images, gap_regression
+from hsgeo.workflows.rikola_joint import calibrate_joint, predict_band
 
 __all__ = [
     "run",
@@ -81,7 +75,7 @@ def observe(
     """Render the bands of the cubes and measure them as a user would (the experiment of 003 §3.2).
 
     The images are rendered one at a time (:class:`hsgeo.simulate.rikola.Renderer`) and measured
-    by the truth-free :func:`hsgeo.workflows.rikola.detect_targets_in_images`; the truth only
+    by the truth-free :func:`hsgeo.workflows.rikola_bands.detect_targets_in_images`; the truth only
     counts the targets fully in view, for the detection rate.
 
     Returns

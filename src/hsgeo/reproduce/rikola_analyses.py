@@ -22,7 +22,7 @@ from hsgeo.report import Row
 from hsgeo.rotations import R_from_opk
 from hsgeo.sensors.frame import mm_to_pixel
 from hsgeo.sensors.rikola import TargetCentroids, focal_from_gap_mm, project_measured_mm
-from hsgeo.workflows.rikola import BANDS, band_problem, calibrate_band, gap_regression
+from hsgeo.workflows.rikola_bands import BANDS, band_problem, calibrate_band, gap_regression
 
 __all__ = [
     "track_targets",

@@ -537,6 +537,9 @@ class RikolaCamera:
     KP: tuple
     rotation_rad: tuple = (0.0, 0.0, 0.0)
     offset_mm: tuple = (0.0, 0.0, 0.0)
+    # the FPI2015 (003 Table 1, hsgeo.papers.RIKOLA_CAMERA: typed here, as workflows may not
+    # import papers; tests/test_config_loader.py checks both agree; hsgeo.io.sensor_file
+    # takes its defaults from here)
     image_size: tuple = (1017, 648)
     pixel_mm: float = 0.0055
     bands: tuple | None = None

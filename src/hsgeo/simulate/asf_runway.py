@@ -43,12 +43,15 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from hsgeo.geocode import PlaneTerrain, intersect
+from hsgeo.papers import ASF_004_FLIGHT
 from hsgeo.sensors.panoramic import PanoramicScanner
 from hsgeo.simulate import as_rng
+from hsgeo.simulate.scenarios import ScenarioInfo
 from hsgeo.trajectory import Trajectory
 
 __all__ = [
     "RunwayScene",
+    "AsfRunwayScenario",
     "Scan",
     "RunwayObservations",
     "RunwayTruth",
@@ -86,16 +89,16 @@ _PAINT = (0.55, 0.60, 0.62, 0.62, 0.62, 0.62, 0.60, 0.58, 0.50, 0.45, 0.40)
 class RunwayScene:
     """The experiment's chosen parameters; defaults from 004 where it gives them."""
 
-    height_m: float = 300.0  # 004: "ground resolution at a flight height of 300 m"
+    height_m: float = ASF_004_FLIGHT["height_m"]  # 004
     runway_width_m: float = 32.0  # 004: "about 50 pixels" (0.63 m at nadir)
     runway_length_m: float = 1400.0
-    reflectance_variation: float = 0.10  # 004: "deviations of up to 20 %" (±10 %)
+    reflectance_variation: float = ASF_004_FLIGHT["reflectance_variation"]  # 004
     n_cosines: int = 12
     texture_min_wavelength_m: float = 15.0
     landmark_spacing_m: float = 15.0
     landmark_size_m: float = 1.5
     landmark_offset_m: float = 3.0  # outside the runway edge
-    sun_zenith_deg: float = 40.0  # 004: "The sun angle of i = 40°"
+    sun_zenith_deg: float = ASF_004_FLIGHT["sun_zenith_deg"]  # 004
     sun_azimuth_deg: float = 201.5  # 004: scan-to-sun 68.5° (left) and 111.5° (right)
     brdf: bool = False
     brdf_even: float = 0.04
@@ -106,9 +109,9 @@ class RunwayScene:
     subsamples: int = 2
     cross_margin_m: float = 14.0
     along_halfwidth_px: int = 50
-    cross_nav_error_m: tuple = (0.6, -0.4, 0.0)
-    along_nav_error_m: tuple = (-0.9, 0.7, 0.0)
-    reverse_nav_error_m: tuple = (0.3, 0.5, 0.0)
+    cross_nav_error_m: tuple[float, ...] = (0.6, -0.4, 0.0)
+    along_nav_error_m: tuple[float, ...] = (-0.9, 0.7, 0.0)
+    reverse_nav_error_m: tuple[float, ...] = (0.3, 0.5, 0.0)
     along_offset_m: float = 1.5  # the along track's distance north of the runway's centre line
     # sub-metre structure of the runway (chosen; 37.6: a runway with none lets any
     # registration pass): sealed transverse joints between the pavement's slabs and the
@@ -125,7 +128,7 @@ class RunwayScene:
     path_radiance: bool = False
     path_radiance_percent: float = 3.0
     # the flights follow each other (one navigation file for all): start times, s
-    flight_start_s: tuple = (0.0, 100.0, 200.0)
+    flight_start_s: tuple[float, ...] = (0.0, 100.0, 200.0)
     sensor: PanoramicScanner = field(default_factory=PanoramicScanner)
 
     @property
@@ -137,6 +140,16 @@ class RunwayScene:
         """Corners (E, N) of the runway, m, counter-clockwise."""
         h, w = self.runway_length_m / 2, self.runway_width_m / 2
         return np.array([[-h, -w], [h, -w], [h, w], [-h, w]])
+
+
+@dataclass(frozen=True)
+class AsfRunwayScenario:
+    """``data_synthetic/asf_runway.toml`` (:func:`hsgeo.simulate.scenarios.load_scenario`): the
+    004 runway flights of the asf chapter, ``[scene]`` a :class:`RunwayScene`.
+    """
+
+    scenario: ScenarioInfo
+    scene: RunwayScene = RunwayScene()
 
 
 @dataclass(frozen=True)

@@ -39,9 +39,11 @@ from hsgeo.papers import P001_CUBE
 from hsgeo.radiometry import FULL_SCALE_DN, eq8_speed_m_s, frame_layout
 from hsgeo.simulate import as_rng
 from hsgeo.simulate.line_lab import LineLab, wavelength_nm
+from hsgeo.simulate.scenarios import ScenarioInfo
 
 __all__ = [
     "CubeSurvey",
+    "CubeSurveyScenario",
     "MATERIALS",
     "material_spectra",
     "SurveyFrames",
@@ -100,16 +102,17 @@ class CubeSurvey:
     illumination_change: float = 0.04  # chosen: ±4 % slow change of the light along track
     # chosen, aperture closed: equally spaced, so that the least-squares σ̂ of a and b stays
     # right although the dark current's shot noise grows with the exposure time
-    dark_exposures_s: tuple = (0.01, 0.21, 0.41, 0.61, 0.81)
+    dark_exposures_s: tuple[float, ...] = (0.01, 0.21, 0.41, 0.61, 0.81)
     dark_frames_per_exposure: int = 4
     dark_rate_dn_s: float = 6.0  # chosen: median dark current of a binned pixel
     dark_rate_spread: float = 0.3  # lognormal σ of the dark current
     offset_spread_dn: float = 2.0  # fixed-pattern spread of b around the sensor's offset
     hot_fraction: float = 0.002  # chosen: share of hot pixels
-    hot_rate_dn_s: tuple = (300.0, 3000.0)  # log-uniform dark current of a hot pixel
+    hot_rate_dn_s: tuple[float, ...] = (300.0, 3000.0)  # log-uniform dark current of a hot pixel
     canopy_half_width_m: float = 0.20  # the vine row's canopy across track
-    panel_m: tuple = (0.04, 0.16, 0.24, 0.36)  # x0, x1, y0, y1 of the grey panel on the soil
-    supersample: tuple = (6, 3)  # sub-positions along track (slit × motion) and across
+    # x0, x1, y0, y1 of the grey panel on the soil
+    panel_m: tuple[float, ...] = (0.04, 0.16, 0.24, 0.36)
+    supersample: tuple[int, ...] = (6, 3)  # sub-positions along track (slit × motion) and across
 
     @property
     def layout(self):
@@ -167,6 +170,16 @@ class CubeSurvey:
         """Electrons of a white reflector on axis per binned row at the exposure time."""
         lam = self.row_wavelength_nm()
         return self.white_e * np.exp(-(((lam - 600.0) / 250.0) ** 2))
+
+
+@dataclass(frozen=True)
+class CubeSurveyScenario:
+    """``data_synthetic/cube_survey.toml`` (:func:`hsgeo.simulate.scenarios.load_scenario`): the
+    001 vineyard survey of the cube chapter at scale 1, ``[survey]`` a :class:`CubeSurvey`.
+    """
+
+    scenario: ScenarioInfo
+    survey: CubeSurvey = CubeSurvey()
 
 
 def _material_at(cfg: CubeSurvey, x, y) -> np.ndarray:

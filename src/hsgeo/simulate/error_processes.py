@@ -1,7 +1,7 @@
 """Error processes of the simulated campaigns: a GNSS/INS solution's error (first-order
 Gauss–Markov), its best spline fit, and atmospheric refraction.
 
-Used by :mod:`hsgeo.simulate.pushbroom_campaign` (which re-exports them) and its scenario types
+Used by :mod:`hsgeo.simulate.pushbroom_campaign` and its scenario types
 (:mod:`hsgeo.simulate.pushbroom_campaign_types`).
 """
 

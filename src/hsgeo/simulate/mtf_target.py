@@ -110,11 +110,13 @@ class BarRows:
 
 @dataclass(frozen=True)
 class MtfBenchScenario:
-    """``data_synthetic/mtf_bench.toml`` (:func:`hsgeo.simulate.scenarios.load_scenario`); the
-    bench itself is :class:`MtfBench`'s defaults.
+    """``data_synthetic/mtf_bench.toml`` (:func:`hsgeo.simulate.scenarios.load_scenario`): the
+    mtf chapter's bench (``[bench]``, a :class:`MtfBench`) and the bar profiles ``make data``
+    writes (``[bars]``).
     """
 
     scenario: ScenarioInfo
+    bench: MtfBench = MtfBench()
     bars: BarRows = BarRows()
 
 

@@ -66,14 +66,13 @@ from hsgeo.sensors.pushbroom import (
     PushbroomObservations,
     project,
 )
-from hsgeo.simulate.error_processes import (  # re-exported
-    RIDGE,
+from hsgeo.simulate.error_processes import (
     _imaged,
     gauss_markov,
     refraction_k,
     spline_fit,
 )
-from hsgeo.simulate.pushbroom_campaign_types import (  # re-exported
+from hsgeo.simulate.pushbroom_campaign_types import (
     CP_RAYS,
     TRAJECTORY_ERRORS,
     CampaignConfig,
@@ -83,19 +82,10 @@ from hsgeo.simulate.pushbroom_campaign_types import (  # re-exported
 from hsgeo.trajectory import SplineNodes
 
 __all__ = [
-    "CampaignConfig",
-    "CampaignObservations",
-    "CampaignTruth",
-    "CP_RAYS",
-    "TRAJECTORY_ERRORS",
     "block_length_m",
     "distortion_ripple_px",
     "noise_free_twin",
-    "gauss_markov",
-    "refraction_k",
     "simulate",
-    "spline_fit",
-    "RIDGE",
     "DEG",
     "CHUNK_ROWS",
     "REFERENCE_EN_M",

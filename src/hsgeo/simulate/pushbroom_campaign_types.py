@@ -2,7 +2,7 @@
 published values and the simulation's own choices), :class:`CampaignObservations` (what the
 adjustment may use) and :class:`CampaignTruth` (what only :mod:`hsgeo.reproduce` compares with).
 
-The simulator is :mod:`hsgeo.simulate.pushbroom_campaign`, which re-exports every name here.
+The simulator is :mod:`hsgeo.simulate.pushbroom_campaign`; import these names from here.
 """
 
 from __future__ import annotations
@@ -13,11 +13,14 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.interpolate import CubicSpline
 
+from hsgeo.papers import P002, P002_CAMPAIGN
 from hsgeo.sensors.pushbroom import BLOCK_NAMES, PushbroomObservations
+from hsgeo.simulate.scenarios import ScenarioInfo
 from hsgeo.trajectory import SplineNodes
 
 __all__ = [
     "CampaignConfig",
+    "PushbroomCampaignScenario",
     "CampaignObservations",
     "CampaignTruth",
     "CP_RAYS",
@@ -35,60 +38,68 @@ CP_RAYS = ("tie points", "all strips")
 
 @dataclass(frozen=True)
 class CampaignConfig:
-    """Published values of 002 §4 (and the simulation's own choices, marked)."""
+    """Published values of 002 §4 (and the simulation's own choices, marked).
 
-    n_tie_points_full: int = 113758  # 002 §4
-    obs_per_point_mean: float = 441587 / 113758  # 002 §4: 2D observations / tie points
-    pixels_per_line: int = 1800  # 002 §4
-    pixel_mm: float = 0.0065  # 002 §4: 6.5 µm
-    c_nominal_mm: float = 40.0  # 002 §4: initial principal distance 4 cm
-    c_mean_mm: float = 40.3  # 002 Fig. 8: mean of the estimated principal distances
+    The paper's values are those of :data:`hsgeo.papers.P002_CAMPAIGN` and
+    :data:`hsgeo.papers.P002` (written once there, with their sources).
+    """
+
+    n_tie_points_full: int = P002["n_tie_points"]  # 002 §4
+    # 002 §4: 2D observations / tie points
+    obs_per_point_mean: float = P002["n_observations_2d"] / P002["n_tie_points"]
+    pixels_per_line: int = P002_CAMPAIGN["pixels_per_line"]
+    pixel_mm: float = P002_CAMPAIGN["pixel_mm"]
+    c_nominal_mm: float = P002_CAMPAIGN["c_nominal_mm"]
+    c_mean_mm: float = P002_CAMPAIGN["c_mean_mm"]
     # per-band principal distance minus the mean, µm: spread ≤ 11.8 µm (002 Fig. 8); the
     # shape (decreasing with wavelength) is our choice
-    c_offsets_um: tuple = (11.0, 6.5, 2.9, -1.0, -4.6, -7.3, -7.5)
-    wavelengths_nm: tuple = (450.0, 527.0, 604.0, 681.0, 758.0, 835.0, 912.0)  # ~77 nm, 002 §4
-    speed_m_s: float = 67.0  # 002 §4
-    line_rate_hz: float = 200.0  # 002 §4: 200 lines ≈ 1 s
-    area_m: float = 600.0  # 002 §4
-    agl_low_m: float = 1875.0  # 002 §4
-    agl_high_m: float = 2500.0  # 002 §4
-    lines_low_east_m: tuple = (-350.0, -250.0, -150.0, -50.0, 50.0, 150.0, 250.0, 350.0)  # ours
-    lines_high_east_m: tuple = (-150.0, -50.0, 50.0, 150.0)  # ours: over the centre (Fig. 5)
+    c_offsets_um: tuple[float, ...] = (11.0, 6.5, 2.9, -1.0, -4.6, -7.3, -7.5)
+    # ~77 nm apart, 002 §4
+    wavelengths_nm: tuple[float, ...] = (450.0, 527.0, 604.0, 681.0, 758.0, 835.0, 912.0)
+    speed_m_s: float = P002_CAMPAIGN["speed_m_s"]
+    line_rate_hz: float = P002_CAMPAIGN["line_rate_hz"]
+    area_m: float = P002_CAMPAIGN["area_m"]
+    agl_low_m: float = P002_CAMPAIGN["agl_low_m"]
+    agl_high_m: float = P002_CAMPAIGN["agl_high_m"]
+    # ours
+    lines_low_east_m: tuple[float, ...] = (-350.0, -250.0, -150.0, -50.0, 50.0, 150.0, 250.0, 350.0)
+    # ours: over the centre (Fig. 5)
+    lines_high_east_m: tuple[float, ...] = (-150.0, -50.0, 50.0, 150.0)
     strip_half_length_m: float = 480.0  # ours: imaged length along each strip
     turn_s: float = 60.0  # ours: time between strips
-    node_interval_s: float = 10.0  # 002 §4
+    node_interval_s: float = P002_CAMPAIGN["node_interval_s"]
     # 002 §4: "a positional STD of < 1.3 cm in each of east and north, and < 2.0 cm in height"
     # (the bounds are taken as the σ)
-    sigma_pos_m: tuple = (0.013, 0.013, 0.020)
+    sigma_pos_m: tuple[float, ...] = P002_CAMPAIGN["sigma_pos_m"]
     # POS AV 510 post-processed attitude RMS, roll/pitch 0.005°, heading 0.008°, as commonly
     # quoted from Applanix's specification sheet (002 §4 names the POS-AV 510 but gives no
     # attitude σ; we could not check the sheet itself): heading worst
-    sigma_att_rad: tuple = (0.005 * DEG, 0.005 * DEG, 0.008 * DEG)
+    sigma_att_rad: tuple[float, ...] = (0.005 * DEG, 0.005 * DEG, 0.008 * DEG)
     # the GNSS/INS error model of the truth: "gauss-markov" (default) or "spline" (the
     # estimator's own model; for the noise-free and identifiability tests)
     trajectory_error: str = "gauss-markov"
     # ours: correlation times of the first-order Gauss–Markov errors, s ("seconds to minutes":
     # GNSS position errors of a smoothed solution wander over minutes, the INS attitude errors
     # over tens of seconds, heading slowest)
-    tau_pos_s: tuple = (60.0, 60.0, 120.0)
-    tau_att_s: tuple = (20.0, 20.0, 60.0)
+    tau_pos_s: tuple[float, ...] = (60.0, 60.0, 120.0)
+    tau_att_s: tuple[float, ...] = (20.0, 20.0, 60.0)
     error_sample_s: float = 0.1  # ours: the error is sampled at 10 Hz (a GNSS epoch rate)
-    boresight_deg: tuple = (0.25, -0.35, 0.15)  # ours: "a few tenths of a degree"
-    lever_arm_m: tuple = (0.12, -0.05, -0.30)  # ours
+    boresight_deg: tuple[float, ...] = (0.25, -0.35, 0.15)  # ours: "a few tenths of a degree"
+    lever_arm_m: tuple[float, ...] = (0.12, -0.05, -0.30)  # ours
     sigma_lever_m: float = 0.02  # ours: tape-measured lever arm
     # Brown terms of 002 eq. (3), x̄ in mm: ≈ −1.2, 0.3, 0.5, −0.15 px at the line's end (ours)
-    distortion: tuple = (-4.0e-5, 3.0e-7, 2.5e-5, -3.0e-5)
+    distortion: tuple[float, ...] = (-4.0e-5, 3.0e-7, 2.5e-5, -3.0e-5)
     x0_mm: float = 0.013  # principal point (fixed, calibrated), ours
     y0_mm: float = 0.0
-    sigma_obs_px: float = 0.5  # 002 §4: observation precision 1/2 px
+    sigma_obs_px: float = P002_CAMPAIGN["sigma_obs_px"]
     # ours, TUNED to 002 Table 1: key-point localisation error before the registration at pixel
     # centres, per image axis: x along the line (across track), y across the line (the matched
     # line, i.e. along track). Tuned so that the reprojection NMADs over 8 campaigns at 0.05 of
     # the tie points meet the paper's 0.32 px (x) and 0.42 px (y) (one σ for both
     # axes, 0.35 px, gave 0.283 and 0.456 px, 13σ and 12σ off; these give 0.321 and 0.419 px)
-    sigma_keypoint_px: tuple = (0.432, 0.29)
+    sigma_keypoint_px: tuple[float, ...] = (0.432, 0.29)
     outlier_share: float = 0.003  # ours: gross errors left after RANSAC
-    sigma_gcp_m: float = 0.01  # 002 §4: RTK ≈ 1 cm
+    sigma_gcp_m: float = P002_CAMPAIGN["sigma_gcp_m"]
     terrain_relief_m: float = 15.0  # ours: tie points between 0 and 15 m above the datum
     mount_motion_rad: float = 0.02 * DEG  # ours: residual motion of the stabilised mount
     # -- candidate explanations of 002's check-point errors (off by default: counterfactuals)
@@ -112,6 +123,16 @@ class CampaignConfig:
     # K2 by more than 15σ̂). Not in the noise-free mode (noise_free_twin keeps it).
     distortion_ripple_px: float = 0.0
     distortion_ripple_periods: float = 3.0
+
+
+@dataclass(frozen=True)
+class PushbroomCampaignScenario:
+    """``data_synthetic/pushbroom_campaign.toml`` (:func:`hsgeo.simulate.scenarios.load_scenario`):
+    the 002 campaign of the pushbroom-ba chapter, ``[campaign]`` a :class:`CampaignConfig`.
+    """
+
+    scenario: ScenarioInfo
+    campaign: CampaignConfig = CampaignConfig()
 
 
 @dataclass(frozen=True)

@@ -1,8 +1,11 @@
 """The scenarios of ``data_synthetic/*.toml``: where they are and how to load them.
 
-Each ``data_synthetic/<name>.toml`` has a ``[scenario]`` table with ``generator`` (see
-:mod:`hsgeo.reproduce.data`, which writes ``data_synthetic/generated/``) and ``seed``; the rest of
-the file is the scenario's configuration, every value citing its source. :func:`load_scenario`
+Each ``data_synthetic/<name>.toml`` has a ``[scenario]`` table with ``generator`` (the simulator
+it configures, a key of :data:`SCENARIOS`) and, if that simulator writes files
+(:mod:`hsgeo.reproduce.data`, which writes ``data_synthetic/generated/``), their ``seed``; the
+rest of the file is the scenario's configuration, every value citing its source. A chapter's
+in-memory scenario (the 002 campaign, the 004 runway, the 001 survey and bench) is such a file
+too, read by its chapter. :func:`load_scenario`
 reads it into the frozen dataclass of its generator (:data:`SCENARIOS`) with the one loader of
 configurations, :func:`hsgeo.io.config.read_dataclass` (unknown keys are errors with a
 suggestion); change a value with :func:`dataclasses.replace`.
@@ -20,10 +23,13 @@ __all__ = ["data_dir", "load_scenario", "scenario_class", "ScenarioInfo", "SCENA
 
 #: scenario generator name -> ``"module:Class"``: the frozen dataclass its file is read into.
 SCENARIOS = {
+    "asf_runway": "hsgeo.simulate.asf_runway:AsfRunwayScenario",
+    "cube_survey": "hsgeo.simulate.cube_survey:CubeSurveyScenario",
     "frame_bench": "hsgeo.simulate.frame_bench:FrameBenchScenario",
     "line_lab": "hsgeo.simulate.line_lab:LineLabScenario",
     "mtf_bench": "hsgeo.simulate.mtf_target:MtfBenchScenario",
     "pula_flight": "hsgeo.simulate.pula_flight:PulaFlightScenario",
+    "pushbroom_campaign": "hsgeo.simulate.pushbroom_campaign_types:PushbroomCampaignScenario",
     "rikola": "hsgeo.simulate.rikola:RikolaBenchScenario",
 }
 
@@ -36,12 +42,14 @@ class ScenarioInfo:
     ----------
     generator : str
         Which simulator the file configures (a key of :data:`SCENARIOS`).
-    seed : int
-        Seed of the data that ``make data`` writes.
+    seed : int, optional
+        Seed of the data that ``make data`` writes (required of a scenario whose generator
+        writes files, :data:`hsgeo.reproduce.data.GENERATORS`); a chapter's scenario, which
+        writes none, takes its seed from ``hsgeo reproduce --seed``.
     """
 
     generator: str
-    seed: int
+    seed: int | None = None
 
 
 def data_dir() -> Path:

@@ -422,7 +422,8 @@ def _px_power(name: str) -> int:
 
 
 def _joint_estimates(obs, sigma_px: float) -> tuple[list[Estimate], dict]:
-    from hsgeo.workflows.rikola import calibrate_joint, initial_focal_mm
+    from hsgeo.workflows.rikola_bands import initial_focal_mm
+    from hsgeo.workflows.rikola_joint import calibrate_joint
 
     j = calibrate_joint(obs, f0_mm=initial_focal_mm(obs), sigma_px=sigma_px)
     R = j.result
@@ -439,7 +440,7 @@ def _joint_estimates(obs, sigma_px: float) -> tuple[list[Estimate], dict]:
 
 
 def _band_estimates(obs, band: int, sigma_px: float, unit: str) -> tuple[list[Estimate], dict]:
-    from hsgeo.workflows.rikola import calibrate_band
+    from hsgeo.workflows.rikola_bands import calibrate_band
 
     c = calibrate_band(obs, band, f0_mm=None, sigma_px=sigma_px)
     est = []
@@ -468,8 +469,8 @@ def calibrate_frame_files(
     sigma_px: float = 0.1,
 ) -> FrameFilesResult:
     """``hsgeo calibrate-frame``: detect a board in image files and self-calibrate, per band
-    (:func:`hsgeo.workflows.rikola.calibrate_band`) or jointly
-    (:func:`hsgeo.workflows.rikola.calibrate_joint`, Rikola band numbering).
+    (:func:`hsgeo.workflows.rikola_bands.calibrate_band`) or jointly
+    (:func:`hsgeo.workflows.rikola_joint.calibrate_joint`, Rikola band numbering).
 
     Returns
     -------
