@@ -142,9 +142,6 @@ def main(argv: list[str] | None = None) -> int:
                 page.goto(f"{base}/lab/tree/{download.name}", timeout=180_000)
                 page.wait_for_selector(".jp-Notebook .jp-Cell", timeout=180_000)
                 page.wait_for_timeout(3000)
-                no_news = page.get_by_role("button", name="No", exact=True)
-                if no_news.count():  # JupyterLab's "notified about news?" toast
-                    no_news.first.click()
                 page.locator(".jp-Notebook .jp-Cell").first.click()
                 page.keyboard.press("Escape")  # command mode: j moves down a cell
                 for _ in range(index):
@@ -161,6 +158,10 @@ def main(argv: list[str] | None = None) -> int:
                 missing = [v for v in values if v not in shown]
                 if len(values) - len(missing) < MIN_VALUES:
                     raise SystemExit(f"the rendered cell does not show {values}: «{shown[:200]}»")
+                no_news = page.get_by_role("button", name="No", exact=True)
+                if no_news.count():  # JupyterLab's "notified about news?" toast
+                    no_news.first.click()
+                    page.wait_for_timeout(1000)
                 png = Path(tmp) / "shot.png"
                 page.screenshot(path=str(png))
                 browser.close()
