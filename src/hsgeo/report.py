@@ -828,7 +828,8 @@ def panel_columns(fig) -> int:
         spec = ax.get_subplotspec() if hasattr(ax, "get_subplotspec") else None
         if spec is None or not ax.get_visible() or ax.get_label() == "<colorbar>":
             continue
-        starts.add(spec.colspan.start)
+        # the figure's own grid (a colour bar nests its panel's cell in a grid of its own)
+        starts.add(spec.get_topmost_subplotspec().colspan.start)
     return max(1, len(starts))
 
 
