@@ -466,9 +466,65 @@ def test_glue_value_and_figure_glue_what_the_chapter_shows(monkeypatch):
     assert glued["a"] == (2.5, False) and type(glued["a"][0]) is float
     glue_value("b", "text")
     assert glued["b"] == ("text", False)
-    fig = plt.figure()
+    fig, _ = plt.subplots(2, 2)
     glue_figure("f", fig)
-    assert glued["f"] == (fig, False) and not plt.fignum_exists(fig.number)  # closed
+    shown, display = glued["f"]
+    assert display is False and not plt.fignum_exists(fig.number)  # hidden, closed
+    assert shown.panel_columns == 2
+
+
+def test_glued_figure_records_its_panel_grid_and_refuses_three_columns(monkeypatch):
+    import io
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import myst_nb
+    from PIL import Image
+
+    from hsgeo.errors import InputError
+    from hsgeo.report import PANEL_COLUMNS_KEY, glue_figure, panel_columns
+
+    glued = {}
+    monkeypatch.setattr(myst_nb, "glue", lambda n, v, display=True: glued.update({n: v}))
+    fig, axes = plt.subplots(3, 2)
+    fig.colorbar(axes[0, 0].imshow([[0, 1]]), ax=axes[0, 0])  # a colour bar is no panel
+    axes[2, 1].set_visible(False)
+    assert panel_columns(fig) == 2
+    glue_figure("f", fig)
+    png = glued["f"]._repr_png_()
+    assert Image.open(io.BytesIO(png)).text[PANEL_COLUMNS_KEY] == "2"
+    wide, _ = plt.subplots(1, 3)
+    with pytest.raises(InputError, match="3 panel columns"):
+        glue_figure("w", wide)
+    assert not plt.fignum_exists(wide.number) and "w" not in glued
+
+
+def test_shown_tables_drop_empty_columns_and_toggle_long_ones():
+    rows = [
+        Row(table="T", quantity=f"q{i}", unit="px", reproduced=1.5 + i, sigma=0.1)
+        for i in range(21)
+    ]
+    rep = Reproduction("x", 0, rows)
+    html = rep.show("T")._repr_html_()
+    assert 'data-label="truth"' not in html and 'data-label="verdict"' not in html  # all "—"
+    assert 'data-label="reproduced"' in html
+    assert html.startswith('<details class="hsgeo-long-table"><summary>The table (21 rows)')
+    short = Reproduction("x", 0, rows[:20]).show("T")._repr_html_()
+    assert "<details" not in short
+
+
+def test_numbers_break_only_before_their_sigma():
+    from hsgeo.report import _runs_on_own_line
+
+    assert _runs_on_own_line("8.661 ± 0.003") == (
+        '<span class="hsgeo-nw">8.661</span> <span class="hsgeo-nw">± 0.003</span>'
+    )
+    assert _runs_on_own_line("0.42") == "0.42"
+    assert _runs_on_own_line("-1.5 × 10⁻⁵ (24 runs)").startswith(
+        '<span class="hsgeo-nw">−1.5</span> <span class="hsgeo-nw">× 10⁻⁵</span><br>'
+    )
 
 
 def test_row_lookup_and_verdict_counts():

@@ -66,6 +66,12 @@ __all__ = [
     "VERDICT_MEANING",
     "true_minus",
     "with_data_labels",
+    "with_toggle",
+    "drop_empty_columns",
+    "MAX_TABLE_ROWS",
+    "panel_columns",
+    "PANEL_COLUMNS_KEY",
+    "MAX_PANEL_COLUMNS",
 ]
 
 #: The verdicts of a claim (ReScience style). ``by construction``: the truth (or the outcome) is
@@ -585,11 +591,33 @@ def true_minus(value) -> str:
     return _HYPHEN_MINUS.sub("\u2212", str(value))
 
 
+_BREAK = re.compile(r" (?=[±×] )")
+
+
+def _unbroken(text: str) -> str:
+    """A number's text as spans that never break inside (``class="hsgeo-nw"``), with a break
+    allowed before its "± σ" and its "× 10ⁿ": "8.661 ± 0.003" may take two lines in a narrow
+    column, so that a table of eight columns fits the book's column on a wide screen.
+    """
+    import html as html_mod
+
+    parts = _BREAK.split(text)
+    if len(parts) == 1:
+        return html_mod.escape(text, quote=False)
+    return " ".join(
+        f'<span class="hsgeo-nw">{html_mod.escape(p, quote=False)}</span>' for p in parts
+    )
+
+
 def _runs_on_own_line(value) -> str:
-    """A number cell's HTML: its "(n runs)" / "(mean of n)" note below the number."""
+    """A number cell's HTML: its "(n runs)" / "(mean of n)" note below the number, a break
+    allowed before "±" and "×" (:func:`_unbroken`).
+    """
     text = true_minus(value)
     m = _RUNS.match(text)
-    return f'{m[1]}<br><span class="hsgeo-runs">{m[2]}</span>' if m else text
+    if m:
+        return f'{_unbroken(m[1])}<br><span class="hsgeo-runs">{m[2]}</span>'
+    return _unbroken(text)
 
 
 _HEAD = re.compile(r'<th [^>]*class="col_heading level0 col(\d+)"[^>]*>(.*?)</th>', re.S)
@@ -610,6 +638,39 @@ def with_data_labels(html: str) -> str:
     return _CELL.sub(lambda m: f'<td data-label="{names.get(int(m[2]), "")}" {m[1]}', html)
 
 
+#: The most rows a table shown in view may have; a longer one is shown under a toggle whose
+#: summary counts its rows and verdicts (issue 40; ``make check-book`` asserts it).
+MAX_TABLE_ROWS = 20
+
+
+def with_toggle(html: str, df) -> str:
+    """A table's HTML as the book shows it: as it is when ``df`` has at most
+    :data:`MAX_TABLE_ROWS` rows, else under a toggle (``<details>``) whose summary says how many
+    rows it holds and, for a table with a verdict column, how many of each verdict.
+    """
+    n = len(df)
+    if n <= MAX_TABLE_ROWS:
+        return html
+    what = f"{n} rows"
+    if "verdict" in df.columns:
+        counts = df["verdict"].value_counts()
+        judged = [f"{k_n} {k}" for k, k_n in counts.items() if k != "—"]
+        if judged:
+            what += ": " + ", ".join(judged)
+    return (
+        f'<details class="hsgeo-long-table"><summary>The table ({what}) — show</summary>'
+        f"{html}</details>"
+    )
+
+
+def drop_empty_columns(df):
+    """``df`` without the columns whose every cell is "—" (nothing to read in them)."""
+    if not len(df):
+        return df
+    empty = [c for c in df.columns if (df[c].astype(str).str.strip() == "—").all()]
+    return df.drop(columns=empty)
+
+
 @functools.cache
 def _card_styler():
     """The pandas Styler whose HTML carries :func:`with_data_labels` (created on first use: pandas
@@ -624,7 +685,9 @@ def _card_styler():
 
         def _repr_html_(self):  # pandas' own calls to_html; labels are added once either way
             html = super()._repr_html_()
-            return with_data_labels(html) if isinstance(html, str) else html
+            if not isinstance(html, str):
+                return html
+            return with_toggle(with_data_labels(html), self.data)
 
     return CardStyler
 
@@ -632,9 +695,13 @@ def _card_styler():
 def styled(df, numeric: tuple[str, ...] = NUMERIC_COLUMNS):
     """A DataFrame of display strings as the book shows a table: a pandas Styler without index,
     class ``hsgeo-table``, every cell padded, the ``numeric`` columns right-aligned (header too,
-    class ``hsgeo-num``) and the others left-aligned (``hsgeo-text``).
+    class ``hsgeo-num``) and the others left-aligned (``hsgeo-text``). Columns whose every cell
+    is "—" are left out (:func:`drop_empty_columns`); a table of more than
+    :data:`MAX_TABLE_ROWS` rows is shown under a toggle (:func:`with_toggle`).
     """
     import pandas as pd
+
+    df = drop_empty_columns(df)
 
     num = [c for c in df.columns if c in numeric]
     text = [c for c in df.columns if c not in numeric]
@@ -656,9 +723,9 @@ def styled(df, numeric: tuple[str, ...] = NUMERIC_COLUMNS):
         .set_table_styles(heads, overwrite=False)
     )
     if num:
-        style = style.set_properties(subset=num, **{"text-align": "right", "white-space": "nowrap"})
-        # "0.0052 (24 runs)": the count on a line of its own, so a table of σ over runs fits
-        # its column on a wide screen (the number itself never breaks)
+        style = style.set_properties(subset=num, **{"text-align": "right"})
+        # "0.0052 (24 runs)": the count on a line of its own, and "8.661 ± 0.003" may break
+        # before its "±", so a table fits its column on a wide screen (a number never breaks)
         style = style.format(_runs_on_own_line, subset=num)
     if text:
         style = style.set_properties(subset=text, **{"text-align": "left"})
@@ -744,14 +811,65 @@ def glue_value(name: str, value) -> None:
     glue(name, value, display=False)
 
 
+#: The PNG text key under which :func:`glue_figure` records a figure's panel columns, read
+#: back from the built book by ``make check-book`` (tests/book/pagecheck.py).
+PANEL_COLUMNS_KEY = "hsgeo panel columns"
+#: The most panel columns a figure may have: wider, its panels are a few px wide on a phone.
+MAX_PANEL_COLUMNS = 2
+
+
+def panel_columns(fig) -> int:
+    """The number of panel columns of a matplotlib figure: the distinct grid columns in which a
+    visible subplot starts (colour bars and axes placed by hand are not panels); 1 for a figure
+    without subplots.
+    """
+    starts = set()
+    for ax in fig.axes:
+        spec = ax.get_subplotspec() if hasattr(ax, "get_subplotspec") else None
+        if spec is None or not ax.get_visible() or ax.get_label() == "<colorbar>":
+            continue
+        # the figure's own grid (a colour bar nests its panel's cell in a grid of its own)
+        starts.add(spec.get_topmost_subplotspec().colspan.start)
+    return max(1, len(starts))
+
+
+class _GluedFigure:
+    """A figure's PNG as IPython's inline backend makes it (``bbox_inches="tight"``, the
+    figure's dpi and colours), with its panel columns in a PNG text chunk
+    (:data:`PANEL_COLUMNS_KEY`).
+    """
+
+    def __init__(self, fig):
+        from IPython.core.pylabtools import print_figure
+
+        self.panel_columns = panel_columns(fig)
+        self._png = print_figure(fig, "png", metadata={PANEL_COLUMNS_KEY: str(self.panel_columns)})
+
+    def _repr_png_(self) -> bytes:
+        return self._png
+
+    def __repr__(self) -> str:
+        return f"<a figure of {self.panel_columns} panel column(s)>"
+
+
 def glue_figure(name: str, fig) -> None:
     """Glue a matplotlib figure for a ``{glue:figure}`` directive, hidden, and close it (so the
-    cell does not show it a second time). Needs myst-nb.
+    cell does not show it a second time). The PNG records the figure's panel columns
+    (:func:`panel_columns`); a figure of more than :data:`MAX_PANEL_COLUMNS` is refused, as its
+    panels would be unreadable on a phone (``make check-book`` checks the built pages too).
+    Needs myst-nb.
     """
     import matplotlib.pyplot as plt
 
     glue = _myst_glue()
-    glue(name, fig, display=False)
+    n = panel_columns(fig)
+    if n > MAX_PANEL_COLUMNS:
+        plt.close(fig)
+        raise InputError(
+            f"figure {name!r} has {n} panel columns: lay its panels out in at most "
+            f"{MAX_PANEL_COLUMNS} columns (more rows), or split it into figures"
+        )
+    glue(name, _GluedFigure(fig), display=False)
     plt.close(fig)
 
 

@@ -12,11 +12,18 @@ import re
 from pathlib import Path
 from urllib.parse import unquote, urlparse
 
+from hsgeo.report import MAX_PANEL_COLUMNS, PANEL_COLUMNS_KEY
+
 #: Viewport widths (px) of a phone and of a desktop screen.
 NARROW_PX = 400
 WIDE_PX = 1400
 #: The most rows a table a reader sees may have (a longer one goes under a toggle, issue 40).
 MAX_TABLE_ROWS = 20
+#: The width (px) of an A4 page's text in print: 210 mm less 10 mm margins each side, 96 px/in.
+PRINT_PX = 718
+#: The least width (px) of a figure's panel as shown at 400 px (the panel grid and its limit,
+#: ``PANEL_COLUMNS_KEY`` and ``MAX_PANEL_COLUMNS``, are hsgeo.report's, which records it).
+MIN_PANEL_PX = 150
 #: The most words of a paper's statement on the scoreboard and the landing page.
 MAX_STATEMENT_WORDS = 80
 
@@ -188,6 +195,20 @@ async () => {
           + (beyond[0].getAttribute("data-label") || "?") + "»)" : ""));
     }
   }
+  // tables wider than the column of text they sit in (on a wide screen and in print, where a
+  // sideways scroll cannot be printed): measured against the article, not the scroll box
+  const wide_tables = [];
+  for (const table of main.querySelectorAll("table")) {
+    if (table.closest("pre, .highlight, mjx-container") || table.offsetParent === null) continue;
+    const column = (table.closest("article") || main).getBoundingClientRect();
+    const r = table.getBoundingClientRect();
+    // the table itself may be the scroll box (the theme makes tables display: block)
+    const content = Math.max(r.width, table.scrollWidth);
+    if (r.width > 0 && (r.left + content > column.right + 1)) {
+      wide_tables.push(describe(table) + ": " + Math.round(content) + " px wide, "
+        + Math.round(r.left + content - column.right) + " px beyond its column");
+    }
+  }
   // long tables and empty columns (issue 40): a table a reader sees (not one under a toggle,
   // <details>, where a long table belongs) has at most MAX_ROWS rows, and no column whose every
   // cell is "—"
@@ -245,13 +266,20 @@ async () => {
     const t = (el.textContent || "").replace(/\s+/g, " ").trim();
     return {text: t.slice(0, 80), words: t ? t.split(" ").length : 0};
   });
+  // the figures' images and their width as shown (the panel grid is read from the PNG)
+  const figure_images = [...main.querySelectorAll("figure img")].map((img) => ({
+    src: img.src, width: Math.round(img.getBoundingClientRect().width),
+    text: describe(img.closest("figure") || img),
+  }));
   const hrefs = [...document.querySelectorAll("a[href]")].map((a) => a.getAttribute("href"));
   const downloads = hrefs.filter((h) => /\.ipynb$/.test(h));
   const sources = hrefs.filter((h) => /_sources\/.*\.md$/.test(h));
   return {
     title: document.title,
+    figure_images: figure_images,
     display_math: main.querySelectorAll("mjx-container[display='true']").length,
     long_tables: long_tables.slice(0, 8),
+    wide_tables: wide_tables.slice(0, 8),
     empty_columns: empty_columns.slice(0, 8),
     uncaused: uncaused.slice(0, 8),
     reprs: reprs,
@@ -291,8 +319,33 @@ async () => {
 """
 
 
-def page_facts(browser, path: Path, width_px: int) -> dict:
-    """Open ``path`` offline at ``width_px`` and measure it (see the module docstring)."""
+def png_panel_columns(src: str) -> int | None:
+    """The panel columns a PNG records (``hsgeo.report.PANEL_COLUMNS_KEY``, written by
+    ``hsgeo.report.glue_figure``) from a ``file:`` or ``data:image/png;base64`` URL; None for
+    another image or a PNG without the record.
+    """
+    import base64
+    import io
+
+    from PIL import Image
+
+    if src.startswith("data:image/png;base64,"):
+        data = io.BytesIO(base64.b64decode(src.split(",", 1)[1]))
+    elif src.startswith("file:") and src.lower().endswith(".png"):
+        data = Path(unquote(urlparse(src).path))
+        if not data.is_file():
+            return None
+    else:
+        return None
+    with Image.open(data) as image:
+        value = getattr(image, "text", {}).get(PANEL_COLUMNS_KEY)
+    return int(value) if value and value.isdigit() else None
+
+
+def page_facts(browser, path: Path, width_px: int, media: str = "screen") -> dict:
+    """Open ``path`` offline at ``width_px`` and measure it (see the module docstring);
+    ``media="print"`` lays it out as printed (at :data:`PRINT_PX`, an A4 page's text width).
+    """
     context = browser.new_context(viewport={"width": width_px, "height": 900}, offline=True)
     blocked: list[str] = []
     failed: list[str] = []
@@ -312,11 +365,14 @@ def page_facts(browser, path: Path, width_px: int) -> dict:
         lambda r: failed.append(r.url) if r.url.startswith("file:") else None,
     )
     try:
+        page.emulate_media(media=media)
         page.goto(path.resolve().as_uri(), wait_until="load")
         facts = page.evaluate(_FACTS_JS.replace("__MAX_ROWS__", str(MAX_TABLE_ROWS)))
         page.wait_for_timeout(100)  # let late font and component loads report
     finally:
         context.close()
+    for image in facts["figure_images"]:
+        image["panel_columns"] = png_panel_columns(image["src"])
     facts["blocked"] = blocked
     facts["failed"] = failed
     facts["path"] = str(path)
@@ -488,3 +544,27 @@ def problems_statements(facts: dict, minimum: int = 0) -> list[str]:
     if len(facts["statements"]) < minimum:
         out.append(f"{len(facts['statements'])} per-paper statements, fewer than {minimum}")
     return out
+
+
+def problems_panels(facts: dict) -> list[str]:
+    """No figure of more than :data:`MAX_PANEL_COLUMNS` panel columns, and on a narrow screen
+    none whose panels are shown narrower than :data:`MIN_PANEL_PX` each (the panel grid as
+    ``hsgeo.report.glue_figure`` recorded it in the PNG).
+    """
+    out = []
+    for image in facts["figure_images"]:
+        n = image.get("panel_columns")
+        if not n:
+            continue
+        if n > MAX_PANEL_COLUMNS:
+            out.append(f"{n} panel columns (> {MAX_PANEL_COLUMNS}): {image['text']}")
+        elif facts["inner_width"] <= NARROW_PX and image["width"] / n < MIN_PANEL_PX:
+            out.append(
+                f"panels {image['width'] / n:.0f} px wide (< {MIN_PANEL_PX}): {image['text']}"
+            )
+    return out
+
+
+def problems_wide_tables(facts: dict) -> list[str]:
+    """No table wider than the column of text it sits in (a wide screen, a printed page)."""
+    return [f"table wider than its column: {d}" for d in facts["wide_tables"]]

@@ -41,10 +41,12 @@ from pagecheck import (
     problems_numbering,
     problems_offline,
     problems_page_width,
+    problems_panels,
     problems_reprs,
     problems_result_tables,
     problems_statements,
     problems_version_footer,
+    problems_wide_tables,
 )
 
 pytestmark = pytest.mark.book
@@ -70,6 +72,28 @@ def _page(tmp_path: Path, name: str, body: str) -> Path:
 def _table(n_rows: int) -> str:
     rows = "".join(f"<tr><td>q{i}</td><td>{i}</td></tr>" for i in range(n_rows))
     return f"<table><thead><tr><th>q</th><th>v</th></tr></thead><tbody>{rows}</tbody></table>"
+
+
+def _figure_png(panel_columns: int) -> str:
+    """A figure of ``panel_columns`` panels side by side, glued as a chapter glues one
+    (hsgeo.report's PNG with its panel grid), as a data: URL in a <figure>."""
+    import base64
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from hsgeo.report import _GluedFigure
+
+    fig, _ = plt.subplots(1, panel_columns, figsize=(2 * panel_columns, 1.5))
+    png = _GluedFigure(fig)._repr_png_()
+    plt.close(fig)
+    src = "data:image/png;base64," + base64.b64encode(png).decode()
+    return (
+        f'<figure><img src="{src}" alt="panels" style="max-width: 100%">'
+        "<figcaption>Fig. 1: panels.</figcaption></figure>"
+    )
 
 
 def _verdicts(*rows: tuple[str, str]) -> str:
@@ -267,6 +291,16 @@ CASES = {
         '<p class="hsgeo-statement">' + "word " * 81 + "</p>",
         '<p class="hsgeo-statement">' + "word " * 80 + "</p>",
     ),
+    "figure-of-three-panel-columns": (
+        problems_panels,
+        _figure_png(3),
+        _figure_png(2),
+    ),
+    "table-wider-than-its-column": (
+        problems_wide_tables,
+        '<table style="width: 1800px"><tr><td>claim</td><td>differs</td></tr></table>',
+        "<table><tr><td>claim</td><td>differs</td></tr></table>",
+    ),
     "network-request": (
         problems_offline,
         '<img src="https://example.org/logo.png" alt="">',
@@ -278,7 +312,8 @@ CASES = {
 @pytest.mark.parametrize("case", list(CASES))
 def test_check_reports_the_defect_and_passes_the_repair(browser, tmp_path, case):
     check, defective, repaired = CASES[case]
-    width = NARROW_PX if check in (problems_page_width, problems_result_tables) else WIDE_PX
+    narrow = (problems_page_width, problems_result_tables, problems_panels)
+    width = NARROW_PX if check in narrow else WIDE_PX
     bad = page_facts(browser, _page(tmp_path, "bad", defective), width)
     good = page_facts(browser, _page(tmp_path, "good", repaired), width)
     assert check(bad), f"{case}: the defect was not reported"

@@ -30,6 +30,7 @@ from hsgeo.report import (
     Reproduction,
     Row,
     _format_paper,
+    _unbroken,
     format_value,
 )
 from hsgeo.reproduce import CHAPTERS, paper_chapters
@@ -352,10 +353,16 @@ class ClaimTable:
     def _repr_html_(self) -> str:
         from html import escape
 
+        # a column whose every cell is "—" is left out (no z where no claim has one)
+        numbers = [
+            c
+            for c in ("paper", "reproduced ± σ", "z")
+            if not len(self.data) or not (self.data[c] == "—").all()
+        ]
         head = "".join(
-            f'<th class="{"hsgeo-num" if c in ("paper", "reproduced ± σ", "z") else "hsgeo-text"}"'
-            f">{escape(c)}</th>"
+            f'<th class="{"hsgeo-num" if c in numbers else "hsgeo-text"}">{escape(c)}</th>'
             for c in self.COLUMNS
+            if c in numbers or c in ("claim", "verdict")
         )
         body = []
         rows = zip(self.data.iterrows(), self.chapters, self.provenance, strict=True)
@@ -367,8 +374,8 @@ class ClaimTable:
             if rec["unit"] not in ("—", ""):
                 claim += f'<br><span class="hsgeo-unit">in {escape(rec["unit"])}</span>'
             cells = [f'<td class="hsgeo-text hsgeo-claim" data-label="claim">{claim}</td>']
-            for c in ("paper", "reproduced ± σ", "z"):
-                cells.append(f'<td class="hsgeo-num" data-label="{c}">{escape(rec[c])}</td>')
+            for c in numbers:
+                cells.append(f'<td class="hsgeo-num" data-label="{c}">{_unbroken(rec[c])}</td>')
             cells.append(
                 f'<td class="hsgeo-text" data-label="verdict">'
                 f'<span class="hsgeo-verdict">{escape(rec["verdict"])}</span>'
