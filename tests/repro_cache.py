@@ -20,6 +20,8 @@ import pickle
 import warnings
 from pathlib import Path
 
+import cloudpickle
+
 #: the directory of the session's cached results (set by tests/conftest.py for the kernels)
 ENV = "HSGEO_TEST_REPRO_CACHE"
 
@@ -58,12 +60,12 @@ def cached_run(directory: str | Path, chapter: str, seed: int = 0, scale: float 
     with open(d / f"{key}.lock", "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)  # a second process waits here for the first's result
         if path.is_file():
-            rep = pickle.loads(path.read_bytes())
+            rep = cloudpickle.loads(path.read_bytes())
             _record(R, chapter, rep)
             return rep
         rep = run(chapter, seed=seed, scale=scale)
-        try:
-            data = pickle.dumps(rep, protocol=pickle.HIGHEST_PROTOCOL)
+        try:  # cloudpickle (dask's) also pickles the local functions of a dask graph (cube)
+            data = cloudpickle.dumps(rep, protocol=pickle.HIGHEST_PROTOCOL)
         except Exception as err:  # an unpicklable extra: not shared, every caller computes it
             warnings.warn(f"{key} not shared between processes: {err}", stacklevel=2)
             _UNSHARED[key] = rep
