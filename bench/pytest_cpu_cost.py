@@ -6,6 +6,9 @@ line per finished test): at the end of the session a JSON file maps
 each test file to its CPU seconds (user + system of the pytest process and the children it
 waited for, ``resource.getrusage``), wall seconds and test count, setup and teardown included
 (a module-scoped fixture is charged to the file's first test). It never asserts a time.
+Under pytest-xdist each worker writes its own file (``HSGEO_TEST_COST_OUT`` with ``.gw0``,
+``.gw1``, … inserted before the suffix), and the live lines of all workers go to the one
+``HSGEO_TEST_COST_LIVE`` file (appended line by line).
 """
 
 from __future__ import annotations
@@ -53,6 +56,10 @@ def pytest_sessionfinish(session, exitstatus):  # noqa: D103
     out = os.environ.get("HSGEO_TEST_COST_OUT")
     if not out:
         return
+    worker = os.environ.get("PYTEST_XDIST_WORKER")
+    if worker:  # one file per worker, or the last worker to finish would overwrite the others
+        root, ext = os.path.splitext(out)
+        out = f"{root}.{worker}{ext}"
     files = dict(sorted(_rows.items(), key=lambda kv: -kv[1]["cpu_s"]))
     top = sorted(_tests, key=lambda t: -t[1])[:120]
     doc = {

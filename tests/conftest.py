@@ -2,7 +2,33 @@ import os
 import sys
 from pathlib import Path
 
+import pytest
+
 sys.path.insert(0, str(Path(__file__).parent))
+
+from repro_cache import cached_run  # noqa: E402
+
+
+@pytest.fixture(scope="session")
+def repro_cache_dir(tmp_path_factory) -> Path:
+    """The session's cache of chapter results (tests/repro_cache.py), shared by the
+    pytest-xdist workers (the parent of a worker's base temporary directory is the session's)
+    and the chapters' kernels (``$HSGEO_TEST_REPRO_CACHE``, set by tests/test_chapters.py)."""
+    base = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        base = base.parent
+    return base / "reproductions"
+
+
+@pytest.fixture(scope="session")
+def reproduction(repro_cache_dir):
+    """``reproduction(chapter, seed, scale)``: ``hsgeo.reproduce.run``'s result, computed once per
+    session for every test and chapter that asks for it (each gets its own copy)."""
+
+    def get(chapter: str, seed: int = 0, scale: float = 1.0):
+        return cached_run(repro_cache_dir, chapter, seed=seed, scale=scale)
+
+    return get
 
 
 def _compile_pushbroom_kernels() -> None:

@@ -18,6 +18,8 @@ import yaml
 
 jupytext = pytest.importorskip("jupytext")
 nbclient = pytest.importorskip("nbclient")
+import nbformat  # noqa: E402
+import repro_cache  # noqa: E402
 from nbclient.exceptions import CellExecutionError  # noqa: E402
 
 from hsgeo.reproduce import chapter_names  # noqa: E402
@@ -26,6 +28,11 @@ BOOK = Path(__file__).resolve().parents[1] / "book"
 TIMEOUT_S = 1800
 SUFFIXES = (".md", ".ipynb")
 _ANSI = re.compile(r"\x1b\[[0-9;]*m")
+# run first in each chapter's kernel: hsgeo.reproduce.run shares its results with the tests
+SHARE_CELL = (
+    f"import sys\nsys.path.insert(0, {str(Path(__file__).resolve().parent)!r})\n"
+    "import repro_cache\nrepro_cache.install()\ndel sys.path[0]"
+)
 
 
 def _toc_files(node) -> list[str]:
@@ -75,7 +82,10 @@ CHAPTERS = _chapters()
 
 @pytest.mark.parametrize("path", CHAPTERS, ids=[p.stem for p in CHAPTERS])
 def test_chapter_executes(
-    path: Path, monkeypatch: pytest.MonkeyPatch, tmp_path_factory: pytest.TempPathFactory
+    path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    tmp_path_factory: pytest.TempPathFactory,
+    repro_cache_dir: Path,
 ) -> None:
     if not _has_code_cells(path):
         pytest.skip(f"{path.relative_to(BOOK)} has no code cells")
@@ -87,11 +97,15 @@ def test_chapter_executes(
     monkeypatch.setenv("HSGEO_RECORD_DIR", str(records))
     monkeypatch.setenv("MPLBACKEND", "Agg")
     monkeypatch.setenv("PYDEVD_DISABLE_FILE_VALIDATION", "1")
+    # a chapter run that a test also runs (same seed and scale) is computed once per session
+    # (tests/repro_cache.py)
+    monkeypatch.setenv(repro_cache.ENV, str(repro_cache_dir))
     for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"):
         if var not in os.environ:
             monkeypatch.setenv(var, "1")
 
     nb = _read(path)
+    nb.cells.insert(0, nbformat.v4.new_code_cell(SHARE_CELL))
     client = nbclient.NotebookClient(
         nb,
         timeout=TIMEOUT_S,

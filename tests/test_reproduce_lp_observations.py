@@ -14,6 +14,7 @@ from hsgeo.papers import P002_STATS
 from hsgeo.reproduce import CHAPTERS, chapter_names, paper_chapters
 from hsgeo.reproduce.lp_judge import match_errors_px, observation_errors_px, within_fractions
 from hsgeo.reproduce.lp_observations import SIM_SCALE_AT_1, run, sim_scale, stat_sigma
+from hsgeo.reproduce.scoreboard import mark_context
 from hsgeo.simulate.lp_campaign import MIN_SCALE
 
 SMALL = 0.3  # renders 0.105 of the block side, 1.1 % of the campaign
@@ -108,8 +109,11 @@ def test_judges_are_exact_on_exact_observations(tiny):
 # ---------------------------------------------------------------------------------------------
 # the whole run at a small scale (slow: about a minute each on 2 cores)
 @pytest.fixture(scope="module")
-def rep():
-    return run(seed=0, scale=SMALL)
+def rep(reproduction):
+    # hsgeo.reproduce.run("lp-observations", seed=0, scale=SMALL): the chapter's run in
+    # tests/test_chapters.py (book/chapters/lp_observations.md at HSGEO_SCALE=small), computed
+    # once per session for both (tests/conftest.py)
+    return reproduction("lp-observations", seed=0, scale=SMALL)
 
 
 ISSUE_QUANTITIES = {
@@ -197,7 +201,8 @@ def test_done_means_observations_and_parameters(rep):
 
 @pytest.mark.slow
 def test_same_seed_same_rows(rep):
-    again = run(seed=0, scale=SMALL, unmodelled=False)
+    # rep comes through hsgeo.reproduce.run, which marks the rows another chapter judges
+    again = mark_context("lp-observations", run(seed=0, scale=SMALL, unmodelled=False))
     a = [r.as_dict() for r in rep.rows if r.table != "unmodelled effect"]
     b = [r.as_dict() for r in again.rows if r.table != "unmodelled effect"]
     assert len(a) > 100 and a == b
