@@ -40,3 +40,8 @@ for name, script, arguments in jobs:
     except SystemExit as e:  # a script's main() returning through sys.exit
         if e.code not in (0, None):
             raise
+# issue 41's table, each figure beside its goal, from the files just written
+if not only or "issue41_audit" in only:
+    print("== issue41_audit.py", flush=True)
+    sys.argv = [str(here / "issue41_audit.py")]
+    runpy.run_path(str(here / "issue41_audit.py"), run_name="__main__")
