@@ -22,7 +22,7 @@ failures, commits).
 **The smallest scale** is 0.05 for every chapter: below it no chapter gets any smaller (each
 clamps ``scale`` to its own floor or has no size knob; the LP campaign refuses less than
 :data:`hsgeo.simulate.lp_campaign.MIN_SCALE`). What each chapter's knob reaches is measured by
-``bench/bench_smallest_scale.py`` (``bench/results/smallest_scale.json``).
+``bench/profile_smallest_scale.py`` (``bench/results/smallest_scale.json``).
 
 This is a benchmark (``make bench``), not a test: one seed of the nine chapters costs about
 400 CPU-s in one warm process (2026-11-28: lp-observations 126, rikola 95, pushbroom-ba 93,
