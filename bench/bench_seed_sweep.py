@@ -152,10 +152,28 @@ def parse_seeds(text: str) -> list[int]:
     return out
 
 
-def _write(path: Path, doc: dict) -> None:
-    tmp = path.with_suffix(".json.part")
-    tmp.write_text(json.dumps(doc, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
-    os.replace(tmp, path)
+def _record(path: Path, doc: dict, run: dict) -> dict:
+    """Add ``run`` to the result file, merged with what other sweeps wrote meanwhile (the
+    file is re-read under a lock: several sweeps, e.g. one per group of chapters, may share
+    it). Returns the document written."""
+    import fcntl
+
+    key = (run["chapter"], run["seed"], run["scale"])
+    with open(path.with_suffix(".lock"), "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if path.exists():
+            disk = json.loads(path.read_text(encoding="utf-8"))
+            doc = {**disk, **{k: v for k, v in doc.items() if k not in ("runs", "chapters")}}
+            doc["runs"] = disk.get("runs", [])
+        doc["runs"] = [x for x in doc["runs"] if (x["chapter"], x["seed"], x["scale"]) != key]
+        doc["runs"].append(run)
+        doc["chapters"] = summarise(doc["runs"])
+        doc["n_runs"] = len(doc["runs"])
+        doc["n_failed"] = sum(not x["ok"] for x in doc["runs"])
+        tmp = path.with_suffix(".json.part")
+        tmp.write_text(json.dumps(doc, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
+        os.replace(tmp, path)
+    return doc
 
 
 def main(argv=None) -> int:
@@ -193,22 +211,20 @@ def main(argv=None) -> int:
         for c in chapters:
             if (c, seed, a.scale) in done and not a.redo:
                 continue
+            if not a.redo and a.out.exists():  # another sweep on the same file did it
+                disk = json.loads(a.out.read_text(encoding="utf-8"))
+                if any((x["chapter"], x["seed"], x["scale"]) == (c, seed, a.scale)
+                       for x in disk.get("runs", [])):  # fmt: skip
+                    continue
             r = {"commit": commit, **one_run(c, seed, a.scale)}
-            doc["runs"] = [
-                x
-                for x in doc["runs"]
-                if (x["chapter"], x["seed"], x["scale"]) != (c, seed, a.scale)
-            ] + [r]
-            doc["chapters"] = summarise(doc["runs"])
-            doc["n_runs"], doc["n_failed"] = len(doc["runs"]), sum(not x["ok"] for x in doc["runs"])
-            _write(a.out, doc)
+            doc = _record(a.out, doc, r)
             print(
                 f"{c} seed {seed}: {'ok' if r['ok'] else 'FAILED'} ({r['cpu_s']} CPU-s)"
                 + ("" if r["ok"] else ": " + r.get("message", "")),
                 file=sys.__stderr__,
                 flush=True,
             )
-    s = summarise(doc["runs"])
+    s = summarise(json.loads(a.out.read_text(encoding="utf-8"))["runs"])
     print(", ".join(f"{c}: {v['failed']} failed of {v['runs']}" for c, v in s.items()))
     return 0
 
