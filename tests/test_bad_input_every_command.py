@@ -367,6 +367,10 @@ def test_interrupted_before_the_parser_is_json(capsys, monkeypatch):
 @pytest.mark.parametrize("cmd", [v for c in COMMANDS if has_json(c) for v in variants(c)])
 def test_exit_0_of_every_command_is_json(cmd, inputs, capsys):  # noqa: F811
     argv = B.base_argv(cmd, inputs.dir)
+    if cmd == "adjust-bal":  # the suite's 40-observation problem does not converge (exit 2)
+        from hsgeo.io.bal import ladybug_path
+
+        argv = [cmd, str(ladybug_path())]
     argv = argv if "--json" in argv else [*argv, "--json"]
     inputs.before = B._sha(inputs.dir)
     rc, out, err = run_cli(argv, capsys)
