@@ -2648,6 +2648,21 @@ def _sha(root: Path) -> dict:
     }
 
 
+def _tree(root: Path) -> dict:
+    """Every file (its SHA-256) and folder under ``root``, readable or not."""
+    out = {}
+    for p in sorted(root.rglob("*")):
+        if "__pycache__" in p.parts:
+            continue
+        try:
+            out[str(p.relative_to(root))] = (
+                "dir" if p.is_dir() else hashlib.sha256(p.read_bytes()).hexdigest()
+            )
+        except OSError:  # a file the case made unreadable
+            out[str(p.relative_to(root))] = "unreadable"
+    return out
+
+
 @dataclass
 class Inputs:
     dir: Path
@@ -2753,10 +2768,16 @@ def test_bad_input(case: Case, inputs: Inputs, capsys):
         argv = case.argv(argv, d)
     inputs.before = _sha(d)
     fresh = [a for a in _outputs(argv) if not os.path.lexists(a)]
+    root = d.parent  # the case's folder: inputs, outputs, working directory
+    tree = _tree(root)
     rc, out, err = run_cli(argv, capsys)
     lines = err.splitlines()
     left = [a for a in fresh if os.path.lexists(a)]
     assert not left, f"output left behind by a failing command: {left}"
+    # issue 42: nothing written, changed or removed anywhere in the case's folder
+    after = _tree(root)
+    changed = sorted(k for k in set(tree) | set(after) if tree.get(k) != after.get(k))
+    assert not changed, f"the case's folder changed: {changed[:10]}"
     assert rc == 2, f"exit {rc}; stderr: {err[-2000:]}"
     assert len(lines) == 1, f"{len(lines)} lines on stderr:\n{err[-3000:]}"
     assert "Traceback" not in err

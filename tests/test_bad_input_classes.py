@@ -204,7 +204,8 @@ CLASSES = [
     ("--json on every exit path", "every command with --json",
      "test:test_cli_json.py::test_every_exit_path_is_json", "added",
      "also test_refused_input_is_json, test_usage_error_is_json, "
-     "test_a_commands_own_refusal_is_json"),
+     "test_a_commands_own_refusal_is_json; every subcommand of the parser on every exit path: "
+     "tests/test_bad_input_every_command.py"),
 ]  # fmt: skip
 
 

@@ -418,22 +418,38 @@ def _json_error(command: str | None, message: str, status: int) -> None:
 
 
 def _json_usage_errors(ap: argparse.ArgumentParser, argv) -> None:
-    """Make the parser's usage errors JSON too when ``--json`` is among the arguments."""
+    """Make the parser's exits JSON too when ``--json`` is among the arguments: a usage error
+    (``{"command", "ok": false, "exit_status": 2, "error"}``, the line standard error shows)
+    and ``--help`` / ``--version`` (``{"command", "ok": true, "exit_status": 0, "text"}``).
+    """
     if "--json" not in argv:
         return
     parsers = [ap]
     for action in ap._actions:  # the subcommands' parsers
         if isinstance(action, argparse._SubParsersAction):
             parsers += list(action.choices.values())
+    names = {p.prog.split()[-1] for p in parsers[1:]}
+    # the root parser refuses what the subcommand left over ("unrecognized arguments"): the
+    # command is the first subcommand name on the line
+    given = next((a for a in argv if a in names), None)
     for p in parsers:
+        command = p.prog.split()[-1] if p is not ap else given
 
-        def error(message, _p=p, _error=p.error):
-            command = _p.prog.split()[-1] if _p is not ap else None
+        def error(message, _p=p, _error=p.error, _command=command):
             line = " ".join(f"{_p.prog}: error: {message} (see {_p.prog} --help)".split())
-            _json_error(command, line, 2)
+            _json_error(_command, line, 2)
             _error(message)  # the parser's own one line on standard error, exit status 2
 
+        def print_message(message, file=None, _print=p._print_message, _command=command):
+            # --help and --version print on standard output through this, then exit 0
+            if message and file is sys.stdout:
+                doc = {"command": _command, "ok": True, "exit_status": 0, "text": message}
+                _print(json_text(doc) + "\n", file)
+            else:
+                _print(message, file)
+
         p.error = error
+        p._print_message = print_message
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -6,6 +6,7 @@ import contextlib
 import errno
 import os
 import tempfile
+import threading
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 
@@ -13,6 +14,7 @@ from hsgeo.errors import InputError
 
 __all__ = [
     "atomic_path",
+    "output_group",
     "refuse_inputs",
     "check_outputs",
     "check_input_file",
@@ -321,10 +323,68 @@ def atomic_path(path, inputs: Iterable = ()) -> Iterator[Path]:
         os.umask(umask)
         os.chmod(tmp, 0o666 & ~umask)
         yield tmp
-        os.replace(tmp, path)
+        group = getattr(_GROUP, "current", None)
+        if group is not None:  # moved into place with the group's other files
+            group.append((tmp, path))
+            tmp = None
+        else:
+            os.replace(tmp, path)
     finally:
         if tmp is not None:
             tmp.unlink(missing_ok=True)
+
+
+_GROUP = threading.local()
+
+
+@contextlib.contextmanager
+def output_group() -> Iterator[None]:
+    """The files written through :func:`atomic_path` inside the block appear together or not at
+    all (a set of outputs: an ENVI file and its header, the files of a flight).
+
+    Each file's rename is deferred to the end of the block; then every one is moved into place,
+    a file it replaces first moved aside. If a rename fails (the disk refuses, Ctrl-C is held
+    back meanwhile), the files already moved are taken back out and the replaced ones restored:
+    the folder is as it was. On an exception in the block nothing is moved. A file written in
+    the block cannot be read back in it (it is not in place yet). Nested groups are one group.
+    """
+    if getattr(_GROUP, "current", None) is not None:
+        yield
+        return
+    pending: list[tuple[Path, Path]] = []
+    _GROUP.current = pending
+    try:
+        yield
+        _GROUP.current = None
+        with _no_interrupt():
+            _commit(pending)
+    finally:
+        _GROUP.current = None
+        for tmp, _ in pending:
+            tmp.unlink(missing_ok=True)
+
+
+def _commit(pending: list[tuple[Path, Path]]) -> None:
+    """Move each (temporary, final) into place, all or none (see :func:`output_group`)."""
+    done: list[tuple[Path, Path | None]] = []
+    try:
+        for tmp, final in pending:
+            backup = None
+            if os.path.lexists(final):
+                backup = final.with_name(f".{final.name}.{os.getpid()}.previous.part")
+                os.replace(final, backup)
+            done.append((final, backup))
+            os.replace(tmp, final)
+    except BaseException:
+        for final, backup in reversed(done):
+            if backup is not None:
+                os.replace(backup, final)
+            else:
+                final.unlink(missing_ok=True)
+        raise
+    for _, backup in done:
+        if backup is not None:
+            backup.unlink(missing_ok=True)
 
 
 @contextlib.contextmanager

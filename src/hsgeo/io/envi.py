@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from hsgeo.errors import InputError
-from hsgeo.io._files import atomic_path, refuse_inputs
+from hsgeo.io._files import atomic_path, output_group, refuse_inputs
 
 __all__ = ["write_envi", "read_envi", "EnviWriter"]
 
@@ -190,6 +190,7 @@ class EnviWriter:
         import contextlib
 
         self._stack = contextlib.ExitStack()
+        self._stack.enter_context(output_group())  # the data and the header, or neither
         tmp = self._stack.enter_context(atomic_path(self.path, self._inputs))
         htmp = self._stack.enter_context(atomic_path(self.header_path, self._inputs))
         self._fh = open(tmp, "wb")  # noqa: SIM115 - closed in __exit__

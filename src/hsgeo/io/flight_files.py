@@ -122,11 +122,7 @@ def write_flight(out, flight, *, overwrite: bool = False) -> list[Path]:
     list of Path
         The files written (module docstring).
     """
-    from rasterio.transform import from_origin
-
-    from hsgeo.io._files import atomic_path, make_folder, write_text
-    from hsgeo.io.envi import write_envi
-    from hsgeo.io.geotiff import write_geotiff
+    from hsgeo.io._files import make_folder, output_group
 
     out = Path(out)
     paths = check_flight_outputs(out, overwrite=overwrite)
@@ -134,6 +130,18 @@ def write_flight(out, flight, *, overwrite: bool = False) -> list[Path]:
     if overwrite:  # write_envi and write_geotiff refuse an existing file
         for p in paths:
             p.unlink(missing_ok=True)
+    with output_group():  # the flight's files all, or none of them (a write refused)
+        _write_files(out, flight)
+    return paths
+
+
+def _write_files(out: Path, flight) -> None:
+    from rasterio.transform import from_origin
+
+    from hsgeo.io._files import atomic_path, write_text
+    from hsgeo.io.envi import write_envi
+    from hsgeo.io.geotiff import write_geotiff
+
     c = flight.config
     write_envi(
         out / "lines.raw",
@@ -182,4 +190,3 @@ def write_flight(out, flight, *, overwrite: bool = False) -> list[Path]:
         Path(tmp).write_text(
             shlex.join(orthorectify_command(out, flight.output_epsg)) + "\n", encoding="utf-8"
         )
-    return paths

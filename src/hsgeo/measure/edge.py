@@ -189,6 +189,11 @@ def _binned_esf(img, a, b, oversample, half_width_px):
     cnt = np.bincount(idx.ravel(), minlength=n)
     tot = np.bincount(idx.ravel(), weights=img.ravel(), minlength=n)
     centre = int(round(-lo))  # the bin of distance [0, d)
+    if not 0 <= centre < n:  # the step found is no edge across this region (a fill boundary)
+        raise ObservationError(
+            "no edge in the region: the brightness step found does not cross it (fill or "
+            "nodata beside the target?); choose a region inside the target across its edge"
+        )
     limit = int(np.floor(half_width_px / d))
     left = 0
     while left < limit and centre - left - 1 >= 0 and cnt[centre - left - 1] > 0:
@@ -222,19 +227,33 @@ def check_region(img, esf, dist, bins, contrast, noise, where: str = "") -> None
 
     Every pixel is compared with the ESF at its distance from the edge: a pixel off by more than
     ``max(6 σ, PLATEAU_TOLERANCE × step)`` on a plateau (0.25 × step in the transition) is
-    something else — fill or nodata, a second edge, a spot. Then both ends of the ESF must be
-    flat (the plateaus reached).
+    something else — fill or nodata, a second edge, a spot; before that, any pixel of the
+    whole region (also beyond the ESF's window) below the dark plateau or above the bright one
+    by more than the plateau's tolerance is fill, nodata or a dead or hot pixel (issue 42: a
+    region reaching the fill by a few pixels, or beyond the window, was measured). Then both
+    ends of the ESF must be flat (the plateaus reached).
 
     Raises
     ------
     ObservationError
         Naming what fails and where (rows and columns of the region).
     """
+    k = max(esf.size // 10, 2)
+    dark, bright = sorted((esf[:k].mean(), esf[-k:].mean()))
+    tol_plateau = max(6.0 * noise, PLATEAU_TOLERANCE * contrast)
+    beyond = (img < dark - tol_plateau) | (img > bright + tol_plateau)  # the whole region
+    if beyond.any():
+        rr, cc = np.nonzero(beyond)
+        raise ObservationError(
+            f"{int(beyond.sum())} px of the region{where} lie below its dark plateau or above "
+            f"its bright one (rows {rr.min()}–{rr.max()}, columns {cc.min()}–{cc.max()} of the "
+            "region, counted along the edge): fill or nodata outside the target, or a dead or "
+            "hot pixel; choose a region inside the target without them"
+        )
     inside = (bins >= 0) & (bins < esf.size)
     expected = np.full(img.shape, np.nan)
     expected[inside] = esf[bins[inside]]
     r = img - expected
-    tol_plateau = max(6.0 * noise, PLATEAU_TOLERANCE * contrast)
     tol_edge = max(6.0 * noise, 0.25 * contrast)
     tol = np.where(np.abs(dist) > 2.0, tol_plateau, tol_edge)
     bad = inside & (np.abs(r) > tol)
@@ -247,7 +266,6 @@ def check_region(img, esf, dist, bins, contrast, noise, where: str = "") -> None
             "region, counted along the edge): fill or nodata outside the target, a second edge "
             "or a spot; choose a region inside the target with only the edge in it"
         )
-    k = max(esf.size // 10, 2)
     for name, end, nxt in (
         ("one", esf[:k], esf[k : 2 * k]),
         ("the other", esf[-k:], esf[-2 * k : -k]),
