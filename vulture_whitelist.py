@@ -76,3 +76,4 @@ _.uv_true_px  # tests/test_calibration.py: the bench's true image points
 _.seconds_split  # bench/bench_pushbroom_ba.py: the solver's time by stage
 _.select_cameras  # bench/bench_bal.py: a BAL problem cut to its first cameras
 _.singular_values  # bench/bench_rikola_drift.py: the datum analysis's singular values
+_._repr_png_  # src/hsgeo/report.py: IPython's display protocol calls _GluedFigure._repr_png_ (the glued PNG)
