@@ -6,7 +6,7 @@ would (the same squared Euclidean distance in float64; a tie, two pixels at the 
 distance, goes to the first given): the points are sorted into buckets of one cell (a counting
 sort, O(n)), and each cell visits only the buckets within the radius. For a swath of about one
 pixel per cell that is tens of nanoseconds per cell, where a kd-tree's build and query cost
-about ten times as much (issue 41's stage profile, ``bench/results/orthomosaic_stages.json``).
+about ten times as much (the stage profile, ``bench/results/orthomosaic_stages.json``).
 """
 
 from __future__ import annotations

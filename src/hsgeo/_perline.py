@@ -2,7 +2,7 @@
 
 :func:`hsgeo.ortho.geolocate_lines` hands the sensor's ``rays`` the time of every pixel (each
 line's time repeated for its pixels); the sensor asks its trajectory for the poses at those
-times. :class:`PerLine` answers from the line times alone (issue 41: the poses were a third of
+times. :class:`PerLine` answers from the line times alone (the poses were a third of
 the orthomosaic's CPU time, ``bench/results/orthomosaic_stages.json``).
 """
 

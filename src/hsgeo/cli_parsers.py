@@ -566,7 +566,7 @@ def add_lp_observations(sub) -> argparse.ArgumentParser:
 
 
 def _geodetic_navigation_options(p, table: str) -> None:
-    """``--nav-crs`` and ``--site`` of the line scanners' commands (issue 38)."""
+    """``--nav-crs`` and ``--site`` of the line scanners' commands."""
     p.add_argument(
         "--nav-crs",
         metavar="EPSG:n",

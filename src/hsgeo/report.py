@@ -639,7 +639,7 @@ def with_data_labels(html: str) -> str:
 
 
 #: The most rows a table shown in view may have; a longer one is shown under a toggle whose
-#: summary counts its rows and verdicts (issue 40; ``make check-book`` asserts it).
+#: summary counts its rows and verdicts (``make check-book`` asserts it).
 MAX_TABLE_ROWS = 20
 
 

@@ -560,7 +560,7 @@ def check_heading_follows_course(traj: Trajectory, name: str) -> None:
     For the line scanners' commands (``lp-observations``, ``adjust-pushbroom``): their
     platform flies forward, so where it moves faster than :data:`COURSE_MIN_SPEED_M_S` the
     heading is the course within a crab angle (:data:`MAX_HEADING_COURSE_DEG`). Refused here: a
-    heading opposite to the course (more than 180° − that angle off; issue 42: exit 0 with
+    heading opposite to the course (more than 180° − that angle off: exit 0 with
     mirrored ground points before). A heading otherwise off (radians, from east) is left to the
     adjustment, whose poor fit names the angle unit (``adjust-pushbroom``). Not applied by
     :func:`read_trajectory` itself: a multirotor carrying a frame camera may fly sideways.
@@ -606,7 +606,7 @@ def _check_heading(name, enu, t, heading_deg, opposite: bool = False) -> None:
     med = float(np.median(d))
     if opposite and _follows_in_radians(hmid[moving], course[moving]):
         return  # radians under a _deg column: the adjustment's poor fit names the unit
-    if med > 180.0 - MAX_HEADING_COURSE_DEG:  # issue 42: a heading 180° off
+    if med > 180.0 - MAX_HEADING_COURSE_DEG:  # a heading 180° off
         raise InputError(
             f"{name}, column heading_deg: the heading is opposite to the course over ground "
             f"({med:.1f}° off, median over {d.size} moving records): the sensor would look "

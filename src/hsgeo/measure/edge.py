@@ -229,7 +229,7 @@ def check_region(img, esf, dist, bins, contrast, noise, where: str = "") -> None
     ``max(6 σ, PLATEAU_TOLERANCE × step)`` on a plateau (0.25 × step in the transition) is
     something else — fill or nodata, a second edge, a spot; before that, any pixel of the
     whole region (also beyond the ESF's window) below the dark plateau or above the bright one
-    by more than the plateau's tolerance is fill, nodata or a dead or hot pixel (issue 42: a
+    by more than the plateau's tolerance is fill, nodata or a dead or hot pixel (a
     region reaching the fill by a few pixels, or beyond the window, was measured). Then both
     ends of the ESF must be flat (the plateaus reached).
 

@@ -8,7 +8,7 @@ returns, per statistic and per claim, the numbers the chapter prints:
 * the **z of STD and NMAD of the heights** over the campaigns, each campaign's statistic minus
   the campaigns' mean over that campaign's σ̂ (from the check points' joint covariance,
   :func:`hsgeo.reproduce.lp_observations.stat_sigma`, and from the per-point blocks alone): a
-  σ̂ that is right gives z with a standard deviation of 1 (issue 37: 1 ± 0.3 over 8);
+  σ̂ that is right gives z with a standard deviation of 1 (1 ± 0.3 over 8 campaigns);
 * the **no-GCP mean height** of the check points with its joint σ̂, and the **principal
   distances without GCPs minus the exact twin's** (the same observations moved to their true
   image position, adjusted alike) with the retrieved σ̂: how many campaigns are within 3σ̂;
@@ -31,7 +31,7 @@ from hsgeo.stats import nmad
 
 __all__ = ["checkpoint_campaigns", "Z_LIMIT"]
 
-#: |z| at most this counts as "within" (issue 37's 3σ̂).
+#: |z| at most this counts as "within" (3σ̂).
 Z_LIMIT = 3.0
 
 
@@ -83,7 +83,7 @@ def _per_group(runs) -> list[dict]:
 
 
 def _flying_height_cause(runs, way: str, i_std: int) -> dict:
-    """The no-GCP heights' scale with the flying height, per campaign (issue 37).
+    """The no-GCP heights' scale with the flying height, per campaign.
 
     Without GCPs a principal-distance error Δc moves every point along its rays by
     −AGL·Δc/c (the no-GCP height rows, :func:`hsgeo.reproduce.lp_observations._height_rows`):

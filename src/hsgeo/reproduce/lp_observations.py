@@ -701,7 +701,7 @@ def run(
     rows += _shift_rows(ev, twin)
     rows += leave_one_out_rows(ev, obs, truth)
     td = tj = None
-    if judges:  # issue 37: judges that do not share what they judge
+    if judges:  # judges that do not share what they judge
         t0 = time.perf_counter()
         td = twin_difference(ev, obs, truth, twin, rng=[seed, 37])
         rows += twin_rows(td, parameter_units(ev))
@@ -720,7 +720,7 @@ def run(
         obs0, truth0 = simulate(s, rng=seed, cfg=replace(LpConfig(), motion_blur_m=0.0))
         off = headline(evaluate(obs0, truth0, seed, nogcp=False, progress=progress, both=False))
         T["motion_blur_off"] = time.perf_counter() - t0
-        # issue 37: a symmetric blur moves no key point; a stamp at the start of the exposure
+        # a symmetric blur moves no key point; a stamp at the start of the exposure
         # does (half the blur along the track, opposite on opposite headings)
         t0 = time.perf_counter()
         obs1, truth1 = simulate(s, rng=seed, cfg=replace(LpConfig(), exposure_stamp="start"))

@@ -1,4 +1,4 @@
-"""Judges of the LP retrieval that do not share what they judge (issue 37 item 4).
+"""Judges of the LP retrieval that do not share what they judge.
 
 Two judges of ``hsgeo reproduce lp-observations`` whose reference is independent of the
 retrieval's own observations:

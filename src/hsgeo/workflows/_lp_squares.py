@@ -47,7 +47,7 @@ COLUMNS = ["point_id", "band", "strip", "line", "t_s", "x_px", "u", "v", "snr", 
 def check_placement(inputs, footprints, margin_m: float = 0.0) -> None:
     """The squares lie on the ground the strips see, in the navigation's frame and units.
 
-    Issue 42: squares far outside the strips, in longitude/latitude, with E and N swapped or
+    Squares far outside the strips, in longitude/latitude, with E and N swapped or
     heights in mm gave an answer without the squares (or with blobs that are not them), exit 0.
     Refused: no square inside any strip's footprint (``footprints``: the strips' quadrilaterals
     on the terrain plane, :func:`hsgeo.workflows._lp_geometry.footprint`); more squares inside
