@@ -46,8 +46,22 @@ step lp-observations in/STRIP_*.nc --trajectory in/NAV.csv --camera in/CAM.toml 
 # the GCPs that the matcher found among the squares (a GCP without observations is refused)
 "$PY" -c "import pandas as pd; o = set(pd.read_parquet('OBS.parquet')['point_id'].astype(str)); \
 g = pd.read_csv('in/GCP.csv', dtype={'point_id': str}); g[g['point_id'].isin(o)].to_csv('GCP.csv', index=False)"
-json adjust-pushbroom OBS.parquet --trajectory in/NAV.csv --camera in/CAM.toml \
-  --gcp GCP.csv --node-interval 10 --json
+echo "+ hsgeo adjust-pushbroom … --json > ADJ.json"
+"$HS" adjust-pushbroom OBS.parquet --trajectory in/NAV.csv --camera in/CAM.toml \
+  --gcp GCP.csv --node-interval 10 --json > ADJ.json
+"$PY" -c "import json; json.load(open('ADJ.json'))"
 step orthorectify in/STRIP_*.nc --trajectory in/NAV.csv --site 59.665,10.775,0 \
   --nav-crs EPSG:4937 --sensor in/CAM.toml --dsm in/DSM.tif --resolution 2 -o mosaic.tif
+# the README's strips line: the adjustment's file, chosen bands, the mosaic rule
+step orthorectify in/STRIP_*.nc --trajectory in/NAV.csv --site 59.665,10.775,0 \
+  --nav-crs EPSG:4937 --sensor in/CAM.toml --adjustment ADJ.json --dsm in/DSM.tif \
+  --resolution 2 --bands 681,604,450 --mosaic nearest-nadir -o mosaic_adj.tif
+# the README's single line over flat terrain (--height), to CF NetCDF
+step orthorectify "$(ls in/STRIP_*.nc | head -n 1)" --trajectory in/NAV.csv \
+  --site 59.665,10.775,0 --nav-crs EPSG:4937 --sensor in/CAM.toml --height 100 -o ortho.nc
+# the README's simulated flight anywhere (shorter line) and the command it prints
+step data flight --site=-33.9,151.2 --length-km 2 --out flight
+step orthorectify flight/lines.raw --line-times flight/line_times.csv \
+  --trajectory flight/nav.csv --sensor flight/sensor.toml --dsm flight/dsm.tif \
+  --vertical ellipsoidal -o flight/ortho.tif
 echo "check-wheel: the installed wheel ran every command above from an empty folder"
