@@ -24,7 +24,7 @@ SRC = ROOT / "src" / "hsgeo"
 
 #: imports that only the book's chapters reach (hsgeo.report.glue_*), declared in the ``book``
 #: extra: module -> extra.
-OPTIONAL = {"myst_nb": "book"}
+OPTIONAL = {"myst_nb": "book", "IPython": "book"}
 #: packages used by name rather than imported: (pattern in the source, distribution). xarray
 #: loads ``engine="h5netcdf"`` itself, pandas loads pyarrow for Parquet.
 USED_BY_NAME = [
