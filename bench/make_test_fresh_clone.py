@@ -29,7 +29,10 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 OUT = HERE / "results" / "make_test_runs.json"
-_SUMMARY = re.compile(r"=+ (?P<body>.*?) in (?P<secs>[0-9.]+)s(?: \((?P<hms>[0-9:]+)\))? =+")
+_SUMMARY = re.compile(
+    r"^=* ?(?P<body>\d+ (?:passed|failed)[^\n]*?) in (?P<secs>[0-9.]+)s(?: \([0-9:]+\))?(?: =+)?$",
+    re.M,
+)
 
 
 def _counts(text: str) -> dict:
