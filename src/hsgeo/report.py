@@ -840,7 +840,13 @@ class _GluedFigure:
     """
 
     def __init__(self, fig):
-        from IPython.core.pylabtools import print_figure
+        try:
+            from IPython.core.pylabtools import print_figure
+        except ImportError as exc:  # a wheel installed without the book extra
+            raise ImportError(
+                "hsgeo.report.glue_figure needs IPython, part of the book's extra: "
+                "pip install 'hsgeo[book]'"
+            ) from exc
 
         self.panel_columns = panel_columns(fig)
         self._png = print_figure(fig, "png", metadata={PANEL_COLUMNS_KEY: str(self.panel_columns)})
