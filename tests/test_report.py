@@ -580,6 +580,20 @@ def test_highlight_below_shades_only_the_cells_under_their_columns_limit():
     assert ">5.5<" in html and ">7.0<" in html and ">3.5<" in html
 
 
+def test_highlight_below_goes_under_a_toggle_when_longer_than_the_books_limit():
+    """The full-scale engine chapter's table of 54 fits failed make check-book (a table in view
+    of more than MAX_TABLE_ROWS rows); a short one stays in view."""
+    import pandas as pd
+
+    from hsgeo.report import MAX_TABLE_ROWS, highlight_below
+
+    for n, toggled in ((MAX_TABLE_ROWS, False), (MAX_TABLE_ROWS + 1, True)):
+        df = pd.DataFrame({"name": [f"p{i}" for i in range(n)], "LRE b": [7.0] * n})
+        html = highlight_below(df, {"LRE b": 6.0})._repr_html_()
+        assert html.startswith("<details") is toggled, n
+        assert f"({n} rows)" in html if toggled else "<details" not in html
+
+
 def test_no_reproduced_rests_on_few_runs_or_a_sigma_over_half_the_paper():
     """Issue 37's scoreboard bar, over every combination of the numbers a row can carry: a
     "reproduced" has a spread from at least 8 runs (or an adjustment's σ̂) and σ at most half

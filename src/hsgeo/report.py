@@ -568,14 +568,16 @@ _PAD = "0.3em 0.5em"
 def highlight_below(df, limits: dict, *, fmt: str = "{:.1f}", colour: str = "#f4b6b6"):
     """A pandas Styler of ``df`` without index: the columns named in ``limits`` formatted with
     ``fmt``, their cells below that column's limit shaded ``colour`` (e.g. a fit whose LRE fails
-    a certification criterion).
+    a certification criterion). As every table of the book, it carries :func:`with_data_labels`
+    and goes under a toggle when it has more than :data:`MAX_TABLE_ROWS` rows.
     """
 
     def shade(col):
         return [f"background-color: {colour}" if v < limits[col.name] else "" for v in col]
 
     cols = list(limits)
-    return df.style.apply(shade, subset=cols).format(fmt, subset=cols).hide(axis="index")
+    style = _card_styler()(df).apply(shade, subset=cols).format(fmt, subset=cols)
+    return style.hide(axis="index")
 
 
 _RUNS = re.compile(r"^(.*\S) (\((?:mean of )?\d+(?: runs)?\))$")
