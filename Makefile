@@ -117,7 +117,8 @@ book/_build/html-student/index.html: book/_build/html/index.html
 
 check-book: $(STAMP) browser book/_build/html/index.html book/_build/html-student/index.html ## open every page of the built book (and the student edition's files) in headless chromium, offline, and check them (builds both first if needed)
 	HSGEO_CHECK_BOOK=1 HSGEO_CHROMIUM="$$(command -v chromium || command -v chromium-browser || echo $(CHROMIUM))" \
-	  $(PY) -m pytest -q -p no:cacheprovider -m book tests/book
+	  $(PY) -m pytest -q -p no:cacheprovider -m book tests/book \
+	  --junitxml=book/_build/check-book.junit.xml  # read by bench/issue40_audit.py
 
 bench: $(STAMP) ## run the benchmarks, results as JSON in bench/results/ (installs requirements-bench.lock: pycolmap/Ceres)
 	$(PY) -m pip install --quiet --disable-pip-version-check -r requirements-bench.lock
