@@ -139,9 +139,17 @@ def test_targets_found_and_judged_against_their_true_centres(judged):
     assert j["targets_found"] >= 3
     assert j["n_observations_on_targets"] >= 9
     assert np.all(j["on_target_distance_m"] <= J.ON_TARGET_M)
-    # a target found at its centre is at most 0.71 px off by the pixel-centre and line rounding
-    assert j["within_target"][1.0] >= 0.8
+    # a survey-style target is found at its centre (white squares over the texture: up to
+    # 0.4 m off it), then off by at most 0.71 px of pixel-centre and line rounding plus the key
+    # point's localisation: the bar, ≥ 95 % within 1 px (white squares: 98.7 % here,
+    # 89.7-99.0 % over 8 campaigns)
+    assert np.all(j["on_target_distance_m"] <= 0.3)
+    assert j["within_target"][1.0] >= 0.95
     assert j["within_target"][0.5] <= j["within_target"][1.0]
+    pp = j["per_tie_point"]
+    assert sum(p["n"] for p in pp) == j["n_observations_on_targets"]
+    assert len({p["target"] for p in pp}) == j["targets_found"]
+    assert all(0 <= p["within_1px"] <= 1 and p["max_error_px"] >= 0 for p in pp)
 
 
 @pytest.mark.slow

@@ -27,7 +27,7 @@ retrieval's own observations:
   trajectory, which both drew the pixels and project the reference (the truth, by design);
   (ii) *which* tie points are judged — those whose own observations' median ground point lies
   within :data:`ON_TARGET_M` of a target (a tie point the matcher put off every target is not
-  judged; on the bench's campaigns the on-target tie points lie ≤ 0.16 m from a centre and
+  judged; on the bench's campaigns the on-target tie points lie ≤ 0.18 m from a centre and
   none between that and 0.6 m, so the radius cuts no continuum). What it does not share: the
   reference position — the target's recorded centre, fixed before any pixel is rendered — is
   moved by no observation, no median and no adjustment.
