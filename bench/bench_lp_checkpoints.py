@@ -224,31 +224,46 @@ def one_seed(seed: int, scale: float) -> dict:
 
 
 def one_seed_table3(seed: int, scale: float) -> dict:
-    """002 Table 3 from pixels of one campaign and what its σ̂ predicts (module docstring)."""
+    """002 Table 3 from pixels of one campaign and what its σ̂ predicts (module docstring):
+    :func:`~hsgeo.reproduce.lp_runs.evaluate`'s retrieval and its no-GCP adjustment and check
+    points (``_adjust`` / ``_check_points`` as ``_squares_judged`` calls them), without the
+    adjustment with GCPs and the match judging, which Table 3 does not use."""
+    from hsgeo.reproduce.lp_runs import _check_points, gcps_by_centroid, retrieval_inputs
+    from hsgeo.workflows.lp_observations import LpOptions, retrieve
+
     t0, c0 = time.perf_counter(), time.process_time()
-    rng = np.random.default_rng([seed, 37])
+    cpu = {}
     obs, truth = simulate(sim_scale(scale), rng=seed)
-    ev = evaluate(obs, truth, seed, both=False)
-    # the same draws, in the same order, as one_seed's tie-point tables
-    t2 = _table(ev["cp_errors_m"], ev["cp_cov_m2"], rng)
-    t3 = _table(ev["cp_errors_nogcp_m"], ev["cp_cov_nogcp_m2"], rng)
-    dr = stat_draws(ev["cp_cov_nogcp_m2"], np.random.default_rng([seed, 38]), 1000)
-    c0_, s0 = _c(ev["adjusted_nogcp"].result)
+    res = retrieve(retrieval_inputs(obs), LpOptions(rng=seed, squares_as="tie_point"))
+    res = replace(res, table=gcps_by_centroid(res, obs.gcp_ids))
+    cpu["simulate_retrieve"] = time.process_time() - c0
+    c1 = time.process_time()
+    pid = res.table["point_id"].to_numpy().astype(str)
+    measured = set(pid) & {str(s) for s in obs.square_ids}
+    gcp_ids = [g for g in obs.gcp_ids if g in measured]
+    cps = [s for s in obs.square_ids if s not in obs.gcp_ids]
+    cam = camera_prior(obs, truth.cfg)
+    r0, pin0, _ = _adjust(res, obs, cam, False, gcp_ids)
+    E0, cov0, ids0, _ = _check_points(r0, pin0, obs, truth, cps)
+    cpu["adjust_nogcp"] = time.process_time() - c1
+    d = {"cp_ids_nogcp": list(ids0)}
+    t3 = _table(E0, cov0, np.random.default_rng([seed, 37]))
+    dr = stat_draws(cov0, np.random.default_rng([seed, 38]), 1000)
+    c0_, s0 = _c(r0.result)
     return {
         "seed": seed,
-        "table2_stats": t2["stats"],
         "table3": t3,
         "table3_draws_mean": dr.mean(axis=0).tolist(),
         "table3_draws_sd": dr.std(axis=0, ddof=1).tolist(),
-        "cp_ids_nogcp": [str(x) for x in ev["cp_ids_nogcp"]],
-        "cp_errors_nogcp_m": np.asarray(ev["cp_errors_nogcp_m"]).tolist(),
-        "cp_agl_nogcp_m": _agl(ev["retrieval"], ev, obs),
+        "cp_ids_nogcp": [str(x) for x in ids0],
+        "cp_errors_nogcp_m": np.asarray(E0).tolist(),
+        "cp_agl_nogcp_m": _agl(res, d, obs),
         "c_nogcp": {
             "truth_mm": np.asarray(truth.camera.c_mm, float).tolist(),
             "value": c0_.tolist(),
             "sigma": s0.tolist(),
         },
-        "cpu_s": time.process_time() - c0,
+        "cpu_s": cpu,
         "seconds": time.perf_counter() - t0,
     }
 
@@ -359,9 +374,19 @@ def main(argv=None) -> dict:
         if out == ap.get_default("out"):
             out = str(Path(__file__).parent / "results" / "lp_checkpoints_table3_seeds.json")
         t0, runs = time.perf_counter(), []
-        for seed in a.seeds:
-            runs.append(one_seed_table3(seed, a.scale))
-            print(f"seed {seed}: {runs[-1]['seconds']:.0f} s", flush=True)
+        if a.merge:  # seeds run in parallel: one run per seed, the first file's
+            by_seed = {}
+            for f in a.merge:
+                for r in json.loads(Path(f).read_text())["runs"]:
+                    by_seed.setdefault(r["seed"], r)
+            runs = [by_seed[k] for k in sorted(by_seed)]
+        todo = [] if a.merge else a.seeds
+        for seed in [None, *todo]:
+            if seed is not None:
+                runs.append(one_seed_table3(seed, a.scale))
+                print(f"seed {seed}: {runs[-1]['seconds']:.0f} s", flush=True)
+            if not runs:
+                continue
             doc = {
                 "bench": "lp_checkpoints_table3_seeds",
                 "scale": a.scale,
