@@ -20,10 +20,10 @@ of retrieved − twin over the parameters and campaigns 1 ± 0.25. Writes
 ``--targets-only`` runs the point-target judge alone (``bench/results/lp_judges_targets_seeds.
 json``): what the within-1-px share uses is the rendered campaign, its retrieval and the truth
 (:func:`hsgeo.reproduce.lp_targets.judge_campaign`'s steps, timed one by one), not the
-adjustment, the twin or the Monte Carlo — which are ≥ 95 % of the full bench's 220–580 s per
-seed: over the 8 seeds at ``--scale 0.05`` the rendering took 1.0–2.3 CPU-s, the retrieval
-9.8–12.4 and the judge 0.1–0.3 (``cpu_s`` of each run; the first seed's rendering includes
-numba's compilation when its cache is cold).
+adjustment, the twin or the Monte Carlo (the full bench recorded 220–580 s per seed, wall
+time on the loaded machine). Over the 8 seeds at ``--scale 0.05`` the rendering took 1.0–2.3
+CPU-s, the retrieval 9.8–12.4 and the judge 0.1–0.3 (``cpu_s`` of each run; 57–159 s wall at
+``nice 5`` under a load of 8–12 on 2 cores).
 The table judged is the one the full bench judges (the same retrieval options and GCP
 centroids as :func:`hsgeo.reproduce.lp_runs.evaluate`).
 """
