@@ -669,7 +669,8 @@ def main() -> None:
         lp_blur(lp),
     ]
     out = {
-        "what": "issue 37's done-means lines measured on main 268652f (+ this branch's mends)",
+        "what": "issue 37's done-means lines measured on main 226bb30 + branch lp37 "
+        "(the LP judges mended)",
         "command": "python bench/issue37_audit.py --runs " + " ".join(map(str, args.runs)),
         "summary": {
             s: sum(e["status"] == s for e in entries) for s in ("met", "short", "not-measured")
