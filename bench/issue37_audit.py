@@ -291,14 +291,18 @@ def _trace() -> dict | None:
     }
 
 
-def _within_line(old_doc: dict) -> dict:
+def _within_line(full_doc: dict) -> dict:
     """The within-1-px line from ``lp_judges_targets_seeds.json`` (bench_lp_judges.py
-    --targets-only: the mended targets), with the white targets' numbers of
-    ``lp_judges_seeds.json`` as "before"."""
+    --targets-only: the mended targets, the judge alone), the full bench's shares on the same
+    campaigns beside it (``lp_judges_seeds.json``, ``full_doc``), and the white targets'
+    numbers (``lp_judges_white_targets_seeds.json``) as "before"."""
     f = RESULTS / "lp_judges_targets_seeds.json"
-    old = old_doc["summary"]
+    old = json.loads((RESULTS / "lp_judges_white_targets_seeds.json").read_text(encoding="utf-8"))[
+        "summary"
+    ]
     before = {
-        "file": "bench/results/lp_judges_seeds.json (white 2-px targets over the texture)",
+        "file": "bench/results/lp_judges_white_targets_seeds.json (white 2-px targets over the "
+        "texture)",
         "within_1px_vs_targets_per_seed": old["within_1px_vs_targets_per_seed"],
         "seeds_meeting_95pct": old["seeds_meeting_95pct_vs_targets"],
     }
@@ -343,6 +347,13 @@ def _within_line(old_doc: dict) -> dict:
                 "within_1px_same_observations_vs_leave_one_out_per_seed"
             ],
             "before": before,
+            "full_bench_same_campaigns": {
+                "file": "bench/results/lp_judges_seeds.json",
+                "within_1px_vs_targets_per_seed": full_doc["summary"][
+                    "within_1px_vs_targets_per_seed"
+                ],
+                "target_config": full_doc.get("target_config"),
+            },
             "what_was_mended": "the reference, not the bar: the white 2-px squares painted over "
             "the texture clip at dn_max in all seven bands and take the texture's asymmetry, so "
             "BRISK found them up to 0.4 m from their recorded centre (the old failing seeds' "
