@@ -16,6 +16,17 @@ observation-level place a height offset would come from, and in thirds of x acro
 Summaries over the seeds: the spread
 of the z of STD and NMAD (against the seeds' mean) with each σ̂. Writes
 ``bench/results/lp_checkpoints_seeds.json``.
+
+``--table3-only`` (``bench/results/lp_checkpoints_table3_seeds.json``) runs what 002 Table 3
+from pixels needs and no more — the rendering, the retrieval and the adjustments with and
+without GCPs (:func:`~hsgeo.reproduce.lp_runs.evaluate`, the centroid table, the twin and the
+Monte Carlo left out) — and records, per campaign, the no-GCP check points' statistics, their
+σ̂ from the joint covariance (the same draws as above: identical numbers), the draws' *mean*
+of each statistic (:func:`hsgeo.reproduce.lp_observations.stat_draws`: the value the
+covariance predicts for this campaign, whose check points' flying heights and c σ̂ are its
+own), each check point's AGL and the principal distances without GCPs against the truth with
+their σ̂. Its summary gives the z of STD and NMAD both about the campaigns' mean (the chapter's
+z) and about each campaign's own predicted value, and the c errors in their σ̂.
 """
 
 from __future__ import annotations
@@ -31,7 +42,7 @@ import numpy as np
 
 from hsgeo.papers import P002_STATS
 from hsgeo.reproduce.lp_judge import observation_errors_px, within_fractions
-from hsgeo.reproduce.lp_observations import sim_scale, stat_sigma
+from hsgeo.reproduce.lp_observations import sim_scale, stat_draws, stat_sigma
 from hsgeo.reproduce.lp_runs import _adjust, camera_prior, evaluate, exact_twin, parameter_z
 from hsgeo.reproduce.lp_targets import N_DRAWS, twin_difference
 from hsgeo.simulate.lp_campaign import simulate
@@ -212,6 +223,92 @@ def one_seed(seed: int, scale: float) -> dict:
     return out
 
 
+def one_seed_table3(seed: int, scale: float) -> dict:
+    """002 Table 3 from pixels of one campaign and what its σ̂ predicts (module docstring):
+    :func:`~hsgeo.reproduce.lp_runs.evaluate`'s retrieval and its no-GCP adjustment and check
+    points (``_adjust`` / ``_check_points`` as ``_squares_judged`` calls them), without the
+    adjustment with GCPs and the match judging, which Table 3 does not use."""
+    from hsgeo.reproduce.lp_runs import _check_points, gcps_by_centroid, retrieval_inputs
+    from hsgeo.workflows.lp_observations import LpOptions, retrieve
+
+    t0, c0 = time.perf_counter(), time.process_time()
+    cpu = {}
+    obs, truth = simulate(sim_scale(scale), rng=seed)
+    res = retrieve(retrieval_inputs(obs), LpOptions(rng=seed, squares_as="tie_point"))
+    res = replace(res, table=gcps_by_centroid(res, obs.gcp_ids))
+    cpu["simulate_retrieve"] = time.process_time() - c0
+    c1 = time.process_time()
+    pid = res.table["point_id"].to_numpy().astype(str)
+    measured = set(pid) & {str(s) for s in obs.square_ids}
+    gcp_ids = [g for g in obs.gcp_ids if g in measured]
+    cps = [s for s in obs.square_ids if s not in obs.gcp_ids]
+    cam = camera_prior(obs, truth.cfg)
+    r0, pin0, _ = _adjust(res, obs, cam, False, gcp_ids)
+    E0, cov0, ids0, _ = _check_points(r0, pin0, obs, truth, cps)
+    cpu["adjust_nogcp"] = time.process_time() - c1
+    d = {"cp_ids_nogcp": list(ids0)}
+    t3 = _table(E0, cov0, np.random.default_rng([seed, 37]))
+    dr = stat_draws(cov0, np.random.default_rng([seed, 38]), 1000)
+    c0_, s0 = _c(r0.result)
+    return {
+        "seed": seed,
+        "table3": t3,
+        "table3_draws_mean": dr.mean(axis=0).tolist(),
+        "table3_draws_sd": dr.std(axis=0, ddof=1).tolist(),
+        "cp_ids_nogcp": [str(x) for x in ids0],
+        "cp_errors_nogcp_m": np.asarray(E0).tolist(),
+        "cp_agl_nogcp_m": _agl(res, d, obs),
+        "c_nogcp": {
+            "truth_mm": np.asarray(truth.camera.c_mm, float).tolist(),
+            "value": c0_.tolist(),
+            "sigma": s0.tolist(),
+        },
+        "cpu_s": cpu,
+        "seconds": time.perf_counter() - t0,
+    }
+
+
+def summary_table3(runs) -> dict:
+    """The z of STD and NMAD of the no-GCP heights over the campaigns, two ways, and the
+    no-GCP principal distances in their σ̂ (module docstring)."""
+    i_std, i_nmad = P002_STATS.index("std"), P002_STATS.index("nmad")
+    i_mean = P002_STATS.index("mean")
+    S = np.array([r["table3"]["stats"] for r in runs])[:, 2]  # heights: (seeds, 6)
+    sg = np.array([r["table3"]["sigma_joint"] for r in runs])[:, 2]
+    mu = np.array([r["table3_draws_mean"] for r in runs])[:, 2]
+    out = {"n_campaigns": len(runs)}
+    for st, i in (("std", i_std), ("nmad", i_nmad)):
+        z_pool = (S[:, i] - S[:, i].mean()) / sg[:, i]
+        z_own = (S[:, i] - mu[:, i]) / sg[:, i]
+        out[f"{st}_h_m"] = S[:, i].tolist()
+        out[f"{st}_h_sigma_joint_m"] = sg[:, i].tolist()
+        out[f"{st}_h_predicted_m"] = mu[:, i].tolist()
+        out[f"{st}_h_z_about_campaigns_mean"] = z_pool.tolist()
+        out[f"sd_z_{st}_h_about_campaigns_mean"] = float(np.std(z_pool, ddof=1))
+        out[f"{st}_h_z_about_own_prediction"] = z_own.tolist()
+        out[f"sd_z_{st}_h_about_own_prediction"] = float(np.std(z_own, ddof=1))
+        out[f"rms_z_{st}_h_about_own_prediction"] = float(np.sqrt(np.mean(z_own**2)))
+    mh = S[:, i_mean]
+    smh = np.array([r["table3"]["mean_h_sigma_joint"] for r in runs])
+    out["mean_h_m"] = mh.tolist()
+    out["mean_h_z"] = (mh / smh).tolist()
+    out["rms_mean_h_z"] = float(np.sqrt(np.mean((mh / smh) ** 2)))
+    zc, agl_spread = [], []
+    for r in runs:
+        v, s_, t = (np.asarray(r["c_nogcp"][k], float) for k in ("value", "sigma", "truth_mm"))
+        ok = np.isfinite(s_) & (s_ > 0)
+        zc.append(((v - t) / np.where(ok, s_, np.nan)).tolist())
+        a = np.asarray(r["cp_agl_nogcp_m"], float)
+        agl_spread.append(float(np.std(a, ddof=1)) if a.size > 1 else float("nan"))
+    zc_a = np.array(zc, float)
+    out["c_z_vs_truth_per_band"] = zc
+    out["rms_c_z_vs_truth_bands_0_3"] = float(np.sqrt(np.nanmean(zc_a[:, :4] ** 2)))
+    out["rms_c_z_vs_truth_bands_4_6"] = float(np.sqrt(np.nanmean(zc_a[:, 4:] ** 2)))
+    out["mean_c_z_vs_truth_bands_4_6"] = float(np.nanmean(zc_a[:, 4:]))
+    out["cp_agl_sd_m"] = agl_spread
+    return out
+
+
 def _summary(runs) -> dict:
     out = {}
     i_std, i_nmad = P002_STATS.index("std"), P002_STATS.index("nmad")
@@ -266,7 +363,43 @@ def main(argv=None) -> dict:
         metavar="JSON",
         help="merge the runs of these result files (seeds run in parallel) into --out",
     )
+    ap.add_argument(
+        "--table3-only",
+        action="store_true",
+        help="002 Table 3 from pixels and its predicted values only (module docstring)",
+    )
     a = ap.parse_args(argv)
+    if a.table3_only:
+        out = a.out
+        if out == ap.get_default("out"):
+            out = str(Path(__file__).parent / "results" / "lp_checkpoints_table3_seeds.json")
+        t0, runs = time.perf_counter(), []
+        if a.merge:  # seeds run in parallel: one run per seed, the first file's
+            by_seed = {}
+            for f in a.merge:
+                for r in json.loads(Path(f).read_text())["runs"]:
+                    by_seed.setdefault(r["seed"], r)
+            runs = [by_seed[k] for k in sorted(by_seed)]
+        todo = [] if a.merge else a.seeds
+        for seed in [None, *todo]:
+            if seed is not None:
+                runs.append(one_seed_table3(seed, a.scale))
+                print(f"seed {seed}: {runs[-1]['seconds']:.0f} s", flush=True)
+            if not runs:
+                continue
+            doc = {
+                "bench": "lp_checkpoints_table3_seeds",
+                "scale": a.scale,
+                "sim_scale": sim_scale(a.scale),
+                "seeds": [r["seed"] for r in runs],
+                "stats": list(P002_STATS),
+                "summary": summary_table3(runs),
+                "runs": runs,
+                "wall_s": time.perf_counter() - t0,
+                "machine": platform.platform(),
+            }
+            Path(out).write_text(json.dumps(doc, indent=1))
+        return doc
     if a.merge:
         docs = [json.loads(Path(f).read_text()) for f in a.merge]
         # one run per seed (the first file's, when a seed was run twice)

@@ -8,8 +8,10 @@
 (bench/asf_texture_bar.py), ``mtf_edge_independent.json`` (bench/bench_mtf_edge_independent.py)
 and ``rikola_drift.json`` (bench/bench_rikola_drift.py). One entry per done-means line (and the
 two "what to build" items the audit was asked about): the line, ``status`` (met / short /
-not-measured) and the evidence (files and numbers). Lines on the LP chapter's check points and
-twin are not measured here (their chapter's helpers own them).
+not-measured) and the evidence (files and numbers). The LP chapter's four lines (check points'
+σ̂, independent judges) are read from the LP benches' files by ``bench/issue37_audit_lp.py``
+(``lp_checkpoints_seeds.json``, ``lp_checkpoints_table3_seeds.json``, ``lp_judges_seeds.json``,
+``lp_judges_targets_seeds.json``, ``lp_judges_white_targets_seeds.json``).
 """
 
 from __future__ import annotations
@@ -19,9 +21,9 @@ import json
 import time
 from pathlib import Path
 
-import numpy as np
-
 RESULTS = Path(__file__).resolve().parent / "results"
+
+from issue37_audit_lp import lp_lines  # noqa: E402  (the LP lines, split off for size)
 
 
 def _load(name: str) -> dict:
@@ -270,189 +272,16 @@ def lp_blur(lp_runs: list[dict]) -> dict:
     }
 
 
-def _trace() -> dict | None:
-    """bench/lp_checkpoint_trace.py's record (one campaign traced point by point), if run."""
-    f = sorted(RESULTS.glob("lp_checkpoint_trace_seed*.json"))
-    if not f:
-        return None
-    d = json.loads(f[0].read_text(encoding="utf-8"))
-    return {
-        "file": str(f[0].relative_to(RESULTS.parent.parent)),
-        "seed": d["seed"],
-        "check_points": [
-            {k: p[k] for k in ("id", "h_error_m", "agl_m", "strips", "ground_offset_from_centre_m")}
-            for p in d["check_points"]
-        ],
-        "fit_k_h_per_agl": d["fit_k_h_per_agl"],
-        "std_h_m": d["std_h_m"],
-        "std_h_after_agl_m": d["std_h_after_agl_m"],
-        "farthest_over_nmad": d["farthest_over_nmad"],
-        "farthest_after_agl_over_nmad": d["farthest_after_agl_over_nmad"],
-    }
-
-
-def lp_lines() -> list[dict]:
-    """The LP chapter's four lines from the two 8-campaign benches (bench_lp_checkpoints.py,
-    bench_lp_judges.py), read through the chapter's own function for the first."""
-    from hsgeo.reproduce.lp_campaigns import checkpoint_campaigns
-
-    cp_file, jd_file = RESULTS / "lp_checkpoints_seeds.json", RESULTS / "lp_judges_seeds.json"
-    cp_doc = json.loads(cp_file.read_text(encoding="utf-8"))
-    cp = checkpoint_campaigns(cp_doc)
-    jd_doc = json.loads(jd_file.read_text(encoding="utf-8"))
-    jd, jd_runs = jd_doc["summary"], jd_doc["runs"]
-    sd = {k: cp[f"table3.{k}_h"]["sd_z"] for k in ("std", "nmad")}
-    n = cp["n_campaigns"]
-    ok_sd = all(abs(v - 1.0) <= 0.3 for v in sd.values())
-    within = jd["seeds_meeting_95pct_vs_targets"]
-    rms = jd["rms_z_sigma_of_difference"]
-    h_in, c_in = cp["mean_h_nogcp_within"], cp["c_within"]
-    mc = "c_within_mc" in cp  # the bench's no-GCP Monte Carlo of retrieved − twin
-    return [
-        {
-            "line": "Over 8 campaigns: the z of std_h and nmad_h from pixels has a standard "
-            "deviation of 1 ± 0.3",
-            "status": "met" if ok_sd and n >= 8 else "short",
-            "evidence": {
-                "file": str(cp_file.relative_to(RESULTS.parent.parent)),
-                "n_campaigns": n,
-                "sd_z_std_h_table3_joint": sd["std"],
-                "sd_z_nmad_h_table3_joint": sd["nmad"],
-                "why_short": None
-                if ok_sd and n >= 8
-                else "the SD of z is outside 1 ± 0.3: the farthest check points are the ones "
-                "seen from the other flying height (named_cause, traced); the bench records "
-                "each check point's AGL (cp_agl_nogcp_m) from this branch on — its file here "
-                "predates that, not re-run (the shared machine's load of 12–26 left a seed "
-                "a few per cent of a core)",
-                "h_farthest_over_nmad": cp["h_farthest_over_nmad"],
-                "h_farthest_m": cp["h_farthest_m"],
-                "named_cause": "in part: without GCPs a principal-distance error moves every "
-                "point along its rays by −AGL·Δc/c, so a check point seen only from the 2500 m "
-                "strips moves 4/3 as far as one seen from 1875 m (traced on seed 1: no blunder "
-                "of the measurement). The fit H ≈ k·AGL per campaign "
-                "(h_farthest_after_agl_over_nmad) removes the far point where the check points "
-                "mix flying heights; where it does not (the others), the far point is not "
-                "traced here",
-                "traced": _trace(),
-                **{
-                    k: cp[k]
-                    for k in (
-                        "agl_k",
-                        "std_h_m",
-                        "std_h_after_agl_m",
-                        "h_farthest_after_agl_over_nmad",
-                        "agl_mix_campaigns",
-                    )
-                    if k in cp
-                },
-            },
-        },
-        {
-            "line": "the within-1-px share against an independent reference is ≥ 95 % in ≥ 7 "
-            "of 8 campaigns",
-            "status": "met" if within >= 7 else "short",
-            "evidence": {
-                "file": str(jd_file.relative_to(RESULTS.parent.parent)),
-                "seeds_meeting_95pct_vs_point_targets": within,
-                "within_1px_vs_targets_per_seed": jd["within_1px_vs_targets_per_seed"],
-                # the same observations against the median of their own tie point's rays and
-                # against the others' (leave-one-out): they agree with each other
-                "within_1px_same_observations_vs_median_per_seed": [
-                    r["within_median_on_targets_1px"] for r in jd_runs
-                ],
-                "within_1px_same_observations_vs_leave_one_out_per_seed": [
-                    r["within_leave_one_out_on_targets_1px"] for r in jd_runs
-                ],
-                "named_cause": "the failing observations are consistent with their own tie "
-                "point's other rays (leave-one-out ≥ "
-                f"{100 * min(r['within_leave_one_out_on_targets_1px'] for r in jd_runs):.1f} % "
-                "within 1 px on the same observations in every campaign) but their feature "
-                "is not the target's recorded "
-                "centre: a 0.6 m (2 px) bright square is found by BRISK at a corner or edge, "
-                "0.3–0.4 m from its centre, and a tie point counts as on a target up to "
-                "ON_TARGET_M = 0.6 m from it (lp_targets.py) — the reference, not the "
-                "measurement, is off by up to ~1.5 px; not mended here (a target whose "
-                "recorded centre is where a corner detector fires, and a re-run of "
-                "bench_lp_judges.py, did not fit the session's CPU)",
-            },
-        },
-        {
-            "line": "RMS z of retrieved − twin is 1 ± 0.25",
-            "status": "met" if abs(rms - 1.0) <= 0.25 else "short",
-            "evidence": {
-                "file": str(jd_file.relative_to(RESULTS.parent.parent)),
-                "rms_z_sigma_of_difference": rms,
-                "rms_z_retrieved_sigma": jd["rms_z_retrieved_sigma"],
-            },
-        },
-        {
-            "line": "|mean H| without GCPs and c − c_twin within 3σ̂ in ≥ 7 of 8 campaigns, or "
-            "a named cause that reproduces the offset",
-            # a bar that can hardly fail is not met: σ̂ of the mean height is metres to tens of
-            # metres at the bench's block size, and c − c_twin is judged with the retrieved σ̂
-            # met: c − c_twin within 3σ of the *difference* (Monte Carlo) in ≥ 7 of 8, and the
-            # named cause — the c–H coupling the draws show — leaves a mean-height residual
-            # within 3σ of the draws' scatter about their regression in ≥ 7 of 8, with |corr|
-            # ≥ 0.9 (a bar of centimetres to decimetres, not tens of metres)
-            "status": "met"
-            if n >= 8
-            and mc
-            and cp["c_within_mc"] >= 7
-            and cp["mean_h_residual_within"] >= 7
-            and np.median(np.abs(cp["coupling_corr"])) >= 0.9
-            else "short",
-            "evidence": {
-                "file": str(cp_file.relative_to(RESULTS.parent.parent)),
-                "n_campaigns": n,
-                "mean_h_within_3sigma": h_in,
-                "c_minus_twin_within_3sigma_retrieved_sigma": c_in,
-                "mean_h_sigma_m": cp["mean_h_nogcp_sigma_m"],
-                "corr_mean_h_with_c_error": cp["corr_mean_h_c"],
-                **{
-                    k: cp.get(k)
-                    for k in (
-                        "c_within_mc",
-                        "c_minus_twin_nogcp_z_mc",
-                        "mean_h_minus_twin_m",
-                        "mean_h_minus_twin_sigma_m",
-                        "mean_h_minus_twin_within",
-                        "coupling_corr",
-                        "coupling_slope_m_per_um",
-                        "mean_h_predicted_from_c_m",
-                        "mean_h_residual_m",
-                        "mean_h_residual_sigma_m",
-                        "mean_h_residual_within",
-                    )
-                    if k in cp
-                },
-                "why_short": (
-                    None
-                    if n >= 8
-                    and cp["c_within_mc"] >= 7
-                    and cp["mean_h_residual_within"] >= 7
-                    and np.median(np.abs(cp["coupling_corr"])) >= 0.9
-                    else f"{n} campaigns with the Monte Carlo; c within in "
-                    f"{cp['c_within_mc']}, mean-height residual after the c coupling within in "
-                    f"{cp['mean_h_residual_within']}"
-                )
-                if mc
-                else "within 3σ̂ in every campaign, but σ̂ of the mean height is "
-                + f"{min(cp['mean_h_nogcp_sigma_m']):.0f}–{max(cp['mean_h_nogcp_sigma_m']):.0f} m "
-                "at this block size (002's offset: 1.13 m), so the bar can hardly fail; the "
-                "bench file predates the no-GCP Monte Carlo of retrieved − twin "
-                "(bench_lp_checkpoints.py nogcp_twin_mc): re-run it",
-            },
-        },
-    ]
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--runs", type=Path, nargs="+", required=True)
     ap.add_argument("--out", type=Path, default=RESULTS / "issue37_audit.json")
     args = ap.parse_args()
-    mtf_runs = [json.loads((d / "mtf.json").read_text(encoding="utf-8")) for d in args.runs]
+    mtf_runs = [
+        json.loads((d / "mtf.json").read_text(encoding="utf-8"))
+        for d in args.runs
+        if (d / "mtf.json").is_file() and (d / "mtf.json").stat().st_size
+    ]
     rik = [
         json.loads((d / "rikola.json").read_text(encoding="utf-8"))
         for d in args.runs
@@ -474,7 +303,8 @@ def main() -> None:
         lp_blur(lp),
     ]
     out = {
-        "what": "issue 37's done-means lines measured on main 268652f (+ this branch's mends)",
+        "what": "issue 37's done-means lines measured on main 226bb30 + branch lp37 "
+        "(the LP judges mended)",
         "command": "python bench/issue37_audit.py --runs " + " ".join(map(str, args.runs)),
         "summary": {
             s: sum(e["status"] == s for e in entries) for s in ("met", "short", "not-measured")

@@ -13,7 +13,13 @@ import pytest
 from hsgeo.papers import P002_STATS
 from hsgeo.reproduce import CHAPTERS, chapter_names, paper_chapters
 from hsgeo.reproduce.lp_judge import match_errors_px, observation_errors_px, within_fractions
-from hsgeo.reproduce.lp_observations import SIM_SCALE_AT_1, run, sim_scale, stat_sigma
+from hsgeo.reproduce.lp_observations import (
+    SIM_SCALE_AT_1,
+    run,
+    sim_scale,
+    stat_draws,
+    stat_sigma,
+)
 from hsgeo.reproduce.scoreboard import mark_context
 from hsgeo.simulate.lp_campaign import MIN_SCALE
 
@@ -60,6 +66,32 @@ def test_stat_sigma_of_a_shared_shift():
     assert sig[2, i_std] < 0.01 and sig[2, i_nmad] < 0.02
     blocks = np.array([C[3 * i : 3 * i + 3, 3 * i : 3 * i + 3] for i in range(k)])
     assert stat_sigma(blocks, np.random.default_rng(5))[2, i_std] > 0.1
+
+
+def test_stat_draws_carry_a_principal_distance_error_seen_from_two_heights():
+    """Without GCPs a c error u moves each check point's height by −AGL_i·u/c: 8 points seen
+    from 1875 m and 2 from 2500 m (1 mm of height noise each). The STD of the heights is then
+    |u|·SD(AGL)/c: half-normal, mean s·SD·√(2/π), spread s·SD·√(1 − 2/π) — what the draws give
+    (and stat_sigma is their spread)."""
+    agl = np.r_[np.full(8, 1875.0), np.full(2, 2500.0)]
+    k, s_rel = agl.size, 0.009  # σ(Δc)/c
+    C = np.zeros((3 * k, 3 * k))
+    for i in range(k):
+        C[3 * i : 3 * i + 3, 3 * i : 3 * i + 3] = np.diag([1e-6, 1e-6, 1e-6])
+    h = np.arange(k) * 3 + 2
+    C[np.ix_(h, h)] += s_rel**2 * np.outer(agl, agl)
+    d = stat_draws(C, np.random.default_rng(2), 4000)
+    assert d.shape == (4000, 3, len(P002_STATS))
+    i_std = P002_STATS.index("std")
+    sd_agl = np.std(agl, ddof=1)
+    assert d[:, 2, i_std].mean() == pytest.approx(s_rel * sd_agl * np.sqrt(2 / np.pi), rel=0.05)
+    assert d[:, 2, i_std].std(ddof=1) == pytest.approx(
+        s_rel * sd_agl * np.sqrt(1 - 2 / np.pi), rel=0.06
+    )
+    np.testing.assert_array_equal(
+        stat_sigma(C, np.random.default_rng(2), 4000), d.std(axis=0, ddof=1)
+    )
+    assert stat_draws(C[:3, :3], np.random.default_rng(0)) is None
 
 
 def test_within_fractions():

@@ -42,6 +42,44 @@ def test_targets_are_painted_white_and_nothing_else_moves():
         assert np.all(g1.reflectance[:, i, j] > g0.reflectance[:, i, j] + 0.3)
 
 
+def test_survey_targets_are_grey_unsaturated_on_a_uniform_dark_surround():
+    cfg = replace(
+        J.target_config(), ground_margin_m=4.0, buildings_per_km2=0.0, motion_blur_m=0.335
+    )
+    tg = np.array([[5.0, 5.0], [-6.0, 4.0]])
+    g, _, t = make_ground(cfg, 8.0, np.array([[0.0, 0.0]]), WL, np.random.default_rng(5), tg)
+    g0, _, _ = _ground(())
+    np.testing.assert_array_equal(t[:, :2], tg)
+    E = g.e0_m + g.cell_m * np.arange(g.reflectance.shape[2])
+    N = g.n0_m + g.cell_m * np.arange(g.reflectance.shape[1])
+    dn = np.asarray(cfg.dn_per_reflectance[: len(WL)])
+
+    def at(e, n):
+        i, j = int(np.argmin(np.abs(N - n))), int(np.argmin(np.abs(E - e)))
+        return g.reflectance[:, i, j]
+
+    for e, n in tg:
+        centre = at(e, n)
+        # bright against the surround in every band, and below the clip at the peak
+        assert np.all(centre > 0.3) and np.all(J.TARGET_REFLECTANCE * dn < cfg.dn_max)
+        # the surround is uniform where FAST's circle lies at the 1875 m strips (3 px of
+        # 0.30 m); at the 2500 m strips' 1.2 m the PSF and the motion blur leak up to ~10 % of
+        # the texture's contrast along track in the near infrared (not tested here)
+        ring = np.array(
+            [
+                at(e + 0.9 * np.cos(a), n + 0.9 * np.sin(a))
+                for a in np.linspace(0, 2 * np.pi, 16, endpoint=False)
+            ]
+        )
+        np.testing.assert_allclose(ring, cfg.target_surround_reflectance, atol=2e-3)
+    # the texture beyond the surround and its blur is the campaign's own
+    d = np.min(
+        [np.maximum(np.abs(E[None, :] - c[0]), np.abs(N[:, None] - c[1])) for c in tg], axis=0
+    )
+    far = d > J.TARGET_SURROUND_M / 2 + 1.0
+    np.testing.assert_array_equal(g0.reflectance[:, far], g.reflectance[:, far])
+
+
 def test_target_grid_does_not_move_the_campaigns_draws():
     cfg = J.target_config()
     assert cfg.target_spacing_m == J.TARGET_SPACING_M
@@ -61,6 +99,10 @@ def test_bad_target_config():
         L.simulate(0.05, cfg=replace(L.LpConfig(), target_spacing_m=-1.0))
     with pytest.raises(InputError, match="target_side_m"):
         L.simulate(0.05, cfg=replace(L.LpConfig(), target_side_m=0.0))
+    with pytest.raises(InputError, match="target_surround_m"):
+        L.simulate(0.05, cfg=replace(L.LpConfig(), target_surround_m=-1.0))
+    with pytest.raises(InputError, match="target_reflectance"):
+        L.simulate(0.05, cfg=replace(L.LpConfig(), target_reflectance=1.5))
 
 
 def test_twin_rows_judge_in_the_sigma_of_the_difference():
@@ -97,9 +139,17 @@ def test_targets_found_and_judged_against_their_true_centres(judged):
     assert j["targets_found"] >= 3
     assert j["n_observations_on_targets"] >= 9
     assert np.all(j["on_target_distance_m"] <= J.ON_TARGET_M)
-    # a target found at its centre is at most 0.71 px off by the pixel-centre and line rounding
-    assert j["within_target"][1.0] >= 0.8
+    # a survey-style target is found at its centre (white squares over the texture: up to
+    # 0.4 m off it), then off by at most 0.71 px of pixel-centre and line rounding plus the key
+    # point's localisation: the issue's bar, ≥ 95 % within 1 px (white squares: 98.7 % here,
+    # 89.7-99.0 % over 8 campaigns)
+    assert np.all(j["on_target_distance_m"] <= 0.3)
+    assert j["within_target"][1.0] >= 0.95
     assert j["within_target"][0.5] <= j["within_target"][1.0]
+    pp = j["per_tie_point"]
+    assert sum(p["n"] for p in pp) == j["n_observations_on_targets"]
+    assert len({p["target"] for p in pp}) == j["targets_found"]
+    assert all(0 <= p["within_1px"] <= 1 and p["max_error_px"] >= 0 for p in pp)
 
 
 @pytest.mark.slow

@@ -73,6 +73,7 @@ __all__ = [
     "RED_EDGE_NM",
     "PAPER_BLOCK_KM2",
     "stat_sigma",
+    "stat_draws",
 ]
 
 #: The renderer's scale at ``hsgeo reproduce lp-observations --scale 1`` (a 210 m block, 12 % of
@@ -267,28 +268,30 @@ def _band_rows(res, wavelengths_nm) -> list[Row]:
     return rows
 
 
-def stat_sigma(cov_m2: np.ndarray, rng, n_draws: int = _N_DRAWS) -> np.ndarray:
-    """σ̂ of each statistic of :data:`P002_STATS` of check-point errors drawn from their
-    a-posteriori covariance: ``(3, 6)`` (E, N, H × statistic), the spread over ``n_draws``
-    draws. The adjustment's own precision, not a spread over campaigns.
+def stat_draws(cov_m2: np.ndarray, rng, n_draws: int = _N_DRAWS) -> np.ndarray | None:
+    """Each statistic of :data:`P002_STATS` of check-point errors drawn from their a-posteriori
+    covariance: ``(n_draws, 3, 6)`` (draw, E/N/H, statistic), or None for fewer than 2 points.
 
     ``cov_m2`` is the joint covariance ``(3k, 3k)`` of the k check points (point by point,
     :func:`hsgeo.reproduce.lp_judge.joint_point_covariance`): the check points share the
     adjustment's datum error (without GCPs the whole block shifts together), which moves their
-    mean, median, min and max but not their STD or NMAD. ``(k, 3, 3)`` per-point blocks draw
-    each point alone (independent points: every statistic then sees each point's whole σ).
+    mean, median, min and max but not their STD or NMAD — and, without GCPs, the principal
+    distance's error, which moves each point along its rays by −AGL·Δc/c, so a block whose
+    check points are seen from two flying heights spreads with it (the draws carry both, as
+    far as the adjustment's covariance does). ``(k, 3, 3)`` per-point blocks draw each point
+    alone (independent points: every statistic then sees each point's whole σ).
     """
     cov_m2 = np.asarray(cov_m2, float)
     if cov_m2.ndim == 3:
         k = cov_m2.shape[0]
         if k < 2:
-            return np.full((3, len(P002_STATS)), np.nan)
+            return None
         L = np.linalg.cholesky(cov_m2 + 1e-18 * np.eye(3))
         draws = np.einsum("kij,nkj->nki", L, rng.standard_normal((n_draws, k, 3)))
     else:
         k = cov_m2.shape[0] // 3
         if k < 2:
-            return np.full((3, len(P002_STATS)), np.nan)
+            return None
         w, V = np.linalg.eigh(0.5 * (cov_m2 + cov_m2.T))
         L = V * np.sqrt(np.clip(w, 0.0, None))
         draws = (rng.standard_normal((n_draws, 3 * k)) @ L.T).reshape(n_draws, k, 3)
@@ -301,11 +304,21 @@ def stat_sigma(cov_m2: np.ndarray, rng, n_draws: int = _N_DRAWS) -> np.ndarray:
         "std": lambda d: d.std(axis=1, ddof=1),
         "nmad": lambda d: nmad(d, axis=1),
     }
-    out = np.empty((3, len(P002_STATS)))
-    for j in range(3):
-        s = np.stack([per[st](draws[:, :, j]) for st in P002_STATS], axis=1)
-        out[j] = s.std(axis=0, ddof=1)
-    return out
+    return np.stack(
+        [np.stack([per[st](draws[:, :, j]) for st in P002_STATS], axis=1) for j in range(3)],
+        axis=1,
+    )
+
+
+def stat_sigma(cov_m2: np.ndarray, rng, n_draws: int = _N_DRAWS) -> np.ndarray:
+    """σ̂ of each statistic of :data:`P002_STATS` of check-point errors drawn from their
+    a-posteriori covariance (:func:`stat_draws`): ``(3, 6)`` (E, N, H × statistic), the spread
+    over ``n_draws`` draws. The adjustment's own precision, not a spread over campaigns.
+    """
+    s = stat_draws(cov_m2, rng, n_draws)
+    if s is None:
+        return np.full((3, len(P002_STATS)), np.nan)
+    return s.std(axis=0, ddof=1)
 
 
 def _stats_rows(table, names, data, unit, paper, sigma=None, reason="") -> list[Row]:

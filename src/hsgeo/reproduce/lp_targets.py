@@ -3,19 +3,34 @@
 Two judges of ``hsgeo reproduce lp-observations`` whose reference is independent of the
 retrieval's own observations:
 
-* **Point targets** (:func:`target_judge`): the same campaign rendered again with small white
-  targets of known ground centre painted over the texture
-  (:attr:`hsgeo.simulate.lp_campaign.LpConfig.target_spacing_m`, :data:`TARGET_SPACING_M`;
-  the chapter's own campaign has none, so its rows do not move), retrieved by the same
-  pipeline. A tie point is *on* a target when the median of the true ground points its
-  observations see lies within :data:`ON_TARGET_M` of the target's recorded centre (the truth
-  only says which tie points lie on a target); each of its observations is then judged against
-  the target's centre projected through the **true** camera and trajectory at the
-  observation's line time (:func:`hsgeo.reproduce.lp_judge.observation_errors_px` with the
-  targets as known points) — a reference that no observation of the retrieval moves. Beside it,
-  on the same retrieval, the shares against the median of the tie point's own observations
-  (the chapter's reference, which shares the observation it judges) and against the median of
-  the others (leave-one-out).
+* **Point targets** (:func:`target_judge`): the same campaign rendered again with small
+  targets of known ground centre (:attr:`hsgeo.simulate.lp_campaign.LpConfig.target_spacing_m`,
+  :data:`TARGET_SPACING_M`; the chapter's own campaign has none, so its rows do not move),
+  retrieved by the same pipeline. A target is made as survey targets are: a 0.6 m grey square
+  (:data:`TARGET_REFLECTANCE`, unsaturated in every band) centred on a uniform dark square of
+  :data:`TARGET_SURROUND_M`, wider than the corner detector's circle in every strip — its image
+  is symmetric about its centre, so BRISK's FAST score peaks there, and the recorded centre is
+  where the detector fires. (White 2-px squares painted over the texture, as before, saturate
+  in every band and take the texture's asymmetry: BRISK found them up to 0.4 m from their
+  centre, a corner or edge, and 4 of 8 campaigns had < 95 % within 1 px of the centre while
+  the same observations were ≥ 95 % within 1 px of their tie point's other rays: the
+  reference, not the measurement, was off.) A tie point is *on* a target when the median of
+  the true ground points its observations see lies within :data:`ON_TARGET_M` of the target's
+  recorded centre; each of its observations is then judged against the target's centre
+  projected through the **true** camera and trajectory at the observation's line time
+  (:func:`hsgeo.reproduce.lp_judge.observation_errors_px` with the targets as known points).
+  Beside it, on the same retrieval, the shares against the median of the tie point's own
+  observations (the chapter's reference, which shares the observation it judges) and against
+  the median of the others (leave-one-out).
+
+  What this judge shares with what it judges: (i) the renderer's camera model and true
+  trajectory, which both drew the pixels and project the reference (the truth, by design);
+  (ii) *which* tie points are judged — those whose own observations' median ground point lies
+  within :data:`ON_TARGET_M` of a target (a tie point the matcher put off every target is not
+  judged; on the bench's campaigns the on-target tie points lie ≤ 0.18 m from a centre and
+  none between that and 0.6 m, so the radius cuts no continuum). What it does not share: the
+  reference position — the target's recorded centre, fixed before any pixel is rendered — is
+  moved by no observation, no median and no adjustment.
 * **Retrieved − twin** (:func:`twin_difference`): the exact twin
   (:func:`hsgeo.reproduce.lp_runs.exact_twin`) shares the navigation error, the priors and the
   tie points with the retrieval, so the retrieved σ̂ (which holds the priors' and the
@@ -48,6 +63,8 @@ from hsgeo.reproduce.lp_judge import observation_errors_px, within_fractions
 
 __all__ = [
     "TARGET_SPACING_M",
+    "TARGET_REFLECTANCE",
+    "TARGET_SURROUND_M",
     "ON_TARGET_M",
     "N_DRAWS",
     "target_config",
@@ -64,6 +81,17 @@ __all__ = [
 #: Spacing (m) of the point targets' jittered grid in the judge's campaign (ours: ~13 px at
 #: 0.30 m GSD, wider than a BRISK descriptor's core, so neighbours do not share a descriptor).
 TARGET_SPACING_M = 4.0
+#: Reflectance of a point target (ours: 0.45 in every band, 2500–3470 DN at this radiometry,
+#: below ``dn_max`` = 4095 in every band; the white squares' 0.86–0.885 clip at 4095 in all seven,
+#: a flat plateau whose highest corner score the texture or the noise picks).
+TARGET_REFLECTANCE = 0.45
+#: Side (m) of the uniform dark square (reflectance 0.05) each target is centred on (ours: FAST's
+#: 16-pixel circle, radius 3 px, reaches 0.9 m from the centre at the 1875 m strips' 0.30 m GSD
+#: and 1.2 m at the 2500 m strips' 0.40 m; half this side, 1.5 m, keeps the circle on the
+#: surround in every strip, so the target's image is symmetric about its centre whatever the
+#: texture around it — to 0.1 % at 0.9 m; at 1.2 m the PSF and the motion blur leak up to 0.04
+#: of reflectance, ~10 % of the contrast, along track in the near infrared).
+TARGET_SURROUND_M = 3.0
 #: A tie point whose observations' true ground points have their median within this distance
 #: (m, horizontal) of a target's centre is on that target (ours: the target's side, 2 px).
 ON_TARGET_M = 0.6
@@ -73,10 +101,18 @@ N_DRAWS = 16
 
 
 def target_config(cfg=None):
-    """The campaign's configuration with the point targets on (:data:`TARGET_SPACING_M`)."""
+    """The campaign's configuration with the point targets on: :data:`TARGET_SPACING_M`, a
+    grey square of :data:`TARGET_REFLECTANCE` on a dark surround of :data:`TARGET_SURROUND_M`
+    (module docstring).
+    """
     from hsgeo.simulate.lp_campaign import LpConfig
 
-    return replace(cfg or LpConfig(), target_spacing_m=TARGET_SPACING_M)
+    return replace(
+        cfg or LpConfig(),
+        target_spacing_m=TARGET_SPACING_M,
+        target_reflectance=TARGET_REFLECTANCE,
+        target_surround_m=TARGET_SURROUND_M,
+    )
 
 
 def targets_on(table, truth, square_ids=()) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -132,7 +168,8 @@ def target_judge(table, truth, square_ids=(), square_xyz_m=None) -> dict:
         ``{1.0, 0.5}``, ``within_median`` / ``within_leave_one_out`` (every tie point's
         observations, the chapter's two references) and the same restricted to the targets'
         tie points (``within_median_on_targets``, ``within_leave_one_out_on_targets``),
-        ``on_target_distance_m``.
+        ``on_target_distance_m``, ``per_tie_point`` (each on-target tie point's id, target,
+        band, distance, observations, share within 1 px and largest error).
     """
     pid = table["point_id"].to_numpy().astype(str)
     is_sq = np.isin(pid, np.asarray(square_ids, str))
@@ -142,6 +179,23 @@ def target_judge(table, truth, square_ids=(), square_xyz_m=None) -> dict:
     e_t = (
         observation_errors_px(table[on], truth, tuple(ids), tg[k]) if on.any() else np.zeros((0, 2))
     )
+    per_point = []
+    if on.any():
+        e_len = np.hypot(e_t[:, 0], e_t[:, 1])
+        pid_on, band_on = pid[on], table["band"].to_numpy()[on]
+        for i, kk, dd in zip(ids, k, dist, strict=True):
+            m = pid_on == i
+            per_point.append(
+                {
+                    "point_id": str(i),
+                    "target": int(kk),
+                    "band": int(band_on[m][0]),
+                    "distance_m": float(dd),
+                    "n": int(m.sum()),
+                    "within_1px": float(np.mean(e_len[m] <= 1.0)),
+                    "max_error_px": float(e_len[m].max()),
+                }
+            )
     sq_xyz = None if square_xyz_m is None else np.asarray(square_xyz_m, float)
     e_med = observation_errors_px(table, truth, square_ids, sq_xyz)
     e_loo = observation_errors_px(table, truth, square_ids, sq_xyz, leave_one_out=True)
@@ -157,6 +211,7 @@ def target_judge(table, truth, square_ids=(), square_xyz_m=None) -> dict:
         "within_median_on_targets": within_fractions(e_med[on]),
         "within_leave_one_out_on_targets": within_fractions(e_loo[on]),
         "on_target_distance_m": dist,
+        "per_tie_point": per_point,
     }
 
 

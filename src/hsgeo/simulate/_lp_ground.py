@@ -11,11 +11,13 @@ What the ground is made of (all drawn from one ``numpy.random.Generator``):
   **buildings** (rotated rectangles with a two-tone gabled roof, a few metres high on the DSM);
 * the **white reference squares** on a grass patch, rasterised with their exact cell coverage
   (anti-aliased), so that the blurred square's centroid is its centre;
-* optionally, small white **point targets** (``targets_en_m``, :attr:`LpConfig.target_side_m`
-  squares of about two pixels, exact cell coverage, painted over the texture): features whose
-  ground centre is known, for judging the matcher's observations against an independent
-  reference (:mod:`hsgeo.reproduce.lp_targets`); none by default, and with none the ground is
-  the same to the bit;
+* optionally, small **point targets** (``targets_en_m``, :attr:`LpConfig.target_side_m`
+  squares of about two pixels, exact cell coverage): white and painted over the texture, or
+  (:attr:`LpConfig.target_reflectance`, :attr:`LpConfig.target_surround_m`) of their own
+  reflectance centred on a uniform dark square, as survey targets are — features whose ground
+  centre is known, for judging the matcher's observations against an independent reference
+  (:mod:`hsgeo.reproduce.lp_targets`); none by default, and with none the ground is the same to
+  the bit;
 * a gently undulating **terrain** under it all (the DSM, with the buildings' height steps).
 
 The reflectance of each material in each band is :data:`SPECTRA` (ours, typical shapes:
@@ -316,12 +318,24 @@ def _reflectance(cfg, r: _Raster, squares_en, wavelengths_nm, rng, targets_en=()
     mod = np.clip(r.bright * (1 + _TEXTURE[r.material] * tex), 0.05, 3.0)
     del tex
     cov = _coverage(r, squares_en, cfg.square_side_m)
-    if len(targets_en):
+    # the point targets: over the texture as white squares (the squares' coverage), or, as
+    # survey targets, a square of their own reflectance on a uniform dark surround
+    surround = cfg.target_surround_m
+    t_refl = cfg.target_reflectance
+    own = len(targets_en) and (surround > 0 or t_refl is not None)
+    if len(targets_en) and not own:
         cov = np.maximum(cov, _coverage(r, targets_en, cfg.target_side_m))
+    cov_t = _coverage(r, targets_en, cfg.target_side_m) if own else None
+    cov_s = _coverage(r, targets_en, surround) if own and surround > 0 else None
     white = spectra[MATERIALS.index("white")]
     refl = np.empty((spectra.shape[1],) + r.shape, np.float32)
     for b in range(refl.shape[0]):
         r_b = spectra[:, b].astype(np.float32)[r.material] * mod
+        if cov_s is not None:
+            r_b = (1 - cov_s) * r_b + cov_s * np.float32(cfg.target_surround_reflectance)
+        if cov_t is not None:
+            tb = white[b] if t_refl is None else t_refl
+            r_b = (1 - cov_t) * r_b + cov_t * np.float32(tb)
         r_b = (1 - cov) * r_b + cov * np.float32(white[b])
         r_b = gaussian_filter(r_b, cfg.psf_sigma_m / r.cell, mode="nearest")
         if box is not None:

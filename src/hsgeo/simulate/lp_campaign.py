@@ -141,6 +141,16 @@ class LpConfig:
     # campaign's other draws do not move; 0 (the default): none, the chapter's campaign
     target_spacing_m: float = 0.0
     target_side_m: float = 0.6
+    # the point targets as survey targets are made (ours): a grey square of reflectance
+    # ``target_reflectance`` (None: the white squares' spectrum, saturated in every band at
+    # this radiometry) centred on a uniform dark square of side ``target_surround_m`` and
+    # reflectance ``target_surround_reflectance`` (0: none, the target painted over the
+    # texture). On the uniform surround the target's image is symmetric about its centre, so
+    # a corner detector fires at the centre (its recorded reference), not where the texture
+    # or a clipped plateau happens to put the highest score
+    target_reflectance: float | None = None
+    target_surround_m: float = 0.0
+    target_surround_reflectance: float = 0.05
     # -- radiometry (ours): DN per unit reflectance per band, one integration time; vegetation
     # (ρ ≈ 0.48) reaches ~90 % of dn_max above the red edge (002 §5.3: "close to saturation")
     dn_max: float = 4095.0
@@ -361,11 +371,20 @@ def _checked(scale, cfg):
             "mount_motion_rad",
             "sigma_pp_calibration_px",
             "target_spacing_m",
+            "target_surround_m",
+            "target_surround_reflectance",
         )
     ):
         raise InputError(
             "LpConfig: psf_sigma_m, motion_blur_m, read_noise_dn, mount_motion_rad, "
-            "sigma_pp_calibration_px and target_spacing_m must be ≥ 0"
+            "sigma_pp_calibration_px, target_spacing_m, target_surround_m and "
+            "target_surround_reflectance must be ≥ 0"
+        )
+    if cfg.target_reflectance is not None and not (
+        np.isfinite(cfg.target_reflectance) and 0 < cfg.target_reflectance <= 1
+    ):
+        raise InputError(
+            f"LpConfig.target_reflectance must be None or in (0, 1], got {cfg.target_reflectance!r}"
         )
     if cfg.exposure_stamp not in ("middle", "start"):
         raise InputError(
