@@ -4,12 +4,16 @@
 
 One entry per done-means line: the line, ``status`` (met / short / not-measured) and the
 evidence (files, test ids, computed numbers). Computed here: the README's command lines against
-those ``.ci/check_wheel.sh`` runs; the seed sweep's counts (``bench/results/seed_sweep.json``);
+those ``.ci/check_wheel.sh`` runs (subcommand, options and the kind of each value) and the last
+``make check-wheel`` log (``bench/results/check_wheel.log``: this script, run to its end); the
+seed sweep's counts (``bench/results/seed_sweep.json``);
 ``mtf-edge`` over every region of a masked target (``tests/test_bad_input_mtf_edge.py``'s
 sweep); every subcommand of the parser on every exit path with ``--json`` (in this process,
 each handler replaced by one that fails); the bad-input suite's cases and classes
-(``tests/test_bad_input.py``, ``tests/test_bad_input_classes.py``). ``--junit`` reads pytest
-JUnit reports of the suite's runs for their pass / fail counts.
+(``tests/test_bad_input.py``, ``tests/test_bad_input_classes.py``) and what each case did in
+the last run (``bench/results/bad_input_cases.jsonl``, written by the suite with
+``HSGEO_BAD_INPUT_RECORD``). ``--junit`` reads pytest JUnit reports of the suite's runs for
+their pass / fail counts.
 """
 
 from __future__ import annotations
@@ -319,6 +323,45 @@ def _junit(files) -> dict:
     return out
 
 
+def _case_records(cases) -> dict:
+    """Counts over ``bench/results/bad_input_cases.jsonl``: one line per case of
+    ``tests/test_bad_input.py::test_bad_input`` written by the run (``HSGEO_BAD_INPUT_RECORD``):
+    its exit status and, whichever assertion failed first, a traceback (or exit 1), an exit 0
+    (an answer on bad input), its inputs changed, its outputs or ``*.part`` files left."""
+    f = RESULTS / "bad_input_cases.jsonl"
+    if not f.exists():
+        return {"file": None, "cases_run": 0}
+    rows = {}
+    for line in f.read_text(encoding="utf-8").splitlines():
+        r = json.loads(line)
+        rows[r["id"]] = r  # a case run twice: its last run
+    ids = {c.id for c in cases}
+    rs = [r for i, r in rows.items() if i in ids]
+
+    def which(key):
+        return sorted(r["id"] for r in rs if r[key])
+
+    out = {
+        "file": str(f.relative_to(ROOT)),
+        "cases": len(ids),
+        "cases_run": len(rs),
+        "exit_status": dict(sorted(Counter(str(r["exit"]) for r in rs).items())),
+        "tracebacks": len(which("traceback")),
+        "silent_wrong_answers": len(which("answer")),
+        "inputs_modified": len(which("inputs_modified")),
+        "partial_outputs_left": len(which("partial_outputs")),
+        "case_folder_changed": len(which("folder_changed")),
+        "not_one_line_on_stderr": sum(not r["one_line"] for r in rs),
+        "cause_not_named": sum(not r["cause_named"] for r in rs),
+    }
+    out["ids"] = {
+        k: which(k) for k in ("traceback", "answer", "inputs_modified", "partial_outputs")
+    }
+    out["ids"]["not_one_line"] = sorted(r["id"] for r in rs if not r["one_line"])
+    out["ids"]["cause_not_named"] = sorted(r["id"] for r in rs if not r["cause_named"])
+    return out
+
+
 def bad_input(junit) -> dict:
     import test_bad_input as B
     import test_bad_input_classes as K
@@ -333,7 +376,25 @@ def bad_input(junit) -> dict:
     open_rows = [(c[0], c[1], c[4][:160]) for c in K.CLASSES if c[3] == "open"]
     silent_open = [r for r in open_rows if r[0].startswith("answer")]
     runs = _junit(junit) if junit else None
-    ok = not silent_open and runs is not None and not runs["failed_ids"]
+    rec = _case_records(B.CASES)
+    zero = ("tracebacks", "silent_wrong_answers", "inputs_modified", "partial_outputs_left")
+    ok = (
+        not silent_open
+        and runs is not None
+        and not runs["failed_ids"]
+        and rec["cases_run"] == len(B.CASES)
+        and all(rec[k] == 0 for k in zero)
+    )
+    short = []
+    if silent_open:
+        short.append(f"{len(silent_open)} open class(es) answer on wrong input")
+    if runs is None:
+        short.append("no JUnit report of the suite given (--junit)")
+    elif runs["failed_ids"]:
+        short.append(f"{len(runs['failed_ids'])} test(s) of the suite failed")
+    if rec["cases_run"] < len(B.CASES):
+        short.append(f"{rec['cases_run']} of {len(B.CASES)} cases recorded")
+    short += [f"{rec[k]} {k.replace('_', ' ')}" for k in zero if rec[k]]
     return {
         "line": "the bad-input suite covers the six commands' failure kinds, with 0 tracebacks, "
         "0 silent wrong answers, 0 inputs modified, 0 partial outputs left",
@@ -357,9 +418,8 @@ def bad_input(junit) -> dict:
             "writing command (cube, data flight, lp-observations, orthorectify × 4): no partial "
             "set of outputs (io.output_group; before: 'lines.raw.hdr' left by data flight)",
             "suite_runs": runs,
-            "why_short": "an open class answers on wrong input (lp-observations --height far "
-            "from the terrain without --squares: exit 0); the whole suite was not run in one "
-            "session on this branch (see suite_runs for what was)",
+            "case_records": rec,
+            "why_short": "; ".join(short) or None,
         },
     }
 
