@@ -842,9 +842,8 @@ for extra, expect in [
     ("[observations]\nsigma_px = 0\n", "sigma_px"),
     ("[gcp]\nsigma_m = -1.0\n", "sigma_m"),
 ]:
-    case(
-        C, "mistyped", f"cam-{extra.split(chr(10))[0]}", expect, [("cam.toml", toml_append(extra))]
-    )
+    head, key = extra.split(chr(10))[0], extra.split(chr(10))[1].split(" =")[0]
+    case(C, "mistyped", f"cam-{head}-{key}", expect, [("cam.toml", toml_append(extra))])
 case(
     C,
     "mistyped",
