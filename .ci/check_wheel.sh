@@ -13,6 +13,7 @@ trap 'rm -rf "$WORK"' EXIT
 "$PYTHON" -m venv "$WORK/venv"
 "$WORK/venv/bin/python" -m pip install --quiet --disable-pip-version-check \
   -c "$ROOT/requirements.lock" "$WHEEL"
+echo "check-wheel: $(basename "$WHEEL"), .ci/check_wheel.sh sha256 $(sha256sum "$ROOT/.ci/check_wheel.sh" | cut -c1-16)"
 HS="$WORK/venv/bin/hsgeo"
 PY="$WORK/venv/bin/python"
 mkdir "$WORK/empty" && cd "$WORK/empty"
@@ -30,8 +31,11 @@ json reproduce rikola --scale 0.1 --json
 G=data_synthetic/generated
 step calibrate-line $G/line_lab_observations.csv --control $G/line_lab_control.csv
 step mtf $G/mtf_bench_profiles.csv --bars $G/mtf_bench_bars.toml
-BAL="$("$PY" -c 'import hsgeo, pathlib; print(pathlib.Path(hsgeo.__file__).parent / "data/reference/bal-ladybug/problem-49-7776-pre.txt.bz2")')"
-step adjust-bal "$BAL"
+# the installed package's own data (not the repository's): the BAL problem, ChArUco photographs
+PKG="$("$PY" -c 'import hsgeo, pathlib; print(pathlib.Path(hsgeo.__file__).parent)')"
+step adjust-bal "$PKG/data/reference/bal-ladybug/problem-49-7776-pre.txt.bz2"
+step calibrate-frame "$PKG"/data/reference/opencv-charuco/images/*.jpg \
+  --board "$PKG/data/reference/opencv-charuco/board.toml" --per-band
 # a usage error says what the option takes (was "a positive number in [-inf, 1]")
 if "$HS" reproduce mtf --scale small 2> "$WORK/err.txt"; then echo "--scale small accepted"; exit 1; fi
 grep -q "(0, 1\]" "$WORK/err.txt" || { cat "$WORK/err.txt"; exit 1; }
@@ -41,6 +45,7 @@ step mtf-edge in/EDGE.png --roi 8,8,88,88
 step mtf-edge in/EDGE.png
 step cube in/raw --dark in/dark --binning 2 -o cube.nc
 step cube in/raw --dark in/dark --binning 2 -o cube.hdr
+step asf in/CROSS.nc in/ALONG.nc --runway in/RUNWAY.csv
 step lp-observations in/STRIP_*.nc --trajectory in/NAV.csv --camera in/CAM.toml \
   --squares in/SQUARES.csv -o OBS.parquet
 # the GCPs that the matcher found among the squares (a GCP without observations is refused)
@@ -64,4 +69,15 @@ step data flight --site=-33.9,151.2 --length-km 2 --out flight
 step orthorectify flight/lines.raw --line-times flight/line_times.csv \
   --trajectory flight/nav.csv --sensor flight/sensor.toml --dsm flight/dsm.tif \
   --vertical ellipsoidal -o flight/ortho.tif
-echo "check-wheel: the installed wheel ran every command above from an empty folder"
+# the README's real-flight line: the same flight as an Applanix SBET, one NetCDF line file and a
+# DSM of EGM96 heights (the geoid from Debian's proj-data, as the README says)
+"$PY" "$ROOT/.ci/wheel_inputs.py" --sbet flight
+step orthorectify flight/LINE.nc --trajectory flight/FLIGHT.sbet --nav-crs EPSG:4979 \
+  --sensor flight/sensor.toml --dsm flight/DSM_egm96.tif --vertical EPSG:5773 -o ortho_sbet.tif
+"$PY" -c "import numpy as np, rasterio; a, b = (rasterio.open(p).read() for p in ('ortho_sbet.tif', \
+'flight/ortho.tif')); assert np.array_equal(np.isnan(a), np.isnan(b)), 'cells differ'; \
+d = np.nanmax(np.abs(a - b)); assert d <= 1e-4 * np.nanmax(np.abs(b)), d"  # the same flight
+# the README's frame-camera line: three frames of the Rikola's two sensors
+step orthorectify in/FRAMES/*.raw --frame-times in/TIMES.csv --trajectory in/FRAMES_NAV.csv \
+  --site 59.665,10.775 --sensor in/RIKOLA.toml --dsm in/FRAMES_DSM.tif -o frames.tif
+echo "check-wheel: the installed wheel ran every command above from an empty folder (${SECONDS} s)"

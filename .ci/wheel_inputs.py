@@ -1,9 +1,18 @@
 """Inputs for `make check-wheel`, written with the *installed* hsgeo (no repository files).
 
-Usage: python wheel_inputs.py DIR. Writes under DIR: raw/ and dark/ frame folders (cube),
+Usage: ``python wheel_inputs.py DIR`` writes under DIR: raw/ and dark/ frame folders (cube),
 eight LP strips of the rendered campaign with their navigation, camera and squares
-(lp-observations, adjust-pushbroom), a DSM around them (orthorectify) and a slanted-edge PNG
-(mtf-edge). The same recipes as tests/test_bad_input.py and tests/test_cli_lp_observations.py.
+(lp-observations, adjust-pushbroom), a DSM around them (orthorectify), a slanted-edge PNG
+(mtf-edge), a crossing and an along scan of the simulated runway with its corners (asf), and
+three Rikola frames with their exposure table, navigation, sensor file and DSM (orthorectify of
+a frame camera). The same recipes as tests/test_bad_input.py, tests/asf_inputs.py,
+tests/test_orthorectify_registry.py and tests/test_cli_lp_observations.py.
+
+``python wheel_inputs.py --sbet FLIGHT`` turns the folder that ``hsgeo data flight`` wrote into
+the README's real-flight line: its geodetic navigation as an Applanix SBET (``FLIGHT.sbet``, in
+:mod:`hsgeo.io.sbet`'s field order), its ENVI lines as one NetCDF line file (``LINE.nc``) and
+its DSM with EGM96 heights (``DSM_egm96.tif``, PROJ's geoid through
+:func:`hsgeo.crs.use_system_proj_grids`).
 """
 
 import sys
@@ -23,6 +32,57 @@ from hsgeo.mapgrid import MapGrid
 from hsgeo.simulate import cube_survey as CS
 from hsgeo.simulate.lp_campaign import simulate
 
+
+def sbet(flight: Path) -> None:
+    """FLIGHT.sbet, LINE.nc and DSM_egm96.tif from a ``hsgeo data flight`` folder."""
+    import rasterio
+    from pyproj import Transformer
+
+    from hsgeo.crs import use_system_proj_grids
+    from hsgeo.io import write_lines
+    from hsgeo.io.envi import read_envi
+    from hsgeo.io.sbet import SBET_FIELDS
+
+    nav = pd.read_csv(flight / "nav.csv", comment="#")
+    rec = np.zeros((len(nav), len(SBET_FIELDS)))
+    col = {f: i for i, f in enumerate(SBET_FIELDS)}
+    wander_rad = 0.3  # any wander angle: platform heading = true heading + wander
+    rec[:, col["time_s"]] = nav["gps_sow_s"]
+    rec[:, col["lat_rad"]] = np.radians(nav["lat_deg"])
+    rec[:, col["lon_rad"]] = np.radians(nav["lon_deg"])
+    rec[:, col["h_m"]] = nav["h_m"]
+    rec[:, col["roll_rad"]] = np.radians(nav["roll_deg"])
+    rec[:, col["pitch_rad"]] = np.radians(nav["pitch_deg"])
+    rec[:, col["platform_heading_rad"]] = np.radians(nav["heading_deg"]) + wander_rad
+    rec[:, col["wander_rad"]] = wander_rad
+    rec.astype("<f8").tofile(flight / "FLIGHT.sbet")
+
+    lines, _ = read_envi(flight / "lines.raw")  # (bands, lines, samples)
+    t = pd.read_csv(flight / "line_times.csv")["t_s"].to_numpy(float)
+    rate_hz = (t.size - 1) / (t[-1] - t[0])
+    assert np.allclose(np.diff(t), 1.0 / rate_hz, rtol=0.0, atol=1e-6), "irregular line times"
+    write_lines(flight / "LINE.nc", lines, np.arange(float(lines.shape[2])), t0_s=float(t[0]),
+                line_rate_hz=float(rate_hz))  # fmt: skip
+
+    use_system_proj_grids()  # EGM96 (egm96_15.gtx) of Debian's proj-data
+    with rasterio.open(flight / "dsm.tif") as src:
+        z = src.read(1).astype(float)
+        transform, crs = src.transform, src.crs
+    rows, cols = np.indices(z.shape)
+    x, y = rasterio.transform.xy(transform, rows.ravel(), cols.ravel())
+    lon, lat = Transformer.from_crs(crs, 4326, always_xy=True).transform(x, y)
+    geoid = Transformer.from_crs("EPSG:4979", "EPSG:4326+5773", always_xy=True)
+    _, _, h_egm96 = geoid.transform(lon, lat, z.ravel(), errcheck=True)
+    n_m = z.ravel() - np.asarray(h_egm96)
+    assert np.all(np.abs(n_m) > 1.0), "the EGM96 grid was not found (geoid height 0)"
+    write_geotiff(flight / "DSM_egm96.tif", np.reshape(h_egm96, z.shape), transform,
+                  crs.to_epsg())  # fmt: skip
+    print(f"SBET, LINE.nc, DSM_egm96.tif (geoid height {n_m.mean():.2f} m) in {flight}")
+
+
+if sys.argv[1] == "--sbet":
+    sbet(Path(sys.argv[2]))
+    sys.exit(0)
 d = Path(sys.argv[1])
 d.mkdir(parents=True, exist_ok=True)
 
@@ -79,4 +139,65 @@ fine = 0.5 * (1 + verf(dist / (0.6 * sqrt(2))))
 img = fine.reshape(n, ss, n, ss).mean(axis=(1, 3))
 
 Image.fromarray(np.round(20 + 200 * img).astype(np.uint8)).save(d / "EDGE.png")
+
+# asf: the simulated runway (a 200-pixel scanner, a 400 m runway), both scans georegistered
+
+from dataclasses import replace  # noqa: E402
+
+from hsgeo.io.scans import write_geoscan  # noqa: E402
+from hsgeo.sensors.panoramic import PanoramicScanner  # noqa: E402
+from hsgeo.simulate.asf_runway import RunwayScene, simulate_runway  # noqa: E402
+from hsgeo.workflows.asf import georegister  # noqa: E402
+
+scene = replace(RunwayScene(), sensor=PanoramicScanner(n_px=200), runway_length_m=400.0)
+runway, _ = simulate_runway(scene, 4, reverse=False)
+for name, s in (("CROSS", runway.cross), ("ALONG", runway.along)):
+    g = georegister(s.values, s.zeta_px, s.t0_s, s.line_rate_hz, s.sensor, s.trajectory)
+    write_geoscan(d / f"{name}.nc", g.values, g.scan_angle_rad, g.E_m, g.N_m)
+P = runway.runway_polygon_m
+pd.DataFrame({"E_m": P[:, 0], "N_m": P[:, 1]}).to_csv(d / "RUNWAY.csv", index=False)
+
+# Rikola frames: the 003 camera's two sensors (two bands), three frames 100 m above flat ground
+# at 59.665 N, 10.775 E, one ENVI file per frame, TIMES.csv (file, time_s, band)
+
+from hsgeo.io.envi import write_envi  # noqa: E402
+from hsgeo.io.sensor_file import sensor_toml  # noqa: E402
+from hsgeo.trajectory import Trajectory  # noqa: E402
+
+fr = d / "FRAMES"
+fr.mkdir(exist_ok=True)
+(d / "RIKOLA.toml").write_text(
+    sensor_toml(
+        "rikola",
+        {
+            "f_band_mm": [1.83, 1.85],
+            "band_sensor": [1, 2],
+            "bands": [1, 2],
+            "pp_I_mm": [0.01, -0.005],
+            "pp_II_mm": [-0.01, 0.005],
+            "image_size_px": [200, 150],
+            "pixel_mm": 0.0055,
+            "boresight_deg": [180.0, 0.0, 0.0],  # the camera looks along -z: turned over
+        },
+    )
+)
+tf = np.arange(0.0, 10.01, 0.1)
+frames_nav = Trajectory(
+    tf, np.column_stack([np.zeros_like(tf), 10.0 * tf - 50.0, np.full(tf.size, 100.0)]),
+    np.zeros((tf.size, 3)),
+)  # fmt: skip
+write_trajectory(d / "FRAMES_NAV.csv", frames_nav)
+v, u = np.mgrid[0:150, 0:200]
+rows = ["file,time_s,band"]
+for i, t0 in enumerate((3.0, 5.0, 7.0)):
+    img = np.stack([(u // 20 + v // 20 + i + b) % 2 for b in (0, 1)]).astype(np.float32)
+    write_envi(fr / f"f{i}.raw", img)
+    rows += [f"f{i}.raw,{t0 + 0.05 * b!r},{b + 1}" for b in (0, 1)]
+(d / "TIMES.csv").write_text("\n".join(rows) + "\n")
+# flat ground at the site's height (0 m) in the site's WGS 84 UTM zone (32N: no --nav-crs)
+from pyproj import Transformer  # noqa: E402
+
+xc, yc = Transformer.from_crs(4326, 32632, always_xy=True).transform(10.775, 59.665)
+grid = MapGrid.covering((xc - 500.0, xc + 500.0), (yc - 500.0, yc + 500.0), 5.0, "EPSG:32632")
+write_geotiff(d / "FRAMES_DSM.tif", np.zeros((grid.y_m.size, grid.x_m.size)), grid.transform, 32632)
 print(f"inputs written to {d}")

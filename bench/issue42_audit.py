@@ -4,12 +4,16 @@
 
 One entry per done-means line: the line, ``status`` (met / short / not-measured) and the
 evidence (files, test ids, computed numbers). Computed here: the README's command lines against
-those ``.ci/check_wheel.sh`` runs; the seed sweep's counts (``bench/results/seed_sweep.json``);
+those ``.ci/check_wheel.sh`` runs (subcommand, options and the kind of each value) and the last
+``make check-wheel`` log (``bench/results/check_wheel.log``: this script, run to its end); the
+seed sweep's counts (``bench/results/seed_sweep.json``);
 ``mtf-edge`` over every region of a masked target (``tests/test_bad_input_mtf_edge.py``'s
 sweep); every subcommand of the parser on every exit path with ``--json`` (in this process,
 each handler replaced by one that fails); the bad-input suite's cases and classes
-(``tests/test_bad_input.py``, ``tests/test_bad_input_classes.py``). ``--junit`` reads pytest
-JUnit reports of the suite's runs for their pass / fail counts.
+(``tests/test_bad_input.py``, ``tests/test_bad_input_classes.py``) and what each case did in
+the last run (``bench/results/bad_input_cases.jsonl``, written by the suite with
+``HSGEO_BAD_INPUT_RECORD``). ``--junit`` reads pytest JUnit reports of the suite's runs for
+their pass / fail counts.
 """
 
 from __future__ import annotations
@@ -33,14 +37,70 @@ SIX = ("cube", "mtf", "mtf-edge", "lp-observations", "orthorectify", "asf")
 
 
 def _hsgeo_lines(text: str) -> list[str]:
-    """The ``hsgeo ...`` command lines of a text (continuations joined, comments dropped)."""
+    """The ``hsgeo ...`` command lines of a text (continuations joined, comments dropped; in a
+    shell script the commands that must succeed: ``step``, ``json`` and ``"$HS"`` lines, not
+    the ``if "$HS" ...`` of a refusal or an ``echo``)."""
     text = re.sub(r"\\\n\s*", " ", text)
     out = []
     for line in text.splitlines():
-        m = re.search(r"(?:\.venv/bin/hsgeo|\$HS|step|json)\s+([a-z][a-z-]+)(.*)", line)
-        if m and "#" not in line.split(m.group(0))[0]:
-            out.append((m.group(1) + m.group(2)).split("#")[0].strip())
+        m = re.search(r'(?:\.venv/bin/hsgeo|"?\$HS"?|step|json)\s+([a-z][a-z-]+)(.*)', line)
+        before = line.split(m.group(0))[0] if m else ""
+        if m and "#" not in before and not re.search(r"\b(if|echo)\b", before):
+            out.append((m.group(1) + m.group(2)).split(" #")[0].strip())
     return out
+
+
+def _signature(cmd: str) -> set[str]:
+    """What a command line exercises: its subcommand, its options (``--x=v`` as ``--x``), the
+    kind of each value (a file's suffix: ``--trajectory:.sbet``, ``-o:.tif``; a word such as
+    ``--vertical:EPSG:5773`` or ``--mosaic:nearest-nadir``; numbers left out) and of each
+    positional argument (``.nc``, ``.raw``, a chapter's name); ``--json``, ``--seed`` and
+    ``--scale`` left out (the check runs the chapters smaller)."""
+    toks = [t.strip("\"'()") for t in cmd.replace("=", " ").split()]
+    sig, opt = {toks[0]}, None
+    for t in toks[1:]:
+        if t.startswith("-") and not re.fullmatch(r"-[\d.,]+", t):
+            opt = None if t in ("--json", "--seed", "--scale") else t
+            if opt:
+                sig.add(opt)
+            continue
+        suffix = re.search(r"\.[A-Za-z][A-Za-z0-9]*$", t)
+        if suffix and not t.startswith("EPSG:"):
+            kind = suffix.group(0).lower()
+        elif re.search(r"[A-Za-z]", t) and "/" not in t and not t.startswith("$"):
+            kind = t  # a mode word (nearest-nadir, EPSG:5773, ellipsoidal, a chapter)
+        else:
+            kind = None  # a number, a folder, a placeholder (RAW_DIR, IMAGES...)
+        if kind and not ((t.isupper() and not t.startswith("EPSG:")) or t.endswith("...")):
+            sig.add(f"{opt}:{kind}" if opt else kind)
+        opt = None
+    return sig
+
+
+def _check_wheel_run(script: str) -> dict:
+    """The last ``make check-wheel`` output kept in ``bench/results/check_wheel.log``: the
+    steps it ran, whether it reached its last line, and whether it ran this check_wheel.sh."""
+    import hashlib
+
+    log = RESULTS / "check_wheel.log"
+    if not log.exists():
+        return {"log": None, "passed_with_this_script": False}
+    text = log.read_text(encoding="utf-8", errors="replace")
+    sha_now = hashlib.sha256(script.encode()).hexdigest()[:16]
+    m = re.search(r"check-wheel: (\S+), \.ci/check_wheel\.sh sha256 ([0-9a-f]+)", text)
+    done = re.search(r"check-wheel: the installed wheel ran every command.*\((\d+) s\)", text)
+    steps = re.findall(r"^\+ hsgeo (.*)$", text, flags=re.M)
+    return {
+        "log": str(log.relative_to(ROOT)),
+        "wheel": m.group(1) if m else None,
+        "script_sha256_16_run": m.group(2) if m else None,
+        "script_sha256_16_now": sha_now,
+        "steps_run": len(steps),
+        "subcommands_run": sorted({s.split()[0] for s in steps if not s.startswith("-")}),
+        "reached_the_end": bool(done),
+        "duration_s": int(done.group(1)) if done else None,
+        "passed_with_this_script": bool(done) and bool(m) and m.group(2) == sha_now,
+    }
 
 
 def wheel() -> dict:
@@ -49,19 +109,16 @@ def wheel() -> dict:
     ci = (ROOT / ".ci" / "check_wheel.sh").read_text(encoding="utf-8")
     ran = (ROOT / ".ci" / "run").read_text(encoding="utf-8")
     readme_cmds = _hsgeo_lines(block)
-    ci_cmds = [c for c in _hsgeo_lines(ci) if not c.startswith(("()", "$"))]
-
-    def options(c):
-        return {t for t in c.split() if t.startswith("--")} - {"--json", "--seed", "--scale"}
+    ci_cmds = _hsgeo_lines(ci)
 
     uncovered = []
     for c in readme_cmds:
-        sub = c.split()[0]
-        same = [x for x in ci_cmds if x.split()[0] == sub]
-        if not any(options(c) <= options(x) for x in same):
-            uncovered.append(c)
+        if not any(_signature(c) <= _signature(x) for x in ci_cmds):
+            missing = min((_signature(c) - _signature(x) for x in ci_cmds), key=len)
+            uncovered.append({"readme": c, "closest_check_wheel_step_lacks": sorted(missing)})
     subs = sorted({c.split()[0] for c in readme_cmds})
-    ok = not uncovered and "make check-wheel" in ran
+    run = _check_wheel_run(ci)
+    ok = not uncovered and "make check-wheel" in ran and run.get("passed_with_this_script")
     return {
         "line": "The wheel, installed alone into a fresh venv, runs every README command from "
         "an empty folder (CI does it)",
@@ -80,8 +137,7 @@ def wheel() -> dict:
             "tests": "tests/test_packaging.py::test_every_third_party_import_is_a_declared_"
             "dependency, ::test_the_wheel_carries_the_scenarios_and_instruments, "
             "::test_scenarios_found_in_the_package_outside_the_repository",
-            "run_here": "not run in this session (a fresh venv from the package index on the "
-            "shared machine); the counts above are of the scripts",
+            "last_run": run,
         },
     }
 
@@ -255,7 +311,7 @@ def json_paths() -> dict:
 
 
 def _junit(files) -> dict:
-    out = {"tests": 0, "failures": 0, "errors": 0, "skipped": 0, "failed_ids": []}
+    out = {"tests": 0, "failures": 0, "errors": 0, "skipped": 0, "failed_ids": [], "skips": {}}
     for f in files:
         root = ET.parse(f).getroot()
         for ts in root.iter("testsuite"):
@@ -264,7 +320,56 @@ def _junit(files) -> dict:
         for tc in root.iter("testcase"):
             if tc.find("failure") is not None or tc.find("error") is not None:
                 out["failed_ids"].append(f"{tc.get('classname')}::{tc.get('name')}")
+            if tc.find("skipped") is not None:
+                out["skips"][tc.get("name")] = tc.find("skipped").get("message", "")
     return out
+
+
+def _case_records(cases) -> dict:
+    """Counts over ``bench/results/bad_input_cases.jsonl``: one line per case of
+    ``tests/test_bad_input.py::test_bad_input`` written by the run (``HSGEO_BAD_INPUT_RECORD``):
+    its exit status and, whichever assertion failed first, a traceback (or exit 1), an exit 0
+    (an answer on bad input), its inputs changed, its outputs or ``*.part`` files left."""
+    f = RESULTS / "bad_input_cases.jsonl"
+    if not f.exists():
+        return {"file": None, "cases_run": 0}
+    rows = {}
+    for line in f.read_text(encoding="utf-8").splitlines():
+        r = json.loads(line)
+        rows[r["id"]] = r  # a case run twice: its last run
+    ids = {c.id for c in cases}
+    rs = [r for i, r in rows.items() if i in ids]
+    not_run = sorted(ids - set(rows))
+
+    def which(key):
+        return sorted(r["id"] for r in rs if r[key])
+
+    out = {
+        "file": str(f.relative_to(ROOT)),
+        "cases": len(ids),
+        "cases_run": len(rs),
+        "not_run": not_run,
+        "exit_status": dict(sorted(Counter(str(r["exit"]) for r in rs).items())),
+        "tracebacks": len(which("traceback")),
+        "silent_wrong_answers": len(which("answer")),
+        "inputs_modified": len(which("inputs_modified")),
+        "partial_outputs_left": len(which("partial_outputs")),
+        "case_folder_changed": len(which("folder_changed")),
+        "not_one_line_on_stderr": sum(not r["one_line"] for r in rs),
+        "cause_not_named": sum(not r["cause_named"] for r in rs),
+    }
+    out["ids"] = {
+        k: which(k) for k in ("traceback", "answer", "inputs_modified", "partial_outputs")
+    }
+    out["ids"]["not_one_line"] = sorted(r["id"] for r in rs if not r["one_line"])
+    out["ids"]["cause_not_named"] = sorted(r["id"] for r in rs if not r["cause_named"])
+    return out
+
+
+def _unexplained(rec: dict, runs: dict | None) -> list:
+    """Cases without a record that the JUnit report does not show skipped (with its reason)."""
+    skips = (runs or {}).get("skips", {})
+    return [i for i in rec.get("not_run", []) if f"test_bad_input[{i}]" not in skips]
 
 
 def bad_input(junit) -> dict:
@@ -281,7 +386,27 @@ def bad_input(junit) -> dict:
     open_rows = [(c[0], c[1], c[4][:160]) for c in K.CLASSES if c[3] == "open"]
     silent_open = [r for r in open_rows if r[0].startswith("answer")]
     runs = _junit(junit) if junit else None
-    ok = not silent_open and runs is not None and not runs["failed_ids"]
+    rec = _case_records(B.CASES)
+    zero = ("tracebacks", "silent_wrong_answers", "inputs_modified", "partial_outputs_left")
+    ok = (
+        not silent_open
+        and runs is not None
+        and not runs["failed_ids"]
+        and all(rec.get(k) == 0 for k in zero)
+        and not _unexplained(rec, runs)
+    )
+    short = []
+    if silent_open:
+        short.append(f"{len(silent_open)} open class(es) answer on wrong input")
+    if runs is None:
+        short.append("no JUnit report of the suite given (--junit)")
+    elif runs["failed_ids"]:
+        short.append(f"{len(runs['failed_ids'])} test(s) of the suite failed")
+    if runs is not None and _unexplained(rec, runs):
+        short.append(f"{len(_unexplained(rec, runs))} case(s) neither recorded nor skipped")
+    short += [f"{rec[k]} {k.replace('_', ' ')}" for k in zero if rec.get(k)]
+    if rec["file"] is None:
+        short.append("no per-case records (run the suite with HSGEO_BAD_INPUT_RECORD)")
     return {
         "line": "the bad-input suite covers the six commands' failure kinds, with 0 tracebacks, "
         "0 silent wrong answers, 0 inputs modified, 0 partial outputs left",
@@ -305,9 +430,12 @@ def bad_input(junit) -> dict:
             "writing command (cube, data flight, lp-observations, orthorectify × 4): no partial "
             "set of outputs (io.output_group; before: 'lines.raw.hdr' left by data flight)",
             "suite_runs": runs,
-            "why_short": "an open class answers on wrong input (lp-observations --height far "
-            "from the terrain without --squares: exit 0); the whole suite was not run in one "
-            "session on this branch (see suite_runs for what was)",
+            "case_records": rec,
+            "not_run_skipped_by_the_suite": {
+                i: (runs or {}).get("skips", {}).get(f"test_bad_input[{i}]")
+                for i in rec.get("not_run", [])
+            },
+            "why_short": "; ".join(short) or None,
         },
     }
 

@@ -842,9 +842,8 @@ for extra, expect in [
     ("[observations]\nsigma_px = 0\n", "sigma_px"),
     ("[gcp]\nsigma_m = -1.0\n", "sigma_m"),
 ]:
-    case(
-        C, "mistyped", f"cam-{extra.split(chr(10))[0]}", expect, [("cam.toml", toml_append(extra))]
-    )
+    head, key = extra.split(chr(10))[0], extra.split(chr(10))[1].split(" =")[0]
+    case(C, "mistyped", f"cam-{head}-{key}", expect, [("cam.toml", toml_append(extra))])
 case(
     C,
     "mistyped",
@@ -2588,6 +2587,18 @@ case(
     C, "units", "cam-pixel-in-10-um", "field of view",
     [("cam.toml", toml_set("camera", "pixel_mm", "0.065"))],
 )  # fmt: skip
+# --height far from the ground the strips see (without --squares: 39 instead of 689
+# observations at 1000 m, exit 0 before): the tie points' rays meet near 11 m
+for h in ("1000", "-600", "400"):
+    case(
+        C, "degenerate", f"height-{h}-m-over-ground-at-0-m", "rays of different strips meet",
+        argv=chain(opt("--squares"), opt("--height", h)),
+    )  # fmt: skip
+# the squares' heights 500 m off (another vertical datum?): the mean H_m named
+case(
+    C, "degenerate", "squares-heights-500-m-off", "mean H_m of the squares",
+    [("squares.csv", _csv_frame(lambda df: df.assign(H_m=df["H_m"] + 500.0)))],
+)  # fmt: skip
 # orthorectify: a DSM of three bands (band 1 read as heights, exit 0 before)
 C = "orthorectify-strips"
 
@@ -2756,6 +2767,31 @@ case(
 )  # fmt: skip
 
 
+def _record(case: Case, rc, err: str, lines, tree: dict, left, changed) -> None:
+    """With ``HSGEO_BAD_INPUT_RECORD=FILE``, append what the case did as one JSON line (every
+    property, whichever assertion fails first): bench/issue42_audit.py counts them. ``tree``:
+    the case's folder before the command (``in/`` its inputs), ``changed``: what differs after.
+    """
+    path = os.environ.get("HSGEO_BAD_INPUT_RECORD")
+    if not path:
+        return
+    rec = {
+        "id": case.id,
+        "exit": rc,
+        "traceback": "Traceback" in err or rc == 1,
+        "answer": rc == 0,
+        "inputs_modified": [k for k in changed if k.startswith("in") and tree.get(k) not in
+                            (None, "dir")],
+        "partial_outputs": sorted({str(a) for a in left} | {k for k in changed if
+                                                            k.endswith(".part")}),
+        "folder_changed": len(changed),
+        "one_line": len(lines) == 1,
+        "cause_named": bool(lines) and case.expect.lower() in lines[0].lower(),
+    }  # fmt: skip
+    with open(path, "a", encoding="utf-8") as f:
+        f.write(json.dumps(rec) + "\n")
+
+
 @pytest.mark.parametrize("case", CASES, ids=[c.id for c in CASES])
 def test_bad_input(case: Case, inputs: Inputs, capsys):
     if "readonly" in case.name and os.geteuid() == 0:
@@ -2773,10 +2809,11 @@ def test_bad_input(case: Case, inputs: Inputs, capsys):
     rc, out, err = run_cli(argv, capsys)
     lines = err.splitlines()
     left = [a for a in fresh if os.path.lexists(a)]
-    assert not left, f"output left behind by a failing command: {left}"
     # issue 42: nothing written, changed or removed anywhere in the case's folder
     after = _tree(root)
     changed = sorted(k for k in set(tree) | set(after) if tree.get(k) != after.get(k))
+    _record(case, rc, err, lines, tree, left, changed)
+    assert not left, f"output left behind by a failing command: {left}"
     assert not changed, f"the case's folder changed: {changed[:10]}"
     assert rc == 2, f"exit {rc}; stderr: {err[-2000:]}"
     assert len(lines) == 1, f"{len(lines)} lines on stderr:\n{err[-3000:]}"
@@ -2922,6 +2959,11 @@ BENIGN += [
     ("lp-observations", "strip-stored-last-first", [("s1.nc", _h5_edit(_last_first))], None),
     ("orthorectify-strips", "strip-stored-last-first", [("s1.nc", _h5_edit(_last_first))], None),
     ("orthorectify-strips", "dsm-nodata-corner", [("dsm.tif", _tif_edit(_nodata_corner))], None),
+    # --height instead of the squares: the ground's (about 0 m; the tie points meet at 11 m)
+    # and 150 m off it (8 % of the 1,860 m above ground: the same observations)
+    ("lp-observations", "height-0-without-squares", [],
+     chain(opt("--squares"), opt("--height", "0"))),
+    ("lp-observations", "height-150-m-off", [], chain(opt("--squares"), opt("--height", "150"))),
 ]  # fmt: skip
 
 

@@ -172,13 +172,14 @@ CLASSES = [
      "the navigation's heading is checked against its course over ground (median over the "
      "moving records): opposite → refused naming heading_deg; also adjust-pushbroom "
      "(case adjust-pushbroom:units:nav-heading-180-off)"),
-    ("answer: --height far from the terrain without --squares", "lp-observations", "", "open",
-     "found here (not in the issue): --height 1000 over terrain at 0 m gives 39 instead of "
-     "879 observations, exit 0. Nothing in the inputs states the terrain height; it is "
-     "detectable only from the tie points themselves (their rays' intersections lie at the "
-     "true height), which lp-observations does not triangulate: not mended here. The "
-     "user's check: the count of observations against a run with --squares, or "
-     "adjust-pushbroom's adjusted points' H_m against --height"),
+    ("answer: --height far from the terrain without --squares", "lp-observations",
+     "case:lp-observations:degenerate:height-1000-m-over-ground-at-0-m", "mended",
+     "found here (not in the issue): --height 1000 over terrain at 0 m gave 39 instead of 689 "
+     "observations, exit 0. The tie points' rays of different strips meet at the ground's "
+     "height (least squares, hsgeo.workflows._lp_height): a plane farther from their median "
+     "than 10 % of the height above ground (plus half their 5-95 % spread) is refused naming "
+     "--height (or the squares' mean H_m), the height the rays give and the remedy; benign: "
+     "--height 0 and 150 m off (test_benign_variant)"),
     ("wrong cause: lp-observations with squares that are not in the strips", "lp-observations",
      "case:lp-observations:degenerate:squares-far-off", "mended",
      "an answer without squares (exit 0) before"),

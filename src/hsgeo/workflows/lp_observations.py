@@ -782,6 +782,7 @@ def lp_observation_files(
     from hsgeo.io.navigation import read_line_navigation
     from hsgeo.io.tables import TABLE_FORMATS, write_table
     from hsgeo.validate import check_navigation_covers
+    from hsgeo.workflows._lp_height import check_terrain_height
     from hsgeo.workflows.pushbroom_ba import GCP_COLUMNS
 
     files = [*scenes, *(line_times or ()), trajectory, camera, squares]
@@ -823,5 +824,20 @@ def lp_observation_files(
             "squares' E_m, N_m, H_m in the navigation's frame? (without --squares, give "
             "--height)"
         )
+    _, height = _check(inputs, options)
+    given = (
+        (
+            "--height",
+            "give the mean terrain height in the navigation's frame (--height "
+            "{h:.0f}) or the reference squares (--squares)",
+        )
+        if height_m is not None
+        else (
+            f"the mean H_m of the squares of {str(squares)!r}",
+            "give the squares' heights in the "
+            "navigation's frame and vertical datum, or the mean terrain height (--height {h:.0f})",
+        )
+    )
+    check_terrain_height(res.table, cam, traj, height, *given)
     write_table(output, pd.DataFrame(res.table), inputs=[f for f in files if f is not None])
     return res
