@@ -315,3 +315,41 @@ def test_a_scenario_that_writes_files_needs_its_seed(tmp_path, monkeypatch):
     with pytest.raises(InputError, match=r"mtf_bench.toml: \[scenario\] seed: missing"):
         generate_all(out=tmp_path / "gen")
     assert not any((tmp_path / "gen").iterdir())
+
+
+#: Chapters whose pages read the scene from their scenario file through the library (the
+#: chapter's reproduce module names it: SCENARIO), never by building the dataclass themselves.
+CHAPTER_PAGES_READING_THEIR_SCENARIO = {
+    "asf": ("hsgeo.reproduce.asf", "hsgeo.simulate.asf_runway:RunwayScene"),
+    "mtf": ("hsgeo.reproduce.mtf", "hsgeo.simulate.mtf_target:MtfBench"),
+}
+
+
+@pytest.mark.parametrize("page", sorted(CHAPTER_PAGES_READING_THEIR_SCENARIO))
+def test_a_chapter_page_reads_its_scene_from_the_scenario_file(page):
+    """The page's scene is the run's: ``load_scenario(SCENARIO)`` of its reproduce module (the
+    scenario file), not a ``RunwayScene()`` / ``MtfBench()`` of its own."""
+    import importlib
+    import re
+    from pathlib import Path
+
+    module, target = CHAPTER_PAGES_READING_THEIR_SCENARIO[page]
+    stem = importlib.import_module(module).SCENARIO
+    assert stem in CHAPTER_SCENARIOS and CHAPTER_SCENARIOS[stem][1] == target
+    text = (Path(__file__).parents[1] / "book" / "chapters" / f"{page}.md").read_text("utf-8")
+    cells = "\n".join(re.findall(r"```\{code-cell\}[^\n]*\n(.*?)```", text, re.S))
+    name = target.split(":")[1]
+    assert not re.search(rf"\b{name}\(", cells), f"{page}.md builds {name}() itself"
+    table = CHAPTER_SCENARIOS[stem][0]
+    assert re.search(rf"load_scenario\(SCENARIO\)\.{table}\b", cells), (
+        f"{page}.md does not read load_scenario(SCENARIO).{table}"
+    )
+    src = inspect_source(module)
+    assert "load_scenario(SCENARIO)" in src and f'load_scenario("{stem}")' not in src
+
+
+def inspect_source(module: str) -> str:
+    import importlib
+    import inspect
+
+    return inspect.getsource(importlib.import_module(module))
