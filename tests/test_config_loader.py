@@ -353,3 +353,21 @@ def inspect_source(module: str) -> str:
     import inspect
 
     return inspect.getsource(importlib.import_module(module))
+
+
+def test_the_lp_campaign_scenario_file_is_lpconfig_and_repeats_no_paper_value():
+    """data_synthetic/lp_campaign.toml: [lp] is LpConfig() (so a chapter reading it flies the
+    campaign of the defaults, bit for bit) and leaves 002's values (the geometry, the 1.2 m
+    squares of 002 §4, the tuned mount motion, the blur from 002's speed) to the dataclass."""
+    import tomllib
+
+    from hsgeo.simulate.lp_campaign import LpConfig
+
+    cfg = load_scenario("lp_campaign")
+    assert _same(cfg.lp, LpConfig())
+    keys = tomllib.loads((data_dir() / "lp_campaign.toml").read_text(encoding="utf-8"))["lp"]
+    assert len(keys) >= 5
+    assert not {"campaign", "square_side_m", "mount_motion_rad", "motion_blur_m"} & set(keys)
+    with pytest.raises(InputError, match="dn_per_reflectanse: unknown key; did you mean"):
+        load_dataclass(type(cfg), {"scenario": {"generator": "lp_campaign"},
+                                   "lp": {"dn_per_reflectanse": [1.0]}}, "f")  # fmt: skip
