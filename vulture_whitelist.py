@@ -22,6 +22,9 @@ _cmd_mtf_edge  # src/hsgeo/cli_parsers.py: a handler named in SUBCOMMANDS
 _cmd_cube  # src/hsgeo/cli_parsers.py: a handler named in SUBCOMMANDS
 _cmd_asf  # src/hsgeo/cli_parsers.py: a handler named in SUBCOMMANDS
 _cmd_versions  # src/hsgeo/cli_parsers.py: a handler named in SUBCOMMANDS
+_.sigma_att_deg  # src/hsgeo/workflows/pushbroom_ba.py: read by name from [gnss_ins] (io.sensor_file.present)
+_.n_reflected_columns  # src/hsgeo/io/sensors.py: read_frame_layouts reads the fields of [frame] by name
+_.n_incident_columns  # src/hsgeo/io/sensors.py: read_frame_layouts reads the fields of [frame] by name
 _._start_state  # src/hsgeo/io/cube.py: a hook of dask.callbacks.Callback, called by dask's scheduler
 _._posttask  # src/hsgeo/io/cube.py: a hook of dask.callbacks.Callback, called by dask's scheduler
 _.cornerRefinementMethod  # src/hsgeo/measure/aruco.py: cv2.aruco.DetectorParameters, read by OpenCV

@@ -73,6 +73,24 @@ def test_asf_command_combines_two_opposite_crossings(asf_dir, capsys):
     assert rc == 0 and "two opposite crossings combined" in text
 
 
+def test_asf_files_returns_one_result_type_for_every_input(asf_dir):
+    """The file front end's one result shape: georegistered scans and raw scans (with and
+    without the reverse crossing) all give a FlightsResult whose to_dict has the same keys."""
+    from hsgeo.workflows.asf_flights import FlightsResult, asf_files
+
+    d, _ = asf_dir
+    geo = asf_files(d / "cross.nc", d / "along.nc", d / "runway.csv")
+    argv = raw_argv(d)
+    kw = {"sensor_path": argv[argv.index("--sensor") + 1]}
+    kw["trajectory_path"] = argv[argv.index("--trajectory") + 1]
+    raw = asf_files(argv[1], argv[2], argv[argv.index("--runway") + 1], **kw)
+    for res in (geo, raw):
+        assert type(res) is FlightsResult and res.reverse is None and res.brdf_odd is None
+        assert res.asf is res.cross.asf and res.usable is res.cross.usable
+        assert set(res.geo) == {"cross", "along"}
+    assert geo.to_dict().keys() == raw.to_dict().keys() == geo.cross.to_dict().keys()
+
+
 def test_asf_command_prints_a_table(asf_dir, capsys):
     d, _ = asf_dir
     rc = main(["asf", str(d / "cross.nc"), str(d / "along.nc"), "--runway", str(d / "runway.csv")])

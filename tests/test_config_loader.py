@@ -315,3 +315,59 @@ def test_a_scenario_that_writes_files_needs_its_seed(tmp_path, monkeypatch):
     with pytest.raises(InputError, match=r"mtf_bench.toml: \[scenario\] seed: missing"):
         generate_all(out=tmp_path / "gen")
     assert not any((tmp_path / "gen").iterdir())
+
+
+#: Chapters whose pages read the scene from their scenario file through the library (the
+#: chapter's reproduce module names it: SCENARIO), never by building the dataclass themselves.
+CHAPTER_PAGES_READING_THEIR_SCENARIO = {
+    "asf": ("hsgeo.reproduce.asf", "hsgeo.simulate.asf_runway:RunwayScene"),
+    "mtf": ("hsgeo.reproduce.mtf", "hsgeo.simulate.mtf_target:MtfBench"),
+}
+
+
+@pytest.mark.parametrize("page", sorted(CHAPTER_PAGES_READING_THEIR_SCENARIO))
+def test_a_chapter_page_reads_its_scene_from_the_scenario_file(page):
+    """The page's scene is the run's: ``load_scenario(SCENARIO)`` of its reproduce module (the
+    scenario file), not a ``RunwayScene()`` / ``MtfBench()`` of its own."""
+    import importlib
+    import re
+    from pathlib import Path
+
+    module, target = CHAPTER_PAGES_READING_THEIR_SCENARIO[page]
+    stem = importlib.import_module(module).SCENARIO
+    assert stem in CHAPTER_SCENARIOS and CHAPTER_SCENARIOS[stem][1] == target
+    text = (Path(__file__).parents[1] / "book" / "chapters" / f"{page}.md").read_text("utf-8")
+    cells = "\n".join(re.findall(r"```\{code-cell\}[^\n]*\n(.*?)```", text, re.S))
+    name = target.split(":")[1]
+    assert not re.search(rf"\b{name}\(", cells), f"{page}.md builds {name}() itself"
+    table = CHAPTER_SCENARIOS[stem][0]
+    assert re.search(rf"load_scenario\(SCENARIO\)\.{table}\b", cells), (
+        f"{page}.md does not read load_scenario(SCENARIO).{table}"
+    )
+    src = inspect_source(module)
+    assert "load_scenario(SCENARIO)" in src and f'load_scenario("{stem}")' not in src
+
+
+def inspect_source(module: str) -> str:
+    import importlib
+    import inspect
+
+    return inspect.getsource(importlib.import_module(module))
+
+
+def test_the_lp_campaign_scenario_file_is_lpconfig_and_repeats_no_paper_value():
+    """data_synthetic/lp_campaign.toml: [lp] is LpConfig() (so a chapter reading it flies the
+    campaign of the defaults, bit for bit) and leaves 002's values (the geometry, the 1.2 m
+    squares of 002 §4, the tuned mount motion, the blur from 002's speed) to the dataclass."""
+    import tomllib
+
+    from hsgeo.simulate.lp_campaign import LpConfig
+
+    cfg = load_scenario("lp_campaign")
+    assert _same(cfg.lp, LpConfig())
+    keys = tomllib.loads((data_dir() / "lp_campaign.toml").read_text(encoding="utf-8"))["lp"]
+    assert len(keys) >= 5
+    assert not {"campaign", "square_side_m", "mount_motion_rad", "motion_blur_m"} & set(keys)
+    with pytest.raises(InputError, match="dn_per_reflectanse: unknown key; did you mean"):
+        load_dataclass(type(cfg), {"scenario": {"generator": "lp_campaign"},
+                                   "lp": {"dn_per_reflectanse": [1.0]}}, "f")  # fmt: skip

@@ -2,6 +2,7 @@
 names the file, the column / key and the remedy."""
 
 import os
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
@@ -13,7 +14,7 @@ from hsgeo.io import (
     atomic_path,
     read_board,
     read_camera_toml,
-    read_config,
+    read_dataclass,
     read_dem,
     read_lines,
     read_opencv_storage,
@@ -128,23 +129,26 @@ def test_read_table_missing_and_unreadable(tmp_path):
         read_table(q, COLS)
 
 
-# ---- TOML with a schema
-SCHEMA = {
-    "a": {
-        "x_m": Key("float", required=True),
-        "n": Key("int", default=3),
-        "v": Key("floats", length=2),
-        "kind": Key("str", choices=("one", "two")),
-    }
-}
+# ---- TOML with a schema: the one loader, as the instrument files use it
+@dataclass(frozen=True, kw_only=True)
+class _A:
+    x_m: float
+    n: int = 3
+    v: tuple[float, ...] | None = field(default=None, metadata={"key": Key("floats", length=2)})
+    kind: str | None = field(default=None, metadata={"key": Key("str", choices=("one", "two"))})
 
 
-def test_read_config_round_trip_and_defaults(tmp_path):
+@dataclass(frozen=True, kw_only=True)
+class _File:
+    a: _A
+
+
+def test_read_dataclass_round_trip_and_defaults(tmp_path):
     p = tmp_path / "c.toml"
     p.write_text("[a]\nx_m = 2\nv = [1, 2.5]\nkind = 'two'\n")
-    cfg = read_config(p, SCHEMA)
-    assert cfg == {"a": {"x_m": 2.0, "n": 3, "v": (1.0, 2.5), "kind": "two"}}
-    assert isinstance(cfg["a"]["x_m"], float)
+    cfg = read_dataclass(p, _File)
+    assert cfg == _File(a=_A(x_m=2.0, n=3, v=(1.0, 2.5), kind="two"))
+    assert isinstance(cfg.a.x_m, float)
 
 
 @pytest.mark.parametrize(
@@ -158,14 +162,14 @@ def test_read_config_round_trip_and_defaults(tmp_path):
         ("[a]\nx_m = 1\nv = [1]\n", ["[a] v: needs 2 numbers"]),
         ("[a]\nx_m = 1\nkind = 'tow'\n", ["[a] kind must be one of 'one', 'two'", "'two'?"]),
         ("[a\n", ["malformed TOML"]),
-        ("", ["[a]: missing table"]),
+        ("", ["[a]: missing table; add a [a] table"]),
     ],
 )
-def test_read_config_errors(tmp_path, text, needle):
+def test_read_dataclass_errors(tmp_path, text, needle):
     p = tmp_path / "c.toml"
     p.write_text(text)
     with pytest.raises(InputError) as e:
-        read_config(p, SCHEMA, "test file", required_tables=("a",))
+        read_dataclass(p, _File, "test file")
     msg = str(e.value)
     assert "c.toml" in msg
     for n in needle:

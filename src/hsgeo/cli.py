@@ -337,8 +337,8 @@ def _cmd_asf(args) -> int:
     if args.json:
         print(json_text(out.to_dict()))
         return 0
-    res = getattr(out, "cross", out)
-    for label, r in (("", res), ("reverse crossing: ", getattr(out, "reverse", None))):
+    res = out.cross
+    for label, r in (("", res), ("reverse crossing: ", out.reverse)):
         reg = None if r is None else r.registration
         if reg is not None:
             print(
@@ -346,9 +346,8 @@ def _cmd_asf(args) -> int:
                 f"{reg.shift_m[1]:+.2f}) m (E, N) from {reg.n_windows} windows; scatter between "
                 f"windows {reg.scatter_px:.2f} px, σ̂ of the shift {reg.sigma_px:.3f} px"
             )
-    usable = getattr(out, "usable", res.usable)
-    asf = getattr(out, "asf", res.asf)
-    if getattr(out, "reverse", None) is not None:
+    usable, asf = out.usable, out.asf
+    if out.reverse is not None:
         print("ASF of the two opposite crossings combined (sqrt of their product)")
     print(f"{int(usable.sum())} of {usable.size} columns usable")
     from hsgeo.workflows.asf import peak_to_peak_percent

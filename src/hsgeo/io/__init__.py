@@ -42,7 +42,7 @@ from __future__ import annotations
 
 from hsgeo.io._files import atomic_path, refuse_inputs
 from hsgeo.io.boards import Board, read_board
-from hsgeo.io.config import Key, read_config, read_toml
+from hsgeo.io.config import Key, load_dataclass, read_dataclass, read_toml
 from hsgeo.io.envi import read_envi, write_envi
 from hsgeo.io.envi_read import line_times, open_envi
 from hsgeo.io.line_cube import open_line_strip, read_line_cube, read_line_strips
@@ -89,7 +89,8 @@ __all__ = [
     "RasterTerrain",
     "read_terrain",
     "Key",
-    "read_config",
+    "read_dataclass",
+    "load_dataclass",
     "read_toml",
     "read_sensor",
     "read_sensor_toml",

@@ -21,17 +21,19 @@ Object coordinates are OpenCV's board frame (x right, y down, z into the board).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from hsgeo.errors import InputError
-from hsgeo.io.config import Key, read_config
+from hsgeo.io.config import Key, read_dataclass
 
 __all__ = [
     "Board",
     "OPENCV_TUTORIAL_CHARUCO",
     "LENGTH_UNITS_MM",
-    "BOARD_SCHEMA",
+    "BoardFile",
+    "BoardTable",
+    "BoardCameraTable",
     "read_board",
     "BOARD_TYPES",
 ]
@@ -173,21 +175,45 @@ OPENCV_TUTORIAL_CHARUCO = Board.charuco(5, 7, 40.0, 20.0, "DICT_6X6_250")
 _CHARUCO = ("squares_x", "squares_y", "square_mm", "marker_mm")
 _GRID = ("markers_x", "markers_y", "marker_mm", "separation_mm")
 
-#: The board file: ``[board]`` (keys of its type, lengths in mm) and an optional ``[camera]``.
-BOARD_SCHEMA = {
-    "board": {
-        "type": Key("str", required=True, choices=("charuco", "aruco_grid")),
-        "dictionary": Key("str", required=True, doc="OpenCV ArUco dictionary, e.g. DICT_6X6_250"),
-        "squares_x": Key("int", positive=True, doc="charuco: squares across"),
-        "squares_y": Key("int", positive=True, doc="charuco: squares down"),
-        "square_mm": Key("float", positive=True, doc="charuco: square side, mm"),
-        "markers_x": Key("int", positive=True, doc="aruco_grid: markers across"),
-        "markers_y": Key("int", positive=True, doc="aruco_grid: markers down"),
-        "separation_mm": Key("float", positive=True, doc="aruco_grid: gap between markers, mm"),
-        "marker_mm": Key("float", positive=True, doc="marker side, mm"),
-    },
-    "camera": {"pixel_mm": Key("float", positive=True, limit=1.0, doc="pixel pitch, mm")},
-}
+
+def _key(kind: str, doc: str, **kw):
+    return field(default=None, metadata={"key": Key(kind, doc=doc, positive=True, **kw)})
+
+
+@dataclass(frozen=True, kw_only=True)
+class BoardTable:
+    """The ``[board]`` table of a board file: the type's keys, lengths in mm (the schema
+    :func:`read_board` loads through :func:`hsgeo.io.config.read_dataclass`).
+    """
+
+    type: str = field(metadata={"key": Key("str", choices=BOARD_TYPES, doc="board type")})
+    dictionary: str = field(
+        metadata={"key": Key("str", doc="OpenCV ArUco dictionary, e.g. DICT_6X6_250")}
+    )
+    squares_x: int | None = _key("int", "charuco: squares across")
+    squares_y: int | None = _key("int", "charuco: squares down")
+    square_mm: float | None = _key("float", "charuco: square side, mm")
+    markers_x: int | None = _key("int", "aruco_grid: markers across")
+    markers_y: int | None = _key("int", "aruco_grid: markers down")
+    separation_mm: float | None = _key("float", "aruco_grid: gap between markers, mm")
+    marker_mm: float | None = _key("float", "marker side, mm")
+
+
+@dataclass(frozen=True, kw_only=True)
+class BoardCameraTable:
+    """The optional ``[camera]`` table of a board file."""
+
+    pixel_mm: float | None = _key("float", "pixel pitch, mm", limit=1.0)
+
+
+@dataclass(frozen=True, kw_only=True)
+class BoardFile:
+    """The board file: ``[board]`` (keys of its type, lengths in mm) and an optional
+    ``[camera]``.
+    """
+
+    board: BoardTable
+    camera: BoardCameraTable = BoardCameraTable()
 
 
 def read_board(path) -> Board:
@@ -202,27 +228,26 @@ def read_board(path) -> Board:
     import cv2
 
     path = Path(path)
-    tables = read_config(path, BOARD_SCHEMA, "board file", required_tables=("board",))
-    b = tables["board"]
-    keys, other = (_CHARUCO, _GRID) if b["type"] == "charuco" else (_GRID, _CHARUCO)
-    missing = [k for k in keys if k not in b]
-    stray = [k for k in other if k in b and k not in keys]
+    f = read_dataclass(path, BoardFile, "board file")
+    b = f.board
+    keys, other = (_CHARUCO, _GRID) if b.type == "charuco" else (_GRID, _CHARUCO)
+    missing = [k for k in keys if getattr(b, k) is None]
+    stray = [k for k in other if getattr(b, k) is not None and k not in keys]
     problems = []
     if missing:
-        problems.append(f"[board] of type {b['type']} is missing {', '.join(missing)}; add them")
+        problems.append(f"[board] of type {b.type} is missing {', '.join(missing)}; add them")
     if stray:
         problems.append(
             f"[board] {', '.join(stray)} belong to the other board type; remove them or change type"
         )
-    if not hasattr(cv2.aruco, b["dictionary"]):
+    if not hasattr(cv2.aruco, b.dictionary):
         problems.append(
-            f"[board] dictionary: unknown ArUco dictionary {b['dictionary']!r} (e.g. DICT_6X6_250)"
+            f"[board] dictionary: unknown ArUco dictionary {b.dictionary!r} (e.g. DICT_6X6_250)"
         )
     if problems:
         raise InputError(f"board file {path}: " + "; ".join(problems))
-    pixel = tables["camera"].get("pixel_mm")
-    make = Board.charuco if b["type"] == "charuco" else Board.aruco_grid
+    make = Board.charuco if b.type == "charuco" else Board.aruco_grid
     try:
-        return make(*(b[k] for k in keys), b["dictionary"], pixel)
+        return make(*(getattr(b, k) for k in keys), b.dictionary, f.camera.pixel_mm)
     except InputError as exc:
         raise InputError(f"board file {path}: {exc}; correct [board]") from None

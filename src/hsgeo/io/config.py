@@ -15,15 +15,15 @@ becomes an instance of it::
 
     cfg = read_dataclass("flight.toml", Scenario, "scenario")   # cfg.flight.height_agl_m
 
-Instrument files whose tables are read into plain values use the older form, a schema that
-maps table names to :class:`Key` descriptions::
-
-    SCHEMA = {"sensor": {"c_px": Key("float", required=True, doc="principal distance, px")}}
-
-:func:`read_config` checks a file against it and returns plain values (floats, ints, strings,
-tuples of floats) with the defaults filled in. Every problem of the file is reported at once, in
-one :class:`~hsgeo.InputError` that names the file, the table and the key, and says what to do
-(``[sensor] borsight_deg: unknown key; did you mean 'boresight_deg'?``).
+Every file of the package goes through it: the scenarios (:mod:`hsgeo.simulate.scenarios`), the
+sensor files (:mod:`hsgeo.io.sensor_file`, one dataclass per model), the board, bar and
+instrument files. A reader whose file holds one of several schemas (the sensor file names its
+model) reads the TOML with :func:`read_toml`, picks the dataclass and hands the mapping to
+:func:`load_dataclass`. Every problem of the file is reported at once, in one
+:class:`~hsgeo.InputError` that names the file, the table and the key, and says what to do
+(``[sensor] borsight_deg: unknown key; did you mean 'boresight_deg'?``). An optional key
+without a default is a field ``X | None = None``; a table that must be present is a dataclass
+field without a default (``[board]: missing table; add a [board] table``).
 """
 
 from __future__ import annotations
@@ -40,7 +40,6 @@ from hsgeo.validate import unit_limits
 __all__ = [
     "Key",
     "read_toml",
-    "read_config",
     "read_dataclass",
     "load_dataclass",
     "closest",
@@ -52,17 +51,15 @@ _KINDS = ("float", "int", "str", "floats", "ints", "bool")
 
 @dataclass(frozen=True)
 class Key:
-    """One key of a configuration table.
+    """How a field of a configuration dataclass is checked: its kind, unit and limits
+    (``field(metadata={"key": Key(...)})``; whether the key is required and its default are
+    the field's own).
 
     Attributes
     ----------
     kind : {"float", "int", "str", "floats", "ints", "bool"}
         ``"floats"`` is an array of numbers, ``"ints"`` one of whole numbers (of ``length``
         entries, if given).
-    required : bool
-        A missing required key is an error.
-    default : object, optional
-        Value of an absent optional key; ``None``: the key is left out of the result.
     doc : str
         What the value is, with its unit (shown in error messages).
     choices : tuple of str
@@ -77,8 +74,6 @@ class Key:
     """
 
     kind: str
-    required: bool = False
-    default: object = None
     doc: str = ""
     choices: tuple = ()
     length: int | None = None
@@ -190,79 +185,6 @@ def _with_unit_limit(key: Key, name: str) -> Key:
     return key
 
 
-def read_config(
-    path,
-    schema: Mapping[str, Mapping[str, Key]],
-    what: str = "file",
-    *,
-    required_tables: tuple[str, ...] = (),
-) -> dict[str, dict]:
-    """Read a TOML file and check it against ``schema``.
-
-    Parameters
-    ----------
-    path : str or Path
-    schema : mapping of table name to mapping of key name to :class:`Key`
-    what : str
-        The file's role, for messages (``"sensor file"``).
-    required_tables : tuple of str
-        Tables that must be present.
-
-    Returns
-    -------
-    dict of dict
-        One dict per table of the schema (empty if absent): the file's values converted to
-        float / int / str / tuple of float, and the defaults of absent keys.
-
-    Raises
-    ------
-    InputError
-        One error listing every problem: unknown tables or keys (with the closest known name),
-        missing required keys, values of the wrong type, NaN or infinite numbers.
-    """
-    path = Path(path)
-    cfg = read_toml(path, what)
-    problems: list[str] = []
-    out: dict[str, dict] = {t: {} for t in schema}
-    for t, table in cfg.items():
-        if t not in schema:
-            problems.append(
-                f"[{t}]: unknown table{did_you_mean(t, schema)} (known: "
-                f"{', '.join(f'[{s}]' for s in schema)})"
-            )
-        elif not isinstance(table, dict):
-            problems.append(f"{t}: must be a table [{t}], got a value {table!r}")
-    for t in required_tables:
-        if t not in cfg:
-            problems.append(f"[{t}]: missing table; add a [{t}] table")
-    for t, keys in schema.items():
-        table = cfg.get(t)
-        if not isinstance(table, dict):
-            table = {}
-        for k in table:
-            if k not in keys:
-                problems.append(
-                    f"[{t}] {k}: unknown key{did_you_mean(k, keys)} (known: {', '.join(keys)})"
-                )
-        for k, key in keys.items():
-            where = f"[{t}] {k}"
-            key = _with_unit_limit(key, k)
-            if k in table:
-                v = _value(table[k], key, where, problems)
-                if v is not None:
-                    out[t][k] = v
-            elif key.required:
-                if t in cfg or t not in required_tables:
-                    problems.append(
-                        f"{where}: missing; add `{k} = ...`" + (f" ({key.doc})" if key.doc else "")
-                    )
-            elif key.default is not None:
-                out[t][k] = key.default
-    if problems:
-        raise InputError(f"{what} {path}: " + "; ".join(problems))
-    return out
-
-
 _SCALAR_KINDS = {float: "float", int: "int", str: "str", bool: "bool"}
 
 
@@ -292,6 +214,17 @@ def _field_kind(hint) -> tuple[str | None, type | None, bool]:
         if args and args[0] in (float, int):
             return ("floats" if args[0] is float else "ints"), None, optional
     raise TypeError(f"unsupported configuration type {hint!r}")
+
+
+def _required_fields(cls) -> list[str]:
+    """The fields of the dataclass ``cls`` without a default (the keys a table must give)."""
+    import dataclasses
+
+    return [
+        f.name
+        for f in dataclasses.fields(cls)
+        if f.init and f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
+    ]
 
 
 def _load(cls, table: Mapping, path: str, problems: list):
@@ -324,6 +257,8 @@ def _load(cls, table: Mapping, path: str, problems: list):
         here = f"{path}.{f.name}" if path else f.name
         if f.name not in table:
             if sub is not None and not has_default and not optional:
+                if _required_fields(sub):
+                    problems.append(f"[{here}]: missing table; add a [{here}] table")
                 kwargs[f.name] = _load(sub, {}, here, problems)
             elif not has_default:
                 doc = f.metadata.get("key", Key("str")).doc

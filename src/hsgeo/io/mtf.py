@@ -21,17 +21,20 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 import numpy as np
 
 from hsgeo.errors import InputError
 from hsgeo.io._files import atomic_path, check_input_file
-from hsgeo.io.config import Key, read_config
+from hsgeo.io.config import Key, read_dataclass
 from hsgeo.io.tables import read_table
 
 __all__ = [
-    "BARS_SCHEMA",
+    "BarsFile",
+    "BarsTargetTable",
+    "BarsProfileTable",
     "read_bars",
     "read_profiles",
     "read_gray_image",
@@ -40,43 +43,68 @@ __all__ = [
     "write_columns",
 ]
 
-BARS_SCHEMA = {
-    "target": {
-        "pair_mm": Key("floats", required=True, positive=True, doc="pair width per group, mm"),
-        "n_pairs": Key("floats", required=True, positive=True, doc="pairs per group"),
-        "white_reflectance": Key("float", required=True, positive=True, limit=10.0),
-        "black_reflectance": Key("float", required=True, limit=10.0),
-    },
-    "profile": {
-        "gsd_mm": Key("float", required=True, positive=True, doc="GSD along the line, mm"),
-        "start_px": Key("float", required=True, doc="start of the target on the profile, px"),
-        "dark_dn": Key("float", default=0.0, doc="dark level, DN"),
-        "saturation_dn": Key("float", default=4095.0, positive=True, doc="saturation, DN"),
-    },
-}
+
+def _key(kind: str, doc: str, **kw):
+    return {"key": Key(kind, doc=doc, **kw)}
+
+
+@dataclass(frozen=True, kw_only=True)
+class BarsTargetTable:
+    """``[target]`` of the bar file: the bar groups and the two reflectances."""
+
+    pair_mm: tuple[float, ...] = field(
+        metadata=_key("floats", "pair width per group, mm", positive=True)
+    )
+    n_pairs: tuple[float, ...] = field(metadata=_key("floats", "pairs per group", positive=True))
+    white_reflectance: float = field(
+        metadata=_key("float", "reflectance of the white bars", positive=True, limit=10.0)
+    )
+    black_reflectance: float = field(
+        metadata=_key("float", "reflectance of the black bars", limit=10.0)
+    )
+
+
+@dataclass(frozen=True, kw_only=True)
+class BarsProfileTable:
+    """``[profile]`` of the bar file: where the target lies on a profile and its levels."""
+
+    gsd_mm: float = field(metadata=_key("float", "GSD along the line, mm", positive=True))
+    start_px: float = field(metadata=_key("float", "start of the target on the profile, px"))
+    dark_dn: float = field(default=0.0, metadata=_key("float", "dark level, DN"))
+    saturation_dn: float = field(
+        default=4095.0, metadata=_key("float", "saturation, DN", positive=True)
+    )
+
+
+@dataclass(frozen=True, kw_only=True)
+class BarsFile:
+    """The bar file of ``hsgeo mtf`` (the schema :func:`read_bars` loads)."""
+
+    target: BarsTargetTable
+    profile: BarsProfileTable
 
 
 def read_bars(path):
-    """The bar file: ``(BarTarget, profile settings dict)``."""
+    """The bar file: ``(BarTarget, BarsProfileTable)``."""
     from hsgeo.mtf import BarTarget
 
-    tables = read_config(path, BARS_SCHEMA, "bar file", required_tables=("target", "profile"))
-    t = tables["target"]
-    if len(t["pair_mm"]) != len(t["n_pairs"]):
+    f = read_dataclass(path, BarsFile, "bar file")
+    t = f.target
+    if len(t.pair_mm) != len(t.n_pairs):
         raise InputError(
-            f"bar file {path}: [target] pair_mm has {len(t['pair_mm'])} groups, n_pairs "
-            f"{len(t['n_pairs'])}; give one pair count per pair width"
+            f"bar file {path}: [target] pair_mm has {len(t.pair_mm)} groups, n_pairs "
+            f"{len(t.n_pairs)}; give one pair count per pair width"
         )
     try:
         target = BarTarget(
-            tuple(t["pair_mm"]),
-            tuple(int(n) if float(n).is_integer() else n for n in t["n_pairs"]),
-            white_reflectance=t["white_reflectance"],
-            black_reflectance=t["black_reflectance"],
+            tuple(t.pair_mm),
+            tuple(int(n) if float(n).is_integer() else n for n in t.n_pairs),
+            white_reflectance=t.white_reflectance,
+            black_reflectance=t.black_reflectance,
         )
     except InputError as exc:
         raise InputError(f"bar file {path}: [target] {exc}") from None
-    return target, tables["profile"]
+    return target, f.profile
 
 
 def read_profiles(path) -> dict:
@@ -132,7 +160,7 @@ def write_bars(path, target, profile: dict) -> Path:
     """Write the bar file (``[target]`` from a :class:`~hsgeo.mtf.BarTarget`, ``[profile]`` from
     ``profile``: gsd_mm, start_px, dark_dn, saturation_dn) atomically.
     """
-    unknown = set(profile) - set(BARS_SCHEMA["profile"])
+    unknown = set(profile) - {f.name for f in fields(BarsProfileTable)}
     if unknown:
         raise InputError(f"unknown [profile] keys {sorted(unknown)}")
     text = (

@@ -1,7 +1,8 @@
 """The one sensor file: ``[sensor] model = "..."`` read through a registry of models.
 
-Kept as one file: the registry (each model's keys and builder) and its one reader are one
-concern; a new model adds its entry here.
+The registry (each model's schema and builder) and its one reader are one concern: a new model
+adds its entry here and its schema, a frozen dataclass of its keys, in
+:mod:`hsgeo.io.sensor_schemas`.
 
 :func:`read_sensor` is the one way a sensor file becomes a sensor of :mod:`hsgeo.sensors`
 (the face of :mod:`hsgeo.sensors.mount`: ``rays`` / ``project``). The file names its model;
@@ -35,7 +36,7 @@ The files each command read before are recognised:
   frame layout) are refused: they say what an instrument records, not its geometry, and the
   message spells out the sensor file to write.
 
-**A mount in the wrong units is refused.** A lever arm beyond :data:`MAX_LEVER_ARM_M` (10 m)
+**A mount in the wrong units is refused.** A lever arm beyond :data:`~hsgeo.io.sensor_schemas.MAX_LEVER_ARM_M` (10 m)
 is taken for millimetres or centimetres. A boresight under ``boresight_deg`` whose every
 non-zero angle, read as radians, is a round number of degrees (a multiple of 0.001° to 1e-9)
 while the value itself is not a round number (not a multiple of 0.001) is taken for radians
@@ -46,31 +47,37 @@ hand are not detected (0.0052 "degrees" is a valid 19″ boresight).
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields, make_dataclass, replace
 from types import MappingProxyType
 
 import numpy as np
 
 from hsgeo.errors import InputError
-from hsgeo.io.config import Key, did_you_mean, read_config, read_toml
+from hsgeo.io.config import did_you_mean, load_dataclass, read_toml
+from hsgeo.io.sensor_schemas import (
+    PUSHBROOM_PRIOR_TABLES,
+    FrameOpenCVKeys,
+    LineScannerKeys,
+    LineScannerLinearKeys,
+    PanoramicKeys,
+    PushbroomKeys,
+    RikolaKeys,
+    ViewAngleKeys,
+    present,
+)
+from hsgeo.sensors.panoramic import PanoramicScanner
+from hsgeo.sensors.rikola import RikolaCamera
 
 __all__ = [
     "SensorModel",
     "MODELS",
     "ALIASES",
-    "MAX_LEVER_ARM_M",
     "read_sensor",
     "read_sensor_tables",
+    "read_sensor_file",
     "model_of",
     "sensor_toml",
-    "BODY",
-    "PUSHBROOM_PRIOR_TABLES",
-    "PUSHBROOM_KEYS",
 ]
-
-#: The largest lever arm taken as metres: no airborne or bench sensor sits 10 m from its
-#: navigation reference point; beyond, the numbers are millimetres or centimetres.
-MAX_LEVER_ARM_M = 10.0
 
 
 @dataclass(frozen=True)
@@ -83,10 +90,12 @@ class SensorModel:
         The ``[sensor] model`` of the file.
     doc : str
         What the model is, with the paper and equation.
-    keys : mapping of str to Key
-        The keys of ``[sensor]`` (besides ``model``).
+    schema : type
+        The frozen dataclass whose fields are the keys of ``[sensor]`` (besides ``model``):
+        the file's ``[sensor]`` table is loaded into it by the one loader
+        (:func:`hsgeo.io.config.load_dataclass`).
     build : callable
-        ``build(values: dict, where: str) -> sensor``, ``values`` the checked keys.
+        ``build(values, where: str) -> sensor``, ``values`` the loaded ``schema`` instance.
     cls : type
         The sensor class built.
     example : dict
@@ -94,113 +103,123 @@ class SensorModel:
     kind : {"scanning", "frame"}
         How the sensor moves: ``rays(pixels, t_s, trajectory)`` or ``rays(pixels, poses,
         view)``.
-    tables : mapping
-        Further tables the file may hold (read by a command, not part of the sensor).
+    tables : mapping of str to type
+        Further tables the file may hold (read by a command, not part of the sensor), each a
+        frozen dataclass whose every key is optional.
+    relative_files : tuple of str
+        Keys holding a file name relative to the sensor file (resolved before ``build``).
     """
 
     name: str
     doc: str
-    keys: Mapping[str, Key]
+    schema: type
     build: Callable
     cls: type
     example: dict
     kind: str = "scanning"
-    tables: Mapping[str, Mapping[str, Key]] = field(default_factory=dict)
-    #: keys holding a file name relative to the sensor file (resolved before ``build``)
+    tables: Mapping[str, type] = field(default_factory=dict)
     relative_files: tuple = ()
 
+    @property
+    def keys(self) -> tuple[str, ...]:
+        """The key names of ``[sensor]`` (the fields of :attr:`schema`)."""
+        return tuple(f.name for f in fields(self.schema))
 
-def _mount_keys(frame: str) -> dict:
-    return {
-        "lever_arm_m": Key(
-            "floats",
-            length=3,
-            default=(0.0, 0.0, 0.0),
-            limit=MAX_LEVER_ARM_M,
-            doc=f"lever arm, projection centre in the {frame} frame, m (not mm)",
-        ),
-        "boresight_deg": Key(
-            "floats",
-            length=3,
-            default=(0.0, 0.0, 0.0),
-            doc="roll, pitch, heading of R_body_from_sensor, degrees",
-        ),
-    }
+    def file_schema(self, table: str = "sensor") -> type:
+        """The frozen dataclass of the whole file: ``[table]`` (the schema) and the optional
+        :attr:`tables`.
+        """
+        return _file_schema(self, table)
 
 
-BODY = "body (x forward, y right, z down)"
+_FILE_SCHEMAS: dict = {}
+
+
+def _file_schema(model: SensorModel, table: str) -> type:
+    key = (model.name, table)
+    if key not in _FILE_SCHEMAS:
+        parts = [(table, model.schema)] + [
+            (t, cls, field(default=cls())) for t, cls in model.tables.items()
+        ]
+        name = f"{model.schema.__name__.removesuffix('Keys')}File"
+        _FILE_SCHEMAS[key] = make_dataclass(name, parts, frozen=True, kw_only=True)
+    return _FILE_SCHEMAS[key]
 
 
 def _mount(v):
     from hsgeo.sensors.mount import Mount
 
-    return Mount.from_rpy(np.deg2rad(v["boresight_deg"]), v["lever_arm_m"])
+    return Mount.from_rpy(np.deg2rad(v.boresight_deg), v.lever_arm_m)
 
 
 def _line(v, where):
     from hsgeo.sensors.line import CalibratedLine, LineScanner
 
-    return LineScanner(CalibratedLine(v["zeta0_px"], v["c_px"], tuple(v["K"])), _mount(v))
+    return LineScanner(CalibratedLine(v.zeta0_px, v.c_px, tuple(v.K)), _mount(v))
 
 
 def _line_ifov(v, where):
     from hsgeo.sensors.line import LinearIFOV, LineScanner
 
-    return LineScanner(LinearIFOV(v["zeta0_px"], v["c_px"]), _mount(v))
+    return LineScanner(LinearIFOV(v.zeta0_px, v.c_px), _mount(v))
+
+
+def _or(value, default):
+    return default if value is None else value
 
 
 def _pushbroom(v, where):
     from hsgeo.sensors.pushbroom import PushbroomCamera
 
-    c = v.get("c_band_mm", (v["c_mm"],) * v["n_bands"])
-    if len(c) != v["n_bands"]:
+    c = _or(v.c_band_mm, (v.c_mm,) * v.n_bands)
+    if len(c) != v.n_bands:
         raise InputError(
-            f"{where}: c_band_mm has {len(c)} values for n_bands = {v['n_bands']}; give one "
+            f"{where}: c_band_mm has {len(c)} values for n_bands = {v.n_bands}; give one "
             "principal distance per band"
         )
     return PushbroomCamera(
         tuple(c),
-        v["pixel_mm"],
-        tuple(v.get("distortion", (0.0, 0.0, 0.0, 0.0))),
-        v.get("x0_mm", 0.0),
-        v.get("y0_mm", 0.0),
-        tuple(float(x) for x in np.deg2rad(v.get("boresight_deg", (0.0, 0.0, 0.0)))),
-        tuple(v.get("lever_arm_m", (0.0, 0.0, 0.0))),
+        v.pixel_mm,
+        tuple(_or(v.distortion, (0.0, 0.0, 0.0, 0.0))),
+        _or(v.x0_mm, 0.0),
+        _or(v.y0_mm, 0.0),
+        tuple(float(x) for x in np.deg2rad(_or(v.boresight_deg, (0.0, 0.0, 0.0)))),
+        tuple(_or(v.lever_arm_m, (0.0, 0.0, 0.0))),
     )
 
 
 def _panoramic(v, where):
     from hsgeo.sensors.panoramic import PanoramicScanner
 
-    return PanoramicScanner(v["n_px"], v["ifov_deg"], _mount(v), v["active_fraction"])
+    return PanoramicScanner(v.n_px, v.ifov_deg, _mount(v), v.active_fraction)
 
 
 def _frame(v, where):
     from hsgeo.sensors.frame import FrameCamera
 
-    intr = (v["fx_px"], v["fy_px"], v["cx_px"], v["cy_px"])
-    size = v.get("image_size_px")
+    intr = (v.fx_px, v.fy_px, v.cx_px, v.cy_px)
+    size = v.image_size_px
     if size is not None and not all(float(x).is_integer() for x in size):
         raise InputError(f"{where}: image_size_px = {list(size)} must be whole pixels (w, h)")
     size = None if size is None else tuple(int(x) for x in size)
-    return FrameCamera(intr, tuple(v["distortion"]), _mount(v), size)
+    return FrameCamera(intr, tuple(v.distortion), _mount(v), size)
 
 
 def _view_angle(v, where):
     from hsgeo.io.view_angles import read_view_angles
     from hsgeo.sensors.view_angle import ViewAngleScanner
 
-    if ("angles_csv" in v) == ("across_deg" in v):
+    if (v.angles_csv is not None) == (v.across_deg is not None):
         raise InputError(
             f"{where}: give the view angles either as angles_csv (a CSV beside the sensor file, "
             "columns pixel, across_deg, along_deg[, band]) or as across_deg (and along_deg) "
             "lists, not both or neither"
         )
-    if "angles_csv" in v:
-        across, along = read_view_angles(v["angles_csv"])
+    if v.angles_csv is not None:
+        across, along = read_view_angles(v.angles_csv)
     else:
-        across = np.asarray(v["across_deg"], float)
-        along = np.asarray(v.get("along_deg", np.zeros_like(across)), float)
+        across = np.asarray(v.across_deg, float)
+        along = np.asarray(_or(v.along_deg, np.zeros_like(across)), float)
         if along.shape != across.shape:
             raise InputError(
                 f"{where}: along_deg has {along.size} values for {across.size} pixels "
@@ -213,10 +232,8 @@ def _view_angle(v, where):
 
 
 def _rikola(v, where):
-    from hsgeo.sensors.rikola import RikolaCamera
-
-    f, s = v["f_band_mm"], v["band_sensor"]
-    bands = v.get("bands")
+    f, s = v.f_band_mm, v.band_sensor
+    bands = v.bands
     problems = []
     if len(s) != len(f):
         problems.append(f"band_sensor has {len(s)} values for {len(f)} bands (f_band_mm)")
@@ -233,58 +250,16 @@ def _rikola(v, where):
     return RikolaCamera(
         tuple(f),
         tuple(int(x) for x in s),
-        (tuple(v["pp_I_mm"]), tuple(v["pp_II_mm"])),
-        tuple(v["distortion"]),
-        tuple(float(x) for x in np.deg2rad(v["rotation_deg"])),
-        tuple(v["offset_mm"]),
-        tuple(int(x) for x in v["image_size_px"]),
-        v["pixel_mm"],
+        (tuple(v.pp_I_mm), tuple(v.pp_II_mm)),
+        tuple(v.distortion),
+        tuple(float(x) for x in np.deg2rad(v.rotation_deg)),
+        tuple(v.offset_mm),
+        tuple(int(x) for x in v.image_size_px),
+        v.pixel_mm,
         None if bands is None else tuple(int(b) for b in bands),
         _mount(v),
     )
 
-
-_LINE_KEYS = {
-    "zeta0_px": Key("float", required=True, limit=1e5, doc="principal point ζ0 on the line, px"),
-    "c_px": Key("float", required=True, positive=True, doc="principal distance, px"),
-}
-#: The priors of ``hsgeo adjust-pushbroom`` a 002 camera file may carry (tables of the file).
-PUSHBROOM_PRIOR_TABLES = {
-    "gnss_ins": {
-        "sigma_pos_m": Key("floats", length=3, positive=True, doc="σ of E, N, H, m"),
-        "sigma_att_deg": Key(
-            "floats", length=3, positive=True, doc="σ of roll, pitch, yaw, degrees"
-        ),
-    },
-    "observations": {"sigma_px": Key("float", positive=True, doc="σ of an image coordinate, px")},
-    "gcp": {"sigma_m": Key("float", positive=True, doc="σ of a GCP coordinate, m")},
-}
-#: The keys of the 002 camera (model ``pushbroom``, and the former ``[camera]`` table).
-PUSHBROOM_KEYS = {
-    "n_bands": Key("int", required=True, positive=True, doc="number of bands"),
-    "pixel_mm": Key(
-        "float", required=True, positive=True, limit=1.0, doc="pixel pitch, mm (at most 1)"
-    ),
-    "c_mm": Key("float", required=True, positive=True, limit=2000.0, doc="principal distance, mm"),
-    "x0_mm": Key("float", limit=100.0, doc="principal point x on the detector, mm"),
-    "y0_mm": Key("float", limit=100.0, doc="principal point y on the detector, mm"),
-    "lever_arm_m": Key(
-        "floats",
-        length=3,
-        limit=MAX_LEVER_ARM_M,
-        doc="lever arm in the platform frame (x forward, y left, z up), m, not mm",
-    ),
-    "sigma_lever_m": Key(
-        "float", positive=True, limit=10.0, doc="σ of the measured lever arm, m (adjust prior)"
-    ),
-    "c_band_mm": Key("floats", positive=True, doc="principal distance of each band, mm"),
-    "distortion": Key(
-        "floats", length=4, doc="K1 (mm^-2), K2 (mm^-4), P1, P2 (mm^-1) of 002 eq. (3)"
-    ),
-    "boresight_deg": Key(
-        "floats", length=3, doc="omega, phi, kappa of the boresight on the nominal mount, deg"
-    ),
-}
 
 MODELS: Mapping[str, SensorModel] = {}
 
@@ -296,25 +271,14 @@ def _register(m: SensorModel) -> None:
 def _models():
     from hsgeo.sensors.frame import FrameCamera
     from hsgeo.sensors.line import LineScanner
-    from hsgeo.sensors.panoramic import DAEDALUS_IFOV_DEG, DAEDALUS_N_PX, PanoramicScanner
     from hsgeo.sensors.pushbroom import PushbroomCamera
-    from hsgeo.sensors.rikola import RikolaCamera
     from hsgeo.sensors.view_angle import ViewAngleScanner
 
     _register(
         SensorModel(
             "line-scanner",
             "the 000 line scanner, calibrated: 000 eq. (2) (hsgeo.sensors.line.CalibratedLine)",
-            {
-                **_LINE_KEYS,
-                "K": Key(
-                    "floats",
-                    length=3,
-                    default=(0.0, 0.0, 0.0),
-                    doc="K1..K3 of 000 eq. (2), px per (100 px)^(3, 5, 7)",
-                ),
-                **_mount_keys(BODY),
-            },
+            LineScannerKeys,
             _line,
             LineScanner,
             {"zeta0_px": 486.8, "c_px": 3539.0, "K": [1.459, -0.1636, 0.00526]},  # 000 Table 1
@@ -324,7 +288,7 @@ def _models():
         SensorModel(
             "line-scanner-linear-ifov",
             "the 000 line scanner, uncalibrated: view angle linear in the pixel (LinearIFOV)",
-            {**_LINE_KEYS, **_mount_keys(BODY)},
+            LineScannerLinearKeys,
             _line_ifov,
             LineScanner,
             {"zeta0_px": 485.0, "c_px": 3600.0},
@@ -334,7 +298,7 @@ def _models():
         SensorModel(
             "pushbroom",
             "the 002 LP camera: 002 eq. (2)-(4) (hsgeo.sensors.pushbroom.PushbroomCamera)",
-            PUSHBROOM_KEYS,
+            PushbroomKeys,
             _pushbroom,
             PushbroomCamera,
             {
@@ -353,20 +317,7 @@ def _models():
         SensorModel(
             "panoramic",
             "the 004 panoramic (whiskbroom) scanner (hsgeo.sensors.panoramic.PanoramicScanner)",
-            {
-                "n_px": Key("int", default=DAEDALUS_N_PX, positive=True, doc="pixels per scan"),
-                "ifov_deg": Key(
-                    "float", default=DAEDALUS_IFOV_DEG, positive=True, doc="angular pixel, deg"
-                ),
-                "active_fraction": Key(
-                    "float",
-                    default=2 * 43.0 / 360.0,
-                    positive=True,
-                    limit=1.0,
-                    doc="share of the line period the mirror sweeps the pixels",
-                ),
-                **_mount_keys(BODY),
-            },
+            PanoramicKeys,
             _panoramic,
             PanoramicScanner,
             {"n_px": 716, "ifov_deg": 0.12, "boresight_deg": [0.2, -0.1, 0.3]},
@@ -376,22 +327,7 @@ def _models():
         SensorModel(
             "frame-opencv",
             "a frame camera in OpenCV's form (hsgeo.sensors.frame.FrameCamera)",
-            {
-                "fx_px": Key("float", required=True, positive=True, doc="focal length x, px"),
-                "fy_px": Key("float", required=True, positive=True, doc="focal length y, px"),
-                "cx_px": Key("float", required=True, doc="principal point x, px"),
-                "cy_px": Key("float", required=True, doc="principal point y, px"),
-                "distortion": Key(
-                    "floats",
-                    length=5,
-                    default=(0.0, 0.0, 0.0, 0.0, 0.0),
-                    doc="k1, k2, p1, p2, k3 (OpenCV order)",
-                ),
-                "image_size_px": Key(
-                    "floats", length=2, positive=True, doc="w, h of the frames, px (optional)"
-                ),
-                **_mount_keys("body"),
-            },
+            FrameOpenCVKeys,
             _frame,
             FrameCamera,
             {
@@ -408,48 +344,7 @@ def _models():
         SensorModel(
             "rikola",
             "the 003 Rikola two-sensor frame camera (hsgeo.sensors.rikola.RikolaCamera)",
-            {
-                "f_band_mm": Key("floats", required=True, positive=True, doc="f of each band, mm"),
-                "band_sensor": Key(
-                    "floats", required=True, positive=True, doc="sensor of each band: 1 or 2"
-                ),
-                "bands": Key("floats", positive=True, doc="band numbers (default 1, 2, ...)"),
-                "pp_I_mm": Key("floats", length=2, required=True, doc="x0, y0 of sensor I, mm"),
-                "pp_II_mm": Key("floats", length=2, required=True, doc="x0, y0 of sensor II, mm"),
-                "distortion": Key(
-                    "floats",
-                    length=5,
-                    default=(0.0, 0.0, 0.0, 0.0, 0.0),
-                    doc="K1 (mm^-2), K2 (mm^-4), K3 (mm^-6), P1, P2 (mm^-1)",
-                ),
-                "rotation_deg": Key(
-                    "floats",
-                    length=3,
-                    default=(0.0, 0.0, 0.0),
-                    doc="omega, phi, kappa of R_I_from_II, deg",
-                ),
-                "offset_mm": Key(
-                    "floats",
-                    length=3,
-                    default=(0.0, 0.0, 0.0),
-                    doc="sensor II's centre in sensor I's frame, mm",
-                ),
-                "image_size_px": Key(
-                    "floats",
-                    length=2,
-                    default=tuple(float(n) for n in RikolaCamera.image_size),
-                    positive=True,
-                    doc="w, h, px",
-                ),
-                "pixel_mm": Key(
-                    "float",
-                    default=RikolaCamera.pixel_mm,
-                    positive=True,
-                    limit=1.0,
-                    doc="pixel pitch, mm",
-                ),
-                **_mount_keys("body"),
-            },
+            RikolaKeys,
             _rikola,
             RikolaCamera,
             {
@@ -471,15 +366,7 @@ def _models():
             "view-angle",
             "a line scanner given by per-pixel view angles, one table or one per band "
             "(hsgeo.sensors.view_angle.ViewAngleScanner; table: hsgeo.io.view_angles)",
-            {
-                "angles_csv": Key(
-                    "str",
-                    doc="CSV beside the sensor file: pixel, across_deg, along_deg[, band]",
-                ),
-                "across_deg": Key("floats", limit=89.0, doc="across-track angle per pixel, deg"),
-                "along_deg": Key("floats", limit=89.0, doc="along-track angle per pixel, deg"),
-                **_mount_keys(BODY),
-            },
+            ViewAngleKeys,
             _view_angle,
             ViewAngleScanner,
             {
@@ -533,20 +420,20 @@ def _instrument_refusal(path, cfg) -> InputError:
     )
 
 
-def read_sensor_tables(path, what: str = "sensor file") -> tuple[str, dict, str]:
-    """The model name and the checked tables of a sensor file (the 002 ``[camera]`` file as
-    model ``pushbroom``): ``(model, {"sensor": values, other tables ...}, table)``, ``table``
-    the name of the sensor's table in the file (``"sensor"``, or ``"camera"``).
+def read_sensor_file(path, what: str = "sensor file"):
+    """A sensor file loaded into its model's schema: ``(model, file, table)``.
 
-    The tables besides ``[sensor]`` are those the model allows (the priors of ``hsgeo
-    adjust-pushbroom`` for ``pushbroom``), empty dicts when absent.
+    ``file`` is an instance of ``MODELS[model].file_schema(table)``: ``getattr(file, table)``
+    the sensor's keys (an instance of the model's :attr:`SensorModel.schema`), the further
+    tables (the priors of ``hsgeo adjust-pushbroom`` for ``pushbroom``) beside it; ``table``
+    is the name of the sensor's table in the file (``"sensor"``, or ``"camera"`` for the 002
+    camera file, read as model ``pushbroom``). The file is read by :func:`read_toml` and
+    loaded by :func:`~hsgeo.io.config.load_dataclass` once its model is known.
     """
     cfg = read_toml(path, what)
     if "camera" in cfg and "sensor" not in cfg:  # the 002 camera file of adjust-pushbroom
-        schema = {"camera": PUSHBROOM_KEYS, **PUSHBROOM_PRIOR_TABLES}
-        out = read_config(path, schema, what, required_tables=("camera",))
-        out["sensor"] = out.pop("camera")
-        _check_mount(path, "camera", out["sensor"])
+        out = load_dataclass(MODELS["pushbroom"].file_schema("camera"), cfg, f"{what} {path}")
+        _check_mount(path, "camera", out.camera)
         return "pushbroom", out, "camera"
     if "instrument" in cfg and "sensor" not in cfg:
         raise _instrument_refusal(path, cfg)
@@ -597,16 +484,27 @@ def read_sensor_tables(path, what: str = "sensor file") -> tuple[str, dict, str]
             )
     if problems:
         raise InputError(f"{what} {path}: " + "; ".join(problems))
-    schema = {"sensor": {"model": Key("str", required=True), **model.keys}, **model.tables}
-    out = read_config(path, schema, what, required_tables=("sensor",))
-    out["sensor"].pop("model")
-    _check_mount(path, "sensor", out["sensor"])
+    table = {k: v for k, v in s.items() if k != "model"}
+    out = load_dataclass(model.file_schema(), {**cfg, "sensor": table}, f"{what} {path}")
+    _check_mount(path, "sensor", out.sensor)
     return name, out, "sensor"
 
 
-def _check_mount(path, table: str, v: dict) -> None:
+def read_sensor_tables(path, what: str = "sensor file") -> tuple[str, dict, str]:
+    """The model name and the checked tables of a sensor file as dicts of the keys the file
+    gives (and the schema's defaults): ``(model, {"sensor": values, other tables ...},
+    table)`` (:func:`read_sensor_file`; the sensor's table under ``"sensor"`` whatever its
+    name in the file). Absent optional tables are empty dicts.
+    """
+    name, out, table = read_sensor_file(path, what)
+    d = present(out)
+    d["sensor"] = d.pop(table)
+    return name, d, table
+
+
+def _check_mount(path, table: str, v) -> None:
     """A boresight in radians under ``boresight_deg`` (see the module docstring)."""
-    b = np.asarray(v.get("boresight_deg", ()), dtype=float)
+    b = np.asarray(_or(v.boresight_deg, ()), dtype=float)
     nz = b[b != 0]
     if nz.size == 0:
         return
@@ -655,11 +553,11 @@ def read_sensor(path):
     """
     from pathlib import Path
 
-    name, tables, table = read_sensor_tables(path)
-    values = dict(tables["sensor"])
+    name, out, table = read_sensor_file(path)
+    values = getattr(out, table)
     for k in MODELS[name].relative_files:  # a file named in the sensor file: beside it
-        if k in values:
-            values[k] = str(Path(path).parent / values[k])
+        if getattr(values, k) is not None:
+            values = replace(values, **{k: str(Path(path).parent / getattr(values, k))})
     return MODELS[name].build(values, f"sensor file {path}: [{table}]")
 
 

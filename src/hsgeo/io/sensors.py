@@ -12,17 +12,21 @@ adjust-pushbroom --json`` prints (apply them with :func:`hsgeo.sensors.adjusted`
 from __future__ import annotations
 
 import json
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
 from hsgeo.errors import InputError
 from hsgeo.io._files import read_text
-from hsgeo.io.config import Key, read_config
-from hsgeo.io.sensor_file import PUSHBROOM_KEYS, PUSHBROOM_PRIOR_TABLES
+from hsgeo.io.config import Key, read_dataclass
 
 __all__ = [
-    "SENSOR_SCHEMA",
-    "CAMERA_SCHEMA",
+    "LineSensorTable",
+    "LineSensorFile",
+    "BandSplitInstrument",
+    "FrameLayoutInstrument",
+    "BandsTable",
+    "FrameTable",
     "read_sensor_toml",
     "read_camera_toml",
     "read_pushbroom_camera",
@@ -30,43 +34,57 @@ __all__ = [
     "read_scanning_sensor",
     "read_band_split",
     "read_frame_layouts",
-    "BAND_SPLIT_SCHEMA",
-    "FRAME_LAYOUT_SCHEMA",
+    "BandSplitFile",
+    "FrameLayoutFile",
     "MAX_NODE_CORRECTION",
 ]
 
-#: ``hsgeo geocode --sensor``: a line scanner (000 eq. (2)) and its boresight.
-SENSOR_SCHEMA = {
-    "sensor": {
-        "model": Key(
-            "str",
-            default="calibrated",
-            choices=("calibrated", "linear-ifov"),
-            doc="'calibrated' (000 eq. (2)) or 'linear-ifov' (no distortion)",
-        ),
-        "zeta0_px": Key(
-            "float", required=True, limit=1e5, doc="principal point ζ0 on the line, px"
-        ),
-        "c_px": Key("float", required=True, positive=True, doc="principal distance, px"),
-        "K": Key(
-            "floats",
-            length=3,
-            default=(0.0, 0.0, 0.0),
-            doc="K1..K3 of 000 eq. (2), px per (100 px)^(3, 5, 7); calibrated only",
-        ),
-        "boresight_deg": Key(
-            "floats",
-            length=3,
-            default=(0.0, 0.0, 0.0),
-            doc="roll, pitch, heading of R_body_from_sensor, degrees",
-        ),
-    },
-}
 
-#: ``hsgeo adjust-pushbroom --camera``: camera and GNSS/INS priors (002 §4), the former file
-#: of the ``pushbroom`` model (its keys are the model's, :mod:`hsgeo.io.sensor_file`). Absent
-#: optional keys are left out of :func:`read_camera_toml`'s result (the workflow's defaults apply).
-CAMERA_SCHEMA = {"camera": dict(PUSHBROOM_KEYS), **PUSHBROOM_PRIOR_TABLES}
+def _key(kind: str, doc: str, **kw):
+    return field(metadata={"key": Key(kind, doc=doc, **kw)})
+
+
+@dataclass(frozen=True, kw_only=True)
+class LineSensorTable:
+    """``[sensor]`` of the former ``hsgeo geocode --sensor`` file: a line scanner (000 eq. (2))
+    and its boresight.
+    """
+
+    model: str = field(
+        default="calibrated",
+        metadata={
+            "key": Key(
+                "str",
+                choices=("calibrated", "linear-ifov"),
+                doc="'calibrated' (000 eq. (2)) or 'linear-ifov' (no distortion)",
+            )
+        },
+    )
+    zeta0_px: float = _key("float", "principal point ζ0 on the line, px", limit=1e5)
+    c_px: float = _key("float", "principal distance, px", positive=True)
+    K: tuple[float, ...] = field(
+        default=(0.0, 0.0, 0.0),
+        metadata={
+            "key": Key(
+                "floats",
+                length=3,
+                doc="K1..K3 of 000 eq. (2), px per (100 px)^(3, 5, 7); calibrated only",
+            )
+        },
+    )
+    boresight_deg: tuple[float, ...] = field(
+        default=(0.0, 0.0, 0.0),
+        metadata={
+            "key": Key("floats", length=3, doc="roll, pitch, heading of R_body_from_sensor, deg")
+        },
+    )
+
+
+@dataclass(frozen=True, kw_only=True)
+class LineSensorFile:
+    """The former ``hsgeo geocode --sensor`` file (the schema of :func:`read_sensor_toml`)."""
+
+    sensor: LineSensorTable
 
 
 def read_sensor_toml(path):
@@ -91,25 +109,26 @@ def read_sensor_toml(path):
     ------
     InputError
         Missing file, malformed TOML, unknown or misspelled keys, missing ``zeta0_px`` /
-        ``c_px``, values of the wrong type (:func:`~hsgeo.io.config.read_config`).
+        ``c_px``, values of the wrong type (:func:`~hsgeo.io.config.read_dataclass`).
     """
     from hsgeo.sensors.line import CalibratedLine, LinearIFOV
 
-    s = read_config(path, SENSOR_SCHEMA, "sensor file", required_tables=("sensor",))["sensor"]
-    if s["model"] == "linear-ifov" and any(s["K"]):
+    s = read_dataclass(path, LineSensorFile, "sensor file").sensor
+    if s.model == "linear-ifov" and any(s.K):
         raise InputError(
             f"sensor file {path}: [sensor] K is the distortion of model 'calibrated'; remove it "
             "or set model = 'calibrated' (model 'linear-ifov' has no distortion)"
         )
-    if s["model"] == "calibrated":
-        geom = CalibratedLine(s["zeta0_px"], s["c_px"], tuple(s["K"]))
+    if s.model == "calibrated":
+        geom = CalibratedLine(s.zeta0_px, s.c_px, tuple(s.K))
     else:
-        geom = LinearIFOV(s["zeta0_px"], s["c_px"])
-    return geom, np.deg2rad(np.asarray(s["boresight_deg"], dtype=float))
+        geom = LinearIFOV(s.zeta0_px, s.c_px)
+    return geom, np.deg2rad(np.asarray(s.boresight_deg, dtype=float))
 
 
 def read_camera_toml(path) -> dict:
-    """The camera file of ``hsgeo adjust-pushbroom`` (:data:`CAMERA_SCHEMA`), checked.
+    """The camera file of ``hsgeo adjust-pushbroom``, checked (the ``pushbroom`` model's
+    schema, :class:`hsgeo.io.sensor_file.PushbroomKeys`, under ``[camera]``, and its priors).
 
     Format::
 
@@ -134,12 +153,16 @@ def read_camera_toml(path) -> dict:
     dict of dict
         The tables with the keys the file gives (angles still in degrees, as named).
     """
-    return read_config(path, CAMERA_SCHEMA, "camera file", required_tables=("camera",))
+    from hsgeo.io.sensor_file import MODELS
+    from hsgeo.io.sensor_schemas import present
+
+    schema = MODELS["pushbroom"].file_schema("camera")
+    return present(read_dataclass(path, schema, "camera file"))
 
 
 def read_pushbroom_camera(path):
     """The 002 camera as a sensor: :func:`hsgeo.io.read_sensor` of a file whose model is
-    ``pushbroom`` (or the ``[camera]`` file of :data:`CAMERA_SCHEMA`).
+    ``pushbroom`` (or the former ``[camera]`` file, :func:`read_camera_toml`).
 
     Uses ``c_band_mm`` (one principal distance per band; default ``c_mm`` for all
     ``n_bands``), ``pixel_mm``, ``x0_mm``, ``y0_mm``, ``distortion``, ``boresight_deg`` and
@@ -182,22 +205,43 @@ def _read_kind(path, models: tuple, what: str):
     return sensor
 
 
-#: An instrument's band split (``data/instruments/*.toml``): which sensor records each band.
-BAND_SPLIT_SCHEMA = {
-    "instrument": {
-        "name": Key("str", required=True, doc="instrument name"),
-        "n_sensors": Key("int", required=True, positive=True, doc="number of sensors"),
-    },
-    "bands": {
-        "band": Key("floats", required=True, doc="band numbers, 1-based"),
-        "sensor": Key("floats", required=True, doc="sensor of each band, 1-based"),
-        "gap_nm": Key("floats", required=True, positive=True, doc="FPI air gap of each band, nm"),
-    },
-}
+@dataclass(frozen=True, kw_only=True)
+class BandSplitInstrument:
+    """``[instrument]`` of a band split."""
+
+    name: str = _key("str", "instrument name")
+    n_sensors: int = _key("int", "number of sensors", positive=True)
+
+
+@dataclass(frozen=True, kw_only=True)
+class FrameLayoutInstrument:
+    """``[instrument]`` of a frame layout."""
+
+    name: str = _key("str", "instrument name")
+    bits: int = _key("int", "bit depth of a raw value", positive=True)
+
+
+@dataclass(frozen=True, kw_only=True)
+class BandsTable:
+    """``[bands]`` of a band split: one entry per band."""
+
+    band: tuple[float, ...] = _key("floats", "band numbers, 1-based")
+    sensor: tuple[float, ...] = _key("floats", "sensor of each band, 1-based")
+    gap_nm: tuple[float, ...] = _key("floats", "FPI air gap of each band, nm", positive=True)
+
+
+@dataclass(frozen=True, kw_only=True)
+class BandSplitFile:
+    """An instrument's band split (``data/instruments/*.toml``): which sensor records each
+    band (the schema of :func:`read_band_split`).
+    """
+
+    instrument: BandSplitInstrument
+    bands: BandsTable
 
 
 def read_band_split(path=None) -> np.ndarray:
-    """An instrument's band split: band, sensor and FPI air gap (:data:`BAND_SPLIT_SCHEMA`).
+    """An instrument's band split: band, sensor and FPI air gap (:class:`BandSplitFile`).
 
     Parameters
     ----------
@@ -213,10 +257,10 @@ def read_band_split(path=None) -> np.ndarray:
 
     if path is None:
         path = Path(__file__).parent.parent / "data" / "instruments" / "rikola_fpi2015.toml"
-    tables = read_config(path, BAND_SPLIT_SCHEMA, "instrument file", required_tables=("bands",))
-    b, n = tables["bands"], tables["instrument"]["n_sensors"]
-    lengths = {len(b[k]) for k in ("band", "sensor", "gap_nm")}
-    band, sensor = np.asarray(b["band"]), np.asarray(b["sensor"])
+    f = read_dataclass(path, BandSplitFile, "instrument file")
+    b, n = f.bands, f.instrument.n_sensors
+    lengths = {len(getattr(b, k)) for k in ("band", "sensor", "gap_nm")}
+    band, sensor = np.asarray(b.band), np.asarray(b.sensor)
     problems = []
     if len(lengths) != 1:
         problems.append("[bands] band, sensor and gap_nm must have one entry per band")
@@ -227,34 +271,39 @@ def read_band_split(path=None) -> np.ndarray:
     if problems:
         raise InputError(f"instrument file {path}: " + "; ".join(problems))
     out = np.zeros(band.size, dtype=[("band", "i4"), ("sensor", "i4"), ("gap_nm", "f8")])
-    out["band"], out["sensor"], out["gap_nm"] = band, sensor, b["gap_nm"]
+    out["band"], out["sensor"], out["gap_nm"] = band, sensor, b.gap_nm
     return out
 
 
-#: A line scanner's raw-frame layout (``data/instruments/*.toml``): rows, columns, the scene's
-#: and the diffuse collector's columns and the frame rate, one entry per binning factor.
-FRAME_LAYOUT_SCHEMA = {
-    "instrument": {
-        "name": Key("str", required=True, doc="instrument name"),
-        "bits": Key("int", required=True, positive=True, doc="bit depth of a raw value"),
-    },
-    "frame": {
-        "binning": Key("floats", required=True, positive=True, doc="binning factors"),
-        "n_rows": Key("floats", required=True, positive=True, doc="spectral rows per frame"),
-        "n_columns": Key("floats", required=True, positive=True, doc="columns per frame"),
-        "n_reflected_columns": Key(
-            "floats", required=True, positive=True, doc="columns that see the scene"
-        ),
-        "n_incident_columns": Key(
-            "floats", required=True, positive=True, doc="columns of the diffuse collector"
-        ),
-        "frame_rate_hz": Key("floats", required=True, positive=True, doc="frame rate, Hz"),
-    },
-}
+@dataclass(frozen=True, kw_only=True)
+class FrameTable:
+    """``[frame]`` of a frame layout: one entry per binning factor."""
+
+    binning: tuple[float, ...] = _key("floats", "binning factors", positive=True)
+    n_rows: tuple[float, ...] = _key("floats", "spectral rows per frame", positive=True)
+    n_columns: tuple[float, ...] = _key("floats", "columns per frame", positive=True)
+    n_reflected_columns: tuple[float, ...] = _key(
+        "floats", "columns that see the scene", positive=True
+    )
+    n_incident_columns: tuple[float, ...] = _key(
+        "floats", "columns of the diffuse collector", positive=True
+    )
+    frame_rate_hz: tuple[float, ...] = _key("floats", "frame rate, Hz", positive=True)
+
+
+@dataclass(frozen=True, kw_only=True)
+class FrameLayoutFile:
+    """A line scanner's raw-frame layout (``data/instruments/*.toml``): rows, columns, the
+    scene's and the diffuse collector's columns and the frame rate, one entry per binning
+    factor (the schema of :func:`read_frame_layouts`).
+    """
+
+    instrument: FrameLayoutInstrument
+    frame: FrameTable
 
 
 def read_frame_layouts(path=None) -> dict:
-    """A line scanner's raw-frame layout per binning factor (:data:`FRAME_LAYOUT_SCHEMA`).
+    """A line scanner's raw-frame layout per binning factor (:class:`FrameLayoutFile`).
 
     Parameters
     ----------
@@ -272,8 +321,8 @@ def read_frame_layouts(path=None) -> dict:
 
     if path is None:
         path = Path(__file__).parent.parent / "data" / "instruments" / "imspector_v9_pixelfly.toml"
-    tables = read_config(path, FRAME_LAYOUT_SCHEMA, "instrument file", required_tables=("frame",))
-    f = tables["frame"]
+    file = read_dataclass(path, FrameLayoutFile, "instrument file")
+    f = {k.name: getattr(file.frame, k.name) for k in fields(file.frame)}
     counts = ("binning", "n_rows", "n_columns", "n_reflected_columns", "n_incident_columns")
     problems = []
     if len({len(v) for v in f.values()}) != 1:
@@ -302,8 +351,8 @@ def read_frame_layouts(path=None) -> dict:
         for i, b in enumerate(f["binning"])
     }
     return {
-        "name": tables["instrument"]["name"],
-        "bits": tables["instrument"]["bits"],
+        "name": file.instrument.name,
+        "bits": file.instrument.bits,
         "layouts": layouts,
     }
 

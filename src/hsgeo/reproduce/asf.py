@@ -63,6 +63,7 @@ from hsgeo.workflows.asf_flights import FlightsInputs, RawScan, asf_from_flights
 
 __all__ = [
     "run",
+    "SCENARIO",
     "asf_at_shift",
     "georegister_scan",
     "flights_inputs",
@@ -73,6 +74,9 @@ __all__ = [
     "path_label",
 ]
 
+#: The chapter's scenario, ``data_synthetic/asf_runway.toml`` (its ``[scene]`` is the
+#: :class:`~hsgeo.simulate.asf_runway.RunwayScene` the run flies; the chapter reads it too).
+SCENARIO = "asf_runway"
 #: Scan angles of the per-angle rows, deg.
 ANGLES_DEG = (-40.0, -20.0, 20.0, 40.0)
 #: What the simulator shares with the estimator (GUIDE §4, "No inverse crime unsaid").
@@ -430,7 +434,7 @@ def _max_err(res, true_n):
 
 def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
     """The chapter's numbers. ``scale`` sets the noise realisations: max(4, round(12·scale))."""
-    scene = load_scenario("asf_runway").scene  # data_synthetic/asf_runway.toml
+    scene = load_scenario(SCENARIO).scene  # data_synthetic/asf_runway.toml [scene]
     options = AsfOptions()
     hw = options.nadir_halfwidth_deg
     n_runs = max(4, int(round(12 * scale)))

@@ -55,6 +55,7 @@ from hsgeo.workflows.mtf import (
 
 __all__ = [
     "run",
+    "SCENARIO",
     "generate",
     "simulate_runs",
     "LINES",
@@ -67,6 +68,9 @@ __all__ = [
     "bias_sentence",
 ]
 
+#: The chapter's scenario, ``data_synthetic/mtf_bench.toml`` (its ``[bench]`` is the
+#: :class:`~hsgeo.simulate.mtf_target.MtfBench` the run renders; the chapter reads it too).
+SCENARIO = "mtf_bench"
 #: The ten spectral lines (001 §3.1 and Fig. 8b: every 100 px).
 LINES = tuple(range(100, 1001, 100))
 #: The lines of 001 Table 3 and Fig. 9.
@@ -641,7 +645,7 @@ def _unmodelled_rows(bench, sim, sim_glare, n_runs) -> list[Row]:
 
 def run(seed: int = 0, scale: float = 1.0) -> Reproduction:
     """The chapter's numbers. ``scale`` sets the noise realisations: max(8, round(24·scale))."""
-    bench = load_scenario("mtf_bench").bench  # data_synthetic/mtf_bench.toml [bench]
+    bench = load_scenario(SCENARIO).bench  # data_synthetic/mtf_bench.toml [bench]
     n_runs = max(8, int(round(24 * scale)))
     sim = simulate_runs(bench, n_runs, seed)
     glare = replace(bench, stray_light=STRAY_LIGHT)

@@ -113,7 +113,7 @@ class LpConfig:
     trees_per_km2: float = 1500.0
     roads_per_km: float = 3.0
     buildings_per_km2: float = 120.0
-    building_height_m: tuple = (3.0, 8.0)  # "small height steps"
+    building_height_m: tuple[float, ...] = (3.0, 8.0)  # "small height steps"
     terrain_relief_m: float = 4.0  # peak-to-peak of the terrain's long waves, roughly
     square_side_m: float = 1.2  # 002 §4
     # a Gaussian PSF of σ 0.15 m (FWHM 0.35 m ≈ the pixel footprint, 0.30–0.41 m at
@@ -154,7 +154,7 @@ class LpConfig:
     # -- radiometry (ours): DN per unit reflectance per band, one integration time; vegetation
     # (ρ ≈ 0.48) reaches ~90 % of dn_max above the red edge (002 §5.3: "close to saturation")
     dn_max: float = 4095.0
-    dn_per_reflectance: tuple = (5600.0, 6800.0, 7400.0, 7600.0, 7700.0, 7700.0, 7300.0)
+    dn_per_reflectance: tuple[float, ...] = (5600.0, 6800.0, 7400.0, 7600.0, 7700.0, 7700.0, 7300.0)
     electrons_per_dn: float = 10.0  # shot noise: σ² = DN / electrons_per_dn (in DN²)
     read_noise_dn: float = 2.0
 

@@ -4,11 +4,11 @@ Each ``data_synthetic/<name>.toml`` has a ``[scenario]`` table with ``generator`
 it configures, a key of :data:`SCENARIOS`) and, if that simulator writes files
 (:mod:`hsgeo.reproduce.data`, which writes ``data_synthetic/generated/``), their ``seed``; the
 rest of the file is the scenario's configuration, every value citing its source. A chapter's
-in-memory scenario (the 002 campaign, the 004 runway, the 001 survey and bench) is such a file
-too, read by its chapter. :func:`load_scenario`
-reads it into the frozen dataclass of its generator (:data:`SCENARIOS`) with the one loader of
-configurations, :func:`hsgeo.io.config.read_dataclass` (unknown keys are errors with a
-suggestion); change a value with :func:`dataclasses.replace`.
+in-memory scenario (the 002 campaign and its LP ground, the 004 runway, the 001 survey and
+bench) is such a file too, read by its chapter. :func:`load_scenario` reads it into the frozen
+dataclass of its generator (:data:`SCENARIOS`) with the one loader of configurations,
+:func:`hsgeo.io.config.read_dataclass` (unknown keys are errors with a suggestion); change a
+value with :func:`dataclasses.replace`.
 """
 
 from __future__ import annotations
@@ -27,6 +27,7 @@ SCENARIOS = {
     "cube_survey": "hsgeo.simulate.cube_survey:CubeSurveyScenario",
     "frame_bench": "hsgeo.simulate.frame_bench:FrameBenchScenario",
     "line_lab": "hsgeo.simulate.line_lab:LineLabScenario",
+    "lp_campaign": "hsgeo.simulate.scenario_lp_campaign:LpCampaignScenario",
     "mtf_bench": "hsgeo.simulate.mtf_target:MtfBenchScenario",
     "pula_flight": "hsgeo.simulate.pula_flight:PulaFlightScenario",
     "pushbroom_campaign": "hsgeo.simulate.pushbroom_campaign_types:PushbroomCampaignScenario",

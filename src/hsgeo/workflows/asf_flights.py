@@ -125,6 +125,11 @@ class FlightsResult:
     usable: np.ndarray
     geo: dict
 
+    @classmethod
+    def of_crossing(cls, res: AsfResult, geo: dict) -> FlightsResult:
+        """The result of one crossing without a reverse one: its ASF and usable columns."""
+        return cls(res, None, res.asf, None, res.usable, geo)
+
     @property
     def scan_angle_deg(self) -> np.ndarray:
         return self.cross.scan_angle_deg
@@ -162,7 +167,7 @@ def asf_from_flights(inputs: FlightsInputs, options: AsfOptions | None = None) -
     names = (inputs.cross.name, inputs.along.name)
     res = asf_from_scans(AsfInputs(geo["cross"], geo["along"], P, names), options)
     if inputs.reverse is None:
-        return FlightsResult(res, None, res.asf, None, res.usable, geo)
+        return FlightsResult.of_crossing(res, geo)
     rc, rr = inputs.cross, inputs.reverse
     if not np.array_equal(np.asarray(rc.zeta_px), np.asarray(rr.zeta_px)):
         raise InputError(
@@ -198,13 +203,15 @@ def asf_files(
     trajectory_path=None,
     reverse_path=None,
     terrain_height_m: float = 0.0,
-):
-    """The file front end of ``hsgeo asf`` (formats in :mod:`hsgeo.io.scans`).
+) -> FlightsResult:
+    """The file front end of ``hsgeo asf`` (formats in :mod:`hsgeo.io.scans`): one
+    :class:`FlightsResult` whatever the input.
 
     With ``sensor_path`` and ``trajectory_path``: raw scans, georegistered here with the sensor
     and the navigation (:func:`hsgeo.workflows.asf_flights.asf_from_flights`; ``reverse_path``
-    a second crossing of opposite heading, combined with the first) → ``FlightsResult``.
-    Without: two scans georegistered elsewhere → :class:`~hsgeo.workflows.asf.AsfResult`.
+    a second crossing of opposite heading, combined with the first). Without: two scans
+    georegistered elsewhere (:func:`hsgeo.workflows.asf.asf_from_scans`), as one crossing
+    (:meth:`FlightsResult.of_crossing`; ``geo`` the two scans as read).
     """
     from pathlib import Path
 
@@ -240,7 +247,8 @@ def asf_files(
         cross = GeoScan(*read_geoscan(cross_path, "CROSS"))
         along = GeoScan(*read_geoscan(along_path, "ALONG"))
         names = (f"CROSS file {str(cross_path)!r}", f"ALONG file {str(along_path)!r}")
-        return asf_from_scans(AsfInputs(cross, along, poly, names), options)
+        res = asf_from_scans(AsfInputs(cross, along, poly, names), options)
+        return FlightsResult.of_crossing(res, {"cross": cross, "along": along})
     from hsgeo.io.navigation import read_trajectory
     from hsgeo.io.scans import read_panoramic_sensor, read_raw_scan
 

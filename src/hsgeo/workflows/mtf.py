@@ -265,9 +265,7 @@ def bars_files(profiles, bars, options: BarOptions = BarOptions()) -> BarProfile
     target, prof = read_bars(bars)
     out = {}
     for row, (x, y) in read_profiles(profiles).items():
-        inp = BarInputs(
-            x, y, target, prof["start_px"], prof["gsd_mm"], prof["dark_dn"], prof["saturation_dn"]
-        )
+        inp = BarInputs(x, y, target, prof.start_px, prof.gsd_mm, prof.dark_dn, prof.saturation_dn)
         try:
             out[row] = mtf_from_bars(inp, options)
         except (ObservationError, InputError) as exc:
