@@ -61,12 +61,14 @@ from hsgeo.reproduce.lp_targets import (
     twin_difference,
     twin_rows,
 )
-from hsgeo.simulate.lp_campaign import MIN_SCALE, LpConfig, simulate
+from hsgeo.simulate.lp_campaign import MIN_SCALE, simulate
+from hsgeo.simulate.scenarios import load_scenario
 from hsgeo.stats import describe, nmad
 from hsgeo.workflows.pushbroom_ba import REPORTED_PARAMETERS
 
 __all__ = [
     "run",
+    "SCENARIO",
     "sim_scale",
     "SIM_SCALE_AT_1",
     "SCENE_LINES",
@@ -75,6 +77,9 @@ __all__ = [
     "stat_sigma",
     "stat_draws",
 ]
+
+#: The chapter's scenario file (data_synthetic/lp_campaign.toml, :func:`load_scenario`).
+SCENARIO = "lp_campaign"
 
 #: The renderer's scale at ``hsgeo reproduce lp-observations --scale 1`` (a 210 m block, 12 % of
 #: the campaign's area: the most a 2-core machine retrieves in a few minutes).
@@ -691,9 +696,10 @@ def run(
     """
     t_start = time.perf_counter()
     s = sim_scale(scale)
+    cfg = load_scenario(SCENARIO).lp  # data_synthetic/lp_campaign.toml [lp]
     T = {}
     t0 = time.perf_counter()
-    obs, truth = simulate(s, rng=seed)
+    obs, truth = simulate(s, rng=seed, cfg=cfg)
     T["simulate"] = time.perf_counter() - t0
     ev = evaluate(obs, truth, seed, progress=progress)
     T.update({f"{k}_200": v for k, v in ev["timings_s"].items()})
@@ -730,13 +736,13 @@ def run(
     off = start = None
     if unmodelled:
         t0 = time.perf_counter()
-        obs0, truth0 = simulate(s, rng=seed, cfg=replace(LpConfig(), motion_blur_m=0.0))
+        obs0, truth0 = simulate(s, rng=seed, cfg=replace(cfg, motion_blur_m=0.0))
         off = headline(evaluate(obs0, truth0, seed, nogcp=False, progress=progress, both=False))
         T["motion_blur_off"] = time.perf_counter() - t0
         # a symmetric blur moves no key point; a stamp at the start of the exposure
         # does (half the blur along the track, opposite on opposite headings)
         t0 = time.perf_counter()
-        obs1, truth1 = simulate(s, rng=seed, cfg=replace(LpConfig(), exposure_stamp="start"))
+        obs1, truth1 = simulate(s, rng=seed, cfg=replace(cfg, exposure_stamp="start"))
         start = headline(evaluate(obs1, truth1, seed, nogcp=False, progress=progress, both=False))
         T["stamp_start"] = time.perf_counter() - t0
     rows += _unmodelled_rows(headline(ev), off, start)
