@@ -8,8 +8,11 @@ scheduler (one core), with the engine's stage functions wrapped by CPU-time coun
 * ``footprint`` — :func:`hsgeo.ortho.strip_footprints` (the graph's block bounding boxes);
 * ``rays`` — the sensor's ``rays`` (the trajectory's poses, the pixels' directions);
 * ``intersection`` — :func:`hsgeo.geocode.intersect` (first crossing with the DSM);
-* ``to_map`` — the ground points into the grid's CRS (``LocalFrame.enu_to_lonlat``,
-  :func:`hsgeo.crs.lonlat_to_crs`, or ``LocalFrame.enu_to_map``);
+* ``to_map`` — every CRS transform: the ground points into the grid's CRS and the DSM
+  intersection's chords (``LocalFrame.enu_to_lonlat``, ``enu_to_map``,
+  :func:`hsgeo.crs.lonlat_to_crs`, and :func:`hsgeo._approx_transform.approx_transform`,
+  the verified polynomial that replaces them on most pixels; ``map_to_enu`` by PROJ is inside
+  ``intersection``);
 * ``neighbour_search`` — the nearest pixel of each cell (whatever the engine calls for it);
 * ``mosaic_rule_and_rest`` — the tile's task minus the stages above (the rule, the values'
   gather, the concatenations);
@@ -71,6 +74,12 @@ def patch(stages, strips, frame):
     for m in ("enu_to_lonlat", "enu_to_map"):
         setattr(fcls, m, stages.wrap("to_map", getattr(fcls, m)))
     hcrs.lonlat_to_crs = stages.wrap("to_map", hcrs.lonlat_to_crs)
+    try:  # the verified polynomial in place of PROJ on every pixel (issue 41)
+        import hsgeo._approx_transform as hax
+
+        hax.approx_transform = stages.wrap("to_map", hax.approx_transform)
+    except ImportError:
+        pass
     if hasattr(ortho, "resample_swath"):  # the kd-tree of the tiles before issue 41
         ortho.resample_swath = stages.wrap("neighbour_search", ortho.resample_swath)
     try:  # the compiled bucket search (imported by the tile's task when it runs)
