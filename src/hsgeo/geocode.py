@@ -25,6 +25,7 @@ from hsgeo._raycast import (
     HIT,
     OUTSIDE,
     GridSurface,
+    cast_chords,
     first_crossing_reference,
     first_crossing_rows,
 )
@@ -300,24 +301,7 @@ def _cast_chord(O, d, u_top, u_bottom, frame, surf, crs_tol_m=None):
         def to_enu(x, y, z):
             return ax.map_to_enu(frame, x, y, z, crs_tol_m)
 
-    u_top = np.broadcast_to(u_top, O.shape[:1])
-    u_bottom = np.broadcast_to(u_bottom, O.shape[:1])
-    P = [O + ((u - O[:, 2]) / d[:, 2])[:, None] * d for u in (u_top, u_bottom)]
-    top_above = O[:, 2] > u_top
-    P[0][~top_above] = O[~top_above]  # a sensor under the top height: from its own centre
-    M = [np.column_stack(to_map(p[:, 0], p[:, 1], p[:, 2])) for p in P]
-    s, status = cast_rays(M[0], M[1] - M[0], surf)
-    hit = status == HIT
-    X = np.full(O.shape, np.nan)
-    if hit.any():
-        Mh = M[0][hit] + s[hit, None] * (M[1][hit] - M[0][hit])
-        E, N, U = to_enu(Mh[:, 0], Mh[:, 1], Mh[:, 2])
-        Q = np.column_stack([E, N, U])
-        # the nearest point of the ray (the chord's crossing lies within micrometres of it)
-        Oh, dh = O[hit], d[hit]
-        t = np.einsum("ij,ij->i", Q - Oh, dh) / np.einsum("ij,ij->i", dh, dh)
-        X[hit] = Oh + t[:, None] * dh
-    return X, status
+    return cast_chords(O, d, u_top, u_bottom, to_map, to_enu, surf)
 
 
 # ----------------------------------------------------------------------------------------------
