@@ -28,11 +28,18 @@ map cell takes the strip's nearest pixel (within the radius of influence). Where
 **Chunks.** :func:`orthomosaic` returns an :class:`xarray.DataArray` ``(band, y, x)`` backed by
 Dask, one chunk per output tile. Each line block is geolocated once, by its own task
 (:func:`block_ground`: map x, y and off-nadir angle of its pixels, the poses computed once per
-line); a tile's task takes the blocks whose footprint (the geolocated perimeter of the block,
-plus the radius of influence) meets the tile, with their lines alone, finds each cell's
+line; the frame's PROJ transforms of the block by a polynomial fitted to PROJ at a few nodes,
+used only where its difference from PROJ, checked on the block, is within 1 mm:
+:mod:`hsgeo._approx_transform`); a tile's task takes the blocks whose footprint (the
+geolocated perimeter of the block, plus the radius of influence) meets the tile, with their
+lines alone, finds each cell's
 nearest pixel once for all bands and applies the rule: the cube may be a lazily generated
 Dask array larger than memory, and the same graph runs on the threaded scheduler or on a
 ``dask.distributed`` cluster.
+
+One module of about 640 lines: the strip, its blocks' geolocation and the tiles' mosaic share
+the block layout and the graph that ties them; the CRS approximation and the compiled kernels
+are modules of their own.
 """
 
 from __future__ import annotations
