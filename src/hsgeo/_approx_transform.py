@@ -24,7 +24,7 @@ another series for the transverse Mercator, still per point, and says nothing of
 GDAL's approximate transformer (``GDALCreateApproxTransformer``: linear interpolation along
 scanlines of an image, within an error threshold) is not exposed by rasterio or pyproj and
 interpolates along image rows, not over scattered points. The polynomial here is evaluated by
-a compiled kernel (numba) at ≈ 30 ns a point, where PROJ takes 300–400 ns.
+a compiled kernel (numba) at ≈ 5 ns a point and output, where PROJ takes 300–400 ns a point.
 """
 
 from __future__ import annotations
@@ -103,8 +103,7 @@ def approx_transform(exact, inputs, tol, *, min_points: int = MIN_POINTS):
     info = {"approx": False, "max_check_error": None, "n_check": 0}
     if n < min_points:
         return _exact(exact, cols, shape), info
-    lo = np.array([v.min() for v in cols])
-    hi = np.array([v.max() for v in cols])
+    lo, hi = _bounds(cols[0], cols[1], cols[2])
     if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):  # a NaN among the points
         return _exact(exact, cols, shape), info
     centre = 0.5 * (lo + hi)
@@ -124,7 +123,9 @@ def approx_transform(exact, inputs, tol, *, min_points: int = MIN_POINTS):
     V = _monomials((nodes - centre) / half)
     coef = np.linalg.lstsq(V, ref[: nodes.shape[0]], rcond=None)[0]  # (N_TERMS, n_out)
     coef = np.ascontiguousarray(coef.T)
-    got = _monomials((check - centre) / half) @ coef.T
+    got = np.empty((coef.shape[0], check.shape[0]))  # the very kernel that is used below
+    _poly3(*(np.ascontiguousarray(v) for v in check.T), centre, 1.0 / half, coef, got)
+    got = got.T
     err = np.abs(got - ref[nodes.shape[0] :]).max(axis=0)
     info.update(max_check_error=err.tolist(), n_check=int(check.shape[0]))
     if not np.all(err <= CHECK_MARGIN * tol):
@@ -190,27 +191,57 @@ def _exact(exact, cols, shape):
 
 @njit(cache=True)
 def _poly3(a, b, c, centre, inv_half, coef, out):  # pragma: no cover - compiled
-    """The cubic of :func:`_monomials` (coefficients ``coef`` (n_out, 20)) at the points."""
-    n_out = coef.shape[0]
-    for p in range(a.size):
-        e = (a[p] - centre[0]) * inv_half[0]
-        n = (b[p] - centre[1]) * inv_half[1]
-        u = (c[p] - centre[2]) * inv_half[2]
-        ee, en, eu, nn, nu, uu = e * e, e * n, e * u, n * n, n * u, u * u
-        for o in range(n_out):
-            k = coef[o]
+    """The cubic of :func:`_monomials` (coefficients ``coef`` (n_out, 20)) at the points, in
+    Horner's form; one output at a time over all points (a loop the compiler vectorises:
+    ≈ 5 ns a point and output, 17 ns with the outputs inside the loop over points).
+    """
+    c0, c1, c2 = centre[0], centre[1], centre[2]
+    h0, h1, h2 = inv_half[0], inv_half[1], inv_half[2]
+    for o in range(coef.shape[0]):
+        k = coef[o]
+        k0, k1, k2, k3, k4, k5, k6, k7, k8, k9 = (
+            k[0],
+            k[1],
+            k[2],
+            k[3],
+            k[4],
+            k[5],
+            k[6],
+            k[7],
+            k[8],
+            k[9],
+        )
+        k10, k11, k12, k13, k14, k15 = k[10], k[11], k[12], k[13], k[14], k[15]
+        k16, k17, k18, k19 = k[16], k[17], k[18], k[19]
+        for p in range(a.size):
+            e = (a[p] - c0) * h0
+            n = (b[p] - c1) * h1
+            u = (c[p] - c2) * h2
             out[o, p] = (
-                k[0]
-                + k[1] * e
-                + k[2] * n
-                + k[3] * u
-                + k[4] * ee
-                + k[5] * en
-                + k[6] * eu
-                + k[7] * nn
-                + k[8] * nu
-                + k[9] * uu
-                + e * (k[10] * ee + k[11] * en + k[12] * eu + k[13] * nn + k[14] * nu + k[15] * uu)
-                + n * (k[16] * nn + k[17] * nu + k[18] * uu)
-                + u * (k[19] * uu)
-            )
+                k0
+                + e * (k1 + e * (k4 + e * k10 + n * k11 + u * k12) + n * (k5 + n * k13 + u * k14)
+                       + u * (k6 + u * k15))
+                + n * (k2 + n * (k7 + n * k16 + u * k17) + u * (k8 + u * k18))
+                + u * (k3 + u * (k9 + u * k19))
+            )  # fmt: skip
+
+
+@njit(cache=True)
+def _bounds(a, b, c):  # pragma: no cover - compiled
+    """(lo, hi) of three columns in one pass; NaN anywhere makes both NaN."""
+    lo = np.full(3, np.inf)
+    hi = np.full(3, -np.inf)
+    bad = False
+    for p in range(a.size):
+        for j in range(3):
+            v = a[p] if j == 0 else (b[p] if j == 1 else c[p])
+            if v != v:
+                bad = True
+            if v < lo[j]:
+                lo[j] = v
+            if v > hi[j]:
+                hi[j] = v
+    if bad:
+        lo[:] = np.nan
+        hi[:] = np.nan
+    return lo, hi
