@@ -58,6 +58,7 @@ def ortho() -> dict:
             "paired_this_median": vs.get("this_median_peak_rss_over_start_mib"),
             "paired_previous_main_median": vs.get("vs_median_peak_rss_over_start_mib"),
         },
+        "every_run": _ortho_runs(),
         "profile": {
             "file": "bench/results/orthomosaic_stages.json",
             "stages_cpu_s_previous_main": s["previous_main"]["stages_cpu_s_median"],
@@ -66,6 +67,30 @@ def ortho() -> dict:
             "what_remains": s["what_remains"],
         },
     }
+
+
+def _ortho_runs() -> list[dict]:
+    """Every committed run of bench_orthomosaic.py (``orthomosaic_run*.json``, then the
+    latest, ``orthomosaic.json``): the spread that the machine's load puts on the figures."""
+    out = []
+    for f in [*sorted(RESULTS.glob("orthomosaic_run*.json")), RESULTS / "orthomosaic.json"]:
+        o = json.loads(f.read_text(encoding="utf-8"))
+        by = {r["path"]: r for r in o["rows"]}
+        vs = o.get("vs_main") or {}
+        out.append(
+            {
+                "file": f.name,
+                "chunked_1_cells_per_cpu_s": by["chunked_1"]["output_px_per_cpu_s"],
+                "paired_this_median": vs.get("this_median_output_px_per_cpu_s"),
+                "paired_previous_main_median": vs.get("vs_median_output_px_per_cpu_s"),
+                "gdal_cells_per_cpu_s": by["gdal_warp_geoloc"]["output_px_per_cpu_s"],
+                "gdal_warp_alone_cells_per_cpu_s": by["gdal_warp_geoloc"].get(
+                    "output_px_per_warp_cpu_s"
+                ),
+                "load_average_1_5_15": by["chunked_1"]["load_average_1_5_15"],
+            }
+        )
+    return out
 
 
 def pushbroom() -> list[dict]:
