@@ -74,3 +74,33 @@ def test_the_orthorectify_help_names_every_suffix(capsys):
     for suffix, name in RASTER_FORMATS.items():
         assert f"OUT{suffix}" in text, suffix
         assert " ".join(name.split()) in text, name
+
+
+def test_the_cog_is_zstd_with_the_float_predictor_and_lossless(tmp_path):
+    """The COG's compression (hsgeo.io.geotiff.COG_COMPRESSION, issue 41): Zstandard level 1
+    with the floating-point predictor, every value as written, tiled 512 with overviews."""
+    import rasterio
+
+    from hsgeo.io.geotiff import COG_COMPRESSION
+
+    rng = np.random.default_rng(5)
+    da = _raster()
+    big = np.repeat(np.repeat(da.values, 90, axis=1), 90, axis=2)  # 630 x 810: overviews
+    big = big + rng.normal(0.0, 0.01, big.shape).astype(np.float32)
+    res = (da.x.values[1] - da.x.values[0]) / 90
+    da = (
+        type(da)(big, dims=da.dims, coords={"band": da.band.values})
+        .assign_coords(
+            x=500_000.0 + res / 2 + res * np.arange(big.shape[2]),
+            y=6_000_000.0 - res / 2 - res * np.arange(big.shape[1]),
+        )
+        .rio.write_crs("EPSG:32633")
+    )
+    path = tmp_path / "m.tif"
+    write_raster(da, path)
+    with rasterio.open(path) as src:
+        assert COG_COMPRESSION["COMPRESS"] == "ZSTD"
+        assert src.compression.name.upper() == "ZSTD"
+        assert src.tags(ns="IMAGE_STRUCTURE").get("PREDICTOR") == "3"  # floating point
+        assert src.block_shapes[0] == (512, 512) and src.overviews(1)
+        np.testing.assert_array_equal(src.read(), big)

@@ -25,6 +25,7 @@ from hsgeo._raycast import (
     HIT,
     OUTSIDE,
     GridSurface,
+    cast_chords,
     first_crossing_reference,
     first_crossing_rows,
 )
@@ -121,6 +122,7 @@ def intersect(
     tol_m: float = 1e-7,
     max_iter: int | None = None,
     on_miss: str = "raise",
+    crs_tol_m: float | None = None,
 ):
     """The first crossing of rays with the terrain.
 
@@ -148,6 +150,11 @@ def intersect(
         A ray that leaves the terrain's grid before it meets the surface, or starts under it:
         an :class:`~hsgeo.errors.ObservationError` naming the count and the grid's extent
         (``"raise"``), or a row of NaN (``"nan"``).
+    crs_tol_m : float, optional
+        A DSM in a map CRS (:class:`~hsgeo.mapgrid.MapTerrain`): the frame's PROJ transforms
+        of the chords replaced by a polynomial within this bound, verified against PROJ
+        (:mod:`hsgeo._approx_transform`, e.g. its ``APPROX_TOL_M``, 1 mm); None: PROJ on
+        every point.
 
     Returns
     -------
@@ -181,7 +188,7 @@ def intersect(
         s, status = cast_rays(O, d, surface)
         X = O + s[:, None] * d
     elif getattr(terrain, "map_surface", None) is not None:
-        X, status = _intersect_map(O, d, terrain)
+        X, status = _intersect_map(O, d, terrain, crs_tol_m)
     else:
         X, status = _intersect_marching(O, d, terrain, tol_m)
     bad = status != HIT
@@ -256,7 +263,7 @@ def _intersect_marching(O, d, terrain, tol_m):
     return X, status
 
 
-def _intersect_map(O, d, terrain):
+def _intersect_map(O, d, terrain, crs_tol_m=None):
     """The first crossing with a DSM on a grid of a map CRS (:class:`hsgeo.mapgrid.MapTerrain`).
 
     The ray between the heights the DSM spans is a straight line in the local frame and very
@@ -268,39 +275,33 @@ def _intersect_map(O, d, terrain):
     """
     frame, surf = terrain.frame, terrain.map_surface
     u_lo, u_hi = terrain.u_range_m
-    X, status = _cast_chord(O, d, u_hi, u_lo, frame, surf)
+    X, status = _cast_chord(O, d, u_hi, u_lo, frame, surf, crs_tol_m)
     span = (u_hi - u_lo) * np.linalg.norm(d, axis=1) / -d[:, 2]
     again = (status == HIT) & (span > 10.0)
     if again.any():
         k = np.flatnonzero(again)
-        X2, st2 = _cast_chord(O[k], d[k], X[k, 2] + 1.0, X[k, 2] - 1.0, frame, surf)
+        X2, st2 = _cast_chord(O[k], d[k], X[k, 2] + 1.0, X[k, 2] - 1.0, frame, surf, crs_tol_m)
         ok = st2 == HIT
         X[k[ok]] = X2[ok]
     return X, status
 
 
-def _cast_chord(O, d, u_top, u_bottom, frame, surf):
+def _cast_chord(O, d, u_top, u_bottom, frame, surf, crs_tol_m=None):
     """Cast the chords of rays between local heights ``u_top`` and ``u_bottom`` in the map CRS;
-    the crossings in the local frame, projected onto the rays, and the status.
+    the crossings in the local frame, projected onto the rays, and the status (``crs_tol_m``:
+    :func:`intersect`'s).
     """
-    u_top = np.broadcast_to(u_top, O.shape[:1])
-    u_bottom = np.broadcast_to(u_bottom, O.shape[:1])
-    P = [O + ((u - O[:, 2]) / d[:, 2])[:, None] * d for u in (u_top, u_bottom)]
-    top_above = O[:, 2] > u_top
-    P[0][~top_above] = O[~top_above]  # a sensor under the top height: from its own centre
-    M = [np.column_stack(frame.enu_to_map(p[:, 0], p[:, 1], p[:, 2])) for p in P]
-    s, status = cast_rays(M[0], M[1] - M[0], surf)
-    hit = status == HIT
-    X = np.full(O.shape, np.nan)
-    if hit.any():
-        Mh = M[0][hit] + s[hit, None] * (M[1][hit] - M[0][hit])
-        E, N, U = frame.map_to_enu(Mh[:, 0], Mh[:, 1], Mh[:, 2])
-        Q = np.column_stack([E, N, U])
-        # the nearest point of the ray (the chord's crossing lies within micrometres of it)
-        Oh, dh = O[hit], d[hit]
-        t = np.einsum("ij,ij->i", Q - Oh, dh) / np.einsum("ij,ij->i", dh, dh)
-        X[hit] = Oh + t[:, None] * dh
-    return X, status
+    to_map, to_enu = frame.enu_to_map, frame.map_to_enu
+    if crs_tol_m is not None:
+        from hsgeo import _approx_transform as ax
+
+        def to_map(E, N, U):
+            return ax.enu_to_map(frame, E, N, U, crs_tol_m)
+
+        def to_enu(x, y, z):
+            return ax.map_to_enu(frame, x, y, z, crs_tol_m)
+
+    return cast_chords(O, d, u_top, u_bottom, to_map, to_enu, surf)
 
 
 # ----------------------------------------------------------------------------------------------

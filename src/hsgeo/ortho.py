@@ -28,11 +28,18 @@ map cell takes the strip's nearest pixel (within the radius of influence). Where
 **Chunks.** :func:`orthomosaic` returns an :class:`xarray.DataArray` ``(band, y, x)`` backed by
 Dask, one chunk per output tile. Each line block is geolocated once, by its own task
 (:func:`block_ground`: map x, y and off-nadir angle of its pixels, the poses computed once per
-line); a tile's task takes the blocks whose footprint (the geolocated perimeter of the block,
-plus the radius of influence) meets the tile, with their lines alone, finds each cell's
+line; the frame's PROJ transforms of the block by a polynomial fitted to PROJ at a few nodes,
+used only where its difference from PROJ, checked on the block, is within 1 mm:
+:mod:`hsgeo._approx_transform`); a tile's task takes the blocks whose footprint (the
+geolocated perimeter of the block, plus the radius of influence) meets the tile, with their
+lines alone, finds each cell's
 nearest pixel once for all bands and applies the rule: the cube may be a lazily generated
 Dask array larger than memory, and the same graph runs on the threaded scheduler or on a
 ``dask.distributed`` cluster.
+
+One module of about 640 lines: the strip, its blocks' geolocation and the tiles' mosaic share
+the block layout and the graph that ties them; the CRS approximation and the compiled kernels
+are modules of their own.
 """
 
 from __future__ import annotations
@@ -41,6 +48,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from hsgeo._approx_transform import APPROX_TOL_M
 from hsgeo._perline import PerLine as _PerLine
 from hsgeo.errors import InputError
 from hsgeo.geocode import intersect
@@ -172,13 +180,21 @@ def geolocate_lines(strip: Strip, terrain, frame, lines=slice(None), columns=sli
         Angle between each ray and the downward vertical of the local frame, degrees.
     """
     m, k = strip.t_s[lines].size, strip.pixels[columns].shape[0]
+    X, off = _ground_off_nadir(strip, terrain, lines, columns)
+    lon, lat, _ = frame.enu_to_lonlat(X[:, 0], X[:, 1], X[:, 2])
+    return X.reshape(m, k, 3), np.stack([lon, lat], -1).reshape(m, k, 2), off.reshape(m, k)
+
+
+def _ground_off_nadir(strip: Strip, terrain, lines, columns, crs_tol_m=None):
+    """Ground points (ENU, ``(m·k, 3)``) and off-nadir angles (degrees, ``(m·k,)``) of pixels
+    ``columns`` of ``lines`` (``crs_tol_m``: :func:`hsgeo.geocode.intersect`'s).
+    """
+    k = strip.pixels[columns].shape[0]
     tt, pp = strip.line_pixels(lines, columns)
     nav = _PerLine(strip.trajectory, strip.t_s[lines], tt, k)
     o, d = strip.sensor.rays(pp, tt, nav, **strip.pixel_kw)
-    X = intersect(o, d, terrain)
-    lon, lat, _ = frame.enu_to_lonlat(X[:, 0], X[:, 1], X[:, 2])
-    off = np.degrees(np.arccos(np.clip(-d[:, 2], -1.0, 1.0)))
-    return X.reshape(m, k, 3), np.stack([lon, lat], -1).reshape(m, k, 2), off.reshape(m, k)
+    X = intersect(o, d, terrain, crs_tol_m=crs_tol_m)
+    return X, np.degrees(np.arccos(np.clip(-d[:, 2], -1.0, 1.0)))
 
 
 def strip_footprints(strip: Strip, terrain, frame, lines_per_block: int, crs: str):
@@ -306,12 +322,21 @@ def ground_points(
     return out
 
 
-def block_ground(strip: Strip, terrain, frame, lines: tuple, crs: str) -> np.ndarray:
+def block_ground(
+    strip: Strip, terrain, frame, lines: tuple, crs: str, crs_tol_m: float | None = None
+) -> np.ndarray:
     """Map x, y (in ``crs``, m) and off-nadir angle (degrees) of every pixel of a line block.
 
     :func:`geolocate_lines` of lines ``line0 … line1 - 1`` (``lines``), the longitude and
     latitude taken to ``crs`` (pyproj): what every tile the block meets shares (one task per
     block in :func:`orthomosaic`'s graph: the geometry is never recomputed per tile or band).
+
+    Parameters
+    ----------
+    crs_tol_m : float, optional
+        The frame's PROJ transforms (the DSM intersection's, then ENU → ``crs``) replaced by a
+        polynomial within this bound in metres, verified against PROJ on the block and exact
+        where not met (:mod:`hsgeo._approx_transform`); None: PROJ on every pixel.
 
     Returns
     -------
@@ -320,10 +345,20 @@ def block_ground(strip: Strip, terrain, frame, lines: tuple, crs: str) -> np.nda
     """
     from hsgeo.crs import lonlat_to_crs
 
-    _, lonlat, off = geolocate_lines(strip, terrain, frame, slice(*lines))
-    ll = lonlat.reshape(-1, 2)
-    x, y = lonlat_to_crs(crs, ll[:, 0], ll[:, 1], frame.datum_epsg)
-    return np.stack([np.asarray(x, float), np.asarray(y, float), off.ravel()])
+    X, off = _ground_off_nadir(strip, terrain, slice(*lines), slice(None), crs_tol_m)
+
+    def to_crs(E, N, U):
+        lon, lat, _ = frame.enu_to_lonlat(E, N, U)
+        return lonlat_to_crs(crs, lon, lat, frame.datum_epsg)
+
+    if crs_tol_m is None:
+        x, y = to_crs(X[:, 0], X[:, 1], X[:, 2])
+    else:
+        from hsgeo._approx_transform import approx_transform, tolerance_in_units
+
+        tol = tolerance_in_units(crs, crs_tol_m)
+        (x, y), _ = approx_transform(to_crs, (X[:, 0], X[:, 1], X[:, 2]), tol)
+    return np.stack([np.asarray(x, float), np.asarray(y, float), off])
 
 
 #: Added to the rank of a cell whose sample holds NaN in a band: any complete sample wins.
@@ -422,6 +457,7 @@ def orthomosaic(
     lines_per_block: int = 256,
     radius_m: float | None = None,
     max_gib: float | None = None,
+    crs_tol_m: float | None = APPROX_TOL_M,
 ):
     """The orthomosaic of strips of any scanning sensor: a Dask-backed DataArray with a CRS.
 
@@ -452,6 +488,11 @@ def orthomosaic(
         The largest mosaic (GiB of float32) built on ``resolution_m``; a larger one (cells far
         finer than the ground pixels), or one a single cell wide, is refused
         (:class:`~hsgeo.InputError`). Default: no size limit.
+    crs_tol_m : float, optional
+        Each line block's PROJ transforms (the DSM intersection's and into the grid's CRS) by
+        a polynomial on PROJ at a few nodes, used only where its difference from PROJ, checked
+        on the block, is within this bound, m (default :data:`hsgeo._approx_transform.
+        APPROX_TOL_M`, 1 mm; :func:`block_ground`); None: PROJ on every pixel.
 
     Returns
     -------
@@ -486,7 +527,7 @@ def orthomosaic(
     if radius_m is None:
         radius_m = 0.55 * np.hypot(across, along) + 0.5 * grid.resolution_m
     data = _mosaic_array(
-        strips, foot, grid, terrain, frame, radius_m, tile_px, lines_per_block, rule
+        strips, foot, grid, terrain, frame, radius_m, tile_px, lines_per_block, rule, crs_tol_m
     )
     bands = {"names": band_names, "wavelength_nm": wavelength_nm, "fwhm_nm": fwhm_nm}
     return _as_dataarray(data, grid, strips, bands, radius_m, rule)
@@ -512,7 +553,9 @@ def _check_size(grid: MapGrid, n_bands: int, spacing_m: float, max_gib: float | 
         )
 
 
-def _mosaic_array(strips, foot, grid, terrain, frame, radius_m, tile_px, lines_per_block, rule):
+def _mosaic_array(
+    strips, foot, grid, terrain, frame, radius_m, tile_px, lines_per_block, rule, crs_tol_m
+):
     """The Dask array ``(n_bands, height, width)``: one task per line block that geolocates it
     (:func:`block_ground`), one per tile that mosaics the blocks meeting it
     (:func:`mosaic_tile`).
@@ -530,11 +573,14 @@ def _mosaic_array(strips, foot, grid, terrain, frame, radius_m, tile_px, lines_p
     ]
     # one key per strip's geometry (dask would unpack a Strip dataclass with its values and make
     # every task depend on every chunk of the cube), one task per block's ground
-    ground = []
-    for s, (blocks, _) in zip(strips, foot, strict=True):
-        g_strip = dask.delayed(s.geometry(), pure=True)
+    ground, block_values = [], []
+    for st, v, (blocks, _) in zip(strips, values, foot, strict=True):
+        g_strip = dask.delayed(st.geometry(), pure=True)
         task = dask.delayed(block_ground, pure=True)
-        ground.append([task(g_strip, g_terrain, g_frame, ab, grid.crs) for ab in blocks])
+        ground.append([task(g_strip, g_terrain, g_frame, ab, grid.crs, crs_tol_m) for ab in blocks])
+        # each block's lines once, one key the tiles share (a slice of the Dask array per tile
+        # and block cost ~3 ms of graph building each: 53 of them on the bench's swath)
+        block_values.append([dask.delayed(v[slice(*ab)], pure=True) for ab in blocks])
     rows = []
     for r0 in range(0, grid.height, tile_px):
         r1 = min(grid.height, r0 + tile_px)
@@ -544,7 +590,7 @@ def _mosaic_array(strips, foot, grid, terrain, frame, radius_m, tile_px, lines_p
             tile = grid.window(r0, r1, c0, c1)
             x0, y0, x1, y1 = tile.extent_m
             layout, args = [], []
-            for g, v, (blocks, bbox) in zip(ground, values, foot, strict=True):
+            for g, v, (_, bbox) in zip(ground, block_values, foot, strict=True):
                 hit = np.flatnonzero(
                     (bbox[:, 0] - radius_m < x1)
                     & (bbox[:, 2] + radius_m > x0)
@@ -553,7 +599,7 @@ def _mosaic_array(strips, foot, grid, terrain, frame, radius_m, tile_px, lines_p
                 )
                 if hit.size:
                     layout.append(int(hit.size))
-                    args += [g[i] for i in hit] + [v[slice(*blocks[i])] for i in hit]
+                    args += [g[i] for i in hit] + [v[i] for i in hit]
             shape = (n_bands, r1 - r0, c1 - c0)
             if layout:
                 task = dask.delayed(_tile_task, pure=True)(
