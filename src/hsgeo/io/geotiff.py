@@ -38,13 +38,13 @@ __all__ = [
 GEOTIFF_FORMATS = {".tif": "GeoTIFF", ".tiff": "GeoTIFF"}
 #: GDAL's block cache while writing, MiB (its default, 5 % of the RAM, would grow with it).
 GDAL_CACHE_MB = 64
-#: The COG's compression: Zstandard at level 1 with the floating-point predictor. On the bench's
+#: The COG's compression: DEFLATE at level 1 with the floating-point predictor. On the bench's
 #: 3-band float32 mosaic (1.2 M cells, bench/results/orthomosaic.json) the COG copy with its
-#: overviews took 0.30 CPU-s at 10.3 MB, where DEFLATE (level 6, before) took 0.71 s at 9.5 MB,
-#: DEFLATE level 1 0.45 s at 10.3 MB, ZSTD level 9 0.74 s at 9.2 MB: the same values (lossless),
-#: read by every GDAL since 2.3 (QGIS, rasterio); a reader without Zstandard (libtiff alone)
-#: needs ``gdal_translate -co COMPRESS=DEFLATE``.
-COG_COMPRESSION = {"COMPRESS": "ZSTD", "LEVEL": 1, "PREDICTOR": "YES"}
+#: overviews took 0.45 CPU-s at 10.3 MB, where DEFLATE level 6 (before) took 0.71 s at 9.5 MB
+#: and Zstandard level 1 0.30 s at 10.3 MB: DEFLATE because every reader opens it unaided
+#: (libtiff alone, older GDAL and ArcGIS, browser COG viewers), Zstandard not; the same values
+#: (lossless) either way.
+COG_COMPRESSION = {"COMPRESS": "DEFLATE", "LEVEL": 1, "PREDICTOR": "YES"}
 
 
 def write_cog(
