@@ -36,10 +36,11 @@ The files each command read before are recognised:
   frame layout) are refused: they say what an instrument records, not its geometry, and the
   message spells out the sensor file to write.
 
-**A mount in the wrong units is refused.** A lever arm beyond :data:`~hsgeo.io.sensor_schemas.MAX_LEVER_ARM_M` (10 m)
-is taken for millimetres or centimetres. A boresight under ``boresight_deg`` whose every
-non-zero angle, read as radians, is a round number of degrees (a multiple of 0.001° to 1e-9)
-while the value itself is not a round number (not a multiple of 0.001) is taken for radians
+**A mount in the wrong units is refused.** A lever arm beyond
+:data:`~hsgeo.io.sensor_schemas.MAX_LEVER_ARM_M` (10 m) is taken for millimetres or centimetres.
+A boresight under ``boresight_deg`` whose every non-zero angle, read as radians, is a round
+number of degrees (a multiple of 0.001° to 1e-9) while the value itself is not a round number
+(not a multiple of 0.001) is taken for radians
 pasted at full precision (``0.005235987755982988`` is 0.3° in radians); radians rounded by
 hand are not detected (0.0052 "degrees" is a valid 19″ boresight).
 """
