@@ -30,7 +30,7 @@ from hsgeo.io.lp_lines import write_lp_lines
 from hsgeo.io.navigation import write_trajectory
 from hsgeo.mapgrid import MapGrid
 from hsgeo.simulate import cube_survey as CS
-from hsgeo.simulate.lp_campaign import simulate
+from hsgeo.simulate.lp_campaign import LpConfig, simulate
 
 
 def sbet(flight: Path) -> None:
@@ -103,9 +103,16 @@ for s in obs.strips[:10:2] + obs.strips[12:15]:
 write_trajectory(d / "NAV.csv", obs.navigation)
 cam = obs.camera
 la = ", ".join(f"{v:.6f}" for v in cam.lever_arm_m)
+c = LpConfig().campaign  # the campaign's instruments (simulate's default LpConfig)
+pos = ", ".join(repr(float(v)) for v in c.sigma_pos_m)
+att = ", ".join(repr(float(v)) for v in np.rad2deg(c.sigma_att_rad))
 (d / "CAM.toml").write_text(
     f"[camera]\nn_bands = {len(cam.c_mm)}\npixel_mm = {cam.pixel_mm}\nc_mm = {cam.c_mm[0]}\n"
     f"x0_mm = {cam.x0_mm}\nlever_arm_m = [{la}]\n"
+    # the a-priori σ of the campaign's instruments (a camera file states them: no default)
+    f"sigma_lever_m = {c.sigma_lever_m!r}\n[gnss_ins]\nsigma_pos_m = [{pos}]\n"
+    f"sigma_att_deg = [{att}]\n[observations]\nsigma_px = {c.sigma_obs_px!r}\n"
+    f"[gcp]\nsigma_m = {c.sigma_gcp_m!r}\n"
 )
 xyz = obs.square_xyz_m
 sq = pd.DataFrame(

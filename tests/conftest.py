@@ -42,16 +42,16 @@ def _compile_pushbroom_kernels() -> None:
     start, every worker loads them from the cache: 19 of the 24 kernels, 123.7 CPU-s with an
     empty cache, 6.9 CPU-s with a warm one (bench/results/test_suite_cost.json).
     """
+    from priors import campaign_prior
+
     from hsgeo.adjust import adjust
     from hsgeo.simulate.pushbroom_campaign import simulate
     from hsgeo.simulate.pushbroom_campaign_types import CampaignConfig
-    from hsgeo.workflows.pushbroom_ba import CameraPrior, build_problem
+    from hsgeo.workflows.pushbroom_ba import build_problem
 
     obs, _ = simulate(0.001, rng=3)
     cfg = CampaignConfig()
-    cam = CameraPrior(
-        n_bands=len(cfg.c_offsets_um), x0_mm=cfg.x0_mm, lever_arm_m=tuple(obs.lever_arm_m)
-    )
+    cam = campaign_prior(x0_mm=cfg.x0_mm, lever_arm_m=tuple(obs.lever_arm_m))
     params, blocks, _ = build_problem(
         obs.lines,
         obs.n_points,

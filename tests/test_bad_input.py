@@ -29,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from priors import priors_toml
 
 ROOT = Path(__file__).resolve().parents[1]
 CHARUCO = ROOT / "src/hsgeo/data/reference/opencv-charuco"
@@ -80,7 +81,7 @@ def _pushbroom(d: Path) -> None:
     la = ", ".join(f"{v:.6f}" for v in obs.lever_arm_m)
     (d / "cam.toml").write_text(
         f"[camera]\nn_bands = 7\npixel_mm = 0.0065\nc_mm = 40.0\nx0_mm = {CampaignConfig().x0_mm}\n"
-        f"lever_arm_m = [{la}]\n"
+        f"lever_arm_m = [{la}]\n" + priors_toml()
     )
 
 
@@ -134,7 +135,7 @@ def _lp(d: Path) -> None:
     la = ", ".join(f"{v:.6f}" for v in cam.lever_arm_m)
     (d / "cam.toml").write_text(
         f"[camera]\nn_bands = {len(cam.c_mm)}\npixel_mm = {cam.pixel_mm}\nc_mm = {cam.c_mm[0]}\n"
-        f"x0_mm = {cam.x0_mm}\nlever_arm_m = [{la}]\n"
+        f"x0_mm = {cam.x0_mm}\nlever_arm_m = [{la}]\n" + priors_toml()
     )
     xyz = obs.square_xyz_m
     pd.DataFrame(
@@ -843,7 +844,20 @@ for extra, expect in [
     ("[gcp]\nsigma_m = -1.0\n", "sigma_m"),
 ]:
     head, key = extra.split(chr(10))[0], extra.split(chr(10))[1].split(" =")[0]
-    case(C, "mistyped", f"cam-{head}-{key}", expect, [("cam.toml", toml_append(extra))])
+    table, value = head.strip("[]"), extra.split(chr(10))[1].split(" = ")[1]
+    # the camera file states every a-priori σ: a known table's key is set in place
+    edit = toml_set(table, key, value) if table in ("gnss_ins", "observations", "gcp") else None
+    case(C, "mistyped", f"cam-{head}-{key}", expect, [("cam.toml", edit or toml_append(extra))])
+# no a-priori σ is a default (a paper's is not the user's instruments'): each missing one named
+for table, key in [
+    ("camera", "sigma_lever_m"),
+    ("gnss_ins", "sigma_pos_m"),
+    ("gnss_ins", "sigma_att_deg"),
+    ("observations", "sigma_px"),
+    ("gcp", "sigma_m"),
+]:
+    expect = f"[{table}] {key}"
+    case(C, "missing", f"cam-no-{key}", expect, [("cam.toml", toml_set(table, key, None))])
 case(
     C,
     "mistyped",

@@ -2,6 +2,7 @@ import json
 
 import numpy as np
 import pandas as pd
+from priors import priors_toml
 
 from hsgeo.cli import main
 from hsgeo.io.navigation import write_trajectory
@@ -34,7 +35,7 @@ def _write(tmp_path, obs):
     la = ", ".join(f"{v:.6f}" for v in obs.lever_arm_m)
     (tmp_path / "cam.toml").write_text(
         f"[camera]\nn_bands = 7\npixel_mm = 0.0065\nc_mm = 40.0\nx0_mm = {CampaignConfig().x0_mm}\n"
-        f"lever_arm_m = [{la}]\n"
+        f"lever_arm_m = [{la}]\n" + priors_toml()
     )
 
 

@@ -213,17 +213,31 @@ def test_sensor_toml_errors(tmp_path, text, needle):
 
 
 def test_camera_toml(tmp_path):
-    from hsgeo.workflows.pushbroom_ba import CameraPrior, read_camera
+    from hsgeo.workflows.pushbroom_ba import read_camera
 
     p = tmp_path / "cam.toml"
-    p.write_text(
-        "[camera]\nn_bands = 7\npixel_mm = 0.0065\nc_mm = 40\n"
-        "[gnss_ins]\nsigma_att_deg = [0.01, 0.01, 0.02]\n[gcp]\nsigma_m = 0.05\n"
-    )
+    head = "[camera]\nn_bands = 7\npixel_mm = 0.0065\nc_mm = 40\n"
+    p.write_text(head + "[gnss_ins]\nsigma_att_deg = [0.01, 0.01, 0.02]\n[gcp]\nsigma_m = 0.05\n")
     assert read_camera_toml(p)["camera"] == {"n_bands": 7, "pixel_mm": 0.0065, "c_mm": 40.0}
+    # no σ is a default (a paper's σ is not the user's instruments'): each missing one by name
+    with pytest.raises(InputError) as e:
+        read_camera(p)
+    msg = str(e.value)
+    for key in ("[camera] sigma_lever_m", "[gnss_ins] sigma_pos_m", "[observations] sigma_px"):
+        assert key in msg, key
+    assert "sigma_att_deg" not in msg and "[gcp] sigma_m" not in msg and "cam.toml" in msg
+    priors = (
+        "sigma_lever_m = 0.03\n[gnss_ins]\nsigma_pos_m = [0.02, 0.02, 0.04]\n"
+        "sigma_att_deg = [0.01, 0.01, 0.02]\n[observations]\nsigma_px = 0.4\n"
+    )
+    p.write_text(head + priors)
+    with pytest.raises(InputError, match=r"\[gcp\] sigma_m"):
+        read_camera(p)  # GCPs need theirs
+    cam = read_camera(p, need_gcp_sigma=False)
+    assert np.isnan(cam.sigma_gcp_m) and cam.sigma_obs_px == 0.4 and cam.sigma_lever_m == 0.03
+    p.write_text(head + priors + "[gcp]\nsigma_m = 0.05\n")
     cam = read_camera(p)
-    default = CameraPrior(n_bands=7)
-    assert cam.sigma_gcp_m == 0.05 and cam.sigma_pos_m == default.sigma_pos_m
+    assert cam.sigma_gcp_m == 0.05 and cam.sigma_pos_m == (0.02, 0.02, 0.04)
     np.testing.assert_allclose(cam.sigma_att_rad, np.deg2rad([0.01, 0.01, 0.02]))
     p.write_text("[camera]\nn_bands = 7\npixel_mm = 0.0065\nc_mm = 40\n[gnss]\n")
     with pytest.raises(InputError, match=r"\[gnss\]: unknown table; did you mean 'gnss_ins'"):

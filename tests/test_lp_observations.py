@@ -5,6 +5,7 @@ end to end on a tiny rendered campaign (hsgeo.simulate.lp_campaign) against the 
 import numpy as np
 import pandas as pd
 import pytest
+from priors import priors_toml
 
 from hsgeo.errors import InputError
 from hsgeo.measure.tie_points import components, link_tie_points
@@ -126,13 +127,15 @@ def test_to_pushbroom_inputs_is_the_adjust_pushbroom_path(tmp_path):
     """A table (here the pushbroom chapter's simulated observations) handed over by
     to_pushbroom_inputs gives exactly what `hsgeo adjust-pushbroom` builds from the same table
     written to a file; an unknown GCP is one clear error."""
+    from priors import campaign_prior
+
     from hsgeo.errors import ObservationError
     from hsgeo.io.navigation import read_trajectory, write_trajectory
     from hsgeo.io.tables import read_table
     from hsgeo.simulate.pushbroom_campaign import simulate
     from hsgeo.trajectory import Trajectory, rph_from_platform_rpy
     from hsgeo.workflows.lp_observations import LpResult, to_pushbroom_inputs
-    from hsgeo.workflows.pushbroom_ba import OBS_COLUMNS, CameraPrior, _observations
+    from hsgeo.workflows.pushbroom_ba import OBS_COLUMNS, _observations
 
     obs, _ = simulate(0.001, rng=4)
     o = obs.lines
@@ -150,7 +153,7 @@ def test_to_pushbroom_inputs_is_the_adjust_pushbroom_path(tmp_path):
         tmp_path / "nav.csv", Trajectory(t, o.xyz_nav_m[i], rph_from_platform_rpy(o.rpy_nav_rad[i]))
     )
     nav = read_trajectory(tmp_path / "nav.csv")
-    cam = CameraPrior(7)
+    cam = campaign_prior(7)
     res = LpResult(table, None, None, None, None, {}, {})
     gid = [f"p{v}" for v in obs.gcp_index]
     inp = to_pushbroom_inputs(res, nav, cam, gid, obs.gcp_xyz_m)
@@ -292,7 +295,7 @@ def test_the_table_feeds_adjust_files(tmp_path, campaign, retrieved):
     la = ", ".join(f"{v:.6f}" for v in cam.lever_arm_m)
     (tmp_path / "cam.toml").write_text(
         f"[camera]\nn_bands = {len(cam.c_mm)}\npixel_mm = {cam.pixel_mm}\nc_mm = "
-        f"{cam.c_mm[0]}\nx0_mm = {cam.x0_mm}\nlever_arm_m = [{la}]\n"
+        f"{cam.c_mm[0]}\nx0_mm = {cam.x0_mm}\nlever_arm_m = [{la}]\n" + priors_toml()
     )
     idx = {s: i for i, s in enumerate(obs.square_ids)}
     g = obs.square_xyz_m[[idx[s] for s in obs.gcp_ids]]

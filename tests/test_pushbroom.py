@@ -2,6 +2,7 @@ import dataclasses
 
 import numpy as np
 import pytest
+from priors import campaign_prior
 
 from hsgeo import InputError
 from hsgeo.adjust import adjust, identifiability
@@ -10,15 +11,13 @@ from hsgeo.sensors.pushbroom import PushbroomLines, PushbroomObservations
 from hsgeo.simulate.pushbroom_campaign import simulate
 from hsgeo.simulate.pushbroom_campaign_types import CampaignConfig, CampaignObservations
 from hsgeo.stats import nmad
-from hsgeo.workflows.pushbroom_ba import CameraPrior, build_problem
+from hsgeo.workflows.pushbroom_ba import build_problem
 
 CFG = CampaignConfig()
 
 
 def _problem(obs, with_gcp=True, node_interval_s=10.0, y_as_time=False):
-    cam = CameraPrior(
-        n_bands=len(CFG.c_offsets_um), x0_mm=CFG.x0_mm, lever_arm_m=tuple(obs.lever_arm_m)
-    )
+    cam = campaign_prior(x0_mm=CFG.x0_mm, lever_arm_m=tuple(obs.lever_arm_m))
     return build_problem(
         obs.lines,
         obs.n_points,
@@ -88,7 +87,7 @@ def test_observations_validate_shapes(tiny):
     with pytest.raises(InputError, match="non-negative integers"):
         dataclasses.replace(o, band=o.band.astype(float))
     with pytest.raises(InputError, match="PushbroomObservations"):
-        build_problem(dataclasses.asdict(o), tiny[0].n_points, CameraPrior(n_bands=7))
+        build_problem(dataclasses.asdict(o), tiny[0].n_points, campaign_prior(7))
 
 
 @pytest.mark.parametrize("y_as_time", [False, True])
@@ -251,7 +250,7 @@ def test_bad_input(tiny):
     point = o.point.copy()
     point[point == 5] = 6  # point 5 unobserved
     with pytest.raises(InputError, match="fewer than two"):
-        build_problem(dataclasses.replace(o, point=point), tiny[0].n_points, CameraPrior(n_bands=7))
+        build_problem(dataclasses.replace(o, point=point), tiny[0].n_points, campaign_prior(7))
 
 
 def test_same_seed_same_bits():
@@ -384,7 +383,7 @@ def test_time_residual_needs_rates_and_reference(tiny):
         )
     no_rates = dataclasses.replace(o, xyz_rate_nav_m_s=None, rpy_rate_nav_rad_s=None)
     with pytest.raises(InputError, match="rates"):
-        build_problem(no_rates, tiny[0].n_points, CameraPrior(n_bands=7), y_as_time=True)
+        build_problem(no_rates, tiny[0].n_points, campaign_prior(7), y_as_time=True)
 
 
 @pytest.mark.parametrize("trajectory_error", ["spline", "gauss-markov"])

@@ -9,6 +9,7 @@ import dataclasses
 
 import numpy as np
 import pytest
+from priors import priors_toml
 
 from hsgeo import InputError
 from hsgeo.io import read_pushbroom_camera, read_scanning_sensor, read_sensor
@@ -64,7 +65,7 @@ def _paths():
 def test_the_issue_36_camera_is_one_camera_in_every_command(tmp_path, form, path_name):
     p = tmp_path / "cam.toml"
     head = "[camera]\n" if form == "[camera]" else '[sensor]\nmodel = "pushbroom"\n'
-    p.write_text(head + ISSUE_36 + "[gnss_ins]\nsigma_pos_m = [0.02, 0.02, 0.03]\n")
+    p.write_text(head + ISSUE_36 + priors_toml())
     got = _paths()[path_name](p)
     assert same(got, EXPECTED), got
     assert same(got, read_sensor(p))
@@ -94,7 +95,7 @@ def test_adjust_pushbroom_starts_from_the_files_camera(tmp_path):
     text = ISSUE_36.replace("n_bands = 3", "n_bands = 7").replace(
         "[40.0, 40.1, 40.2]", "[40.0, 40.1, 40.2, 40.3, 40.4, 40.5, 40.6]"
     )
-    p.write_text('[sensor]\nmodel = "pushbroom"\n' + text)
+    p.write_text('[sensor]\nmodel = "pushbroom"\n' + text + priors_toml())
     cam = read_camera(p)
     params, _, _ = build_problem(obs.lines, obs.n_points, cam, t_span_s=obs.t_span_s)
     np.testing.assert_array_equal(params.value("boresight_rad"), np.deg2rad([0.3, -0.2, 0.1]))

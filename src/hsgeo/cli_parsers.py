@@ -418,7 +418,10 @@ def add_adjust_pushbroom(sub) -> argparse.ArgumentParser:
         description="Observation table: point_id, band, t_s, x_px, y_px; GCPs: point_id, E_m, "
         'N_m, H_m (CSV or Parquet); camera: the sensor file ([sensor] model = "pushbroom", '
         "or the former [camera] table; see hsgeo.io.read_sensor), whose c_band_mm, distortion "
-        "and boresight_deg the adjustment starts from. "
+        "and boresight_deg the adjustment starts from, and whose a-priori σ weight it (your "
+        "instruments', required: sigma_lever_m in that table; [gnss_ins] sigma_pos_m = [E, N, "
+        "H] m and sigma_att_deg = [roll, pitch, yaw]; [observations] sigma_px; [gcp] sigma_m "
+        "with --gcp). "
         "NAV: the navigation file of every command, CSV or Parquet with t_s, E_m, N_m, U_m, "
         "roll_deg, pitch_deg, heading_deg (positions east-north-up in m; attitude of the body, "
         "x forward, y right, z down, in north-east-down, in degrees; see hsgeo.io.navigation). "

@@ -85,7 +85,7 @@ REPORTED_PARAMETERS = (
 )
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class CameraPrior:
     """A-priori camera and GNSS/INS values (the adjustment's starting point and priors).
 
@@ -93,6 +93,8 @@ class CameraPrior:
     principal distance per band (``c_band_mm``, default ``c_mm`` for every band), the
     distortion of 002 eq. (3) and the boresight (ω, φ, κ on the nominal mount, rad); the
     adjustment starts from them, not from zero. :meth:`camera` is that camera as a sensor.
+    The a-priori σ have no defaults: they are the user's instruments' (a chapter passes its
+    campaign's, :func:`hsgeo.reproduce.pushbroom_runs.camera_prior`).
 
     References
     ----------
@@ -103,16 +105,16 @@ class CameraPrior:
     """
 
     n_bands: int
-    pixel_mm: float = 0.0065
-    c_mm: float = 40.0
+    pixel_mm: float
+    c_mm: float
+    sigma_lever_m: float
+    sigma_pos_m: tuple
+    sigma_att_rad: tuple
+    sigma_obs_px: float
+    sigma_gcp_m: float
     x0_mm: float = 0.0
     y0_mm: float = 0.0
     lever_arm_m: tuple = (0.0, 0.0, 0.0)
-    sigma_lever_m: float = 0.02
-    sigma_pos_m: tuple = (0.013, 0.013, 0.020)
-    sigma_att_rad: tuple = tuple(np.deg2rad([0.005, 0.005, 0.008]))
-    sigma_obs_px: float = 0.5
-    sigma_gcp_m: float = 0.01
     c_band_mm: tuple | None = None
     distortion: tuple = (0.0, 0.0, 0.0, 0.0)
     boresight_rad: tuple = (0.0, 0.0, 0.0)
@@ -543,12 +545,13 @@ OBS_COLUMNS = ("point_id", "band", "t_s", "x_px", "y_px")
 GCP_COLUMNS = ("point_id", "E_m", "N_m", "H_m")
 
 
-def read_camera(path) -> CameraPrior:
+def read_camera(path, need_gcp_sigma: bool = True) -> CameraPrior:
     """Camera and GNSS/INS priors from a sensor file of model ``pushbroom`` (or the former
     ``[camera]`` file): the camera as :func:`hsgeo.io.read_sensor` reads it (per-band c,
     distortion, boresight and lever arm: the adjustment starts from them), the σ keys and
-    tables (``sigma_lever_m``, ``[gnss_ins]``, ``[observations]``, ``[gcp]``) as given; keys the
-    file does not give keep the defaults of :class:`CameraPrior`.
+    tables (``sigma_lever_m``, ``[gnss_ins]``, ``[observations]``, ``[gcp]``) as given. Every
+    σ is required (``[gcp] sigma_m`` only with ``need_gcp_sigma``): a missing one is refused by
+    name, as no paper's σ is the right default for a user's instruments.
     """
     from hsgeo.io.sensor_file import read_sensor, read_sensor_tables
 
@@ -572,17 +575,31 @@ def read_camera(path) -> CameraPrior:
         "distortion": tuple(camera.distortion),
         "boresight_rad": tuple(camera.boresight_rad),
     }
-    if "sigma_lever_m" in cam:
-        kw["sigma_lever_m"] = cam["sigma_lever_m"]
-    if "sigma_pos_m" in nav:
-        kw["sigma_pos_m"] = nav["sigma_pos_m"]
-    if "sigma_att_deg" in nav:
-        kw["sigma_att_rad"] = tuple(np.deg2rad(nav["sigma_att_deg"]))
+    # the a-priori σ are the user's instruments' (a paper's values are never a default here)
     obs, gcp = tables["observations"], tables["gcp"]
-    if "sigma_px" in obs:
-        kw["sigma_obs_px"] = obs["sigma_px"]
-    if "sigma_m" in gcp:
-        kw["sigma_gcp_m"] = gcp["sigma_m"]
+    wanted = [  # (table, key, the table's values, what it is)
+        ("camera", "sigma_lever_m", cam, "σ of the measured lever arm, m"),
+        ("gnss_ins", "sigma_pos_m", nav, "σ of the GNSS/INS positions E, N, H, m"),
+        ("gnss_ins", "sigma_att_deg", nav, "σ of the GNSS/INS roll, pitch, yaw, degrees"),
+        ("observations", "sigma_px", obs, "σ of an image coordinate, px"),
+    ]
+    if need_gcp_sigma:
+        wanted.append(("gcp", "sigma_m", gcp, "σ of a GCP coordinate, m"))
+    missing = [f"[{t}] {k} ({what})" for t, k, have, what in wanted if k not in have]
+    if missing:
+        raise InputError(
+            f"camera file {path}: no a-priori σ for " + "; ".join(missing) + ". hsgeo "
+            "adjust-pushbroom weights the navigation, the lever arm, the image observations and "
+            "the GCPs by these: add each key under its table with your instruments' values "
+            "(the GNSS/INS's post-processing report, the matcher's precision, the survey's)"
+        )
+    kw.update(
+        sigma_lever_m=cam["sigma_lever_m"],
+        sigma_pos_m=nav["sigma_pos_m"],
+        sigma_att_rad=tuple(np.deg2rad(nav["sigma_att_deg"])),
+        sigma_obs_px=obs["sigma_px"],
+        sigma_gcp_m=gcp.get("sigma_m", np.nan),  # used only with GCPs
+    )
     return CameraPrior(**kw)
 
 
@@ -653,7 +670,7 @@ def adjust_files(
     traj, _ = read_line_navigation(
         trajectory, crs=nav_crs, site=site, frame_needed_by="--gcp" if gcp is not None else None
     )
-    cam = read_camera(camera)
+    cam = read_camera(camera, need_gcp_sigma=gcp is not None)
     obs, ids = _observations(obs_df, observations, trajectory, traj, cam, max_nav_gap_s)
     _check_node_memory(obs.t_s, node_interval_s)
     gi = gx = None
