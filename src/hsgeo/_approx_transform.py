@@ -57,8 +57,6 @@ CHECK_MARGIN = 0.25
 MIN_POINTS = 4096
 #: Nodes of the fit along each input axis, less one: the cubic is determined on each axis.
 DEGREE = (3, 3, 3)
-#: Terms of the polynomial: the monomials of total degree ≤ 3 in three variables.
-N_TERMS = 20
 #: Points of the input taken into the check set (every k-th, k = n // CHECK_POINTS).
 CHECK_POINTS = 256
 #: An input axis spanning less than this (in its units) is constant for the fit (degree 0).
@@ -121,7 +119,7 @@ def approx_transform(exact, inputs, tol, *, min_points: int = MIN_POINTS):
     if not np.all(np.isfinite(ref)):
         return _exact(exact, cols, shape), info
     V = _monomials((nodes - centre) / half)
-    coef = np.linalg.lstsq(V, ref[: nodes.shape[0]], rcond=None)[0]  # (N_TERMS, n_out)
+    coef = np.linalg.lstsq(V, ref[: nodes.shape[0]], rcond=None)[0]  # (20 terms, n_out)
     coef = np.ascontiguousarray(coef.T)
     got = np.empty((coef.shape[0], check.shape[0]))  # the very kernel that is used below
     _poly3(*(np.ascontiguousarray(v) for v in check.T), centre, 1.0 / half, coef, got)
@@ -143,7 +141,7 @@ def _lattice(lo, hi, deg):
 
 
 def _monomials(S):
-    """The :data:`N_TERMS` monomials of total degree ≤ 3 of scaled points ``S`` (m, 3), in
+    """The 20 monomials of total degree ≤ 3 of scaled points ``S`` (m, 3), in
     :func:`_poly3`'s order.
     """
     e, n, u = S.T
