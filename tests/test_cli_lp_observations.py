@@ -6,6 +6,7 @@ import json
 
 import pandas as pd
 import pytest
+from priors import priors_toml
 
 from hsgeo.cli import main
 
@@ -29,7 +30,7 @@ def files(tmp_path_factory):
     la = ", ".join(f"{v:.6f}" for v in cam.lever_arm_m)
     (d / "cam.toml").write_text(
         f"[camera]\nn_bands = {len(cam.c_mm)}\npixel_mm = {cam.pixel_mm}\nc_mm = {cam.c_mm[0]}\n"
-        f"x0_mm = {cam.x0_mm}\nlever_arm_m = [{la}]\n"
+        f"x0_mm = {cam.x0_mm}\nlever_arm_m = [{la}]\n" + priors_toml()
     )
     xyz = obs.square_xyz_m
     sq = pd.DataFrame(
