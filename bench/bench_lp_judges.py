@@ -49,6 +49,16 @@ def _f(x):
     return [None if not np.isfinite(v) else float(v) for v in x.ravel()]
 
 
+def _target_fields(tj: dict) -> dict:
+    """The point-target judge's counts and within-1-px / ½-px shares, as the results keep them."""
+    keys = ("within_target", "within_median", "within_leave_one_out")
+    keys += ("within_median_on_targets", "within_leave_one_out_on_targets")
+    counts = ("targets", "targets_found", "n_observations_on_targets", "n_tie_observations")
+    return {k: tj[k] for k in counts} | {
+        f"{k}_{'1px' if lim == 1.0 else 'half_px'}": tj[k][lim] for k in keys for lim in (1.0, 0.5)
+    }
+
+
 def one_seed(seed: int, scale: float, n_draws: int) -> dict:
     t0 = time.perf_counter()
     obs, truth = simulate(sim_scale(scale), rng=seed, cfg=target_config())
@@ -59,21 +69,7 @@ def one_seed(seed: int, scale: float, n_draws: int) -> dict:
     tr = twin_difference(ev, obs, truth, tw, n_draws=n_draws, rng=[seed, 38], method="resample")
     return {
         "seed": seed,
-        "targets": tj["targets"],
-        "targets_found": tj["targets_found"],
-        "n_observations_on_targets": tj["n_observations_on_targets"],
-        "n_tie_observations": tj["n_tie_observations"],
-        **{
-            f"{k}_{'1px' if lim == 1.0 else 'half_px'}": tj[k][lim]
-            for k in (
-                "within_target",
-                "within_median",
-                "within_leave_one_out",
-                "within_median_on_targets",
-                "within_leave_one_out_on_targets",
-            )
-            for lim in (1.0, 0.5)
-        },
+        **_target_fields(tj),
         "labels": td["labels"],
         "difference": _f(td["difference"]),
         "sigma_difference": _f(td["sigma_difference"]),
@@ -105,21 +101,7 @@ def one_seed_targets(seed: int, scale: float) -> dict:
     cpu["judge"] = time.process_time() - c0
     return {
         "seed": seed,
-        "targets": tj["targets"],
-        "targets_found": tj["targets_found"],
-        "n_observations_on_targets": tj["n_observations_on_targets"],
-        "n_tie_observations": tj["n_tie_observations"],
-        **{
-            f"{k}_{'1px' if lim == 1.0 else 'half_px'}": tj[k][lim]
-            for k in (
-                "within_target",
-                "within_median",
-                "within_leave_one_out",
-                "within_median_on_targets",
-                "within_leave_one_out_on_targets",
-            )
-            for lim in (1.0, 0.5)
-        },
+        **_target_fields(tj),
         "error_vs_target_px_quantiles_50_90_99_100": _f(
             np.percentile(np.hypot(*tj["errors_target_px"].T), [50, 90, 99, 100])
             if tj["errors_target_px"].size
