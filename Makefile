@@ -51,13 +51,14 @@ data: $(STAMP) ## regenerate data_synthetic/generated from the scenario TOMLs an
 # order in one process, so the scoreboard reads the records of the chapters before it. The
 # compiled kernels (numba, cache=True) are cached beside the sources (__pycache__) and shared by
 # every process, so a fresh clone compiles each kernel once (both processes may race on the first).
+# `--durations=40` prints the 40 slowest tests at the end: where the suite's time goes (issue 41).
 TEST_WORKERS ?= 2
 TEST_XDIST = $(if $(filter 0,$(TEST_WORKERS)),,-n $(TEST_WORKERS) --dist loadfile)
 
 test: $(STAMP) proj-data ## the docstrings' examples (doctest) and the whole test suite, chapters included
 	$(PY) -m hsgeo.cli data --verify
 	$(PY) -m pytest -q -p no:cacheprovider --doctest-modules src/hsgeo
-	$(PY) -m pytest -q $(TEST_XDIST) tests
+	$(PY) -m pytest -q $(TEST_XDIST) --durations=40 tests
 
 test-fast: $(STAMP) proj-data ## the test suite without the chapter executions and slow Monte Carlo tests
 	$(PY) -m pytest -q $(TEST_XDIST) -m "not slow" --ignore=tests/test_chapters.py tests
