@@ -131,6 +131,14 @@ def test_tolerance_in_units():
     assert ftx == pytest.approx(1e-3 / 0.3048006096)
 
 
+def test_the_approximation_is_the_default():
+    import inspect
+
+    from hsgeo.ortho import orthomosaic
+
+    assert inspect.signature(orthomosaic).parameters["crs_tol_m"].default == ax.APPROX_TOL_M
+
+
 def test_block_geometry_and_mosaic_against_proj_on_every_pixel():
     """The orthomosaic's block ground (map x, y) within 1 mm of PROJ on every pixel, and its
     cells the same (every cell, here: the differences are nanometres)."""
@@ -148,9 +156,8 @@ def test_block_geometry_and_mosaic_against_proj_on_every_pixel():
     print(f"block ground: largest difference {d:.2e} m")
     assert 0 < d <= ax.APPROX_TOL_M
     np.testing.assert_array_equal(fast[2], exact[2])
-    a = orthomosaic(fl.strips, fl.terrain, FRAME, resolution_m=0.3, crs_tol_m=ax.APPROX_TOL_M)
-    a = a.values
-    b = orthomosaic(fl.strips, fl.terrain, FRAME, resolution_m=0.3).values  # default: exact
+    a = orthomosaic(fl.strips, fl.terrain, FRAME, resolution_m=0.3).values  # default: 1 mm
+    b = orthomosaic(fl.strips, fl.terrain, FRAME, resolution_m=0.3, crs_tol_m=None).values
     np.testing.assert_array_equal(a, b)
 
 
