@@ -11,7 +11,9 @@ order (Amanatides & Woo's grid traversal, on two levels: blocks of ``block`` cel
 highest node the ray may pass above whole, then the cells of a block it does not) and returns
 the smallest root of the quadratic in the first cell where there is one. No step size, no
 tolerance: the first crossing to rounding (≈ 1e-12 m), however steep the wall, however wide the
-angle, and a ray that grazes a roof's corner is occluded by it.
+angle, and a ray that grazes a roof's corner is occluded by it. (The one margin: each ray is
+followed :data:`FLOOR_MARGIN` of its heights under the grid's lowest node, so that a crossing AT
+the lowest height, a flat DSM or a lake, is not lost to the rounding of the ray's height there.)
 
 :func:`first_crossing_reference` is the numpy reference: a dense march down the ray and a
 bisection of the first bracket (any ``height(E, N)``; it misses a dip of the ray under the
@@ -48,6 +50,7 @@ __all__ = [
     "cast_chords",
     "bilinear",
     "first_crossing_reference",
+    "FLOOR_MARGIN",
 ]
 
 HIT, OUTSIDE, BELOW = 0, 1, 2
@@ -200,6 +203,18 @@ def _index(p, q, s, lo, hi):  # pragma: no cover - compiled
     return min(max(k, lo), hi)
 
 
+#: The floor of a ray's traversal lies this share of the largest height magnitude (at least
+#: 1 m) under the grid's lowest node: ≈ 4,500 times float64's rounding of those heights, 1e-12
+#: m at heights of 1 m, 1e-8 m at 10 km.
+FLOOR_MARGIN = 1e-12
+
+
+@njit(cache=True, inline="always")
+def _floor_margin(oz, zmin):  # pragma: no cover - compiled
+    """How far under the lowest node ``zmin`` a ray from height ``oz`` is followed, m."""
+    return FLOOR_MARGIN * max(1.0, abs(oz), abs(zmin))
+
+
 @njit(cache=True, inline="always")
 def first_crossing(
     ox, oy, oz, dx, dy, dz, z, e0, n0, de, dn, bmax, blk, zmin, zmax
@@ -229,10 +244,16 @@ def first_crossing(
     qy = dy / dn
     # the heights the surface spans: from where the ray is at its top to where it is at its floor
     s0 = 0.0 if oz <= zmax else (zmax - oz) / dz
-    s1 = (zmin - oz) / dz
-    if s1 < 0.0:  # the origin is under the lowest node
+    if (zmin - oz) / dz < 0.0:  # the origin is under the lowest node
         over = 0.0 <= px <= nc - 1.0 and 0.0 <= py <= nr - 1.0
         return np.nan, BELOW if over else OUTSIDE
+    # the floor a rounding margin under the lowest node: a crossing AT the lowest height (a flat
+    # DSM, a lake at its lowest) is where ``oz + s dz`` rounds to either side of zmin, and a
+    # floor at zmin itself lost such rays as OUTSIDE (every ray of a flat DSM at 0.3 m;
+    # tests/test_raycast_flat.py); the crossing found is the cell's root, not the floor, so a
+    # ray that met the surface before meets it at the same s (but one within rounding of the
+    # old floor, which was returned as the floor itself)
+    s1 = (zmin - _floor_margin(oz, zmin) - oz) / dz
     # the part of the ray over the grid (slabs)
     lo, hi = s0, s1
     if qx == 0.0:

@@ -48,6 +48,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from hsgeo._approx_transform import APPROX_TOL_M
 from hsgeo._perline import PerLine as _PerLine
 from hsgeo.errors import InputError
 from hsgeo.geocode import intersect
@@ -456,7 +457,7 @@ def orthomosaic(
     lines_per_block: int = 256,
     radius_m: float | None = None,
     max_gib: float | None = None,
-    crs_tol_m: float | None = None,
+    crs_tol_m: float | None = APPROX_TOL_M,
 ):
     """The orthomosaic of strips of any scanning sensor: a Dask-backed DataArray with a CRS.
 
@@ -490,12 +491,11 @@ def orthomosaic(
     crs_tol_m : float, optional
         Each line block's PROJ transforms (the DSM intersection's and into the grid's CRS) by
         a polynomial on PROJ at a few nodes, used only where its difference from PROJ, checked
-        on the block, is within this bound, m (e.g. :data:`hsgeo._approx_transform.
-        APPROX_TOL_M`, 1 mm; :func:`block_ground`). Default None: PROJ on every pixel. Not the
-        default because on the wheel check's 8 LP strips (``make check-wheel``) the mosaic with
-        1 mm refused 7,614 or 10,144 rays as outside the DSM from run to run, where PROJ on
-        every pixel succeeds every time: a race under dask's threads, not yet found (each
-        block's polynomial was within 2e-8 m of PROJ).
+        on the block, is within this bound, m (default :data:`hsgeo._approx_transform.
+        APPROX_TOL_M`, 1 mm; :func:`block_ground`); None: PROJ on every pixel. (Briefly not
+        the default: on ``make check-wheel``'s flat DSM it refused rays as outside the DSM,
+        which was the compiled crossing's floor at the DSM's lowest height, not the
+        approximation: :data:`hsgeo._raycast.FLOOR_MARGIN`.)
 
     Returns
     -------
