@@ -803,8 +803,8 @@ class PushbroomCamera:
         """
         n = np.shape(xy_px)[0]
         t = np.asarray(t_s, dtype=np.float64)
-        if t.ndim == 0 or t.size == 1:
-            t = np.full(n, t.ravel()[0] if t.size else np.nan)
+        if t.size == 1:
+            t = np.full(n, t.item())
         if t.shape != (n,):
             raise InputError(f"t_s must be one time or one per pixel ({n}), got {t.shape}")
         starts = line_runs(t)
