@@ -3,7 +3,8 @@
 Kept as one file: the one 002 LP camera model in its three faces (the sensor
 :class:`PushbroomCamera`, the numpy reference :func:`project`, the residual block
 :class:`PushbroomLines`) sharing its geometry; the compiled kernel is in
-:mod:`hsgeo.sensors._pushbroom_kernel`.
+:mod:`hsgeo.sensors._pushbroom_kernel`, the compiled rays of lines of pixels (one pose per line,
+one camera direction per column) in :mod:`hsgeo.sensors._pushbroom_rays`.
 
 002 eq. 2–4.
 
@@ -93,6 +94,7 @@ from hsgeo.distortion import (
 from hsgeo.errors import InputError, ObservationError
 from hsgeo.rotations import R_from_opk, R_from_rpy, dR_dopk, dR_drpy
 from hsgeo.sensors._pushbroom_kernel import _lines_kernel
+from hsgeo.sensors._pushbroom_rays import line_runs, rays_by_line
 from hsgeo.sensors.mount import Mount, line_time, unit
 from hsgeo.trajectory import R_BODY_FROM_PLATFORM, SplineNodes, bspline_basis
 
@@ -709,8 +711,62 @@ class PushbroomCamera:
             raise InputError(f"band indices must be integers in 0…{c.size - 1}")
         return c[b]
 
+    def _unit_camera_directions(self, xy_px, band) -> np.ndarray:
+        """Unit camera-frame directions ``(x̄, ȳ, c_b) / |·|`` of pixels ``(n, 2)`` (002 eq. (3)
+        inverted: the pixel in mm from the principal point, undistorted, and the band's c).
+        """
+        xy_mm = xy_px * self.pixel_mm - np.array([self.x0_mm, self.y0_mm])
+        if any(self.distortion):
+            xy_mm = undistort_pushbroom_line(xy_mm, self.distortion)  # 002 eq. (3) inverted
+        return unit(np.column_stack([xy_mm, self._band_c(band, xy_mm.shape[0])]))
+
+    def _rays_by_line(self, xy_px, band, starts, xyz_platform_m, R_map_from_platform):
+        """Rays of pixels grouped in lines ``starts`` (:func:`~hsgeo.sensors._pushbroom_rays.
+        line_runs`) with one platform pose per line: the one implementation of :meth:`rays`
+        and :meth:`rays_at`.
+
+        ``R_map_from_platform βᵀ`` and the origin ``x + R l^p`` are formed once per line; the
+        camera directions once per column when every line has the same pixels (and bands),
+        else once per pixel; :func:`~hsgeo.sensors._pushbroom_rays.rays_by_line` turns them.
+        """
+        xy = np.asarray(xy_px, dtype=np.float64)
+        if xy.ndim != 2 or xy.shape[1] != 2:
+            raise InputError(f"pixels must be (n, 2) (x, y) px, got shape {xy.shape}")
+        n, m = xy.shape[0], starts.size - 1
+        b = np.asarray(band)
+        if b.ndim and b.shape != (n,):
+            raise InputError(f"band must be one index or one per pixel ({n}), got {b.shape}")
+        k = int(starts[1] - starts[0]) if m else 0
+        per_column = (
+            m > 1
+            and n == m * k
+            and np.array_equal(starts, np.arange(m + 1) * k)
+            and bool(np.all(xy.reshape(m, k, 2) == xy[:k]))
+            and (b.ndim == 0 or bool(np.all(b.reshape(m, k) == b[:k])))
+        )
+        if per_column:
+            u_cam = self._unit_camera_directions(xy[:k], b if b.ndim == 0 else b[:k])
+        else:
+            u_cam = self._unit_camera_directions(xy, b)
+        R = np.asarray(R_map_from_platform, dtype=np.float64).reshape(m, 3, 3)
+        # 002 eq. (4) read backwards, per line: x + R l^p and R βᵀ
+        origin = self.platform_mount.origins(np.reshape(xyz_platform_m, (m, 3)), R)
+        R_map_from_cam = np.ascontiguousarray(R @ self.beta.T)
+        origins, dirs = np.empty((n, 3)), np.empty((n, 3))
+        rays_by_line(
+            starts,
+            np.ascontiguousarray(origin, dtype=np.float64),
+            R_map_from_cam,
+            np.ascontiguousarray(u_cam),
+            per_column,
+            origins,
+            dirs,
+        )
+        return origins, dirs
+
     def rays_at(self, xy_px, band, xyz_platform_m, R_map_from_platform):
-        """Rays of pixels at given platform poses (the core of :meth:`rays`).
+        """Rays of pixels at given platform poses (one pose per pixel; :meth:`rays` groups the
+        pixels of a line under one pose).
 
         Parameters
         ----------
@@ -725,30 +781,37 @@ class PushbroomCamera:
         origins_m, directions : (n, 3) ndarray
             Projection centres ``x + R l^p`` and unit directions ``R βᵀ (x̄, ȳ, c_b)``.
         """
-        xy_mm = np.asarray(xy_px, dtype=float) * self.pixel_mm - np.array([self.x0_mm, self.y0_mm])
-        if any(self.distortion):
-            xy_mm = undistort_pushbroom_line(xy_mm, self.distortion)  # 002 eq. (3) inverted
-        n = xy_mm.shape[0]
-        d_cam = np.column_stack([xy_mm, self._band_c(band, n)])
-        R = np.asarray(R_map_from_platform, dtype=float)
-        m = self.platform_mount  # 002 eq. (4) read backwards: x + R l^p and R βᵀ d_cam
-        return m.origins(xyz_platform_m, R), unit(m.directions(R, d_cam))
+        n = np.shape(xy_px)[0]
+        xyz = np.broadcast_to(np.asarray(xyz_platform_m, dtype=np.float64), (n, 3))
+        R = np.broadcast_to(np.asarray(R_map_from_platform, dtype=np.float64), (n, 3, 3))
+        return self._rays_by_line(xy_px, band, np.arange(n + 1, dtype=np.int64), xyz, R)
 
     def rays(self, xy_px, t_s, trajectory, band=0) -> tuple[np.ndarray, np.ndarray]:
         """Origins (m) and unit directions of the rays of pixels seen at times ``t_s``.
 
+        The pose is computed once per run of equal consecutive times (the pixels of one line)
+        and the camera direction once per column when the lines share their pixels.
+
         Parameters
         ----------
         xy_px : (n, 2) array_like, px
-        t_s : (n,) array_like, s
+        t_s : float or (n,) array_like, s
         trajectory : hsgeo.trajectory.Trajectory
             GNSS/INS poses of the body (corrected ones, for an adjusted trajectory).
         band : int or (n,) int array_like
             Band of each pixel (its principal distance).
         """
-        pos, _ = trajectory.pose(t_s)
-        R = trajectory.R_map_from_body(t_s) @ R_BODY_FROM_PLATFORM
-        return self.rays_at(xy_px, band, pos, R)
+        n = np.shape(xy_px)[0]
+        t = np.asarray(t_s, dtype=np.float64)
+        if t.size == 1:
+            t = np.full(n, t.item())
+        if t.shape != (n,):
+            raise InputError(f"t_s must be one time or one per pixel ({n}), got {t.shape}")
+        starts = line_runs(t)
+        t_line = t[starts[:-1]]
+        pos, _ = trajectory.pose(t_line)
+        R = trajectory.R_map_from_body(t_line) @ R_BODY_FROM_PLATFORM
+        return self._rays_by_line(xy_px, band, starts, pos, R)
 
     def project_at(self, xyz_map_m, band, xyz_platform_m, R_map_from_platform) -> np.ndarray:
         """Pixels ``(n, 2)`` of map points at given platform poses (002 eq. (2)–(4))."""
