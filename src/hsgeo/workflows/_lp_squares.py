@@ -124,8 +124,9 @@ def candidates(sc, predicted, inputs, options, bands) -> list:
     h_px = (inputs.n_px_full - 1) / 2
     found = []
     # each band as float64 once per scene (the measurers' own conversion is then a no-op),
-    # not once per square and candidate (issue 41)
-    image = {}
+    # not once per square and candidate; and each peak's blob once per band, however many
+    # squares' search windows find it (issue 41)
+    image, blobs = {}, {}
     for k in np.flatnonzero(np.isfinite(line)):
         u0 = line[k] - sc.line0
         if not (0 <= u0 <= n - 1):
@@ -138,9 +139,12 @@ def candidates(sc, predicted, inputs, options, bands) -> list:
                 image[b], uv0, box_px=box, search_px=options.square_search_px
             )
             for c, s in zip(cand, snr, strict=True):
-                uv, ok = blob_centroid(image[b], c, box_px=box)
+                key = (b, int(c[0]), int(c[1]))
+                if key not in blobs:
+                    blobs[key] = blob_centroid(image[b], c, box_px=box)
+                uv, ok = blobs[key]
                 if ok:
-                    found.append((k, b, uv0, c, float(s), uv))
+                    found.append((k, b, uv0, c, float(s), uv.copy()))
     if not found:
         return []
     # back to the original lines, all candidates at once (element by element as one by one)
