@@ -75,6 +75,10 @@ def test_convex_overlap_and_inside():
     pts = np.array([[5.0, 5], [11, 5], [-0.5, 5]])
     assert geo.inside_convex(pts, sq).tolist() == [True, False, False]
     assert geo.inside_convex(pts, sq, margin_m=1).tolist() == [True, True, True]
+    # the edges computed once (match_all) give the same answer as the polygon
+    e = geo.convex_edges(sq[::-1])
+    assert geo.inside_convex(pts, None, 1.0, edges=e).tolist() == [True, True, True]
+    assert geo.inside_convex(pts, None, edges=e).tolist() == [True, False, False]
 
 
 def _flight(t, heading_deg=90.0, E0=0.0, N0=0.0, speed=67.0, H=1965.0):

@@ -82,6 +82,18 @@ def test_trajectory_interpolation_and_errors():
         tr.t_s = t
 
 
+def test_R_map_from_body_is_the_attitude_of_pose_bitwise():
+    """R_map_from_body interpolates the attitude only (issue 41): the same bits as from pose()."""
+    t = np.linspace(0.0, 10.0, 11)
+    rng = np.random.default_rng(5)
+    tr = Trajectory(t, rng.normal(size=(11, 3)) * 100, rng.uniform(-3, 3, (11, 3)))
+    tq = rng.uniform(0.0, 10.0, 57)
+    _, a = tr.pose(tq)
+    assert np.array_equal(tr.R_map_from_body(tq), R_ENU_FROM_NED @ R_from_rpy(*a.T))
+    with pytest.raises(InputError, match="outside the trajectory"):
+        tr.R_map_from_body([10.5])
+
+
 def test_R_map_from_body_axes():
     """Level, heading 30°: body x points 30° east of north, body z down, in ENU."""
     h = np.deg2rad(30.0)

@@ -277,16 +277,24 @@ class Trajectory:
         InputError
             If a time falls outside the record.
         """
+        t = self._times(t_s)
+        pos = np.stack([np.interp(t, self.t_s, self.xyz_m[:, k]) for k in range(3)], axis=1)
+        return pos, self._attitude(t)
+
+    def _times(self, t_s) -> np.ndarray:
+        """``t_s`` as a flat float array, checked to lie within the record."""
         t = np.atleast_1d(np.asarray(t_s, dtype=np.float64)).ravel()
         if np.any(t < self.t_s[0]) or np.any(t > self.t_s[-1]):
             raise InputError(
                 f"times {t.min():.3f}…{t.max():.3f} s fall outside the trajectory "
                 f"{self.t_s[0]:.3f}…{self.t_s[-1]:.3f} s: the navigation does not cover them"
             )
+        return t
+
+    def _attitude(self, t: np.ndarray) -> np.ndarray:
+        """Roll, pitch, heading at checked times ``t`` (:meth:`pose`'s second output)."""
         a = self.roll_pitch_heading_rad
-        pos = np.stack([np.interp(t, self.t_s, self.xyz_m[:, k]) for k in range(3)], axis=1)
-        att = np.stack([np.interp(t, self.t_s, a[:, k]) for k in range(3)], axis=1)
-        return pos, att
+        return np.stack([np.interp(t, self.t_s, a[:, k]) for k in range(3)], axis=1)
 
     def rates(self, t_s, step_s: float = 1e-3) -> tuple[np.ndarray, np.ndarray]:
         """Velocity and attitude-angle rates at the given times.
@@ -314,7 +322,7 @@ class Trajectory:
 
         Takes body vectors (x forward, y right, z down) to the east-north-up map frame.
         """
-        _, a = self.pose(t_s)
+        a = self._attitude(self._times(t_s))  # the attitude of pose(), without the positions
         return R_ENU_FROM_NED @ R_from_rpy(a[:, 0], a[:, 1], a[:, 2])
 
 

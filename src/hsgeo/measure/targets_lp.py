@@ -142,7 +142,10 @@ def square_candidates(
     finite = np.isfinite(win)
     if finite.sum() < 0.5 * win.size:
         return none
-    win = np.where(finite, win, np.median(win[finite]))
+    if finite.all():  # a window inside the scene needs no fill: no median to compute
+        win = np.ascontiguousarray(win)
+    else:
+        win = np.where(finite, win, np.median(win[finite]))
     con = box_contrast(win, box_px)
     inner = np.full(con.shape, -np.inf)
     s = slice(3 * box_px, -3 * box_px)
@@ -176,7 +179,7 @@ def blob_centroid(band, uv_peak, *, box_px: int = 4, max_area_factor: float = 4.
     sub = a[pr - h : pr + h + 1, pc - h : pc + h + 1]
     if not np.all(np.isfinite(sub)):  # at the scene's edge
         return np.full(2, np.nan), False
-    border = np.r_[sub[0], sub[-1], sub[1:-1, 0], sub[1:-1, -1]]
+    border = np.concatenate([sub[0], sub[-1], sub[1:-1, 0], sub[1:-1, -1]])
     w = sub - np.median(border)
     rc, blob = weighted_blob_centroid(w, np.unravel_index(np.argmax(w), w.shape))
     if (

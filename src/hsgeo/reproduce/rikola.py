@@ -71,12 +71,14 @@ def observe(
     refine: str = "subpix",
     compare_refine: str | None = None,
     keep_images=(),
+    grids: dict | None = None,
 ):
     """Render the bands of the cubes and measure them as a user would (the experiment of 003 §3.2).
 
     The images are rendered one at a time (:class:`hsgeo.simulate.rikola.Renderer`) and measured
     by the truth-free :func:`hsgeo.workflows.rikola_bands.detect_targets_in_images`; the truth only
-    counts the targets fully in view, for the detection rate.
+    counts the targets fully in view, for the detection rate. ``grids``: the Renderer's cache of
+    ideal-coordinate grids, to share with another campaign of the same camera (``run``).
 
     Returns
     -------
@@ -91,7 +93,7 @@ def observe(
     """
     from hsgeo.simulate.rikola import Renderer
 
-    r = Renderer(cfg, truth)
+    r = Renderer(cfg, truth, grids)
     plate = r.plate
     cam = cfg.camera
     size = (int(cam.width_px), int(cam.height_px))
@@ -143,7 +145,14 @@ def setup(seed: int = 0, scale: float = 1.0, *, eop_drift: bool = True):
 
 
 def campaign(
-    cfg: RikolaBenchScenario, truth, seed: int, cubes, bands, *, contour: bool = True
+    cfg: RikolaBenchScenario,
+    truth,
+    seed: int,
+    cubes,
+    bands,
+    *,
+    contour: bool = True,
+    grids: dict | None = None,
 ) -> dict:
     """Render and measure the bench, then calibrate it as a user would
     (:func:`hsgeo.workflows.rikola.calibrate_rikola`) and predict the held-out bands.
@@ -152,7 +161,7 @@ def campaign(
     -------
     dict with ``obs``, ``obs_contour`` (None without ``contour``), ``images``, ``expected``,
     ``result`` (:class:`~hsgeo.workflows.rikola.RikolaResult`), ``held`` (RMS per held-out band
-    and route) and ``seconds``.
+    and route) and ``seconds``. ``grids``: see :func:`observe`.
     """
     sigma_px = float(cfg.measure.sigma_px)
     t0 = time.time()
@@ -164,6 +173,7 @@ def campaign(
         bands,
         compare_refine="contour" if contour else None,
         keep_images=[(ROP_CUBE, b) for b in (1, 5, 20)],
+        grids=grids,
     )
     t_observe = time.time() - t0
     t0 = time.time()
@@ -528,7 +538,8 @@ def run(seed: int = 0, scale: float = 1.0, *, unmodelled: bool = True) -> Reprod
     """
     t_start = time.time()
     cfg, truth, cubes, bands = setup(seed, scale, eop_drift=unmodelled)
-    c = campaign(cfg, truth, seed, cubes, bands)
+    grids: dict = {}  # the ideal-coordinate grids, shared by both campaigns (one camera)
+    c = campaign(cfg, truth, seed, cubes, bands, grids=grids)
     obs, obs_contour, res = c["obs"], c["obs_contour"], c["result"]
     cals, joint = res.bands, res.joint
     rows, side = result_rows(c, truth)
@@ -540,7 +551,7 @@ def run(seed: int = 0, scale: float = 1.0, *, unmodelled: bool = True) -> Reprod
     if unmodelled:
         t0 = time.time()
         _, truth_off, _, _ = setup(seed, scale, eop_drift=False)
-        c_off = campaign(cfg, truth_off, seed, cubes, bands, contour=False)
+        c_off = campaign(cfg, truth_off, seed, cubes, bands, contour=False, grids=grids)
         rows_off, _ = result_rows(c_off, truth_off)
         rows += unmodelled_rows(rows, rows_off, c["result"], c_off["result"])
         c["seconds"]["unmodelled_off"] = time.time() - t0

@@ -168,12 +168,13 @@ def corner_bias(obs: Observations, truth) -> dict[int, dict[str, float]]:
     out = {}
     for b in np.unique(obs.band):
         o = obs.select(obs.band == b)
-        true = np.stack(
-            [
-                mm_to_pixel(truth.project(int(c), int(b), X), obs.image_size, obs.pixel_mm)
-                for c, X in zip(o.cube, o.corners_obj, strict=True)
-            ]
-        )
+        # the true corners, one projection per cube (its targets stacked: (n, 4, 3) points
+        # projected slice by slice as one target at a time would be, to the bit)
+        true = np.empty(np.shape(o.corners_px))
+        for c in np.unique(o.cube):
+            k = o.cube == c
+            xy_mm = truth.project(int(c), int(b), o.corners_obj[k])
+            true[k] = mm_to_pixel(xy_mm, obs.image_size, obs.pixel_mm)
         e = o.corners_px - true
         centre = true.mean(axis=1, keepdims=True)
         u = true - centre

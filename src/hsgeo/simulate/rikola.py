@@ -32,6 +32,7 @@ from hsgeo.papers import RIKOLA_BANDS, RIKOLA_CAMERA
 from hsgeo.rotations import R_from_opk, opk_from_R
 from hsgeo.sensors.frame import pixel_to_mm
 from hsgeo.sensors.rikola import focal_from_gap_mm, project_measured_mm
+from hsgeo.simulate._rikola_render import plate_texel_maps
 from hsgeo.simulate.scenarios import ScenarioInfo
 
 __all__ = [
@@ -462,26 +463,39 @@ class Renderer:
     cfg : RikolaBenchScenario
         Scenario configuration.
     truth : RikolaTruth
+    grids : dict, optional
+        A cache of the ideal-coordinate grids to share between the Renderers of one run (a
+        campaign and its twin without the EOP drift): keyed by everything a grid depends on
+        (image size, pixel pitch, supersampling, the sensor's principal point, the distortion),
+        so Renderers of different cameras may share it safely. Default: a cache of its own.
     """
 
-    def __init__(self, cfg: RikolaBenchScenario, truth: RikolaTruth):
+    def __init__(self, cfg: RikolaBenchScenario, truth: RikolaTruth, grids: dict | None = None):
         self.cfg, self.truth = cfg, truth
         self.plate = cfg.plate
-        self._grids: dict[int, np.ndarray] = {}
+        self._grids: dict = {} if grids is None else grids
 
     def _grid(self, sensor: int) -> np.ndarray:
-        if sensor not in self._grids:
-            cam = self.cfg.camera
-            s = int(self.cfg.radiometry.supersample)
-            w, h = cam.width_px, cam.height_px
+        cam = self.cfg.camera
+        s = int(self.cfg.radiometry.supersample)
+        w, h = cam.width_px, cam.height_px
+        key = (
+            int(w),
+            int(h),
+            float(cam.pixel_mm),
+            s,
+            np.asarray(self.truth.pp_mm[sensor - 1], float).tobytes(),
+            np.asarray(self.truth.KP, float).tobytes(),
+        )
+        if key not in self._grids:
             u = (np.arange(w * s) + 0.5) / s - 0.5
             v = (np.arange(h * s) + 0.5) / s - 0.5
             uu, vv = np.meshgrid(u, v)
             xy = pixel_to_mm(np.stack([uu, vv], axis=-1), (w, h), cam.pixel_mm)
             xbar = xy - self.truth.pp_mm[sensor - 1]
             ideal = xbar + brown_correction(xbar, self.truth.KP[:3], self.truth.KP[3:])
-            self._grids[sensor] = ideal.astype(np.float32)
-        return self._grids[sensor]
+            self._grids[key] = ideal.astype(np.float32)
+        return self._grids[key]
 
     def reflectance(self, cube: int, band: int) -> np.ndarray:
         """Noise-free reflectance image (height, width) after PSF and pixel integration."""
@@ -492,20 +506,12 @@ class Renderer:
         ideal = self._grid(sensor)
         pose = t.band_pose(cube, band)
         R = R_from_opk(*pose[:3]).astype(np.float32)
-        f = np.float32(t.f_mm[t.band_row(band)])
-        ix, iy = ideal[..., 0], ideal[..., 1]
-        d = [R[i, 0] * ix + R[i, 1] * iy - R[i, 2] * f for i in range(3)]  # ray in the world
-        with np.errstate(divide="ignore", invalid="ignore"):
-            tt = np.float32(-pose[5]) / d[2]
-        X = np.float32(pose[3]) + tt * d[0]
-        Y = np.float32(pose[4]) + tt * d[1]
         pl = self.plate
         x_min, _, _, y_max = pl.extent_mm
-        col = (X - np.float32(x_min)) / np.float32(pl.texel_mm) - np.float32(0.5)
-        row = (np.float32(y_max) - Y) / np.float32(pl.texel_mm) - np.float32(0.5)
-        bad = ~(tt > 0)
-        col[bad] = -1e6
-        row[bad] = -1e6
+        # the ray of each pixel meets the plate Z = 0: texel coordinates, in float32 (compiled)
+        col, row = plate_texel_maps(
+            ideal, R, t.f_mm[t.band_row(band)], pose, x_min, y_max, pl.texel_mm
+        )
         fine = cv2.remap(
             pl.texture,
             col,

@@ -12,7 +12,14 @@ import numpy as np
 from hsgeo.errors import ObservationError
 from hsgeo.geocode import PlaneTerrain, intersect
 
-__all__ = ["ground_points", "footprint", "convex_overlap", "inside_convex", "crossing_lines"]
+__all__ = [
+    "ground_points",
+    "footprint",
+    "convex_overlap",
+    "convex_edges",
+    "inside_convex",
+    "crossing_lines",
+]
 
 
 def ground_points(camera, x_px, t_s, trajectory, band, height_m: float) -> np.ndarray:
@@ -62,9 +69,18 @@ def convex_overlap(P, Q, margin_m: float = 0.0) -> bool:
     return True
 
 
-def inside_convex(points, P, margin_m: float = 0.0) -> np.ndarray:
-    """Points ``(n, 2)`` inside a convex polygon (either orientation), or within ``margin_m``."""
-    n, c = _edges(P)
+def convex_edges(P) -> tuple[np.ndarray, np.ndarray]:
+    """A convex polygon's edges as :func:`inside_convex` uses them (``edges=``): computed once
+    for a polygon tested against many point sets.
+    """
+    return _edges(P)
+
+
+def inside_convex(points, P, margin_m: float = 0.0, *, edges=None) -> np.ndarray:
+    """Points ``(n, 2)`` inside a convex polygon (either orientation), or within ``margin_m``;
+    ``edges``: the polygon's :func:`convex_edges`, when already computed (``P`` is then unused).
+    """
+    n, c = _edges(P) if edges is None else edges
     return np.all(np.asarray(points, float) @ n.T - c <= margin_m, axis=1)
 
 

@@ -122,23 +122,34 @@ def candidates(sc, predicted, inputs, options, bands) -> list:
     n = sc.image.shape[0]
     box = max(2, int(np.ceil(options.square_size_m / gsd_m)))
     h_px = (inputs.n_px_full - 1) / 2
-    out = []
+    found = []
+    # each band as float64 once per scene (the measurers' own conversion is then a no-op),
+    # not once per square and candidate; and each peak's blob once per band, however many
+    # squares' search windows find it (issue 41)
+    image, blobs = {}, {}
     for k in np.flatnonzero(np.isfinite(line)):
         u0 = line[k] - sc.line0
         if not (0 <= u0 <= n - 1):
             continue
         uv0 = np.array([u0, x[k] + h_px - sc.col0])  # δx is far inside the search window
         for b in bands:
+            if b not in image:
+                image[b] = np.asarray(sc.image[:, :, b], dtype=np.float64)
             cand, snr = square_candidates(
-                sc.image[:, :, b], uv0, box_px=box, search_px=options.square_search_px
+                image[b], uv0, box_px=box, search_px=options.square_search_px
             )
             for c, s in zip(cand, snr, strict=True):
-                uv, ok = blob_centroid(sc.image[:, :, b], c, box_px=box)
-                if not ok:
-                    continue
-                ln, xx = scene_to_line(sc, uv[None, :])
-                out.append((k, b, uv0, c, float(s), uv, int(ln[0]), float(xx[0]), box))
-    return out
+                key = (b, int(c[0]), int(c[1]))
+                if key not in blobs:
+                    blobs[key] = blob_centroid(image[b], c, box_px=box)
+                uv, ok = blobs[key]
+                if ok:
+                    found.append((k, b, uv0, c, float(s), uv.copy()))
+    if not found:
+        return []
+    # back to the original lines, all candidates at once (element by element as one by one)
+    ln, xx = scene_to_line(sc, np.array([f[5] for f in found]))
+    return [(*f, int(ln[i]), float(xx[i]), box) for i, f in enumerate(found)]
 
 
 def choose(cands: list, strip, predicted, inputs, options) -> list:

@@ -137,18 +137,22 @@ def _ransac_pair(uv1, uv2, options, seed):
     return np.asarray(lp, bool), np.asarray(fr, bool)
 
 
-def _inside(keys, scene: int, band: int, fp, margin) -> np.ndarray:
-    """Key points of a scene's band predicted inside a footprint (with a margin)."""
+def _inside(keys, scene: int, band: int, edges, margin) -> np.ndarray:
+    """Key points of a scene's band predicted inside a footprint (its
+    :func:`~hsgeo.workflows._lp_geometry.convex_edges`, with a margin).
+    """
     sl = keys.slices[(scene, band)]
     idx = np.arange(sl.start, sl.stop)
-    return idx[geo.inside_convex(keys.ground[idx], fp, margin)]
+    return idx[geo.inside_convex(keys.ground[idx], None, margin, edges=edges)]
 
 
-def _match_pair(keys, ga, fa, gb, fb, band, options, rows, m, seed, timings) -> None:
-    """One scene pair in one band: matches inside the overlap, both RANSACs, appended."""
+def _match_pair(keys, ga, ea, gb, eb, band, options, rows, m, seed, timings) -> None:
+    """One scene pair in one band: matches inside the overlap, both RANSACs, appended
+    (``ea``, ``eb``: the scenes' footprints as :func:`~hsgeo.workflows._lp_geometry.convex_edges`).
+    """
     t0 = time.perf_counter()
-    ia = _inside(keys, ga, band, fb, options.overlap_margin_m)
-    ib = _inside(keys, gb, band, fa, options.overlap_margin_m)
+    ia = _inside(keys, ga, band, eb, options.overlap_margin_m)
+    ib = _inside(keys, gb, band, ea, options.overlap_margin_m)
     i1, i2, dist = match_hamming(keys.desc[ia], keys.desc[ib], ratio=options.ratio)
     a, b = ia[i1], ib[i2]
     t1 = time.perf_counter()
@@ -178,16 +182,18 @@ def match_all(per_strip, keys, options, bands, rows, timings, progress) -> dict:
     rng = np.random.default_rng(options.rng)
     m = {k: [] for k in ("pair", "a", "b", "hamming", "lp", "frame")}
     n = len(per_strip)
+    # each footprint's edges once, not once per pair and band (issue 41)
+    edges = [[geo.convex_edges(f) for _, f in s] for s in per_strip]
     for i in range(n):
         timings["_ransac_strip"] = 0.0
         for j in range(i + 1, n):
-            for ga, fa in per_strip[i]:
-                for gb, fb in per_strip[j]:
+            for (ga, fa), ea in zip(per_strip[i], edges[i], strict=True):
+                for (gb, fb), eb in zip(per_strip[j], edges[j], strict=True):
                     if not geo.convex_overlap(fa, fb, options.overlap_margin_m):
                         continue
                     for b in bands:
                         seed = int(rng.integers(2**31))
-                        _match_pair(keys, ga, fa, gb, fb, b, options, rows, m, seed, timings)
+                        _match_pair(keys, ga, ea, gb, eb, b, options, rows, m, seed, timings)
         timings["ransac"] += timings["_ransac_strip"]
         timings["ransac_per_strip"].append(timings.pop("_ransac_strip"))
         if progress is not None:
