@@ -183,3 +183,38 @@ def test_same_seed_same_bytes():
 def test_bad_scale(scale):
     with pytest.raises(InputError, match="scale"):
         L.simulate(scale=scale)
+
+
+def _block_share_in_patches(scale, seed):
+    """Share of the rendered block within a square's plain grass patch (the layout of simulate)."""
+    from hsgeo.simulate._lp_ground import patch_radii_m
+    from hsgeo.simulate.pushbroom_campaign import REFERENCE_EN_M
+
+    rng = np.random.default_rng(seed)
+    sq = (np.asarray(REFERENCE_EN_M, float) + rng.uniform(-20, 20, (17, 2))) * scale
+    half = 300.0 * scale
+    g = np.linspace(-half, half, 301)
+    E, N = np.meshgrid(g, g)
+    d = np.hypot(E[..., None] - sq[:, 0], N[..., None] - sq[:, 1])
+    return float((d < patch_radii_m(sq)).any(axis=-1).mean()), patch_radii_m(sq)
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_the_squares_patches_leave_the_smallest_block_its_fields(seed):
+    # 6 m patches covered 97-98 % of the 30 m block at MIN_SCALE (no texture for key points)
+    share, radii = _block_share_in_patches(L.MIN_SCALE, seed)
+    assert share < 0.7  # 0.58-0.61 now
+    assert radii.min() >= 3.5  # a square keeps plain grass around it
+    share1, radii1 = _block_share_in_patches(1.0, seed)
+    assert np.all(radii1 == 6.0) and share1 < 0.01  # 002's scale: unchanged
+
+
+@pytest.mark.slow
+def test_seed_13_at_the_smallest_scale_has_tie_points():
+    # issue 42: the block was plain grass, 69 of 2854 matches kept and no tie point (exit 2)
+    from hsgeo.reproduce.lp_runs import retrieval_inputs
+    from hsgeo.workflows.lp_observations import LpOptions, retrieve
+
+    obs, _ = L.simulate(scale=L.MIN_SCALE, rng=13)
+    res = retrieve(retrieval_inputs(obs), LpOptions(rng=13, squares_as="tie_point"))
+    assert res.table["point_id"].nunique() > 50

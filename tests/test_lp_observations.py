@@ -462,3 +462,21 @@ def test_squares_as_tie_points_takes_the_matchers_points_on_a_square():
     far = blobs.assign(x_px=blobs["x_px"] + 5.0)
     got, taken = as_tie_points(ties, far, np.zeros(5))
     assert len(got) == 0 and taken.size == 0
+
+
+def test_no_tie_point_message_names_the_cause():
+    # issue 42: seed 13 at scale 0.05 read "RANSAC kept 69 of 2854 matches … give more
+    # overlapping strips", but RANSAC had kept all 69 matches of the 6 pairs it could test
+    import numpy as np
+
+    from hsgeo.workflows.lp_observations import LpOptions, _no_tie_point_message
+
+    opts = LpOptions()
+    few = [{"n_matches": 3}] * 100 + [{"n_matches": 12}] * 2
+    msg = _no_tie_point_message(opts, np.r_[np.zeros(300, bool), np.ones(24, bool)], few)
+    assert "only 2 of 102 scene pairs have the 11 matches" in msg and "--bands" in msg
+    many = [{"n_matches": 50}] * 10
+    msg = _no_tie_point_message(opts, np.r_[np.zeros(480, bool), np.ones(20, bool)], many)
+    assert "RANSAC kept only 20 of the 500 matches" in msg and "--threshold-px 1" in msg
+    msg = _no_tie_point_message(opts, np.ones(500, bool), many)
+    assert "give more overlapping strips" in msg

@@ -473,12 +473,7 @@ def retrieve(inputs: LpInputs, options: LpOptions = LpOptions(), progress=None) 
     )
     timings["tie_points"] = time.perf_counter() - t0
     if link["n_points"] == 0:
-        raise ObservationError(
-            f"no tie point is seen in ≥ {options.min_lines} lines of ≥ {options.min_strips} "
-            f"strips (002 §4): RANSAC kept {int(kept.sum())} of {kept.size} matches in "
-            f"{len(rows['pairs'])} scene pairs; give more overlapping strips, or scenes with "
-            "texture in these bands (--bands)"
-        )
+        raise ObservationError(_no_tie_point_message(options, kept, rows["pairs"]))
     score = _mean_hamming(point, m, kept)
     by_way = _table(inputs, options, keys, point, rows["squares"], score)
     square_tables = {
@@ -492,6 +487,39 @@ def retrieve(inputs: LpInputs, options: LpOptions = LpOptions(), progress=None) 
         inputs, options, bands, keys, point, link, (table, all_bands), matches, rows, timings
     )
     return replace(out, tables_by_squares=square_tables)
+
+
+def _no_tie_point_message(options, kept, pairs) -> str:
+    """Why no tie point was linked: too few matches per scene pair for RANSAC to test, RANSAC
+    rejecting most of those it tested, or kept matches that do not chain across the strips.
+    """
+    n = np.array([r["n_matches"] for r in pairs])
+    testable = n >= MIN_MATCHES
+    n_test = int(n[testable].sum())
+    k = int(kept.sum())
+    head = (
+        f"no tie point is seen in ≥ {options.min_lines} lines of ≥ {options.min_strips} "
+        "strips (002 §4): "
+    )
+    if n_test < 0.5 * kept.size:  # most matches lie in pairs RANSAC cannot test
+        return head + (
+            f"only {int(testable.sum())} of {n.size} scene pairs have the {MIN_MATCHES} matches "
+            f"RANSAC needs (002 §3.1; they hold {n_test} of {kept.size} matches, RANSAC kept "
+            f"{k}): the scenes have too little texture in these bands (--bands) or are too "
+            "short (--scene-lines), or the strips overlap too little"
+        )
+    if k < 0.5 * n_test:  # RANSAC rejected most of what it tested
+        return head + (
+            f"RANSAC kept only {k} of the {n_test} matches in the {int(testable.sum())} scene "
+            f"pairs it could test: they do not fit one LP epipolar geometry within "
+            f"--threshold-px {options.threshold_px:g}; the navigation or the camera varies too "
+            "much within a scene (check the navigation's time scale and the lines' times), or "
+            "give a larger --threshold-px"
+        )
+    return head + (
+        f"RANSAC kept {k} of {kept.size} matches in {n.size} scene pairs, but they do not "
+        "chain through enough lines and strips: give more overlapping strips"
+    )
 
 
 def _observation_x(x, options, n_px_full):
