@@ -456,8 +456,9 @@ def retrieve(inputs: LpInputs, options: LpOptions = LpOptions(), progress=None) 
         raise ObservationError(
             f"no pair of overlapping scenes has {MIN_MATCHES} matches (the LP fundamental "
             f"matrix's minimum, 002 §3.1; at most {most}): the scenes are too short "
-            "(--scene-lines), the bands too poor in texture, or the navigation or camera too "
-            "far off for the footprints" + _wide_camera(inputs)
+            "(--scene-lines), the bands too poor in texture, or the navigation, the camera or "
+            f"the terrain height ({height:.6g} m: --height, or the squares' H_m) too far off "
+            "for the footprints" + _wide_camera(inputs)
         )
     kept = m["lp"] if options.ransac == "lp" else m["frame"]
     t0 = time.perf_counter()
