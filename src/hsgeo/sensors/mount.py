@@ -88,6 +88,12 @@ class Mount:
             return xyz.copy()
         return xyz + np.asarray(R_map_from_body) @ self.lever_arm_m
 
+    def R_map_from_sensor(self, R_map_from_body) -> np.ndarray:
+        """The sensor-to-map rotations ``R_map_from_body · R_body_from_sensor``, ``(n, 3, 3)``:
+        :meth:`directions`' rotation formed once per pose (for many directions at one pose).
+        """
+        return np.ascontiguousarray(np.asarray(R_map_from_body) @ self.R_body_from_sensor)
+
     def directions(self, R_map_from_body, d_sensor) -> np.ndarray:
         """Sensor-frame directions ``(n, 3)`` in the map frame (not normalised)."""
         d_body = np.asarray(d_sensor, dtype=np.float64) @ self.R_body_from_sensor.T

@@ -750,8 +750,9 @@ class PushbroomCamera:
             u_cam = self._unit_camera_directions(xy, b)
         R = np.asarray(R_map_from_platform, dtype=np.float64).reshape(m, 3, 3)
         # 002 eq. (4) read backwards, per line: x + R l^p and R βᵀ
-        origin = self.platform_mount.origins(np.reshape(xyz_platform_m, (m, 3)), R)
-        R_map_from_cam = np.ascontiguousarray(R @ self.beta.T)
+        mount = self.platform_mount
+        origin = mount.origins(np.reshape(xyz_platform_m, (m, 3)), R)
+        R_map_from_cam = mount.R_map_from_sensor(R)
         origins, dirs = np.empty((n, 3)), np.empty((n, 3))
         rays_by_line(
             starts,
