@@ -158,26 +158,6 @@ def _local_columns(cols, fcol, fw, order, a0, a1, grow, pos, gl):  # pragma: no 
 
 
 @njit(cache=True, inline="always")
-def _sort_slots(gl, nl, pos):  # pragma: no cover - compiled
-    """Sort the slot columns ``gl[:nl]`` and renumber them (``pos``), so that one triangle of
-    the local columns is one triangle of the global ones (A's writes stay in its upper
-    triangle). A point's observations usually come in camera order: nothing moves then.
-    """
-    moved = False
-    for e in range(1, nl):
-        c = gl[e]
-        f = e - 1
-        while f >= 0 and gl[f] > c:
-            gl[f + 1] = gl[f]
-            f -= 1
-            moved = True
-        gl[f + 1] = c
-    if moved:
-        for e in range(nl):
-            pos[gl[e]] = e
-
-
-@njit(cache=True, inline="always")
 def _upper_from(a, G, kf):  # pragma: no cover - compiled
     """The first local column of row ``a`` that the expansion reads: the whole ``kf × kf``
     diagonal block of a group row (``a < G = ng·kf``), else the diagonal on (one triangle).
@@ -395,7 +375,7 @@ def _slot_point(cols, vals, jp, order, a0, a1, scratch, Vinv, i, A):  # pragma: 
     """``J_c,iᵀ J_c,i − W_i V_i⁻¹ W_iᵀ`` of a point whose rows have slot columns only (one
     triangle, the diagonal halved) added into A.
 
-    On the nl local columns (sorted, so that one triangle of them is A's upper triangle):
+    On the nl local columns (in the order the rows bring them, as on the groups' path):
     ``Z = Yᵀ J_p`` (p × nl) and ``Yᵀ Y`` per run of rows with the same columns (an
     observation's x and y), ``T = V_i⁻¹ Z``, the upper triangle of ``C = Yᵀ Y − Tᵀ Z`` in
     ``Cs`` (row stride nl), and C's rows added into A along the runs of consecutive positions
@@ -403,7 +383,8 @@ def _slot_point(cols, vals, jp, order, a0, a1, scratch, Vinv, i, A):  # pragma: 
     negative-index test on a signed index kept them scalar. About ``(p + 1)·nl²/2``
     operations against ``(2p + 1)·nl²`` on the groups' path; on BAL Ladybug-49 the kernel
     took 2.1–2.4× less CPU time than previous main's, with the same bits (the same
-    operations on each entry, in the same order; bench/results/bal.json).
+    operations on each entry, in the same order, into the same triangle of A;
+    bench/results/bal.json).
     """
     pos, gl, sl, run_end, li, si, yv, nl, Z, T, Cs = scratch
     K = cols.shape[1]
@@ -469,13 +450,14 @@ def _slot_point(cols, vals, jp, order, a0, a1, scratch, Vinv, i, A):  # pragma: 
                         else:
                             Cs[np.uint64(lb) * u + np.uint64(la)] += w
         rr = q1
-    # T = V_i⁻¹ Z (V_i⁻¹ symmetric)
+    # T = (Zᵀ V_i⁻¹)ᵀ, V_i⁻¹ read as the groups' path reads it (the same bits when a
+    # pseudo-inverse is not exactly symmetric)
     for k in range(p):
         Tk = T[k]
         for a in range(u):
             Tk[a] = 0.0
         for j in range(p):
-            w = Vinv[i, k, j]
+            w = Vinv[i, j, k]
             Zj = Z[j]
             for a in range(u):
                 Tk[a] += w * Zj[a]
@@ -607,8 +589,6 @@ def _reduced_kernel(
             if a1 == a0:
                 continue
             ng, nl = _local_columns(cols, fcol, fw, order, a0, a1, grow, pos, gl)
-            if ng == 0:
-                _sort_slots(gl, nl, pos)
             L = ng * kf + nl
             G = ng * kf
             miss = 0
