@@ -39,7 +39,14 @@ no later than Ceres' end; ``converged_no_later_than_ceres`` — hsgeo's own conv
 Gauss–Newton test at 1e-6, which ends 6.5e-6 lower than Ceres' function-tolerance stop, within
 2e-8 of the minimum ``ceres_converged_cost``) no later than Ceres' end.
 
-Usage: ``python bench/bench_bal.py [--repeats 3] [--no-scipy]``; a case alone:
+**Paired with the previous main** (issue 41): ``--vs DIR`` (a checkout of the previous main)
+runs its hsgeo in turn with this one and Ceres, ``--repeats`` times (Ceres, hsgeo, previous
+main, Ceres, …); ``vs_main`` holds each pair's CPU seconds to Ceres' cost, their ratio and
+medians, and the load average before each run; the CPU model and the BLAS libraries with
+the core type they chose (``cpu_model``, ``blas_hsgeo``, ``machine_info``) stand beside the
+figures, because the lead over Ceres differed between two machines of the same kind.
+
+Usage: ``python bench/bench_bal.py [--repeats 3] [--no-scipy] [--vs DIR]``; a case alone:
 ``python bench/bench_bal.py --case hsgeo``.
 """
 
@@ -273,8 +280,16 @@ def case_scipy():
     }
 
 
-def _run_case(name: str, *args: str) -> dict:
+def _run_case(name: str, *args: str, tree: Path | None = None) -> dict:
+    """One case in a fresh subprocess (one thread each); ``tree``: run hsgeo from another
+    checkout's ``src`` (the previous main of ``--vs``), its numba cache kept apart.
+    """
     env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", NUMBA_NUM_THREADS="1")
+    if tree is not None:
+        env["PYTHONPATH"] = str(tree / "src")
+        env["PYTHONDONTWRITEBYTECODE"] = "1"
+        env["NUMBA_CACHE_DIR"] = str(Path(os.environ.get("TMPDIR", "/tmp")) / "bench_bal_vs_numba")
+    load = list(os.getloadavg())
     out = subprocess.run(
         [sys.executable, __file__, "--case", name, *args],
         env=env,
@@ -282,7 +297,49 @@ def _run_case(name: str, *args: str) -> dict:
         capture_output=True,
         text=True,
     )
-    return json.loads(out.stdout.strip().splitlines()[-1])
+    res = json.loads(out.stdout.strip().splitlines()[-1])
+    res["load_average_1_5_15_before"] = load
+    return res
+
+
+def _vs_main(hs: list, vs: list, ceres: list, tree: Path | None) -> dict | None:
+    """The paired runs against the previous main (``--vs``): medians and per-pair ratios."""
+    if not vs:
+        return None
+    med = statistics.median
+    this = [x["cpu_seconds_to_target"] for x in hs]
+    prev = [x["cpu_seconds_to_target"] for x in vs]
+    return {
+        "tree": str(tree),
+        "commit": _commit(tree),
+        "pairs": len(vs),
+        "order": "ceres, hsgeo (this), hsgeo (previous main), repeated",
+        "this_cpu_seconds_to_ceres_cost_runs": this,
+        "previous_main_cpu_seconds_to_ceres_cost_runs": prev,
+        "this_median_cpu_seconds_to_ceres_cost": med(this),
+        "previous_main_median_cpu_seconds_to_ceres_cost": med(prev),
+        "ratio_previous_over_this_each_pair": [p / t for p, t in zip(prev, this, strict=True)],
+        "ratio_previous_over_this_median": med(p / t for p, t in zip(prev, this, strict=True)),
+        "previous_main_iterations_to_ceres_cost": vs[0]["iterations_to_target"],
+        "previous_main_final_cost": vs[0]["final_cost"],
+        "previous_main_cpu_speedup_over_ceres_median": med(
+            c["cpu_seconds"] / v["cpu_seconds_to_target"] for c, v in zip(ceres, vs, strict=True)
+        ),
+        "load_average_1_5_15_each_run": [x["load_average_1_5_15_before"] for x in vs],
+    }
+
+
+def _commit(tree: Path | None) -> str | None:
+    try:
+        out = subprocess.run(
+            ["git", "-C", str(tree or HERE), "rev-parse", "--short", "HEAD"],
+            capture_output=True,
+            text=True,
+            check=True,
+        )
+        return out.stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return None
 
 
 def main(argv=None) -> None:
@@ -291,6 +348,13 @@ def main(argv=None) -> None:
     ap.add_argument("--no-scipy", action="store_true")
     ap.add_argument("--case", choices=["ceres", "ceres_converged", "hsgeo", "scipy"])
     ap.add_argument("--target", type=float, default=None)
+    ap.add_argument(
+        "--vs",
+        type=Path,
+        default=None,
+        help="a checkout of the previous main: its hsgeo runs in turn with this one and Ceres "
+        "(paired, alternating), and the ratios go to bal.json's vs_main",
+    )
     args = ap.parse_args(argv)
     if args.case:
         fn = {
@@ -311,12 +375,16 @@ def main(argv=None) -> None:
             "bench_bal: pycolmap (Ceres) is not installed: pip install -r requirements-bench.lock "
             "(make bench does it)"
         )
-    ceres, hs = [], []
+    ceres, hs, vs = [], [], []
     for k in range(args.repeats):
+        # in turn: Ceres, hsgeo, the previous main's hsgeo (with --vs), on the same machine
         ceres.append(_run_case("ceres"))
-        print(f"  ceres run {k + 1}: {ceres[-1]['seconds']:.2f} s", flush=True)
+        print(f"  ceres run {k + 1}: {ceres[-1]['cpu_seconds']:.2f} CPU-s", flush=True)
         hs.append(_run_case("hsgeo", "--target", repr(ceres[0]["final_cost"])))
-        print(f"  hsgeo run {k + 1}: {hs[-1]['seconds']:.2f} s", flush=True)
+        print(f"  hsgeo run {k + 1}: {hs[-1]['cpu_seconds_to_target']:.2f} CPU-s", flush=True)
+        if args.vs is not None:
+            vs.append(_run_case("hsgeo", "--target", repr(ceres[0]["final_cost"]), tree=args.vs))
+            print(f"  vs    run {k + 1}: {vs[-1]['cpu_seconds_to_target']:.2f} CPU-s", flush=True)
     conv = _run_case("ceres_converged")
     sc = None if args.no_scipy else _run_case("scipy")
     c, h = ceres[0], hs[0]
@@ -381,6 +449,10 @@ def main(argv=None) -> None:
         "ceres_peak_rss_mb": max(x["peak_rss_mb"] for x in ceres),
         "scipy_peak_rss_mb": None if sc is None else sc["peak_rss_mb"],
         "pycolmap": c["pycolmap"],
+        "commit": _commit(None),
+        # make bench's malloc setting (the Makefile's GLIBC_TUNABLES: freed memory kept, so the
+        # arrays of each iteration reuse pages instead of fresh zeroed ones); "" if unset
+        "glibc_tunables": os.environ.get("GLIBC_TUNABLES", ""),
         "machine": f"{platform.machine()}, {os.cpu_count()} cores, {platform.python_version()}",
         "load_average": os.getloadavg()[0],
         # the CPU model and the BLAS core type beside the figures: the lead over Ceres was
@@ -390,7 +462,19 @@ def main(argv=None) -> None:
         "blas_ceres_process": c.get("blas"),
         "machine_info": _machine_info(),
         "cpu_speedup_to_ceres_cost": None if cpu_to is None else ce_cpu / cpu_to,
+        # each run's ratio against the Ceres run just before it (the pairs see the same load)
+        "cpu_speedup_to_ceres_cost_each_run": [
+            c["cpu_seconds"] / h["cpu_seconds_to_target"] if h["cpu_seconds_to_target"] else None
+            for c, h in zip(ceres, hs, strict=True)
+        ],
+        "hsgeo_cpu_seconds_to_ceres_cost_runs": [x["cpu_seconds_to_target"] for x in hs],
+        "ceres_cpu_seconds_runs": [x["cpu_seconds"] for x in ceres],
+        "load_average_1_5_15_each_run": {
+            "ceres": [x["load_average_1_5_15_before"] for x in ceres],
+            "hsgeo": [x["load_average_1_5_15_before"] for x in hs],
+        },
         "goal_cpu_speedup_min": 1.5,
+        "vs_main": _vs_main(hs, vs, ceres, args.vs),
     }
     (HERE / "results").mkdir(exist_ok=True)
     path = HERE / "results" / "bal.json"

@@ -155,13 +155,25 @@ def bal() -> dict:
             "ceres": b["ceres_iterations"],
         },
         "goal_ratio": 1.5,
+        "ratio_each_pair": b.get("cpu_speedup_to_ceres_cost_each_run"),
         "machine": b["machine"],
+        "cpu_model": b.get("cpu_model"),
+        "blas_core_type": sorted(
+            {f"{x['internal_api']} {x['version']} {x['architecture']}" for x in b["blas_hsgeo"]}
+        )
+        if b.get("blas_hsgeo")
+        else None,
+        "glibc_tunables": b.get("glibc_tunables"),
         "load_average": b["load_average"],
-        "paired_with_previous_main": 0,
+        "load_average_1_5_15_each_run": b.get("load_average_1_5_15_each_run"),
+        "paired_with_previous_main": (b.get("vs_main") or {}).get("pairs", 0),
+        "previous_main": b.get("vs_main"),
         "profile": {
             "file": "bench/results/bal_profile.json",
             "reduced_matrix_kernel_share": p["calls"]["reduced_matrix_kernel"]["share_of_solve"],
             "reduced_matrix_formations": p["reduced_matrix_formations"],
+            "cpu_seconds_per_iteration_split": p.get("cpu_seconds_per_iteration_split"),
+            "what_remains": p.get("what_remains"),
         },
     }
 

@@ -360,6 +360,71 @@ def test_reduced_kernel_equals_dense_schur(consecutive):
     assert cache.pattern is not stale
 
 
+def test_reduced_kernel_slot_points_equal_dense_schur():
+    """Points whose rows have slot columns only (frame cameras: ``_fast._slot_point``) against
+    the dense formula, in one call with points that have factored groups too.
+
+    The slot points see cameras in any order (their local columns sorted by the kernel), an
+    observation's x and y rows share their columns, some rows list their columns out of order
+    or share columns with the other observations of the point (intrinsics: not a camera's
+    consecutive block), some slots are empty, one row has a column twice, and one point sees
+    every camera (its local matrix outgrows the first one's).
+    """
+    from hsgeo.adjust._fast import reduced_points
+    from hsgeo.adjust.system import _RowJac
+
+    rng = np.random.default_rng(7)
+    n_cam, k_cam, n_shared, kf, q, p = 9, 6, 2, 2, 2, 3
+    shared = n_cam * k_cam + np.arange(n_shared)  # columns every observation touches
+    item_start = shared[-1] + 1 + kf * np.arange(4)
+    n_c = int(item_start[-1] + kf)
+    cams = [rng.choice(n_cam, rng.integers(2, 5), replace=False) for _ in range(30)]
+    cams.append(rng.permutation(n_cam))  # a point seen by every camera, in shuffled order
+    rows_cols, pidx, groups = [], [], []
+    for i, cs in enumerate(cams):
+        for c in cs:
+            cc = list(c * k_cam + np.arange(k_cam))
+            if i % 3 == 0:
+                cc += list(shared)
+            if i % 4 == 1:
+                cc = cc[::-1]  # columns out of order within the row
+            for _ in range(2):  # x and y
+                rows_cols.append(cc + [-1] * (k_cam + n_shared - len(cc)))
+                pidx.append(i)
+                groups.append(i % 5 == 2)  # some points also have factored groups
+    cols = np.array(rows_cols, dtype=np.int32)
+    M = cols.shape[0]
+    cols[rng.random(M) < 0.1, 0] = -1  # empty slots
+    cols[5, -1] = cols[5, 1]  # a column twice in a row (its entries add up)
+    vals = rng.normal(size=cols.shape)
+    groups = np.array(groups)
+    fcol = np.where(groups[:, None], item_start[rng.integers(0, 4, (M, 1)) + [[0]]], -1)
+    fcol = np.concatenate([fcol, np.full((M, q - 1), -1)], axis=1).astype(np.int32)
+    fw = rng.random((M, q))
+    fd = rng.normal(size=(M, kf))
+    jp = rng.normal(size=(M, p))
+    pidx = np.array(pidx)
+    n_pts = len(cams)
+    J = _RowJac(cols, vals, n_c, fcol, fw, fd)
+    Jc = J.tocsr().toarray()
+    V = np.zeros((n_pts, p, p))
+    np.add.at(V, pidx, jp[:, :, None] * jp[:, None, :])
+    Vinv = np.linalg.inv(V + np.eye(p))
+    S_ref = np.zeros((n_c, n_c))
+    for i in range(n_pts):
+        r = pidx == i
+        W = Jc[r].T @ jp[r]
+        S_ref += Jc[r].T @ Jc[r] - W @ Vinv[i] @ W.T
+    order = np.argsort(pidx, kind="stable").astype(np.int64)
+    ptr = np.concatenate([[0], np.cumsum(np.bincount(pidx, minlength=n_pts))]).astype(np.int64)
+    S = reduced_points(J.arrays, jp, order, ptr, Vinv, n_c)
+    np.testing.assert_allclose(S, S_ref, rtol=1e-12, atol=1e-12 * np.abs(S_ref).max())
+    # the points visited in another order: the same matrix to rounding
+    pt_order = rng.permutation(n_pts).astype(np.int64)
+    S2 = reduced_points(J.arrays, jp, order, ptr, Vinv, n_c, pt_order)
+    np.testing.assert_allclose(S2, S, rtol=1e-12, atol=1e-12 * np.abs(S_ref).max())
+
+
 def test_spd_inverse_against_numpy_and_singular():
     from hsgeo.adjust.schur import _spd_inverse
 
