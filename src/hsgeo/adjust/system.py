@@ -432,9 +432,10 @@ def _assemble(
     vals_all = np.empty((M, K))
     Q = max([sl.qk[0] for part in slot_parts for sl in parts_of(part) if sl.factored] + [0])
     Kf = factored_k if Q else 0
-    fcol = np.full((M, Q), -1, dtype=itype)
-    fw = np.zeros((M, Q))
-    fd = np.zeros((M, Kf))
+    # written row range by row range below (a fused part writes its own share: no pass first)
+    fcol = np.empty((M, Q), dtype=itype)
+    fw = np.empty((M, Q))
+    fd = np.empty((M, Kf))
     pidx = np.empty(M, dtype=np.int64)
     Jp = np.empty((M, layout.p))
     row0 = 0
@@ -443,6 +444,10 @@ def _assemble(
         rs = slice(row0, row0 + n)
         pidx[rs] = pi
         k0 = 0
+        q, kf = part.qk if isinstance(part, _FusedPart) else (0, 0)
+        fcol[rs, q:] = -1  # what the part does not write: empty factored slots
+        fw[rs, q:] = 0.0
+        fd[rs, kf:] = 0.0
         if isinstance(part, _FusedPart):
             part.row_range = (row0, row0 + n)
             part.fill(values, cols_all[rs], vals_all[rs], fcol[rs], fw[rs], fd[rs], Jp[rs], clock)
