@@ -335,9 +335,13 @@ class _Solve:
         self._damping_diagonal(ne)
         if check_datum:
             t0 = time.perf_counter()
+            points_checked = False
             if opts.drop_undetermined_points:
+                ne_before = ne
                 sy, ne = self._drop_undetermined(sy, ne)
-            _check_datum(self.layout, ne, opts.rank_rtol)
+                # none dropped: the same normal equations, whose point blocks were just tested
+                points_checked = ne is ne_before
+            _check_datum(self.layout, ne, opts.rank_rtol, points_checked)
             self.clock.add("datum", t0)
         lam, nu = opts.lambda0, 2.0
         cost = sy.cost
