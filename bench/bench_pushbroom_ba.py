@@ -465,6 +465,7 @@ def main(argv=None):
         "goals": {"solver_seconds_max": 5.0, "peak_rss_mb_max": 1536, "speedup_min": 30},
         "machine": _machine(load0),
         "seed": args.seed,
+        "commit": _commit(),
     }
     return _write(out, args.out)
 
