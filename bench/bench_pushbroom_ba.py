@@ -78,8 +78,7 @@ def _load_compiled_kernels(seed):
 
 
 def case_ours(scale, seed, reject):
-    from hsgeo.reproduce.pushbroom_ba import REJECT_K
-    from hsgeo.workflows.pushbroom_ba import solve
+    from hsgeo.workflows.pushbroom_ba import REJECT_K, solve
 
     obs, p, blocks = _problem(scale, seed)
     jit = _load_compiled_kernels(seed)
