@@ -78,8 +78,7 @@ def _load_compiled_kernels(seed):
 
 
 def case_ours(scale, seed, reject):
-    from hsgeo.reproduce.pushbroom_ba import REJECT_K
-    from hsgeo.workflows.pushbroom_ba import solve
+    from hsgeo.workflows.pushbroom_ba import REJECT_K, solve
 
     obs, p, blocks = _problem(scale, seed)
     jit = _load_compiled_kernels(seed)
@@ -465,6 +464,7 @@ def main(argv=None):
         "goals": {"solver_seconds_max": 5.0, "peak_rss_mb_max": 1536, "speedup_min": 30},
         "machine": _machine(load0),
         "seed": args.seed,
+        "commit": _commit(),
     }
     return _write(out, args.out)
 

@@ -101,7 +101,9 @@ def pushbroom() -> list[dict]:
     one, ten = rows[1.0], rows[10.0]
     goals = sc["goals"]
     designs = {k: v["cpu_seconds"] for k, v in prof["designs_at_1x"].items()}
+    outcomes = {k: v.get("outcome") for k, v in prof["designs_at_1x"].items()}
     wall1 = b["solver_seconds"]
+    vs = _load("pushbroom_vs_main.json") if (RESULTS / "pushbroom_vs_main.json").exists() else {}
     return [
         {
             "line": "pushbroom adjustment, paper size: ≤ 2.0 s wall, ≤ 3.0 CPU-s",
@@ -114,12 +116,34 @@ def pushbroom() -> list[dict]:
             "figure_cpu_s_file": f"bench/results/pushbroom_scaling.json (scale 1, {sc['commit']})",
             "goal_wall_s": goals["paper_size_solver_seconds_max"],
             "goal_cpu_s": 3.0,
-            "paired_with_previous_main": 0,
+            "figure_load_average_1_5_15": sc["machine"]["loadavg_at_start"],
+            "paired_with_previous_main": vs.get("pairs", 0),
+            "paired": {
+                "file": "bench/results/pushbroom_vs_main.json (bench/pushbroom_vs_main.py)",
+                "scale": vs.get("scale"),
+                "commits_this_previous_main": [
+                    vs.get("commit_this"),
+                    vs.get("commit_previous_main"),
+                ],
+                "median_this": vs.get("median_this"),
+                "median_previous_main": vs.get("median_previous_main"),
+                "median_ratio_this_over_previous_main": vs.get(
+                    "median_ratio_this_over_previous_main"
+                ),
+                "load_average_each_run": [
+                    r["load_average_1_5_15_before"]
+                    for side in ("this", "previous_main")
+                    for r in vs.get("runs", {}).get(side, [])
+                ],
+            },
             "profile": {
                 "file": "bench/results/pushbroom_profile.json",
                 "designs_cpu_s_at_1x": designs,
-                "measured_outcome_of_A_and_B": "built on a branch (session 14): 1.05× CPU, 2× "
-                "system time, +10 % memory, so not merged (closing note of session 14)",
+                "designs_outcome": outcomes,
+                "what_remains_at_1x": prof.get("what_remains_at_1x"),
+                "profile_cpu_s_one_thread": prof["rows"][0]["user_seconds"]
+                + prof["rows"][0]["system_seconds"],
+                "profile_load_average_1_5_15": prof.get("loadavg"),
             },
         },
         {

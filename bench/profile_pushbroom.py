@@ -91,9 +91,29 @@ def _calls(pstat: Path) -> dict:
     return out
 
 
+#: What became of the three designs (measured in session 18, 1×, on a loaded 2-core machine).
+DESIGN_OUTCOMES = {
+    "A_arrays_kept_column_indices_once": "built differently: the fused part's column indices, "
+    "factored columns and whitened residuals are written by one compiled pass "
+    "(adjust._fused._fused_columns, ≈ 0.02-0.03 CPU-s per linearisation) instead of numpy "
+    "expressions with ≈ 100 MB of temporaries; keeping them between linearisations would "
+    "save at most that pass (≈ 0.1 CPU-s a solve), not built",
+    "B_trial_with_derivatives_double_buffered": "not built: the second set of arrays "
+    "(≈ 270 MB at 1×) is new memory whose first touch costs system time on these machines "
+    "(0.25-0.95 s for 283 MB measured), more than the ≤ 0.3 CPU-s of trial evaluations "
+    "it would save (session 14: 2× system time)",
+    "C_one_reduced_matrix_formation_fewer": "measured, not built: chord steps from the "
+    "first iterate with the initial values' matrix are refused at 1× (cost 7.375e5 → "
+    "9.553e6), so the matrix is formed there anyway and a trial is lost; the formation at "
+    "the final iterate is the convergence test's and the covariance's. Three formations "
+    "(initial values: datum check and first step; first iterate; final iterate) stay",
+}
+
+
 def _designs(row: dict) -> dict | None:
     """Upper bounds, from the 1× row's calls, of what three designs for the paper-size goal
-    would save (CPU seconds and share of the solve); none of them is built."""
+    would save (CPU seconds and share of the solve); what became of each:
+    :data:`DESIGN_OUTCOMES`."""
     c = row["calls"]
     need = ("solve_total", "assembly_fused_fill", "model_linearisation", "model_trial")
     if not all(k in c for k in need + ("reduced_matrix_kernel",)):
@@ -110,12 +130,40 @@ def _designs(row: dict) -> dict | None:
     # C: one reduced-matrix formation fewer (changes the iterates: not to 1e-9)
     cc = c["reduced_matrix_kernel"]["cpu_seconds_per_call"]
     return {
-        name: {"cpu_seconds": v, "share_of_solve": v / total}
+        name: {"cpu_seconds": v, "share_of_solve": v / total, "outcome": DESIGN_OUTCOMES[name]}
         for name, v in (
             ("A_arrays_kept_column_indices_once", a),
             ("B_trial_with_derivatives_double_buffered", b),
             ("C_one_reduced_matrix_formation_fewer", cc),
         )
+    }
+
+
+def _remains(row: dict) -> dict | None:
+    """Where the 1× solve's CPU seconds go, by share: the three reduced-matrix formations
+    (the compiled Schur kernel), the LP model's evaluations (with and without derivatives),
+    the system time (first touch of new memory) and the rest."""
+    c = row["calls"]
+    if "solve_total" not in c:
+        return None
+    total = row["user_seconds"] + row["system_seconds"]
+    parts = {
+        "reduced_matrix_kernel": c.get("reduced_matrix_kernel", {}).get("cpu_seconds", 0.0),
+        "model_linearisation": c.get("model_linearisation", {}).get("cpu_seconds", 0.0),
+        "model_trial": c.get("model_trial", {}).get("cpu_seconds", 0.0),
+    }
+    parts["system_time_first_touch"] = row["system_seconds"]
+    parts["rest"] = max(total - sum(parts.values()), 0.0)
+    return {
+        "cpu_seconds": parts,
+        "share": {k: v / total for k, v in parts.items()},
+        "why": "the reduced matrix is formed 3 times (fewer is design C, measured above); its "
+        "kernel's internals are the BAL benchmark's (adjust._fast._reduced_kernel). The model "
+        "is 002 eq. (2)-(4) with the crossing time by Newton, one pass per observation per "
+        "evaluation (1 + its trial per iteration and the final residuals); error_model="
+        "'numpy' or fastmath on it changed its CPU seconds by < 3 % (measured). The system "
+        "time is the first touch of the ≈ 270 MB of row-compressed arrays of one "
+        "linearisation (their format is the kernels')",
     }
 
 
@@ -133,6 +181,7 @@ def _summary(rows: list[dict]) -> dict:
     designs = _designs(one) if one is not None else None
     return {
         "designs_at_1x": designs,
+        "what_remains_at_1x": _remains(one) if one is not None else None,
         "problem": "the scaling benchmark's rows (bench_pushbroom_ba.py --scaling), adjusted "
         "as in the chapter, profiled by call with cProfile(time.process_time), one numba "
         "thread, one BLAS thread, the Makefile's GLIBC_TUNABLES",
@@ -177,6 +226,10 @@ def main(argv=None) -> int:
     out["date"] = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
     out["loadavg"] = os.getloadavg()
     out["glibc_tunables"] = os.environ.get("GLIBC_TUNABLES", "")
+    sys.path.insert(0, str(HERE))
+    from bench_pushbroom_ba import _commit
+
+    out["commit"] = _commit()
     Path(args.out).write_text(json.dumps(out, indent=1) + "\n")
     print(json.dumps(out, indent=1))
     return 0

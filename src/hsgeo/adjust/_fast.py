@@ -1082,21 +1082,24 @@ def fill_factored(
             fd_dst[t, j] = d[i, j] * wi
 
 
-@njit(cache=True)
-def point_normals(pidx, jp, r, n_pts):  # pragma: no cover - compiled
-    """``V_i = Σ jpᵀ jp`` and ``g_p,i = Σ jpᵀ r`` over the rows of each point (pidx ≥ 0)."""
+@njit(cache=True, parallel=True)
+def point_normals(order, ptr, jp, r):  # pragma: no cover - compiled
+    """``V_i = Σ jpᵀ jp`` and ``g_p,i = Σ jpᵀ r`` over the rows of each point, point by point
+    (its rows ``order[ptr[i]:ptr[i + 1]]``, ascending: the sums of a pass over the rows in
+    their order, bit for bit, on any number of threads).
+    """
+    n_pts = ptr.size - 1
     p = jp.shape[1]
     V = np.zeros((n_pts, p, p))
     g = np.zeros((n_pts, p))
-    for t in range(pidx.size):
-        i = pidx[t]
-        if i < 0:
-            continue
-        for a in range(p):
-            ja = jp[t, a]
-            g[i, a] += ja * r[t]
-            for b in range(p):
-                V[i, a, b] += ja * jp[t, b]
+    for i in prange(n_pts):
+        for s in range(ptr[i], ptr[i + 1]):
+            t = order[s]
+            for a in range(p):
+                ja = jp[t, a]
+                g[i, a] += ja * r[t]
+                for b in range(p):
+                    V[i, a, b] += ja * jp[t, b]
     return V, g
 
 

@@ -6,8 +6,11 @@ copies it (whitened, rows kept) into the engine's ``(M, K)`` arrays: every deriv
 written twice and read once in between. A block with ``fused_spec()`` and ``evaluate_into``
 (:class:`hsgeo.sensors.pushbroom.PushbroomLines`) is instead evaluated once the arrays are
 allocated, into its own rows of them; the engine writes the column indices (static for a
-given set of kept rows) and the block's residuals. The numbers are those of the generic path
-bit for bit (the same products, in the same rows); ``tests/test_engine_fused.py``.
+given set of kept rows) and the block's whitened residuals in one compiled pass
+(:func:`_fused_columns`): at the paper's pushbroom size the numpy expressions it replaced made
+≈ 100 MB of temporaries per linearisation, new memory whose first touch costs system time.
+The numbers are those of the generic path bit for bit (the same products, in the same rows);
+``tests/test_engine_fused.py``.
 """
 
 from __future__ import annotations
@@ -15,6 +18,7 @@ from __future__ import annotations
 import time
 
 import numpy as np
+from numba import njit, prange
 
 from hsgeo.adjust.residuals import ResidualBlock
 
@@ -99,24 +103,69 @@ class _FusedPart:
         self.g, self.d = gd.sum(axis=1)
         clock.add("model", t)  # (the rest is the caller's "jacobian")
         self.nonfinite = np.flatnonzero(~np.isfinite(r))[:5]  # checked by system._assemble
-        np.multiply(r.take(self.rows), self.w.take(self.rows), out=self.r_kept)
         fname, fidx, _ = self.spec["factored"]
-        fi = fidx.take(self.rows, axis=0)
-        fcol[:, :q] = np.where(fi >= 0, layout.colmap[fname][0] + fi * k, -1)
-        if (fi < 0).any():
-            fw[:, :q][fi < 0] = 0.0
-        s0 = 0
+        # the slots' columns: a dense block's columns are the same in every row (-1 in
+        # plan_col: an indexed slot, its column looked up per row in ix_cm)
+        plan_col, plan_ix, ix_index, ix_cm, ix_off = [], [], [], [], [0]
         for name, index in self.spec["slots"]:
             cm = layout.colmap[name]
             if index is None:
-                cols[:, s0 : s0 + cm.size] = cm
-                fixed = np.flatnonzero(cm < 0)
-                if fixed.size:
-                    vals[:, s0 + fixed] = 0.0
-                s0 += cm.size
+                plan_col += cm.tolist()
+                plan_ix += [-1] * cm.size
             else:
-                c = cm.take(index.take(self.rows))
-                cols[:, s0] = c
-                if (c < 0).any():
-                    vals[c < 0, s0] = 0.0
-                s0 += 1
+                plan_col.append(-1)
+                plan_ix.append(len(ix_index))
+                ix_index.append(np.asarray(index, dtype=np.int64))
+                ix_cm.append(cm)
+                ix_off.append(ix_off[-1] + cm.size)
+        ix = ix_index[0][None, :] if len(ix_index) == 1 else np.stack(ix_index)
+        if not ix_index:
+            ix = np.zeros((0, blk.m), dtype=np.int64)
+        _fused_columns(
+            self.rows,
+            np.asarray(fidx, dtype=np.int64),
+            int(layout.colmap[fname][0]),
+            k,
+            np.asarray(plan_col, dtype=np.int64),
+            np.asarray(plan_ix, dtype=np.int64),
+            ix,
+            np.concatenate(ix_cm).astype(np.int64) if ix_cm else np.zeros(0, dtype=np.int64),
+            np.asarray(ix_off, dtype=np.int64),
+            r,
+            self.w,
+            cols,
+            vals[:, :w],
+            fcol[:, :q],
+            fw[:, :q],
+            self.r_kept,
+        )
+
+
+@njit(cache=True, parallel=True)
+def _fused_columns(
+    rows, fidx, fc0, k, plan_col, plan_ix, ix_index, ix_cm, ix_off, r, w, cols, vals, fcol, fw, rk
+):  # pragma: no cover - compiled
+    """The engine's share of a fused part's rows, in one pass without temporaries: destination
+    row t is block row ``rows[t]``; its factored group's columns ``fc0 + k·item`` (``-1`` and a
+    zero weight where the item is -1), its slots' columns (``plan_col[s]``, or for an indexed
+    slot ``ix_cm[ix_off[j] + ix_index[j, row]]`` with ``j = plan_ix[s]``; a fixed entry's slot
+    empty, its value zeroed) and its whitened residual ``rk[t] = r · w``.
+    """
+    q = fcol.shape[1]
+    width = plan_col.size
+    for t in prange(rows.size):
+        i = rows[t]
+        for a in range(q):
+            it = fidx[i, a]
+            if it >= 0:
+                fcol[t, a] = fc0 + it * k
+            else:
+                fcol[t, a] = -1
+                fw[t, a] = 0.0
+        for s in range(width):
+            j = plan_ix[s]
+            c = plan_col[s] if j < 0 else ix_cm[ix_off[j] + ix_index[j, i]]
+            cols[t, s] = c
+            if c < 0:
+                vals[t, s] = 0.0
+        rk[t] = r[i] * w[i]

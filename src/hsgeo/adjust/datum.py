@@ -189,7 +189,9 @@ def identifiability(
         return _analyse(layout, _normal(layout, sy, options), options.rank_rtol)
 
 
-def _surely_full_rank(layout: _Layout, ne: _Normal, rtol: float) -> bool:
+def _surely_full_rank(
+    layout: _Layout, ne: _Normal, rtol: float, points_checked: bool = False
+) -> bool:
     """A sufficient test of full rank, at the cost of one Cholesky factorisation.
 
     With the unit-diagonal scaled reduced matrix ``Ss`` and ``b ≥ λ_max`` its largest absolute
@@ -197,8 +199,10 @@ def _surely_full_rank(layout: _Layout, ne: _Normal, rtol: float) -> bool:
     ``λ_min > rtol·b ≥ rtol·λ_max``: :func:`_analyse`'s eigenvalue test then passes too. False
     means "not proven" (the eigenvalues decide). The eigendecomposition costs several times a
     Cholesky factorisation: seconds for the ~3000 unknowns of a long pushbroom block.
+    ``points_checked``: the caller found no undetermined point in ``ne`` already (the test of
+    100,000 point blocks is not repeated).
     """
-    if _undetermined_points(layout, ne, rtol):
+    if not points_checked and _undetermined_points(layout, ne, rtol):
         return False
     if layout.n_c == 0:
         return True
@@ -214,9 +218,11 @@ def _surely_full_rank(layout: _Layout, ne: _Normal, rtol: float) -> bool:
     return True
 
 
-def _check_datum(layout: _Layout, ne: _Normal, rtol: float) -> None:
-    """Raise :class:`~hsgeo.DatumError` if the normal equations at ``ne`` are rank deficient."""
-    if _surely_full_rank(layout, ne, rtol):
+def _check_datum(layout: _Layout, ne: _Normal, rtol: float, points_checked: bool = False) -> None:
+    """Raise :class:`~hsgeo.DatumError` if the normal equations at ``ne`` are rank deficient
+    (``points_checked``: no point block of ``ne`` is singular, the caller tested them).
+    """
+    if _surely_full_rank(layout, ne, rtol, points_checked):
         return
     ident = _analyse(layout, ne, rtol)
     if not ident.full_rank:

@@ -207,7 +207,7 @@ def _normal_equations(layout, sy, options, orders) -> _Normal:
     if compiled:
         from hsgeo.adjust._fast import point_normals
 
-        V, gp = point_normals(sy.pidx, sy.Jp, sy.r, n_pts)
+        V, gp = point_normals(order, ptr, sy.Jp, sy.r)
     else:
         rows = np.flatnonzero(sy.pidx >= 0)
         pi = sy.pidx[rows]

@@ -73,7 +73,7 @@ from hsgeo.adjust.schur import (
     _reduced_inverse,
     _step,
 )
-from hsgeo.adjust.system import _Clock, _evaluate, _Layout, _NonFinite, _System
+from hsgeo.adjust.system import _Buffers, _Clock, _evaluate, _Layout, _NonFinite, _System
 from hsgeo.adjust.threads import engine_threads
 from hsgeo.errors import ConvergenceError, DatumError, InputError, ObservationError
 
@@ -238,6 +238,9 @@ class _Solve:
         self.dropped_rows = [np.zeros(b.m, dtype=bool) for b in blocks]  # ... their rows
         self.settled_seen = False  # an iterate was settled (accepted steps no longer held)
         self.clock = _Clock()  # AdjustmentResult.seconds_split
+        #: the Jacobian's arrays, written again by each linearisation (the previous system is
+        #: always dropped first: see minimise)
+        self.buffers = _Buffers()
         #: SolverOptions.robust_start: the loss until the first settled iterate, and the
         #: scales of the last linearisation (the trial steps are costed with the same)
         self.loss_on = options.robust_start is not None
@@ -256,6 +259,7 @@ class _Solve:
             clock=self.clock,
             loss=(opts.robust_start, opts.robust_start_k, None) if self.loss_on else None,
             fused=opts.fused,
+            buffers=self.buffers,
         )
         self.loss_c = sy.loss_c
         if check_redundancy:
@@ -335,9 +339,13 @@ class _Solve:
         self._damping_diagonal(ne)
         if check_datum:
             t0 = time.perf_counter()
+            points_checked = False
             if opts.drop_undetermined_points:
+                ne_before = ne
                 sy, ne = self._drop_undetermined(sy, ne)
-            _check_datum(self.layout, ne, opts.rank_rtol)
+                # none dropped: the same normal equations, whose point blocks were just tested
+                points_checked = ne is ne_before
+            _check_datum(self.layout, ne, opts.rank_rtol, points_checked)
             self.clock.add("datum", t0)
         lam, nu = opts.lambda0, 2.0
         cost = sy.cost

@@ -267,7 +267,8 @@ def _lines_kernel(
     (``y(t*) = y_obs``, Newton from the line time ``t_e`` with the navigation pose moved by its
     rates and the spline piece of ``t_e`` continued); the residuals are ``x(t*) − x_obs`` and
     ``ẏ_ref (t_e − t*)``, and their derivatives follow from the implicit function theorem,
-    ``∂t*/∂θ = −(∂y/∂θ)/ẏ``. The spline weights used are returned in ``w_out``. ``dt_start``
+    ``∂t*/∂θ = −(∂y/∂θ)/ẏ``. The spline weights used are returned in ``w_out`` (unless it has
+    no rows). ``dt_start``
     (in and out): ``t* − t_e`` at which Newton starts, overwritten with this evaluation's.
 
     Fused path (``dst.size == m``): the derivatives of observation j go to rows
@@ -280,6 +281,7 @@ def _lines_kernel(
     """
     fused = dst.size == pidx.size
     m = pidx.size
+    keep_w = w_out.shape[0] == m  # the spline weights are wanted (an empty w_out: not)
     n_chunks = 64 if m > 6400 else 1
     gradient = fused and gd.shape[1] > 0
     if gradient:
@@ -331,8 +333,9 @@ def _lines_kernel(
                     break
                 if it < n_it:
                     dt = min(max(dt - ey, -T_MAX), T_MAX)
-            for b in range(4):
-                w_out[j, b] = w[b]
+            if keep_w:
+                for b in range(4):
+                    w_out[j, b] = w[b]
             if timed:
                 dt_start[j] = min(max(dt - ey, -T_MAX), T_MAX)
             r[2 * j] = x * k_px - xy_obs[j, 0] - xdot * ey  # x at t* (0 if not timed)

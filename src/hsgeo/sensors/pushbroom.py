@@ -501,7 +501,7 @@ class PushbroomLines(ResidualBlock):
         nm = self.blocks
         m = self.point.size
         r = np.empty(2 * m)
-        w_out = np.empty((m, 4))
+        w_out = np.empty((m if jacobian else 0, 4))  # the spline weights: only for the Jacobian
         shp = (2 * m,) if jacobian else (0,)
         dP = np.empty(shp + (3,))
         dN = np.empty(shp + (6,))  # d r / d δ(t); the node columns are B_a(t) × this
@@ -577,9 +577,9 @@ class PushbroomLines(ResidualBlock):
             columns of the boresight, lever arm and distortion entries, of each band's
             principal distance (-1: fixed) and of the first node entry.
         """
-        m = self.point.size
         derivs = (jp, fd, vals[:, 0:3], vals[:, 3:6], vals[:, 6:10], vals[:, 10:11])
-        self._kernel(values, True, r, np.empty((m, 4)), derivs, dst, w_row, fw, gd, cols)
+        # the spline weights go to fw, whitened rows' factored weights (no w_out)
+        self._kernel(values, True, r, np.empty((0, 4)), derivs, dst, w_row, fw, gd, cols)
 
     def _kernel(self, values, jacobian, r, w_out, derivs, dst, w_row, fw, gd=None, cols=None):
         """One call of the compiled kernel (see ``_pushbroom_kernel._lines_kernel``)."""
