@@ -50,7 +50,8 @@ data: $(STAMP) ## regenerate data_synthetic/generated from the scenario TOMLs an
 # simulated campaign, one reproduction) are computed once, and the chapters run in the book's
 # order in one process, so the scoreboard reads the records of the chapters before it. The
 # compiled kernels (numba, cache=True) are cached beside the sources (__pycache__) and shared by
-# every process, so a fresh clone compiles each kernel once (both processes may race on the first).
+# every process; on a fresh clone each kernel is compiled once, by the first process that needs it
+# (tests/compile_lock.py), and the costliest files begin first (tests/conftest.py).
 # `--durations=40` prints the 40 slowest tests at the end: where the suite's time goes (issue 41).
 TEST_WORKERS ?= 2
 TEST_XDIST = $(if $(filter 0,$(TEST_WORKERS)),,-n $(TEST_WORKERS) --dist loadfile)

@@ -4,8 +4,18 @@ from pathlib import Path
 
 import pytest
 
+# The compiled kernels' threads (numba's OpenMP layer, libgomp) wait for work by spinning on
+# their core unless told otherwise: with two pytest-xdist workers on two cores, each with its
+# threads, a spinning thread takes the core from the other worker after every parallel loop.
+# Passive waiting changes no result (the same threads split the same loops) and only the CPU
+# spent waiting (issue 41: bench/results/test_suite_cost.json). Set before any process of the
+# session loads libgomp (it reads the variable once); the workers, the chapters' kernels and the
+# CLI's subprocesses inherit it.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
 sys.path.insert(0, str(Path(__file__).parent))
 
+import compile_lock  # noqa: E402
 from repro_cache import cached_run  # noqa: E402
 
 
@@ -31,45 +41,74 @@ def reproduction(repro_cache_dir):
     return get
 
 
-def _compile_pushbroom_kernels() -> None:
-    """One tiny pushbroom adjustment: numba compiles the engine's kernels into its cache.
+@pytest.fixture(scope="session", autouse=True)
+def _compile_once(tmp_path_factory) -> None:
+    """Each compiled kernel compiled by one process of the session (tests/compile_lock.py): the
+    workers, the chapters' kernels and the CLI's subprocesses share a folder of lock files."""
+    base = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        base = base.parent
+    os.environ[compile_lock.ENV] = str(base / "compile-locks")
+    compile_lock.install()
 
-    The kernels (``cache=True``) are cached beside the sources and shared by every process, but
-    on a fresh clone each process that calls one before it is cached compiles it itself. Two
-    pytest-xdist workers reaching the pushbroom engine at the same time both compiled its 24
-    kernels: 137 CPU-s each (issue 41, measured on a cold cache: tests/test_kernels.py and
-    tests/test_pushbroom.py 163 CPU-s cold, 26 warm). Compiled once here, before the workers
-    start, every worker loads them from the cache: 19 of the 24 kernels, 123.7 CPU-s with an
-    empty cache, 6.9 CPU-s with a warm one (bench/results/test_suite_cost.json).
-    """
-    from priors import campaign_prior
 
-    from hsgeo.adjust import adjust
-    from hsgeo.simulate.pushbroom_campaign import simulate
-    from hsgeo.simulate.pushbroom_campaign_types import CampaignConfig
-    from hsgeo.workflows.pushbroom_ba import build_problem
+#: The test files by CPU seconds, the costliest first (a fresh clone of main 3072200, `make test`
+#: with bench/pytest_cpu_cost.py; bench/results/test_suite_cost.json). pytest-xdist hands a
+#: worker its next file when it is done with one: begun first, the long files end together
+#: instead of one worker running the chapters alone at the end (xdist's default order is by
+#: number of tests, which put tests/test_chapters.py, 314 CPU-s in 19 tests, last). Files not
+#: named here follow in the order collected. CPU-s of each file in that run in the comments.
+COSTLIEST_FIRST = (
+    "test_bad_input.py",  # 353
+    "test_chapters.py",  # 314
+    # after test_cube.py: a worker takes the next file when its own is nearly done, and 3rd
+    # this file began in the other worker while the lp-observations chapter computed the run
+    # both need (seed 0, 0.3) and waited 78 s for it (tests/repro_cache.py's lock); 4th it
+    # begins after the chapters or after test_cube.py (139 s more) and finds the run cached
+    "test_cube.py",  # 156
+    "test_reproduce_lp_observations.py",  # 168
+    "test_bad_input_every_command.py",  # 66
+    "test_asf.py",  # 60
+    "test_reproduce_lp_mosaic.py",  # 55
+    "test_geodetic_002_flight.py",  # 48
+    "test_reproduce_asf.py",  # 36
+    "test_lp_campaign.py",  # 35
+    "test_rikola.py",  # 35
+    "test_reproduce_geocoding.py",  # 28
+    "test_cli_lp_observations.py",  # 25
+    "test_cli_lp_observations_envi.py",  # 24
+    "test_ortho_scale.py",  # 22
+    "test_orthorectify_registry.py",  # 19
+    "test_geodetic_geolocation.py",  # 18
+    "test_engine_threads.py",  # 17
+    "test_approx_transform.py",  # 17
+    "test_raycast_rows.py",  # 15
+    "test_lp_observations.py",  # 14
+    "test_bad_input_classes.py",  # 14
+    "test_reproduce_lp_targets.py",  # 13
+    "test_cli_orthorectify.py",  # 12
+    "test_reproduce_line_calibration.py",  # 12
+    "test_cli_orthorectify_envi.py",  # 11
+    "test_cli_asf.py",  # 11
+    "test_ortho.py",  # 11
+    "test_bal.py",  # 11
+    "test_measure_mtf.py",  # 10
+)
 
-    obs, _ = simulate(0.001, rng=3)
-    cfg = CampaignConfig()
-    cam = campaign_prior(x0_mm=cfg.x0_mm, lever_arm_m=tuple(obs.lever_arm_m))
-    params, blocks, _ = build_problem(
-        obs.lines,
-        obs.n_points,
-        cam,
-        node_interval_s=10.0,
-        t_span_s=obs.t_span_s,
-        node_prior_mean=obs.node_prior_mean,
-        gcp_index=obs.gcp_index,
-        gcp_xyz_m=obs.gcp_xyz_m,
-    )
-    # with rejection (robust leverages) and the points' covariance: their kernels too
-    res = adjust(params, blocks, reject_k=5.0, reject_every_iteration=True, keep_jacobian=True)
-    res.point_covariance()
+
+def pytest_collection_modifyitems(session, config, items):
+    """Under pytest-xdist: the files in :data:`COSTLIEST_FIRST` order (each file's tests in
+    their own order). Both workers collect the same order, as xdist requires."""
+    if not os.environ.get("PYTEST_XDIST_WORKER"):
+        return
+    rank = {name: i for i, name in enumerate(COSTLIEST_FIRST)}
+    files = list(dict.fromkeys(item.nodeid.split("::")[0] for item in items))
+    order = {f: (rank.get(Path(f).name, len(rank)), i) for i, f in enumerate(files)}
+    items.sort(key=lambda item: order[item.nodeid.split("::")[0]])
 
 
 def pytest_configure(config):
-    # Only in pytest-xdist's controller (`make test` runs two workers): a worker has
-    # `workerinput`, a single-process run has no `numprocesses`.
-    workers = getattr(config.option, "numprocesses", None)
-    if workers and not hasattr(config, "workerinput") and not os.environ.get("HSGEO_NO_WARMUP"):
-        _compile_pushbroom_kernels()
+    # pytest-xdist's controller schedules the files in the order the workers collected them
+    # (pytest_collection_modifyitems), not by their number of tests
+    if hasattr(config.option, "loadscopereorder") and not hasattr(config, "workerinput"):
+        config.option.loadscopereorder = False

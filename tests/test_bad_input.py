@@ -292,22 +292,56 @@ def _ortho(d: Path) -> None:
     write_ortho_inputs(d, adjusted=True)
 
 
+#: each command's valid inputs: its folder under ``valid`` and the function that writes it
+VALID_BUILDERS: dict[str, Callable[[Path], None]] = {
+    "asf": _asf,
+    "mtf": _mtf,
+    "mtf-edge": _mtf_edge,
+    "adjust-bal": _bal,
+    "cube": _cube,
+    "calibrate-line": _line,
+    "adjust-pushbroom": _pushbroom,
+    "orthorectify-line": _geocode,
+    "calibrate-frame": _frame,
+    "lp-observations": _lp,
+    "orthorectify-strips": _ortho,
+    "orthorectify-envi": _envi_lines,
+    "orthorectify-frames": _frames,
+}
+
+
 def build_valid(root: Path) -> Path:
     """Write the valid inputs of every command under ``root`` (one folder per command)."""
-    _asf(root / "asf")
-    _mtf(root / "mtf")
-    _mtf_edge(root / "mtf-edge")
-    _bal(root / "adjust-bal")
-    _cube(root / "cube")
-    _line(root / "calibrate-line")
-    _pushbroom(root / "adjust-pushbroom")
-    _geocode(root / "orthorectify-line")
-    _frame(root / "calibrate-frame")
-    _lp(root / "lp-observations")
-    _ortho(root / "orthorectify-strips")
-    _envi_lines(root / "orthorectify-envi")
-    _frames(root / "orthorectify-frames")
+    for cmd in VALID_BUILDERS:
+        valid_inputs(root, cmd)
     return root
+
+
+def valid_inputs(root: Path, cmd: str) -> Path | None:
+    """``root / cmd``, the valid inputs of ``cmd``, written by the first process that asks.
+
+    The folder of :func:`valid` is shared by the pytest-xdist workers and by the three files
+    that use it (tests/test_bad_input*.py): each command's inputs are written once per session
+    (≈ 30 CPU-s for all thirteen; before issue 41 once per file that used them), a lock file per
+    command making a second process wait for the first one's folder. The cases only copy it.
+    ``None`` for a command without inputs of its own (``hsgeo data``, ``reproduce``).
+    """
+    import fcntl
+
+    if cmd not in VALID_BUILDERS:
+        return None
+    d = root / cmd
+    root.mkdir(parents=True, exist_ok=True)
+    with open(root / f"{cmd}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)  # a second process waits here for the first's folder
+        if not d.is_dir():  # written beside, renamed when complete: never seen half-written
+            stage = root / f".{cmd}.{os.getpid()}"
+            shutil.rmtree(stage, ignore_errors=True)
+            stage.mkdir()
+            VALID_BUILDERS[cmd](stage / cmd)
+            (stage / cmd).rename(d)
+            stage.rmdir()
+    return d
 
 
 def base_argv(cmd: str, d: Path) -> list[str]:
@@ -2664,7 +2698,13 @@ case(C, "options", "scheduler-an-http-port", "--scheduler", argv=_scheduler_http
 
 @pytest.fixture(scope="session")
 def valid(tmp_path_factory) -> Path:
-    return build_valid(tmp_path_factory.mktemp("valid"))
+    """The folder of every command's valid inputs, one per session: the pytest-xdist workers
+    share it (the parent of a worker's base temporary directory is the session's); each
+    command's folder is written on first use (:func:`valid_inputs`)."""
+    base = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        base = base.parent
+    return base / "valid"
 
 
 def _sha(root: Path) -> dict:
@@ -2706,8 +2746,9 @@ def inputs(tmp_path, valid, request, monkeypatch):
     c = request.node.callspec.params.get("case") if hasattr(request.node, "callspec") else None
     cmd = c.cmd if c is not None else cmd
     d = tmp_path / "in"
-    if cmd is not None and (valid / cmd).is_dir():
-        shutil.copytree(valid / cmd, d)
+    src = valid_inputs(valid, cmd) if cmd is not None else None
+    if src is not None:
+        shutil.copytree(src, d)
     else:
         d.mkdir()
     cwd = tmp_path / "cwd"

@@ -28,10 +28,12 @@ BOOK = Path(__file__).resolve().parents[1] / "book"
 TIMEOUT_S = 1800
 SUFFIXES = (".md", ".ipynb")
 _ANSI = re.compile(r"\x1b\[[0-9;]*m")
-# run first in each chapter's kernel: hsgeo.reproduce.run shares its results with the tests
+# run first in each chapter's kernel: hsgeo.reproduce.run shares its results with the tests,
+# and a kernel another process of the session is compiling is waited for, not compiled again
 SHARE_CELL = (
     f"import sys\nsys.path.insert(0, {str(Path(__file__).resolve().parent)!r})\n"
-    "import repro_cache\nrepro_cache.install()\ndel sys.path[0]"
+    "import compile_lock, repro_cache\ncompile_lock.install()\nrepro_cache.install()\n"
+    "del sys.path[0]"
 )
 
 
