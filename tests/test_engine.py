@@ -303,6 +303,21 @@ def test_outliers_rejected_every_iteration_like_rounds():
     )
 
 
+def _dense_schur(Jc, jp, pidx, n_pts):
+    """The reduced (Schur) matrix by its dense formula, point by point, with V_i + I as each
+    point's block: (V⁻¹, S) = Σ_i Jcᵢᵀ Jcᵢ − Wᵢ V_i⁻¹ Wᵢᵀ, Wᵢ = Jcᵢᵀ jpᵢ."""
+    p = jp.shape[1]
+    V = np.zeros((n_pts, p, p))
+    np.add.at(V, pidx, jp[:, :, None] * jp[:, None, :])
+    Vinv = np.linalg.inv(V + np.eye(p))
+    S_ref = np.zeros((Jc.shape[1], Jc.shape[1]))
+    for i in range(n_pts):
+        r = pidx == i
+        W = Jc[r].T @ jp[r]
+        S_ref += Jc[r].T @ Jc[r] - W @ Vinv[i] @ W.T
+    return Vinv, S_ref
+
+
 @pytest.mark.parametrize("consecutive", [True, False])
 def test_reduced_kernel_equals_dense_schur(consecutive):
     """The compiled Schur kernel (tiles for the factored items) against the dense formula.
@@ -337,14 +352,7 @@ def test_reduced_kernel_equals_dense_schur(consecutive):
     jp = rng.normal(size=(M, p))
     J = _RowJac(cols, vals, n_c, fcol, fw, fd)
     Jc = J.tocsr().toarray()
-    V = np.zeros((n_pts, p, p))
-    np.add.at(V, pidx, jp[:, :, None] * jp[:, None, :])
-    Vinv = np.linalg.inv(V + np.eye(p))
-    S_ref = np.zeros((n_c, n_c))
-    for i in range(n_pts):
-        r = pidx == i
-        W = Jc[r].T @ jp[r]
-        S_ref += Jc[r].T @ Jc[r] - W @ Vinv[i] @ W.T
+    Vinv, S_ref = _dense_schur(Jc, jp, pidx, n_pts)
     order = np.arange(M, dtype=np.int64)
     ptr = np.concatenate([[0], np.cumsum(rows_per_pt)]).astype(np.int64)
     S = reduced_points(J.arrays, jp, order, ptr, Vinv, n_c)
@@ -407,14 +415,7 @@ def test_reduced_kernel_slot_points_equal_dense_schur():
     n_pts = len(cams)
     J = _RowJac(cols, vals, n_c, fcol, fw, fd)
     Jc = J.tocsr().toarray()
-    V = np.zeros((n_pts, p, p))
-    np.add.at(V, pidx, jp[:, :, None] * jp[:, None, :])
-    Vinv = np.linalg.inv(V + np.eye(p))
-    S_ref = np.zeros((n_c, n_c))
-    for i in range(n_pts):
-        r = pidx == i
-        W = Jc[r].T @ jp[r]
-        S_ref += Jc[r].T @ Jc[r] - W @ Vinv[i] @ W.T
+    Vinv, S_ref = _dense_schur(Jc, jp, pidx, n_pts)
     order = np.argsort(pidx, kind="stable").astype(np.int64)
     ptr = np.concatenate([[0], np.cumsum(np.bincount(pidx, minlength=n_pts))]).astype(np.int64)
     S = reduced_points(J.arrays, jp, order, ptr, Vinv, n_c)

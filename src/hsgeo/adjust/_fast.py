@@ -318,24 +318,6 @@ def _slot_blocks(C, fcol, fw, grow, g, ng, kf, nl, sl, A):  # pragma: no cover
 
 
 @njit(cache=True, inline="always")
-def _slot_runs(sl, nl, run_e, run_n):  # pragma: no cover - compiled
-    """Split the slot columns' positions ``sl[:nl]`` into runs of consecutive positions (a
-    camera's columns): their starts and lengths; the number of runs.
-    """
-    nr = 0
-    e = 0
-    while e < nl:
-        f = e + 1
-        while f < nl and sl[f] == sl[f - 1] + 1:
-            f += 1
-        run_e[nr] = e
-        run_n[nr] = f - e
-        nr += 1
-        e = f
-    return nr
-
-
-@njit(cache=True, inline="always")
 def _slot_slot(C, Z, T, ng, kf, gl, nl, sl, run_e, run_n, nr, A):  # pragma: no cover
     """The slot columns against each other (one triangle, the diagonal halved) into A, each
     row of ``C − Z V_i⁻¹ Zᵀ`` formed (:func:`_schur_row`) just before it is added: runs of
@@ -568,7 +550,8 @@ def _reduced_kernel(
         pos = np.full(n_c, -1, dtype=np.int64)
         gl = np.empty(capc, dtype=np.int64)  # global column of each local slot column
         sl = np.empty(capc, dtype=np.int64)  # its position among the slot columns (sc_of)
-        run_e = np.empty(capc, dtype=np.int64)  # runs of consecutive positions (_slot_runs)
+        run_e = np.empty(capc, dtype=np.int64)  # runs of consecutive positions (_runs)
+        run_s = np.empty(capc, dtype=np.int64)  # each run's first position (unused here)
         run_n = np.empty(capc, dtype=np.int64)
         grow = np.empty(capg, dtype=np.int64)  # a row of each group (its items and weights)
         C = np.zeros((0, 0))  # (Lmax, Lmax) from the first point with groups
@@ -628,7 +611,7 @@ def _reduced_kernel(
                         C, fcol, fw, grow, g, h, kf, tile_of, slot_of, tiles, R
                     )
                 _slot_blocks(C, fcol, fw, grow, g, ng, kf, nl, sl, A)
-            nr = _slot_runs(sl, nl, run_e, run_n)
+            nr = _runs(sl, nl, run_e, run_s, run_n)
             _slot_slot(C, Z, T, ng, kf, gl, nl, sl, run_e, run_n, nr, A)
     return out, out_t, misses.sum()
 
