@@ -1,6 +1,7 @@
 """``make test`` on a fresh clone, timed: one record added to make_test_runs.json.
 
     python bench/make_test_fresh_clone.py [--commit REV] [--busy-cores N] [--workdir DIR]
+        [--role before|after] [--note TEXT]
 
 Clones this repository at ``REV`` (default HEAD) into an empty folder, runs the README's test
 command (``make test``) there exactly as CI does, and records the wall time of the whole command
@@ -9,6 +10,10 @@ system CPU seconds (``os.wait4``), the peak resident memory of the largest child
 and the load average before and after. ``--busy-cores N`` runs N busy loops beside it (one core
 busy: the issue's second condition), each a ``python -c 'while 1: pass'`` at the same priority,
 killed at the end.
+
+``--role`` marks the record as the "before" (the commit the issue measured) or "after" figure
+of issue 41's done-means, which ``issue41_audit.py`` puts side by side; give it only to a run
+that had the machine to itself (apart from its own busy loops).
 
 The figure depends on the machine's load: a record carries it; compare records taken at the
 same load (or the same busy-core count on an otherwise idle machine).
@@ -47,12 +52,26 @@ def _counts(text: str) -> dict:
     return out
 
 
+_DURATION = re.compile(
+    r"^(?P<s>[0-9.]+)s (?P<phase>call|setup|teardown) +(?P<test>\S.*?)\s*$", re.M
+)
+
+
+def _slowest(text: str) -> list[dict]:
+    """pytest's ``--durations`` table (the Makefile asks for the slowest 40), as records."""
+    return [
+        {"seconds": float(m["s"]), "phase": m["phase"], "test": m["test"]}
+        for m in _DURATION.finditer(text)
+    ]
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--commit", default="HEAD")
     ap.add_argument("--busy-cores", type=int, default=0)
     ap.add_argument("--workdir", type=Path, default=None)
     ap.add_argument("--note", default="")
+    ap.add_argument("--role", choices=("before", "after"), default=None)
     args = ap.parse_args()
     rev = subprocess.run(
         ["git", "-C", str(ROOT), "rev-parse", "--short", args.commit],
@@ -94,7 +113,9 @@ def main() -> None:
         "loadavg_end": list(os.getloadavg()),
         "cpus": os.cpu_count(),
         "note": args.note,
+        **({"role": args.role} if args.role else {}),
         **_counts(text),
+        "slowest": _slowest(text),
     }
     runs = json.loads(OUT.read_text(encoding="utf-8")) if OUT.is_file() else {"runs": []}
     runs["runs"].append(rec)

@@ -1,10 +1,15 @@
 """The chapter's pushbroom adjustment, this checkout against a previous main, in turn (A B A B …).
 
     python bench/pushbroom_vs_main.py --vs /path/to/previous-main [--scale 1] [--pairs 4]
+        [--threads N] [--out FILE]
 
-Each run is one fresh process of ``bench_pushbroom_ba.py --child scaling`` of its own checkout
-(its own ``src`` first on the path): the same problem, the compiled kernels loaded, then the
-solve timed (wall, CPU seconds of all its threads, system seconds, minor faults, peak RSS).
+Each run is one fresh process of this script's ``--child`` mode with the other checkout's
+``src`` first on the path: it runs that checkout's own ``bench_pushbroom_ba.case_scaling`` (the
+same problem, the compiled kernels loaded) and times the solve by wrapping the checkout's
+``hsgeo.workflows.pushbroom_ba.solve`` (wall, CPU seconds of all its threads, system seconds,
+minor faults; peak RSS of the process), so that any checkout whose bench has
+``case_scaling`` can be the other side, also one from before these figures were recorded (the
+issue's own commit).
 Runs alternate so that a drift of the shared machine's speed falls on both; the load average
 is recorded before each run. Writes ``bench/results/pushbroom_vs_main.json``: every run, the
 medians of each side and the median of the pairwise ratios (this / previous main).
@@ -32,19 +37,69 @@ def _commit(root: Path) -> str | None:
     return cp.stdout.strip() or None
 
 
-def _run(root: Path, scale: float, seed: int) -> dict:
+def _child(root: Path, scale: float, seed: int) -> dict:
+    """In a fresh process with ``root/src`` first on the path: that checkout's scaling case,
+    its solve timed from outside (the checkout's own bench need not report CPU seconds)."""
+    import resource
+
+    sys.path.insert(0, str(root / "bench"))
+    import hsgeo.workflows.pushbroom_ba as W
+
+    if not Path(W.__file__).resolve().is_relative_to(root.resolve()):
+        raise SystemExit(f"hsgeo imported from {W.__file__}, not from {root}")
+    solve, got = W.solve, {}
+
+    def timed(*a, **k):
+        r0, t0 = resource.getrusage(resource.RUSAGE_SELF), time.perf_counter()
+        res = solve(*a, **k)
+        wall = time.perf_counter() - t0
+        r1 = resource.getrusage(resource.RUSAGE_SELF)
+        got.clear()  # the last call is the timed solve (the first loads the compiled kernels)
+        got.update(
+            wall_seconds=wall,
+            solver_cpu_seconds=(r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime),
+            solver_system_seconds=r1.ru_stime - r0.ru_stime,
+            solver_minor_faults=r1.ru_minflt - r0.ru_minflt,
+            iterations=res.iterations,
+            sigma0=res.sigma0,
+            n_observations=getattr(res, "n_observations", None),
+            final_cost=float(res.cost_history[-1]),
+        )
+        return res
+
+    W.solve = timed
+    import bench_pushbroom_ba as B
+
+    B.case_scaling(scale, seed)
+    got["peak_rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    return got
+
+
+def _run(root: Path, scale: float, seed: int, threads: int | None) -> dict:
     env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")
     env["PYTHONPATH"] = str(root / "src")
-    script = root / "bench" / "bench_pushbroom_ba.py"
-    cmd = [sys.executable, str(script), "--child", "scaling", "--scale", str(scale)]
-    cmd += ["--seed", str(seed)]
+    if threads:
+        env["NUMBA_NUM_THREADS"] = str(threads)
+    cmd = [sys.executable, str(Path(__file__).resolve()), "--child", str(root)]
+    cmd += ["--scale", str(scale), "--seed", str(seed), "--vs", "-"]
     load = os.getloadavg()
     cp = subprocess.run(cmd, env=env, capture_output=True, text=True, check=True)
-    out = next(json.loads(x[7:]) for x in cp.stdout.splitlines() if x.startswith("RESULT "))
-    keep = FIGURES + ("peak_rss_mb", "iterations", "sigma0", "n_observations")
-    row = {k: out[k] for k in keep}
+    row = next(json.loads(x[7:]) for x in cp.stdout.splitlines() if x.startswith("RESULT "))
     row["load_average_1_5_15_before"] = load
     return row
+
+
+def _cpu() -> dict:
+    """The CPU as the kernel reports it: a VM's model name alone ("AMD EPYC") does not tell
+    machines apart; family, model and stepping do better."""
+    info = {}
+    for line in Path("/proc/cpuinfo").read_text().splitlines():
+        k, _, v = line.partition(":")
+        k = k.strip()
+        if k in ("model name", "cpu family", "model", "stepping", "cpu MHz") and k not in info:
+            info[k] = v.strip()
+    info["cores"] = os.cpu_count()
+    return info
 
 
 def main(argv=None) -> int:
@@ -53,14 +108,19 @@ def main(argv=None) -> int:
     ap.add_argument("--scale", type=float, default=1.0)
     ap.add_argument("--pairs", type=int, default=4)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--threads", type=int, default=None, help="NUMBA_NUM_THREADS (default: all)")
+    ap.add_argument("--child", type=Path, default=None, help=argparse.SUPPRESS)
     ap.add_argument("--out", default=str(HERE / "results" / "pushbroom_vs_main.json"))
     args = ap.parse_args(argv)
+    if args.child is not None:
+        print("RESULT " + json.dumps(_child(args.child, args.scale, args.seed)), flush=True)
+        return 0
     this, other = HERE.parent, Path(args.vs).resolve()
     runs: dict[str, list] = {"this": [], "previous_main": []}
     for i in range(args.pairs):
         for side, root in (("previous_main", other), ("this", this)):
             print(f"pair {i + 1}/{args.pairs}: {side} ...", file=sys.stderr, flush=True)
-            runs[side].append(_run(root, args.scale, args.seed))
+            runs[side].append(_run(root, args.scale, args.seed, args.threads))
 
     def med(side, k):
         return statistics.median(r[k] for r in runs[side])
@@ -72,10 +132,9 @@ def main(argv=None) -> int:
         for k in FIGURES
     }
     out = {
-        "what": "the chapter's pushbroom adjustment (bench_pushbroom_ba.py --child scaling: "
-        "the solve after the compiled kernels were loaded), this checkout and the previous "
-        "main in turn, each run a fresh process; numba's default threads (the cores), "
-        "OPENBLAS_NUM_THREADS=1",
+        "what": "the chapter's pushbroom adjustment (each checkout's bench_pushbroom_ba."
+        "case_scaling, its solve timed from outside after the compiled kernels were loaded), "
+        "this checkout and the other in turn, each run a fresh process; OPENBLAS_NUM_THREADS=1",
         "scale": args.scale,
         "pairs": args.pairs,
         "commit_this": _commit(this),
@@ -85,7 +144,8 @@ def main(argv=None) -> int:
         "median_ratio_this_over_previous_main": ratios,
         "runs": runs,
         "glibc_tunables": os.environ.get("GLIBC_TUNABLES", ""),
-        "numba_threads": os.environ.get("NUMBA_NUM_THREADS", "default"),
+        "numba_threads": args.threads or os.environ.get("NUMBA_NUM_THREADS", "default"),
+        "cpu": _cpu(),
         "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
     }
     Path(args.out).write_text(json.dumps(out, indent=1) + "\n")
