@@ -37,10 +37,18 @@ def _commit(root: Path) -> str | None:
     return cp.stdout.strip() or None
 
 
-def _child(root: Path, scale: float, seed: int) -> dict:
+def _child(root: Path, scale: float, seed: int, as_command: bool = False) -> dict:
     """In a fresh process with ``root/src`` first on the path: that checkout's scaling case,
-    its solve timed from outside (the checkout's own bench need not report CPU seconds)."""
+    its solve timed from outside (the checkout's own bench need not report CPU seconds).
+    ``as_command``: first what that checkout's ``hsgeo`` command does to its process
+    (``hsgeo.terminal.keep_freed_memory``, where it exists)."""
     import resource
+
+    kept = None
+    if as_command:
+        import hsgeo.terminal as T
+
+        kept = T.keep_freed_memory() if hasattr(T, "keep_freed_memory") else None
 
     sys.path.insert(0, str(root / "bench"))
     import hsgeo.workflows.pushbroom_ba as W
@@ -72,16 +80,18 @@ def _child(root: Path, scale: float, seed: int) -> dict:
 
     B.case_scaling(scale, seed)
     got["peak_rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    got["kept_freed_memory"] = kept
     return got
 
 
-def _run(root: Path, scale: float, seed: int, threads: int | None) -> dict:
+def _run(root: Path, scale: float, seed: int, threads: int | None, as_command=False) -> dict:
     env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")
     env["PYTHONPATH"] = str(root / "src")
     if threads:
         env["NUMBA_NUM_THREADS"] = str(threads)
     cmd = [sys.executable, str(Path(__file__).resolve()), "--child", str(root)]
     cmd += ["--scale", str(scale), "--seed", str(seed), "--vs", "-"]
+    cmd += ["--as-command"] if as_command else []
     load = os.getloadavg()
     cp = subprocess.run(cmd, env=env, capture_output=True, text=True, check=True)
     row = next(json.loads(x[7:]) for x in cp.stdout.splitlines() if x.startswith("RESULT "))
@@ -110,17 +120,23 @@ def main(argv=None) -> int:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--threads", type=int, default=None, help="NUMBA_NUM_THREADS (default: all)")
     ap.add_argument("--child", type=Path, default=None, help=argparse.SUPPRESS)
+    ap.add_argument(
+        "--as-command",
+        action="store_true",
+        help="each side's process set up as its hsgeo command sets up its own (memory kept)",
+    )
     ap.add_argument("--out", default=str(HERE / "results" / "pushbroom_vs_main.json"))
     args = ap.parse_args(argv)
     if args.child is not None:
-        print("RESULT " + json.dumps(_child(args.child, args.scale, args.seed)), flush=True)
+        got = _child(args.child, args.scale, args.seed, args.as_command)
+        print("RESULT " + json.dumps(got), flush=True)
         return 0
     this, other = HERE.parent, Path(args.vs).resolve()
     runs: dict[str, list] = {"this": [], "previous_main": []}
     for i in range(args.pairs):
         for side, root in (("previous_main", other), ("this", this)):
             print(f"pair {i + 1}/{args.pairs}: {side} ...", file=sys.stderr, flush=True)
-            runs[side].append(_run(root, args.scale, args.seed, args.threads))
+            runs[side].append(_run(root, args.scale, args.seed, args.threads, args.as_command))
 
     def med(side, k):
         return statistics.median(r[k] for r in runs[side])
@@ -146,6 +162,7 @@ def main(argv=None) -> int:
         "glibc_tunables": os.environ.get("GLIBC_TUNABLES", ""),
         "numba_threads": args.threads or os.environ.get("NUMBA_NUM_THREADS", "default"),
         "cpu": _cpu(),
+        "as_command": args.as_command,
         "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
     }
     Path(args.out).write_text(json.dumps(out, indent=1) + "\n")

@@ -454,6 +454,7 @@ def _json_usage_errors(ap: argparse.ArgumentParser, argv) -> None:
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``hsgeo`` console script."""
     terminal.setup_streams()  # any locale: Σ, σ, … in ASCII where the terminal cannot show them
+    terminal.keep_freed_memory()  # freed arrays reused, not faulted in again (its docstring)
     args = None
     argv_list = list(sys.argv[1:] if argv is None else argv)
 
