@@ -163,7 +163,9 @@ def _remains(row: dict) -> dict | None:
         "evaluation (1 + its trial per iteration and the final residuals); error_model="
         "'numpy' or fastmath on it changed its CPU seconds by < 3 % (measured). The system "
         "time is the first touch of the ≈ 270 MB of row-compressed arrays of one "
-        "linearisation (their format is the kernels')",
+        "linearisation (their format is the kernels'); keeping freed memory (the Makefile's "
+        "GLIBC_TUNABLES, the command's keep_freed_memory) did not lower it at 1× "
+        "(pushbroom_malloc.json: these pages are the peak's, touched once), at 10× it did",
     }
 
 
