@@ -239,6 +239,18 @@ def pushbroom() -> list[dict]:
             "commit": sc["commit"],
             "paired_with_previous_main": 0,
             "paired_with_issue_commit": vs10,
+            # each side's process set up as its own hsgeo command does (this one keeps freed
+            # memory, hsgeo.terminal.keep_freed_memory; 8477cad's did not)
+            "paired_with_issue_commit_as_command": _vs_issue(
+                "pushbroom_vs_issue_10x_command.json",
+                {"wall_seconds": (30.0, ISSUE_PUSHBROOM["ten_wall_s"])},
+            ),
+            # both sides under the Makefile's GLIBC_TUNABLES, the condition of the issue's own
+            # 38.5 s (make bench, 5792f1c's pushbroom_scaling.json)
+            "paired_with_issue_commit_under_make_tunables": _vs_issue(
+                "pushbroom_vs_issue_10x_tunables.json",
+                {"wall_seconds": (30.0, ISSUE_PUSHBROOM["ten_wall_s"])},
+            ),
         },
     ]
 
