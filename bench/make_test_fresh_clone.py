@@ -116,6 +116,7 @@ def main() -> None:
         **({"role": args.role} if args.role else {}),
         **_counts(text),
         "slowest": _slowest(text),
+        "failed_tests": re.findall(r"^(?:FAILED|ERROR) (\S+)", text, re.M),
     }
     runs = json.loads(OUT.read_text(encoding="utf-8")) if OUT.is_file() else {"runs": []}
     runs["runs"].append(rec)
