@@ -194,6 +194,15 @@ def pushbroom() -> list[dict]:
             "figure_load_average_1_5_15": sc["machine"]["loadavg_at_start"],
             "paired_with_previous_main": vs.get("pairs", 0),
             "paired_with_issue_commit": vs1,
+            # both sides under the Makefile's GLIBC_TUNABLES (the condition of the issue's own
+            # figures: make bench)
+            "paired_with_issue_commit_under_make_tunables": _vs_issue(
+                "pushbroom_vs_issue_tunables.json",
+                {
+                    "wall_seconds": (2.0, ISSUE_PUSHBROOM["paper_wall_s"]),
+                    "solver_cpu_seconds": (3.0, ISSUE_PUSHBROOM["paper_cpu_s"]),
+                },
+            ),
             "issue_figures": ISSUE_PUSHBROOM,
             "paired": {
                 "file": "bench/results/pushbroom_vs_main.json (bench/pushbroom_vs_main.py)",
@@ -251,8 +260,39 @@ def pushbroom() -> list[dict]:
                 "pushbroom_vs_issue_10x_tunables.json",
                 {"wall_seconds": (30.0, ISSUE_PUSHBROOM["ten_wall_s"])},
             ),
+            "profile": _profile_10x(prof),
         },
     ]
+
+
+def _profile_10x(prof: dict) -> dict | None:
+    """The 10× row of the profile (one thread) and what remains in it, beside the same calls
+    of the issue's commit profiled on the same machine (``pushbroom_profile_8477cad.json``)."""
+    ten = next((r for r in prof["rows"] if r["scale"] == 10.0), None)
+    if ten is None:
+        return None
+    out = {
+        "file": "bench/results/pushbroom_profile.json",
+        "profile_cpu_s_one_thread": ten["user_seconds"] + ten["system_seconds"],
+        "system_s": ten["system_seconds"],
+        "what_remains_at_10x": prof.get("what_remains_at_10x"),
+        "profile_load_average_1_5_15": prof.get("loadavg"),
+    }
+    f = RESULTS / "pushbroom_profile_8477cad.json"
+    if f.exists():
+        old = next((r for r in _load(f.name)["rows"] if r["scale"] == 10.0), None)
+        if old is not None:
+            out["issue_commit"] = {
+                "file": f"bench/results/{f.name}",
+                "profile_cpu_s_one_thread": old["user_seconds"] + old["system_seconds"],
+                "system_s": old["system_seconds"],
+                "cpu_s_by_call_this_issue_commit": {
+                    k: [v["cpu_seconds"], old["calls"][k]["cpu_seconds"]]
+                    for k, v in ten["calls"].items()
+                    if k in old["calls"]
+                },
+            }
+    return out
 
 
 def bal() -> dict:
