@@ -158,27 +158,20 @@ def _local_columns(cols, fcol, fw, order, a0, a1, grow, pos, gl):  # pragma: no 
 
 
 @njit(cache=True, inline="always")
-def _upper_from(a, G, kf):  # pragma: no cover - compiled
-    """The first local column of row ``a`` that the expansion reads: the whole ``kf × kf``
-    diagonal block of a group row (``a < G = ng·kf``), else the diagonal on (one triangle).
-    """
-    return (a // kf) * kf if a < G else a
-
-
-@njit(cache=True, inline="always")
 def _point_normals_local(
     cols, vals, fcol, fd, jp, order, a0, a1, grow, ng, pos, L, C, Z, li, lv
 ):  # pragma: no cover - compiled
-    """``C = Yᵀ Y`` and ``Z = Yᵀ J_p`` of one point on its L local columns; of ``C`` only what
-    the expansion reads (:func:`_upper_from`: one triangle and the groups' diagonal blocks).
+    """``C = Yᵀ Y`` and ``Z = Yᵀ J_p`` of one point on its L local columns, the whole of ``C``
+    (its rows on loops without a branch: forming only the triangle that the expansion reads,
+    with a test per entry, took ≈ 15 % more CPU time at 10× the paper's pushbroom block;
+    bench/results/schur_kernel_vs_issue.json).
     """
     K = cols.shape[1]
     kf = fd.shape[1]
     p = jp.shape[1]
-    G = ng * kf
     for a in range(L):
         Crow = C[a]
-        for b in range(_upper_from(a, G, kf), L):
+        for b in range(L):
             Crow[b] = 0.0
         for k in range(p):
             Z[k, a] = 0.0
@@ -204,24 +197,24 @@ def _point_normals_local(
             va = lv[e]
             for k in range(p):
                 Z[k, la] += va * jp[r, k]
-            lo = _upper_from(la, G, kf)
             Crow = C[la]
             for e2 in range(n):
-                lb = li[e2]
-                if lb >= lo:
-                    Crow[lb] += va * lv[e2]
+                Crow[li[e2]] += va * lv[e2]
 
 
 @njit(cache=True, inline="always")
 def _schur_row(C, Z, T, a, b0, L):  # pragma: no cover - compiled
     """``C[a, b0:L] −= T[a] Z[:, b0:L]``: row ``a`` of ``C − Z V_i⁻¹ Zᵀ`` (``T = Zᵀ V_i⁻¹``)
-    from column ``b0`` on, in place.
+    from column ``b0`` on, in place; the loop runs on unsigned offsets (numba's negative-index
+    test on a signed start kept it scalar).
     """
     Crow = C[a]
+    ub0 = np.uint64(b0)
+    uL = np.uint64(L)
     for k in range(Z.shape[0]):
         t = T[a, k]
         Zk = Z[k]
-        for b in range(b0, L):
+        for b in range(ub0, uL):
             Crow[b] -= t * Zk[b]
 
 
@@ -525,7 +518,8 @@ def _reduced_kernel(
     (at 10× the paper's pushbroom campaign most item pairs never meet). The blocks against
     slot columns go to the first output ``(n_c, n_sc)``, column ``sc_of[c]`` for column c. Only
     one triangle of the pairs of local units is written (the diagonal units halved), hence
-    ``A + Aᵀ``; of ``C`` only that triangle (and the groups' diagonal blocks) is formed.
+    ``A + Aᵀ``; of ``C − Z V⁻¹ Zᵀ`` only that triangle (and the groups' diagonal blocks) is
+    formed (:func:`_schur_row`, on unsigned offsets, which vectorise).
 
     A point without groups (frame cameras: BAL) takes :func:`_slot_point`, which forms the
     same entries in the same order without the groups' bookkeeping, on loops that vectorise.
@@ -554,7 +548,8 @@ def _reduced_kernel(
         run_s = np.empty(capc, dtype=np.int64)  # each run's first position (unused here)
         run_n = np.empty(capc, dtype=np.int64)
         grow = np.empty(capg, dtype=np.int64)  # a row of each group (its items and weights)
-        C = np.zeros((0, 0))  # (Lmax, Lmax) from the first point with groups
+        Lc = Lmax if capg > 0 else 0
+        C = np.zeros((Lc, Lc))  # the groups' local matrix (none without groups: BAL)
         Z = np.zeros((p, Lmax))
         T = np.zeros((Lmax, p))
         # a point with slot columns only (_slot_point): V_i⁻¹ Z, its local matrix (row
@@ -590,8 +585,6 @@ def _reduced_kernel(
                 for e in range(nl):
                     pos[gl[e]] = -1
                 continue
-            if C.shape[0] == 0:
-                C = np.zeros((Lmax, Lmax))
             _point_normals_local(
                 cols, vals, fcol, fd, jp, order, a0, a1, grow, ng, pos, L, C, Z, li, lv
             )
