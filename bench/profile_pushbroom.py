@@ -205,8 +205,9 @@ def _remains_10x(row: dict, one: dict | None, touch: dict | None) -> dict | None
     parts = _remains(row)
     n = row["n_observations"] / one["n_observations"]
     growth = {}
+    base = (_remains(one) or {}).get("cpu_seconds", {})
     for k, v in parts["cpu_seconds"].items():
-        v1 = (_remains(one) or {}).get("cpu_seconds", {}).get(k)
+        v1 = base.get(k)
         if v1:
             growth[k] = v / v1 / n
     kernel = row["calls"].get("reduced_matrix_kernel", {})
@@ -233,10 +234,11 @@ def _remains_10x(row: dict, one: dict | None, touch: dict | None) -> dict | None
         "first_touch_of_peak": first,
         "why": "the parts of the 1× account at ten times the observations: the reduced "
         f"matrix, {kernel.get('calls', 0)} formations, grows "
-        f"{growth.get('reduced_matrix_kernel', float('nan')):.2f}× per observation (the "
-        "tiles of the item pairs that occur outgrow the caches, so each point's group × group "
-        "blocks are written to memory rather than cache); the model's evaluations grow "
-        "linearly, with the extra linearisation and trials of the 10× solve (a refused step "
+        f"{growth.get('reduced_matrix_kernel', float('nan')):.2f}× per observation (not "
+        "measured why; the lead: the tiles of the item pairs that occur outgrow the caches, "
+        "so each point's group × group blocks would be written to memory rather than "
+        "cache); the model's evaluations grow linearly, with the extra linearisation and "
+        "trials of the 10× solve (a refused step "
         "retried with the thrown points held); the system time is the kernel zeroing the "
         "pages of the peak memory on their first touch, at this machine's cost per GiB "
         "(first_touch_of_peak: lower only with a lower peak)",
