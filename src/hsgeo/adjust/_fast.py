@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from hsgeo.adjust.threads import chunks
+from hsgeo.adjust.threads import chunks, over_chunks
 
 __all__ = [
     "normal_cc",
@@ -472,7 +472,6 @@ def _slot_point(cols, vals, jp, order, a0, a1, scratch, Vinv, i, A):  # pragma: 
             f0 = f1
 
 
-@njit(cache=True, parallel=True, fastmath={"nnan", "ninf", "nsz", "arcp", "contract", "afn"})
 def _reduced_kernel(
     cols,
     vals,
@@ -493,7 +492,7 @@ def _reduced_kernel(
     sc_of,
     n_sc,
     n_chunks,
-):  # pragma: no cover - compiled
+):
     """A with ``A + Aᵀ = Σ_i (J_c,iᵀ J_c,i − W_i V_i⁻¹ W_iᵀ)`` over the points, in two
     compact parts (see :func:`reduced_points`), and the number of units that fell outside the
     pattern (tile or column not in ``slot_of``/``sc_of``: the pattern is stale; nothing of
@@ -530,84 +529,118 @@ def _reduced_kernel(
     with reassociation the fused updates of :func:`_slot_point` came out in another order.
     """
     n_pts = ptr.size - 1
+    kk = fd.shape[1] ** 2
+    out = np.zeros((n_chunks, n_c, n_sc))
+    out_t = np.zeros((n_chunks, n_slots * kk))
+    step = (n_pts + n_chunks - 1) // n_chunks
+    args = (cols, vals, fcol, fw, fd, jp, order, ptr, pt_order, Vinv, capg, capc, tile_of)
+    misses = over_chunks(_reduced_chunk, n_chunks, step, *args, slot_of, sc_of, out, out_t)
+    return out, out_t, int(sum(misses))
+
+
+@njit(cache=True, nogil=True, fastmath={"nnan", "ninf", "nsz", "arcp", "contract", "afn"})
+def _reduced_chunk(
+    ch,
+    step,
+    cols,
+    vals,
+    fcol,
+    fw,
+    fd,
+    jp,
+    order,
+    ptr,
+    pt_order,
+    Vinv,
+    capg,
+    capc,
+    tile_of,
+    slot_of,
+    sc_of,
+    out,
+    out_t,
+):  # pragma: no cover - compiled
+    """Chunk ``ch`` of :func:`_reduced_kernel`: the points ``pt_order[ch·step : (ch+1)·step]``
+    into ``out[ch]`` and ``out_t[ch]``; the number of units outside the pattern. Run on the
+    kernels' threads by :func:`~hsgeo.adjust.threads.over_chunks`, not as the body of a
+    ``prange`` loop: numba's parallel passes over this body took two thirds of the kernel's
+    compile time on a fresh cache (24 of 36 s; issue 41).
+    """
+    A = out[ch]
+    tiles = out_t[ch]
+    i0 = ch * step
+    i1 = min(ptr.size - 1, i0 + step)
+    n_c = A.shape[0]
     K = cols.shape[1]
     kf = fd.shape[1]
     p = jp.shape[1]
     Lmax = capg * kf + capc
     kk = kf * kf
-    out = np.zeros((n_chunks, n_c, n_sc))
-    out_t = np.zeros((n_chunks, n_slots * kk))
-    misses = np.zeros(n_chunks, dtype=np.int64)  # units outside the pattern (see below)
-    step = (n_pts + n_chunks - 1) // n_chunks
-    for ch in prange(n_chunks):
-        A = out[ch]
-        tiles = out_t[ch]
-        pos = np.full(n_c, -1, dtype=np.int64)
-        gl = np.empty(capc, dtype=np.int64)  # global column of each local slot column
-        sl = np.empty(capc, dtype=np.int64)  # its position among the slot columns (sc_of)
-        run_e = np.empty(capc, dtype=np.int64)  # runs of consecutive positions (_runs)
-        run_s = np.empty(capc, dtype=np.int64)  # each run's first position (unused here)
-        run_n = np.empty(capc, dtype=np.int64)
-        grow = np.empty(capg, dtype=np.int64)  # a row of each group (its items and weights)
-        Lc = Lmax if capg > 0 else 0
-        C = np.zeros((Lc, Lc))  # the groups' local matrix (none without groups: BAL)
-        Z = np.zeros((p, Lmax))
-        T = np.zeros((Lmax, p))
-        # a point with slot columns only (_slot_point): V_i⁻¹ Z, its local matrix (row
-        # stride nl, grown as needed), a row's slots and values
-        Tz = np.zeros((p, capc))
-        Cs = np.empty(0)
-        si = np.empty(K, dtype=np.int64)
-        yv = np.empty(K)
-        R = np.zeros(kk)
-        li = np.empty(K + kf, dtype=np.int64)
-        lv = np.empty(K + kf)
-        for ii in range(ch * step, min(n_pts, (ch + 1) * step)):
-            i = pt_order[ii]
-            a0, a1 = ptr[i], ptr[i + 1]
-            if a1 == a0:
-                continue
-            ng, nl = _local_columns(cols, fcol, fw, order, a0, a1, grow, pos, gl)
-            L = ng * kf + nl
-            G = ng * kf
-            miss = 0
-            for e in range(nl):
-                sl[e] = sc_of[gl[e]]
-                if sl[e] < 0:
-                    miss += 1
-            if ng == 0:  # slot columns only (frame cameras): straight into A
-                if miss:
-                    misses[ch] += miss
-                elif nl > 0:
-                    if nl * nl > Cs.size:
-                        Cs = np.empty(min(max(nl * nl, 2 * Cs.size), capc * capc))
-                    sp = (pos, gl, sl, run_e, li, si, yv, nl, Z, Tz, Cs)
-                    _slot_point(cols, vals, jp, order, a0, a1, sp, Vinv, i, A)
-                for e in range(nl):
-                    pos[gl[e]] = -1
-                continue
-            _point_normals_local(
-                cols, vals, fcol, fd, jp, order, a0, a1, grow, ng, pos, L, C, Z, li, lv
-            )
-            _schur_rows(Z, T, Vinv, i, L)
-            for a in range(G):  # the groups' rows of C − Z V⁻¹ Zᵀ, as the expansion reads them
-                _schur_row(C, Z, T, a, (a // kf) * kf, L)
+    n_miss = 0
+    pos = np.full(n_c, -1, dtype=np.int64)
+    gl = np.empty(capc, dtype=np.int64)  # global column of each local slot column
+    sl = np.empty(capc, dtype=np.int64)  # its position among the slot columns (sc_of)
+    run_e = np.empty(capc, dtype=np.int64)  # runs of consecutive positions (_runs)
+    run_s = np.empty(capc, dtype=np.int64)  # each run's first position (unused here)
+    run_n = np.empty(capc, dtype=np.int64)
+    grow = np.empty(capg, dtype=np.int64)  # a row of each group (its items and weights)
+    Lc = Lmax if capg > 0 else 0
+    C = np.zeros((Lc, Lc))  # the groups' local matrix (none without groups: BAL)
+    Z = np.zeros((p, Lmax))
+    T = np.zeros((Lmax, p))
+    # a point with slot columns only (_slot_point): V_i⁻¹ Z, its local matrix (row
+    # stride nl, grown as needed), a row's slots and values
+    Tz = np.zeros((p, capc))
+    Cs = np.empty(0)
+    si = np.empty(K, dtype=np.int64)
+    yv = np.empty(K)
+    R = np.zeros(kk)
+    li = np.empty(K + kf, dtype=np.int64)
+    lv = np.empty(K + kf)
+    for ii in range(i0, i1):
+        i = pt_order[ii]
+        a0, a1 = ptr[i], ptr[i + 1]
+        if a1 == a0:
+            continue
+        ng, nl = _local_columns(cols, fcol, fw, order, a0, a1, grow, pos, gl)
+        L = ng * kf + nl
+        G = ng * kf
+        miss = 0
+        for e in range(nl):
+            sl[e] = sc_of[gl[e]]
+            if sl[e] < 0:
+                miss += 1
+        if ng == 0:  # slot columns only (frame cameras): straight into A
+            if miss:
+                n_miss += miss
+            elif nl > 0:
+                if nl * nl > Cs.size:
+                    Cs = np.empty(min(max(nl * nl, 2 * Cs.size), capc * capc))
+                sp = (pos, gl, sl, run_e, li, si, yv, nl, Z, Tz, Cs)
+                _slot_point(cols, vals, jp, order, a0, a1, sp, Vinv, i, A)
             for e in range(nl):
                 pos[gl[e]] = -1
-            if miss:  # the pattern is stale: the caller computes it again
-                misses[ch] += miss
-                continue
-            # expand into the global columns: group × group into the tiles, group × slot
-            # columns and slot × slot columns into A
-            for g in range(ng):
-                for h in range(g, ng):
-                    misses[ch] += _group_tiles(
-                        C, fcol, fw, grow, g, h, kf, tile_of, slot_of, tiles, R
-                    )
-                _slot_blocks(C, fcol, fw, grow, g, ng, kf, nl, sl, A)
-            nr = _runs(sl, nl, run_e, run_s, run_n)
-            _slot_slot(C, Z, T, ng, kf, gl, nl, sl, run_e, run_n, nr, A)
-    return out, out_t, misses.sum()
+            continue
+        _point_normals_local(
+            cols, vals, fcol, fd, jp, order, a0, a1, grow, ng, pos, L, C, Z, li, lv
+        )
+        _schur_rows(Z, T, Vinv, i, L)
+        for a in range(G):  # the groups' rows of C − Z V⁻¹ Zᵀ, as the expansion reads them
+            _schur_row(C, Z, T, a, (a // kf) * kf, L)
+        for e in range(nl):
+            pos[gl[e]] = -1
+        if miss:  # the pattern is stale: the caller computes it again
+            n_miss += miss
+            continue
+        # expand into the global columns: group × group into the tiles, group × slot
+        # columns and slot × slot columns into A
+        for g in range(ng):
+            for h in range(g, ng):
+                n_miss += _group_tiles(C, fcol, fw, grow, g, h, kf, tile_of, slot_of, tiles, R)
+            _slot_blocks(C, fcol, fw, grow, g, ng, kf, nl, sl, A)
+        nr = _runs(sl, nl, run_e, run_s, run_n)
+        _slot_slot(C, Z, T, ng, kf, gl, nl, sl, run_e, run_n, nr, A)
+    return n_miss
 
 
 def _symmetrise_upper(U: np.ndarray) -> np.ndarray:

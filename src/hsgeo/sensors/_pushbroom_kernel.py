@@ -16,7 +16,7 @@ module's docstring for the model and the time residual.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from hsgeo._kernels import (
     bspline_weights,
@@ -25,6 +25,7 @@ from hsgeo._kernels import (
     pushbroom_line_distortion_dcoeff,
     rpy_rotation,
 )
+from hsgeo.adjust.threads import over_chunks
 
 __all__ = ["T_MAX", "NEWTON_TOL_S"]
 
@@ -218,7 +219,6 @@ def _accumulate(
                 dg[base + a] += v * v
 
 
-@njit(cache=True, parallel=True)
 def _lines_kernel(
     P,
     pidx,
@@ -260,7 +260,7 @@ def _lines_kernel(
     cam_cols,
     c_cols,
     node_c0,
-):  # pragma: no cover
+):
     """002 eq. (2)–(4) and their derivatives, one observation per iteration (rows 2j, 2j+1).
 
     ``timed``: the observation is evaluated at the model's crossing time ``t*`` of the line
@@ -279,96 +279,192 @@ def _lines_kernel(
     accumulates the gradient (``gd[0]``) and the diagonal (``gd[1]``) of the non-point unknowns
     in its row (see ``_accumulate``; the caller sums the chunks in order).
     """
+    m = pidx.size
+    n_chunks = 64 if m > 6400 else 1
+    if dst.size == m and gd.shape[1] > 0:  # fused, with the gradient: its chunks
+        n_chunks = gd.shape[1]
+    step = (m + n_chunks - 1) // n_chunks
+    over_chunks(
+        _lines_chunk,
+        n_chunks,
+        step,
+        P,
+        pidx,
+        idx,
+        u0,
+        inv_dt,
+        nodes,
+        xyz_nav,
+        rpy_nav,
+        xyz_rate,
+        rpy_rate,
+        band,
+        c_b,
+        dist,
+        beta,
+        dbeta,
+        lever,
+        x0,
+        y0,
+        k_px,
+        xy_obs,
+        timed,
+        n_newton,
+        y_rate_ref,
+        jac,
+        dt_start,
+        r,
+        w_out,
+        dP,
+        dN,
+        dB,
+        dL,
+        dD,
+        dC,
+        dst,
+        w_row,
+        fw,
+        gd,
+        cam_cols,
+        c_cols,
+        node_c0,
+    )
+
+
+@njit(cache=True, nogil=True)
+def _lines_chunk(
+    ch,
+    step,
+    P,
+    pidx,
+    idx,
+    u0,
+    inv_dt,
+    nodes,
+    xyz_nav,
+    rpy_nav,
+    xyz_rate,
+    rpy_rate,
+    band,
+    c_b,
+    dist,
+    beta,
+    dbeta,
+    lever,
+    x0,
+    y0,
+    k_px,
+    xy_obs,
+    timed,
+    n_newton,
+    y_rate_ref,
+    jac,
+    dt_start,
+    r,
+    w_out,
+    dP,
+    dN,
+    dB,
+    dL,
+    dD,
+    dC,
+    dst,
+    w_row,
+    fw,
+    gd,
+    cam_cols,
+    c_cols,
+    node_c0,
+):  # pragma: no cover
+    """Chunk ``ch`` of :func:`_lines_kernel`: the observations ``ch·step … (ch+1)·step − 1``
+    (run on the kernels' threads by :func:`~hsgeo.adjust.threads.over_chunks`, not as the
+    body of a ``prange`` loop, whose parallel passes cost compile time; issue 41).
+    """
     fused = dst.size == pidx.size
     m = pidx.size
     keep_w = w_out.shape[0] == m  # the spline weights are wanted (an empty w_out: not)
-    n_chunks = 64 if m > 6400 else 1
     gradient = fused and gd.shape[1] > 0
-    if gradient:
-        n_chunks = gd.shape[1]
-    step = (m + n_chunks - 1) // n_chunks
-    for ch in prange(n_chunks):
-        R = np.empty((3, 3))
-        dR = np.empty((3, 3, 3))
-        d = np.empty(3)
-        q = np.empty(3)
-        p = np.empty(3)
-        dl = np.empty(6)
-        rate = np.empty(6)
-        Jp = np.empty((2, 3))
-        JpB = np.empty((2, 3))
-        d6 = np.empty((2, 6))
-        w = np.empty(4)
-        dw = np.empty(4)
-        for j in range(ch * step, min(m, (ch + 1) * step)):
-            dt = dt_start[j] if timed else 0.0  # t − t_e, from the last evaluation's t*
+    R = np.empty((3, 3))
+    dR = np.empty((3, 3, 3))
+    d = np.empty(3)
+    q = np.empty(3)
+    p = np.empty(3)
+    dl = np.empty(6)
+    rate = np.empty(6)
+    Jp = np.empty((2, 3))
+    JpB = np.empty((2, 3))
+    d6 = np.empty((2, 6))
+    w = np.empty(4)
+    dw = np.empty(4)
+    for j in range(ch * step, min(m, (ch + 1) * step)):
+        dt = dt_start[j] if timed else 0.0  # t − t_e, from the last evaluation's t*
+        xdot = 0.0
+        ydot = 1.0
+        ey = 0.0
+        n_it = n_newton if timed else 0
+        c = c_b[band[j]]
+        # defined before the Newton loop: set only inside it and read only after it, they
+        # would not survive the loop under prange
+        x = y = xb = yb = gx = gy = 0.0
+        for it in range(n_it + 1):
+            _spline(j, dt, u0, inv_dt, nodes, idx, xyz_rate, rpy_rate, w, dw, dl, rate)
+            _pose(j, dt, P, pidx, xyz_nav, rpy_nav, xyz_rate, rpy_rate, dl, R, dR, d)
+            x, y, xb, yb, gx, gy = _image(
+                R, dR, d, lever, beta, c, dist, x0, y0, k_px, q, p, Jp, JpB, d6
+            )
+            if not timed:
+                break
+            # image rates (px/s) along the trajectory: ∂(x, y)/∂pose · pose rate
             xdot = 0.0
-            ydot = 1.0
-            ey = 0.0
-            n_it = n_newton if timed else 0
-            c = c_b[band[j]]
-            # defined before the Newton loop: set only inside it and read only after it, they
-            # would not survive the loop under prange
-            x = y = xb = yb = gx = gy = 0.0
-            for it in range(n_it + 1):
-                _spline(j, dt, u0, inv_dt, nodes, idx, xyz_rate, rpy_rate, w, dw, dl, rate)
-                _pose(j, dt, P, pidx, xyz_nav, rpy_nav, xyz_rate, rpy_rate, dl, R, dR, d)
-                x, y, xb, yb, gx, gy = _image(
-                    R, dR, d, lever, beta, c, dist, x0, y0, k_px, q, p, Jp, JpB, d6
-                )
-                if not timed:
-                    break
-                # image rates (px/s) along the trajectory: ∂(x, y)/∂pose · pose rate
-                xdot = 0.0
-                ydot = 0.0
-                for a in range(6):
-                    xdot += d6[0, a] * rate[a]
-                    ydot += d6[1, a] * rate[a]
-                # every real geometry has ẏ near ẏ_ref; a far-off trial point may not
-                ydot = max(ydot, 0.25 * y_rate_ref)
-                ey = (y * k_px - xy_obs[j, 1]) / ydot
-                if abs(ey) < NEWTON_TOL_S:
-                    # converged: the last correction is kept in the residual, which is then
-                    # exact to O(ey²)
-                    break
-                if it < n_it:
-                    dt = min(max(dt - ey, -T_MAX), T_MAX)
-            if keep_w:
-                for b in range(4):
-                    w_out[j, b] = w[b]
-            if timed:
-                dt_start[j] = min(max(dt - ey, -T_MAX), T_MAX)
-            r[2 * j] = x * k_px - xy_obs[j, 0] - xdot * ey  # x at t* (0 if not timed)
-            if timed:
-                # ẏ_ref (t_e − t*), t* = t_e + dt − ey (the last Newton correction included)
-                r[2 * j + 1] = y_rate_ref * (ey - dt)
-            else:
-                r[2 * j + 1] = y * k_px - xy_obs[j, 1]
-            if not jac:
-                continue
-            t = dst[j] if fused else j
-            if t < 0:
-                continue
-            _derivatives(t, d6, Jp, JpB, dbeta, q, c, xb, yb, gx, gy, k_px, dP, dN, dB, dL, dD, dC)
-            if timed:
-                _through_time(t, xdot / ydot, y_rate_ref / ydot, dP, dN, dB, dL, dD, dC)
-            if fused:
-                _whiten(t, w_row[2 * j], w_row[2 * j + 1], w, fw, dP, dN, dB, dL, dD, dC)
-            if gradient:
-                _accumulate(
-                    t,
-                    r[2 * j] * w_row[2 * j],
-                    r[2 * j + 1] * w_row[2 * j + 1],
-                    idx[j],
-                    w,
-                    cam_cols,
-                    c_cols[band[j]],
-                    node_c0,
-                    gd[0, ch],
-                    gd[1, ch],
-                    dN,
-                    dB,
-                    dL,
-                    dD,
-                    dC,
-                )
+            ydot = 0.0
+            for a in range(6):
+                xdot += d6[0, a] * rate[a]
+                ydot += d6[1, a] * rate[a]
+            # every real geometry has ẏ near ẏ_ref; a far-off trial point may not
+            ydot = max(ydot, 0.25 * y_rate_ref)
+            ey = (y * k_px - xy_obs[j, 1]) / ydot
+            if abs(ey) < NEWTON_TOL_S:
+                # converged: the last correction is kept in the residual, which is then
+                # exact to O(ey²)
+                break
+            if it < n_it:
+                dt = min(max(dt - ey, -T_MAX), T_MAX)
+        if keep_w:
+            for b in range(4):
+                w_out[j, b] = w[b]
+        if timed:
+            dt_start[j] = min(max(dt - ey, -T_MAX), T_MAX)
+        r[2 * j] = x * k_px - xy_obs[j, 0] - xdot * ey  # x at t* (0 if not timed)
+        if timed:
+            # ẏ_ref (t_e − t*), t* = t_e + dt − ey (the last Newton correction included)
+            r[2 * j + 1] = y_rate_ref * (ey - dt)
+        else:
+            r[2 * j + 1] = y * k_px - xy_obs[j, 1]
+        if not jac:
+            continue
+        t = dst[j] if fused else j
+        if t < 0:
+            continue
+        _derivatives(t, d6, Jp, JpB, dbeta, q, c, xb, yb, gx, gy, k_px, dP, dN, dB, dL, dD, dC)
+        if timed:
+            _through_time(t, xdot / ydot, y_rate_ref / ydot, dP, dN, dB, dL, dD, dC)
+        if fused:
+            _whiten(t, w_row[2 * j], w_row[2 * j + 1], w, fw, dP, dN, dB, dL, dD, dC)
+        if gradient:
+            _accumulate(
+                t,
+                r[2 * j] * w_row[2 * j],
+                r[2 * j + 1] * w_row[2 * j + 1],
+                idx[j],
+                w,
+                cam_cols,
+                c_cols[band[j]],
+                node_c0,
+                gd[0, ch],
+                gd[1, ch],
+                dN,
+                dB,
+                dL,
+                dD,
+                dC,
+            )
