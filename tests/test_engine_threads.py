@@ -15,6 +15,7 @@ from hsgeo.adjust.threads import (
     PARALLEL_MIN_ROWS,
     chunks,
     engine_threads,
+    over_chunks,
     pool_size,
     resolve,
 )
@@ -122,3 +123,35 @@ def test_bal_example_same_minimum_on_one_and_two_blas_threads():
         assert fit.result.converged
         assert np.all(np.isfinite(np.diag(fit.result.covariance)))
     assert fits[1].final_cost == pytest.approx(fits[0].final_cost, rel=1e-9)
+
+
+@numba.njit(nogil=True)
+def _chunk_sum(ch, step, x, out):  # pragma: no cover - compiled
+    s = 0.0
+    for i in range(ch * step, min(x.size, (ch + 1) * step)):
+        s += x[i] * x[i]
+    out[ch] = s
+    return ch * 10
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+def test_over_chunks_runs_every_chunk_once_in_order(threads):
+    """over_chunks (the reduced-matrix and pushbroom-lines kernels' chunks, issue 41): every
+    chunk once, its return values in chunk order, the same outputs on one thread or two."""
+    x = np.random.default_rng(0).normal(size=1001)
+    out = np.full(7, np.nan)
+    with engine_threads(threads, 10**9):
+        got = over_chunks(_chunk_sum, 7, 143, x, out)
+    assert got == [0, 10, 20, 30, 40, 50, 60]
+    want = [float(np.sum(x[c * 143 : (c + 1) * 143] ** 2)) for c in range(7)]
+    np.testing.assert_allclose(out, want, rtol=1e-12)
+
+
+def test_over_chunks_raises_what_a_chunk_raises():
+    def chunk(ch):
+        if ch == 2:
+            raise ValueError("chunk 2")
+        return ch
+
+    with engine_threads(2, 10**9), pytest.raises(ValueError, match="chunk 2"):
+        over_chunks(chunk, 4)

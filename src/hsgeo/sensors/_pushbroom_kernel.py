@@ -3,10 +3,13 @@
 ``_lines_kernel`` makes one pass per observation: the spline correction and the pose at the
 trial time (``_spline``, ``_pose``), the projection and its partials (``_image``), the Newton on
 the crossing time, the derivatives (``_derivatives``) and their chain through the crossing time
-(``_through_time``); the helpers are inlined into the kernel (``inline="always"``), so the
-compiled loop is that of one function. The values the Newton loop sets and only later lines
-read (x, y, xb, yb, gx, gy) are defined before it: left undefined there, numba lost them under
-``prange`` once the loop moved into helpers (every x residual wrong at 64 chunks).
+(``_through_time``); the helpers are inlined into the chunk function ``_lines_chunk``
+(``inline="always"``), so the compiled loop is that of one function, and the chunks run on the
+kernels' threads (:func:`hsgeo.adjust.threads.over_chunks`: with numba's ``prange`` over them
+the kernel's two compilations on a fresh cache took 28 s, without it 17 s; issue 41). The
+values the Newton loop sets and only later lines read (x, y, xb, yb, gx, gy) are defined
+before it: left undefined there, numba lost them under ``prange`` once the loop moved into
+helpers (every x residual wrong at 64 chunks).
 
 Moved out of :mod:`hsgeo.sensors.pushbroom` unchanged: one observation per iteration, the
 crossing time by Newton (the residual across the line as a time) and the derivatives; see that
