@@ -2,11 +2,17 @@
 one thread below PARALLEL_MIN_RAYS rays)."""
 
 import numpy as np
+import pytest
 
 from hsgeo import _raycast as rc
+from hsgeo._chunks import over_chunks
+from hsgeo.adjust.threads import engine_threads
 
 
-def test_serial_and_parallel_rows_agree_bit_for_bit():
+@pytest.mark.parametrize("threads", [1, 2])
+def test_serial_and_parallel_rows_agree_bit_for_bit(threads):
+    """One chunk on one thread (first_crossing_rows below PARALLEL_MIN_RAYS) and 7 or 64
+    chunks on one or two threads: the same values, bit for bit."""
     rng = np.random.default_rng(4)
     y, x = np.mgrid[0:60, 0:80]
     z = 100.0 + 3.0 * np.sin(x / 7.0) * np.cos(y / 5.0) + rng.normal(0, 0.2, x.shape)
@@ -15,10 +21,15 @@ def test_serial_and_parallel_rows_agree_bit_for_bit():
     O = np.column_stack([rng.uniform(10, 150, n), rng.uniform(10, 110, n), np.full(n, 400.0)])
     D = np.column_stack([rng.normal(0, 0.1, n), rng.normal(0, 0.1, n), -np.ones(n)])
     out = []
-    for rows in (rc._rows_serial, rc._rows_parallel, rc.first_crossing_rows):
+    with engine_threads(threads, 10**9):
         s, st = np.empty(n), np.empty(n, np.int8)
-        rows(O, D, *surf.args(), s, st)
+        rc.first_crossing_rows(O, D, *surf.args(), s, st)
         out.append((s, st))
+        for n_chunks in (7, 64):
+            s, st = np.full(n, np.nan), np.full(n, -99, np.int8)
+            step = (n + n_chunks - 1) // n_chunks
+            over_chunks(rc._rows_chunk, n_chunks, step, O, D, *surf.args(), s, st)
+            out.append((s, st))
     assert (out[0][1] == rc.HIT).mean() > 0.5  # most rays meet the surface
     for s, st in out[1:]:
         np.testing.assert_array_equal(s, out[0][0])

@@ -562,7 +562,7 @@ def _reduced_chunk(
 ):  # pragma: no cover - compiled
     """Chunk ``ch`` of :func:`_reduced_kernel`: the points ``pt_order[ch·step : (ch+1)·step]``
     into ``out[ch]`` and ``out_t[ch]``; the number of units outside the pattern. Run on the
-    kernels' threads by :func:`~hsgeo.adjust.threads.over_chunks`, not as the body of a
+    kernels' threads by :func:`~hsgeo._chunks.over_chunks`, not as the body of a
     ``prange`` loop: numba's parallel passes over this body took two thirds of the kernel's
     compile time on a fresh cache (24 of 36 s; issue 41).
     """

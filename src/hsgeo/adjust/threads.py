@@ -34,10 +34,11 @@ from __future__ import annotations
 
 import contextlib
 import functools
-from collections.abc import Callable, Iterator
-from concurrent.futures import ThreadPoolExecutor
+from collections.abc import Iterator
 
 import numba
+
+from hsgeo._chunks import over_chunks
 
 __all__ = [
     "PARALLEL_MIN_ROWS",
@@ -82,24 +83,6 @@ def resolve(threads: int | str, rows: int) -> int:
 def chunks(n: int, per_chunk: int) -> int:
     """Chunks for ``n`` items, at least ``per_chunk`` each, at most :data:`MAX_CHUNKS`."""
     return max(1, min(MAX_CHUNKS, n // per_chunk + 1))
-
-
-def over_chunks(chunk: Callable, n_chunks: int, *args) -> list:
-    """``[chunk(ch, *args) for ch in range(n_chunks)]``, on the kernels' threads.
-
-    ``chunk`` is a compiled function of one chunk (``nogil=True``), run on
-    ``numba.get_num_threads()`` Python threads (the number :func:`engine_threads` sets).
-    Why not numba's ``prange`` over the chunks: its parallel passes optimise the chunk's body
-    once more inside the parallel region, which took 12 of the 21 s that the reduced-matrix
-    kernel took to compile on a fresh cache (issue 41; a first run of ``hsgeo adjust-pushbroom``
-    compiles it). The chunks write disjoint outputs, so the order they run in changes nothing;
-    threads that wait do not spin (GNU OpenMP's do, see above).
-    """
-    n = min(numba.get_num_threads(), n_chunks)
-    if n <= 1:
-        return [chunk(ch, *args) for ch in range(n_chunks)]
-    with ThreadPoolExecutor(max_workers=n, thread_name_prefix="hsgeo-chunk") as pool:
-        return list(pool.map(lambda ch: chunk(ch, *args), range(n_chunks)))
 
 
 @functools.cache

@@ -5,7 +5,7 @@ trial time (``_spline``, ``_pose``), the projection and its partials (``_image``
 the crossing time, the derivatives (``_derivatives``) and their chain through the crossing time
 (``_through_time``); the helpers are inlined into the chunk function ``_lines_chunk``
 (``inline="always"``), so the compiled loop is that of one function, and the chunks run on the
-kernels' threads (:func:`hsgeo.adjust.threads.over_chunks`: with numba's ``prange`` over them
+kernels' threads (:func:`hsgeo._chunks.over_chunks`: with numba's ``prange`` over them
 the kernel's two compilations on a fresh cache took 28 s, without it 17 s; issue 41). The
 values the Newton loop sets and only later lines read (x, y, xb, yb, gx, gy) are defined
 before it: left undefined there, numba lost them under ``prange`` once the loop moved into
@@ -21,6 +21,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from hsgeo._chunks import over_chunks
 from hsgeo._kernels import (
     bspline_weights,
     pushbroom_camera_point,
@@ -28,7 +29,6 @@ from hsgeo._kernels import (
     pushbroom_line_distortion_dcoeff,
     rpy_rotation,
 )
-from hsgeo.adjust.threads import over_chunks
 
 __all__ = ["T_MAX", "NEWTON_TOL_S"]
 
@@ -380,7 +380,7 @@ def _lines_chunk(
     node_c0,
 ):  # pragma: no cover
     """Chunk ``ch`` of :func:`_lines_kernel`: the observations ``ch·step … (ch+1)·step − 1``
-    (run on the kernels' threads by :func:`~hsgeo.adjust.threads.over_chunks`, not as the
+    (run on the kernels' threads by :func:`~hsgeo._chunks.over_chunks`, not as the
     body of a ``prange`` loop, whose parallel passes cost compile time; issue 41).
     """
     fused = dst.size == pidx.size
