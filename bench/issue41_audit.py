@@ -402,7 +402,19 @@ def make_test() -> dict:
         "goal_pytest_seconds": goal,
         "file": "bench/results/make_test_runs.json (bench/make_test_fresh_clone.py)",
         "profile": _suite_profile(),
+        "first_run": _first_run(),
     }
+
+
+def _first_run() -> dict | None:
+    """A user's first run of a command on an empty kernel cache (bench_first_run.py): the
+    compile wait that every fresh clone's test processes and every new installation meet."""
+    try:
+        d = _load("first_run.json")
+    except FileNotFoundError:
+        return None
+    return {"file": "bench/results/first_run.json", "commands": d.get("commands"),
+            "summary": d.get("summary"), "note": d.get("note")}  # fmt: skip
 
 
 def main() -> None:
