@@ -261,8 +261,33 @@ def pushbroom() -> list[dict]:
                 {"wall_seconds": (30.0, ISSUE_PUSHBROOM["ten_wall_s"])},
             ),
             "profile": _profile_10x(prof),
+            "kernel_tiles_probe": _tiles_probe(),
         },
     ]
+
+
+def _tiles_probe() -> dict | None:
+    """What the reduced-matrix kernel's tiles cost (schur_tiles_probe.py): the kernel as is
+    against its tiles folded into L1, per row at each scale, and the share of distinct group
+    pairs (whether blocks could be summed before their expansion)."""
+    try:
+        d = _load("schur_tiles_probe.json")
+    except FileNotFoundError:
+        return None
+    v = d["variants"]
+    per_row = {sc: {k: round(x["cpu_ns_per_row"]) for k, x in row.items()} for sc, row in v.items()}
+    out = {"file": "bench/results/schur_tiles_probe.json", "cpu_ns_per_row": per_row}
+    if "1x" in v and "10x" in v:
+        out["tiles_share_of_kernel"] = {
+            sc: 1
+            - v[sc]["tiles_in_l1"]["median_cpu_seconds"] / v[sc]["as_is"]["median_cpu_seconds"]
+            for sc in ("1x", "10x")
+        }
+        out["growth_per_row_1x_to_10x"] = {
+            k: v["10x"][k]["cpu_ns_per_row"] / v["1x"][k]["cpu_ns_per_row"] for k in v["1x"]
+        }
+    out["group_pairs"] = d.get("group_pairs_at_smallest_scale")
+    return out
 
 
 def _profile_10x(prof: dict) -> dict | None:
