@@ -472,27 +472,7 @@ def _slot_point(cols, vals, jp, order, a0, a1, scratch, Vinv, i, A):  # pragma: 
             f0 = f1
 
 
-def _reduced_kernel(
-    cols,
-    vals,
-    fcol,
-    fw,
-    fd,
-    jp,
-    order,
-    ptr,
-    pt_order,
-    Vinv,
-    n_c,
-    capg,
-    capc,
-    tile_of,
-    slot_of,
-    n_slots,
-    sc_of,
-    n_sc,
-    n_chunks,
-):
+def _reduced_kernel(*args):
     """A with ``A + Aᵀ = Σ_i (J_c,iᵀ J_c,i − W_i V_i⁻¹ W_iᵀ)`` over the points, in two
     compact parts (see :func:`reduced_points`), and the number of units that fell outside the
     pattern (tile or column not in ``slot_of``/``sc_of``: the pattern is stale; nothing of
@@ -527,14 +507,21 @@ def _reduced_kernel(
     ``fastmath`` without ``reassoc``: every entry is computed in the order written (contracted
     multiply-adds allowed), so the bits do not depend on how the compiler vectorised a loop;
     with reassociation the fused updates of :func:`_slot_point` came out in another order.
+
+    ``args``: the point rows ``cols, vals, fcol, fw, fd, jp, order, ptr, pt_order, Vinv``
+    (:func:`_reduced_chunk`'s arguments of those names), then ``n_c, capg, capc, tile_of,
+    slot_of, n_slots, sc_of, n_sc, n_chunks``.
     """
-    n_pts = ptr.size - 1
-    kk = fd.shape[1] ** 2
+    rows = args[:10]
+    n_c, capg, capc, tile_of, slot_of, n_slots, sc_of, n_sc, n_chunks = args[10:]
+    n_pts = rows[7].size - 1  # ptr
+    kk = rows[4].shape[1] ** 2  # fd
     out = np.zeros((n_chunks, n_c, n_sc))
     out_t = np.zeros((n_chunks, n_slots * kk))
     step = (n_pts + n_chunks - 1) // n_chunks
-    args = (cols, vals, fcol, fw, fd, jp, order, ptr, pt_order, Vinv, capg, capc, tile_of)
-    misses = over_chunks(_reduced_chunk, n_chunks, step, *args, slot_of, sc_of, out, out_t)
+    misses = over_chunks(
+        _reduced_chunk, n_chunks, step, *rows, capg, capc, tile_of, slot_of, sc_of, out, out_t
+    )
     return out, out_t, int(sum(misses))
 
 

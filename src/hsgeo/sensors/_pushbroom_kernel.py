@@ -18,6 +18,8 @@ module's docstring for the model and the time residual.
 
 from __future__ import annotations
 
+import inspect
+
 import numpy as np
 from numba import njit
 
@@ -222,48 +224,7 @@ def _accumulate(
                 dg[base + a] += v * v
 
 
-def _lines_kernel(
-    P,
-    pidx,
-    idx,
-    u0,
-    inv_dt,
-    nodes,
-    xyz_nav,
-    rpy_nav,
-    xyz_rate,
-    rpy_rate,
-    band,
-    c_b,
-    dist,
-    beta,
-    dbeta,
-    lever,
-    x0,
-    y0,
-    k_px,
-    xy_obs,
-    timed,
-    n_newton,
-    y_rate_ref,
-    jac,
-    dt_start,
-    r,
-    w_out,
-    dP,
-    dN,
-    dB,
-    dL,
-    dD,
-    dC,
-    dst,
-    w_row,
-    fw,
-    gd,
-    cam_cols,
-    c_cols,
-    node_c0,
-):
+def _lines_kernel(*args):
     """002 eq. (2)–(4) and their derivatives, one observation per iteration (rows 2j, 2j+1).
 
     ``timed``: the observation is evaluated at the model's crossing time ``t*`` of the line
@@ -281,57 +242,18 @@ def _lines_kernel(
     ``gd`` of shape ``(2, n_chunks, n_c)`` (fused path) each chunk of observations also
     accumulates the gradient (``gd[0]``) and the diagonal (``gd[1]``) of the non-point unknowns
     in its row (see ``_accumulate``; the caller sums the chunks in order).
+
+    ``args`` are :func:`_lines_chunk`'s after ``ch`` and ``step`` (``P, pidx, idx, …, node_c0``).
     """
+    if len(args) != len(_ARGS):
+        raise TypeError(f"_lines_kernel takes {len(_ARGS)} arguments ({len(args)} given)")
+    pidx, dst, gd = args[_ARGS.index("pidx")], args[_ARGS.index("dst")], args[_ARGS.index("gd")]
     m = pidx.size
     n_chunks = 64 if m > 6400 else 1
     if dst.size == m and gd.shape[1] > 0:  # fused, with the gradient: its chunks
         n_chunks = gd.shape[1]
     step = (m + n_chunks - 1) // n_chunks
-    over_chunks(
-        _lines_chunk,
-        n_chunks,
-        step,
-        P,
-        pidx,
-        idx,
-        u0,
-        inv_dt,
-        nodes,
-        xyz_nav,
-        rpy_nav,
-        xyz_rate,
-        rpy_rate,
-        band,
-        c_b,
-        dist,
-        beta,
-        dbeta,
-        lever,
-        x0,
-        y0,
-        k_px,
-        xy_obs,
-        timed,
-        n_newton,
-        y_rate_ref,
-        jac,
-        dt_start,
-        r,
-        w_out,
-        dP,
-        dN,
-        dB,
-        dL,
-        dD,
-        dC,
-        dst,
-        w_row,
-        fw,
-        gd,
-        cam_cols,
-        c_cols,
-        node_c0,
-    )
+    over_chunks(_lines_chunk, n_chunks, step, *args)
 
 
 @njit(cache=True, nogil=True)
@@ -471,3 +393,7 @@ def _lines_chunk(
                 dD,
                 dC,
             )
+
+
+#: :func:`_lines_kernel`'s arguments: :func:`_lines_chunk`'s after ``ch`` and ``step``
+_ARGS = tuple(inspect.signature(_lines_chunk.py_func).parameters)[2:]
