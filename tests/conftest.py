@@ -12,6 +12,18 @@ import pytest
 # session loads libgomp (it reads the variable once); the workers, the chapters' kernels and the
 # CLI's subprocesses inherit it.
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+# BLAS on one thread in every process of the session, as `make test` sets it (Makefile) and as
+# the command line runs: BLAS threads change a result's last digits (README, "threads"), so a
+# plain `pytest` in a shell without these variables compared a chapter's kernel (one thread,
+# tests/test_chapters.py) with a worker (all cores) and found σ̂ of lp-observations 4e-13
+# apart (test_same_seed_same_rows, session 22). The variables reach the workers, the chapters'
+# kernels and the CLI's subprocesses; threadpoolctl limits a BLAS this process already loaded.
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+if os.environ["OPENBLAS_NUM_THREADS"] == "1":
+    from threadpoolctl import threadpool_limits
+
+    threadpool_limits(limits=1, user_api="blas")
 
 sys.path.insert(0, str(Path(__file__).parent))
 

@@ -835,61 +835,60 @@ def _assemble(parts, tparts, sc_cols, starts, slot_t, slot_u, n_c, kf):  # pragm
     return S
 
 
-@njit(cache=True, parallel=True)
-def _point_cov_kernel(
-    cols, vals, fcol, fw, fd, jp, order, ptr, points, Vinv, S_inv, cap
+@njit(cache=True, nogil=True)
+def _point_cov_chunk(
+    ch, step, cols, vals, fcol, fw, fd, jp, order, ptr, points, Vinv, S_inv, cap, out
 ):  # pragma: no cover
-    """V_i⁻¹ + V_i⁻¹ W_iᵀ S⁻¹ W_i V_i⁻¹ for the listed points, on each point's local columns."""
+    """V_i⁻¹ + V_i⁻¹ W_iᵀ S⁻¹ W_i V_i⁻¹ for the points ``points[ch·step : (ch+1)·step]``, on
+    each point's local columns, into ``out`` (chunks on the kernels' threads,
+    :func:`~hsgeo._chunks.over_chunks`: numba's parallel passes over a ``prange`` loop cost
+    8 s of compile time on a fresh cache, issue 41).
+    """
     K = cols.shape[1] + fcol.shape[1] * fd.shape[1]
     p = jp.shape[1]
     n_c = S_inv.shape[0]
     n = points.size
-    out = np.zeros((n, p, p))
-    n_chunks = min(n, 64)
-    step = (n + n_chunks - 1) // n_chunks
-    for ch in prange(n_chunks):
-        pos = np.full(n_c, -1, dtype=np.int64)
-        cl = np.empty(cap, dtype=np.int64)
-        Z = np.zeros((p, cap))
-        A = np.zeros((p, cap))
-        rc = np.empty(K, dtype=np.int64)
-        rv = np.empty(K)
-        for q in range(ch * step, min(n, (ch + 1) * step)):
-            i = points[q]
-            nl = 0
-            for rr in range(ptr[i], ptr[i + 1]):
-                r = order[rr]
-                ne = _expand_row(r, cols, vals, fcol, fw, fd, rc, rv)
-                for s in range(ne):
-                    c = rc[s]
-                    if pos[c] < 0:
-                        pos[c] = nl
-                        cl[nl] = c
-                        for k in range(p):
-                            Z[k, nl] = 0.0
-                        nl += 1
-                    la = pos[c]
+    pos = np.full(n_c, -1, dtype=np.int64)
+    cl = np.empty(cap, dtype=np.int64)
+    Z = np.zeros((p, cap))
+    A = np.zeros((p, cap))
+    rc = np.empty(K, dtype=np.int64)
+    rv = np.empty(K)
+    for q in range(ch * step, min(n, (ch + 1) * step)):
+        i = points[q]
+        nl = 0
+        for rr in range(ptr[i], ptr[i + 1]):
+            r = order[rr]
+            ne = _expand_row(r, cols, vals, fcol, fw, fd, rc, rv)
+            for s in range(ne):
+                c = rc[s]
+                if pos[c] < 0:
+                    pos[c] = nl
+                    cl[nl] = c
                     for k in range(p):
-                        Z[k, la] += rv[s] * jp[r, k]
-            for k in range(p):
-                for a in range(nl):
-                    acc = 0.0
-                    for j in range(p):
-                        acc += Vinv[i, k, j] * Z[j, a]
-                    A[k, a] = acc
-            for k in range(p):
-                for j in range(p):
-                    acc = Vinv[i, k, j]
-                    for a in range(nl):
-                        t = 0.0
-                        ca = cl[a]
-                        for b in range(nl):
-                            t += S_inv[ca, cl[b]] * A[j, b]
-                        acc += A[k, a] * t
-                    out[q, k, j] = acc
+                        Z[k, nl] = 0.0
+                    nl += 1
+                la = pos[c]
+                for k in range(p):
+                    Z[k, la] += rv[s] * jp[r, k]
+        for k in range(p):
             for a in range(nl):
-                pos[cl[a]] = -1
-    return out
+                acc = 0.0
+                for j in range(p):
+                    acc += Vinv[i, k, j] * Z[j, a]
+                A[k, a] = acc
+        for k in range(p):
+            for j in range(p):
+                acc = Vinv[i, k, j]
+                for a in range(nl):
+                    t = 0.0
+                    ca = cl[a]
+                    for b in range(nl):
+                        t += S_inv[ca, cl[b]] * A[j, b]
+                    acc += A[k, a] * t
+                out[q, k, j] = acc
+        for a in range(nl):
+            pos[cl[a]] = -1
 
 
 def point_covariance(arrays, jp, order, ptr, points, Vinv, S_inv) -> np.ndarray:
@@ -901,7 +900,14 @@ def point_covariance(arrays, jp, order, ptr, points, Vinv, S_inv) -> np.ndarray:
     max_rows = int(np.max(np.diff(ptr)[points]))
     width = cols.shape[1] + fcol.shape[1] * fd.shape[1]
     cap = int(min(S_inv.shape[0], max(1, max_rows * width)))
-    return _point_cov_kernel(*arrays, jp, order, ptr, points, Vinv, S_inv, cap)
+    p = jp.shape[1]
+    out = np.zeros((points.size, p, p))
+    n_chunks = min(points.size, 64)
+    step = (points.size + n_chunks - 1) // n_chunks
+    over_chunks(
+        _point_cov_chunk, n_chunks, step, *arrays, jp, order, ptr, points, Vinv, S_inv, cap, out
+    )
+    return out
 
 
 @njit(cache=True, parallel=True)

@@ -505,15 +505,20 @@ class PushbroomLines(ResidualBlock):
         shp = (2 * m,) if jacobian else (0,)
         dP = np.empty(shp + (3,))
         dN = np.empty(shp + (6,))  # d r / d δ(t); the node columns are B_a(t) × this
-        dB = np.empty(shp + (3,))
-        dL = np.empty(shp + (3,))
-        dD = np.empty(shp + (4,))
-        dC = np.empty(shp + (1,))
+        # the camera's columns as views of one (2m, 11) array and a read-only w_row, as
+        # evaluate_into passes them: the kernel is compiled once for both (a second
+        # compilation cost 8 s of a first run; issue 41). Two unused rows without the
+        # Jacobian: numpy calls any empty view contiguous, and numba would type it so.
+        V = np.empty((2 * m if jacobian else 2, 11))
+        dB, dL, dD, dC = V[:, 0:3], V[:, 3:6], V[:, 6:10], V[:, 10:11]
         none = np.zeros(0, dtype=np.int64)
+        no_w = np.zeros(0)
+        no_w.flags.writeable = False
         derivs = (dP, dN, dB, dL, dD, dC)
-        self._kernel(values, jacobian, r, w_out, derivs, none, np.zeros(0), np.zeros((0, 4)))
+        self._kernel(values, jacobian, r, w_out, derivs, none, no_w, np.zeros((0, 4)))
         if not jacobian:
             return r, None
+        dB, dL, dD, dC = (np.ascontiguousarray(d) for d in (dB, dL, dD, dC))
         jac = {
             nm["points"]: Indexed(self._pidx2, dP),
             # 002 eq. (4) through the spline: ∂r/∂c_a = B_a(t*) ∂r/∂δ (factored)

@@ -12,8 +12,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
+from hsgeo._chunks import over_chunks
 from hsgeo._raycast import HIT, GridSurface, first_crossing
 
 __all__ = ["Ground", "render_rays", "render_lines", "dsm_height", "BLOCK_CELLS"]
@@ -84,11 +85,19 @@ def _bilinear(a, u, v):  # pragma: no cover - compiled
     )
 
 
-@njit(cache=True, parallel=True)
-def _render_kernel(
-    O, D, z, e0, n0, de, dn, bmax, blk, zmin, zmax, refl, ge0, gn0, gcell, out_en, out_v
+#: Chunks of the rendering kernels' loops, run on the kernels' threads
+#: (:func:`hsgeo._chunks.over_chunks`; a ``prange`` loop's parallel passes cost compile time,
+#: 12.6 and 10.3 s for these two kernels on a fresh cache, issue 41). Each ray is independent of
+#: the others, so the number of chunks changes no value.
+N_CHUNKS = 64
+
+
+@njit(cache=True, nogil=True)
+def _render_chunk(
+    ch, step, O, D, z, e0, n0, de, dn, bmax, blk, zmin, zmax, refl, ge0, gn0, gcell, out_en, out_v
 ):  # pragma: no cover
-    for k in prange(O.shape[0]):
+    """Rays ``ch·step … (ch+1)·step − 1`` of :func:`render_rays`."""
+    for k in range(ch * step, min(O.shape[0], (ch + 1) * step)):
         s, status = first_crossing(
             O[k, 0], O[k, 1], O[k, 2], D[k, 0], D[k, 1], D[k, 2], z, e0, n0, de, dn, bmax, blk,
             zmin, zmax,
@@ -106,17 +115,17 @@ def _render_kernel(
             out_v[k] = _bilinear(refl, (E - ge0) / gcell, (N - gn0) / gcell)
 
 
-@njit(cache=True, parallel=True)
-def _render_lines_kernel(
-    R, O, d_plat, z, e0, n0, de, dn, bmax, blk, zmin, zmax, refl, ge0, gn0, gcell, out
+@njit(cache=True, nogil=True)
+def _render_lines_chunk(
+    ch, step, R, O, d_plat, z, e0, n0, de, dn, bmax, blk, zmin, zmax, refl, ge0, gn0, gcell, out
 ):  # pragma: no cover
-    """``out[l, c, b]``: reflectance of band ``b`` where the ray ``O[l] + s R[l] d_plat[b, c]``
-    of column ``c`` of line ``l`` first meets the DSM (NaN where it leaves the DSM first).
+    """Lines ``ch·step … (ch+1)·step − 1`` of :func:`render_lines`: ``out[l, c, b]``, the
+    reflectance of band ``b`` where the ray ``O[l] + s R[l] d_plat[b, c]`` of column ``c`` of
+    line ``l`` first meets the DSM (NaN where it leaves the DSM first).
     """
-    nl = R.shape[0]
     nb = d_plat.shape[0]
     nc = d_plat.shape[1]
-    for li in prange(nl):
+    for li in range(ch * step, min(R.shape[0], (ch + 1) * step)):
         ox, oy, oz = O[li, 0], O[li, 1], O[li, 2]
         for c in range(nc):
             for b in range(nb):
@@ -133,6 +142,12 @@ def _render_lines_kernel(
                 E = ox + s * dx
                 N = oy + s * dy
                 out[li, c, b] = _bilinear(refl[b], (E - ge0) / gcell, (N - gn0) / gcell)
+
+
+def _over(chunk, n: int, *args) -> None:
+    """``chunk`` over ``n`` rays or lines in :data:`N_CHUNKS` chunks (fewer when n is small)."""
+    n_chunks = max(1, min(N_CHUNKS, n))
+    over_chunks(chunk, n_chunks, (n + n_chunks - 1) // n_chunks, *args)
 
 
 def render_rays(origins_m, directions, ground: Ground, band: int | None = None):
@@ -158,8 +173,18 @@ def render_rays(origins_m, directions, ground: Ground, band: int | None = None):
     refl = ground.reflectance[band] if band is not None else np.zeros((0, 0), np.float32)
     en = np.empty((O.shape[0], 2))
     val = np.empty(O.shape[0])
-    _render_kernel(
-        O, D, *_surface(ground).args(), refl, ground.e0_m, ground.n0_m, ground.cell_m, en, val
+    _over(
+        _render_chunk,
+        O.shape[0],
+        O,
+        D,
+        *_surface(ground).args(),
+        refl,
+        ground.e0_m,
+        ground.n0_m,
+        ground.cell_m,
+        en,
+        val,
     )
     return en, (val if band is not None else None)
 
@@ -203,7 +228,9 @@ def render_lines(R_map_from_platform, origins_m, d_platform, ground: Ground) -> 
     if ground.reflectance.shape[0] < nb:
         raise ValueError("more bands of rays than of the ground's reflectance")
     out = np.empty((R.shape[0], d.shape[1], nb), np.float32)
-    _render_lines_kernel(
+    _over(
+        _render_lines_chunk,
+        R.shape[0],
         R,
         O,
         d,
