@@ -18,7 +18,7 @@ import scipy.linalg as sla
 from hsgeo.adjust.options import SolverOptions
 from hsgeo.adjust.parameters import Parameters
 from hsgeo.adjust.residuals import ResidualBlock
-from hsgeo.adjust.schur import _Normal, _normal, _reduced
+from hsgeo.adjust.schur import _coupled, _Normal, _normal, _reduced
 from hsgeo.adjust.system import _evaluate, _Layout
 from hsgeo.adjust.threads import engine_threads
 from hsgeo.errors import DatumError
@@ -210,6 +210,11 @@ def _surely_full_rank(
     if unobserved:
         return False
     b = float(np.abs(Ss).sum(axis=1).max())
+    keep = _coupled(Ss)
+    if keep is not None:  # the uncoupled columns: 1 × 1 blocks of the unit diagonal
+        if not 1.0 - rtol * b > 0.0:
+            return False
+        Ss = Ss[np.ix_(keep, keep)]
     Ss[np.diag_indices_from(Ss)] -= rtol * b
     try:
         sla.cholesky(Ss, lower=True, overwrite_a=True, check_finite=False)

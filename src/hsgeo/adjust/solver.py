@@ -71,6 +71,7 @@ from hsgeo.adjust.schur import (
     _reduced,
     _reduced_estimable_inverse,
     _reduced_inverse,
+    _spd_solve,
     _step,
 )
 from hsgeo.adjust.system import _Buffers, _Clock, _evaluate, _Layout, _NonFinite, _System
@@ -516,7 +517,7 @@ class _Solve:
         D = ne.damping_diagonal()
         S, _, _, _ = _reduced(layout, ne, lam)
         try:
-            a = -sla.cho_solve(sla.cho_factor(S, check_finite=False), g_vv, check_finite=False)
+            a = -_spd_solve(S, g_vv)
         except (np.linalg.LinAlgError, sla.LinAlgError):
             return None
         w = np.sqrt(np.maximum(D, 0.0))
