@@ -80,3 +80,4 @@ _.seconds_split  # bench/bench_pushbroom_ba.py: the solver's time by stage
 _.select_cameras  # bench/bench_bal.py: a BAL problem cut to its first cameras
 _.singular_values  # bench/bench_rikola_drift.py: the datum analysis's singular values
 _._repr_png_  # src/hsgeo/report.py: IPython's display protocol calls _GluedFigure._repr_png_ (the glued PNG)
+_.writeable  # src/hsgeo/sensors/pushbroom.py: numpy's flags.writeable = False (a read-only array for the kernel's one signature)
