@@ -116,8 +116,17 @@ def _as_rotation(R: ArrayLike, name: str = "R") -> NDArray[np.float64]:
 
 
 def _stack33(rows: list[list[NDArray[np.float64]]]) -> NDArray[np.float64]:
-    """Build a (..., 3, 3) array from a nested list of (...) arrays."""
-    return np.stack([np.stack(r, axis=-1) for r in rows], axis=-2)
+    """Build a (..., 3, 3) array from a nested list of (...) arrays of one shape.
+
+    The entries are copied into one array (the values of ``np.stack`` of the rows' stacks, in
+    a third of its time: the nested stacks made the elementary rotations 4 of the 105 CPU-s of
+    ``hsgeo reproduce lp-observations --scale 0.3``, issue 41).
+    """
+    flat = [x for r in rows for x in r]
+    out = np.empty(np.shape(flat[0]) + (3, 3), dtype=np.result_type(*flat))
+    for k, x in enumerate(flat):
+        out[..., k // 3, k % 3] = x
+    return out
 
 
 def _Rx(a: NDArray[np.float64]) -> NDArray[np.float64]:
