@@ -12,7 +12,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numba
 
-__all__ = ["over_chunks"]
+__all__ = ["over_chunks", "over_items"]
 
 
 def over_chunks(chunk: Callable, n_chunks: int, *args) -> list:
@@ -32,3 +32,13 @@ def over_chunks(chunk: Callable, n_chunks: int, *args) -> list:
         return [chunk(ch, *args) for ch in range(n_chunks)]
     with ThreadPoolExecutor(max_workers=n, thread_name_prefix="hsgeo-chunk") as pool:
         return list(pool.map(lambda ch: chunk(ch, *args), range(n_chunks)))
+
+
+def over_items(chunk: Callable, n_items: int, n_chunks: int, *args) -> list:
+    """:func:`over_chunks` over ``n_items`` items in ``n_chunks`` chunks of ``step`` items
+    (the last one shorter): ``chunk(ch, step, *args)`` handles items ``ch·step …
+    min((ch+1)·step, n_items) − 1``. The chunks are set by the problem's size, never by the
+    threads, so their partial results are the same on any machine.
+    """
+    step = (n_items + n_chunks - 1) // n_chunks
+    return over_chunks(chunk, n_chunks, step, *args)

@@ -40,7 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from hsgeo._chunks import over_chunks
+from hsgeo._chunks import over_items
 
 __all__ = [
     "HIT",
@@ -362,10 +362,7 @@ def first_crossing_rows(O, D, z, e0, n0, de, dn, bmax, blk, zmin, zmax, s, statu
     """
     n = O.shape[0]
     n_chunks = 64 if n >= PARALLEL_MIN_RAYS else 1
-    step = (n + n_chunks - 1) // n_chunks
-    over_chunks(
-        _rows_chunk, n_chunks, step, O, D, z, e0, n0, de, dn, bmax, blk, zmin, zmax, s, status
-    )
+    over_items(_rows_chunk, n, n_chunks, O, D, z, e0, n0, de, dn, bmax, blk, zmin, zmax, s, status)
 
 
 @njit(cache=True, nogil=True)

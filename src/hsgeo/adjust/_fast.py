@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from hsgeo.adjust.threads import chunks, over_chunks
+from hsgeo.adjust.threads import chunks, over_items
 
 __all__ = [
     "normal_cc",
@@ -518,9 +518,8 @@ def _reduced_kernel(*args):
     kk = rows[4].shape[1] ** 2  # fd
     out = np.zeros((n_chunks, n_c, n_sc))
     out_t = np.zeros((n_chunks, n_slots * kk))
-    step = (n_pts + n_chunks - 1) // n_chunks
-    misses = over_chunks(
-        _reduced_chunk, n_chunks, step, *rows, capg, capc, tile_of, slot_of, sc_of, out, out_t
+    misses = over_items(
+        _reduced_chunk, n_pts, n_chunks, *rows, capg, capc, tile_of, slot_of, sc_of, out, out_t
     )
     return out, out_t, int(sum(misses))
 
@@ -913,10 +912,19 @@ def point_covariance(arrays, jp, order, ptr, points, Vinv, S_inv) -> np.ndarray:
     cap = int(min(S_inv.shape[0], max(1, max_rows * width)))
     p = jp.shape[1]
     out = np.zeros((points.size, p, p))
-    n_chunks = min(points.size, 64)
-    step = (points.size + n_chunks - 1) // n_chunks
-    over_chunks(
-        _point_cov_chunk, n_chunks, step, *arrays, jp, order, ptr, points, Vinv, S_inv, cap, out
+    over_items(
+        _point_cov_chunk,
+        points.size,
+        min(points.size, 64),
+        *arrays,
+        jp,
+        order,
+        ptr,
+        points,
+        Vinv,
+        S_inv,
+        cap,
+        out,
     )
     return out
 

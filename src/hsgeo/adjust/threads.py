@@ -38,7 +38,7 @@ from collections.abc import Iterator
 
 import numba
 
-from hsgeo._chunks import over_chunks
+from hsgeo._chunks import over_chunks, over_items
 
 __all__ = [
     "PARALLEL_MIN_ROWS",
@@ -49,6 +49,7 @@ __all__ = [
     "pool_size",
     "chunks",
     "over_chunks",
+    "over_items",
 ]
 
 #: Residual rows (observation components, priors included) from which ``threads="auto"`` runs

@@ -23,7 +23,7 @@ import inspect
 import numpy as np
 from numba import njit
 
-from hsgeo._chunks import over_chunks
+from hsgeo._chunks import over_items
 from hsgeo._kernels import (
     bspline_weights,
     pushbroom_camera_point,
@@ -252,8 +252,7 @@ def _lines_kernel(*args):
     n_chunks = 64 if m > 6400 else 1
     if dst.size == m and gd.shape[1] > 0:  # fused, with the gradient: its chunks
         n_chunks = gd.shape[1]
-    step = (m + n_chunks - 1) // n_chunks
-    over_chunks(_lines_chunk, n_chunks, step, *args)
+    over_items(_lines_chunk, m, n_chunks, *args)
 
 
 @njit(cache=True, nogil=True)

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from hsgeo._chunks import over_chunks
+from hsgeo._chunks import over_items
 from hsgeo._raycast import HIT, GridSurface, first_crossing
 
 __all__ = ["Ground", "render_rays", "render_lines", "dsm_height", "BLOCK_CELLS"]
@@ -146,8 +146,7 @@ def _render_lines_chunk(
 
 def _over(chunk, n: int, *args) -> None:
     """``chunk`` over ``n`` rays or lines in :data:`N_CHUNKS` chunks (fewer when n is small)."""
-    n_chunks = max(1, min(N_CHUNKS, n))
-    over_chunks(chunk, n_chunks, (n + n_chunks - 1) // n_chunks, *args)
+    over_items(chunk, n, max(1, min(N_CHUNKS, n)), *args)
 
 
 def render_rays(origins_m, directions, ground: Ground, band: int | None = None):
