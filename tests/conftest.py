@@ -4,13 +4,13 @@ from pathlib import Path
 
 import pytest
 
-# OpenMP threads (libgomp) wait for work by spinning on their core unless told otherwise: with
-# two pytest-xdist workers on two cores, a spinning thread takes the core from the other worker
-# after every parallel loop (issue 41: bench/results/test_suite_cost.json). hsgeo's compiled
-# kernels no longer run OpenMP loops (their chunks run on Python threads: hsgeo._chunks); this
-# stays for any library of the session that does. Set before any process of the session loads
-# libgomp (it reads the variable once); the workers, the chapters' kernels and the CLI's
-# subprocesses inherit it.
+# The compiled kernels' threads (numba's OpenMP layer, libgomp) wait for work by spinning on
+# their core unless told otherwise: with two pytest-xdist workers on two cores, each with its
+# threads, a spinning thread takes the core from the other worker after every parallel loop.
+# Passive waiting changes no result (the same threads split the same loops) and only the CPU
+# spent waiting (issue 41: bench/results/test_suite_cost.json). Set before any process of the
+# session loads libgomp (it reads the variable once); the workers, the chapters' kernels and the
+# CLI's subprocesses inherit it.
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 # BLAS on one thread in every process of the session, as `make test` sets it (Makefile) and as
 # the command line runs: BLAS threads change a result's last digits (README, "threads"), so a

@@ -24,7 +24,7 @@ The generic scipy.sparse path in :mod:`hsgeo.adjust.schur` computes the same qua
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from hsgeo.adjust.threads import chunks, over_items
 
@@ -83,42 +83,38 @@ def _expand_row(i, cols, vals, fcol, fw, fd, cl, v):  # pragma: no cover - compi
     return n
 
 
-def _normal_cc_kernel(cols, vals, fcol, fw, fd, row_order, n_c, n_chunks):
-    """The upper triangles of ``J_cᵀ J_c`` over the rows ``row_order``, one per chunk."""
-    out = np.zeros((n_chunks, n_c, n_c))
-    over_items(_normal_cc_chunk, row_order.size, n_chunks, cols, vals, fcol, fw, fd, row_order, out)
-    return out
-
-
-@njit(cache=True, nogil=True)
-def _normal_cc_chunk(ch, step, cols, vals, fcol, fw, fd, row_order, out):  # pragma: no cover
-    """Chunk ``ch`` of :func:`_normal_cc_kernel` (the rows ``row_order[ch·step : (ch+1)·step]``)
-    into ``out[ch]``.
-    """
+@njit(cache=True, parallel=True)
+def _normal_cc_kernel(
+    cols, vals, fcol, fw, fd, row_order, n_c, n_chunks
+):  # pragma: no cover - compiled
     K = cols.shape[1] + fcol.shape[1] * fd.shape[1]
     M = row_order.size
-    N = out[ch]
-    cl = np.empty(K, dtype=np.int64)
-    v = np.empty(K)
-    run_l = np.empty(K, dtype=np.int64)
-    run_c = np.empty(K, dtype=np.int64)
-    run_n = np.empty(K, dtype=np.int64)
-    for ii in range(ch * step, min(M, (ch + 1) * step)):
-        i = row_order[ii]
-        nl = _expand_row(i, cols, vals, fcol, fw, fd, cl, v)
-        nr = _runs(cl, nl, run_l, run_c, run_n)
-        for a in range(nl):
-            ca = cl[a]
-            va = v[a]
-            for q in range(nr):
-                c0 = run_c[q]
-                L = run_n[q]
-                if c0 + L <= ca:
-                    continue
-                j0 = ca - c0 if ca > c0 else 0
-                l0 = run_l[q]
-                for j in range(j0, L):
-                    N[ca, c0 + j] += va * v[l0 + j]
+    out = np.zeros((n_chunks, n_c, n_c))
+    step = (M + n_chunks - 1) // n_chunks
+    for ch in prange(n_chunks):
+        N = out[ch]
+        cl = np.empty(K, dtype=np.int64)
+        v = np.empty(K)
+        run_l = np.empty(K, dtype=np.int64)
+        run_c = np.empty(K, dtype=np.int64)
+        run_n = np.empty(K, dtype=np.int64)
+        for ii in range(ch * step, min(M, (ch + 1) * step)):
+            i = row_order[ii]
+            nl = _expand_row(i, cols, vals, fcol, fw, fd, cl, v)
+            nr = _runs(cl, nl, run_l, run_c, run_n)
+            for a in range(nl):
+                ca = cl[a]
+                va = v[a]
+                for q in range(nr):
+                    c0 = run_c[q]
+                    L = run_n[q]
+                    if c0 + L <= ca:
+                        continue
+                    j0 = ca - c0 if ca > c0 else 0
+                    l0 = run_l[q]
+                    for j in range(j0, L):
+                        N[ca, c0 + j] += va * v[l0 + j]
+    return out
 
 
 @njit(cache=True, inline="always")
@@ -933,27 +929,34 @@ def point_covariance(arrays, jp, order, ptr, points, Vinv, S_inv) -> np.ndarray:
     return out
 
 
-def rmatvec_diag(cols, vals, fcol, fw, fd, y, n_c, want_diag):
+@njit(cache=True, parallel=True)
+def rmatvec_diag(cols, vals, fcol, fw, fd, y, n_c, want_diag):  # pragma: no cover - compiled
     """``Jᵀ y`` and (optionally) ``diag(JᵀJ)`` of a row-compressed matrix, in one pass."""
-    M = cols.shape[0]
+    M, K = cols.shape
     n_chunks = 8 if M > 80000 else 1
     gs = np.zeros((n_chunks, n_c))
     ds = np.zeros((n_chunks, n_c))
-    over_items(_rmatvec_chunk, M, n_chunks, cols, vals, fcol, fw, fd, y, want_diag, gs, ds)
+    step = (M + n_chunks - 1) // n_chunks
+    for ch in prange(n_chunks):
+        _rmatvec_rows(
+            cols,
+            vals,
+            fcol,
+            fw,
+            fd,
+            y,
+            want_diag,
+            ch * step,
+            min(M, (ch + 1) * step),
+            gs[ch],
+            ds[ch],
+        )
     g = gs[0].copy()
     d = ds[0].copy()
     for ch in range(1, n_chunks):  # fixed order: the same bits for any thread count
         g += gs[ch]
         d += ds[ch]
     return g, d
-
-
-@njit(cache=True, nogil=True)
-def _rmatvec_chunk(ch, step, cols, vals, fcol, fw, fd, y, want_diag, gs, ds):  # pragma: no cover
-    i0 = ch * step
-    _rmatvec_rows(
-        cols, vals, fcol, fw, fd, y, want_diag, i0, min(cols.shape[0], i0 + step), gs[ch], ds[ch]
-    )
 
 
 @njit(cache=True, inline="always")
@@ -980,32 +983,13 @@ def _rmatvec_rows(cols, vals, fcol, fw, fd, y, want_diag, i0, i1, g, d):  # prag
                         d[c0 + j] += v * v
 
 
-#: Rows (or points) per chunk of the kernels whose every output element is its own (the
-#: chunking changes the speed, never a bit)
-_PER_CHUNK = 20000
-
-
-def _over_rows(chunk, n: int, *args) -> None:
-    """``chunk(ch, step, *args)`` over ``n`` rows or points in :func:`_chunks` chunks, on the
-    kernels' threads (:func:`~hsgeo._chunks.over_chunks`): as ``prange`` loops these kernels
-    took numba's parallel passes at compile time, and GNU OpenMP's idle threads spin between
-    them (issue 41).
-    """
-    over_items(chunk, n, _chunks(n, _PER_CHUNK), *args)
-
-
-def matvec(cols, vals, fcol, fw, fd, x):
+@njit(cache=True, parallel=True)
+def matvec(cols, vals, fcol, fw, fd, x):  # pragma: no cover - compiled
     """``J x`` of a row-compressed matrix."""
-    out = np.zeros(cols.shape[0])
-    _over_rows(_matvec_chunk, cols.shape[0], cols, vals, fcol, fw, fd, x, out)
-    return out
-
-
-@njit(cache=True, nogil=True)
-def _matvec_chunk(ch, step, cols, vals, fcol, fw, fd, x, out):  # pragma: no cover - compiled
     M, K = cols.shape
     Q, kf = fcol.shape[1], fd.shape[1]
-    for i in range(ch * step, min(M, (ch + 1) * step)):
+    out = np.zeros(M)
+    for i in prange(M):
         acc = 0.0
         for s in range(K):
             c = cols[i, s]
@@ -1019,38 +1003,30 @@ def _matvec_chunk(ch, step, cols, vals, fcol, fw, fd, x, out):  # pragma: no cov
                     t += fd[i, j] * x[c0 + j]
                 acc += fw[i, a] * t
         out[i] = acc
+    return out
 
 
-def point_rows_dot(jp, pidx, y):
+@njit(cache=True, parallel=True)
+def point_rows_dot(jp, pidx, y):  # pragma: no cover - compiled
     """``u_i = J_p,i · y[pidx_i]`` (0 for rows without a point): ``J_p y`` row by row."""
-    u = np.zeros(jp.shape[0])
-    _over_rows(_point_rows_dot_chunk, jp.shape[0], jp, pidx, y, u)
-    return u
-
-
-@njit(cache=True, nogil=True)
-def _point_rows_dot_chunk(ch, step, jp, pidx, y, u):  # pragma: no cover - compiled
     M, p = jp.shape
-    for i in range(ch * step, min(M, (ch + 1) * step)):
+    u = np.zeros(M)
+    for i in prange(M):
         q = pidx[i]
         if q >= 0:
             acc = 0.0
             for k in range(p):
                 acc += jp[i, k] * y[q, k]
             u[i] = acc
+    return u
 
 
-def point_leverage(jp, pidx, Vinv):
+@njit(cache=True, parallel=True)
+def point_leverage(jp, pidx, Vinv):  # pragma: no cover - compiled
     """``h_i = J_p,iᵀ V⁻¹ J_p,i`` of each row on its point (0 for rows without a point)."""
-    h = np.zeros(jp.shape[0])
-    _over_rows(_point_leverage_chunk, jp.shape[0], jp, pidx, Vinv, h)
-    return h
-
-
-@njit(cache=True, nogil=True)
-def _point_leverage_chunk(ch, step, jp, pidx, Vinv, h):  # pragma: no cover - compiled
     M, p = jp.shape
-    for i in range(ch * step, min(M, (ch + 1) * step)):
+    h = np.zeros(M)
+    for i in prange(M):
         q = pidx[i]
         if q >= 0:
             acc = 0.0
@@ -1060,6 +1036,7 @@ def _point_leverage_chunk(ch, step, jp, pidx, Vinv, h):  # pragma: no cover - co
                     t += Vinv[q, j, k] * jp[i, k]
                 acc += jp[i, j] * t
             h[i] = acc
+    return h
 
 
 @njit(cache=True)
@@ -1080,16 +1057,12 @@ def scatter_points(jp, pidx, u, n_pts):  # pragma: no cover - compiled
 # ``rows[t]`` is the block row written to destination row t; ``w`` the whitening weights 1/σ;
 # ``cm`` the block's column map (-1: fixed entry, written as an empty slot).
 # ----------------------------------------------------------------------------------------------
-def fill_indexed(index, d, rows, w, cm, cols_dst, vals_dst):
+@njit(cache=True, parallel=True)
+def fill_indexed(index, d, rows, w, cm, cols_dst, vals_dst):  # pragma: no cover - compiled
     """Slots of an ``Indexed(index (m, q), d (m, q, k))`` Jacobian."""
-    _over_rows(_fill_indexed_chunk, rows.size, index, d, rows, w, cm, cols_dst, vals_dst)
-
-
-@njit(cache=True, nogil=True)
-def _fill_indexed_chunk(ch, step, index, d, rows, w, cm, cols_dst, vals_dst):  # pragma: no cover
     q = index.shape[1]
     k = d.shape[2]
-    for t in range(ch * step, min(rows.size, (ch + 1) * step)):
+    for t in prange(rows.size):
         i = rows[t]
         wi = w[i]
         for a in range(q):
@@ -1100,15 +1073,11 @@ def _fill_indexed_chunk(ch, step, index, d, rows, w, cm, cols_dst, vals_dst):  #
                 vals_dst[t, a * k + j] = d[i, a, j] * wi if c >= 0 else 0.0
 
 
-def fill_dense(J, rows, w, cm, cols_dst, vals_dst):
+@njit(cache=True, parallel=True)
+def fill_dense(J, rows, w, cm, cols_dst, vals_dst):  # pragma: no cover - compiled
     """Slots of a dense ``(m, size)`` Jacobian."""
-    _over_rows(_fill_dense_chunk, rows.size, J, rows, w, cm, cols_dst, vals_dst)
-
-
-@njit(cache=True, nogil=True)
-def _fill_dense_chunk(ch, step, J, rows, w, cm, cols_dst, vals_dst):  # pragma: no cover
     k = J.shape[1]
-    for t in range(ch * step, min(rows.size, (ch + 1) * step)):
+    for t in prange(rows.size):
         i = rows[t]
         wi = w[i]
         for j in range(k):
@@ -1117,20 +1086,14 @@ def _fill_dense_chunk(ch, step, J, rows, w, cm, cols_dst, vals_dst):  # pragma: 
             vals_dst[t, j] = J[i, j] * wi if c >= 0 else 0.0
 
 
-def fill_factored(index, weights, d, rows, w, c0, fcol_dst, fw_dst, fd_dst):
-    """The factored group of ``Indexed(index (m, q), d (m, k), weights (m, q))``."""
-    _over_rows(
-        _fill_factored_chunk, rows.size, index, weights, d, rows, w, c0, fcol_dst, fw_dst, fd_dst
-    )
-
-
-@njit(cache=True, nogil=True)
-def _fill_factored_chunk(
-    ch, step, index, weights, d, rows, w, c0, fcol_dst, fw_dst, fd_dst
+@njit(cache=True, parallel=True)
+def fill_factored(
+    index, weights, d, rows, w, c0, fcol_dst, fw_dst, fd_dst
 ):  # pragma: no cover - compiled
+    """The factored group of ``Indexed(index (m, q), d (m, k), weights (m, q))``."""
     q = index.shape[1]
     k = d.shape[1]
-    for t in range(ch * step, min(rows.size, (ch + 1) * step)):
+    for t in prange(rows.size):
         i = rows[t]
         for a in range(q):
             it = index[i, a]
@@ -1141,7 +1104,8 @@ def _fill_factored_chunk(
             fd_dst[t, j] = d[i, j] * wi
 
 
-def point_normals(order, ptr, jp, r):
+@njit(cache=True, parallel=True)
+def point_normals(order, ptr, jp, r):  # pragma: no cover - compiled
     """``V_i = Σ jpᵀ jp`` and ``g_p,i = Σ jpᵀ r`` over the rows of each point, point by point
     (its rows ``order[ptr[i]:ptr[i + 1]]``, ascending: the sums of a pass over the rows in
     their order, bit for bit, on any number of threads).
@@ -1150,14 +1114,7 @@ def point_normals(order, ptr, jp, r):
     p = jp.shape[1]
     V = np.zeros((n_pts, p, p))
     g = np.zeros((n_pts, p))
-    _over_rows(_point_normals_chunk, n_pts, order, ptr, jp, r, V, g)
-    return V, g
-
-
-@njit(cache=True, nogil=True)
-def _point_normals_chunk(ch, step, order, ptr, jp, r, V, g):  # pragma: no cover - compiled
-    p = jp.shape[1]
-    for i in range(ch * step, min(ptr.size - 1, (ch + 1) * step)):
+    for i in prange(n_pts):
         for s in range(ptr[i], ptr[i + 1]):
             t = order[s]
             for a in range(p):
@@ -1165,9 +1122,11 @@ def _point_normals_chunk(ch, step, order, ptr, jp, r, V, g):  # pragma: no cover
                 g[i, a] += ja * r[t]
                 for b in range(p):
                     V[i, a, b] += ja * jp[t, b]
+    return V, g
 
 
-def inv3(V, rtol):
+@njit(cache=True, parallel=True)
+def inv3(V, rtol):  # pragma: no cover - compiled
     """Inverses of ``(n, 3, 3)`` blocks by cofactors; ``ok`` False where (nearly) singular:
     unless the determinant of the unit-diagonal scaled block is at least ``27·rtol``, which
     proves its smallest eigenvalue at least ``rtol`` times its largest (those blocks are left
@@ -1176,13 +1135,7 @@ def inv3(V, rtol):
     n = V.shape[0]
     out = np.zeros_like(V)
     ok = np.zeros(n, dtype=np.bool_)
-    _over_rows(_inv3_chunk, n, V, float(rtol), out, ok)
-    return out, ok
-
-
-@njit(cache=True, nogil=True)
-def _inv3_chunk(ch, step, V, rtol, out, ok):  # pragma: no cover - compiled
-    for i in range(ch * step, min(V.shape[0], (ch + 1) * step)):
+    for i in prange(n):
         a, b, c = V[i, 0, 0], V[i, 0, 1], V[i, 0, 2]
         d, e, f = V[i, 1, 0], V[i, 1, 1], V[i, 1, 2]
         g, h, k = V[i, 2, 0], V[i, 2, 1], V[i, 2, 2]
@@ -1203,3 +1156,4 @@ def _inv3_chunk(ch, step, V, rtol, out, ok):  # pragma: no cover - compiled
         out[i, 2, 0] = C * r
         out[i, 2, 1] = (b * g - a * h) * r
         out[i, 2, 2] = (a * e - b * d) * r
+    return out, ok

@@ -18,10 +18,9 @@ from __future__ import annotations
 import time
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from hsgeo.adjust.residuals import ResidualBlock
-from hsgeo.adjust.threads import chunks, over_items
 
 __all__: list[str] = []
 
@@ -142,41 +141,19 @@ class _FusedPart:
         )
 
 
-def _fused_columns(*args):
+@njit(cache=True, parallel=True)
+def _fused_columns(
+    rows, fidx, fc0, k, plan_col, plan_ix, ix_index, ix_cm, ix_off, r, w, cols, vals, fcol, fw, rk
+):  # pragma: no cover - compiled
     """The engine's share of a fused part's rows, in one pass without temporaries: destination
     row t is block row ``rows[t]``; its factored group's columns ``fc0 + k·item`` (``-1`` and a
     zero weight where the item is -1), its slots' columns (``plan_col[s]``, or for an indexed
     slot ``ix_cm[ix_off[j] + ix_index[j, row]]`` with ``j = plan_ix[s]``; a fixed entry's slot
     empty, its value zeroed) and its whitened residual ``rk[t] = r · w``.
     """
-    over_items(_fused_columns_chunk, args[0].size, chunks(args[0].size, 20000), *args)
-
-
-@njit(cache=True, nogil=True)
-def _fused_columns_chunk(
-    ch,
-    step,
-    rows,
-    fidx,
-    fc0,
-    k,
-    plan_col,
-    plan_ix,
-    ix_index,
-    ix_cm,
-    ix_off,
-    r,
-    w,
-    cols,
-    vals,
-    fcol,
-    fw,
-    rk,
-):  # pragma: no cover - compiled
-    """Chunk ``ch`` of :func:`_fused_columns`: destination rows ``ch·step …``."""
     q = fcol.shape[1]
     width = plan_col.size
-    for t in range(ch * step, min(rows.size, (ch + 1) * step)):
+    for t in prange(rows.size):
         i = rows[t]
         for a in range(q):
             it = fidx[i, a]

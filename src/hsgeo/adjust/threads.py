@@ -1,13 +1,11 @@
 """How many threads the engine's compiled kernels and BLAS use, chosen by the work.
 
-The compiled kernels run their chunks on Python threads (:func:`over_chunks`; numba's
-``nogil`` functions), not in numba's OpenMP parallel regions: those cost compile time, and GNU
-OpenMP's threads spin while they wait for the next region. On a parallel split, when another
-process holds a core, the second thread has to wait for it to be scheduled: a line-calibration
-run of 252 small adjustments took 142 s of wall time (81 s of CPU) with numba's two OpenMP
-threads against 8 s with one, for identical output (2026-11-24, one core busy). Multi-threaded
-OpenBLAS does the same on the small dense factorisations of the reduced normal matrix (GUIDE
-§9).
+A parallel region of the compiled kernels (numba's OpenMP layer) costs a few microseconds on an
+idle machine, but when another process holds a core the second thread has to wait for it to
+be scheduled, and GNU OpenMP's threads spin while they wait: a line-calibration run of 252
+small adjustments took 142 s of wall time (81 s of CPU) with numba's two threads against 8 s
+with one, for identical output (2026-11-24, one core busy). Multi-threaded OpenBLAS does the
+same on the small dense factorisations of the reduced normal matrix (GUIDE §9).
 
 So the engine decides, per solve, from the size of the problem:
 
@@ -101,7 +99,7 @@ def _controller():
 @contextlib.contextmanager
 def blas_threads(n: int) -> Iterator[None]:
     """The BLAS libraries (numpy's and scipy's OpenBLAS) limited to ``n`` threads inside the
-    block (the compiled kernels' threads are set by :func:`engine_threads`).
+    block (numba's own OpenMP pool is set by :func:`engine_threads`).
     """
     with _controller().limit(limits=n, user_api="blas"):
         yield

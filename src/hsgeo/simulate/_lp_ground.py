@@ -40,9 +40,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
-from hsgeo._chunks import over_items
 from hsgeo.simulate._lp_render import Ground, _bilinear, dsm_height
 
 __all__ = ["Ground", "MATERIALS", "SPECTRA", "make_ground"]
@@ -98,22 +97,11 @@ def _voronoi(nr, nc, cell, e0, n0, seeds, spacing):  # pragma: no cover - compil
     return out
 
 
-def _upsample_add(out, coarse, step, weight):
-    """``out += weight · bilinear(coarse)`` with ``step`` coarse cells per fine cell, in chunks
-    of rows on the kernels' threads (:func:`~hsgeo._chunks.over_items`).
-    """
-    over_items(_upsample_add_chunk, out.shape[0], _N_CHUNKS, out, coarse, step, weight)
-
-
-#: chunks of rows of :func:`_upsample_add` (each output cell is its own: the chunking changes
-#: the speed, never a bit)
-_N_CHUNKS = 16
-
-
-@njit(cache=True, nogil=True)
-def _upsample_add_chunk(ch, rstep, out, coarse, step, weight):  # pragma: no cover - compiled
+@njit(cache=True, parallel=True)
+def _upsample_add(out, coarse, step, weight):  # pragma: no cover - compiled
+    """``out += weight · bilinear(coarse)`` with ``step`` coarse cells per fine cell."""
     nr, nc = out.shape
-    for i in range(ch * rstep, min(nr, (ch + 1) * rstep)):
+    for i in prange(nr):
         for j in range(nc):
             out[i, j] += weight * _bilinear(coarse, j * step, i * step)
 
