@@ -22,6 +22,8 @@ _cmd_mtf_edge  # src/hsgeo/cli_parsers.py: a handler named in SUBCOMMANDS
 _cmd_cube  # src/hsgeo/cli_parsers.py: a handler named in SUBCOMMANDS
 _cmd_asf  # src/hsgeo/cli_parsers.py: a handler named in SUBCOMMANDS
 _cmd_versions  # src/hsgeo/cli_parsers.py: a handler named in SUBCOMMANDS
+__getattr__  # src/hsgeo/io/__init__.py: hsgeo.io.NAME loads NAME's module on first use (PEP 562, called by Python)
+__dir__  # src/hsgeo/io/__init__.py: dir(hsgeo.io) and tab completion list the names not yet loaded (PEP 562)
 _.sigma_att_deg  # src/hsgeo/workflows/pushbroom_ba.py: read by name from [gnss_ins] (io.sensor_file.present)
 _.n_reflected_columns  # src/hsgeo/io/sensors.py: read_frame_layouts reads the fields of [frame] by name
 _.n_incident_columns  # src/hsgeo/io/sensors.py: read_frame_layouts reads the fields of [frame] by name

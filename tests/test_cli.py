@@ -51,6 +51,28 @@ def test_console_script_runs():
     assert out.stdout.startswith("hsgeo ")
 
 
+#: what a command's computation loads, never its help or its usage errors (0.3 s instead of 2.4 s
+#: before hsgeo.io loaded its modules on first use)
+HEAVY = ("numba", "pandas", "scipy", "xarray", "rasterio", "cv2", "dask", "matplotlib", "pyproj")
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [["--help"], ["--version"], ["orthorectify", "--help"], ["adjust-pushbroom"], ["cube", "-x"]],
+    ids=["help", "version", "subcommand-help", "missing-argument", "unknown-option"],
+)
+def test_help_and_usage_errors_load_nothing_heavy(argv):
+    """A user's first contact (``hsgeo --help``, a mistyped option) answers at once: the
+    parser and its messages load no numerical library."""
+    code = (
+        "import sys\nfrom hsgeo.cli import main\n"
+        "try:\n    main(sys.argv[1:])\nexcept SystemExit:\n    pass\n"
+        f"print([m for m in {HEAVY!r} if m in sys.modules])\n"
+    )
+    p = subprocess.run([sys.executable, "-c", code, *argv], capture_output=True, text=True)
+    assert p.stdout.strip().splitlines()[-1] == "[]", (p.stdout[-500:], p.stderr[-500:])
+
+
 def test_data_manifest_verifies():
     from hsgeo.reproduce.data import generate_all
 

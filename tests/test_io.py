@@ -560,3 +560,26 @@ def test_read_dsm(tmp_path):
         read_dsm(tmp_path / "x.tif")
     with pytest.raises(InputError, match="not found"):
         read_dsm(tmp_path / "missing.tif")
+
+
+def test_the_package_loads_its_modules_on_first_use():
+    """``hsgeo.io`` loads a reader's module when a name of it is first used (PEP 562), and
+    answers as a package that imported them: names, modules, ``dir``, an unknown name."""
+    import importlib
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, hsgeo.io as io\n"
+        "print('hsgeo.io.terrain' in sys.modules)\n"
+        "io.read_terrain\n"
+        "print('hsgeo.io.terrain' in sys.modules)\n"
+    )
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert p.stdout.split() == ["False", "True"]
+    io = importlib.import_module("hsgeo.io")
+    assert io.tables is importlib.import_module("hsgeo.io.tables")  # a module by attribute
+    assert io.read_table is io.tables.read_table
+    assert set(io.__all__) <= set(dir(io))
+    with pytest.raises(AttributeError, match="no attribute 'read_tabel'"):
+        io.read_tabel  # noqa: B018
