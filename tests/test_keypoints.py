@@ -1,6 +1,7 @@
 """BRISK key points and Hamming matching (hsgeo.measure.keypoints); the reference squares'
 centroids (hsgeo.measure.targets_lp)."""
 
+import cv2
 import numpy as np
 import pytest
 from scipy.ndimage import gaussian_filter
@@ -94,6 +95,38 @@ def _square_image(rng, centre_uv, gsd_m=0.33, n=200, ss=8):
     cover = sq.reshape(n, ss, n, ss).mean(axis=(1, 3))
     img = 100 + 20 * gaussian_filter(rng.normal(size=(n, n)), 2) + 300 * cover
     return gaussian_filter(img, 0.5) + rng.normal(0, 2, (n, n))
+
+
+def _bf_reference(d1, d2, ratio, cross_check):
+    """The matching as OpenCV's BFMatcher does it (knnMatch, then match back), object by object."""
+    bf = cv2.BFMatcher(cv2.NORM_HAMMING, crossCheck=False)
+    k = 2 if ratio is not None and d2.shape[0] >= 2 else 1
+    out = []
+    for m in bf.knnMatch(d1, d2, k=k):
+        second = m[1].distance if len(m) > 1 else np.inf
+        if k == 1 or m[0].distance < ratio * second:
+            out.append((m[0].queryIdx, m[0].trainIdx, m[0].distance))
+    if cross_check and out:
+        cand = np.unique([o[1] for o in out])
+        back = {int(cand[b.queryIdx]): b.trainIdx for b in bf.match(d2[cand], d1)}
+        out = [o for o in out if back[o[1]] == o[0]]
+    return out
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_matching_is_opencvs_brute_force_matcher(seed):
+    """The same matches, ties included, as OpenCV's BFMatcher (knnMatch, match), on descriptors
+    built to tie: few distinct 64-byte words with a few bits flipped."""
+    rng = np.random.default_rng(seed)
+    words = rng.integers(0, 256, (40, 4), dtype=np.uint8)
+    for n1, n2 in ((1, 1), (1, 2), (30, 1), (300, 250), (120, 400)):
+        d1 = np.repeat(words[rng.integers(0, 40, n1)], 16, axis=1)
+        d2 = np.repeat(words[rng.integers(0, 40, n2)], 16, axis=1)
+        d2 ^= (rng.random(d2.shape) < 0.02) * rng.integers(0, 256, d2.shape, dtype=np.uint8)
+        for ratio, cross in ((0.8, True), (0.8, False), (None, True), (None, False)):
+            i1, i2, dist = match_hamming(d1, d2, ratio=ratio, cross_check=cross)
+            got = list(zip(i1.tolist(), i2.tolist(), dist.tolist(), strict=True))
+            assert got == _bf_reference(d1, d2, ratio, cross), (n1, n2, ratio, cross)
 
 
 def test_square_centroid_on_rendered_squares():

@@ -224,22 +224,25 @@ def match_hamming(
         raise InputError(f"descriptors of different kinds: shapes {d1.shape} and {d2.shape}")
     if d1.shape[0] == 0 or d2.shape[0] == 0:
         return empty
-    bf = cv2.BFMatcher(cv2.NORM_HAMMING, crossCheck=False)
+    # cv2.batchDistance is the brute-force search BFMatcher.knnMatch and .match run (the same
+    # nearest neighbours, ties broken alike), returned as arrays instead of a Python object per
+    # match: the list comprehensions over those objects cost as much as the search (issue 41)
     k = 2 if ratio is not None and d2.shape[0] >= 2 else 1
-    knn = bf.knnMatch(d1, d2, k=k)
-    i1 = np.array([m[0].queryIdx for m in knn if m], dtype=np.int64)
-    i2 = np.array([m[0].trainIdx for m in knn if m], dtype=np.int64)
-    dist = np.array([m[0].distance for m in knn if m], dtype=np.float64)
+    dk, nk = cv2.batchDistance(d1, d2, cv2.CV_32S, normType=cv2.NORM_HAMMING, K=k)
+    found = nk[:, 0] >= 0
+    i1 = np.flatnonzero(found).astype(np.int64)
+    i2 = nk[found, 0].astype(np.int64)
+    dist = dk[found, 0].astype(np.float64)
     keep = np.ones(i1.size, bool)
     if k == 2:
-        second = np.array([m[1].distance if len(m) > 1 else np.inf for m in knn if m])
+        second = np.where(nk[found, 1] >= 0, dk[found, 1], np.inf)
         keep &= dist < ratio * second
     if cross_check and keep.any():
         # nearest neighbour in desc1 of the desc2 that are still matched (not of all desc2:
         # the same answer at a fraction of the brute-force cost)
         cand = np.unique(i2[keep])
-        back = bf.match(d2[cand], d1)
+        _, back = cv2.batchDistance(d2[cand], d1, cv2.CV_32S, normType=cv2.NORM_HAMMING, K=1)
         nn21 = np.full(d2.shape[0], -1, np.int64)
-        nn21[cand[[m.queryIdx for m in back]]] = [m.trainIdx for m in back]
+        nn21[cand] = back[:, 0]
         keep &= nn21[i2] == i1
     return i1[keep], i2[keep], dist[keep]
