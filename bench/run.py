@@ -2,8 +2,9 @@
 
 ``python bench/run.py [NAME ...]`` runs only the named ones (``engine``, ``pushbroom_ba``,
 ``pushbroom_scaling``, ``bal``, ``nist_strd``, ``mtf``, ``cube``, ``busy_machine``,
-``lp_ransac``, ``lp_observations``, ``lp_parameters``, ``lp_scene_length``, ``orthomosaic``); each
-script also runs on its own with its options (``python bench/bench_pushbroom_ba.py --help``).
+``lp_ransac``, ``lp_observations``, ``lp_parameters``, ``lp_scene_length``, ``orthomosaic``,
+``cli_startup``); each script also runs on its own with its options
+(``python bench/bench_pushbroom_ba.py --help``).
 ``pushbroom_scaling`` is ``bench_pushbroom_ba.py --scaling …``, run after the pushbroom
 benchmark (issue 14).
 
