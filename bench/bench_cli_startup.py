@@ -1,9 +1,11 @@
-"""How long ``hsgeo`` takes to answer before any computation: help, version, a usage error.
+"""How long ``hsgeo`` takes to answer before any computation: help, version, a usage error,
+a file not found.
 
     python bench/bench_cli_startup.py [--rounds N] [--vs TREE] [--out FILE]
 
-Each command runs in a fresh process (``python -m hsgeo.cli ...``) and is timed with
-``os.wait4``: CPU seconds (user + system) and wall seconds, the median of ``--rounds`` runs.
+Each command runs in a fresh process (``python -m hsgeo.cli ...``; the file not found is looked
+for in an empty temporary folder) and is timed with ``os.wait4``: CPU seconds (user + system)
+and wall seconds, the median of ``--rounds`` runs.
 Beside them, in the same rounds, the floor of any Python command: ``python -c pass`` and
 ``python -c "import numpy"`` (the validators need numpy). ``--vs TREE`` times another checkout
 (its ``src``) in turn with this one, command by command, so that both see the same machine
@@ -20,6 +22,7 @@ import platform
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -34,6 +37,15 @@ COMMANDS = {
     "hsgeo orthorectify --help": ["orthorectify", "--help"],
     "hsgeo adjust-pushbroom (missing arguments)": ["adjust-pushbroom"],
     "hsgeo cube -x (unknown option)": ["cube", "-x"],
+    # a mistyped file name: the handler imports its workflow before the file is looked for
+    "hsgeo adjust-pushbroom (a file not found)": [
+        "adjust-pushbroom",
+        "{tmp}/obs.csv",
+        "--trajectory",
+        "{tmp}/nav.csv",
+        "--camera",
+        "{tmp}/camera.toml",
+    ],
 }
 FLOOR = {"python -c pass": ["-c", "pass"], "python -c 'import numpy'": ["-c", "import numpy"]}
 
@@ -60,7 +72,12 @@ def main(argv: list[str] | None = None) -> int:
     trees = {"this": ROOT / "src"}
     if a.vs is not None:
         trees["vs"] = a.vs.resolve() / "src"
-    jobs = [(name, ["-m", "hsgeo.cli", *args], True) for name, args in COMMANDS.items()]
+    tmp = Path(tempfile.mkdtemp(prefix="cli_startup_"))
+    (tmp / "camera.toml").write_text("[sensor]\n", encoding="utf-8")
+    jobs = [
+        (name, ["-m", "hsgeo.cli", *(x.format(tmp=tmp) for x in args)], True)
+        for name, args in COMMANDS.items()
+    ]
     jobs += [(name, args, False) for name, args in FLOOR.items()]
     runs: dict = {t: {name: [] for name, _, _ in jobs} for t in trees}
     load = os.getloadavg()

@@ -23,13 +23,15 @@ References
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
-import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 
 from hsgeo.errors import InputError, ObservationError
+
+if TYPE_CHECKING:  # pandas (0.45 s to import) only where a table is asked for
+    import pandas as pd
 
 __all__ = [
     "bias",
@@ -278,6 +280,8 @@ def describe_table(
     >>> describe_table({"x": [0.1, -0.2, 0.3], "y": [1.0, 2.0, 4.0]}).loc["median"].tolist()
     [0.1, 2.0]
     """
+    import pandas as pd
+
     if not isinstance(columns, dict) or len(columns) == 0:
         raise InputError(
             "columns must be a non-empty dict mapping a name to an array of values, "
