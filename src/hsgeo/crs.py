@@ -28,6 +28,7 @@ The output CRS defaults to the UTM zone of the data's centre on that datum
 
 from __future__ import annotations
 
+import functools
 import re
 import threading
 from dataclasses import dataclass
@@ -541,6 +542,19 @@ def geographic_3d_crs(crs):
     return c
 
 
+@functools.lru_cache(maxsize=256)
+def _utm_crs_infos(name: str, lon: float, lat: float) -> tuple:
+    """PROJ's UTM CRSs of the datum ``name`` whose area of use holds the point, kept for the
+    process: the database query takes 0.1 s, and a process that orthorectifies several times
+    (a notebook, the test suite) asks for the same point again (issue 41)."""
+    from pyproj.aoi import AreaOfInterest
+    from pyproj.database import query_utm_crs_info
+
+    return tuple(
+        query_utm_crs_info(datum_name=name, area_of_interest=AreaOfInterest(lon, lat, lon, lat))
+    )
+
+
 def default_output_crs(lon_deg: float, lat_deg: float, datum):
     """The UTM zone of a point on a datum: the default output CRS of the data centred there.
 
@@ -567,8 +581,6 @@ def default_output_crs(lon_deg: float, lat_deg: float, datum):
         If the datum has no UTM zone there (e.g. ETRS89 outside Europe): pass ``--crs``.
     """
     from pyproj import CRS
-    from pyproj.aoi import AreaOfInterest
-    from pyproj.database import query_utm_crs_info
 
     lon = float((float(lon_deg) + 180.0) % 360.0 - 180.0)
     lat = float(lat_deg)
@@ -580,7 +592,7 @@ def default_output_crs(lon_deg: float, lat_deg: float, datum):
         name = datum.strip()
     else:
         name = geographic_3d_crs(datum).to_2d().name
-    infos = query_utm_crs_info(datum_name=name, area_of_interest=AreaOfInterest(lon, lat, lon, lat))
+    infos = _utm_crs_infos(name, lon, lat)
     zones = {}
     for info in infos:  # easting-northing UTM only (not ETRS89's "UTM zone 32N (N-E)" variants)
         m = re.fullmatch(rf"{re.escape(name)} / UTM zone (\d+)([NS])", info.name)
