@@ -546,7 +546,8 @@ def geographic_3d_crs(crs):
 def _utm_crs_infos(name: str, lon: float, lat: float) -> tuple:
     """PROJ's UTM CRSs of the datum ``name`` whose area of use holds the point, kept for the
     process: the database query takes 0.1 s, and a process that orthorectifies several times
-    (a notebook, the test suite) asks for the same point again (issue 41)."""
+    (a notebook, the test suite) asks for the same point again (issue 41).
+    """
     from pyproj.aoi import AreaOfInterest
     from pyproj.database import query_utm_crs_info
 
