@@ -283,8 +283,17 @@ class _Linearised:
         self.image = image
         self.shape = np.array(image.shape)[:, None]
 
-    def __call__(self, dE, dN, idx=slice(None)):
-        lp = self.lp0[:, idx] + self.Jinv[:, 0, idx] * dE + self.Jinv[:, 1, idx] * dN
+    def subset(self, idx) -> _Linearised:
+        """The same map at the points ``idx`` only: a search or a window evaluates it at the
+        same points hundreds of times, and taking the points once is most of a call's cost.
+        """
+        out = object.__new__(_Linearised)
+        out.lp0, out.Jinv = self.lp0[:, idx], self.Jinv[:, :, idx]
+        out.image, out.shape = self.image, self.shape
+        return out
+
+    def __call__(self, dE, dN):
+        lp = self.lp0 + self.Jinv[:, 0] * dE + self.Jinv[:, 1] * dN
         v = map_coordinates(self.image, lp, order=1, mode="constant", cval=np.nan)
         return np.where(np.any((lp < 0) | (lp > self.shape - 1), axis=0), np.nan, v)
 
@@ -304,14 +313,16 @@ def _ncc_sum(c, a, win, n_win) -> float:
     return float(np.sum(num[good] / den[good]))
 
 
-def _lucas_kanade(c, lin, idx, d0, h=0.2, n_iter=10):
-    """Shift (E, N) and gain/offset of one window, c ≈ g·a(P + d) + o, by Gauss–Newton."""
+def _lucas_kanade(c, lin, d0, h=0.2, n_iter=10):
+    """Shift (E, N) and gain/offset of one window, c ≈ g·a(P + d) + o, by Gauss–Newton
+    (``lin``: the along image at the window's points, :meth:`_Linearised.subset`).
+    """
     d = np.array(d0, float)
     g, o = 1.0, 0.0
     for _ in range(n_iter):
-        a = lin(d[0], d[1], idx)
-        ae = (lin(d[0] + h, d[1], idx) - lin(d[0] - h, d[1], idx)) / (2 * h)
-        an = (lin(d[0], d[1] + h, idx) - lin(d[0], d[1] - h, idx)) / (2 * h)
+        a = lin(d[0], d[1])
+        ae = (lin(d[0] + h, d[1]) - lin(d[0] - h, d[1])) / (2 * h)
+        an = (lin(d[0], d[1] + h) - lin(d[0], d[1] - h)) / (2 * h)
         ok = np.isfinite(a) & np.isfinite(ae) & np.isfinite(an)
         if ok.sum() < 20:
             return None
@@ -374,13 +385,13 @@ def register(
         (options.search_step_m / 2, options.search_step_m / 4, sub),
     ):
         g = np.arange(-half, half + 1e-9, step)
+        lin_idx, c_idx, w_idx = lin.subset(idx), cval[idx], win[idx]
         score = np.array(
             [
-                [_ncc_sum(cval[idx], lin(d0[0] + de, d0[1] + dn, idx), win[idx], len(sel))
-                 for dn in g]
+                [_ncc_sum(c_idx, lin_idx(d0[0] + de, d0[1] + dn), w_idx, len(sel)) for dn in g]
                 for de in g
             ]
-        )  # fmt: skip
+        )
         if not np.any(np.nan_to_num(score) != 0):
             break  # the along image covers no window: the check of the windows below says so
         i, j = np.unravel_index(np.nanargmax(score), score.shape)
@@ -390,7 +401,7 @@ def register(
     centres, shifts = [], []
     for k in range(len(sel)):
         idx = np.flatnonzero(win == k)
-        d = _lucas_kanade(cval[idx], lin, idx, d0)
+        d = _lucas_kanade(cval[idx], lin.subset(idx), d0)
         if d is not None:
             centres.append(cen[k])
             shifts.append(d)
