@@ -328,10 +328,10 @@ def _unmodelled_rows(cfg, seed, base_spectra, base_groups, truth_bands, lam) -> 
     # the lines the two patches span, computed once: a patch taken from the lazy cube by its
     # lines and samples computes every chunk of lines it touches, and the spectra and the
     # group means took each patch again (issue 41: 6 of the run's 13 CPU-s at the tests' size)
-    lo = min(int(lines.min()) for lines, _ in patches.values())
-    hi = max(int(lines.max()) for lines, _ in patches.values()) + 1
-    cube = res.cube[["reflectance"]].isel(line=slice(lo, hi)).compute()
-    patches = {k: (lines - lo, samples) for k, (lines, samples) in patches.items()}
+    first = min(int(lines.min()) for lines, _ in patches.values())
+    stop = max(int(lines.max()) for lines, _ in patches.values()) + 1
+    cube = res.cube[["reflectance"]].isel(line=slice(first, stop)).compute()
+    patches = {k: (lines - first, samples) for k, (lines, samples) in patches.items()}
     spectra = patch_spectra(cube, patches)
     groups = _group_means(cube, patches, lam)
     rows = []
