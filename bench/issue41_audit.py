@@ -13,6 +13,7 @@ figure also stands beside the previous main in a paired run (the done-means) is 
 
 from __future__ import annotations
 
+import calendar
 import json
 import time
 from pathlib import Path
@@ -372,6 +373,46 @@ def _suite_profile() -> dict:
     }
 
 
+#: the issue's figure for ``make test`` (its table: pytest 10 min 47 s, 2,558 tests, one pytest
+#: process, on the machine of the day it was filed)
+ISSUE_MAKE_TEST_S = 647.0
+#: two runs pair when the second began within this many seconds of the first one's end
+PAIR_GAP_S = 900.0
+
+
+def _stamp(r: dict) -> float:
+    """A run's end (``date_utc`` is written when it ends), in seconds."""
+    return calendar.timegm(time.strptime(r["date_utc"], "%Y-%m-%dT%H:%M:%SZ"))
+
+
+def _make_test_pairs(runs: list[dict], busy_cores: int) -> list[dict]:
+    """Back-to-back runs of the issue's commit (``role`` before) and of a later main (after) on
+    the same machine state and load (``busy_cores``), one right after the other: the ratio
+    after / before is what the same machine says of the change. This machine's speed moved by
+    a factor of 2.5 between days (the issue's 647 s for 8477cad's suite; the same commit's
+    1,600 s on 2026-11-29), so a figure of one day beside a goal of another is not a verdict."""
+    got = [r for r in runs if r.get("role") and r.get("busy_cores", 0) == busy_cores]
+    out = []
+    for a, b in zip(got, got[1:]):
+        if {a["role"], b["role"]} != {"before", "after"}:
+            continue
+        gap = _stamp(b) - (b.get("wall_seconds_with_venv") or 0.0) - _stamp(a)
+        if gap > PAIR_GAP_S:
+            continue
+        bef, aft = (a, b) if a["role"] == "before" else (b, a)
+        out.append(
+            {
+                "before": {k: bef.get(k) for k in ("commit", "date_utc", "pytest_seconds",
+                                                   "passed", "failed", "loadavg_start")},
+                "after": {k: aft.get(k) for k in ("commit", "date_utc", "pytest_seconds",
+                                                  "passed", "failed", "loadavg_start")},
+                "ratio_after_over_before": aft["pytest_seconds"] / bef["pytest_seconds"],
+                "gap_between_runs_s": round(gap, 1),
+            }
+        )  # fmt: skip
+    return out
+
+
 def make_test() -> dict:
     d = _load("make_test_runs.json")
     runs = [r for r in d["runs"] if r.get("pytest_seconds") and r.get("exit_status") == 0]
@@ -413,13 +454,27 @@ def make_test() -> dict:
                 if got
                 else None
             )
-    after = table["after_idle"]
+    # the verdict: the latest back-to-back pair on an idle machine, read both ways: the after
+    # run within the goal in seconds, and the ratio after / before within what the goal asks of
+    # the issue's figure (goal / 647 s), so that neither a fast hour nor a slow one decides it
+    pairs_idle, pairs_busy = _make_test_pairs(d["runs"], 0), _make_test_pairs(d["runs"], 1)
+    asked = goal / ISSUE_MAKE_TEST_S
+    last_pair = pairs_idle[-1] if pairs_idle else None
+    met = bool(
+        last_pair
+        and last_pair["after"]["pytest_seconds"] <= goal
+        and last_pair["ratio_after_over_before"] <= asked
+        and pairs_busy
+    )
     return {
         "line": "make test on a fresh clone: ≤ 8 min, no test removed for speed; reported idle "
         "and with one core busy, before and after",
-        "status": "met"
-        if after and after["pytest_seconds"] <= goal and table["after_one_core_busy"]
-        else "short",
+        "status": "met" if met else "short",
+        "verdict_from": "the latest idle pair (paired_idle[-1]): its after run ≤ goal_pytest_seconds "
+        "and its ratio after / before ≤ goal_over_issue_figure; a one-core-busy pair reported",
+        "goal_over_issue_figure": asked,
+        "paired_idle": pairs_idle,
+        "paired_one_core_busy": pairs_busy,
         "before_and_after": table,
         "reported_idle_and_busy_before_and_after": all(v is not None for v in table.values()),
         "latest_idle": last,
