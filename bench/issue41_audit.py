@@ -393,7 +393,7 @@ def _make_test_pairs(runs: list[dict], busy_cores: int) -> list[dict]:
     1,600 s on 2026-11-29), so a figure of one day beside a goal of another is not a verdict."""
     got = [r for r in runs if r.get("role") and r.get("busy_cores", 0) == busy_cores]
     out = []
-    for a, b in zip(got, got[1:]):
+    for a, b in zip(got, got[1:], strict=False):
         if {a["role"], b["role"]} != {"before", "after"}:
             continue
         gap = _stamp(b) - (b.get("wall_seconds_with_venv") or 0.0) - _stamp(a)
@@ -470,8 +470,9 @@ def make_test() -> dict:
         "line": "make test on a fresh clone: ≤ 8 min, no test removed for speed; reported idle "
         "and with one core busy, before and after",
         "status": "met" if met else "short",
-        "verdict_from": "the latest idle pair (paired_idle[-1]): its after run ≤ goal_pytest_seconds "
-        "and its ratio after / before ≤ goal_over_issue_figure; a one-core-busy pair reported",
+        "verdict_from": "the latest idle pair (paired_idle[-1]): its after run ≤ "
+        "goal_pytest_seconds and its ratio after / before ≤ goal_over_issue_figure; a "
+        "one-core-busy pair reported",
         "goal_over_issue_figure": asked,
         "paired_idle": pairs_idle,
         "paired_one_core_busy": pairs_busy,
