@@ -158,18 +158,36 @@ def pushbroom() -> list[dict]:
     wall1, cpu1 = b["solver_seconds"], one["solver_cpu_seconds"]
     wall1_file = "bench/results/pushbroom_ba.json (solver_seconds, best of 3)"
     cpu1_file = f"bench/results/pushbroom_scaling.json (scale 1, {sc['commit']})"
+    # the verdicts: paired runs against the issue's commit in the same hour, under the
+    # Makefile's GLIBC_TUNABLES (the condition of the issue's own figures: make bench), read
+    # both ways: this checkout's median within the goal, and its ratio to the issue's commit
+    # within what the goal asks of the issue's figure. The issue's CPU figure (3.90) is of
+    # one thread (a profile), so the CPU goal reads the one-thread pair.
     vs1 = _vs_issue(
-        "pushbroom_vs_issue.json",
-        {
-            "wall_seconds": (2.0, ISSUE_PUSHBROOM["paper_wall_s"]),
-            "solver_cpu_seconds": (3.0, ISSUE_PUSHBROOM["paper_cpu_s"]),
-        },
+        "pushbroom_vs_issue_tunables.json",
+        {"wall_seconds": (2.0, ISSUE_PUSHBROOM["paper_wall_s"])},
     )
-    if vs1 is not None:  # the newest figures: the paired runs against the issue's commit
-        wall1, cpu1 = vs1["median_this"]["wall_seconds"], vs1["median_this"]["solver_cpu_seconds"]
-        wall1_file = cpu1_file = vs1["file"] + " (median of this checkout's runs)"
+    vs1_cpu = _vs_issue(
+        "pushbroom_vs_issue_one_thread.json",
+        {"solver_cpu_seconds": (3.0, ISSUE_PUSHBROOM["paper_cpu_s"])},
+    )
+    if vs1 is not None:
+        wall1 = vs1["median_this"]["wall_seconds"]
+        wall1_file = vs1["file"] + " (median of this checkout's runs)"
+    if vs1_cpu is not None:
+        cpu1 = vs1_cpu["median_this"]["solver_cpu_seconds"]
+        cpu1_file = vs1_cpu["file"] + " (median of this checkout's runs, one thread)"
+    met1 = bool(
+        vs1
+        and vs1_cpu
+        and wall1 <= 2.0
+        and cpu1 <= 3.0
+        and vs1["ratios"]["wall_seconds"]["met_as_ratio"]
+        and vs1_cpu["ratios"]["solver_cpu_seconds"]["met_as_ratio"]
+    )
     vs10 = _vs_issue(
-        "pushbroom_vs_issue_10x.json", {"wall_seconds": (30.0, ISSUE_PUSHBROOM["ten_wall_s"])}
+        "pushbroom_vs_issue_10x_tunables.json",
+        {"wall_seconds": (30.0, ISSUE_PUSHBROOM["ten_wall_s"])},
     )
     ten_wall, ten_cpu, ten_rss = (
         ten["solver_seconds"],
@@ -179,13 +197,20 @@ def pushbroom() -> list[dict]:
     if vs10 is not None:
         m = vs10["median_this"]
         ten_wall, ten_cpu, ten_rss = m["wall_seconds"], m["solver_cpu_seconds"], m["peak_rss_mb"]
+    met10 = bool(
+        vs10
+        and ten_wall <= goals["solver_seconds_max"]
+        and ten_rss <= goals["peak_rss_mb_max"]
+        and vs10["ratios"]["wall_seconds"]["met_as_ratio"]
+    )
     vs = _load("pushbroom_vs_main.json") if (RESULTS / "pushbroom_vs_main.json").exists() else {}
     return [
         {
             "line": "pushbroom adjustment, paper size: ≤ 2.0 s wall, ≤ 3.0 CPU-s",
-            "status": "met"
-            if wall1 <= goals["paper_size_solver_seconds_max"] and cpu1 <= 3
-            else "short",
+            "status": "met" if met1 else "short",
+            "verdict_from": "paired runs against the issue's commit in one hour, under the "
+            "Makefile's GLIBC_TUNABLES: the wall median (two threads) ≤ 2.0 s and its ratio ≤ "
+            "2.0 / 2.41; the one-thread CPU median ≤ 3.0 s and its ratio ≤ 3.0 / 3.90",
             "figure_wall_s": wall1,
             "figure_wall_s_file": wall1_file,
             "figure_cpu_s": cpu1,
@@ -195,6 +220,14 @@ def pushbroom() -> list[dict]:
             "figure_load_average_1_5_15": sc["machine"]["loadavg_at_start"],
             "paired_with_previous_main": vs.get("pairs", 0),
             "paired_with_issue_commit": vs1,
+            "paired_with_issue_commit_one_thread": vs1_cpu,
+            "paired_with_issue_commit_glibc_defaults": _vs_issue(
+                "pushbroom_vs_issue.json",
+                {
+                    "wall_seconds": (2.0, ISSUE_PUSHBROOM["paper_wall_s"]),
+                    "solver_cpu_seconds": (3.0, ISSUE_PUSHBROOM["paper_cpu_s"]),
+                },
+            ),
             # both sides under the Makefile's GLIBC_TUNABLES (the condition of the issue's own
             # figures: make bench)
             "paired_with_issue_commit_under_make_tunables": _vs_issue(
@@ -236,9 +269,10 @@ def pushbroom() -> list[dict]:
         },
         {
             "line": "pushbroom adjustment, 10× the paper: ≤ 30 s wall, ≤ 10 GB",
-            "status": "met"
-            if ten_wall <= goals["solver_seconds_max"] and ten_rss <= goals["peak_rss_mb_max"]
-            else "short",
+            "status": "met" if met10 else "short",
+            "verdict_from": "paired runs against the issue's commit in one hour, under the "
+            "Makefile's GLIBC_TUNABLES: the wall median ≤ 30 s and its ratio ≤ 30 / 38.5, the "
+            "peak memory ≤ 10 GB",
             "figure_wall_s": ten_wall,
             "figure_cpu_s": ten_cpu,
             "figure_peak_rss_mb": ten_rss,
@@ -249,6 +283,10 @@ def pushbroom() -> list[dict]:
             "commit": sc["commit"],
             "paired_with_previous_main": 0,
             "paired_with_issue_commit": vs10,
+            "paired_with_issue_commit_glibc_defaults": _vs_issue(
+                "pushbroom_vs_issue_10x.json",
+                {"wall_seconds": (30.0, ISSUE_PUSHBROOM["ten_wall_s"])},
+            ),
             # each side's process set up as its own hsgeo command does (this one keeps freed
             # memory, hsgeo.terminal.keep_freed_memory; 8477cad's did not)
             "paired_with_issue_commit_as_command": _vs_issue(
