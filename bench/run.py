@@ -3,8 +3,8 @@
 ``python bench/run.py [NAME ...]`` runs only the named ones (``engine``, ``pushbroom_ba``,
 ``pushbroom_scaling``, ``bal``, ``nist_strd``, ``mtf``, ``cube``, ``busy_machine``,
 ``lp_ransac``, ``lp_observations``, ``lp_parameters``, ``lp_scene_length``, ``orthomosaic``,
-``cli_startup``); each script also runs on its own with its options
-(``python bench/bench_pushbroom_ba.py --help``).
+``cli_startup``, ``issue41_pairs``, ``issue41_audit``); each script also runs on its own with
+its options (``python bench/bench_pushbroom_ba.py --help``).
 ``pushbroom_scaling`` is ``bench_pushbroom_ba.py --scaling …``, run after the pushbroom
 benchmark (issue 14).
 
@@ -41,6 +41,12 @@ for name, script, arguments in jobs:
     except SystemExit as e:  # a script's main() returning through sys.exit
         if e.code not in (0, None):
             raise
+# issue 41's pairs: this checkout and the issue's commit in turn (a git worktree of it), so
+# that the audit's verdicts do not depend on the machine's hour (bench/issue41_pairs.py)
+if not only or "issue41_pairs" in only:
+    print("== issue41_pairs.py", flush=True)
+    sys.argv = [str(here / "issue41_pairs.py")]
+    runpy.run_path(str(here / "issue41_pairs.py"), run_name="__main__")
 # issue 41's table, each figure beside its goal, from the files just written
 if not only or "issue41_audit" in only:
     print("== issue41_audit.py", flush=True)
