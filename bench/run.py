@@ -27,8 +27,11 @@ for script in sorted(here.glob("bench_*.py")):
         script.stem == "bench_pushbroom_ba"
     ):  # the scaling rows: bench/results/pushbroom_scaling.json
         jobs.append(("pushbroom_scaling", script, ["--scaling", "0.1,0.3,1,3,10"]))
+#: run by issue41_pairs.py in a whole `make bench`, in turn with the issue's commit (their files
+#: are written once, with the paired rounds); named alone they run as before
+PAIRED = {"bal", "orthomosaic"}
 for name, script, arguments in jobs:
-    if only and name not in only:
+    if (only and name not in only) or (not only and name in PAIRED):
         continue
     print(
         f"== {script.name} {' '.join(arguments)} "
