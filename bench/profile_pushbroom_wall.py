@@ -35,6 +35,7 @@ def main() -> None:
     ap.add_argument("--threads", type=int, default=None, help="numba threads (default: all)")
     ap.add_argument("--top", type=int, default=15)
     ap.add_argument("--out", default=str(HERE / "results" / "pushbroom_wall_profile.json"))
+    ap.add_argument("--pstats", help="also dump cProfile's statistics to this file (callers)")
     args = ap.parse_args()
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     import numba
@@ -56,6 +57,8 @@ def main() -> None:
     res = solve(p, blocks)
     pr.disable()
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    if args.pstats:
+        pr.dump_stats(args.pstats)
     st = pstats.Stats(pr).stats
     lock = "<method 'acquire' of '_thread.lock' objects>"
     waited = sum(v[2] for k, v in st.items() if k[2] == lock)

@@ -14,7 +14,10 @@ process):
 * ``points_by_item``: the points visited in the order of their first and last items (spline
   nodes), so that consecutive points write nearby tiles (fewer distinct tiles per 2,000 points);
 * ``rows_contiguous``: each point's rows gathered next to each other (no gather from the
-  observation order).
+  observation order);
+* ``rows_and_points_by_item``: both, the points in the order of ``points_by_item`` and their
+  rows gathered in that order (what the kernel would see were the rows written by point, the
+  points numbered along the items; the gather itself is not timed).
 
 It also counts, at the smallest scale, how many of the group × group expansions of a formation
 are of distinct pairs of groups (a group is one observation's spline items and weights): were
@@ -37,7 +40,13 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
-VARIANTS = ("as_is", "tiles_in_l1", "points_by_item", "rows_contiguous")
+VARIANTS = (
+    "as_is",
+    "tiles_in_l1",
+    "points_by_item",
+    "rows_contiguous",
+    "rows_and_points_by_item",
+)
 
 
 def _variant(args: list, name: str) -> list:
@@ -45,6 +54,19 @@ def _variant(args: list, name: str) -> list:
 
     a = list(args)
     cols, vals, fcol, fw, fd, jp, order, ptr = a[:8]
+    if name == "rows_and_points_by_item":
+        a = _variant(a, "points_by_item")
+        po = a[8]
+        counts = np.diff(ptr)[po]
+        rows = order[np.repeat(ptr[po] - np.r_[0, np.cumsum(counts)[:-1]], counts)
+                     + np.arange(counts.sum())]  # fmt: skip
+        for k in range(6):
+            a[k] = np.ascontiguousarray(a[k][rows])
+        a[6] = np.arange(rows.size, dtype=np.int64)
+        a[7] = np.r_[0, np.cumsum(counts)].astype(np.int64)
+        a[8] = np.arange(po.size, dtype=np.int64)
+        a[9] = np.ascontiguousarray(a[9][po])  # V⁻¹ of each point
+        return a
     if name == "tiles_in_l1":
         slot_of = a[14]
         a[14] = np.where(slot_of >= 0, slot_of % 64, -1)
@@ -124,7 +146,9 @@ def main(argv=None) -> int:
 
     scales = [float(s) for s in args.scales.split(",")]
     env = dict(os.environ, NUMBA_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1")
-    out = {"what": __doc__.split("\n\n")[0], "variants": {}, "runs": [],
+    import pushbroom_vs_main as V
+
+    out = {"what": __doc__.split("\n\n")[0], "variants": {}, "runs": [], "cpu": V._cpu(),
            "date_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}  # fmt: skip
     with tempfile.TemporaryDirectory(prefix="hsgeo-tiles-") as tmp:
         for sc in scales:
