@@ -258,6 +258,9 @@ def pushbroom() -> list[dict]:
                 "profile_cpu_s_one_thread": prof["rows"][0]["user_seconds"]
                 + prof["rows"][0]["system_seconds"],
                 "profile_load_average_1_5_15": prof.get("loadavg"),
+                "kernel_stages_probe": _stages_probe(),
+                "kernel_tiles_probe": _tiles_probe(),
+                "first_touch_probe": _first_touch_probe(),
             },
         },
         {
@@ -316,6 +319,40 @@ def _tiles_probe() -> dict | None:
         }
     out["group_pairs"] = d.get("group_pairs_at_smallest_scale")
     return out
+
+
+def _stages_probe() -> dict | None:
+    """What each stage of the reduced-matrix kernel costs at 1× (schur_stage_probe.py: the
+    kernel's source with the stage taken out, CPU seconds per formation, one thread)."""
+    try:
+        d = _load("schur_stage_probe.json")
+    except FileNotFoundError:
+        return None
+    return {
+        "file": "bench/results/schur_stage_probe.json",
+        "scale": d["scale"],
+        "formation_cpu_s": d["median_cpu_seconds"]["as_is"],
+        "stage_cpu_s": d["stage_cpu_seconds"],
+        "stage_share_of_kernel": d["stage_share_of_kernel"],
+        "cpu": d.get("cpu"),
+        "date_utc": d.get("date_utc"),
+    }
+
+
+def _first_touch_probe() -> dict | None:
+    """The first touch of the solve's memory (pushbroom_first_touch.py: two solves in one
+    process, the second reusing the first one's pages), with numpy's huge pages and without."""
+    try:
+        d = _load("pushbroom_first_touch.json")
+    except FileNotFoundError:
+        return None
+    return {
+        "file": "bench/results/pushbroom_first_touch.json",
+        "summary": d["summary"],
+        "transparent_hugepage": d.get("transparent_hugepage"),
+        "cpu": d.get("cpu"),
+        "date_utc": d.get("date_utc"),
+    }
 
 
 def _profile_10x(prof: dict) -> dict | None:

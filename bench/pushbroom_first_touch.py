@@ -8,9 +8,17 @@ Each run is one fresh process (one numba thread, one BLAS thread, the Makefile's
 scaling benchmark's problem (``bench_pushbroom_ba._problem``) is adjusted twice in a row, and
 each solve's user and system seconds and minor page faults are recorded. The second solve
 reuses the pages the first one faulted in, so the difference between the two is the first
-touch of the solve's memory. Each run is made twice, with numpy's default (``madvise`` of huge
-pages on its large arrays) and with ``NUMPY_MADVISE_HUGEPAGE=0`` (numpy's documented switch),
-in turn. Writes ``bench/results/pushbroom_first_touch.json``.
+touch of the solve's memory. Each run is made in three ways, in turn:
+
+* ``as_is``: the engine as it is (the Jacobian's kept arrays advised small pages,
+  ``hsgeo.adjust.system._small_pages_empty``; numpy advises huge pages for its other large
+  arrays);
+* ``buffers_numpy_default``: the Jacobian's arrays left to numpy's advice (huge pages), as
+  before the engine advised them;
+* ``all_small_pages``: ``NUMPY_MADVISE_HUGEPAGE=0`` (numpy's documented switch): no array of
+  the process advised huge pages.
+
+Writes ``bench/results/pushbroom_first_touch.json``.
 """
 
 from __future__ import annotations
@@ -27,12 +35,19 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 TUNABLES = "glibc.malloc.mmap_max=0:glibc.malloc.trim_threshold=4294967296"
-MODES = {"numpy_default_huge_pages": None, "numpy_madvise_hugepage_0": "0"}
+MODES = {"as_is": None, "buffers_numpy_default": None, "all_small_pages": "0"}
 
 
-def _child(scale: float, seed: int) -> dict:
+def _child(scale: float, seed: int, mode: str) -> dict:
     import gc
     import resource
+
+    import numpy as np
+
+    import hsgeo.adjust.system as S
+
+    if mode == "buffers_numpy_default":
+        S._small_pages_empty = lambda shape, dtype=np.float64: np.empty(shape, dtype=dtype)
 
     sys.path.insert(0, str(HERE))
     import bench_pushbroom_ba as B
@@ -78,10 +93,11 @@ def main(argv=None) -> int:
     ap.add_argument("--rounds", default="3,1", help="rounds per scale, in the order of --scales")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", type=Path, default=HERE / "results" / "pushbroom_first_touch.json")
-    ap.add_argument("--child", nargs=2, help=argparse.SUPPRESS)
+    ap.add_argument("--child", nargs=3, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.child:
-        print("RESULT " + json.dumps(_child(float(args.child[0]), int(args.child[1]))))
+        sc, seed, mode = args.child
+        print("RESULT " + json.dumps(_child(float(sc), int(seed), mode)))
         return 0
     sys.path.insert(0, str(HERE))
     import pushbroom_vs_main as V
@@ -106,7 +122,7 @@ def main(argv=None) -> int:
                 env.pop("NUMPY_MADVISE_HUGEPAGE", None)
                 if value is not None:
                     env["NUMPY_MADVISE_HUGEPAGE"] = value
-                cmd = [sys.executable, __file__, "--child", str(sc), str(args.seed)]
+                cmd = [sys.executable, __file__, "--child", str(sc), str(args.seed), mode]
                 load = os.getloadavg()
                 cp = subprocess.run(cmd, env=env, capture_output=True, text=True, check=True)
                 r = next(json.loads(x[7:]) for x in cp.stdout.splitlines() if x[:7] == "RESULT ")

@@ -10,6 +10,8 @@ convergence, or in every iteration from a settled iterate on
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from hsgeo.adjust.schur import _inv_blocks, _Normal
@@ -58,7 +60,9 @@ def _reject(blocks, masks, sy: _System, reject_k: float, row_point=None, leverag
         score = np.zeros(b.m)
         score[kept] = r[off : off + kept.size]
         off += kept.size
-        score = score.reshape(-1, g).max(axis=1)  # per group
+        # per group: the maximum of its g strided rows (numpy's max over a length-2 axis ran
+        # 7× slower, 0.12 against 0.016 CPU-s for 8.8 M rows; the same values)
+        score = functools.reduce(np.maximum, [score[k::g] for k in range(1, g)], score[0::g])
         cand = np.flatnonzero(score > reject_k)
         if not cand.size:
             continue

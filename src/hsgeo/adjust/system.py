@@ -11,6 +11,10 @@ path (:mod:`hsgeo.adjust._fast`).
 
 from __future__ import annotations
 
+import ctypes
+import functools
+import mmap
+import sys
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -433,8 +437,57 @@ class _Buffers:
         a = self.arrays.get(name)
         if a is None or a.dtype != dtype or a.shape[1:] != shape[1:] or a.shape[0] < shape[0]:
             self.arrays.pop(name, None)  # (its memory is free for the new one)
-            a = self.arrays[name] = np.empty(shape, dtype=dtype)
+            a = self.arrays[name] = _small_pages_empty(shape, dtype)
         return a[: shape[0]]
+
+
+#: Arrays from this size on are advised small pages by :func:`_small_pages_empty` (numpy
+#: advises huge pages from 4 MiB on).
+_SMALL_PAGES_MIN_BYTES = 4 << 20
+_PAGE = 4096
+
+
+@functools.cache
+def _madvise():
+    """The C library's ``madvise`` and ``MADV_NOHUGEPAGE`` (None where there is none)."""
+    advice = getattr(mmap, "MADV_NOHUGEPAGE", None)
+    if advice is None or not sys.platform.startswith("linux"):
+        return None
+    try:
+        fn = ctypes.CDLL(None, use_errno=True).madvise
+    except (OSError, AttributeError):  # pragma: no cover - a C library without it
+        return None
+    fn.argtypes = (ctypes.c_void_p, ctypes.c_size_t, ctypes.c_int)
+    fn.restype = ctypes.c_int
+    return fn, advice
+
+
+def _small_pages_empty(shape: tuple, dtype=np.float64) -> np.ndarray:
+    """``np.empty(shape, dtype)``, its whole pages advised ``MADV_NOHUGEPAGE`` before their
+    first touch where the platform has it (Linux) and the array has
+    :data:`_SMALL_PAGES_MIN_BYTES` or more.
+
+    numpy advises huge pages for its large arrays. On a virtual machine the first touch of a
+    huge page the guest has not used lately costs the host's backing of 2 MiB, and the
+    Jacobian's arrays are touched first in the first linearisation. Measured on a 2-core
+    virtual machine, the first solve of a process, one thread, the Makefile's GLIBC_TUNABLES:
+    at the paper's pushbroom size 0.14 system seconds with the advice and 0.60 without; at 10×
+    the paper 3.1 and 7.1; the user seconds the same (the kernels stream these arrays row by
+    row: huge pages' shorter page walks gained nothing measurable). A second solve in the same
+    process reuses the memory either way (0.03 against 0.01 system seconds at 1×). Mapping the
+    arrays anew with the advice instead gained as much in the first solve but faulted them in
+    again in every later one (0.12 to 0.16 system seconds at 1×, 2.1 to 2.3 at 10×).
+    """
+    a = np.empty(shape, dtype=dtype)
+    if a.nbytes < _SMALL_PAGES_MIN_BYTES:
+        return a
+    m = _madvise()
+    if m is not None:
+        addr = a.ctypes.data
+        start = (addr + _PAGE - 1) // _PAGE * _PAGE
+        end = (addr + a.nbytes) // _PAGE * _PAGE
+        m[0](start, end - start, m[1])  # (a refusal changes the speed only: ignored)
+    return a
 
 
 def _assemble(
@@ -568,9 +621,14 @@ def _evaluate(
         r, jac = _block_residuals(blk, values, jacobian)
         t = clock.add("model", t)
         w = 1.0 / blk.sigma
-        rows_kept = np.flatnonzero(keep)
-        all_kept = rows_kept.size == blk.m
-        rw = r * w if all_kept else r.take(rows_kept) * w.take(rows_kept)
+        if jacobian:
+            rows_kept = np.flatnonzero(keep)
+            all_kept = rows_kept.size == blk.m
+            rw = r * w if all_kept else r.take(rows_kept) * w.take(rows_kept)
+        else:
+            # the residuals alone (a trial step): the kept rows by their mask, the same
+            # products; the indices and two gathers cost 1.7× as much at 8.8 M rows
+            rw = r * w if keep.all() else (r * w)[keep]
         if loss is not None:
             w, rw, loss_c[ib], part = _robust_rows(loss, ib, blk, w, rw, keep, jacobian)
             rho_sum += part
@@ -604,7 +662,7 @@ def _evaluate(
             slot_parts.append(blk_slots)
             pidx_parts.append(pidx)
             jp_parts.append(jp)
-        offset += rows_kept.size
+        offset += rw.size
     n_obs_rows = offset
     offset += _prior_rows(layout, jacobian, r_parts, slot_parts, pidx_parts, jp_parts)
     lc = loss_c if loss is not None else None
