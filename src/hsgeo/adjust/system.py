@@ -470,13 +470,15 @@ def _small_pages_empty(shape: tuple, dtype=np.float64) -> np.ndarray:
     numpy advises huge pages for its large arrays. On a virtual machine the first touch of a
     huge page the guest has not used lately costs the host's backing of 2 MiB, and the
     Jacobian's arrays are touched first in the first linearisation. Measured on a 2-core
-    virtual machine, the first solve of a process, one thread, the Makefile's GLIBC_TUNABLES:
-    at the paper's pushbroom size 0.14 system seconds with the advice and 0.60 without; at 10×
-    the paper 3.1 and 7.1; the user seconds the same (the kernels stream these arrays row by
-    row: huge pages' shorter page walks gained nothing measurable). A second solve in the same
-    process reuses the memory either way (0.03 against 0.01 system seconds at 1×). Mapping the
-    arrays anew with the advice instead gained as much in the first solve but faulted them in
-    again in every later one (0.12 to 0.16 system seconds at 1×, 2.1 to 2.3 at 10×).
+    virtual machine, the first solve of a process, one thread, the Makefile's GLIBC_TUNABLES
+    (bench/results/pushbroom_first_touch.json): at the paper's pushbroom size 3.45 CPU-s with
+    the advice, 0.24 of them system seconds, against 3.77 and 0.58 with numpy's huge pages (3
+    runs each); at 10× the paper 40.9 and 3.2 against 43.6 and 6.6 (one run each). A later
+    solve in the same process reuses the memory either way (3.27 and 3.26 CPU-s at 1×); the
+    user seconds are the same (the kernels stream these arrays row by row: huge pages' shorter
+    page walks gained nothing measurable). Mapping the arrays anew with the advice gained as
+    much in the first solve but faulted them in again in every later one (measured ad hoc,
+    0.11–0.18 system seconds a later solve at 1×; not kept).
     """
     a = np.empty(shape, dtype=dtype)
     if a.nbytes < _SMALL_PAGES_MIN_BYTES:
