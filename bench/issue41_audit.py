@@ -139,7 +139,8 @@ def _vs_issue(name: str, goals: dict) -> dict | None:
 
 def _kept_stages(prof: dict) -> float | None:
     """CPU seconds (one thread) of the stages the profile says stay: the three reduced-matrix
-    formations and the LP model's evaluations; beside the 3.0-CPU-s goal they bound it."""
+    formations and the LP model's evaluations, to set beside the 3.0-CPU-s goal (what the rest
+    of the solve may take at most)."""
     w = (prof.get("what_remains_at_1x") or {}).get("cpu_seconds")
     if not w:
         return None

@@ -186,13 +186,16 @@ def _remains(row: dict) -> dict | None:
         "share": {k: v / total for k, v in parts.items()},
         "why": "the reduced matrix is formed 3 times (fewer is design C, measured above); its "
         "kernel's internals are the BAL benchmark's (adjust._fast._reduced_kernel). The model "
-        "is 002 eq. (2)-(4) with the crossing time by Newton, one pass per observation per "
-        "evaluation (1 + its trial per iteration and the final residuals); error_model="
+        "is 002 eq. (2)-(4) with the crossing time by Newton, evaluated once per "
+        "linearisation and once per trial (the passes of each call: "
+        "pushbroom_model_passes.json); error_model="
         "'numpy' or fastmath on it changed its CPU seconds by < 3 % (measured). The system "
         "time is the first touch of the ≈ 270 MB of row-compressed arrays of one "
-        "linearisation (their format is the kernels'); keeping freed memory (the Makefile's "
-        "GLIBC_TUNABLES, the command's keep_freed_memory) did not lower it at 1× "
-        "(pushbroom_malloc.json: these pages are the peak's, touched once), at 10× it did",
+        "linearisation (their format is the kernels'), advised small pages since 38ed0da "
+        "(its cost with and without: pushbroom_first_touch.json); keeping freed memory "
+        "(the Makefile's GLIBC_TUNABLES, the command's "
+        "keep_freed_memory) did not lower it at 1× (pushbroom_malloc.json: these pages are "
+        "the peak's, touched once), at 10× it did",
     }
 
 
@@ -234,14 +237,15 @@ def _remains_10x(row: dict, one: dict | None, touch: dict | None) -> dict | None
         "first_touch_of_peak": first,
         "why": "the parts of the 1× account at ten times the observations: the reduced "
         f"matrix, {kernel.get('calls', 0)} formations, grows "
-        f"{growth.get('reduced_matrix_kernel', float('nan')):.2f}× per observation (not "
-        "measured why; the lead: the tiles of the item pairs that occur outgrow the caches, "
-        "so each point's group × group blocks would be written to memory rather than "
-        "cache); the model's evaluations grow linearly, with the extra linearisation and "
+        f"{growth.get('reduced_matrix_kernel', float('nan')):.2f}× per observation (the tiles "
+        "of the item pairs that occur outgrow the caches: their cost held in L1, at 1× and "
+        "10×, is in schur_tiles_probe.json); the model's evaluations grow linearly, with "
+        "the extra linearisation and "
         "trials of the 10× solve (a refused step "
         "retried with the thrown points held); the system time is the kernel zeroing the "
         "pages of the peak memory on their first touch, at this machine's cost per GiB "
-        "(first_touch_of_peak: lower only with a lower peak)",
+        "(first_touch_of_peak), lower with a lower peak or with small pages for the "
+        "Jacobian's arrays (pushbroom_first_touch.json)",
     }
 
 

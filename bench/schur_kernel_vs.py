@@ -61,8 +61,6 @@ def _capture(scale: float, seed: int, path: Path) -> None:
 
 
 def _time(root: Path, path: Path, calls: int) -> dict:
-    import resource
-
     import hsgeo.adjust._fast as F
 
     if not Path(F.__file__).resolve().is_relative_to(root.resolve()):
@@ -72,14 +70,23 @@ def _time(root: Path, path: Path, calls: int) -> dict:
     out = F._reduced_kernel(*args)
     digest = hashlib.sha1(out[0].tobytes() + out[1].tobytes()).hexdigest()[:12]
     del out
+    return {"hash": digest, "cpu_seconds": kernel_cpu_seconds(F._reduced_kernel, args, calls)}
+
+
+def kernel_cpu_seconds(kernel, args, calls: int) -> list[float]:
+    """The CPU seconds (user + system, this process) of ``calls`` calls of ``kernel(*args)``,
+    each on its own; the caller has called it once already (compiled kernels loaded, pages
+    touched). Shared by the kernel probes (schur_tiles_probe.py, schur_stage_probe.py)."""
+    import resource
+
     cpu = []
     for _ in range(calls):
         r0 = resource.getrusage(resource.RUSAGE_SELF)
-        out = F._reduced_kernel(*args)
+        out = kernel(*args)
         r1 = resource.getrusage(resource.RUSAGE_SELF)
         cpu.append((r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime))
         del out
-    return {"hash": digest, "cpu_seconds": cpu}
+    return cpu
 
 
 def _commit(root: Path) -> str | None:

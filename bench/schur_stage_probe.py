@@ -91,19 +91,14 @@ def _write_variants(tmp: Path) -> None:
 
 
 def _child(tmp: Path, path: Path, name: str, calls: int) -> dict:
-    import resource
+    sys.path[:0] = [str(tmp), str(HERE)]
+    from schur_kernel_vs import kernel_cpu_seconds
 
-    sys.path.insert(0, str(tmp))
     F = importlib.import_module(f"_fast_{name}")
     with open(path, "rb") as f:
         args = pickle.load(f)
     F._reduced_kernel(*args)  # compiled, pages touched
-    cpu = []
-    for _ in range(calls):
-        r0 = resource.getrusage(resource.RUSAGE_SELF)
-        F._reduced_kernel(*args)
-        r1 = resource.getrusage(resource.RUSAGE_SELF)
-        cpu.append((r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime))
+    cpu = kernel_cpu_seconds(F._reduced_kernel, args, calls)
     return {"cpu_seconds": cpu, "points": int(args[7].size - 1), "rows": int(args[6].size)}
 
 

@@ -86,20 +86,16 @@ def _variant(args: list, name: str) -> list:
 
 
 def _child(path: Path, name: str, calls: int) -> dict:
-    import resource
-
     import hsgeo.adjust._fast as F
+
+    sys.path.insert(0, str(HERE))
+    from schur_kernel_vs import kernel_cpu_seconds
 
     with open(path, "rb") as f:
         args = _variant(pickle.load(f), name)
     F._reduced_kernel(*args)  # compiled kernels loaded, pages touched
-    cpu = []
-    for _ in range(calls):
-        r0 = resource.getrusage(resource.RUSAGE_SELF)
-        F._reduced_kernel(*args)
-        r1 = resource.getrusage(resource.RUSAGE_SELF)
-        cpu.append((r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime))
-    return {"cpu_seconds": cpu, "rows": int(args[6].size)}
+    return {"cpu_seconds": kernel_cpu_seconds(F._reduced_kernel, args, calls),
+            "rows": int(args[6].size)}  # fmt: skip
 
 
 def _distinct_pairs(path: Path) -> dict:

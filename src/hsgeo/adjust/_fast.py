@@ -1072,8 +1072,9 @@ def point_excess(r_trial, r, u, pidx, n_pts):  # pragma: no cover - compiled
     over the linearly predicted squared residual of a step (``u = J h``), rows without a point
     left out. The values of numpy's ``np.bincount(pidx[rows], weights=r_trial[rows] ** 2 −
     (r[rows] + u[rows]) ** 2)`` (the same products, summed in row order) in one pass without
-    the four gathered copies, which took 0.9 of the 1.3 s that ``_hold_points`` spent at 10×
-    the paper's pushbroom block (issue 41).
+    the gathered copies: at 10× the paper's pushbroom block they and the bincount took 0.62
+    of the 1.33 s that ``_hold_points`` spent on the main thread over the solve's 3 calls
+    (py-spy samples; issue 41).
     """
     out = np.zeros(n_pts)
     for i in range(pidx.size):
