@@ -7,9 +7,10 @@ settings) on one numba thread and one BLAS thread, with :func:`_lines_kernel` (0
 crossing time by Newton) wrapped from outside: for each call, whether it formed the derivatives
 (a linearisation) or only the residuals (a trial), its CPU seconds, and how far each
 observation's crossing time moved from where its Newton started (``|Δt|``, s). An observation
-whose time moved by less than ``NEWTON_TOL_S`` was evaluated in one pass; the others took two
-or more. What this measures is where design B of issue 29 (the trial evaluated with its
-derivatives, reused as the next linearisation) would save: a linearisation right after an
+whose time moved by less than the call's tolerance (``NEWTON_TOL_S``; a trial's
+``TRIAL_TOL_S`` since issue 41) was evaluated in one pass; the others took two or more. What
+this measures is where design B of issue 29 (the trial evaluated with its derivatives, reused
+as the next linearisation) would save: a linearisation right after an
 accepted trial evaluates the model at the trial's own crossing times once more. Nothing in the
 library is changed; it writes ``bench/results/pushbroom_model_passes.json``.
 """
@@ -59,7 +60,7 @@ def main() -> None:
                "observations": int(a[names.index("pidx")].size)}  # fmt: skip
         if a[names.index("timed")]:
             moved = np.abs(dts - before)
-            row["share_one_pass"] = float((moved < K.NEWTON_TOL_S).mean())
+            row["share_one_pass"] = float((moved < a[names.index("tol_s")]).mean())
             q = np.quantile(moved, [0.5, 0.9, 0.99])
             row["moved_s_quantiles_50_90_99"] = [float(v) for v in q]
         calls.append(row)

@@ -320,7 +320,10 @@ def test_navigation_in_radians_names_the_unit(cmd, inputs, capsys):  # noqa: F81
     assert rc == 2 and "navigation angles not in degrees" in err, err
     assert "Traceback" not in err
     res = json.loads(out)
-    assert res["fit"]["verdict"] == "poor" and res["sigma0"] > 1e3
+    # σ0 is that of an adjustment that does not converge in 50 iterations, whose path on
+    # such input is chaotic (crossing times whose Newton does not converge go on at the next
+    # evaluation): 3.8e4 before issue 41's trial residuals, 795 after; any such σ0 is poor
+    assert res["fit"]["verdict"] == "poor" and res["sigma0"] > 100
     rc, out, err = run_cli([*base_argv(cmd, d), "--json", "--accept-poor-fit"], capsys)
     assert rc == 0, err
     assert json.loads(out)["fit"]["verdict"] == "poor"

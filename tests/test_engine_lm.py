@@ -107,3 +107,57 @@ def test_geodesic_acceleration_refuses_a_points_block():
     p.add("points", P, points=True)
     with pytest.raises(InputError, match="geodesic is not available with a points block"):
         adjust(p, [Bearings(st, pt, th, 1e-3)], geodesic=0.75)
+
+
+class _CountedSqrt(_Sqrt):
+    """_Sqrt that counts its evaluations, the trial ones apart."""
+
+    def __init__(self, t, y):
+        super().__init__(t, y)
+        self.calls = {"linearisation": 0, "residuals": 0, "trial": 0}
+
+    def evaluate(self, values, jacobian):
+        self.calls["linearisation" if jacobian else "residuals"] += 1
+        return super().evaluate(values, jacobian)
+
+    def trial_residuals(self, values):
+        self.calls["trial"] += 1
+        return super().evaluate(values, False)[0]
+
+
+def test_the_solver_costs_its_trial_steps_with_trial_residuals():
+    """A trial step's cost comes from ``ResidualBlock.trial_residuals`` (a block may stop an
+    internal iteration earlier there), never from ``evaluate`` without the Jacobian.
+    """
+    t = np.linspace(1.0, 2.0, 5)
+    blk = _CountedSqrt(t, 0.01 * t)
+    p = Parameters()
+    p.add("a", [4.0])
+    res = adjust(p, [blk], xtol=1e-12)
+    assert res.converged
+    assert blk.calls["trial"] >= res.iterations > 0
+    assert blk.calls["residuals"] == 1  # the result's residuals of every row, at the solution
+
+
+class _LowTrial(_CountedSqrt):
+    """A block whose trial residuals understate the cost (half the residuals)."""
+
+    def trial_residuals(self, values):
+        self.calls["trial"] += 1
+        return 0.5 * super().evaluate(values, False)[0]
+
+
+def test_a_trial_cost_below_the_exact_cost_switches_to_exact_trials():
+    """The first accepted trial whose cost the linearisation at its point finds too low (by
+    more than 1e-9 relative) ends the use of trial_residuals for the solve; the minimum is
+    the same.
+    """
+    t = np.linspace(1.0, 2.0, 5)
+    blk = _LowTrial(t, 0.01 * t)
+    p = Parameters()
+    p.add("a", [2e-4])  # near enough that the first trial is accepted
+    res = adjust(p, [blk], xtol=1e-12)
+    assert res.converged
+    assert res.value("a")[0] == pytest.approx(1e-4, rel=1e-9)
+    assert blk.calls["trial"] == 1
+    assert blk.calls["residuals"] > 1  # the later trials, and the result's residuals

@@ -403,3 +403,55 @@ def test_simulated_navigation_rates_are_the_derivative_of_the_poses(trajectory_e
     np.testing.assert_allclose(
         o.rpy_rate_nav_rad_s, (poses[0][1] - poses[1][1]) / (2 * h), atol=1e-9
     )
+
+
+def test_crossing_time_held_at_the_bound_is_a_fixed_point(tiny):
+    """An observation whose crossing time is held at ±T_MAX stops its Newton there (a further
+    pass would evaluate at the same time): its residuals equal those of an evaluation started
+    at the bound, and the other observations' equal those of a start at their crossing time.
+    """
+    from hsgeo.sensors._pushbroom_kernel import T_MAX
+
+    _, blocks, _ = _problem(tiny[0], y_as_time=True)
+    vals = dict(tiny[1].values)
+    pts = np.array(vals["points_m"], dtype=float)
+    pts[::3, 1] += 40.0  # a third of the points 40 m along track: their times run to the bound
+    vals["points_m"] = pts
+    a = blocks[0].fresh()
+    r_a, _ = a.evaluate(vals, False)
+    held = np.abs(a._dt_s) >= T_MAX
+    assert 0 < held.mean() < 1  # the case is exercised
+    b = blocks[0].fresh()
+    b._dt_s[:] = a._dt_s
+    r_b, _ = b.evaluate(vals, False)
+    rows = np.repeat(held, 2)
+    np.testing.assert_array_equal(r_a[rows], r_b[rows])
+    np.testing.assert_array_equal(b._dt_s[held], a._dt_s[held])
+    np.testing.assert_allclose(r_a[~rows], r_b[~rows], rtol=0, atol=1e-9)
+
+
+def test_trial_residuals_stop_the_newton_earlier_within_its_error(tiny):
+    """``trial_residuals`` stops the crossing time's Newton at a correction below TRIAL_TOL_S:
+    a small step from the last crossing times is one pass where ``evaluate`` takes two, and
+    its residuals differ from the converged ones by the second-order remainder only.
+    """
+    from hsgeo.sensors._pushbroom_kernel import NEWTON_TOL_S, TRIAL_TOL_S
+
+    _, blocks, _ = _problem(tiny[0], y_as_time=True)
+    vals = dict(tiny[1].values)
+    a = blocks[0].fresh()
+    a.evaluate(vals, True)  # the crossing times at the truth
+    b = blocks[0].fresh()
+    b._dt_s[:] = a._dt_s
+    step = dict(vals)
+    step["points_m"] = np.asarray(vals["points_m"], dtype=float) + np.array([0.0, 0.005, 0.0])
+    start = a._dt_s.copy()
+    r_exact, _ = a.evaluate(step, False)
+    r_trial = b.trial_residuals(step)
+    moved = np.abs(a._dt_s - start)
+    assert np.all((moved > NEWTON_TOL_S) & (moved < TRIAL_TOL_S))  # one pass in the trial
+    assert not np.array_equal(r_trial, r_exact)
+    # the remainder ½ ÿ e², e < 1e-4 s: far below a micro-pixel
+    np.testing.assert_allclose(r_trial, r_exact, rtol=0, atol=1e-6)
+    # the corrected times: where evaluate's second pass would start, within its tolerance
+    np.testing.assert_allclose(b._dt_s, a._dt_s, rtol=0, atol=NEWTON_TOL_S)

@@ -20,7 +20,11 @@ Jacobians come in one of three forms, keyed by parameter-block name:
 * a dense ``(m, block.size)`` array, for small global blocks (focal length, distortion).
 * a ``scipy.sparse`` matrix ``(m, block.size)``.
 
-Subclass :class:`ResidualBlock` and implement :meth:`~ResidualBlock.evaluate`.
+Subclass :class:`ResidualBlock` and implement :meth:`~ResidualBlock.evaluate`. A block whose
+model iterates internally may also implement :meth:`~ResidualBlock.trial_residuals`, the
+residuals with which the solver costs a trial step (the solver checks each accepted trial's cost
+against the linearisation that follows, and costs its trials with ``evaluate`` from the first
+that falls short).
 
 A residual block names the parameter blocks it depends on in one way: the mapping
 ``blocks`` from *role* (what the model calls the block: ``"poses"``, ``"intrinsics"``) to the
@@ -253,3 +257,16 @@ class ResidualBlock:
             ``∂r/∂(block)`` for each block the residuals depend on (see the module docstring).
         """
         raise NotImplementedError
+
+    def trial_residuals(self, values: dict[str, np.ndarray]) -> np.ndarray:
+        """The residuals at the solver's trial point of a step, whose cost only decides whether
+        the step is taken (and, rejecting in each iteration, which rows are outliers).
+
+        A block whose model iterates internally (a Newton on a crossing time) may stop earlier
+        here, with an error of second order in what its iteration still moves; the residuals
+        of a linearisation are always :meth:`evaluate`'s. The solver compares an accepted
+        trial's cost with the exact cost of the linearisation at its point, and costs every
+        later trial with :meth:`evaluate` once a trial's falls short by more than 1e-9
+        relative. The default is ``evaluate(values, False)[0]``.
+        """
+        return self.evaluate(values, False)[0]

@@ -78,6 +78,10 @@ from hsgeo.adjust.system import _Buffers, _Clock, _evaluate, _Layout, _NonFinite
 from hsgeo.adjust.threads import engine_threads
 from hsgeo.errors import ConvergenceError, DatumError, InputError, ObservationError
 
+#: An accepted trial's cost may fall short of the exact cost at its point by this much,
+#: relative, before the solver costs its trials exactly (see _Solve._confirm_trial)
+_TRIAL_COST_RTOL = 1e-9
+
 __all__ = ["adjust", "progress_text"]
 
 
@@ -246,6 +250,10 @@ class _Solve:
         #: scales of the last linearisation (the trial steps are costed with the same)
         self.loss_on = options.robust_start is not None
         self.loss_c: dict | None = None
+        #: trial steps without a loss are costed with the blocks' trial_residuals until one
+        #: accepted trial's cost is found below the exact cost of the linearisation at its
+        #: point (see _confirm_trial); from then on with evaluate, as the linearisations
+        self.trial_residuals = True
 
     # -- the linearised system -------------------------------------------------------------
     def linearise(self, check_redundancy: bool = False) -> tuple[_System, _Normal]:
@@ -282,8 +290,26 @@ class _Solve:
         if self.loss_on and self.loss_c is not None:
             loss = (opts.robust_start, opts.robust_start_k, self.loss_c)
         return _evaluate(
-            self.layout, self.blocks, self.masks, False, opts.compiled, self.clock, loss
-        )
+            self.layout, self.blocks, self.masks, False, opts.compiled, self.clock, loss,
+            trial=self.trial_residuals and loss is None,
+        )  # fmt: skip
+
+    def _confirm_trial(self, trial_cost: float | None, cost: float) -> None:
+        """Check an accepted trial's cost against the exact cost at its point.
+
+        ``trial_cost``: the cost of the accepted trial step, with the same rows and without a
+        loss as the linearisation at its point whose cost is ``cost`` (None: not comparable).
+        :meth:`ResidualBlock.trial_residuals` may stop an internal iteration early, with an
+        error of second order in what it still moves (≤ 3e-12 relative in the chapter's
+        pushbroom adjustment); if the exact cost exceeds the trial's by more than 1e-9
+        relative, the model is not that smooth here (grossly wrong inputs, a crossing time
+        with two solutions), and every later trial is costed exactly (``evaluate``). The step
+        already taken stays: the minimisation goes on from its point, as from a restart.
+        """
+        if trial_cost is None or not self.trial_residuals:
+            return
+        if not cost <= trial_cost + _TRIAL_COST_RTOL * abs(trial_cost):
+            self.trial_residuals = False
 
     def reject(self, residuals: _System, sy: _System, ne: _Normal) -> bool:
         """Test the residuals of ``residuals`` (leverages from ``sy``, ``ne``); see robust."""
@@ -416,12 +442,17 @@ class _Solve:
                 self.loss_on = False
                 step.system = self.trial()
                 self.history[-1] = new_cost = step.system.cost
+            rejected_now = False
             if self.each and (rejecting or settled):
                 # 002 §3.4: outliers are rejected in each iteration, on the residuals at the
                 # new point, from the first settled iterate: before that, residuals reflect
                 # the initial values, not gross errors
                 rejecting = True
-                tested = not self.reject(step.system, sy, ne)
+                rejected_now = self.reject(step.system, sy, ne)
+                tested = not rejected_now
+            # the trial's cost, if the linearisation at its point costs the same rows the
+            # same way (no loss, no row rejected since)
+            check = None if self.loss_on or rejected_now else new_cost
             self._report(new_cost, lam)
             # chord steps (Kelley 1995, ch. 5): from a settled iterate on, the reduced matrix
             # barely changes, so the next steps reuse the last one formed (the gradient and
@@ -438,6 +469,7 @@ class _Solve:
             if chord is not None and ne.compiled_schur:
                 ne.S_chord = chord
             cost = sy.cost  # (lower than new_cost when observations were just rejected)
+            self._confirm_trial(check, cost)
 
     def _gauss_newton_step(self, ne: _Normal, lam: float, tol: float, cost: float):
         """The damped step at λ and its predicted decrease; converged chord steps are

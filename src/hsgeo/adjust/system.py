@@ -352,9 +352,14 @@ class _NonFinite(InputError):
     """A residual block returned non-finite residuals (at a trial step: a refused step)."""
 
 
-def _block_residuals(blk: ResidualBlock, values, jacobian: bool):
-    """One block's residuals (checked: shape and finite) and Jacobians."""
-    r, jac = blk.evaluate(values, jacobian)
+def _block_residuals(blk: ResidualBlock, values, jacobian: bool, trial: bool = False):
+    """One block's residuals (checked: shape and finite) and Jacobians (``trial``, without
+    them: :meth:`ResidualBlock.trial_residuals`).
+    """
+    if trial and not jacobian:
+        r, jac = blk.trial_residuals(values), None
+    else:
+        r, jac = blk.evaluate(values, jacobian)
     r = np.asarray(r, dtype=np.float64)
     if r.shape != (blk.m,):
         raise InputError(
@@ -580,6 +585,7 @@ def _evaluate(
     loss: tuple | None = None,
     fused: bool = True,
     buffers: _Buffers | None = None,
+    trial: bool = False,
 ) -> _System:
     """Whitened residuals (and with ``jacobian`` the row-compressed Jacobian) at the current
     values of ``layout.params``; rows of ``masks[i] == False`` are left out. ``compiled``
@@ -594,7 +600,8 @@ def _evaluate(
     ``fused`` (compiled, no loss): blocks with ``evaluate_into`` write their rows themselves
     (:class:`_FusedPart`), evaluated in :func:`_assemble`. ``buffers``: the Jacobian's arrays
     kept from the caller's last system, written again (:class:`_Buffers`; that system is
-    no longer used).
+    no longer used). ``trial`` (without ``jacobian``): the residuals at a trial point of a
+    step (:meth:`ResidualBlock.trial_residuals`).
     """
     from hsgeo.adjust._fused import _FusedPart
 
@@ -620,7 +627,7 @@ def _evaluate(
             jp_parts.append(None)
             offset += part.rows.size
             continue
-        r, jac = _block_residuals(blk, values, jacobian)
+        r, jac = _block_residuals(blk, values, jacobian, trial)
         t = clock.add("model", t)
         w = 1.0 / blk.sigma
         if jacobian:

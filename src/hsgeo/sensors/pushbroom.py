@@ -48,9 +48,14 @@ across the line is instead a time: the model's crossing time ``t*`` of the line,
 moved by its velocity and angular rate and the spline piece of ``t_e`` continued. It starts
 from the crossing time of the block's previous evaluation (``t_e`` at the first): near the
 solution an iteration moves most crossings by less than 1e-8 s, and one evaluation of the pose
-per observation suffices instead of two. The residuals carry the last Newton correction to
-first order (``ẏ_ref (t_e − t_k + e)`` and ``x − ẋ e``), so stopping at ``|e| < 1e-8 s`` leaves
-an error of ``½ ÿ e²`` (below 1e-13 px with the mount's ÿ of a few hundred px/s²); the
+per observation suffices instead of two. A time held at the bound ``±T_MAX`` ends its Newton
+(a further pass would evaluate the same time). The residuals carry the last Newton correction
+to first order (``ẏ_ref (t_e − t_k + e)`` and ``x − ẋ e``), so stopping at ``|e| < 1e-8 s``
+leaves an error of ``½ ÿ e²`` (below 1e-13 px with the mount's ÿ of a few hundred px/s²); the
+solver's trial steps (:meth:`PushbroomLines.trial_residuals`) stop at ``|e| < 1e-4 s``
+(``TRIAL_TOL_S``: 2.5e-6 px at that ÿ; the chapter's ÿ is below 0.5 px/s²), one pass per
+observation from the second step on, and the solver checks each accepted trial's cost against
+the exact cost of the linearisation at its point (:class:`hsgeo.adjust.ResidualBlock`); the
 derivatives, taken at ``t_k``, depend on where Newton started only to ~1e-9 relative. ``ẏ``
 and ``ẋ`` are the image rates along the corrected trajectory. The derivatives
 are evaluated at ``t*``, so they do not contain the time error, and the node derivatives keep
@@ -93,7 +98,7 @@ from hsgeo.distortion import (
 )
 from hsgeo.errors import InputError, ObservationError
 from hsgeo.rotations import R_from_opk, R_from_rpy, dR_dopk, dR_drpy
-from hsgeo.sensors._pushbroom_kernel import _lines_kernel
+from hsgeo.sensors._pushbroom_kernel import NEWTON_TOL_S, TRIAL_TOL_S, _lines_kernel
 from hsgeo.sensors._pushbroom_rays import line_runs, rays_by_line
 from hsgeo.sensors.mount import Mount, line_time, unit
 from hsgeo.trajectory import R_BODY_FROM_PLATFORM, SplineNodes, bspline_basis
@@ -586,7 +591,30 @@ class PushbroomLines(ResidualBlock):
         # the spline weights go to fw, whitened rows' factored weights (no w_out)
         self._kernel(values, True, r, np.empty((0, 4)), derivs, dst, w_row, fw, gd, cols)
 
-    def _kernel(self, values, jacobian, r, w_out, derivs, dst, w_row, fw, gd=None, cols=None):
+    def trial_residuals(self, values):
+        """The residuals at the solver's trial point of a step (see
+        :meth:`~hsgeo.adjust.ResidualBlock.trial_residuals`): the crossing time's Newton stops
+        at a correction below ``TRIAL_TOL_S`` (1e-4 s) instead of ``NEWTON_TOL_S``. From the
+        second step on most observations then take one pass instead of two (the residuals
+        carry the correction to first order: exact to ``½ ÿ e²``, see ``TRIAL_TOL_S``); the
+        linearisation at an accepted step starts from the corrected times.
+        """
+        m = self.point.size
+        r = np.empty(2 * m)
+        V = np.empty((2, 11))  # as evaluate without the Jacobian (one compilation)
+        no_w = np.zeros(0)
+        no_w.flags.writeable = False
+        derivs = (np.empty((0, 3)), np.empty((0, 6)), V[:, 0:3], V[:, 3:6], V[:, 6:10], V[:, 10:11])
+        self._kernel(
+            values, False, r, np.empty((0, 4)), derivs, np.zeros(0, dtype=np.int64), no_w,
+            np.zeros((0, 4)), tol_s=TRIAL_TOL_S,
+        )  # fmt: skip
+        return r
+
+    def _kernel(
+        self, values, jacobian, r, w_out, derivs, dst, w_row, fw, gd=None, cols=None,
+        tol_s=NEWTON_TOL_S,
+    ):  # fmt: skip
         """One call of the compiled kernel (see ``_pushbroom_kernel._lines_kernel``)."""
         nm = self.blocks
         idx = self._basis[0]
@@ -616,6 +644,7 @@ class PushbroomLines(ResidualBlock):
             self.xy_px,
             self.timed,
             self.newton_iterations,
+            tol_s,
             self.y_rate_ref_px_s,
             bool(jacobian),
             self._dt_s,
