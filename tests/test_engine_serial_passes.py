@@ -5,7 +5,7 @@ import pytest
 from test_engine_fused import _masks
 from test_pushbroom import _problem
 
-from hsgeo.adjust._fast import point_excess
+from hsgeo.adjust._fast import kept_whitened, point_excess
 from hsgeo.adjust.solver import _largest
 from hsgeo.adjust.system import _evaluate, _Layout
 from hsgeo.simulate.pushbroom_campaign import simulate
@@ -21,6 +21,20 @@ def test_point_excess_equals_the_numpy_expression_bit_for_bit():
         pidx[rows], weights=r_trial[rows] ** 2 - (r[rows] + u[rows]) ** 2, minlength=n_pts
     )
     np.testing.assert_array_equal(point_excess(r_trial, r, u, pidx, n_pts), want)
+
+
+@pytest.mark.parametrize("share", [0.0, 0.3])
+def test_kept_whitened_equals_the_numpy_expression_bit_for_bit(share):
+    rng = np.random.default_rng(5)
+    m = 4001
+    r = rng.standard_normal(m) * 10.0 ** rng.uniform(-3, 3, m)
+    sigma = 10.0 ** rng.uniform(-2, 1, m)
+    keep = rng.random(m) >= share
+    out = np.full(m + 3, np.nan)
+    kept_whitened(r, sigma, keep, out)
+    n = int(keep.sum())
+    np.testing.assert_array_equal(out[:n], (r * (1.0 / sigma))[keep])
+    assert np.isnan(out[n:]).all()  # nothing written past the kept rows
 
 
 @pytest.mark.parametrize("seed", range(5))

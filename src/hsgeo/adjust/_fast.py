@@ -1067,6 +1067,18 @@ def scatter_points(jp, pidx, u, n_pts):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
+def kept_whitened(r, sigma, keep, out):  # pragma: no cover - compiled
+    """``out[:n] = (r · (1/σ))[keep]``, ``n`` the kept rows, in one pass: the products of
+    numpy's ``r * (1.0 / sigma)``, bit for bit (see ``system._residuals_only``).
+    """
+    t = 0
+    for i in range(r.size):
+        if keep[i]:
+            out[t] = r[i] * (1.0 / sigma[i])
+            t += 1
+
+
+@njit(cache=True)
 def point_excess(r_trial, r, u, pidx, n_pts):  # pragma: no cover - compiled
     """Per point, the sum over its rows of ``r_trial² − (r + u)²``: the excess of the actual
     over the linearly predicted squared residual of a step (``u = J h``), rows without a point

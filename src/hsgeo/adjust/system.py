@@ -606,6 +606,8 @@ def _evaluate(
     from hsgeo.adjust._fused import _FusedPart
 
     clock = clock or _Clock()
+    if not jacobian and loss is None:
+        return _residuals_only(layout, blocks, masks, clock, trial)
     t = time.perf_counter()
     values = layout.params.values()
     r_parts, slot_parts, pidx_parts, jp_parts = [], [], [], []
@@ -695,6 +697,36 @@ def _evaluate(
     gd_parts = [(*sl.row_range, sl.g, sl.d) for sl in slot_parts if isinstance(sl, _FusedPart)]
     clock.add("jacobian", t)
     return _System(r_all, Jrc, pidx, Jp, n_obs_rows, lc, robust, gd_parts)
+
+
+def _residuals_only(layout: _Layout, blocks, masks, clock: _Clock, trial: bool) -> _System:
+    """:func:`_evaluate` without the Jacobian and without a loss: the kept rows' whitened
+    residuals, written once into the system's vector (:func:`_fast.kept_whitened`, the same
+    products ``r · (1/σ)`` as the linearisation's) instead of a product, a selection and a
+    concatenation of new arrays each (at 10× the paper's pushbroom block, 8.8 M rows: 0.17 s of
+    wall time a trial step, on the main thread alone).
+    """
+    from hsgeo.adjust._fast import kept_whitened
+
+    t = time.perf_counter()
+    values = layout.params.values()
+    priors: list[np.ndarray] = []
+    _prior_rows(layout, False, priors, [], [], [])
+    kept = [int(np.count_nonzero(keep)) for keep in masks]
+    out = np.empty(sum(kept) + sum(p.size for p in priors))
+    offset = 0
+    for blk, keep, n in zip(blocks, masks, kept, strict=True):
+        r, _ = _block_residuals(blk, values, False, trial)
+        t = clock.add("model", t)
+        sigma = np.broadcast_to(np.asarray(blk.sigma, dtype=np.float64), (blk.m,))
+        kept_whitened(r, np.ascontiguousarray(sigma), np.asarray(keep, dtype=bool), out[offset:])
+        offset += n
+    n_obs_rows = offset
+    for p in priors:
+        out[offset : offset + p.size] = p
+        offset += p.size
+    clock.add("model", t)
+    return _System(out, None, None, None, n_obs_rows, None)
 
 
 def _robust_rows(loss, ib: int, blk: ResidualBlock, w, rw, keep, jacobian: bool):
