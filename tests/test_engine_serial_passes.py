@@ -5,7 +5,16 @@ import pytest
 from test_engine_fused import _masks
 from test_pushbroom import _problem
 
-from hsgeo.adjust._fast import kept_whitened, point_excess
+from hsgeo.adjust._fast import (
+    group_scores,
+    kept_whitened,
+    matvec,
+    matvec_points,
+    point_blocks_doubt,
+    point_excess,
+    point_rows_dot,
+    standardised,
+)
 from hsgeo.adjust.solver import _largest
 from hsgeo.adjust.system import _evaluate, _Layout
 from hsgeo.simulate.pushbroom_campaign import simulate
@@ -96,3 +105,64 @@ def test_small_pages_arrays_are_numpy_arrays_advised_small_pages():
             assert "nh" in line.split()[1:]
             return
     raise AssertionError("no mapping holds the array")
+
+
+def test_matvec_points_equals_matvec_plus_point_rows_bit_for_bit(tiny):
+    p, blocks, _ = _problem(tiny[0])
+    lay = _Layout(p)
+    sy = _evaluate(lay, blocks, _masks(blocks, 0.1), True)
+    rng = np.random.default_rng(6)
+    x = rng.standard_normal(lay.n_c)
+    y = rng.standard_normal((lay.n_pts, 3))
+    want = matvec(*sy.Jrc.arrays, x) + point_rows_dot(sy.Jp, sy.pidx, y)
+    np.testing.assert_array_equal(matvec_points(*sy.Jrc.arrays, x, sy.Jp, sy.pidx, y), want)
+
+
+def test_point_blocks_doubt_equals_the_numpy_test():
+    """The compiled point-block test flags the blocks numpy's determinant test flagged: zero
+    diagonals as bad, singular and near-singular blocks as doubtful, regular ones as neither.
+    """
+    rng = np.random.default_rng(7)
+    n = 3000
+    A = rng.standard_normal((n, 3, 3)) * 10.0 ** rng.uniform(-3, 3, (n, 1, 1))
+    V = A @ A.transpose(0, 2, 1)
+    V[::7, 2, :] = V[::7, 1, :] * 2.0  # singular: rows (and columns) dependent
+    V[::7, :, 2] = V[::7, :, 1] * 2.0
+    V[::7, 2, 2] = 4.0 * V[::7, 1, 1]
+    V[3::11] *= np.array([1.0, 1.0, 0.0])[:, None] * np.array([1.0, 1.0, 0.0])  # a zero diagonal
+    thresh = 1e-11 * 27
+    bad, doubt, dv = point_blocks_doubt(V, thresh)
+    d = np.sqrt(np.maximum(np.diagonal(V, axis1=1, axis2=2), 0.0))
+    dz = d == 0
+    d = np.where(dz, 1.0, d)
+    Vs = V / d[:, :, None] / d[:, None, :]
+    want_bad = dz.any(axis=1)
+    want_doubt = ~(np.linalg.det(Vs) >= thresh) & ~want_bad
+    np.testing.assert_array_equal(bad, want_bad)
+    np.testing.assert_array_equal(doubt & ~bad, want_doubt)
+    np.testing.assert_array_equal(dv, d)
+    assert want_bad.sum() > 100 and want_doubt.sum() > 100 and (~want_bad & ~want_doubt).sum()
+
+
+@pytest.mark.parametrize("g", [1, 2, 3])
+def test_rejection_scores_equal_the_numpy_expressions_bit_for_bit(g):
+    """The outlier test's standardised residuals and per-group maxima, compiled, against the
+    numpy expressions they replaced (hsgeo.adjust.robust._reject).
+    """
+    rng = np.random.default_rng(8)
+    m = 3 * 1000
+    r = rng.standard_normal(m) * 10.0 ** rng.uniform(-2, 2, m)
+    h = rng.uniform(0.0, 1.2, m)  # leverages above 0.99 take the floor 1e-2
+    np.testing.assert_array_equal(
+        standardised(r, h), np.abs(r) / np.sqrt(np.maximum(1.0 - h, 1e-2))
+    )
+    np.testing.assert_array_equal(standardised(r, np.zeros(0)), np.abs(r))
+    keep = rng.random(m) > 0.3
+    keep[: 2 * g] = False  # whole groups without a kept row
+    score_rows = np.abs(rng.standard_normal(int(keep.sum())))
+    full = np.zeros(m)
+    full[np.flatnonzero(keep)] = score_rows
+    want = full[0::g].copy()
+    for k in range(1, g):
+        want = np.maximum(want, full[k::g])
+    np.testing.assert_array_equal(group_scores(score_rows, keep, g), want)

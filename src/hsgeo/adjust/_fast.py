@@ -1078,6 +1078,108 @@ def kept_whitened(r, sigma, keep, out):  # pragma: no cover - compiled
             t += 1
 
 
+@njit(cache=True, parallel=True)
+def matvec_points(cols, vals, fcol, fw, fd, x, jp, pidx, y):  # pragma: no cover - compiled
+    """``J_c x + J_p y`` row by row in one pass: :func:`matvec` plus :func:`point_rows_dot`,
+    the same sums added (bit for bit), without the two vectors and their sum as new arrays.
+    """
+    M, K = cols.shape
+    Q, kf = fcol.shape[1], fd.shape[1]
+    p = jp.shape[1]
+    out = np.zeros(M)
+    for i in prange(M):
+        acc = 0.0
+        for s in range(K):
+            c = cols[i, s]
+            if c >= 0:
+                acc += vals[i, s] * x[c]
+        for a in range(Q):
+            c0 = fcol[i, a]
+            if c0 >= 0:
+                t = 0.0
+                for j in range(kf):
+                    t += fd[i, j] * x[c0 + j]
+                acc += fw[i, a] * t
+        q = pidx[i]
+        u = 0.0
+        if q >= 0:
+            for k in range(p):
+                u += jp[i, k] * y[q, k]
+        out[i] = acc + u
+    return out
+
+
+@njit(cache=True, parallel=True)
+def point_blocks_doubt(V, thresh):  # pragma: no cover - compiled
+    """For 3 × 3 point blocks ``V``: ``bad`` (a zero diagonal entry), ``doubt`` (the others
+    whose unit-diagonal scaled determinant is not ``≥ thresh``: their eigenvalues decide) and
+    the scales ``dv = √max(diag V, 0)`` (1 where 0), as ``datum._undetermined_points`` forms
+    them with numpy (the scaled entries ``V_ij / dv_i / dv_j`` the same; the determinant by
+    cofactors, not LU: the two differ by rounding, ~1e-16, far below the threshold,
+    ``27 rank_rtol`` = 2.7e-10 by default).
+    """
+    n = V.shape[0]
+    bad = np.zeros(n, dtype=np.bool_)
+    doubt = np.zeros(n, dtype=np.bool_)
+    dv = np.empty((n, 3))
+    for q in prange(n):
+        zero = False
+        for k in range(3):
+            d = np.sqrt(max(V[q, k, k], 0.0))
+            if d == 0.0:
+                zero = True
+                d = 1.0
+            dv[q, k] = d
+        if zero:
+            bad[q] = True
+            continue
+        a = V[q, 0, 0] / dv[q, 0] / dv[q, 0]
+        b = V[q, 0, 1] / dv[q, 0] / dv[q, 1]
+        c = V[q, 0, 2] / dv[q, 0] / dv[q, 2]
+        d_ = V[q, 1, 0] / dv[q, 1] / dv[q, 0]
+        e = V[q, 1, 1] / dv[q, 1] / dv[q, 1]
+        f = V[q, 1, 2] / dv[q, 1] / dv[q, 2]
+        g = V[q, 2, 0] / dv[q, 2] / dv[q, 0]
+        h = V[q, 2, 1] / dv[q, 2] / dv[q, 1]
+        k_ = V[q, 2, 2] / dv[q, 2] / dv[q, 2]
+        det = a * (e * k_ - f * h) - b * (d_ * k_ - f * g) + c * (d_ * h - e * g)
+        doubt[q] = not det >= thresh
+    return bad, doubt, dv
+
+
+@njit(cache=True, parallel=True)
+def standardised(r, h):  # pragma: no cover - compiled
+    """``|r| / √max(1 − h, 0.01)`` (``|r|`` if ``h`` is empty): numpy's values of that
+    expression in one pass (the outlier test, :func:`hsgeo.adjust.robust._reject`).
+    """
+    out = np.empty(r.size)
+    if h.size == 0:
+        for i in prange(r.size):
+            out[i] = abs(r[i])
+    else:
+        for i in prange(r.size):
+            out[i] = abs(r[i]) / np.sqrt(max(1.0 - h[i], 1e-2))
+    return out
+
+
+@njit(cache=True)
+def group_scores(r_kept, keep, g):  # pragma: no cover - compiled
+    """Per group of ``g`` rows of a block, the largest of its kept rows' scores (0 if none is
+    kept); ``r_kept`` holds the kept rows' scores in order, ``keep`` the block's row mask.
+    """
+    m = keep.size
+    out = np.zeros(m // g)
+    t = 0
+    for i in range(m):
+        if keep[i]:
+            v = r_kept[t]
+            t += 1
+            j = i // g
+            if v > out[j]:
+                out[j] = v
+    return out
+
+
 @njit(cache=True)
 def point_excess(r_trial, r, u, pidx, n_pts):  # pragma: no cover - compiled
     """Per point, the sum over its rows of ``r_trial² − (r + u)²``: the excess of the actual

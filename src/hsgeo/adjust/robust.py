@@ -10,8 +10,6 @@ convergence, or in every iteration from a settled iterate on
 
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 
 from hsgeo.adjust.schur import _inv_blocks, _Normal
@@ -48,21 +46,22 @@ def _reject(blocks, masks, sy: _System, reject_k: float, row_point=None, leverag
     row of block ``i`` (blocks without points: every group on its own). ``masks`` is updated
     in place; returns True if any group was rejected.
     """
-    r = np.abs(sy.r[: sy.n_obs_rows])
-    if leverage is not None:
-        r = r / np.sqrt(np.maximum(1.0 - leverage[: sy.n_obs_rows], 1e-2))
+    from hsgeo.adjust._fast import group_scores, standardised
+
+    n = sy.n_obs_rows
+    # |r| / √max(1 − h, 0.01) in one compiled pass (numpy's expressions, the same values: at
+    # 10× the paper's pushbroom block these lines took 0.5 s on the main thread alone)
+    r = standardised(sy.r[:n], np.zeros(0) if leverage is None else leverage[:n])
     r /= max(NMAD_SCALE * float(np.median(r)), 1e-300) if r.size else 1.0  # robust σ about 0
     off = 0
     new_any = False
     for i, b in enumerate(blocks):
         g = b.group_size
-        kept = np.flatnonzero(masks[i])
-        score = np.zeros(b.m)
-        score[kept] = r[off : off + kept.size]
-        off += kept.size
-        # per group: the maximum of its g strided rows (numpy's max over a length-2 axis ran
-        # 7× slower, 0.12 against 0.016 CPU-s for 8.8 M rows; the same values)
-        score = functools.reduce(np.maximum, [score[k::g] for k in range(1, g)], score[0::g])
+        keep = np.asarray(masks[i], dtype=bool)
+        nk = int(np.count_nonzero(keep))
+        # per group: the largest score of its kept rows (0: none kept)
+        score = group_scores(r[off : off + nk], keep, g)
+        off += nk
         cand = np.flatnonzero(score > reject_k)
         if not cand.size:
             continue

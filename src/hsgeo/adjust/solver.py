@@ -671,11 +671,11 @@ class _Solve:
         ``−gᵀh − ½‖J h‖²``. Returns ``(trial, actual, pred, rho)`` of the retried step (the
         parameters at it), or None (the parameters back at ``state``).
         """
-        from hsgeo.adjust._fast import point_excess, point_rows_dot
+        from hsgeo.adjust._fast import matvec_points, point_excess, point_rows_dot
 
         if dp is None or not np.all(np.isfinite(trial.r)) or trial.r.size != sy.r.size:
             return None
-        u = sy.Jrc.matvec(dc) + point_rows_dot(sy.Jp, sy.pidx, dp)
+        u = matvec_points(*sy.Jrc.arrays, np.ascontiguousarray(dc), sy.Jp, sy.pidx, dp)
         per_pt = point_excess(trial.r, sy.r, u, sy.pidx, dp.shape[0])
         pos = np.sort(per_pt[per_pt > 0])[::-1]
         if not pos.size:
