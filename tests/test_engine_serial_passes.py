@@ -14,6 +14,7 @@ from hsgeo.adjust._fast import (
     point_excess,
     point_rows_dot,
     standardised,
+    subtract_point_rows,
 )
 from hsgeo.adjust.solver import _largest
 from hsgeo.adjust.system import _evaluate, _Layout
@@ -166,3 +167,21 @@ def test_rejection_scores_equal_the_numpy_expressions_bit_for_bit(g):
     for k in range(1, g):
         want = np.maximum(want, full[k::g])
     np.testing.assert_array_equal(group_scores(score_rows, keep, g), want)
+
+
+def test_subtract_point_rows_equals_point_rows_dot_bit_for_bit():
+    rng = np.random.default_rng(9)
+    m, n_pts = 6000, 400
+    jp = rng.standard_normal((m, 3))
+    pidx = rng.integers(-1, n_pts, m)
+    u = rng.standard_normal(m)
+    held = rng.choice(n_pts, 5, replace=False)
+    y = np.zeros((n_pts, 3))
+    y[held] = rng.standard_normal((5, 3))
+    mask = np.zeros(n_pts, dtype=bool)
+    mask[held] = True
+    want = u - point_rows_dot(jp, pidx, y)
+    got = u.copy()
+    subtract_point_rows(got, jp, pidx, y, mask)
+    np.testing.assert_array_equal(got, want)
+    assert not np.array_equal(got, u)

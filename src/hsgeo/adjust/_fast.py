@@ -1110,6 +1110,22 @@ def matvec_points(cols, vals, fcol, fw, fd, x, jp, pidx, y):  # pragma: no cover
 
 
 @njit(cache=True, parallel=True)
+def subtract_point_rows(u, jp, pidx, y, held):  # pragma: no cover - compiled
+    """``u_i −= J_p,i · y[pidx_i]`` for the rows of the points ``held`` (a mask), in place:
+    ``u − point_rows_dot(jp, pidx, y)`` bit for bit when ``y`` is zero at every other point,
+    without a pass over their rows' derivatives.
+    """
+    p = jp.shape[1]
+    for i in prange(pidx.size):
+        q = pidx[i]
+        if q >= 0 and held[q]:
+            acc = 0.0
+            for k in range(p):
+                acc += jp[i, k] * y[q, k]
+            u[i] -= acc
+
+
+@njit(cache=True, parallel=True)
 def point_blocks_doubt(V, thresh):  # pragma: no cover - compiled
     """For 3 × 3 point blocks ``V``: ``bad`` (a zero diagonal entry), ``doubt`` (the others
     whose unit-diagonal scaled determinant is not ``≥ thresh``: their eigenvalues decide) and

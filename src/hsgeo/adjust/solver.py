@@ -671,7 +671,7 @@ class _Solve:
         ``−gᵀh − ½‖J h‖²``. Returns ``(trial, actual, pred, rho)`` of the retried step (the
         parameters at it), or None (the parameters back at ``state``).
         """
-        from hsgeo.adjust._fast import matvec_points, point_excess, point_rows_dot
+        from hsgeo.adjust._fast import matvec_points, point_excess, subtract_point_rows
 
         if dp is None or not np.all(np.isfinite(trial.r)) or trial.r.size != sy.r.size:
             return None
@@ -700,7 +700,9 @@ class _Solve:
             return None
         dp_h = dp.copy()
         dp_h[held] = 0.0
-        u -= point_rows_dot(sy.Jp, sy.pidx, dp - dp_h)
+        mask = np.zeros(dp.shape[0], dtype=bool)
+        mask[held] = True
+        subtract_point_rows(u, sy.Jp, sy.pidx, dp - dp_h, mask)  # u: J h with the points held
         pred = -float(ne.gc @ dc) - float(np.sum(ne.gp * dp_h)) - 0.5 * float(u @ u)
         layout = self.layout
         layout.set_state(state)
