@@ -29,7 +29,7 @@ HERE = Path(__file__).resolve().parent
 CALLS = [
     ("reduced_matrix_kernel", "adjust/_fast.py", "_reduced_kernel"),
     ("model_linearisation", "sensors/pushbroom.py", "evaluate_into"),
-    ("model_trial", "sensors/pushbroom.py", "evaluate"),
+    ("model_trial", "sensors/pushbroom.py", "trial_residuals"),
     ("assembly_fused_fill", "adjust/_fused.py", "fill"),
     ("jacobian_matvec", "adjust/_fast.py", "matvec"),
     ("jacobian_rmatvec_diag", "adjust/_fast.py", "rmatvec_diag"),
@@ -187,7 +187,8 @@ def _remains(row: dict) -> dict | None:
         "why": "the reduced matrix is formed 3 times (fewer is design C, measured above); its "
         "kernel's internals are the BAL benchmark's (adjust._fast._reduced_kernel). The model "
         "is 002 eq. (2)-(4) with the crossing time by Newton, evaluated once per "
-        "linearisation and once per trial (the passes of each call: "
+        "linearisation and once per trial (PushbroomLines.trial_residuals, to 1e-4 s: one "
+        "pass for most observations from the third trial on; the passes of each call: "
         "pushbroom_model_passes.json); error_model="
         "'numpy' or fastmath on it changed its CPU seconds by < 3 % (measured). The system "
         "time is the first touch of the ≈ 270 MB of row-compressed arrays of one "
@@ -275,7 +276,8 @@ def _summary(rows: list[dict], touch: dict | None = None) -> dict:
         "notes": "cpu_seconds are cumulative (the call and what it calls); "
         "per_call_per_observation_per_1x: CPU seconds per call per observation relative to "
         "the 1x row (1: linear growth); model_linearisation is the LP kernel with derivatives "
-        "(fused path), model_trial without",
+        "(fused path), model_trial without (PushbroomLines.trial_residuals, the solver's trial "
+        "steps)",
     }
 
 
