@@ -153,3 +153,41 @@ def test_fused_adjustment_equals_generic(tiny, y_as_time):
     np.testing.assert_array_equal(a.outliers(), b.outliers())
     assert a.outliers().any()  # the rejection was exercised
     assert a.iterations == b.iterations
+
+
+@pytest.mark.parametrize("fixed", [False, True])
+def test_fused_columns_kept_in_the_buffers_give_the_same_arrays(tiny, fixed, monkeypatch):
+    """A linearisation into the arrays of the last one, with the same rows, writes only what
+    the block's evaluation overwrote (_fused_refresh): the same arrays bit for bit as a fresh
+    fill, with empty slots (fixed entries) in a dense and an indexed block; other rows (a
+    rejection) write the columns again.
+    """
+    import hsgeo.adjust._fused as F
+    from hsgeo.adjust.system import _Buffers
+
+    writes = []
+    columns = F._fused_columns
+    monkeypatch.setattr(F, "_fused_columns", lambda *a: writes.append(1) or columns(*a))
+    p, blocks, _ = _problem(tiny[0], y_as_time=True)
+    if fixed:
+        p.fix("distortion", index=1)
+        p.fix("c_mm", index=0)
+    lay = _Layout(p)
+    buffers = _Buffers()
+    masks = _masks(blocks, 0.1)
+    dt0 = blocks[0]._dt_s.copy()
+    _evaluate(lay, blocks, masks, True, buffers=buffers)  # writes the columns
+    for share, written in ((0.1, 0), (0.2, 1)):  # the same rows: a refresh; then fewer rows
+        masks = _masks(blocks, share)
+        blocks[0]._dt_s[:] = dt0
+        before = len(writes)
+        kept = _evaluate(lay, blocks, masks, True, buffers=buffers)
+        assert len(writes) - before == written
+        blocks[0]._dt_s[:] = dt0
+        fresh = _evaluate(lay, blocks, masks, True)
+        for name in ("cols", "vals", "fcol", "fw", "fd"):
+            np.testing.assert_array_equal(
+                getattr(kept.Jrc, name), getattr(fresh.Jrc, name), err_msg=name
+            )
+        np.testing.assert_array_equal(kept.r, fresh.r)
+        np.testing.assert_array_equal(kept.gradient_diag()[0], fresh.gradient_diag()[0])

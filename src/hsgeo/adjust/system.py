@@ -437,6 +437,8 @@ class _Buffers:
 
     def __init__(self) -> None:
         self.arrays: dict[str, np.ndarray] = {}
+        #: what a fused part wrote into the arrays last (see _fused._FusedPart.fill)
+        self.memo: dict = {}
 
     def empty(self, name: str, shape: tuple, dtype=np.float64) -> np.ndarray:
         a = self.arrays.get(name)
@@ -546,7 +548,10 @@ def _assemble(
         fd[rs, kf:] = 0.0
         if isinstance(part, _FusedPart):
             part.row_range = (row0, row0 + n)
-            part.fill(values, cols_all[rs], vals_all[rs], fcol[rs], fw[rs], fd[rs], Jp[rs], clock)
+            memo = buffers.memo if buffers is not None and not layout.tie_blocks else None
+            part.fill(
+                values, cols_all[rs], vals_all[rs], fcol[rs], fw[rs], fd[rs], Jp[rs], clock, memo
+            )
             if part.nonfinite.size:
                 raise _NonFinite(
                     f"residual block {part.blk.name!r} produced non-finite residuals at rows "
