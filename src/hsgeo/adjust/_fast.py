@@ -997,26 +997,31 @@ def _rmatvec_rows(cols, vals, fcol, fw, fd, y, want_diag, i0, i1, g, d):  # prag
                         d[c0 + j] += v * v
 
 
+@njit(cache=True, inline="always")
+def _row_dot(cols, vals, fcol, fw, fd, x, i):  # pragma: no cover - compiled
+    """Row ``i`` of ``J x`` (its slots, then its factored groups)."""
+    acc = 0.0
+    for s in range(cols.shape[1]):
+        c = cols[i, s]
+        if c >= 0:
+            acc += vals[i, s] * x[c]
+    for a in range(fcol.shape[1]):
+        c0 = fcol[i, a]
+        if c0 >= 0:
+            t = 0.0
+            for j in range(fd.shape[1]):
+                t += fd[i, j] * x[c0 + j]
+            acc += fw[i, a] * t
+    return acc
+
+
 @njit(cache=True, parallel=True)
 def matvec(cols, vals, fcol, fw, fd, x):  # pragma: no cover - compiled
     """``J x`` of a row-compressed matrix."""
-    M, K = cols.shape
-    Q, kf = fcol.shape[1], fd.shape[1]
+    M = cols.shape[0]
     out = np.zeros(M)
     for i in prange(M):
-        acc = 0.0
-        for s in range(K):
-            c = cols[i, s]
-            if c >= 0:
-                acc += vals[i, s] * x[c]
-        for a in range(Q):
-            c0 = fcol[i, a]
-            if c0 >= 0:
-                t = 0.0
-                for j in range(kf):
-                    t += fd[i, j] * x[c0 + j]
-                acc += fw[i, a] * t
-        out[i] = acc
+        out[i] = _row_dot(cols, vals, fcol, fw, fd, x, i)
     return out
 
 
@@ -1083,23 +1088,11 @@ def matvec_points(cols, vals, fcol, fw, fd, x, jp, pidx, y):  # pragma: no cover
     """``J_c x + J_p y`` row by row in one pass: :func:`matvec` plus :func:`point_rows_dot`,
     the same sums added (bit for bit), without the two vectors and their sum as new arrays.
     """
-    M, K = cols.shape
-    Q, kf = fcol.shape[1], fd.shape[1]
+    M = cols.shape[0]
     p = jp.shape[1]
     out = np.zeros(M)
     for i in prange(M):
-        acc = 0.0
-        for s in range(K):
-            c = cols[i, s]
-            if c >= 0:
-                acc += vals[i, s] * x[c]
-        for a in range(Q):
-            c0 = fcol[i, a]
-            if c0 >= 0:
-                t = 0.0
-                for j in range(kf):
-                    t += fd[i, j] * x[c0 + j]
-                acc += fw[i, a] * t
+        acc = _row_dot(cols, vals, fcol, fw, fd, x, i)
         q = pidx[i]
         u = 0.0
         if q >= 0:
