@@ -50,8 +50,9 @@ NEWTON_TOL_S = 1e-8
 #: (:meth:`~hsgeo.adjust.ResidualBlock.trial_residuals`), whose cost only decides whether the
 #: step is taken: the residuals carry the last correction ``e`` to first order, so they are
 #: exact to ``½ ÿ e²`` — 2.5e-6 px at 1e-4 s and the mount's ÿ of a few hundred px/s² (the
-#: chapter's problem: ÿ < 0.5 px/s², 2e-9 px), and the linearisation at an accepted step,
-#: started from the corrected time, is converged in its first pass as before.
+#: chapter's problem: ÿ ≤ 0.4 px/s² for 99 % of the observations, 2e-9 px), and the
+#: linearisation at an accepted step, started from the corrected time, is converged in its
+#: first pass as before.
 TRIAL_TOL_S = 1e-4
 
 

@@ -53,9 +53,10 @@ per observation suffices instead of two. A time held at the bound ``±T_MAX`` en
 to first order (``ẏ_ref (t_e − t_k + e)`` and ``x − ẋ e``), so stopping at ``|e| < 1e-8 s``
 leaves an error of ``½ ÿ e²`` (below 1e-13 px with the mount's ÿ of a few hundred px/s²); the
 solver's trial steps (:meth:`PushbroomLines.trial_residuals`) stop at ``|e| < 1e-4 s``
-(``TRIAL_TOL_S``: 2.5e-6 px at that ÿ; the chapter's ÿ is below 0.5 px/s²), one pass per
-observation from the second step on, and the solver checks each accepted trial's cost against
-the exact cost of the linearisation at its point (:class:`hsgeo.adjust.ResidualBlock`); the
+(``TRIAL_TOL_S``: 2.5e-6 px at that ÿ; the chapter's ÿ is below 0.4 px/s² for 99 % of the
+observations), one pass for most observations from the third trial on, and the solver
+checks each accepted trial's cost against the exact cost of the linearisation at its point
+(:class:`hsgeo.adjust.ResidualBlock`); the
 derivatives, taken at ``t_k``, depend on where Newton started only to ~1e-9 relative. ``ẏ``
 and ``ẋ`` are the image rates along the corrected trajectory. The derivatives
 are evaluated at ``t*``, so they do not contain the time error, and the node derivatives keep
@@ -502,7 +503,10 @@ class PushbroomLines(ResidualBlock):
         }
         return r, jac
 
-    def evaluate(self, values, jacobian):
+    def evaluate(self, values, jacobian, tol_s=NEWTON_TOL_S):
+        """See :meth:`ResidualBlock.evaluate`; ``tol_s``: the crossing time's Newton
+        tolerance (:meth:`trial_residuals` passes ``TRIAL_TOL_S``).
+        """
         nm = self.blocks
         m = self.point.size
         r = np.empty(2 * m)
@@ -520,7 +524,7 @@ class PushbroomLines(ResidualBlock):
         no_w = np.zeros(0)
         no_w.flags.writeable = False
         derivs = (dP, dN, dB, dL, dD, dC)
-        self._kernel(values, jacobian, r, w_out, derivs, none, no_w, np.zeros((0, 4)))
+        self._kernel(values, jacobian, r, w_out, derivs, none, no_w, np.zeros((0, 4)), tol_s=tol_s)
         if not jacobian:
             return r, None
         dB, dL, dD, dC = (np.ascontiguousarray(d) for d in (dB, dL, dD, dC))
@@ -595,21 +599,12 @@ class PushbroomLines(ResidualBlock):
         """The residuals at the solver's trial point of a step (see
         :meth:`~hsgeo.adjust.ResidualBlock.trial_residuals`): the crossing time's Newton stops
         at a correction below ``TRIAL_TOL_S`` (1e-4 s) instead of ``NEWTON_TOL_S``. From the
-        second step on most observations then take one pass instead of two (the residuals
-        carry the correction to first order: exact to ``½ ÿ e²``, see ``TRIAL_TOL_S``); the
-        linearisation at an accepted step starts from the corrected times.
+        third trial of the chapter's adjustment on, 97–100 % of the observations then take one
+        pass instead of two (the residuals carry the correction to first order: exact to
+        ``½ ÿ e²``, see ``TRIAL_TOL_S``); the linearisation at an accepted step starts from the
+        corrected times.
         """
-        m = self.point.size
-        r = np.empty(2 * m)
-        V = np.empty((2, 11))  # as evaluate without the Jacobian (one compilation)
-        no_w = np.zeros(0)
-        no_w.flags.writeable = False
-        derivs = (np.empty((0, 3)), np.empty((0, 6)), V[:, 0:3], V[:, 3:6], V[:, 6:10], V[:, 10:11])
-        self._kernel(
-            values, False, r, np.empty((0, 4)), derivs, np.zeros(0, dtype=np.int64), no_w,
-            np.zeros((0, 4)), tol_s=TRIAL_TOL_S,
-        )  # fmt: skip
-        return r
+        return self.evaluate(values, False, tol_s=TRIAL_TOL_S)[0]
 
     def _kernel(
         self, values, jacobian, r, w_out, derivs, dst, w_row, fw, gd=None, cols=None,
