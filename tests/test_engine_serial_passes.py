@@ -185,3 +185,37 @@ def test_subtract_point_rows_equals_point_rows_dot_bit_for_bit():
     subtract_point_rows(got, jp, pidx, y, mask)
     np.testing.assert_array_equal(got, want)
     assert not np.array_equal(got, u)
+
+
+def test_pair_marks_equal_every_pair_of_a_point_s_rows():
+    """The Schur pattern's item pairs, from each point's distinct rows once per pair, are the
+    pairs of every two rows of a point (both orders), as the kernel reads them."""
+    from hsgeo.adjust._fast import _pair_marks
+
+    rng = np.random.default_rng(8)
+    n_pts, q, n_tiles = 400, 4, 60
+    rows = []
+    for i in range(n_pts):
+        for _ in range(rng.integers(0, 6)):
+            t0 = rng.integers(0, n_tiles - q)
+            f = 6 * (t0 + np.arange(q))
+            f[rng.random(q) < 0.1] = -1  # an item not set
+            rows.append((i, f))
+            if rng.random() < 0.7:
+                rows.append((i, f.copy()))  # the y row of the x row before it
+    rng.shuffle(rows)
+    pidx = np.array([i for i, _ in rows])
+    fcol = np.array([f for _, f in rows], dtype=np.int32)
+    order = np.argsort(pidx, kind="stable").astype(np.int64)
+    ptr = np.concatenate([[0], np.cumsum(np.bincount(pidx, minlength=n_pts))]).astype(np.int64)
+    tile_of = np.full(6 * n_tiles, -1, dtype=np.int64)
+    tile_of[::6] = np.arange(n_tiles)
+    want = np.zeros((n_tiles, n_tiles), dtype=bool)
+    for i in range(n_pts):
+        mine = order[ptr[i] : ptr[i + 1]]
+        for ra in mine:
+            for rb in mine:
+                for ca in fcol[ra][fcol[ra] >= 0]:
+                    for cb in fcol[rb][fcol[rb] >= 0]:
+                        want[tile_of[ca], tile_of[cb]] = True
+    np.testing.assert_array_equal(_pair_marks(fcol, order, ptr, tile_of, n_tiles), want)
