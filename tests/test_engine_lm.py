@@ -161,3 +161,46 @@ def test_a_trial_cost_below_the_exact_cost_switches_to_exact_trials():
     assert res.value("a")[0] == pytest.approx(1e-4, rel=1e-9)
     assert blk.calls["trial"] == 1
     assert blk.calls["residuals"] > 1  # the later trials, and the result's residuals
+
+
+def test_start_trial_gets_the_step_s_linear_prediction_of_the_residuals():
+    """Before a trial (ahead of the first settled iterate) a block's ``start_trial`` is given
+    ``J h`` on its rows, in the units of sigma: the first step's prediction of the change of
+    its residuals (a bundle of bearings, adjusted from perturbed values)."""
+    from toy_models import Bearings, bearing_scene
+
+    class _Told(Bearings):
+        def __init__(self, *a):
+            super().__init__(*a)
+            self.log = []
+
+        def evaluate(self, values, jacobian):
+            r, jac = super().evaluate(values, jacobian)
+            self.log.append(("evaluate" if jacobian else "residuals", r.copy()))
+            return r, jac
+
+        def trial_residuals(self, values):
+            r = super().evaluate(values, False)[0]
+            self.log.append(("trial", r.copy()))
+            return r
+
+        def start_trial(self, change):
+            self.log.append(("start", np.array(change, dtype=float)))
+
+    S, P, st, pt, th = bearing_scene(0)
+    rng = np.random.default_rng(1)
+    p = Parameters()
+    p.add("stations", S + np.column_stack([rng.normal(0, 0.3, (len(S), 2)), np.zeros(len(S))]))
+    p.fix("stations", index=[0, 1])
+    p.add("points", P + rng.normal(0, 0.3, P.shape), points=True)
+    blk = _Told(st, pt, th, 1e-3)
+    res = adjust(p, [blk], hold_points=True)
+    assert res.converged
+    kinds = [k for k, _ in blk.log]
+    i = kinds.index("start")
+    assert kinds[i - 1] == "evaluate" and kinds[i + 1] == "trial"
+    change = blk.log[i][1]
+    actual = blk.log[i + 1][1] - blk.log[i - 1][1]
+    assert change.shape == (blk.m,) and np.all(np.isfinite(change))
+    # the linear prediction of the first step's change, to its second-order remainder
+    assert np.linalg.norm(change - actual) < 0.05 * np.linalg.norm(actual)

@@ -455,3 +455,34 @@ def test_trial_residuals_stop_the_newton_earlier_within_its_error(tiny):
     np.testing.assert_allclose(r_trial, r_exact, rtol=0, atol=1e-6)
     # the corrected times: where evaluate's second pass would start, within its tolerance
     np.testing.assert_allclose(b._dt_s, a._dt_s, rtol=0, atol=NEWTON_TOL_S)
+
+
+def test_start_trial_starts_the_newton_at_the_predicted_crossing_times(tiny):
+    """``start_trial`` moves each crossing time's Newton start from the linearisation's time
+    by ``−Δr_y / ẏ_ref``: given the step's exact change of the time residuals, the start is the
+    step's converged crossing time; a predicted move above TRIAL_PREDICTION_MAX_S, a row left
+    out (NaN) and a time held at ±T_MAX keep the start where the last evaluation ended.
+    """
+    from hsgeo.sensors._pushbroom_kernel import NEWTON_TOL_S, T_MAX, TRIAL_PREDICTION_MAX_S
+
+    _, blocks, _ = _problem(tiny[0], y_as_time=True)
+    vals = dict(tiny[1].values)
+    a = blocks[0].fresh()
+    r_lin, _ = a.evaluate(vals, True)  # the linearisation: its crossing times kept
+    at_lin = a._dt_s.copy()
+    step = dict(vals)
+    step["points_m"] = np.asarray(vals["points_m"], dtype=float) + np.array([0.0, 0.3, 0.0])
+    b = blocks[0].fresh()
+    b._dt_s[:] = a._dt_s
+    r_step, _ = b.evaluate(step, False)  # converged at the step
+    change = r_step - r_lin
+    m = a.point.size
+    change[1] = np.nan  # observation 0: a row left out
+    change[3] = -a.y_rate_ref_px_s * 2 * TRIAL_PREDICTION_MAX_S  # observation 1: too far
+    a._dt_s[:] = 0.123  # where a refused trial ended
+    a._dt_lin_s[2] = T_MAX  # observation 2: held at the bound
+    a.start_trial(change)
+    kept = np.arange(m) >= 3
+    assert np.all(np.abs(b._dt_s - at_lin)[kept] > 10 * NEWTON_TOL_S)  # the step moved them
+    np.testing.assert_allclose(a._dt_s[kept], b._dt_s[kept], rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(a._dt_s[:3], 0.123)

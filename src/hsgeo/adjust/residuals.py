@@ -270,3 +270,16 @@ class ResidualBlock:
         relative. The default is ``evaluate(values, False)[0]``.
         """
         return self.evaluate(values, False)[0]
+
+    def start_trial(self, change: np.ndarray) -> None:
+        """Before the solver's trial point of a step: ``change`` (m,), the step's linear
+        prediction of this block's residuals' change from the last linearisation
+        (``J h``, in the units of ``sigma``; NaN on the rows the solver leaves out).
+
+        A block whose model iterates internally (a Newton on a crossing time) may start its
+        next :meth:`trial_residuals` there instead of where its last evaluation ended: with a
+        large step the iteration then needs fewer passes. It changes where the iteration
+        starts, not where it stops. The solver gives it when it has ``J h`` at hand (before the
+        first settled iterate, for its test of points thrown by the step). The default does
+        nothing.
+        """

@@ -281,11 +281,15 @@ class _Solve:
                 )
         return sy, _normal(layout, sy, self.options, self.orders, self.clock)
 
-    def trial(self) -> _System:
+    def trial(self, change: np.ndarray | None = None) -> _System:
         """The residuals at the current values (no Jacobian), under the loss of the last
-        linearisation if the robust start is on; raises ``_NonFinite``.
+        linearisation if the robust start is on; raises ``_NonFinite``. ``change``: the
+        step's ``J h`` on the system's rows, given to the blocks first
+        (:meth:`ResidualBlock.start_trial`).
         """
         opts = self.options
+        if change is not None:
+            self._start_trials(change)
         loss = None
         if self.loss_on and self.loss_c is not None:
             loss = (opts.robust_start, opts.robust_start_k, self.loss_c)
@@ -293,6 +297,20 @@ class _Solve:
             self.layout, self.blocks, self.masks, False, opts.compiled, self.clock, loss,
             trial=self.trial_residuals and loss is None,
         )  # fmt: skip
+
+    def _start_trials(self, change: np.ndarray) -> None:
+        """Each block that takes it (:meth:`ResidualBlock.start_trial`) is given its rows of the
+        whitened ``change`` (the kept rows, in the system's order), in its units (× σ).
+        """
+        off = 0
+        for blk, keep in zip(self.blocks, self.masks, strict=True):
+            nk = int(np.count_nonzero(keep))
+            if type(blk).start_trial is not ResidualBlock.start_trial:
+                sigma = np.broadcast_to(np.asarray(blk.sigma, dtype=np.float64), (blk.m,))
+                ch = np.full(blk.m, np.nan)
+                ch[keep] = change[off : off + nk] * sigma[keep]
+                blk.start_trial(ch)
+            off += nk
 
     def _confirm_trial(self, trial_cost: float | None, cost: float) -> None:
         """Check an accepted trial's cost against the exact cost at its point.
@@ -577,6 +595,8 @@ class _Solve:
         A failed chord step is first retried with the matrix of this point. The parameters
         are at the new point on return, or back at the old one if λ exceeded ``lambda_max``.
         """
+        from hsgeo.adjust._fast import matvec_points
+
         layout = self.layout
         state = layout.get_state()
         geodesic = self.options.geodesic is not None and sy is not None
@@ -592,9 +612,22 @@ class _Solve:
                     pred = _predicted_decrease(layout, ne, lam, dc, dp)
                     continue
                 dc, pred = acc
+            # J h, for the test of points thrown by the step (_hold_thrown), computed before the
+            # trial, which starts the blocks' internal iterations from it (start_trial)
+            u = None
+            if (
+                sy is not None
+                and dp is not None
+                and self.options.hold_points
+                and not self.settled_seen
+                and ne.S_chord is None
+                and not self.loss_on
+                and not geodesic
+            ):
+                u = matvec_points(*sy.Jrc.arrays, np.ascontiguousarray(dc), sy.Jp, sy.pidx, dp)
             layout.apply(dc, dp)
             try:
-                trial = self.trial()
+                trial = self.trial(change=u)
             except _NonFinite:
                 # the step left the model's domain (an overflow, a log of a negative): a step
                 # that does not decrease the cost, refused like one
@@ -606,7 +639,7 @@ class _Solve:
                 and sy is not None
                 and self.options.hold_points
             ):
-                held = self._hold_points(sy, ne, trial, state, cost, dc, dp)
+                held = self._hold_points(sy, ne, trial, state, cost, dc, dp, u=u)
                 if held is not None:
                     trial, actual, pred, rho = held
             if (
@@ -618,7 +651,7 @@ class _Solve:
                 and ne.S_chord is None
             ):
                 trial, actual, pred, rho = self._hold_thrown(
-                    sy, ne, trial, state, cost, dc, dp, (trial, actual, pred, rho)
+                    sy, ne, trial, state, cost, dc, dp, (trial, actual, pred, rho), u
                 )
             if rho > 0 and np.isfinite(trial.cost):
                 lam *= max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3)
@@ -635,7 +668,7 @@ class _Solve:
             dc, dp = _step(layout, ne, lam)
             pred = _predicted_decrease(layout, ne, lam, dc, dp)
 
-    def _hold_thrown(self, sy, ne, trial, state, cost, dc, dp, accepted):
+    def _hold_thrown(self, sy, ne, trial, state, cost, dc, dp, accepted, u=None):
         """An accepted step that threw a few points: the same step with them held, if that
         costs less (see :meth:`_hold_points`; ``SolverOptions.thrown_share``). Returns
         ``(trial, actual, pred, rho)`` of the step taken, the parameters at it.
@@ -647,7 +680,7 @@ class _Solve:
         by orders of magnitude and decays over many iterations.
         """
         held = self._hold_points(
-            sy, ne, trial, state, cost, dc, dp, min_share=self.options.thrown_share
+            sy, ne, trial, state, cost, dc, dp, min_share=self.options.thrown_share, u=u
         )
         if held is not None and held[0].cost < trial.cost:
             return held
@@ -656,8 +689,9 @@ class _Solve:
         return accepted
 
     def _hold_points(
-        self, sy: _System, ne: _Normal, trial: _System, state, cost, dc, dp, min_share=None
-    ):
+        self, sy: _System, ne: _Normal, trial: _System, state, cost, dc, dp, min_share=None,
+        u=None,
+    ):  # fmt: skip
         """Retry a refused step with the few points that refused it held where they are.
 
         A Gauss–Newton step can throw one weakly intersected point far off (a tie point with a
@@ -669,13 +703,16 @@ class _Solve:
         (and at least one) carry 90 % of the total excess, the step is tried again with their
         increments set to zero, and its predicted decrease taken from the quadratic model
         ``−gᵀh − ½‖J h‖²``. Returns ``(trial, actual, pred, rho)`` of the retried step (the
-        parameters at it), or None (the parameters back at ``state``).
+        parameters at it), or None (the parameters back at ``state``). ``u``: ``J h`` of this
+        step if the caller has it (not changed here).
         """
         from hsgeo.adjust._fast import matvec_points, point_excess, subtract_point_rows
 
         if dp is None or not np.all(np.isfinite(trial.r)) or trial.r.size != sy.r.size:
             return None
-        u = matvec_points(*sy.Jrc.arrays, np.ascontiguousarray(dc), sy.Jp, sy.pidx, dp)
+        given = u is not None
+        if not given:
+            u = matvec_points(*sy.Jrc.arrays, np.ascontiguousarray(dc), sy.Jp, sy.pidx, dp)
         per_pt = point_excess(trial.r, sy.r, u, sy.pidx, dp.shape[0])
         pos = np.sort(per_pt[per_pt > 0])[::-1]
         if not pos.size:
@@ -702,6 +739,7 @@ class _Solve:
         dp_h[held] = 0.0
         mask = np.zeros(dp.shape[0], dtype=bool)
         mask[held] = True
+        u = u.copy() if given else u  # (the caller's J h is left as it was)
         subtract_point_rows(u, sy.Jp, sy.pidx, dp - dp_h, mask)  # u: J h with the points held
         pred = -float(ne.gc @ dc) - float(np.sum(ne.gp * dp_h)) - 0.5 * float(u @ u)
         layout = self.layout

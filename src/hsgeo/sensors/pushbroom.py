@@ -99,7 +99,13 @@ from hsgeo.distortion import (
 )
 from hsgeo.errors import InputError, ObservationError
 from hsgeo.rotations import R_from_opk, R_from_rpy, dR_dopk, dR_drpy
-from hsgeo.sensors._pushbroom_kernel import NEWTON_TOL_S, TRIAL_TOL_S, _lines_kernel
+from hsgeo.sensors._pushbroom_kernel import (
+    NEWTON_TOL_S,
+    T_MAX,
+    TRIAL_PREDICTION_MAX_S,
+    TRIAL_TOL_S,
+    _lines_kernel,
+)
 from hsgeo.sensors._pushbroom_rays import line_runs, rays_by_line
 from hsgeo.sensors.mount import Mount, line_time, unit
 from hsgeo.trajectory import R_BODY_FROM_PLATFORM, SplineNodes, bspline_basis
@@ -400,6 +406,7 @@ class PushbroomLines(ResidualBlock):
         self._u0 = np.ascontiguousarray(u)  # the kernel's Newton moves along this piece
         # t* − t_e of the last evaluation: where the next one's Newton starts (module docstring)
         self._dt_s = np.zeros(m)
+        self._dt_lin_s: np.ndarray | None = None  # ... of the last one with derivatives
         self.timed = timed
         zeros = np.zeros((m, 3))
         self.xyz_rate = np.ascontiguousarray(xyz_rate_m_s if timed else zeros, dtype=np.float64)
@@ -431,6 +438,7 @@ class PushbroomLines(ResidualBlock):
         """
         other = super().fresh()
         other._dt_s = np.zeros_like(self._dt_s)
+        other._dt_lin_s = None
         return other
 
     def evaluate_numpy(self, values, jacobian):
@@ -606,6 +614,25 @@ class PushbroomLines(ResidualBlock):
         """
         return self.evaluate(values, False, tol_s=TRIAL_TOL_S)[0]
 
+    def start_trial(self, change):
+        """See :meth:`~hsgeo.adjust.ResidualBlock.start_trial`: the crossing times' Newton of
+        the next trial starts at the linearisation's times moved by their linear prediction,
+        ``Δt* = −Δr_y / ẏ_ref`` (the y row is the time residual, ``y_as_time``), where that
+        is at most ``TRIAL_PREDICTION_MAX_S`` and the linearisation's time was not held at
+        ``±T_MAX``; elsewhere where the last evaluation ended, as before.
+
+        In the chapter's adjustment the second trial then takes one pass for most observations
+        instead of two (0.114 against 0.060 CPU-s at the paper's size; the first trial, whose
+        crossings move up to ``T_MAX``, gains nothing and is left as it was by the bound on
+        the prediction: bench/results/pushbroom_model_passes.json).
+        """
+        if not self.timed or self._dt_lin_s is None:
+            return
+        dt = np.asarray(change[1::2], dtype=np.float64) * (-1.0 / self.y_rate_ref_px_s)
+        ok = np.abs(dt) <= TRIAL_PREDICTION_MAX_S  # (False where NaN: a row left out)
+        ok &= np.abs(self._dt_lin_s) < T_MAX
+        np.add(self._dt_lin_s, dt, out=self._dt_s, where=ok)
+
     def _kernel(
         self, values, jacobian, r, w_out, derivs, dst, w_row, fw, gd=None, cols=None,
         tol_s=NEWTON_TOL_S,
@@ -652,6 +679,10 @@ class PushbroomLines(ResidualBlock):
             np.zeros((2, 0, 0)) if gd is None else gd,
             *(_no_cols() if cols is None else cols),
         )
+        if jacobian:  # where start_trial's prediction starts from
+            if self._dt_lin_s is None or self._dt_lin_s.shape != self._dt_s.shape:
+                self._dt_lin_s = np.empty_like(self._dt_s)
+            np.copyto(self._dt_lin_s, self._dt_s)
 
 
 # ----------------------------------------------------------------------------------------------
