@@ -219,3 +219,20 @@ def test_pair_marks_equal_every_pair_of_a_point_s_rows():
                     for cb in fcol[rb][fcol[rb] >= 0]:
                         want[tile_of[ca], tile_of[cb]] = True
     np.testing.assert_array_equal(_pair_marks(fcol, order, ptr, tile_of, n_tiles), want)
+
+
+def test_rows_by_point_equals_a_stable_argsort_and_the_counts():
+    from hsgeo.adjust._fast import rows_by_point
+
+    rng = np.random.default_rng(9)
+    n_pts = 500
+    pidx = rng.integers(-1, n_pts, 20000)  # −1: a row without a point (a prior)
+    pidx[:50] = 7  # a point with many rows
+    rows = np.flatnonzero(pidx >= 0)
+    want_order = rows[np.argsort(pidx[rows], kind="stable")]
+    want_ptr = np.concatenate([[0], np.cumsum(np.bincount(pidx[rows], minlength=n_pts))])
+    order, ptr = rows_by_point(pidx, n_pts)
+    np.testing.assert_array_equal(order, want_order)
+    np.testing.assert_array_equal(ptr, want_ptr)
+    with pytest.raises(ValueError, match="point index"):
+        rows_by_point(np.array([0, 5]), 5)

@@ -137,7 +137,9 @@ def _scaled_reduced(layout: _Layout, ne: _Normal):
     d = np.diag(S).copy()
     unobserved = [layout.labels_c[i] for i in np.flatnonzero(d <= 0)]
     d = np.sqrt(np.where(d > 0, d, 1.0))
-    return S / d[:, None] / d[None, :], unobserved
+    Ss = S / d[:, None]  # (S may be the normal equations' own: a new array, one)
+    Ss /= d[None, :]
+    return Ss, unobserved
 
 
 def _analyse(layout: _Layout, ne: _Normal, rtol: float) -> Identifiability:

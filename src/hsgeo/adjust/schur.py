@@ -127,7 +127,7 @@ class _OrderCache:
 
     def get(self, layout: _Layout, sy: _System):
         """``(order, ptr, row_order, pt_order)`` for ``sy``, computed on a change of structure."""
-        from hsgeo.adjust._fast import locality_orders
+        from hsgeo.adjust._fast import locality_orders, rows_by_point
 
         key = self.key
         if (
@@ -143,12 +143,7 @@ class _OrderCache:
             return self.value
         order = ptr = None
         if layout.pblock is not None:
-            pi_all = sy.pidx
-            rows_p = np.flatnonzero(pi_all >= 0)
-            order = rows_p[np.argsort(pi_all[rows_p], kind="stable")].astype(np.int64)
-            ptr = np.concatenate(
-                [[0], np.cumsum(np.bincount(pi_all[rows_p], minlength=layout.n_pts))]
-            ).astype(np.int64)
+            order, ptr = rows_by_point(np.asarray(sy.pidx, dtype=np.int64), layout.n_pts)
         # the rows without a point (priors) form N_cc directly; the others go through the
         # Schur kernel point by point
         rows_np = np.flatnonzero(sy.pidx < 0) if layout.pblock is not None else None
