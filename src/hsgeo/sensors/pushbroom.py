@@ -49,7 +49,8 @@ moved by its velocity and angular rate and the spline piece of ``t_e`` continued
 from the crossing time of the block's previous evaluation (``t_e`` at the first): near the
 solution an iteration moves most crossings by less than 1e-8 s, and one evaluation of the pose
 per observation suffices instead of two. A trial step given the step's linear prediction
-(:meth:`PushbroomLines.start_trial`) starts from the linearisation's time moved by it. A time held at the bound ``±T_MAX`` ends its Newton
+(:meth:`PushbroomLines.start_trial`) starts from the linearisation's time moved by it.
+A time held at the bound ``±T_MAX`` ends its Newton
 (a further pass would evaluate the same time). The residuals carry the last Newton correction
 to first order (``ẏ_ref (t_e − t_k + e)`` and ``x − ẋ e``), so stopping at ``|e| < 1e-8 s``
 leaves an error of ``½ ÿ e²`` (below 1e-13 px with the mount's ÿ of a few hundred px/s²); the
