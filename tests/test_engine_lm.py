@@ -136,7 +136,11 @@ def test_the_solver_costs_its_trial_steps_with_trial_residuals():
     res = adjust(p, [blk], xtol=1e-12)
     assert res.converged
     assert blk.calls["trial"] >= res.iterations > 0
-    assert blk.calls["residuals"] == 1  # the result's residuals of every row, at the solution
+    # the result's residuals of every row are the final linearisation's (at the solution)
+    assert blk.calls["residuals"] == 0
+    np.testing.assert_array_equal(
+        res.residuals(blk.name), _Sqrt(t, 0.01 * t).evaluate(res.params.values(), False)[0]
+    )
 
 
 class _LowTrial(_CountedSqrt):
@@ -204,3 +208,26 @@ def test_start_trial_gets_the_step_s_linear_prediction_of_the_residuals():
     assert change.shape == (blk.m,) and np.all(np.isfinite(change))
     # the linear prediction of the first step's change, to its second-order remainder
     assert np.linalg.norm(change - actual) < 0.05 * np.linalg.norm(actual)
+
+
+def test_the_result_s_residuals_come_from_the_linearisation_only_at_its_values():
+    """``_all_residuals`` takes every row's residuals from a linearisation evaluated at the
+    current values (the rows left out included), and evaluates the blocks again otherwise."""
+    from hsgeo.adjust.solver import _all_residuals
+    from hsgeo.adjust.system import _evaluate, _Layout
+
+    t = np.linspace(1.0, 2.0, 5)
+    blk = _CountedSqrt(t, 0.01 * t)
+    p = Parameters()
+    p.add("a", [4.0])
+    lay = _Layout(p)
+    mask = np.array([True, False, True, True, True])  # a row left out
+    sy = _evaluate(lay, [blk], [mask], True)
+    calls = dict(blk.calls)
+    got = _all_residuals(lay, [blk], sy)
+    assert blk.calls == calls  # nothing evaluated
+    np.testing.assert_array_equal(got[blk.name], _Sqrt(t, 0.01 * t).evaluate({"a": [4.0]}, 0)[0])
+    lay.apply(np.array([-1.0]), None)  # the values moved since the linearisation
+    got = _all_residuals(lay, [blk], sy)
+    assert blk.calls["residuals"] == calls["residuals"] + 1
+    np.testing.assert_array_equal(got[blk.name], _Sqrt(t, 0.01 * t).evaluate({"a": [3.0]}, 0)[0])

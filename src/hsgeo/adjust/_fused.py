@@ -56,6 +56,7 @@ class _FusedPart:
         #: accumulated by the block's pass (see _System.gd_parts), and the rows' range
         self.g = self.d = None
         self.row_range = (0, 0)
+        self.r_all: np.ndarray | None = None  # after fill: the residuals of every row
 
     @staticmethod
     def spec_of(layout, blk: ResidualBlock, keep, factored_k) -> dict | None:
@@ -109,6 +110,7 @@ class _FusedPart:
         self.g, self.d = gd.sum(axis=1)
         clock.add("model", t)  # (the rest is the caller's "jacobian")
         self.nonfinite = np.flatnonzero(~np.isfinite(r))[:5]  # checked by system._assemble
+        self.r_all = r  # every row's residual (the system's raw, see _System.residuals_at)
         fname, fidx, _ = self.spec["factored"]
         # the slots' columns: a dense block's columns are the same in every row (-1 in
         # plan_col: an indexed slot, its column looked up per row in ix_cm)

@@ -193,6 +193,20 @@ class _System:
     #: ``(row0, row1, g, d)`` of rows whose gradient ``Jᵀ r`` and diagonal ``diag(JᵀJ)`` of
     #: the non-point unknowns the fused path accumulated already (see :meth:`gradient_diag`)
     gd_parts: list | None = None
+    #: at a linearisation: each block's residuals of every row (its units, the rows left out
+    #: included) and the parameter values they were evaluated at (see ``residuals_at``)
+    raw: list | None = None
+    values_at: list | None = None
+
+    def residuals_at(self, state: list) -> list | None:
+        """Each block's residuals of every row if this linearisation was evaluated at the
+        parameter values ``state`` (:meth:`_Layout.get_state`), else None.
+        """
+        if self.raw is None or self.values_at is None or len(state) != len(self.values_at):
+            return None
+        if all(np.array_equal(a, b) for a, b in zip(self.values_at, state, strict=True)):
+            return self.raw
+        return None
 
     def gradient_diag(self) -> tuple[np.ndarray, np.ndarray]:
         """``(J_cᵀ r, diag(J_cᵀ J_c))`` (compiled path): the fused parts' sums, the other rows
@@ -620,6 +634,7 @@ def _evaluate(
     offset = 0
     pname = layout.pblock.name if layout.pblock is not None else None
     loss_c, rho_sum = {}, 0.0
+    raw: list = []  # each block's residuals of every row (a fused part's: after _assemble)
     for ib, (blk, keep) in enumerate(zip(blocks, masks, strict=True)):
         t = clock.add("jacobian", t)
         spec = None
@@ -633,8 +648,10 @@ def _evaluate(
             pidx_parts.append(part.pidx)
             jp_parts.append(None)
             offset += part.rows.size
+            raw.append(part)
             continue
         r, jac = _block_residuals(blk, values, jacobian, trial)
+        raw.append(r)
         t = clock.add("model", t)
         w = 1.0 / blk.sigma
         if jacobian:
@@ -700,8 +717,11 @@ def _evaluate(
         prior = r_all[n_obs_rows:]
         robust = 0.5 * (rho_sum + float(prior @ prior))
     gd_parts = [(*sl.row_range, sl.g, sl.d) for sl in slot_parts if isinstance(sl, _FusedPart)]
+    raw = [x.r_all if isinstance(x, _FusedPart) else x for x in raw]
     clock.add("jacobian", t)
-    return _System(r_all, Jrc, pidx, Jp, n_obs_rows, lc, robust, gd_parts)
+    sy = _System(r_all, Jrc, pidx, Jp, n_obs_rows, lc, robust, gd_parts)
+    sy.raw, sy.values_at = raw, layout.get_state()
+    return sy
 
 
 def _residuals_only(layout: _Layout, blocks, masks, clock: _Clock, trial: bool) -> _System:
