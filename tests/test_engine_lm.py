@@ -231,3 +231,25 @@ def test_the_result_s_residuals_come_from_the_linearisation_only_at_its_values()
     got = _all_residuals(lay, [blk], sy)
     assert blk.calls["residuals"] == calls["residuals"] + 1
     np.testing.assert_array_equal(got[blk.name], _Sqrt(t, 0.01 * t).evaluate({"a": [3.0]}, 0)[0])
+
+
+def test_start_trials_gives_each_block_its_kept_rows_in_its_units():
+    """The system's whitened J h (kept rows only, block after block) goes to each block that
+    takes it, times σ, NaN on the rows left out; a block without start_trial is skipped."""
+    from hsgeo.adjust.solver import _Solve
+
+    class _Takes(_Sqrt):
+        def start_trial(self, change):
+            self.got = np.array(change)
+
+    t = np.linspace(1.0, 2.0, 4)
+    a, b, c = _Takes(t, t), _Sqrt(t, t), _Takes(t, t)
+    a.sigma = np.array([1.0, 2.0, 3.0, 4.0])
+    c.sigma = np.full(4, 0.5)
+    solve = _Solve.__new__(_Solve)
+    solve.blocks = [a, b, c]
+    solve.masks = [np.array([True, False, True, True]), np.ones(4, bool), np.ones(4, bool)]
+    change = np.arange(11.0)  # 3 + 4 + 4 kept rows
+    solve._start_trials(change)
+    np.testing.assert_array_equal(a.got, [0.0 * 1.0, np.nan, 1.0 * 3.0, 2.0 * 4.0])
+    np.testing.assert_array_equal(c.got, 0.5 * np.arange(7.0, 11.0))

@@ -307,8 +307,11 @@ class _Solve:
             nk = int(np.count_nonzero(keep))
             if type(blk).start_trial is not ResidualBlock.start_trial:
                 sigma = np.broadcast_to(np.asarray(blk.sigma, dtype=np.float64), (blk.m,))
-                ch = np.full(blk.m, np.nan)
-                ch[keep] = change[off : off + nk] * sigma[keep]
+                if nk == blk.m:  # every row kept: no selection
+                    ch = change[off : off + nk] * sigma
+                else:
+                    ch = np.full(blk.m, np.nan)
+                    ch[keep] = change[off : off + nk] * sigma[keep]
                 blk.start_trial(ch)
             off += nk
 
