@@ -159,8 +159,9 @@ def test_fused_adjustment_equals_generic(tiny, y_as_time):
 def test_fused_columns_kept_in_the_buffers_give_the_same_arrays(tiny, fixed, monkeypatch):
     """A linearisation into the arrays of the last one, with the same rows, writes only what
     the block's evaluation overwrote (_fused_refresh): the same arrays bit for bit as a fresh
-    fill, with empty slots (fixed entries) in a dense and an indexed block; other rows (a
-    rejection) write the columns again.
+    fill, with empty slots (fixed entries) in a dense and an indexed block; fewer rows (a
+    rejection) move the indices of the rows still kept up (_compact_rows), the same arrays
+    again; rows not among the last ones write the columns again.
     """
     import hsgeo.adjust._fused as F
     from hsgeo.adjust.system import _Buffers
@@ -177,12 +178,18 @@ def test_fused_columns_kept_in_the_buffers_give_the_same_arrays(tiny, fixed, mon
     masks = _masks(blocks, 0.1)
     dt0 = blocks[0]._dt_s.copy()
     _evaluate(lay, blocks, masks, True, buffers=buffers)  # writes the columns
-    for share, written in ((0.1, 0), (0.2, 1)):  # the same rows: a refresh; then fewer rows
+    compacted = []
+    compact = F._compact_rows
+    monkeypatch.setattr(F, "_compact_rows", lambda *a: compacted.append(1) or compact(*a))
+    # the same rows: a refresh; fewer rows (those left out at 0.1 are left out at 0.2):
+    # compacted; then more rows: the columns written again
+    for share, written, moved in ((0.1, 0, 0), (0.2, 0, 1), (0.05, 1, 0)):
         masks = _masks(blocks, share)
         blocks[0]._dt_s[:] = dt0
-        before = len(writes)
+        before, before_c = len(writes), len(compacted)
         kept = _evaluate(lay, blocks, masks, True, buffers=buffers)
         assert len(writes) - before == written
+        assert len(compacted) - before_c == moved
         blocks[0]._dt_s[:] = dt0
         fresh = _evaluate(lay, blocks, masks, True)
         for name in ("cols", "vals", "fcol", "fw", "fd"):
