@@ -204,7 +204,9 @@ class AdjustmentResult:
 
     # -- residuals ----------------------------------------------------------------------------
     def residuals(self, block: str | int = 0) -> np.ndarray:
-        """Residuals model − observation of a residual block, in its units (all rows)."""
+        """Residuals model − observation of a residual block, in its units, at the solution
+        (all rows, the rejected ones too).
+        """
         return self._residuals[self._block_name(block)]
 
     def normalized_residuals(self, block: str | int = 0) -> np.ndarray:
