@@ -366,6 +366,14 @@ def test_reduced_kernel_equals_dense_schur(consecutive):
     S2 = reduced_points(J.arrays, jp, order, ptr, Vinv, n_c, cache=cache)
     np.testing.assert_array_equal(S2, S)
     assert cache.pattern is not stale
+    # the kernel's output arrays kept in the cache: zeroed and written again, the same S
+    cache = types.SimpleNamespace(pattern=None, kernel_out={})
+    S3 = reduced_points(J.arrays, jp, order, ptr, Vinv, n_c, cache=cache)
+    kept = dict(cache.kernel_out)
+    S4 = reduced_points(J.arrays, jp, order, ptr, Vinv, n_c, cache=cache)
+    assert kept and all(cache.kernel_out[k] is v for k, v in kept.items())
+    np.testing.assert_array_equal(S3, S)
+    np.testing.assert_array_equal(S4, S)
 
 
 def test_reduced_kernel_slot_points_equal_dense_schur():

@@ -472,7 +472,7 @@ def _slot_point(cols, vals, jp, order, a0, a1, scratch, Vinv, i, A):  # pragma: 
             f0 = f1
 
 
-def _reduced_kernel(*args):
+def _reduced_kernel(*args, buffers=None):
     """A with ``A + Aᵀ = Σ_i (J_c,iᵀ J_c,i − W_i V_i⁻¹ W_iᵀ)`` over the points, in two
     compact parts (see :func:`reduced_points`), and the number of units that fell outside the
     pattern (tile or column not in ``slot_of``/``sc_of``: the pattern is stale; nothing of
@@ -516,12 +516,27 @@ def _reduced_kernel(*args):
     n_c, capg, capc, tile_of, slot_of, n_slots, sc_of, n_sc, n_chunks = args[10:]
     n_pts = rows[7].size - 1  # ptr
     kk = rows[4].shape[1] ** 2  # fd
-    out = np.zeros((n_chunks, n_c, n_sc))
-    out_t = np.zeros((n_chunks, n_slots * kk))
+    out = _zeros(buffers, "out", (n_chunks, n_c, n_sc))
+    out_t = _zeros(buffers, "out_t", (n_chunks, n_slots * kk))
     misses = over_items(
         _reduced_chunk, n_pts, n_chunks, *rows, capg, capc, tile_of, slot_of, sc_of, out, out_t
     )
     return out, out_t, int(sum(misses))
+
+
+def _zeros(buffers: dict | None, name: str, shape: tuple) -> np.ndarray:
+    """``np.zeros(shape)``, in the array of that shape kept in ``buffers`` (a dict) if it has
+    one (zeroed again: the formations of one solve reuse their memory, which a fresh
+    allocation may not find where the last one was, and then touches first again).
+    """
+    if buffers is None:
+        return np.zeros(shape)
+    a = buffers.get(name)
+    if a is None or a.shape != shape:
+        a = buffers[name] = np.zeros(shape)
+    else:
+        a.fill(0.0)
+    return a
 
 
 @njit(cache=True, nogil=True, fastmath={"nnan", "ninf", "nsz", "arcp", "contract", "afn"})
@@ -837,6 +852,7 @@ def reduced_points(arrays, jp, order, ptr, Vinv, n_c: int, pt_order=None, cache=
         sc_of,
         sc_cols.size,
         nch,
+        buffers=getattr(cache, "kernel_out", None),
     )
     if misses:
         if fresh:  # pragma: no cover - the pattern is computed from these very rows

@@ -124,6 +124,8 @@ class _OrderCache:
         self.key: tuple | None = None
         self.value: tuple | None = None
         self.pattern: tuple | None = None  # _fast.schur_pattern (on first use, see get)
+        #: the reduced-matrix kernel's output arrays, reused by each formation (_fast._zeros)
+        self.kernel_out: dict = {}
 
     def get(self, layout: _Layout, sy: _System):
         """``(order, ptr, row_order, pt_order)`` for ``sy``, computed on a change of structure."""
