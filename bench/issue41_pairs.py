@@ -12,9 +12,10 @@ The issue's commit is checked out into a temporary git worktree (the repository'
 enough: nothing is downloaded) and each benchmark's ``--vs`` mode runs both sides in turn, with
 this process's environment (``make bench``: the Makefile's ``GLIBC_TUNABLES``, one BLAS thread):
 
-* the paper-size pushbroom solve on the kernels' threads (4 pairs) and on one thread (4 pairs:
-  the issue's 3.90 CPU-s is of one thread), ``pushbroom_vs_issue_tunables.json``,
-  ``pushbroom_vs_issue_one_thread.json``;
+* the paper-size pushbroom solve on the kernels' threads (4 pairs) and on one thread (8 pairs:
+  the issue's 3.90 CPU-s is of one thread; two runs of 4 pairs of the same code gave 0.751 and
+  0.774 of the issue's commit, either side of the 0.769 asked),
+  ``pushbroom_vs_issue_tunables.json``, ``pushbroom_vs_issue_one_thread.json``;
 * 10× the paper, 2 pairs and 1 pair on one thread (``pushbroom_vs_issue_10x_tunables.json``,
   ``pushbroom_vs_issue_10x_one_thread.json``; about 4 min);
 * orthorectification (``bench_orthomosaic.py --pairs 3 --vs-src``, ``orthomosaic.json``) and
@@ -47,7 +48,7 @@ def _pairs(vs: Path, quick: bool) -> list[list[str]]:
 
     jobs = [
         [*pb, "--scale", "1", "--pairs", "4", *out("_tunables")],
-        [*pb, "--scale", "1", "--pairs", "4", "--threads", "1", *out("_one_thread")],
+        [*pb, "--scale", "1", "--pairs", "8", "--threads", "1", *out("_one_thread")],
     ]
     if not quick:
         jobs += [
