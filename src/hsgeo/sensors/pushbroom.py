@@ -624,7 +624,7 @@ class PushbroomLines(ResidualBlock):
         ``±T_MAX``; elsewhere where the last evaluation ended, as before.
 
         In the chapter's adjustment the second trial then takes one pass for most observations
-        instead of two (0.114 against 0.060 CPU-s at the paper's size; the first trial, whose
+        instead of two (0.118 against 0.065 CPU-s at the paper's size; the first trial, whose
         crossings move up to ``T_MAX``, gains nothing and is left as it was by the bound on
         the prediction: bench/results/pushbroom_model_passes.json).
         """
