@@ -2,11 +2,12 @@
 
 ``_lines_kernel`` makes one pass per observation: the spline correction and the pose at the
 trial time (``_spline``, ``_pose``), the projection and its partials (``_image``), the Newton on
-the crossing time, the derivatives (``_derivatives``) and their chain through the crossing time
-(``_through_time``); the helpers are inlined into the chunk function ``_lines_chunk``
-(``inline="always"``), so the compiled loop is that of one function, and the chunks run on the
-kernels' threads (:func:`hsgeo._chunks.over_chunks`: with numba's ``prange`` over them
-the kernel's two compilations on a fresh cache took 28 s, without it 17 s; issue 41). The
+the crossing time, and the derivatives (``_derivatives``), each entry chained through the
+crossing time and whitened as it is written (``_pair``); the helpers are inlined into the chunk
+function ``_lines_chunk`` (``inline="always"``), so the compiled loop is that of one function,
+and the chunks run on the kernels' threads (:func:`hsgeo._chunks.over_chunks`: with numba's
+``prange`` over them the kernel's two compilations on a fresh cache took 28 s, without it 17 s;
+issue 41). The
 values the Newton loop sets and only later lines read (x, y, xb, yb, gx, gy) are defined
 before it: left undefined there, numba lost them under ``prange`` once the loop moved into
 helpers (every x residual wrong at 64 chunks).
@@ -18,6 +19,14 @@ tolerance is an argument (``NEWTON_TOL_S``, or ``TRIAL_TOL_S`` for a trial step'
 and a time held at ``±T_MAX`` ends its Newton: evaluating the same time again gave the same
 values (at the paper's size 31 % of the first linearisation's observations end there, and
 that linearisation took 0.34 CPU-s instead of 0.23).
+
+The helpers pass their results as values (tuples of floats), not through small arrays: held in
+local variables, the compiler keeps them in registers, where each store to a small array went
+to memory and each later read came back from it. With the same arithmetic in the same order
+(bit-identical outputs), one pass at the paper's size took 0.032 instead of 0.056 CPU-s
+without derivatives and 0.064 instead of 0.091 with them (issue 41, one thread). Tuples are
+indexed by constants only: a loop over a tuple's entries made the derivative pass slower than
+before (0.098).
 """
 
 from __future__ import annotations
@@ -29,11 +38,11 @@ from numba import njit
 
 from hsgeo._chunks import over_items
 from hsgeo._kernels import (
-    bspline_weights,
-    pushbroom_camera_point,
+    bspline_weights_values,
+    pushbroom_camera_point_values,
     pushbroom_image_mm,
     pushbroom_line_distortion_dcoeff,
-    rpy_rotation,
+    rpy_rotation_values,
 )
 
 __all__ = ["T_MAX", "NEWTON_TOL_S", "TRIAL_TOL_S", "TRIAL_PREDICTION_MAX_S"]
@@ -64,146 +73,175 @@ TRIAL_PREDICTION_MAX_S = 0.01
 
 
 @njit(cache=True, inline="always")
-def _spline(j, dt, u0, inv_dt, nodes, idx, xyz_rate, rpy_rate, w, dw, dl, rate):  # pragma: no cover
-    """The spline correction of observation j at ``t_e + dt``: its weights (w, dw), the
-    correction ``dl`` of the pose and the pose rate ``rate`` (navigation rate included).
+def _spline(j, dt, u0, inv_dt, nodes, idx, xyz_rate, rpy_rate, dl, rate):  # pragma: no cover
+    """The spline correction of observation j at ``t_e + dt``: writes the correction ``dl`` of
+    the pose and the pose rate ``rate`` (navigation rate included); returns the weights
+    ``(w0, w1, w2, w3)``.
     """
-    bspline_weights(u0[j] + dt * inv_dt, inv_dt, w, dw)
+    w0, w1, w2, w3, dw0, dw1, dw2, dw3 = bspline_weights_values(u0[j] + dt * inv_dt, inv_dt)
+    i0, i1, i2, i3 = idx[j, 0], idx[j, 1], idx[j, 2], idx[j, 3]
     for a in range(6):
+        n0, n1, n2, n3 = nodes[i0, a], nodes[i1, a], nodes[i2, a], nodes[i3, a]
         acc = 0.0
+        acc += w0 * n0
+        acc += w1 * n1
+        acc += w2 * n2
+        acc += w3 * n3
         acc_r = 0.0
-        for b in range(4):
-            acc += w[b] * nodes[idx[j, b], a]
-            acc_r += dw[b] * nodes[idx[j, b], a]
+        acc_r += dw0 * n0
+        acc_r += dw1 * n1
+        acc_r += dw2 * n2
+        acc_r += dw3 * n3
         dl[a] = acc
         rate[a] = acc_r + (xyz_rate[j, a] if a < 3 else rpy_rate[j, a - 3])
+    return w0, w1, w2, w3
 
 
 @njit(cache=True, inline="always")
-def _pose(j, dt, P, pidx, xyz_nav, rpy_nav, xyz_rate, rpy_rate, dl, R, dR, d):  # pragma: no cover
+def _pose(j, dt, P, pidx, xyz_nav, rpy_nav, xyz_rate, rpy_rate, dl):  # pragma: no cover
     """The pose of observation j at ``t_e + dt`` (navigation moved by its rates, plus ``dl``):
-    the rotation R (and ∂R in dR), and ``d = P − position``.
+    returns the rotation R and ∂R (:func:`~hsgeo._kernels.rpy_rotation_values`) and
+    ``d = P − position`` (three values).
     """
-    rpy_rotation(
+    R, dR = rpy_rotation_values(
         rpy_nav[j, 0] + dt * rpy_rate[j, 0] + dl[3],
         rpy_nav[j, 1] + dt * rpy_rate[j, 1] + dl[4],
         rpy_nav[j, 2] + dt * rpy_rate[j, 2] + dl[5],
-        R,
-        dR,
     )
     pt = pidx[j]
-    for a in range(3):
-        d[a] = P[pt, a] - xyz_nav[j, a] - dt * xyz_rate[j, a] - dl[a]
+    d0 = P[pt, 0] - xyz_nav[j, 0] - dt * xyz_rate[j, 0] - dl[0]
+    d1 = P[pt, 1] - xyz_nav[j, 1] - dt * xyz_rate[j, 1] - dl[1]
+    d2 = P[pt, 2] - xyz_nav[j, 2] - dt * xyz_rate[j, 2] - dl[2]
+    return R, dR, d0, d1, d2
 
 
 @njit(cache=True, inline="always")
-def _image(R, dR, d, lever, beta, c, dist, x0, y0, k_px, q, p, Jp, JpB, d6):  # pragma: no cover
-    """The image point (mm) and its partials: Jp w.r.t. the camera point (px), JpB through β,
-    d6 w.r.t. the pose (position, attitude) of the platform; returns x, y, xb, yb, gx, gy.
+def _sum3(a0, a1, a2, b0, b1, b2):  # pragma: no cover - compiled
+    """``a·b`` summed from 0.0 in order (the order the kernel's loops had)."""
+    v = 0.0
+    v += a0 * b0
+    v += a1 * b1
+    v += a2 * b2
+    return v
+
+
+@njit(cache=True, inline="always")
+def _image(R, dR, d0, d1, d2, lever, beta, c, dist, x0, y0, k_px):  # pragma: no cover
+    """The image point (mm) and its partials: returns ``x, y, xb, yb, gx, gy``, ``q`` (the
+    platform-frame point, 3), ``Jp`` (w.r.t. the camera point, px, 2 × 3 row by row), ``JpB``
+    (through β, 2 × 3) and ``d6`` (w.r.t. the pose: position, attitude; 2 × 6 row by row).
     """
-    pushbroom_camera_point(R, d, lever, beta, q, p)  # 002 eq. (4)
+    q0, q1, q2, p0, p1, p2 = pushbroom_camera_point_values(
+        R, d0, d1, d2, lever, beta
+    )  # 002 eq. (4)
     xm, ym, xb, yb, iz, gx, gy = pushbroom_image_mm(
-        p[0], p[1], p[2], c, dist[0], dist[1], dist[2], dist[3]
+        p0, p1, p2, c, dist[0], dist[1], dist[2], dist[3]
     )  # 002 eq. (3)
     a_ = c * iz
-    Jp[0, 0] = gx * a_ * k_px
-    Jp[0, 1] = 0.0
-    Jp[0, 2] = -gx * xb * iz * k_px
-    Jp[1, 0] = gy * a_ * k_px
-    Jp[1, 1] = a_ * k_px
-    Jp[1, 2] = (-yb * iz - gy * xb * iz) * k_px
-    for u in range(2):
-        for a in range(3):
-            JpB[u, a] = Jp[u, 0] * beta[0, a] + Jp[u, 1] * beta[1, a] + Jp[u, 2] * beta[2, a]
-    for u in range(2):
-        for a in range(3):
-            d6[u, a] = -(JpB[u, 0] * R[a, 0] + JpB[u, 1] * R[a, 1] + JpB[u, 2] * R[a, 2])
-        for kk in range(3):
-            v = 0.0
-            for i in range(3):
-                dq = dR[kk, 0, i] * d[0] + dR[kk, 1, i] * d[1] + dR[kk, 2, i] * d[2]
-                v += JpB[u, i] * dq
-            d6[u, 3 + kk] = v
-    return xm + x0, ym + y0, xb, yb, gx, gy
+    J00 = gx * a_ * k_px
+    J01 = 0.0
+    J02 = -gx * xb * iz * k_px
+    J10 = gy * a_ * k_px
+    J11 = a_ * k_px
+    J12 = (-yb * iz - gy * xb * iz) * k_px
+    B00 = J00 * beta[0, 0] + J01 * beta[1, 0] + J02 * beta[2, 0]
+    B01 = J00 * beta[0, 1] + J01 * beta[1, 1] + J02 * beta[2, 1]
+    B02 = J00 * beta[0, 2] + J01 * beta[1, 2] + J02 * beta[2, 2]
+    B10 = J10 * beta[0, 0] + J11 * beta[1, 0] + J12 * beta[2, 0]
+    B11 = J10 * beta[0, 1] + J11 * beta[1, 1] + J12 * beta[2, 1]
+    B12 = J10 * beta[0, 2] + J11 * beta[1, 2] + J12 * beta[2, 2]
+    # ∂q/∂angle_k = ∂Rᵀ/∂angle_k d: dq[k][i] = Σ_a dR[k, a, i] d_a
+    r0 = dR[0] * d0 + dR[3] * d1 + dR[6] * d2
+    r1 = dR[1] * d0 + dR[4] * d1 + dR[7] * d2
+    r2 = dR[2] * d0 + dR[5] * d1 + dR[8] * d2
+    t0 = dR[9] * d0 + dR[12] * d1 + dR[15] * d2
+    t1 = dR[10] * d0 + dR[13] * d1 + dR[16] * d2
+    t2 = dR[11] * d0 + dR[14] * d1 + dR[17] * d2
+    s0 = dR[18] * d0 + dR[21] * d1 + dR[24] * d2
+    s1 = dR[19] * d0 + dR[22] * d1 + dR[25] * d2
+    s2 = dR[20] * d0 + dR[23] * d1 + dR[26] * d2
+    d6 = (
+        -(B00 * R[0] + B01 * R[1] + B02 * R[2]),  # position: −JpB Rᵀ
+        -(B00 * R[3] + B01 * R[4] + B02 * R[5]),
+        -(B00 * R[6] + B01 * R[7] + B02 * R[8]),
+        _sum3(B00, B01, B02, r0, r1, r2),  # attitude: JpB ∂q/∂angle
+        _sum3(B00, B01, B02, t0, t1, t2),
+        _sum3(B00, B01, B02, s0, s1, s2),
+        -(B10 * R[0] + B11 * R[1] + B12 * R[2]),
+        -(B10 * R[3] + B11 * R[4] + B12 * R[5]),
+        -(B10 * R[6] + B11 * R[7] + B12 * R[8]),
+        _sum3(B10, B11, B12, r0, r1, r2),
+        _sum3(B10, B11, B12, t0, t1, t2),
+        _sum3(B10, B11, B12, s0, s1, s2),
+    )
+    Jp = (J00, J01, J02, J10, J11, J12)
+    JpB = (B00, B01, B02, B10, B11, B12)
+    return xm + x0, ym + y0, xb, yb, gx, gy, (q0, q1, q2), Jp, JpB, d6
+
+
+@njit(cache=True, inline="always")
+def _pair(vx, vy, timed, fx, fy, fused, s0, s1):  # pragma: no cover - compiled
+    """One column of rows 2j, 2j+1: through the crossing time (if ``timed``), x(t*(θ)) takes
+    ∂x/∂θ − fx ∂y/∂θ (fx = ẋ/ẏ) and ẏ_ref (t_e − t*) takes fy ∂y/∂θ (fy = ẏ_ref/ẏ); then
+    scaled by the rows' whitening weights ``s0``, ``s1`` (1/σ, fused path).
+    """
+    if timed:
+        vx -= fx * vy
+        vy *= fy
+    if fused:
+        vx *= s0
+        vy *= s1
+    return vx, vy
 
 
 @njit(cache=True, inline="always")
 def _derivatives(
-    j, d6, Jp, JpB, dbeta, q, c, xb, yb, gx, gy, k_px, dP, dN, dB, dL, dD, dC
+    t, tf, q, Jp, JpB, d6, dbeta, c, xb, yb, gx, gy, k_px, dP, dN, dB, dL, dD, dC
 ):  # pragma: no cover - compiled
-    """Rows 2j, 2j+1 (j: the destination pair, see ``dst`` of ``_lines_kernel``) of the
+    """Rows 2t, 2t+1 (t: the destination pair, see ``dst`` of ``_lines_kernel``) of the
     derivatives w.r.t. the point, the spline nodes (× their weights), the boresight, the lever
-    arm, the distortion and the principal distance.
+    arm, the distortion and the principal distance, each column through :func:`_pair` with
+    ``tf = (timed, fx, fy, fused, s0, s1)``. Each entry is written once.
     """
-    for u in range(2):
-        row = 2 * j + u
-        for a in range(3):
-            dP[row, a] = -d6[u, a]  # dp/dP = β Rᵀ = −dp/dx
-            dN[row, a] = d6[u, a]  # × the spline weights (factored Jacobian)
-            dL[row, a] = -JpB[u, a]
-            dN[row, 3 + a] = d6[u, 3 + a]
-        for kk in range(3):
-            # boresight: dp/dbore_k = dβ_k q
-            v = 0.0
-            for i in range(3):
-                v += Jp[u, i] * (
-                    dbeta[kk, i, 0] * q[0] + dbeta[kk, i, 1] * q[1] + dbeta[kk, i, 2] * q[2]
-                )
-            dB[row, kk] = v
-    dC[2 * j, 0] = gx * xb / c * k_px
-    dC[2 * j + 1, 0] = (yb / c + gy * xb / c) * k_px
+    timed, fx, fy, fused, s0, s1 = tf
+    rx, ry = 2 * t, 2 * t + 1
+    # dp/dP = β Rᵀ = −dp/dx (unrolled: the values are tuples, indexed by constants)
+    dP[rx, 0], dP[ry, 0] = _pair(-d6[0], -d6[6], timed, fx, fy, fused, s0, s1)
+    dP[rx, 1], dP[ry, 1] = _pair(-d6[1], -d6[7], timed, fx, fy, fused, s0, s1)
+    dP[rx, 2], dP[ry, 2] = _pair(-d6[2], -d6[8], timed, fx, fy, fused, s0, s1)
+    # the nodes, × the spline weights (factored Jacobian)
+    dN[rx, 0], dN[ry, 0] = _pair(d6[0], d6[6], timed, fx, fy, fused, s0, s1)
+    dN[rx, 1], dN[ry, 1] = _pair(d6[1], d6[7], timed, fx, fy, fused, s0, s1)
+    dN[rx, 2], dN[ry, 2] = _pair(d6[2], d6[8], timed, fx, fy, fused, s0, s1)
+    dN[rx, 3], dN[ry, 3] = _pair(d6[3], d6[9], timed, fx, fy, fused, s0, s1)
+    dN[rx, 4], dN[ry, 4] = _pair(d6[4], d6[10], timed, fx, fy, fused, s0, s1)
+    dN[rx, 5], dN[ry, 5] = _pair(d6[5], d6[11], timed, fx, fy, fused, s0, s1)
+    dL[rx, 0], dL[ry, 0] = _pair(-JpB[0], -JpB[3], timed, fx, fy, fused, s0, s1)
+    dL[rx, 1], dL[ry, 1] = _pair(-JpB[1], -JpB[4], timed, fx, fy, fused, s0, s1)
+    dL[rx, 2], dL[ry, 2] = _pair(-JpB[2], -JpB[5], timed, fx, fy, fused, s0, s1)
+    for kk in range(3):
+        # boresight: dp/dbore_k = dβ_k q
+        b0 = dbeta[kk, 0, 0] * q[0] + dbeta[kk, 0, 1] * q[1] + dbeta[kk, 0, 2] * q[2]
+        b1 = dbeta[kk, 1, 0] * q[0] + dbeta[kk, 1, 1] * q[1] + dbeta[kk, 1, 2] * q[2]
+        b2 = dbeta[kk, 2, 0] * q[0] + dbeta[kk, 2, 1] * q[1] + dbeta[kk, 2, 2] * q[2]
+        dB[rx, kk], dB[ry, kk] = _pair(
+            _sum3(Jp[0], Jp[1], Jp[2], b0, b1, b2),
+            _sum3(Jp[3], Jp[4], Jp[5], b0, b1, b2),
+            timed,
+            fx,
+            fy,
+            fused,
+            s0,
+            s1,
+        )
+    dC[rx, 0], dC[ry, 0] = _pair(
+        gx * xb / c * k_px, (yb / c + gy * xb / c) * k_px, timed, fx, fy, fused, s0, s1
+    )
     x3, x5, x2_3, x2 = pushbroom_line_distortion_dcoeff(xb)  # 002 eq. (3), hsgeo._kernels
-    dD[2 * j, 0] = x3 * k_px
-    dD[2 * j, 1] = x5 * k_px
-    dD[2 * j, 2] = x2_3 * k_px
-    dD[2 * j, 3] = 0.0
-    dD[2 * j + 1, 0] = 0.0
-    dD[2 * j + 1, 1] = 0.0
-    dD[2 * j + 1, 2] = 0.0
-    dD[2 * j + 1, 3] = x2 * k_px
-
-
-@njit(cache=True, inline="always")
-def _through_time(j, fx, fy, dP, dN, dB, dL, dD, dC):  # pragma: no cover - compiled
-    """Rows 2j, 2j+1 through the crossing time: x(t*(θ)) takes ∂x/∂θ − fx ∂y/∂θ (fx = ẋ/ẏ),
-    ẏ_ref (t_e − t*) takes fy ∂y/∂θ (fy = ẏ_ref/ẏ).
-    """
-    rx, ry = 2 * j, 2 * j + 1
-    for a in range(3):
-        dP[rx, a] -= fx * dP[ry, a]
-        dL[rx, a] -= fx * dL[ry, a]
-        dB[rx, a] -= fx * dB[ry, a]
-        dP[ry, a] *= fy
-        dL[ry, a] *= fy
-        dB[ry, a] *= fy
-    for a in range(6):
-        dN[rx, a] -= fx * dN[ry, a]
-        dN[ry, a] *= fy
-    for a in range(4):
-        dD[rx, a] -= fx * dD[ry, a]
-        dD[ry, a] *= fy
-    dC[rx, 0] -= fx * dC[ry, 0]
-    dC[ry, 0] *= fy
-
-
-@njit(cache=True, inline="always")
-def _whiten(t, w0, w1, wts, fw, dP, dN, dB, dL, dD, dC):  # pragma: no cover - compiled
-    """Rows 2t, 2t+1 scaled by their whitening weights ``w0``, ``w1`` (1/σ), and the spline
-    weights ``wts`` written as the rows' factored weights ``fw`` (fused path).
-    """
-    for u in range(2):
-        row = 2 * t + u
-        s = w0 if u == 0 else w1
-        for a in range(3):
-            dP[row, a] *= s
-            dB[row, a] *= s
-            dL[row, a] *= s
-        for a in range(6):
-            dN[row, a] *= s
-        for a in range(4):
-            dD[row, a] *= s
-            fw[row, a] = wts[a]
-        dC[row, 0] *= s
+    dD[rx, 0], dD[ry, 0] = _pair(x3 * k_px, 0.0, timed, fx, fy, fused, s0, s1)
+    dD[rx, 1], dD[ry, 1] = _pair(x5 * k_px, 0.0, timed, fx, fy, fused, s0, s1)
+    dD[rx, 2], dD[ry, 2] = _pair(x2_3 * k_px, 0.0, timed, fx, fy, fused, s0, s1)
+    dD[rx, 3], dD[ry, 3] = _pair(0.0, x2 * k_px, timed, fx, fy, fused, s0, s1)
 
 
 @njit(cache=True, inline="always")
@@ -328,18 +366,9 @@ def _lines_chunk(
     m = pidx.size
     keep_w = w_out.shape[0] == m  # the spline weights are wanted (an empty w_out: not)
     gradient = fused and gd.shape[1] > 0
-    R = np.empty((3, 3))
-    dR = np.empty((3, 3, 3))
-    d = np.empty(3)
-    q = np.empty(3)
-    p = np.empty(3)
     dl = np.empty(6)
     rate = np.empty(6)
-    Jp = np.empty((2, 3))
-    JpB = np.empty((2, 3))
-    d6 = np.empty((2, 6))
     w = np.empty(4)
-    dw = np.empty(4)
     for j in range(ch * step, min(m, (ch + 1) * step)):
         dt = dt_start[j] if timed else 0.0  # t − t_e, from the last evaluation's t*
         xdot = 0.0
@@ -350,20 +379,33 @@ def _lines_chunk(
         # defined before the Newton loop: set only inside it and read only after it, they
         # would not survive the loop under prange
         x = y = xb = yb = gx = gy = 0.0
+        w0 = w1 = w2 = w3 = 0.0
+        q = (0.0, 0.0, 0.0)
+        Jp = JpB = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+        d6 = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
         for it in range(n_it + 1):
-            _spline(j, dt, u0, inv_dt, nodes, idx, xyz_rate, rpy_rate, w, dw, dl, rate)
-            _pose(j, dt, P, pidx, xyz_nav, rpy_nav, xyz_rate, rpy_rate, dl, R, dR, d)
-            x, y, xb, yb, gx, gy = _image(
-                R, dR, d, lever, beta, c, dist, x0, y0, k_px, q, p, Jp, JpB, d6
+            w0, w1, w2, w3 = _spline(j, dt, u0, inv_dt, nodes, idx, xyz_rate, rpy_rate, dl, rate)
+            R, dR, d0, d1, d2 = _pose(j, dt, P, pidx, xyz_nav, rpy_nav, xyz_rate, rpy_rate, dl)
+            x, y, xb, yb, gx, gy, q, Jp, JpB, d6 = _image(
+                R, dR, d0, d1, d2, lever, beta, c, dist, x0, y0, k_px
             )
             if not timed:
                 break
             # image rates (px/s) along the trajectory: ∂(x, y)/∂pose · pose rate
             xdot = 0.0
             ydot = 0.0
-            for a in range(6):
-                xdot += d6[0, a] * rate[a]
-                ydot += d6[1, a] * rate[a]
+            xdot += d6[0] * rate[0]  # unrolled: d6 is a tuple, indexed by constants
+            xdot += d6[1] * rate[1]
+            xdot += d6[2] * rate[2]
+            xdot += d6[3] * rate[3]
+            xdot += d6[4] * rate[4]
+            xdot += d6[5] * rate[5]
+            ydot += d6[6] * rate[0]
+            ydot += d6[7] * rate[1]
+            ydot += d6[8] * rate[2]
+            ydot += d6[9] * rate[3]
+            ydot += d6[10] * rate[4]
+            ydot += d6[11] * rate[5]
             # every real geometry has ẏ near ẏ_ref; a far-off trial point may not
             ydot = max(ydot, 0.25 * y_rate_ref)
             ey = (y * k_px - xy_obs[j, 1]) / ydot
@@ -378,6 +420,7 @@ def _lines_chunk(
                     # again at the same time would give the same values
                     break
                 dt = dt_next
+        w[0], w[1], w[2], w[3] = w0, w1, w2, w3
         if keep_w:
             for b in range(4):
                 w_out[j, b] = w[b]
@@ -394,11 +437,19 @@ def _lines_chunk(
         t = dst[j] if fused else j
         if t < 0:
             continue
-        _derivatives(t, d6, Jp, JpB, dbeta, q, c, xb, yb, gx, gy, k_px, dP, dN, dB, dL, dD, dC)
-        if timed:
-            _through_time(t, xdot / ydot, y_rate_ref / ydot, dP, dN, dB, dL, dD, dC)
-        if fused:
-            _whiten(t, w_row[2 * j], w_row[2 * j + 1], w, fw, dP, dN, dB, dL, dD, dC)
+        tf = (
+            timed,
+            xdot / ydot if timed else 0.0,
+            y_rate_ref / ydot if timed else 1.0,
+            fused,
+            w_row[2 * j] if fused else 1.0,
+            w_row[2 * j + 1] if fused else 1.0,
+        )
+        _derivatives(t, tf, q, Jp, JpB, d6, dbeta, c, xb, yb, gx, gy, k_px, dP, dN, dB, dL, dD, dC)
+        if fused:  # the rows' spline weights (factored Jacobian)
+            for a in range(4):
+                fw[2 * t, a] = w[a]
+                fw[2 * t + 1, a] = w[a]
         if gradient:
             _accumulate(
                 t,
