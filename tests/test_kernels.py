@@ -67,3 +67,33 @@ def test_scalar_cores_equal_their_rows():
     x, y, xb, yb, iz, gx, gy = KN.pushbroom_image_mm(*p, 17.0, 1e-4, 1e-6, 1e-5, 2e-5)
     np.testing.assert_array_equal([x, y], rows[2][0])
     np.testing.assert_array_equal([xb, yb, iz, gx, gy], [r[0] for r in rows[3:]])
+
+
+def test_value_cores_equal_the_formulas():
+    """The ``*_values`` cores, which the pushbroom kernel inlines, against the rotations
+    module and numpy (the array forms unpack them, so these are the one implementation)."""
+    rng = np.random.default_rng(2)
+    for ro, pi, ya in rng.uniform(-3, 3, (10, 3)):
+        Rv, dRv = KN.rpy_rotation_values(ro, pi, ya)
+        np.testing.assert_allclose(
+            np.reshape(Rv, (3, 3)), R_from_rpy(ro, pi, ya), rtol=0, atol=5e-16
+        )
+        np.testing.assert_allclose(
+            np.reshape(dRv, (3, 3, 3)), dR_drpy(ro, pi, ya), rtol=0, atol=5e-16
+        )
+    for u in (-0.1, 0.0, 0.3, 1.0):
+        v = np.array(KN.bspline_weights_values(u, 0.5))
+        w = np.array(
+            [(1 - u) ** 3, 3 * u**3 - 6 * u**2 + 4, -3 * u**3 + 3 * u**2 + 3 * u + 1, u**3]
+        )
+        dw = np.array([-3 * (1 - u) ** 2, 9 * u**2 - 12 * u, -9 * u**2 + 6 * u + 3, 3 * u**2])
+        np.testing.assert_allclose(v[:4], w / 6, rtol=1e-14, atol=1e-15)
+        np.testing.assert_allclose(v[4:], dw / 6 * 0.5, rtol=1e-14, atol=1e-15)
+    R = R_from_rpy(0.01, -0.02, 1.0)
+    d = np.array([3.0, -4.0, -100.0])
+    lever = np.array([0.12, -0.05, -0.3])
+    beta = R_from_opk(1e-3, -2e-3, 5e-4)
+    out = KN.pushbroom_camera_point_values(tuple(R.ravel()), *d, lever, beta)
+    q = R.T @ d - lever
+    np.testing.assert_allclose(out[:3], q, rtol=1e-14)
+    np.testing.assert_allclose(out[3:], beta @ q, rtol=1e-14)
