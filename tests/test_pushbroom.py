@@ -344,13 +344,17 @@ def test_factored_node_jacobian_compiled_equals_generic(tiny, lam, fix_node):
     """The compiled path's factored spline Jacobian forms the same normal equations as scipy.
 
     ``fix_node`` fixes one node entry, which makes the engine expand the factored Jacobian
-    into ordinary slots (non-contiguous columns).
+    into ordinary slots (non-contiguous columns). The x and y rows have different σ, so that
+    each row's whitening weight is its own (the compiled kernel whitens the pair's two rows in
+    one step).
     """
     from hsgeo.adjust import SolverOptions
     from hsgeo.adjust.schur import _normal, _reduced, _step
     from hsgeo.adjust.system import _evaluate, _Layout
 
     p, blocks, _ = _problem(tiny[0], y_as_time=True)
+    m = blocks[0].m
+    blocks[0].sigma = np.where(np.arange(m) % 2 == 0, 0.5, 0.8) * (1 + np.arange(m) / m)
     if fix_node:
         p.fix("nodes", index=(3, 4))
     lay = _Layout(p)
