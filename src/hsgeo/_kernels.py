@@ -13,17 +13,18 @@ Cores
   convention of :func:`hsgeo.rotations.R_from_rpy` / :func:`hsgeo.rotations.dR_drpy` (tested
   against them).
 * :func:`pushbroom_camera_point` — 002 eq. (4): ``q = Rᵀ d − l``, ``p^c = β q``.
-
-The first three also come as ``*_values`` functions that return their results instead of
-writing them into arrays (the array forms call them): a compiled kernel that holds the values
-in local variables lets the compiler keep them in registers, where small arrays go through
-memory (issue 41: the pushbroom kernel's passes took 0.032 instead of 0.056 CPU-s).
 * :func:`pushbroom_line_distortion` — the line distortion of 002 eq. (3),
   ``x = x̄ + K1 x̄³ + K2 x̄⁵ + 3 P1 x̄²``, ``y = ȳ + P2 x̄²``, with its derivatives with respect
   to ``x̄`` (:func:`hsgeo.distortion.distort_pushbroom_line` is its array face).
 * :func:`pushbroom_image_mm` — 002 eq. (3): collinearity ``x̄ = c p_x / p_z``, ``ȳ = c p_y / p_z``
   followed by the line distortion (the principal point is added by the caller);
   :func:`pushbroom_image_rows` for arrays.
+
+The first three also come as ``*_values`` functions that return their results instead of
+writing them into arrays (the array forms call them): a compiled kernel that holds the values
+in local variables lets the compiler keep them in registers, where small arrays go through
+memory (issue 41: the pushbroom kernel's passes without derivatives took 0.034 instead of
+0.056 CPU-s).
 
 Numba's on-disk cache of a kernel in another module does not notice edits to this file; after
 changing a core, delete the ``__pycache__/*.nbi``/``*.nbc`` files of the modules that call it.
@@ -84,7 +85,7 @@ def bspline_weights(u, inv_dt, w, dw):  # pragma: no cover - compiled
 def bspline_weights_values(u, inv_dt):  # pragma: no cover - compiled
     """:func:`bspline_weights` as values, ``(w0, w1, w2, w3, dw0, dw1, dw2, dw3)``: a compiled
     kernel that keeps them in local variables, not in arrays, lets the compiler hold them in
-    registers (issue 41: the pushbroom kernel's passes took 0.056 against 0.032 CPU-s).
+    registers (issue 41: see :mod:`hsgeo.sensors._pushbroom_kernel`).
     """
     v = 1.0 - u
     return (

@@ -23,8 +23,8 @@ that linearisation took 0.34 CPU-s instead of 0.23).
 The helpers pass their results as values (tuples of floats), not through small arrays: held in
 local variables, the compiler keeps them in registers, where each store to a small array went
 to memory and each later read came back from it. With the same arithmetic in the same order
-(bit-identical outputs), one pass at the paper's size took 0.032 instead of 0.056 CPU-s
-without derivatives and 0.064 instead of 0.091 with them (issue 41, one thread). Tuples are
+(bit-identical outputs), one pass at the paper's size took 0.034 instead of 0.056 CPU-s
+without derivatives and 0.065 instead of 0.092 with them (issue 41, one thread). Tuples are
 indexed by constants only: a loop over a tuple's entries made the derivative pass slower than
 before (0.098).
 """
