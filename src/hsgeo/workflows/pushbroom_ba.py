@@ -194,7 +194,7 @@ def intersect_two_rays(point, origin, direction, n_points, min_angle_deg: float 
         )
     first = order[starts]
     cosang = np.einsum("mi,mi->m", direction[order], direction[first][ps])
-    # per point, the ray with the smallest cosine to the first ray
+    # per point, the ray with the smallest cosine to the most vertical one
     key = np.lexsort((cosang, ps))
     second = order[key[starts]]
     o1, d1, o2, d2 = origin[first], direction[first], origin[second], direction[second]
