@@ -16,7 +16,6 @@ fresh process.
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import json
 import os
 import subprocess
@@ -41,15 +40,7 @@ def _child(scale: float, seed: int) -> dict:
     cp_xyz = truth.values["points_m"][cp]
     del truth
     lines = obs.lines
-    perm = np.random.default_rng(1).permutation(lines.n)
-    shuffled = dataclasses.replace(
-        lines,
-        **{
-            f.name: getattr(lines, f.name)[perm]
-            for f in dataclasses.fields(lines)
-            if getattr(lines, f.name) is not None
-        },
-    )
+    shuffled = lines.take(np.random.default_rng(1).permutation(lines.n))
     out, P0, P = {}, {}, {}
     for name, rows in (("as_simulated", lines), ("random_order", shuffled)):
         p, blocks, _ = build_problem(

@@ -88,7 +88,7 @@ Jonassen et al. (2024), 002 eq. (2)–(4), §3.3–3.5.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields, replace
 from types import MappingProxyType
 
 import numpy as np
@@ -280,6 +280,22 @@ class PushbroomObservations:
     def has_rates(self) -> bool:
         """Whether the GNSS/INS rates are given."""
         return self.xyz_rate_nav_m_s is not None
+
+    def take(self, rows) -> PushbroomObservations:
+        """The observations at ``rows``: indices (in their order: the table sorted or shuffled)
+        or a boolean mask of :attr:`n` (a subset), every column alike.
+        """
+        rows = np.asarray(rows)
+        if rows.dtype == bool and rows.shape != (self.n,):
+            raise InputError(f"observations: a mask of {rows.shape} for {self.n} observations")
+        return replace(
+            self,
+            **{
+                f.name: getattr(self, f.name)[rows]
+                for f in fields(self)
+                if getattr(self, f.name) is not None
+            },
+        )
 
 
 def _no_cols():
